@@ -1,0 +1,1 @@
+//! IGRF-14 main field (work in progress).

@@ -1,0 +1,1 @@
+//! Digital filters: Butterworth design, zero-phase filtering, FIR windows.

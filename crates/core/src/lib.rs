@@ -1,0 +1,39 @@
+//! # aeromag-core
+//!
+//! The physics and signal-processing base of aeromag.
+//!
+//! ## Frames and conventions (used by every crate)
+//!
+//! * **Navigation frame NED**: x north, y east, z down.
+//! * **Body frame**: x forward (nose), y right wing, z down.
+//! * **Euler angles** yaw ψ, pitch θ, roll φ, applied in the aerospace Z-Y-X
+//!   order; `C_nb` ([`frames::Attitude::c_nb`]) rotates body vectors into NED:
+//!   `v_n = C_nb · v_b`.
+//! * **Units**: SI inside the code (tesla, metre, second, radian, A·m²);
+//!   files use nT and degrees. Every public function names its units.
+//!
+//! ## Modules
+//!
+//! | module | contents |
+//! |---|---|
+//! | [`frames`] | rotations, Euler angles, WGS84 geodetic ↔ geocentric |
+//! | [`field`] | magnetic dipole field and gradients; IGRF-14 main field |
+//! | [`filter`] | Butterworth design, zero-phase filtering, FIR windows |
+//! | [`spectrum`] | Welch power spectral density |
+//! | [`time`] | calendar dates and decimal years |
+
+pub mod error;
+pub mod field;
+pub mod filter;
+pub mod frames;
+pub mod spectrum;
+pub mod time;
+
+pub use error::CoreError;
+
+/// μ0/(4π) in T·m/A (exactly 1e-7 to the precision used here).
+pub const MU0_OVER_4PI: f64 = 1e-7;
+/// Tesla per nanotesla.
+pub const T_PER_NT: f64 = 1e-9;
+/// Nanotesla per tesla.
+pub const NT_PER_T: f64 = 1e9;
