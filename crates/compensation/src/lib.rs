@@ -1,0 +1,13 @@
+//! # aeromag-compensation
+//!
+//! Fixed-wing magnetic interference ("deviation") compensation, spec
+//! `compensation.md`, seed `000_…` chapters 1–2.
+//!
+//! | module | contents |
+//! |---|---|
+//! | [`tolles_lawson`] | the Tolles-Lawson/Leliak design matrix and its fits |
+
+pub mod error;
+pub mod tolles_lawson;
+
+pub use error::{CompError, Result};

@@ -1,0 +1,322 @@
+//! Tolles-Lawson / Leliak design-matrix terms.
+//!
+//! Spec: `compensation.md`, "The interference model"; seed `000_…`, chapter 1.
+//!
+//! The aircraft field seen by the scalar sensor is, to first order,
+//! `b = |B0| + eᵀ(K + L B0 + M dB0/dt)` with `e = B0/|B0|` measured by the
+//! vector magnetometer as `e = B_F/|B_F|`. Expanding gives the design-matrix
+//! columns (`Bt = |B_F|`, all products divided by `bt_scale`, default 50 000 nT):
+//!
+//! | group | columns | count |
+//! |---|---|---|
+//! | `p3` permanent | `e_x, e_y, e_z` | 3 |
+//! | `i6` induced | `e_i B_j` for ij = xx, xy, xz, yy, yz, zz | 6 |
+//! | `i5` | `i6` without zz | 5 |
+//! | `e9` eddy | `e_i dB_j` for i, j in x, y, z, row-major | 9 |
+//! | `e8` | `e9` without zz | 8 |
+//! | `bias` | 1 | 1 |
+//!
+//! (`e_i B_j = Bt e_i e_j`.) Because `eᵀe = 1` and `eᵀde = 0`, `p3+i6+e9` has two
+//! near-exact collinearities; `p3+i5+e8` are the 16 observable parameters of
+//! the thesis. Columns always come in the order of the table, whatever order
+//! the user names the groups in.
+//!
+//! Derivative conventions ([`Convention`]):
+//! * `Physical` (default): `dB_j` is the time derivative in nT/s, a central
+//!   difference over the actual time stamps, first-order one-sided at the ends,
+//!   so coefficients do not depend on the sampling rate.
+//! * `MagNav`: MagNav.jl's `create_TL_A`, bit for bit: `dB_j` is the
+//!   per-sample central difference `(x[i+1] − x[i−1])/2`, `x[1] − x[0]` and
+//!   `x[n−1] − x[n−2]` at the ends, not divided by the sampling interval.
+
+use crate::error::{CompError, Result};
+use serde::{Deserialize, Serialize};
+
+/// Default scale of the induced and eddy columns, nT.
+pub const DEFAULT_BT_SCALE_NT: f64 = 50_000.0;
+
+/// A group of Tolles-Lawson terms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "lowercase")]
+pub enum TermGroup {
+    /// Permanent: `e_x, e_y, e_z`.
+    P3,
+    /// Induced, all six products.
+    I6,
+    /// Induced without `zz`.
+    I5,
+    /// Eddy currents, all nine products.
+    E9,
+    /// Eddy currents without `zz`.
+    E8,
+    /// A constant column.
+    Bias,
+}
+
+impl TermGroup {
+    /// The group's name as written in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TermGroup::P3 => "p3",
+            TermGroup::I6 => "i6",
+            TermGroup::I5 => "i5",
+            TermGroup::E9 => "e9",
+            TermGroup::E8 => "e8",
+            TermGroup::Bias => "bias",
+        }
+    }
+
+    fn parse(s: &str) -> Result<Self> {
+        Ok(match s.trim().to_ascii_lowercase().as_str() {
+            "p3" | "p" | "permanent" => TermGroup::P3,
+            "i6" | "i" | "induced" => TermGroup::I6,
+            "i5" => TermGroup::I5,
+            "e9" | "e" | "eddy" => TermGroup::E9,
+            "e8" => TermGroup::E8,
+            "bias" | "b" => TermGroup::Bias,
+            other => {
+                return Err(CompError::InvalidTerms(format!(
+                    "unknown term group `{other}` (use p3, i6, i5, e9, e8, bias)"
+                )));
+            }
+        })
+    }
+}
+
+/// How the field derivative `dB_j` of the eddy-current columns is formed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Convention {
+    /// Time derivative in nT/s over the actual time stamps.
+    #[default]
+    Physical,
+    /// MagNav.jl `create_TL_A`: per-sample central difference, not divided by dt.
+    MagNav,
+}
+
+impl std::str::FromStr for Convention {
+    type Err = CompError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "physical" => Ok(Convention::Physical),
+            "magnav" => Ok(Convention::MagNav),
+            o => Err(CompError::InvalidTerms(format!("unknown derivative convention `{o}` (physical or magnav)"))),
+        }
+    }
+}
+
+/// A validated, ordered set of term groups.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TermSet {
+    groups: Vec<TermGroup>,
+}
+
+const XYZ: [&str; 3] = ["x", "y", "z"];
+const PAIRS6: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+impl TermSet {
+    /// The thesis' 16 observable parameters: `p3, i5, e8`.
+    pub fn observable16() -> Self {
+        Self { groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8] }
+    }
+
+    /// All 18 classical terms `p3, i6, e9` (two near-collinearities).
+    pub fn full18() -> Self {
+        Self { groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9] }
+    }
+
+    /// A set from groups; sorted into the canonical order. Rejects an empty
+    /// set, duplicates, and both variants of one family (`i6`+`i5`, `e9`+`e8`).
+    pub fn new(groups: &[TermGroup]) -> Result<Self> {
+        let mut g = groups.to_vec();
+        g.sort();
+        g.dedup();
+        if g.is_empty() {
+            return Err(CompError::InvalidTerms("no term groups given".into()));
+        }
+        if g.contains(&TermGroup::I6) && g.contains(&TermGroup::I5) {
+            return Err(CompError::InvalidTerms("choose one of i6 and i5".into()));
+        }
+        if g.contains(&TermGroup::E9) && g.contains(&TermGroup::E8) {
+            return Err(CompError::InvalidTerms("choose one of e9 and e8".into()));
+        }
+        Ok(Self { groups: g })
+    }
+
+    /// Parse a comma-separated list such as `p3,i5,e8,bias`.
+    pub fn parse(s: &str) -> Result<Self> {
+        let groups = s.split(',').filter(|t| !t.trim().is_empty()).map(TermGroup::parse).collect::<Result<Vec<_>>>()?;
+        Self::new(&groups)
+    }
+
+    /// The groups, in canonical order.
+    pub fn groups(&self) -> &[TermGroup] {
+        &self.groups
+    }
+
+    /// Whether any eddy-current group is present (needs derivatives).
+    pub fn has_eddy(&self) -> bool {
+        self.groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8))
+    }
+
+    /// Column names, e.g. `p_x`, `i_xy`, `e_zy`, `bias`, in column order.
+    pub fn column_names(&self) -> Vec<String> {
+        let mut names = Vec::new();
+        for g in &self.groups {
+            match g {
+                TermGroup::P3 => names.extend(XYZ.iter().map(|a| format!("p_{a}"))),
+                TermGroup::I6 | TermGroup::I5 => {
+                    let n = if *g == TermGroup::I6 { 6 } else { 5 };
+                    names.extend(PAIRS6[..n].iter().map(|&(i, j)| format!("i_{}{}", XYZ[i], XYZ[j])));
+                }
+                TermGroup::E9 | TermGroup::E8 => {
+                    let n = if *g == TermGroup::E9 { 9 } else { 8 };
+                    names.extend((0..n).map(|k| format!("e_{}{}", XYZ[k / 3], XYZ[k % 3])));
+                }
+                TermGroup::Bias => names.push("bias".into()),
+            }
+        }
+        names
+    }
+
+    /// Number of columns.
+    pub fn n_columns(&self) -> usize {
+        self.groups
+            .iter()
+            .map(|g| match g {
+                TermGroup::P3 => 3,
+                TermGroup::I6 => 6,
+                TermGroup::I5 => 5,
+                TermGroup::E9 => 9,
+                TermGroup::E8 => 8,
+                TermGroup::Bias => 1,
+            })
+            .sum()
+    }
+
+    /// Comma-separated names, e.g. `p3,i5,e8`.
+    pub fn to_spec_string(&self) -> String {
+        self.groups.iter().map(|g| g.name()).collect::<Vec<_>>().join(",")
+    }
+
+    /// One design-matrix row into `out` (length [`TermSet::n_columns`]) from
+    /// the vector field `b` (nT, body frame) and its derivative `db` (units of
+    /// the convention). Non-finite inputs give non-finite rows, never a panic.
+    pub fn row(&self, b: [f64; 3], db: [f64; 3], bt_scale: f64, out: &mut [f64]) {
+        let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        let e = [b[0] / bt, b[1] / bt, b[2] / bt];
+        let mut k = 0;
+        for g in &self.groups {
+            match g {
+                TermGroup::P3 => {
+                    out[k..k + 3].copy_from_slice(&e);
+                    k += 3;
+                }
+                TermGroup::I6 | TermGroup::I5 => {
+                    let n = if *g == TermGroup::I6 { 6 } else { 5 };
+                    for &(i, j) in &PAIRS6[..n] {
+                        out[k] = e[i] * b[j] / bt_scale;
+                        k += 1;
+                    }
+                }
+                TermGroup::E9 | TermGroup::E8 => {
+                    let n = if *g == TermGroup::E9 { 9 } else { 8 };
+                    for m in 0..n {
+                        out[k] = e[m / 3] * db[m % 3] / bt_scale;
+                        k += 1;
+                    }
+                }
+                TermGroup::Bias => {
+                    out[k] = 1.0;
+                    k += 1;
+                }
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for TermSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.to_spec_string())
+    }
+}
+
+/// Derivative of a series under a convention.
+///
+/// `Physical`: `(x[i+1] − x[i−1]) / (t[i+1] − t[i−1])`, one-sided at the
+/// ends, nT/s. `MagNav`: `(x[i+1] − x[i−1]) / 2`, one-sided at the ends,
+/// per sample (MagNav.jl `fdm(x; scheme=:central)`). Series of fewer than
+/// 3 samples give zeros (MagNav's behaviour for the central scheme).
+pub fn derivative(x: &[f64], t: &[f64], convention: Convention) -> Vec<f64> {
+    let n = x.len();
+    let mut d = vec![0.0; n];
+    if n < 3 {
+        return d;
+    }
+    match convention {
+        Convention::MagNav => {
+            d[0] = x[1] - x[0];
+            for i in 1..n - 1 {
+                d[i] = (x[i + 1] - x[i - 1]) / 2.0;
+            }
+            d[n - 1] = x[n - 1] - x[n - 2];
+        }
+        Convention::Physical => {
+            d[0] = (x[1] - x[0]) / (t[1] - t[0]);
+            for i in 1..n - 1 {
+                d[i] = (x[i + 1] - x[i - 1]) / (t[i + 1] - t[i - 1]);
+            }
+            d[n - 1] = (x[n - 1] - x[n - 2]) / (t[n - 1] - t[n - 2]);
+        }
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_and_names() {
+        assert_eq!(TermSet::observable16().n_columns(), 16);
+        assert_eq!(TermSet::full18().n_columns(), 18);
+        let t = TermSet::parse("bias,e8,p3,i5").unwrap();
+        assert_eq!(t.to_spec_string(), "p3,i5,e8,bias");
+        let names = t.column_names();
+        assert_eq!(names.len(), 17);
+        assert_eq!(names[0], "p_x");
+        assert_eq!(names[7], "i_yz");
+        assert_eq!(names[8], "e_xx");
+        assert_eq!(names[15], "e_zy");
+        assert_eq!(names[16], "bias");
+        assert!(TermSet::parse("i5,i6").is_err());
+        assert!(TermSet::parse("").is_err());
+        assert!(TermSet::parse("p3,x7").is_err());
+    }
+
+    #[test]
+    fn identities_of_the_full_set() {
+        // eᵀe = 1: the induced xx+yy+zz columns sum to Bt/bt_scale;
+        // eᵀdB = d|B|: the eddy diagonal sums to dBt/bt_scale.
+        let t = TermSet::full18();
+        let b = [20_000.0, -3_000.0, 45_000.0];
+        let db = [1.5, -0.7, 0.2];
+        let mut row = vec![0.0; 18];
+        t.row(b, db, DEFAULT_BT_SCALE_NT, &mut row);
+        let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        let ind = row[3] + row[6] + row[8];
+        assert!((ind - bt / DEFAULT_BT_SCALE_NT).abs() < 1e-15);
+        let e = [b[0] / bt, b[1] / bt, b[2] / bt];
+        let dbt = e[0] * db[0] + e[1] * db[1] + e[2] * db[2];
+        assert!((row[9] + row[13] + row[17] - dbt / DEFAULT_BT_SCALE_NT).abs() < 1e-18);
+    }
+
+    #[test]
+    fn derivative_conventions() {
+        let t = [0.0, 0.1, 0.2, 0.3];
+        let x = [0.0, 1.0, 4.0, 9.0];
+        assert_eq!(derivative(&x, &t, Convention::MagNav), vec![1.0, 2.0, 4.0, 5.0]);
+        let p = derivative(&x, &t, Convention::Physical);
+        assert!((p[1] - 20.0).abs() < 1e-12 && (p[0] - 10.0).abs() < 1e-12 && (p[3] - 50.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,5 @@
+//! Linear least squares.
+
+pub mod normal_equations;
+
+pub use normal_equations::{LsSolution, NormalEquations};

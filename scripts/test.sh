@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# The whole test suite, as CI runs it. Heavy numerics are tested in release mode.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! cargo nextest --version >/dev/null 2>&1; then
+    echo "cargo-nextest not found; installing it from crates.io" >&2
+    cargo install --locked cargo-nextest
+fi
+cargo nextest run --workspace --release --no-fail-fast "$@"
+# nextest does not run doc tests
+cargo test --workspace --release --doc
