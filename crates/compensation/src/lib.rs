@@ -5,9 +5,12 @@
 //!
 //! | module | contents |
 //! |---|---|
+//! | [`metrics`] | FOM, manoeuvre detection, improvement ratio |
 //! | [`tolles_lawson`] | the Tolles-Lawson/Leliak design matrix and its fits |
 
 pub mod error;
+pub mod metrics;
+pub mod model_file;
 pub mod tolles_lawson;
 
 pub use error::{CompError, Result};

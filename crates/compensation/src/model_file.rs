@@ -1,0 +1,163 @@
+//! The compensation model file (`spec/data-formats.md`, "Model files").
+//!
+//! JSON, versioned by `"format": "aeromag-model/1"`. It records everything
+//! needed to rebuild the design matrix on new data (terms, derivative
+//! convention, `bt_scale`), how the model was fitted (method, band, trim, λ),
+//! the coefficients with names and standard deviations, fit statistics, the
+//! input columns used, and the software version.
+
+use crate::error::{CompError, Result};
+use crate::tolles_lawson::{Convention, TermSet};
+use serde::{Deserialize, Serialize};
+
+/// The format tag of this version of the model file.
+pub const MODEL_FORMAT: &str = "aeromag-model/1";
+
+/// One named coefficient.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Coefficient {
+    /// Column name, e.g. `p_x`, `i_xy`, `e_zy`.
+    pub name: String,
+    /// Value.
+    pub value: f64,
+    /// Standard deviation (NaN when unknown).
+    pub std: f64,
+}
+
+/// Fit statistics recorded in the model file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct FitStats {
+    /// Rows used by the fit.
+    pub rows: usize,
+    /// Segments used.
+    pub segments: usize,
+    /// Scaled condition number.
+    pub condition: f64,
+    /// RMS fit residual (filtered for `ls`), nT.
+    pub residual_rms_nt: f64,
+    /// Warnings raised while fitting.
+    pub warnings: Vec<String>,
+}
+
+/// A Tolles-Lawson compensation model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TlModel {
+    /// Always [`MODEL_FORMAT`].
+    pub format: String,
+    /// Model kind, `"tolles-lawson"`.
+    pub kind: String,
+    /// Fitting method: `"ls"` or `"kalman"`.
+    pub method: String,
+    /// Term groups.
+    pub terms: TermSet,
+    /// Derivative convention.
+    pub convention: Convention,
+    /// Scale of the induced and eddy columns, nT.
+    pub bt_scale_nt: f64,
+    /// Pass band used by the fit, Hz (`null` when unfiltered).
+    pub band_hz: Option<(f64, f64)>,
+    /// Filter order.
+    pub filter_order: usize,
+    /// Samples trimmed per segment end.
+    pub trim: usize,
+    /// Ridge parameter.
+    pub lambda: f64,
+    /// Coefficients in column order.
+    pub coefficients: Vec<Coefficient>,
+    /// Fit statistics.
+    pub fit: FitStats,
+    /// Input columns used (canonical name → file column name).
+    pub columns: std::collections::BTreeMap<String, String>,
+    /// Version of aeromag that wrote the file.
+    pub software_version: String,
+}
+
+impl TlModel {
+    /// Coefficient values in column order.
+    pub fn coef(&self) -> Vec<f64> {
+        self.coefficients.iter().map(|c| c.value).collect()
+    }
+
+    /// Serialize to pretty JSON.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| CompError::BadData(format!("cannot serialise model: {e}")))
+    }
+
+    /// Parse and check a model file's text; `origin` names the file in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        let v: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| CompError::BadData(format!("{origin}: not a JSON model file ({e})")))?;
+        match v.get("format").and_then(|f| f.as_str()) {
+            Some(MODEL_FORMAT) => {}
+            Some(other) => {
+                return Err(CompError::BadData(format!(
+                    "{origin}: model format `{other}` is not supported (expected `{MODEL_FORMAT}`)"
+                )));
+            }
+            None => return Err(CompError::BadData(format!("{origin}: no \"format\" key; not an aeromag model file"))),
+        }
+        let m: TlModel =
+            serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
+        let expect = m.terms.column_names();
+        let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
+        if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
+            return Err(CompError::BadData(format!(
+                "{origin}: coefficient names {got:?} do not match terms `{}` ({expect:?})",
+                m.terms
+            )));
+        }
+        if m.coefficients.iter().any(|c| !c.value.is_finite()) {
+            return Err(CompError::BadData(format!("{origin}: a coefficient is not finite")));
+        }
+        Ok(m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> TlModel {
+        let terms = TermSet::parse("p3,bias").unwrap();
+        TlModel {
+            format: MODEL_FORMAT.into(),
+            kind: "tolles-lawson".into(),
+            method: "ls".into(),
+            coefficients: terms
+                .column_names()
+                .into_iter()
+                .enumerate()
+                .map(|(k, name)| Coefficient { name, value: k as f64 + 0.5, std: 0.1 })
+                .collect(),
+            terms,
+            convention: Convention::Physical,
+            bt_scale_nt: 50_000.0,
+            band_hz: Some((0.1, 0.9)),
+            filter_order: 4,
+            trim: 20,
+            lambda: 0.0,
+            fit: FitStats::default(),
+            columns: Default::default(),
+            software_version: "test".into(),
+        }
+    }
+
+    #[test]
+    fn round_trip() {
+        let m = sample();
+        let back = TlModel::from_json(&m.to_json().unwrap(), "m.json").unwrap();
+        assert_eq!(m, back);
+    }
+
+    #[test]
+    fn wrong_format_and_names_are_rejected() {
+        let mut m = sample();
+        m.format = "other/9".into();
+        let e = TlModel::from_json(&serde_json::to_string(&m).unwrap(), "m.json").unwrap_err();
+        assert!(e.to_string().contains("m.json") && e.to_string().contains("other/9"));
+        let mut m = sample();
+        m.coefficients[0].name = "q".into();
+        assert!(TlModel::from_json(&serde_json::to_string(&m).unwrap(), "m.json").is_err());
+        assert!(TlModel::from_json("{", "m.json").is_err());
+    }
+}

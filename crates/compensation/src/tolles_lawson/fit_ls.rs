@@ -1,0 +1,346 @@
+//! Method 1: band-pass least squares (the industry and MagNav.jl baseline).
+//!
+//! Spec `compensation.md`, "Method 1"; seed `000_…` chapter 1 (the classical
+//! approach the thesis improves on).
+//!
+//! For every contiguous segment (leg) of the calibration flight:
+//! 1. build the design matrix `A` from the vector magnetometer
+//!    ([`super::design::design_columns`]);
+//! 2. band-pass every non-constant column of `A` and the scalar reading `y`
+//!    with a zero-phase Butterworth filter (order 4, 0.1–0.9 Hz by default),
+//!    so that the slowly varying external field (main field, geology,
+//!    diurnal) is suppressed while the manoeuvre-induced interference stays;
+//!    a column is constant when its standard deviation is ≤ ε (MagNav's rule);
+//! 3. drop `trim` samples at each end (filter transients);
+//! 4. accumulate the normal equations.
+//!
+//! Then solve the ridge problem `(AᵀA + λI) c = Aᵀy` with equilibration
+//! ([`aeromag_estimation::least_squares::NormalEquations`]). Memory is
+//! `O(segment length × columns)` for the filtering and `O(columns²)` for the
+//! fit, whatever the number of segments.
+//!
+//! The compensated signal is `mag − A_unfiltered c`.
+//!
+//! **Uncertainties.** The filtered residuals are correlated: only a fraction
+//! `2 (f_hi − f_lo) / f_s` of the samples is independent. Standard
+//! deviations use that effective number of rows.
+//!
+//! **Diagnostics.** Coefficients whose variance inflation factor exceeds
+//! [`LsConfig::max_vif`] are reported by name as poorly determined (the
+//! flight does not separate them from the other terms: typically one heading
+//! or missing manoeuvres), and near-null combinations are spelled out.
+
+use super::design::design_columns;
+use super::segments::median_step;
+use super::terms::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
+use crate::error::{CompError, Result};
+use aeromag_core::filter::sos::Sos;
+use aeromag_core::filter::{butter, sosfiltfilt, Band};
+use aeromag_estimation::least_squares::{LsSolution, NormalEquations};
+use serde::{Deserialize, Serialize};
+
+/// Settings of the band-pass least-squares fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LsConfig {
+    /// Term groups (default `p3,i5,e8`: the 16 observable parameters).
+    pub terms: TermSet,
+    /// Derivative convention of the eddy columns.
+    pub convention: Convention,
+    /// Scale of induced and eddy columns, nT (default 50 000).
+    pub bt_scale_nt: f64,
+    /// Pass band in Hz (default 0.1–0.9 Hz); `None` fits unfiltered data.
+    pub band_hz: Option<(f64, f64)>,
+    /// Butterworth order (default 4).
+    pub filter_order: usize,
+    /// Samples dropped at each end of each filtered segment (default 20).
+    pub trim: usize,
+    /// Ridge parameter λ ≥ 0 (default 0), in the units of `AᵀA`.
+    pub lambda: f64,
+    /// Variance inflation factor above which a term is reported as poorly
+    /// determined (default 1e4: its standard deviation is inflated 100×).
+    pub max_vif: f64,
+}
+
+impl Default for LsConfig {
+    fn default() -> Self {
+        Self {
+            terms: TermSet::observable16(),
+            convention: Convention::Physical,
+            bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            band_hz: Some((0.1, 0.9)),
+            filter_order: 4,
+            trim: 20,
+            lambda: 0.0,
+            max_vif: 1e4,
+        }
+    }
+}
+
+/// One contiguous segment of calibration data (equal-length slices).
+#[derive(Debug, Clone, Copy)]
+pub struct Segment<'a> {
+    /// Time, s, strictly increasing.
+    pub time: &'a [f64],
+    /// Vector magnetometer, body frame, nT.
+    pub flux: [&'a [f64]; 3],
+    /// Scalar magnetometer, nT.
+    pub mag: &'a [f64],
+}
+
+/// Result of a fit.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct LsFit {
+    /// Column names.
+    pub names: Vec<String>,
+    /// Coefficients.
+    pub coef: Vec<f64>,
+    /// Standard deviations of the coefficients.
+    pub std: Vec<f64>,
+    /// Variance inflation factor of each coefficient.
+    pub vif: Vec<f64>,
+    /// Scaled condition number of the normal equations.
+    pub condition: f64,
+    /// RMS of the filtered fit residual, nT.
+    pub residual_rms_nt: f64,
+    /// Rows used (after trimming).
+    pub rows: usize,
+    /// Segments used.
+    pub segments_used: usize,
+    /// Warnings for the user (ill-conditioning, poorly determined terms,
+    /// segments too short to filter).
+    pub warnings: Vec<String>,
+}
+
+/// Zero-phase filtering of every non-constant column and of `y`, then trim.
+fn filtered_segment(seg: &Segment, cfg: &LsConfig, sos: Option<&Sos>) -> Result<(Vec<Vec<f64>>, Vec<f64>)> {
+    let mut cols = design_columns(&cfg.terms, cfg.convention, cfg.bt_scale_nt, seg.time, seg.flux);
+    let mut y = seg.mag.to_vec();
+    let n = y.len();
+    let (a, b) = match sos {
+        Some(sos) => {
+            for c in cols.iter_mut() {
+                if std_dev(c) > f64::EPSILON {
+                    *c = sosfiltfilt(sos, c)?;
+                }
+            }
+            y = sosfiltfilt(sos, &y)?;
+            (cfg.trim, n - cfg.trim)
+        }
+        None => (0, n),
+    };
+    let cols = cols.into_iter().map(|c| c[a..b].to_vec()).collect();
+    Ok((cols, y[a..b].to_vec()))
+}
+
+/// Fit the Tolles-Lawson coefficients to calibration segments.
+pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
+    validate(cfg)?;
+    let ncol = cfg.terms.n_columns();
+    let mut ne = NormalEquations::new(ncol);
+    let mut warnings = Vec::new();
+    let mut used = 0;
+    let mut fs_used = Vec::new();
+    for (k, seg) in segments.iter().enumerate() {
+        let n = seg.time.len();
+        if seg.mag.len() != n || seg.flux.iter().any(|f| f.len() != n) {
+            return Err(CompError::BadData(format!("segment {k}: columns of unequal length")));
+        }
+        let dt = median_step(seg.time);
+        if !(dt > 0.0) {
+            warnings.push(format!("segment {k} ({n} samples) has no valid time step; skipped"));
+            continue;
+        }
+        let fs = 1.0 / dt;
+        let sos = match cfg.band_hz {
+            Some((lo, hi)) => Some(butter(cfg.filter_order, Band::Bandpass { low_hz: lo, high_hz: hi }, fs)?),
+            None => None,
+        };
+        let min_len = sos.as_ref().map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
+        if n < min_len {
+            warnings.push(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"));
+            continue;
+        }
+        let (cols, y) = filtered_segment(seg, cfg, sos.as_ref())?;
+        let refs: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();
+        ne.add_columns(&refs, &y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))?;
+        used += 1;
+        fs_used.push(fs);
+    }
+    if used == 0 {
+        return Err(CompError::BadData("no segment is long enough to fit (see the warnings)".into()));
+    }
+    let independent_fraction = match cfg.band_hz {
+        Some((lo, hi)) => {
+            let fs = fs_used.iter().sum::<f64>() / fs_used.len() as f64;
+            (2.0 * (hi - lo) / fs).min(1.0)
+        }
+        None => 1.0,
+    };
+    let sol = ne
+        .solve_with_dof(cfg.lambda, ne.rows() as f64 * independent_fraction)
+        .map_err(|e| CompError::BadData(format!("least-squares fit failed: {e}")))?;
+    let names = cfg.terms.column_names();
+    warnings.extend(diagnose(&sol, &names, cfg.max_vif));
+    Ok(LsFit {
+        coef: sol.coef.iter().copied().collect(),
+        std: sol.std.iter().copied().collect(),
+        vif: sol.vif.iter().copied().collect(),
+        condition: sol.condition,
+        residual_rms_nt: (sol.rss / sol.rows as f64).sqrt(),
+        rows: sol.rows,
+        segments_used: used,
+        names,
+        warnings,
+    })
+}
+
+/// Plain-language warnings about what the flight does not determine.
+pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String> {
+    let mut w = Vec::new();
+    let bad = sol.poorly_determined(max_vif);
+    if !bad.is_empty() {
+        let list: Vec<String> = bad.iter().map(|&j| format!("{} (VIF {:.1e})", names[j], sol.vif[j])).collect();
+        w.push(format!(
+            "poorly determined terms: {} — the flight does not separate them from the other terms \
+             (fly all four headings with roll, pitch and yaw manoeuvres, or drop these terms)",
+            list.join(", ")
+        ));
+    }
+    if sol.is_ill_conditioned() {
+        w.push(format!("the fit is ill-conditioned (scaled condition number {:.2e})", sol.condition));
+    }
+    for dir in sol.null_directions(max_vif * 10.0) {
+        let mut idx: Vec<usize> = (0..dir.len()).collect();
+        idx.sort_by(|&a, &b| dir[b].abs().total_cmp(&dir[a].abs()));
+        let terms: Vec<String> =
+            idx.iter().take(4).filter(|&&j| dir[j].abs() > 0.1).map(|&j| format!("{:+.2}·{}", dir[j], names[j])).collect();
+        w.push(format!("not determined by this flight: the combination {}", terms.join(" ")));
+    }
+    w
+}
+
+fn validate(cfg: &LsConfig) -> Result<()> {
+    if let Some((lo, hi)) = cfg.band_hz {
+        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+            return Err(CompError::BadData(format!("pass band {lo}–{hi} Hz: need 0 < low < high")));
+        }
+    }
+    if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
+        return Err(CompError::BadData(format!("bt_scale {} must be positive", cfg.bt_scale_nt)));
+    }
+    if !(cfg.lambda >= 0.0 && cfg.lambda.is_finite()) {
+        return Err(CompError::BadData(format!("ridge λ = {} must be ≥ 0", cfg.lambda)));
+    }
+    Ok(())
+}
+
+fn std_dev(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    if x.len() < 2 {
+        return 0.0;
+    }
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aeromag_core::frames::Attitude;
+    use nalgebra::Vector3;
+
+    /// A synthetic calibration leg: heading `yaw0` (deg), roll/pitch/yaw
+    /// oscillations, Earth field (NED) fixed, interference from `coef`
+    /// through the design row itself (a solver test, not a physics test),
+    /// plus a slow external variation and white noise.
+    fn leg(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+        let b_ned = Vector3::new(17_000.0, 1_500.0, 48_000.0);
+        let dt = 0.1;
+        let n = 1800;
+        let (mut t, mut fx, mut fy, mut fz) = (vec![], vec![], vec![], vec![]);
+        for i in 0..n {
+            let s = i as f64 * dt;
+            let (r, p, y) = if maneuvers {
+                let w = |period: f64, start: f64, amp: f64| {
+                    if s >= start && s < start + 50.0 { amp * (std::f64::consts::TAU * (s - start) / period).sin() } else { 0.0 }
+                };
+                (w(5.0, 10.0, 10.0), w(4.5, 70.0, 5.0), w(5.5, 125.0, 5.0))
+            } else {
+                (0.3 * (0.5 * s).sin(), 1.0, 0.0)
+            };
+            let b = Attitude::from_degrees(r, p, yaw0 + y).c_bn() * b_ned;
+            t.push(t0 + s);
+            fx.push(b.x);
+            fy.push(b.y);
+            fz.push(b.z);
+        }
+        let mut mag = Vec::with_capacity(n);
+        let db = [0, 1, 2].map(|k| super::super::terms::derivative([&fx, &fy, &fz][k], &t, Convention::Physical));
+        let mut row = vec![0.0; terms.n_columns()];
+        let mut noise = 12345u64;
+        for i in 0..n {
+            terms.row([fx[i], fy[i], fz[i]], [db[0][i], db[1][i], db[2][i]], DEFAULT_BT_SCALE_NT, &mut row);
+            let interf: f64 = row.iter().zip(coef).map(|(a, c)| a * c).sum();
+            noise = noise.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let u = ((noise >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
+            let bt = (fx[i] * fx[i] + fy[i] * fy[i] + fz[i] * fz[i]).sqrt();
+            mag.push(bt + interf + 5.0 * (0.002 * t[i]).sin() + 0.02 * u);
+        }
+        (t, [fx, fy, fz], mag)
+    }
+
+    fn coef16() -> Vec<f64> {
+        vec![30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0, 2.0, -1.5, 0.5, 1.0, -0.7, 0.3, 1.2, -0.4]
+    }
+
+    #[test]
+    fn recovers_interference_from_a_four_heading_box() {
+        let terms = TermSet::observable16();
+        let coef = coef16();
+        let legs: Vec<_> =
+            [0.0, 90.0, 180.0, 270.0].iter().enumerate().map(|(k, h)| leg(*h, &coef, &terms, k as f64 * 1000.0, true)).collect();
+        let segs: Vec<Segment> =
+            legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect();
+        let fit = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
+        assert_eq!(fit.segments_used, 4);
+        // Compare the modelled interference (minus its mean) with the truth.
+        let (t, f, _) = &legs[1];
+        let flux = [f[0].as_slice(), f[1].as_slice(), f[2].as_slice()];
+        let est = super::super::design::interference(&terms, Convention::Physical, DEFAULT_BT_SCALE_NT, &fit.coef, t, flux);
+        let tru = super::super::design::interference(&terms, Convention::Physical, DEFAULT_BT_SCALE_NT, &coef, t, flux);
+        let d: Vec<f64> = est.iter().zip(&tru).map(|(a, b)| a - b).collect();
+        let m = d.iter().sum::<f64>() / d.len() as f64;
+        let rms = (d.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / d.len() as f64).sqrt();
+        assert!(rms < 0.01, "interference error RMS {rms} nT");
+        assert!(fit.warnings.is_empty(), "{:?}", fit.warnings);
+        assert!(fit.residual_rms_nt < 0.02, "{}", fit.residual_rms_nt);
+    }
+
+    #[test]
+    fn one_heading_without_maneuvers_is_reported() {
+        let terms = TermSet::observable16();
+        let coef = coef16();
+        let (t, f, m) = leg(0.0, &coef, &terms, 0.0, false);
+        let seg = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m };
+        match fit_band_pass_ls(&[seg], &LsConfig::default()) {
+            Ok(fit) => {
+                let text = fit.warnings.join("\n");
+                assert!(text.contains("poorly determined terms"), "{text}");
+                assert!(text.contains("e_") && text.contains("i_"), "{text}");
+            }
+            Err(e) => assert!(e.to_string().contains("singular"), "{e}"),
+        }
+    }
+
+    #[test]
+    fn short_segments_are_skipped_with_a_warning_and_bad_config_rejected() {
+        let terms = TermSet::observable16();
+        let (t, f, m) = leg(0.0, &coef16(), &terms, 0.0, true);
+        let short = Segment { time: &t[..50], flux: [&f[0][..50], &f[1][..50], &f[2][..50]], mag: &m[..50] };
+        let e = fit_band_pass_ls(&[short], &LsConfig::default()).unwrap_err();
+        assert!(e.to_string().contains("no segment"), "{e}");
+        let cfg = LsConfig { band_hz: Some((0.9, 0.1)), ..LsConfig::default() };
+        let seg = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m };
+        assert!(fit_band_pass_ls(&[seg], &cfg).is_err());
+    }
+}

@@ -1,0 +1,76 @@
+//! Splitting a flight into contiguous segments for filtering and fitting.
+//!
+//! A zero-phase filter must not run across a gap in time, a change of line
+//! (calibration files hold several legs) or a missing sample. A segment is a
+//! maximal run of usable rows with the same line label and no time step
+//! larger than `max_gap_factor` × the median step.
+
+use std::ops::Range;
+
+/// Segments of `time` (s) where `usable[i]` holds, split at changes of
+/// `line` (if given) and at time steps over `max_gap_factor` × the median
+/// step. Segments shorter than `min_len` are dropped (and returned second so
+/// the caller can report them: nothing is dropped silently).
+pub fn split_segments(
+    time: &[f64],
+    line: Option<&[f64]>,
+    usable: &[bool],
+    max_gap_factor: f64,
+    min_len: usize,
+) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+    let n = time.len();
+    let dt = median_step(time);
+    let max_gap = if dt > 0.0 { dt * max_gap_factor } else { f64::INFINITY };
+    let same_line = |a: usize, b: usize| match line {
+        Some(l) => l[a] == l[b] || (l[a].is_nan() && l[b].is_nan()),
+        None => true,
+    };
+    let mut kept = Vec::new();
+    let mut short = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if !usable[i] {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        i += 1;
+        while i < n && usable[i] && same_line(i - 1, i) && (time[i] - time[i - 1]) <= max_gap {
+            i += 1;
+        }
+        if i - start >= min_len { kept.push(start..i) } else { short.push(start..i) }
+    }
+    (kept, short)
+}
+
+/// Median of the positive finite time steps, s (0 if there are none).
+pub fn median_step(time: &[f64]) -> f64 {
+    let mut d: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).filter(|v| *v > 0.0 && v.is_finite()).collect();
+    if d.is_empty() {
+        return 0.0;
+    }
+    let m = d.len() / 2;
+    *d.select_nth_unstable_by(m, |a, b| a.total_cmp(b)).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splits_at_gaps_lines_and_unusable_rows() {
+        let mut t: Vec<f64> = (0..100).map(|i| i as f64 * 0.1).collect();
+        for v in t.iter_mut().skip(60) {
+            *v += 5.0; // a 5 s gap before row 60
+        }
+        let line: Vec<f64> = (0..100).map(|i| if i < 30 { 1.0 } else { 2.0 }).collect();
+        let mut usable = vec![true; 100];
+        usable[45] = false;
+        let (kept, short) = split_segments(&t, Some(&line), &usable, 1.5, 10);
+        assert_eq!(kept, vec![0..30, 30..45, 46..60, 60..100]);
+        assert!(short.is_empty());
+        let (kept, short) = split_segments(&t, Some(&line), &usable, 1.5, 20);
+        assert_eq!(kept, vec![0..30, 60..100]);
+        assert_eq!(short, vec![30..45, 46..60]);
+    }
+}

@@ -1,1 +1,0 @@
-//! IGRF-14 main field (work in progress).

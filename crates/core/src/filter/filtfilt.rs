@@ -1,0 +1,299 @@
+//! Zero-phase (forward–backward) filtering, equal to SciPy's
+//! `sosfiltfilt(sos, x)` and `filtfilt(b, a, x)` with their defaults
+//! (`padtype='odd'`, default `padlen`, `method='pad'`).
+//!
+//! Running a filter `H` forward and then backward over the reversed result
+//! gives the response `|H(e^{iΩ})|²`: zero phase, squared magnitude (so a
+//! Butterworth band-pass of order `N` has its edges at −6 dB, and the
+//! effective order is `2N`; Gustafsson 1996 for the initial conditions).
+//!
+//! **Padding convention** (SciPy reference guide, `filtfilt`,
+//! `sosfiltfilt`): the signal `x[0..n]` is extended by `P` samples at both
+//! ends with an *odd* (point-symmetric) extension
+//!
+//! ```text
+//! x[−j]      = 2 x[0]   − x[j],        j = 1…P
+//! x[n−1+j]   = 2 x[n−1] − x[n−1−j],    j = 1…P
+//! ```
+//!
+//! which continues the local slope and so keeps edge transients small. The
+//! default pad length is `P = 3·ntaps` with
+//! `ntaps = 2L + 1 − min(#{b2 = 0}, #{a2 = 0})` for `L` second-order sections
+//! and `ntaps = max(len a, len b)` for a transfer function; the signal must
+//! have at least `P + 1` samples. The forward pass starts from the
+//! steady-state state `zi · x_ext[0]` and the backward pass from
+//! `zi · y[last]` (`zi` from [`super::sos::Sos::zi`] /
+//! [`super::transfer::TransferFunction::zi`]); finally the padding is cut off.
+//!
+//! Memory: the extended signal (`n + 2P` samples) is the only buffer; both
+//! passes run in place and the result is moved to its front, so
+//! [`sosfiltfilt`] holds one copy of the signal besides the input and
+//! [`sosfiltfilt_in_place`] writes back into the input.
+
+use super::sos::Sos;
+use super::transfer::{LinearFilter, TransferFunction};
+use super::validate::{check_finite, check_len};
+use crate::error::Result;
+
+/// Zero-phase filtering through second-order sections, equal to SciPy's
+/// `sosfiltfilt(sos, x)` (odd padding of `sos.padlen()` samples).
+///
+/// Errors: `TooShort` when `x.len() < sos.padlen() + 1` (names that
+/// minimum), `NonFinite` naming the first non-finite sample.
+pub fn sosfiltfilt(sos: &Sos, x: &[f64]) -> Result<Vec<f64>> {
+    zero_phase(sos, x)
+}
+
+/// [`sosfiltfilt`] writing the result back into `x` (one scratch buffer of
+/// `x.len() + 2·padlen` samples). On error `x` is unchanged.
+pub fn sosfiltfilt_in_place(sos: &Sos, x: &mut [f64]) -> Result<()> {
+    zero_phase_in_place(sos, x)
+}
+
+/// Zero-phase filtering with a transfer function, equal to SciPy's
+/// `filtfilt(b, a, x)` (odd padding of `3·max(len a, len b)` samples).
+///
+/// Errors: those of [`TransferFunction::new`] and [`TransferFunction::zi`],
+/// `TooShort` when `x.len() < 3·max(len a, len b) + 1`, `NonFinite` naming
+/// the first non-finite sample.
+pub fn filtfilt(b: &[f64], a: &[f64], x: &[f64]) -> Result<Vec<f64>> {
+    zero_phase(&TransferFunction::new(b.to_vec(), a.to_vec())?, x)
+}
+
+/// Forward–backward pass over the odd-extended signal; returns the extended
+/// buffer (filtered) and the pad length.
+fn filter_extended(f: &impl LinearFilter, x: &[f64]) -> Result<(Vec<f64>, usize)> {
+    let n = x.len();
+    let pad = f.padlen();
+    check_len("x", n, pad + 1)?;
+    check_finite("x", x)?;
+    let zi = f.steady_state()?;
+
+    let mut ext = Vec::with_capacity(n + 2 * pad);
+    let (first, last) = (x[0], x[n - 1]);
+    ext.extend((1..=pad).rev().map(|j| 2.0 * first - x[j]));
+    ext.extend_from_slice(x);
+    ext.extend((1..=pad).map(|j| 2.0 * last - x[n - 1 - j]));
+
+    let mut state: Vec<f64> = zi.iter().map(|z| z * ext[0]).collect();
+    f.run(ext.iter_mut(), &mut state);
+    let y_last = ext[ext.len() - 1];
+    for (s, z) in state.iter_mut().zip(&zi) {
+        *s = z * y_last;
+    }
+    f.run(ext.iter_mut().rev(), &mut state);
+    Ok((ext, pad))
+}
+
+/// Zero-phase filter returning a new vector (the extended buffer, trimmed).
+pub(crate) fn zero_phase(f: &impl LinearFilter, x: &[f64]) -> Result<Vec<f64>> {
+    let (mut ext, pad) = filter_extended(f, x)?;
+    ext.copy_within(pad..pad + x.len(), 0);
+    ext.truncate(x.len());
+    Ok(ext)
+}
+
+/// Zero-phase filter writing into `x`.
+pub(crate) fn zero_phase_in_place(f: &impl LinearFilter, x: &mut [f64]) -> Result<()> {
+    let (ext, pad) = filter_extended(f, x)?;
+    x.copy_from_slice(&ext[pad..pad + x.len()]);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::CoreError;
+
+    fn sos() -> Sos {
+        Sos::new(vec![[0.2, 0.4, 0.2, 1.0, -0.5, 0.3]]).unwrap()
+    }
+
+    #[test]
+    fn length_limits() {
+        let s = sos();
+        let p = s.padlen();
+        assert_eq!(p, 9);
+        let err = sosfiltfilt(&s, &vec![1.0; p]).unwrap_err();
+        assert_eq!(
+            err,
+            CoreError::TooShort {
+                name: "x",
+                len: p,
+                min: p + 1
+            }
+        );
+        assert!(sosfiltfilt(&s, &vec![1.0; p + 1]).is_ok());
+        assert!(matches!(
+            sosfiltfilt(&s, &[]),
+            Err(CoreError::TooShort { min: 10, .. })
+        ));
+        assert!(matches!(
+            filtfilt(&[1.0, 1.0], &[1.0, -0.5], &[1.0; 6]),
+            Err(CoreError::TooShort { min: 7, .. })
+        ));
+    }
+
+    #[test]
+    fn non_finite_is_reported_with_index() {
+        let mut x = vec![0.5; 50];
+        x[17] = f64::NAN;
+        assert_eq!(
+            sosfiltfilt(&sos(), &x),
+            Err(CoreError::NonFinite {
+                name: "x",
+                index: 17
+            })
+        );
+        let before = x.clone();
+        assert!(sosfiltfilt_in_place(&sos(), &mut x).is_err());
+        assert_eq!(x[..17], before[..17]);
+        x[17] = f64::NEG_INFINITY;
+        assert!(matches!(
+            filtfilt(&[1.0], &[1.0], &x),
+            Err(CoreError::NonFinite { index: 17, .. })
+        ));
+    }
+
+    #[test]
+    fn in_place_equals_returned() {
+        let x: Vec<f64> = (0..200)
+            .map(|k| (k as f64 * 0.3).sin() + 0.01 * k as f64)
+            .collect();
+        let y = sosfiltfilt(&sos(), &x).unwrap();
+        let mut z = x.clone();
+        sosfiltfilt_in_place(&sos(), &mut z).unwrap();
+        assert_eq!(y, z);
+    }
+
+    #[test]
+    fn sos_and_tf_forms_agree() {
+        // one biquad = the transfer function with the same b, a, and both
+        // pad lengths are 9 (3·(2·1 + 1) and 3·max(3, 3)): same result.
+        let x: Vec<f64> = (0..300)
+            .map(|k| (k as f64 * 0.11).cos() * (1.0 + 0.002 * k as f64))
+            .collect();
+        let y1 = sosfiltfilt(&sos(), &x).unwrap();
+        let y2 = filtfilt(&[0.2, 0.4, 0.2], &[1.0, -0.5, 0.3], &x).unwrap();
+        for (u, v) in y1.iter().zip(&y2) {
+            assert!((u - v).abs() < 1e-13);
+        }
+    }
+}
+
+#[cfg(test)]
+mod invariants {
+    use super::*;
+    use crate::filter::{Band, butter};
+    use proptest::prelude::*;
+
+    /// A designed filter: (order, band, fs) with valid frequencies.
+    fn filter_spec() -> impl Strategy<Value = Sos> {
+        (1usize..=6, 0usize..4, 0.02f64..0.2, 0.05f64..0.25).prop_map(|(order, kind, a, w)| {
+            let fs = 10.0;
+            let band = match kind {
+                0 => Band::Lowpass { cutoff_hz: a * fs },
+                1 => Band::Highpass { cutoff_hz: a * fs },
+                2 => Band::Bandpass {
+                    low_hz: a * fs,
+                    high_hz: (a + w) * fs,
+                },
+                _ => Band::Bandstop {
+                    low_hz: a * fs,
+                    high_hz: (a + w) * fs,
+                },
+            };
+            butter(order, band, fs).unwrap()
+        })
+    }
+
+    fn signal(n: usize) -> impl Strategy<Value = Vec<f64>> {
+        proptest::collection::vec(-100.0f64..100.0, n)
+    }
+
+    fn max_abs(x: &[f64]) -> f64 {
+        x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    /// Largest pole radius of the sections (roots of z² + a1 z + a2).
+    fn pole_radius(sos: &Sos) -> f64 {
+        sos.sections()
+            .iter()
+            .map(|s| {
+                let (a1, a2) = (s[4], s[5]);
+                let disc = a1 * a1 - 4.0 * a2;
+                if disc < 0.0 {
+                    a2.sqrt()
+                } else {
+                    ((-a1).abs() + disc.sqrt()) / 2.0
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// filtfilt(a x + b y) = a filtfilt(x) + b filtfilt(y), to rounding.
+        #[test]
+        fn zero_phase_filter_is_linear(sos in filter_spec(), x in signal(300), y in signal(300),
+                                       a in -5.0f64..5.0, b in -5.0f64..5.0) {
+            let mix: Vec<f64> = x.iter().zip(&y).map(|(u, v)| a * u + b * v).collect();
+            let fm = sosfiltfilt(&sos, &mix).unwrap();
+            let fx = sosfiltfilt(&sos, &x).unwrap();
+            let fy = sosfiltfilt(&sos, &y).unwrap();
+            let scale = a.abs() * max_abs(&x) + b.abs() * max_abs(&y);
+            for k in 0..mix.len() {
+                prop_assert!((fm[k] - (a * fx[k] + b * fy[k])).abs() <= 1e-10 * scale);
+            }
+        }
+
+        /// A constant passes a low-pass unchanged (DC gain 1, steady-state
+        /// initial conditions: no transient) and is removed by a band-pass
+        /// (DC gain 0).
+        #[test]
+        fn constants_through_lowpass_and_bandpass(order in 1usize..=8, c in -1e5f64..1e5,
+                                                  lo in 0.01f64..1.0, width in 0.1f64..3.0,
+                                                  n_extra in 1usize..200) {
+            let fs = 10.0;
+            let lp = butter(order, Band::Lowpass { cutoff_hz: lo + width }, fs).unwrap();
+            let x = vec![c; lp.padlen() + n_extra];
+            for v in sosfiltfilt(&lp, &x).unwrap() {
+                prop_assert!((v - c).abs() <= 1e-12 * c.abs().max(1.0));
+            }
+            let bp = butter(order, Band::Bandpass { low_hz: lo, high_hz: lo + width }, fs).unwrap();
+            let x = vec![c; bp.padlen() + n_extra];
+            for v in sosfiltfilt(&bp, &x).unwrap() {
+                prop_assert!(v.abs() <= 1e-12 * c.abs().max(1.0));
+            }
+        }
+
+        /// Filtering the reversed signal gives the reversed result away from
+        /// the ends: forward–backward and backward–forward passes commute
+        /// for an LTI filter, and only the boundary transients (decaying as
+        /// ρᵏ, ρ the largest pole radius) differ.
+        #[test]
+        fn time_reversal_symmetry_away_from_edges(sos in filter_spec(), x in signal(1500)) {
+            let y = sosfiltfilt(&sos, &x).unwrap();
+            let mut xr = x.clone();
+            xr.reverse();
+            let mut yr = sosfiltfilt(&sos, &xr).unwrap();
+            yr.reverse();
+            let rho = pole_radius(&sos);
+            prop_assert!(rho < 1.0);
+            // distance from the ends beyond which ρ^k < 1e-13
+            let settle = ((1e-13f64).ln() / rho.ln()).ceil() as usize;
+            let scale = max_abs(&x);
+            let mut checked = 0;
+            for k in settle..x.len().saturating_sub(settle) {
+                prop_assert!((y[k] - yr[k]).abs() <= 1e-9 * scale, "k {} diff {}", k, (y[k] - yr[k]).abs());
+                checked += 1;
+            }
+            // the edges really do differ for all but trivial filters,
+            // which is why the property is stated away from them
+            if checked == 0 {
+                prop_assume!(false);
+            }
+        }
+    }
+}

@@ -1,0 +1,395 @@
+//! Streaming assembly of a [`FlightTable`] from rows of byte fields.
+//!
+//! Both readers (CSV and whitespace/XYZ) hand their rows to one
+//! [`TableBuilder`] through the [`RowSource`] trait, so the column typing,
+//! missing-value handling and error messages are the same for every format.
+//!
+//! # Column typing
+//!
+//! A column whose role (canonical name, directly or through the column map)
+//! is canonical (except `line`) or `true_*` must be numeric: text in it is an
+//! error. Any other column starts numeric and turns into a text column at its
+//! first cell that is not a number (or missing marker). The rows before that
+//! cell were stored as numbers, so their original text is recovered by a
+//! second pass over those rows only (usually none: a text column such as a
+//! flight id already fails on the first row).
+//!
+//! # Memory
+//!
+//! Cells are parsed straight into one `Vec<f64>` per column; the file's text
+//! is never held (one record buffer is reused). After
+//! [`RESERVE_AFTER_ROWS`] rows the number of rows is estimated from the file
+//! size and the bytes per row so far, and every column reserves
+//! `1.02 × estimate` values at once, so the vectors are allocated about once
+//! at their final size instead of growing by doubling. If the estimate is
+//! short (later rows longer than the first ones) the vectors grow by
+//! doubling from there (large reallocations are page remaps, not copies, on
+//! Linux/glibc). At the end, vectors with more than 1/8 spare capacity are
+//! shrunk. Peak memory is therefore about 1.02–1.1 × the f64 data when the
+//! estimate holds, and at most about 2× when it does not. Text columns cost a
+//! `String` per row (24 bytes plus the text).
+
+use std::path::PathBuf;
+
+use crate::ReadOptions;
+use crate::cell::{Cell, CellError, MissingKind, check_text, parse_cell};
+use crate::columns::{MappedColumn, must_be_numeric, resolve};
+use crate::error::{IoError, Result};
+use crate::table::{ColumnData, FlightTable, Missing};
+
+/// Rows read before the capacity of the columns is estimated.
+pub(crate) const RESERVE_AFTER_ROWS: usize = 1024;
+
+/// A stream of data rows whose field count already matches the header.
+pub(crate) trait RowSource {
+    /// Advances to the next data row; `false` at the end of the input.
+    fn next_row(&mut self) -> Result<bool>;
+    /// 1-based file line of the current row.
+    fn line(&self) -> u64;
+    /// Field `i` of the current row (`i` < number of header columns).
+    fn field(&self, i: usize) -> &[u8];
+    /// Bytes of the file consumed so far (for the capacity estimate).
+    fn bytes_read(&self) -> u64;
+}
+
+/// What a reader knows once the header is parsed.
+pub(crate) struct Layout {
+    /// The file.
+    pub path: PathBuf,
+    /// Column names as in the header (trimmed; not yet de-duplicated).
+    pub names: Vec<String>,
+    /// 1-based line of the header.
+    pub header_line: u64,
+    /// File size in bytes.
+    pub file_size: u64,
+    /// Bytes consumed up to the end of the header.
+    pub header_bytes: u64,
+    /// Cells may use a decimal comma (delimiter is not a comma): adds a hint to parse errors.
+    pub decimal_comma_hint: bool,
+}
+
+enum ColState {
+    Numeric {
+        values: Vec<f64>,
+        missing: Missing,
+    },
+    /// Text from row `from_row` on; rows before it need the second pass.
+    Text {
+        values: Vec<String>,
+        from_row: usize,
+    },
+}
+
+/// Builds a [`FlightTable`] row by row (see the module docs).
+pub(crate) struct TableBuilder {
+    file: String,
+    path: PathBuf,
+    names: Vec<String>,
+    labels: Vec<String>,
+    numeric_only: Vec<bool>,
+    cols: Vec<ColState>,
+    aliases: Vec<MappedColumn>,
+    header_line: u64,
+    file_size: u64,
+    header_bytes: u64,
+    decimal_comma_hint: bool,
+    n_rows: usize,
+    row_lines: Vec<(usize, u64)>,
+    last_line: u64,
+}
+
+impl TableBuilder {
+    /// Checks the header (empty names become `unnamed_<position>`, repeated
+    /// names are an error) and resolves the column map.
+    pub(crate) fn new(layout: Layout, opts: &ReadOptions) -> Result<Self> {
+        let file = layout.path.display().to_string();
+        let names: Vec<String> = layout
+            .names
+            .into_iter()
+            .enumerate()
+            .map(|(i, n)| {
+                if n.is_empty() {
+                    format!("unnamed_{}", i + 1)
+                } else {
+                    n
+                }
+            })
+            .collect();
+        for (j, name) in names.iter().enumerate() {
+            if let Some(i) = names[..j].iter().position(|n| n == name) {
+                return Err(IoError::DuplicateHeader {
+                    file,
+                    line: layout.header_line,
+                    column: name.clone(),
+                    first: i + 1,
+                    second: j + 1,
+                });
+            }
+        }
+        let aliases = resolve(&file, &names, &opts.columns, opts.magnav_preset)?;
+        let role_of = |name: &str| {
+            aliases
+                .iter()
+                .find(|m| m.file_column == name)
+                .map_or(name.to_string(), |m| m.canonical.clone())
+        };
+        let labels = names
+            .iter()
+            .map(|n| {
+                let role = role_of(n);
+                if role == *n {
+                    format!("'{n}'")
+                } else {
+                    format!("'{n}' (mapped to '{role}')")
+                }
+            })
+            .collect();
+        let numeric_only = names.iter().map(|n| must_be_numeric(&role_of(n))).collect();
+        let cols = names
+            .iter()
+            .map(|_| ColState::Numeric {
+                values: Vec::new(),
+                missing: Missing::default(),
+            })
+            .collect();
+        Ok(TableBuilder {
+            file,
+            path: layout.path,
+            names,
+            labels,
+            numeric_only,
+            cols,
+            aliases,
+            header_line: layout.header_line,
+            file_size: layout.file_size,
+            header_bytes: layout.header_bytes,
+            decimal_comma_hint: layout.decimal_comma_hint,
+            n_rows: 0,
+            row_lines: Vec::new(),
+            last_line: 0,
+        })
+    }
+
+    /// Column names after de-duplication checks (header order).
+    pub(crate) fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Appends the current row of `src`.
+    pub(crate) fn push_row<S: RowSource>(&mut self, src: &S) -> Result<()> {
+        let row = self.n_rows;
+        let line = src.line();
+        if row == RESERVE_AFTER_ROWS {
+            self.reserve(src.bytes_read());
+        }
+        for (i, col) in self.cols.iter_mut().enumerate() {
+            let bytes = src.field(i);
+            match col {
+                ColState::Numeric { values, missing } => match parse_cell(bytes) {
+                    Ok(Cell::Value(v)) => values.push(v),
+                    Ok(Cell::Missing(kind)) => {
+                        values.push(f64::NAN);
+                        match kind {
+                            MissingKind::Blank => missing.blank += 1,
+                            MissingKind::Nan => missing.nan += 1,
+                            MissingKind::Dummy => missing.dummy += 1,
+                        }
+                    }
+                    Err(CellError::NotNumber) if !self.numeric_only[i] => {
+                        // First text cell of a free column: it becomes a text column.
+                        let mut text = Vec::with_capacity(values.capacity());
+                        text.push(String::from_utf8_lossy(bytes).into_owned());
+                        *col = ColState::Text {
+                            values: text,
+                            from_row: row,
+                        };
+                    }
+                    Err(e) => {
+                        return Err(cell_error(
+                            e,
+                            &self.file,
+                            line,
+                            row,
+                            &self.labels[i],
+                            bytes,
+                            self.decimal_comma_hint,
+                        ));
+                    }
+                },
+                ColState::Text { values, .. } => match check_text(bytes) {
+                    Ok(s) => values.push(s.to_string()),
+                    Err(e) => {
+                        return Err(cell_error(
+                            e,
+                            &self.file,
+                            line,
+                            row,
+                            &self.labels[i],
+                            bytes,
+                            false,
+                        ));
+                    }
+                },
+            }
+        }
+        if line != self.last_line + 1 || row == 0 {
+            self.row_lines.push((row, line));
+        }
+        self.last_line = line;
+        self.n_rows += 1;
+        Ok(())
+    }
+
+    /// Reserves every column for the estimated total number of rows.
+    fn reserve(&mut self, bytes_read: u64) {
+        let used = bytes_read.saturating_sub(self.header_bytes).max(1);
+        let rest = self.file_size.saturating_sub(self.header_bytes);
+        let estimate = (rest as f64 / used as f64 * self.n_rows as f64 * 1.02) as usize + 16;
+        // Guard against absurd estimates (e.g. a file growing while read).
+        let estimate = estimate.min(self.file_size as usize / 2 + 16);
+        for col in &mut self.cols {
+            match col {
+                ColState::Numeric { values, .. } => {
+                    values.reserve_exact(estimate.saturating_sub(values.len()))
+                }
+                ColState::Text { values, .. } => {
+                    values.reserve_exact(estimate.saturating_sub(values.len()))
+                }
+            }
+        }
+    }
+
+    /// Finishes the table. Text columns that started as numbers get their
+    /// first rows' text from a second pass over a fresh source from `reopen`.
+    pub(crate) fn finish<S: RowSource>(
+        self,
+        reopen: impl FnOnce() -> Result<S>,
+    ) -> Result<FlightTable> {
+        if self.n_rows == 0 {
+            return Err(IoError::NoData {
+                file: self.file,
+                header_line: self.header_line,
+            });
+        }
+        let TableBuilder {
+            file,
+            path,
+            names,
+            mut cols,
+            aliases,
+            n_rows,
+            row_lines,
+            ..
+        } = self;
+        let pending: Vec<(usize, usize)> = cols
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match c {
+                ColState::Text { from_row, .. } if *from_row > 0 => Some((i, *from_row)),
+                _ => None,
+            })
+            .collect();
+        if let Some(max_row) = pending.iter().map(|(_, r)| *r).max() {
+            let mut src = reopen()?;
+            let mut prefixes: Vec<Vec<String>> = pending
+                .iter()
+                .map(|(_, r)| Vec::with_capacity(*r))
+                .collect();
+            let mut row = 0;
+            while row < max_row && src.next_row()? {
+                for ((c, from_row), prefix) in pending.iter().zip(&mut prefixes) {
+                    if row < *from_row {
+                        prefix.push(String::from_utf8_lossy(src.field(*c)).into_owned());
+                    }
+                }
+                row += 1;
+            }
+            if row < max_row {
+                return Err(IoError::Read {
+                    file,
+                    line: src.line(),
+                    source: std::io::Error::other("the file changed while it was being read"),
+                });
+            }
+            for ((c, _), mut prefix) in pending.into_iter().zip(prefixes) {
+                if let ColState::Text { values, .. } = &mut cols[c] {
+                    prefix.append(values);
+                    *values = prefix;
+                }
+            }
+        }
+        let columns = names
+            .into_iter()
+            .zip(cols)
+            .map(|(name, col)| {
+                let data = match col {
+                    ColState::Numeric {
+                        mut values,
+                        missing,
+                    } => {
+                        shrink(&mut values);
+                        ColumnData::Numeric { values, missing }
+                    }
+                    ColState::Text { mut values, .. } => {
+                        shrink(&mut values);
+                        ColumnData::Text(values)
+                    }
+                };
+                (name, data)
+            })
+            .collect();
+        Ok(FlightTable::from_parts(
+            path, n_rows, columns, aliases, row_lines,
+        ))
+    }
+}
+
+/// Shrinks a vector with more than 1/8 spare capacity.
+fn shrink<T>(v: &mut Vec<T>) {
+    if v.capacity() > v.len() + v.len() / 8 {
+        v.shrink_to_fit();
+    }
+}
+
+/// The user-facing error for a cell that cannot be stored.
+pub(crate) fn cell_error(
+    e: CellError,
+    file: &str,
+    line: u64,
+    row: usize,
+    label: &str,
+    bytes: &[u8],
+    decimal_comma_hint: bool,
+) -> IoError {
+    match e {
+        CellError::Nul => IoError::Binary {
+            file: file.to_string(),
+            line,
+            what: format!("NUL byte in column {label} (data row {})", row + 1),
+        },
+        CellError::NotUtf8 => IoError::Binary {
+            file: file.to_string(),
+            line,
+            what: format!("invalid UTF-8 in column {label} (data row {})", row + 1),
+        },
+        CellError::NotNumber => {
+            let text = String::from_utf8_lossy(bytes).into_owned();
+            let hint = if decimal_comma_hint
+                && text.contains(',')
+                && text.replace(',', ".").trim().parse::<f64>().is_ok()
+            {
+                " (decimal comma? numbers must use '.')".to_string()
+            } else {
+                String::new()
+            };
+            IoError::ParseNumber {
+                file: file.to_string(),
+                line,
+                row,
+                column: label.to_string(),
+                text,
+                hint,
+            }
+        }
+    }
+}

@@ -1,0 +1,455 @@
+//! Canonical column names and the mapping of file columns onto them.
+//!
+//! Every command of aeromag works on the canonical names of
+//! `spec/data-formats.md` ("Flight data tables"):
+//!
+//! | column | unit | meaning |
+//! |---|---|---|
+//! | `time` | s | strictly increasing |
+//! | `lat`, `lon` | deg | WGS84 |
+//! | `alt` | m | altitude |
+//! | `vn`, `ve`, `vd` | m/s | NED velocity |
+//! | `roll`, `pitch`, `yaw` | deg | attitude, Z-Y-X Euler angles |
+//! | `mag` | nT | scalar magnetometer, uncompensated |
+//! | `flux_x`, `flux_y`, `flux_z` | nT | vector magnetometer, body frame |
+//! | `line` | — | line label |
+//! | `diurnal`, `igrf` | nT | optional |
+//!
+//! Columns named `true_*` (the simulator's known truth, e.g. `true_anomaly`)
+//! pass through and are always numeric.
+//!
+//! A file may call its columns differently. A [`ColumnMap`], parsed from the
+//! command-line text `--columns mag=mag_1_uc,flux_x=flux_a_x`, says which file
+//! column plays which canonical role. Rules (checked by [`ColumnMap::parse`]):
+//!
+//! - entries are `canonical=file_column`, separated by commas; spaces around
+//!   names are ignored; an empty text is an empty map;
+//! - the left side must be a canonical name or a `true_*` name (anything else
+//!   is rejected with a "did you mean" suggestion: a typo such as `flux_X`
+//!   would otherwise silently do nothing);
+//! - a canonical name may appear once, and a file column may be mapped once.
+//!
+//! Mapping does not rename anything: the file column keeps its name (and is
+//! written back under it); the canonical name becomes an alias that
+//! [`FlightTable::column`](crate::FlightTable::column) resolves. An explicit
+//! mapping wins over a file column that happens to have the canonical name.
+//!
+//! # The MagNav preset
+//!
+//! Files exported from the MagNav.jl / SGL (Signal Geophysics Ltd.) HDF5
+//! flight data use MagNav's field names (MagNav.jl `get_XYZ20`, `get_XYZ0`
+//! docs): `tt` time (s), `lat`/`lon` (deg) (GPS), `utm_z` (GPS altitude used
+//! by MagNav as trajectory altitude) or `ins_alt` (m), `ins_lat`/`ins_lon`
+//! (deg), `ins_roll`/`ins_pitch`/`ins_yaw` (deg), `ins_vn`/`ins_ve`/`ins_vd`
+//! (m/s), `mag_1_uc`…`mag_5_uc` (nT) (uncompensated scalar magnetometers),
+//! `flux_a_x`…`flux_d_z` (nT) (vector magnetometers A–D), `line`, `diurnal`,
+//! `igrf`. When [`ReadOptions::magnav_preset`](crate::ReadOptions) is on
+//! (default) and a canonical column is neither in the file nor mapped by the
+//! user, the first present candidate of [`MAGNAV_PRESET`] is used, and the
+//! table records it (origin [`MapOrigin::MagNavPreset`]) so the command line
+//! can report what was mapped. The flux triplet is taken from the first
+//! magnetometer (A, B, C, D) that has all three components. The SGL raw
+//! velocities `ins_vw`/`ins_vu` (west/up) are not mapped: they need a sign
+//! change, and velocities are derived from positions when absent.
+
+use serde::Serialize;
+
+use crate::error::{IoError, Result};
+
+/// The canonical column names of `spec/data-formats.md`, in the spec's order.
+pub const CANONICAL_COLUMNS: [&str; 17] = [
+    "time", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "mag", "flux_x",
+    "flux_y", "flux_z", "line", "diurnal", "igrf",
+];
+
+/// Magnetic-induction columns (nT): checked for tesla-like values by
+/// [`check_units`](crate::check_units).
+pub const MAGNETIC_COLUMNS: [&str; 6] = ["mag", "flux_x", "flux_y", "flux_z", "diurnal", "igrf"];
+
+/// MagNav/SGL preset: canonical name → candidate file columns, first present wins.
+/// The flux components are handled as a triplet (see the module docs).
+pub const MAGNAV_PRESET: [(&str, &[&str]); 13] = [
+    ("time", &["tt"]),
+    ("lat", &["ins_lat"]),
+    ("lon", &["ins_lon"]),
+    ("alt", &["utm_z", "ins_alt"]),
+    ("vn", &["ins_vn"]),
+    ("ve", &["ins_ve"]),
+    ("vd", &["ins_vd"]),
+    ("roll", &["ins_roll"]),
+    ("pitch", &["ins_pitch"]),
+    ("yaw", &["ins_yaw"]),
+    (
+        "mag",
+        &["mag_1_uc", "mag_2_uc", "mag_3_uc", "mag_4_uc", "mag_5_uc"],
+    ),
+    ("diurnal", &["diurnal"]),
+    ("igrf", &["igrf"]),
+];
+
+/// MagNav vector magnetometer prefixes, in order of preference (`flux_a_x`, …).
+const MAGNAV_FLUX_PREFIXES: [&str; 4] = ["flux_a", "flux_b", "flux_c", "flux_d"];
+
+/// True for the canonical names of [`CANONICAL_COLUMNS`].
+pub fn is_canonical(name: &str) -> bool {
+    CANONICAL_COLUMNS.contains(&name)
+}
+
+/// True for simulator truth columns: `true_` followed by at least one character.
+pub fn is_truth_column(name: &str) -> bool {
+    name.len() > "true_".len() && name.starts_with("true_")
+}
+
+/// True when text in the column (by its canonical role) is an error rather
+/// than a pass-through text column: every canonical column except `line`
+/// (which the spec calls a label and may be text such as `L1010`), and every
+/// `true_*` column.
+pub(crate) fn must_be_numeric(role: &str) -> bool {
+    (is_canonical(role) && role != "line") || is_truth_column(role)
+}
+
+/// Where a canonical alias came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapOrigin {
+    /// The user's `--columns` map.
+    User,
+    /// The built-in MagNav/SGL preset ([`MAGNAV_PRESET`]).
+    MagNavPreset,
+}
+
+/// One resolved alias: the canonical name `canonical` reads the file column `file_column`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MappedColumn {
+    /// Canonical (or `true_*`) name.
+    pub canonical: String,
+    /// Column name in the file.
+    pub file_column: String,
+    /// Who asked for it.
+    pub origin: MapOrigin,
+}
+
+/// A user's mapping of canonical names onto file column names
+/// (`--columns mag=mag_1_uc,flux_x=flux_a_x`). See the module docs for the rules.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ColumnMap {
+    pairs: Vec<(String, String)>,
+}
+
+impl ColumnMap {
+    /// An empty map.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Parses `canonical=file_column,...`. Errors ([`IoError::ColumnMap`]) on
+    /// an entry without exactly one `=`, an empty name, an unknown canonical
+    /// name, or a name used twice.
+    pub fn parse(text: &str) -> Result<Self> {
+        let mut map = ColumnMap::new();
+        if text.trim().is_empty() {
+            return Ok(map);
+        }
+        let err = |reason: String| IoError::ColumnMap {
+            text: text.to_string(),
+            reason,
+        };
+        for (k, entry) in text.split(',').enumerate() {
+            let entry = entry.trim();
+            if entry.is_empty() {
+                return Err(err(format!(
+                    "entry {} is empty (two commas in a row, or a trailing comma?)",
+                    k + 1
+                )));
+            }
+            let mut parts = entry.split('=');
+            let (Some(canonical), Some(file_column), None) =
+                (parts.next(), parts.next(), parts.next())
+            else {
+                return Err(err(format!(
+                    "entry '{entry}' must have the form canonical=file_column"
+                )));
+            };
+            map.insert(canonical.trim(), file_column.trim())
+                .map_err(|e| match e {
+                    IoError::ColumnMap { reason, .. } => err(reason),
+                    other => other,
+                })?;
+        }
+        Ok(map)
+    }
+
+    /// Adds one mapping with the same checks as [`ColumnMap::parse`].
+    pub fn insert(&mut self, canonical: &str, file_column: &str) -> Result<()> {
+        let err = |reason: String| IoError::ColumnMap {
+            text: format!("{canonical}={file_column}"),
+            reason,
+        };
+        if canonical.is_empty() || file_column.is_empty() {
+            return Err(err("both sides of '=' need a name".into()));
+        }
+        if !is_canonical(canonical) && !is_truth_column(canonical) {
+            let hint = closest_canonical(canonical)
+                .map(|c| format!("did you mean '{c}'? "))
+                .unwrap_or_default();
+            return Err(err(format!(
+                "'{canonical}' is not a canonical column name; {hint}known names: {}, or true_*",
+                CANONICAL_COLUMNS.join(", ")
+            )));
+        }
+        if self.get(canonical).is_some() {
+            return Err(err(format!("'{canonical}' is mapped twice")));
+        }
+        if let Some((c, _)) = self.pairs.iter().find(|(_, f)| f == file_column) {
+            return Err(err(format!(
+                "file column '{file_column}' is already mapped to '{c}'"
+            )));
+        }
+        self.pairs
+            .push((canonical.to_string(), file_column.to_string()));
+        Ok(())
+    }
+
+    /// The file column mapped to `canonical`, if any.
+    pub fn get(&self, canonical: &str) -> Option<&str> {
+        self.pairs
+            .iter()
+            .find(|(c, _)| c == canonical)
+            .map(|(_, f)| f.as_str())
+    }
+
+    /// `(canonical, file_column)` pairs in the order given.
+    pub fn pairs(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.pairs.iter().map(|(c, f)| (c.as_str(), f.as_str()))
+    }
+
+    /// True when nothing is mapped.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+}
+
+impl std::str::FromStr for ColumnMap {
+    type Err = IoError;
+    fn from_str(s: &str) -> Result<Self> {
+        ColumnMap::parse(s)
+    }
+}
+
+/// Resolves the aliases for a file with the given header: the user's map
+/// first (every mapped file column must exist), then, if `preset` is on, the
+/// MagNav preset for canonical names that are neither in the header nor mapped.
+pub(crate) fn resolve(
+    file: &str,
+    header: &[String],
+    map: &ColumnMap,
+    preset: bool,
+) -> Result<Vec<MappedColumn>> {
+    let has = |name: &str| header.iter().any(|h| h == name);
+    let mut out: Vec<MappedColumn> = Vec::new();
+    for (canonical, file_column) in map.pairs() {
+        if !has(file_column) {
+            return Err(IoError::MappedColumnAbsent {
+                file: file.to_string(),
+                canonical: canonical.to_string(),
+                file_column: file_column.to_string(),
+                present: header.join(", "),
+            });
+        }
+        out.push(MappedColumn {
+            canonical: canonical.to_string(),
+            file_column: file_column.to_string(),
+            origin: MapOrigin::User,
+        });
+    }
+    if !preset {
+        return Ok(out);
+    }
+    let taken = |out: &[MappedColumn], canonical: &str, file_column: &str| {
+        has(canonical)
+            || out
+                .iter()
+                .any(|m| m.canonical == canonical || m.file_column == file_column)
+    };
+    for (canonical, candidates) in MAGNAV_PRESET {
+        if let Some(c) = candidates
+            .iter()
+            .find(|c| has(c) && !taken(&out, canonical, c))
+            && *c != canonical
+        {
+            out.push(MappedColumn {
+                canonical: canonical.to_string(),
+                file_column: c.to_string(),
+                origin: MapOrigin::MagNavPreset,
+            });
+        }
+    }
+    let flux = ["flux_x", "flux_y", "flux_z"];
+    if flux
+        .iter()
+        .all(|f| !has(f) && !out.iter().any(|m| m.canonical == *f))
+    {
+        for prefix in MAGNAV_FLUX_PREFIXES {
+            let names: Vec<String> = ["x", "y", "z"]
+                .iter()
+                .map(|a| format!("{prefix}_{a}"))
+                .collect();
+            if names
+                .iter()
+                .all(|n| has(n) && !out.iter().any(|m| &m.file_column == n))
+            {
+                for (canonical, file_column) in flux.iter().zip(names) {
+                    out.push(MappedColumn {
+                        canonical: canonical.to_string(),
+                        file_column,
+                        origin: MapOrigin::MagNavPreset,
+                    });
+                }
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The canonical name closest to `name` (case-insensitive edit distance ≤ 2).
+fn closest_canonical(name: &str) -> Option<&'static str> {
+    let lower = name.to_ascii_lowercase();
+    CANONICAL_COLUMNS
+        .iter()
+        .map(|c| (edit_distance(&lower, c), *c))
+        .filter(|(d, _)| *d <= 2)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+/// Levenshtein distance between two short strings (by chars).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header(names: &[&str]) -> Vec<String> {
+        names.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn parses_pairs_with_spaces() {
+        let m = ColumnMap::parse(" mag = mag_1_uc , flux_x=flux_a_x,true_anomaly=anom").unwrap();
+        assert_eq!(m.get("mag"), Some("mag_1_uc"));
+        assert_eq!(m.get("flux_x"), Some("flux_a_x"));
+        assert_eq!(m.get("true_anomaly"), Some("anom"));
+        assert_eq!(m.get("flux_y"), None);
+        assert!(ColumnMap::parse("  ").unwrap().is_empty());
+    }
+
+    #[test]
+    fn rejects_malformed_text() {
+        for bad in [
+            "mag",
+            "mag=",
+            "=x",
+            "mag=a=b",
+            "mag=a,,flux_x=b",
+            "mag=a,",
+            "mag=a,mag=b",
+            "mag=a,igrf=a",
+            "true_=x",
+        ] {
+            let e = ColumnMap::parse(bad).unwrap_err();
+            assert!(matches!(e, IoError::ColumnMap { .. }), "{bad}: {e}");
+            assert!(e.to_string().contains(bad), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn unknown_canonical_gets_suggestion() {
+        let e = ColumnMap::parse("flux_X=a").unwrap_err().to_string();
+        assert!(e.contains("did you mean 'flux_x'"), "{e}");
+        let e = ColumnMap::parse("speed=a").unwrap_err().to_string();
+        assert!(
+            !e.contains("did you mean") && e.contains("not a canonical"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn user_map_requires_present_column() {
+        let m = ColumnMap::parse("mag=mag_9_uc").unwrap();
+        let e = resolve("f.csv", &header(&["time", "mag_1_uc"]), &m, true).unwrap_err();
+        let s = e.to_string();
+        assert!(matches!(e, IoError::MappedColumnAbsent { .. }));
+        assert!(
+            s.contains("mag_9_uc") && s.contains("f.csv") && s.contains("time, mag_1_uc"),
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn magnav_preset_fills_only_absent_names() {
+        let h = header(&[
+            "tt",
+            "lat",
+            "lon",
+            "utm_z",
+            "ins_alt",
+            "ins_lat",
+            "ins_roll",
+            "ins_pitch",
+            "ins_yaw",
+            "mag_1_uc",
+            "mag_3_uc",
+            "flux_a_x",
+            "flux_a_y",
+            "flux_b_x",
+            "flux_b_y",
+            "flux_b_z",
+            "line",
+        ]);
+        let m = resolve("f", &h, &ColumnMap::new(), true).unwrap();
+        let get = |c: &str| {
+            m.iter()
+                .find(|x| x.canonical == c)
+                .map(|x| x.file_column.as_str())
+        };
+        assert_eq!(get("time"), Some("tt"));
+        assert_eq!(get("lat"), None, "lat is in the file itself");
+        assert_eq!(get("alt"), Some("utm_z"));
+        assert_eq!(get("roll"), Some("ins_roll"));
+        assert_eq!(get("mag"), Some("mag_1_uc"));
+        // flux_a lacks z: the complete triplet B is used.
+        assert_eq!(get("flux_x"), Some("flux_b_x"));
+        assert_eq!(get("flux_z"), Some("flux_b_z"));
+        assert!(m.iter().all(|x| x.origin == MapOrigin::MagNavPreset));
+        // User map wins and the preset does not reuse its column.
+        let user = ColumnMap::parse("mag=mag_3_uc").unwrap();
+        let m = resolve("f", &h, &user, true).unwrap();
+        assert_eq!(m.iter().filter(|x| x.canonical == "mag").count(), 1);
+        assert_eq!(m[0].origin, MapOrigin::User);
+        assert!(
+            resolve("f", &h, &ColumnMap::new(), false)
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn edit_distance_is_levenshtein() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("flux_x", "flux_x"), 0);
+    }
+}

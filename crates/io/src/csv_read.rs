@@ -1,0 +1,357 @@
+//! CSV reader.
+//!
+//! Accepted layout (spec `data-formats.md`, "Flight data tables"):
+//!
+//! - optional UTF-8 byte-order mark; `\n` or `\r\n` line ends; the last line
+//!   may lack its line end;
+//! - lines starting with `#` are comments, before the header and anywhere
+//!   after it; blank lines are skipped (in a one-column file a blank line is
+//!   therefore not a blank cell);
+//! - one header row with the column names (trimmed; an empty name becomes
+//!   `unnamed_<position>`; a repeated name is an error);
+//! - one data row per sample with exactly as many fields as the header has
+//!   names: a shorter or longer row is an error (rows are never dropped or
+//!   padded); fields may be quoted (`"…"`, `""` for a quote);
+//! - missing values: empty cell, `NaN` (any case), `*`; numbers in Rust's
+//!   `f64` syntax, surrounding whitespace ignored (see `cell.rs`).
+//!
+//! # Delimiter
+//!
+//! [`ReadOptions::delimiter`](crate::ReadOptions) forces one. Otherwise it is
+//! detected from the header line: the most frequent of comma, tab and
+//! semicolon (comma on a tie). A header with none of them but with several
+//! whitespace-separated names (`time lat lon`) makes the file a
+//! whitespace-separated table, read by the same tokenizer as Geosoft XYZ
+//! with `#` comments and the first content line as header. A header without
+//! any separator is a one-column table. When a forced delimiter does not
+//! occur in the header but another candidate does, the error
+//! [`IoError::WrongDelimiter`] says so ("wrong delimiter? the header has one
+//! column 'a;b;c'"). With a semicolon or tab delimiter, a number with a
+//! decimal comma gets a hint in its parse error.
+//!
+//! The file is streamed with `csv::ByteRecord` (one reused buffer) into the
+//! per-column vectors of the [`TableBuilder`](crate::builder); see there for
+//! the memory bound.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+use crate::ReadOptions;
+use crate::builder::{Layout, RowSource, TableBuilder};
+use crate::cell::check_text;
+use crate::error::{IoError, Result};
+use crate::sniff::{BOM, first_content_line, read_prefix};
+use crate::table::FlightTable;
+use crate::xyz;
+
+/// Reads a CSV (or whitespace-separated) flight-data file. See the module docs.
+pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
+    let file = path.display().to_string();
+    let prefix = read_prefix(path)?;
+    let Some((header_line, header, _)) = first_content_line(&prefix.bytes, |l| l.starts_with(b"#"))
+    else {
+        return Err(IoError::Empty { file });
+    };
+    let header_text = check_text(header).map_err(|_| IoError::Binary {
+        file: file.clone(),
+        line: header_line,
+        what: "invalid bytes in the header row".to_string(),
+    })?;
+    let delimiter = match opts.delimiter {
+        Some(d) => {
+            check_forced_delimiter(&file, header_line, header_text, d)?;
+            d
+        }
+        None => match detect_delimiter(header_text) {
+            Some(d) => d,
+            None => return xyz::read_whitespace(path, opts),
+        },
+    };
+    let open = || CsvSource::open(path, delimiter, prefix.file_size);
+    let mut src = open()?;
+    let names = src.header()?;
+    let layout = Layout {
+        path: path.to_path_buf(),
+        names,
+        header_line: src.header_line,
+        file_size: prefix.file_size,
+        header_bytes: src.bytes_read(),
+        decimal_comma_hint: delimiter != b',',
+    };
+    let mut builder = TableBuilder::new(layout, opts)?;
+    src.n_fields = builder.names().len();
+    while src.next_row()? {
+        builder.push_row(&src)?;
+    }
+    builder.finish(|| {
+        let mut s = open()?;
+        s.n_fields = s.header()?.len();
+        Ok(s)
+    })
+}
+
+/// The delimiter of a header line: most frequent of `,` `\t` `;` (comma on a
+/// tie); `None` for a whitespace-separated header; comma for a single name.
+fn detect_delimiter(header: &str) -> Option<u8> {
+    let count = |c: char| header.matches(c).count();
+    let candidates = [(b',', count(',')), (b'\t', count('\t')), (b';', count(';'))];
+    let best = candidates.iter().fold(
+        (b',', 0),
+        |acc, &(d, n)| if n > acc.1 { (d, n) } else { acc },
+    );
+    if best.1 > 0 {
+        return Some(best.0);
+    }
+    if header.split_ascii_whitespace().count() > 1 {
+        None
+    } else {
+        Some(b',')
+    }
+}
+
+/// Errors when a forced delimiter leaves the header as one column although
+/// another delimiter (or whitespace) separates it.
+fn check_forced_delimiter(file: &str, line: u64, header: &str, d: u8) -> Result<()> {
+    if header.as_bytes().contains(&d) {
+        return Ok(());
+    }
+    let other = [b',', b'\t', b';']
+        .iter()
+        .any(|c| *c != d && header.as_bytes().contains(c))
+        || header.split_ascii_whitespace().count() > 1;
+    if other {
+        return Err(IoError::WrongDelimiter {
+            file: file.to_string(),
+            line,
+            header: header.to_string(),
+            delimiter: delimiter_name(d),
+        });
+    }
+    Ok(())
+}
+
+/// A delimiter in words, for messages.
+pub(crate) fn delimiter_name(d: u8) -> String {
+    match d {
+        b',' => "comma".into(),
+        b';' => "semicolon".into(),
+        b'\t' => "tab".into(),
+        b' ' => "whitespace".into(),
+        other => format!("'{}'", other as char),
+    }
+}
+
+/// The last byte of a file (`None` when empty).
+fn last_byte(file: &str, path: &Path, size: u64) -> Result<Option<u8>> {
+    use std::io::{Read, Seek, SeekFrom};
+    if size == 0 {
+        return Ok(None);
+    }
+    let err = |source| IoError::Read {
+        file: file.to_string(),
+        line: 1,
+        source,
+    };
+    let mut f = File::open(path).map_err(|source| IoError::Open {
+        file: file.to_string(),
+        source,
+    })?;
+    f.seek(SeekFrom::End(-1)).map_err(err)?;
+    let mut b = [0u8];
+    f.read_exact(&mut b).map_err(err)?;
+    Ok(Some(b[0]))
+}
+
+/// Rows of a CSV file through `csv::Reader` (see [`RowSource`]). The
+/// terminator is `\n` alone so that every record consumes its own line end
+/// and csv-core's line counter gives exact line numbers (comments and blank
+/// lines included). In a file whose header line ends with `\r\n`, the `\r`
+/// left on the last field of each row is trimmed (so a quoted text cell
+/// ending in `\r` in the last column of a CRLF file loses that `\r`).
+struct CsvSource {
+    rdr: csv::Reader<BufReader<File>>,
+    rec: csv::ByteRecord,
+    file: String,
+    delimiter: u8,
+    header_line: u64,
+    n_fields: usize,
+    row: usize,
+    line: u64,
+    bom: u64,
+    file_size: u64,
+    ends_with_newline: bool,
+    last: usize,
+    crlf: bool,
+}
+
+impl CsvSource {
+    fn open(path: &Path, delimiter: u8, file_size: u64) -> Result<Self> {
+        let file = path.display().to_string();
+        let f = File::open(path).map_err(|source| IoError::Open {
+            file: file.clone(),
+            source,
+        })?;
+        let mut reader = BufReader::with_capacity(256 * 1024, f);
+        let head = reader.fill_buf().map_err(|source| IoError::Read {
+            file: file.clone(),
+            line: 1,
+            source,
+        })?;
+        let bom = if head.starts_with(BOM) { BOM.len() } else { 0 };
+        reader.consume(bom);
+        let ends_with_newline = last_byte(&file, path, file_size)? == Some(b'\n');
+        let rdr = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .delimiter(delimiter)
+            .terminator(csv::Terminator::Any(b'\n'))
+            .buffer_capacity(if file_size > (1 << 20) {
+                256 * 1024
+            } else {
+                16 * 1024
+            })
+            .from_reader(reader);
+        Ok(CsvSource {
+            rdr,
+            rec: csv::ByteRecord::new(),
+            file,
+            delimiter,
+            header_line: 0,
+            n_fields: 0,
+            row: 0,
+            line: 0,
+            bom: bom as u64,
+            file_size,
+            ends_with_newline,
+            last: 0,
+            crlf: false,
+        })
+    }
+
+    /// Reads one record; skips whitespace-only lines. `false` at the end.
+    fn read_record(&mut self) -> Result<bool> {
+        loop {
+            match self.rdr.read_byte_record(&mut self.rec) {
+                Ok(false) => return Ok(false),
+                Ok(true) => {}
+                Err(e) => {
+                    let line = e.position().map_or(self.line + 1, |p| p.line());
+                    let source = match e.into_kind() {
+                        csv::ErrorKind::Io(io) => io,
+                        other => std::io::Error::other(format!("{other:?}")),
+                    };
+                    return Err(IoError::Read {
+                        file: self.file.clone(),
+                        line,
+                        source,
+                    });
+                }
+            }
+            // The line counter of csv-core counts every '\n' consumed. The
+            // record's own '\n' has been consumed unless it is the unterminated
+            // last line; quoted fields may contain more line ends.
+            let pos = self.rdr.position();
+            let at_end = pos.byte() + self.bom >= self.file_size;
+            let last_line = pos.line() - u64::from(!at_end || self.ends_with_newline);
+            let embedded = self.rec.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
+            self.line = last_line.saturating_sub(embedded).max(1);
+            if self.rec.len() == 1 && self.rec[0].trim_ascii().is_empty() {
+                continue;
+            }
+            return Ok(true);
+        }
+    }
+
+    /// Reads the header record and returns its names (trimmed).
+    fn header(&mut self) -> Result<Vec<String>> {
+        if !self.read_record()? {
+            return Err(IoError::Empty {
+                file: self.file.clone(),
+            });
+        }
+        self.header_line = self.line;
+        self.last = self.rec.len().saturating_sub(1);
+        self.crlf = self.rec.get(self.last).is_some_and(|f| f.ends_with(b"\r"));
+        self.rec
+            .iter()
+            .map(|f| {
+                check_text(f)
+                    .map(|s| s.trim().to_string())
+                    .map_err(|_| IoError::Binary {
+                        file: self.file.clone(),
+                        line: self.line,
+                        what: "invalid bytes in the header row".to_string(),
+                    })
+            })
+            .collect()
+    }
+}
+
+impl RowSource for CsvSource {
+    fn next_row(&mut self) -> Result<bool> {
+        if !self.read_record()? {
+            return Ok(false);
+        }
+        if self.rec.len() != self.n_fields {
+            return Err(IoError::FieldCount {
+                file: self.file.clone(),
+                line: self.line,
+                row: self.row,
+                expected: self.n_fields,
+                found: self.rec.len(),
+                header_line: self.header_line,
+                delimiter: delimiter_name(self.delimiter),
+            });
+        }
+        self.row += 1;
+        Ok(true)
+    }
+
+    fn line(&self) -> u64 {
+        self.line
+    }
+
+    #[inline]
+    fn field(&self, i: usize) -> &[u8] {
+        let f = &self.rec[i];
+        // With '\n' as the terminator, a CRLF file leaves '\r' on the last field.
+        if self.crlf && i == self.last {
+            f.strip_suffix(b"\r").unwrap_or(f)
+        } else {
+            f
+        }
+    }
+
+    fn bytes_read(&self) -> u64 {
+        self.rdr.position().byte() + self.bom
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn delimiter_detection() {
+        assert_eq!(detect_delimiter("time,lat,lon"), Some(b','));
+        assert_eq!(detect_delimiter("time;lat;lon"), Some(b';'));
+        assert_eq!(detect_delimiter("time\tlat\tlon"), Some(b'\t'));
+        assert_eq!(detect_delimiter("a;b;c,d"), Some(b';'));
+        assert_eq!(detect_delimiter("time lat  lon"), None);
+        assert_eq!(detect_delimiter("mag"), Some(b','));
+    }
+
+    #[test]
+    fn forced_delimiter_mismatch() {
+        let e = check_forced_delimiter("f.csv", 3, "a;b;c", b',').unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.contains("wrong delimiter?") && s.contains("'a;b;c'") && s.contains("line 3"),
+            "{s}"
+        );
+        assert!(check_forced_delimiter("f.csv", 3, "a,b", b',').is_ok());
+        assert!(check_forced_delimiter("f.csv", 3, "mag", b',').is_ok());
+    }
+}

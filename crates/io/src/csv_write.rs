@@ -1,0 +1,123 @@
+//! CSV writer.
+//!
+//! Output layout: one header row with the table's column names (file names;
+//! aliases are not written), one row per table row, comma separated, `\n`
+//! line ends, a final line end.
+//!
+//! - Numbers are written with the shortest text that reads back to the same
+//!   `f64` (Ryū: `0.1`, `53210.4`, `1e-7`, `-0.0`, `inf`), so a write → read
+//!   round trip preserves every finite value and infinity bit for bit.
+//! - Missing values (`NaN`) are written as **empty cells** (the reader reads
+//!   them back as missing, `Missing::blank`); the NaN payload and sign are not
+//!   kept. Exception: in a one-column table they are written as `NaN`, because
+//!   an empty line would be skipped as a blank line and the row lost.
+//! - Text cells and names are written as they are, quoted (`"…"`, inner `"`
+//!   doubled) when they contain a comma, a quote, a line end, or start with
+//!   `#` (which would otherwise read as a comment).
+//!
+//! A text column whose cells all look like numbers reads back as a numeric
+//! column (column types are not stored in CSV).
+//!
+//! The writer streams row by row into a 1 MiB buffer.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{IoError, Result};
+use crate::table::{ColumnData, FlightTable};
+
+/// Writes `table` as CSV to the file `path` (created or truncated).
+pub fn write_csv(table: &FlightTable, path: &Path) -> Result<()> {
+    let file = path.display().to_string();
+    let write_err = |source| IoError::Write {
+        file: file.clone(),
+        source,
+    };
+    let f = File::create(path).map_err(write_err)?;
+    let mut out = BufWriter::with_capacity(1 << 20, f);
+    write_csv_to(table, &mut out).map_err(write_err)?;
+    out.flush().map_err(write_err)
+}
+
+/// Writes `table` as CSV to any writer (wrap unbuffered writers in a `BufWriter`).
+pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Result<()> {
+    let mut line: Vec<u8> = Vec::with_capacity(4096);
+    for (i, c) in table.columns().iter().enumerate() {
+        if i > 0 {
+            line.push(b',');
+        }
+        push_text(&mut line, c.name());
+    }
+    line.push(b'\n');
+    out.write_all(&line)?;
+    let mut ryu = ryu::Buffer::new();
+    let missing: &[u8] = if table.columns().len() == 1 {
+        b"NaN"
+    } else {
+        b""
+    };
+    for row in 0..table.n_rows() {
+        line.clear();
+        for (i, c) in table.columns().iter().enumerate() {
+            if i > 0 {
+                line.push(b',');
+            }
+            match c.data() {
+                ColumnData::Numeric { values, .. } => {
+                    let v = values[row];
+                    if v.is_nan() {
+                        line.extend_from_slice(missing);
+                    } else {
+                        line.extend_from_slice(ryu.format(v).as_bytes());
+                    }
+                }
+                ColumnData::Text(t) => push_text(&mut line, &t[row]),
+            }
+        }
+        line.push(b'\n');
+        out.write_all(&line)?;
+    }
+    Ok(())
+}
+
+/// Appends a text cell, quoted when needed (see the module docs).
+fn push_text(line: &mut Vec<u8>, s: &str) {
+    let needs_quotes =
+        s.starts_with('#') || s.bytes().any(|b| matches!(b, b',' | b'"' | b'\n' | b'\r'));
+    if !needs_quotes {
+        line.extend_from_slice(s.as_bytes());
+        return;
+    }
+    line.push(b'"');
+    for b in s.bytes() {
+        if b == b'"' {
+            line.push(b'"');
+        }
+        line.push(b);
+    }
+    line.push(b'"');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_numbers_missing_and_quoted_text() {
+        let mut t = FlightTable::new();
+        t.add_column("time", vec![0.1, 1e-7]).unwrap();
+        t.add_column("mag", vec![f64::NAN, -0.0]).unwrap();
+        t.add_text_column("note", vec!["a,b".into(), "say \"hi\"".into()])
+            .unwrap();
+        t.add_text_column("id", vec!["#1".into(), "plain".into()])
+            .unwrap();
+        let mut out = Vec::new();
+        write_csv_to(&t, &mut out).unwrap();
+        let s = String::from_utf8(out).unwrap();
+        assert_eq!(
+            s,
+            "time,mag,note,id\n0.1,,\"a,b\",\"#1\"\n1e-7,-0.0,\"say \"\"hi\"\"\",plain\n"
+        );
+    }
+}

@@ -1,0 +1,296 @@
+//! The error type of `aeromag-io`.
+//!
+//! Every variant's `Display` text is the message a user sees on the command
+//! line: it names the file, the 1-based line number in the file, the data row
+//! and the column wherever they are known.
+//!
+//! Numbering conventions used in every message and field:
+//!
+//! - `line`: 1-based line number in the file, counting every physical line
+//!   (comments, blank lines and the header included), as an editor shows it.
+//! - `row`: 0-based index of the data row in the [`FlightTable`](crate::FlightTable).
+//!   Messages print it 1-based as "data row N" (the first data row is
+//!   "data row 1"), so `row` 14 is printed as "data row 15".
+
+/// Everything that can go wrong while reading, mapping, checking or writing
+/// flight-data tables.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum IoError {
+    /// The file does not exist or cannot be opened.
+    #[error("cannot open '{file}': {source}")]
+    Open {
+        /// File as given.
+        file: String,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// An I/O error while reading an opened file.
+    #[error("error reading '{file}' near line {line}: {source}")]
+    Read {
+        /// File as given.
+        file: String,
+        /// Line reached when the error happened.
+        line: u64,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file has no header row (zero bytes, or only comments and blank lines).
+    #[error("'{file}' is empty: expected a header row with column names")]
+    Empty {
+        /// File as given.
+        file: String,
+    },
+    /// The file has a header row but not a single data row.
+    #[error("'{file}' has a header (line {header_line}) but no data rows")]
+    NoData {
+        /// File as given.
+        file: String,
+        /// Line of the header.
+        header_line: u64,
+    },
+    /// Invalid UTF-8 or NUL bytes: the file is binary or in another encoding.
+    #[error(
+        "'{file}' line {line}: {what}; this is not a UTF-8 text table (binary file, or another encoding?)"
+    )]
+    Binary {
+        /// File as given.
+        file: String,
+        /// Line where the bad byte is.
+        line: u64,
+        /// What was found, e.g. "NUL byte in column 'mag'".
+        what: String,
+    },
+    /// The header row splits into a single column although it contains
+    /// another likely delimiter.
+    #[error(
+        "'{file}' line {line}: wrong delimiter? the header has one column '{header}' when split at {delimiter}"
+    )]
+    WrongDelimiter {
+        /// File as given.
+        file: String,
+        /// Line of the header.
+        line: u64,
+        /// The header text.
+        header: String,
+        /// The delimiter used, in words ("comma", "tab", …).
+        delimiter: String,
+    },
+    /// A column name appears twice in the header.
+    #[error(
+        "'{file}' line {line}: column name '{column}' appears twice in the header (columns {first} and {second}, counted from 1)"
+    )]
+    DuplicateHeader {
+        /// File as given.
+        file: String,
+        /// Line of the header.
+        line: u64,
+        /// The repeated name.
+        column: String,
+        /// 1-based position of its first occurrence.
+        first: usize,
+        /// 1-based position of its second occurrence.
+        second: usize,
+    },
+    /// A data row has more or fewer fields than the header has columns.
+    /// Rows are never dropped, so this is an error.
+    #[error(
+        "'{file}' line {line} (data row {}): {found} fields, but the header (line {header_line}) has {expected} columns (fields separated by {delimiter})",
+        .row + 1
+    )]
+    FieldCount {
+        /// File as given.
+        file: String,
+        /// Line of the bad row.
+        line: u64,
+        /// 0-based data row index.
+        row: usize,
+        /// Number of header columns.
+        expected: usize,
+        /// Number of fields found.
+        found: usize,
+        /// Line of the header.
+        header_line: u64,
+        /// The delimiter, in words.
+        delimiter: String,
+    },
+    /// Text in a column that must be numeric.
+    #[error(
+        "cannot parse '{text}' as a number in column {column} at line {line} (data row {}) of '{file}'{hint}",
+        .row + 1
+    )]
+    ParseNumber {
+        /// File as given.
+        file: String,
+        /// Line of the cell.
+        line: u64,
+        /// 0-based data row index.
+        row: usize,
+        /// Column, quoted, with its canonical name when mapped, e.g. `'mag_1_uc' (mapped to 'mag')`.
+        column: String,
+        /// The cell text.
+        text: String,
+        /// Extra advice (starts with a space or is empty).
+        hint: String,
+    },
+    /// A column that a command needs is not in the table.
+    #[error("'{file}': required column '{column}' is missing; columns present: {present}{hint}")]
+    MissingColumn {
+        /// File (or `"<in-memory table>"`).
+        file: String,
+        /// The required (canonical) name.
+        column: String,
+        /// Comma-separated list of the columns present.
+        present: String,
+        /// Extra advice (starts with a space or is empty).
+        hint: String,
+    },
+    /// A column is text where numbers are needed.
+    #[error("'{file}': column '{column}' holds text, but numbers are needed")]
+    NotNumeric {
+        /// File (or `"<in-memory table>"`).
+        file: String,
+        /// The column.
+        column: String,
+    },
+    /// `--columns` maps a canonical name onto a column the file does not have.
+    #[error(
+        "'{file}': the column map sends '{canonical}' to column '{file_column}', which is not in the file; columns present: {present}"
+    )]
+    MappedColumnAbsent {
+        /// File as given.
+        file: String,
+        /// Canonical name on the left of `=`.
+        canonical: String,
+        /// File column on the right of `=`.
+        file_column: String,
+        /// Comma-separated list of the columns present.
+        present: String,
+    },
+    /// Malformed `--columns` text.
+    #[error("invalid column map '{text}': {reason}")]
+    ColumnMap {
+        /// The whole map text.
+        text: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A column added to a table has the wrong length.
+    #[error("column '{column}' has {found} values, but the table has {expected} rows")]
+    LengthMismatch {
+        /// Column name.
+        column: String,
+        /// Rows of the table.
+        expected: usize,
+        /// Values given.
+        found: usize,
+    },
+    /// A column added to a table already exists.
+    #[error("column '{column}' already exists in the table")]
+    ColumnExists {
+        /// Column name.
+        column: String,
+    },
+    /// Geosoft XYZ: no usable column-name header.
+    #[error("'{file}' line {line}: {message}")]
+    XyzHeader {
+        /// File as given.
+        file: String,
+        /// Line of the first data line (or of the bad record).
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// Time (or another column that must increase) steps back or repeats.
+    #[error(
+        "'{file}': column '{column}' must be strictly increasing, but data row {}{} has {value_b} after data row {}{} has {value_a}",
+        .row_b + 1, fmt_line(*.line_b), .row_a + 1, fmt_line(*.line_a)
+    )]
+    NotIncreasing {
+        /// File (or `"<in-memory table>"`).
+        file: String,
+        /// Column checked.
+        column: String,
+        /// 0-based index of the earlier row.
+        row_a: usize,
+        /// Its file line, when known.
+        line_a: Option<u64>,
+        /// Its value.
+        value_a: f64,
+        /// 0-based index of the later row.
+        row_b: usize,
+        /// Its file line, when known.
+        line_b: Option<u64>,
+        /// Its value.
+        value_b: f64,
+    },
+    /// A missing value where one is not allowed (e.g. time).
+    #[error("'{file}': column '{column}' has a missing value at data row {}{}", .row + 1, fmt_line(*.line))]
+    MissingValue {
+        /// File (or `"<in-memory table>"`).
+        file: String,
+        /// Column.
+        column: String,
+        /// 0-based row index.
+        row: usize,
+        /// File line, when known.
+        line: Option<u64>,
+    },
+    /// Values in implausible units (e.g. tesla where nT is expected).
+    #[error("'{file}': column '{column}': {message}")]
+    Units {
+        /// File (or `"<in-memory table>"`).
+        file: String,
+        /// Column.
+        column: String,
+        /// What looks wrong and how to fix it.
+        message: String,
+    },
+    /// Writing an output file failed.
+    #[error("cannot write '{file}': {source}")]
+    Write {
+        /// File as given.
+        file: String,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file format this build cannot read.
+    #[error("'{file}': {reason}")]
+    Unsupported {
+        /// File as given.
+        file: String,
+        /// Why, and what to do.
+        reason: String,
+    },
+}
+
+impl IoError {
+    /// True when the error is caused by the user's input (a file, a column,
+    /// a column map, a value): the command line exits with code 2 for these.
+    /// False for failures of the machine (I/O errors while reading an opened
+    /// file, write failures) and for programming errors of a caller
+    /// (`LengthMismatch`, `ColumnExists`).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(
+            self,
+            IoError::Read { .. }
+                | IoError::Write { .. }
+                | IoError::LengthMismatch { .. }
+                | IoError::ColumnExists { .. }
+        )
+    }
+}
+
+/// " (line N)" or "" when the line is unknown (in-memory tables).
+fn fmt_line(line: Option<u64>) -> String {
+    match line {
+        Some(l) => format!(" (line {l})"),
+        None => String::new(),
+    }
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, IoError>;

@@ -1,0 +1,405 @@
+//! [`FlightTable`]: column-major flight data.
+//!
+//! A table is a list of equally long named columns. A column holds either
+//! `f64` values (missing samples are `NaN`; the reason — blank cell, `NaN`
+//! text, `*` dummy — is counted per column in [`Missing`]) or text (columns
+//! that are not numbers, such as a flight id, which pass through unchanged).
+//!
+//! Canonical names (see [`columns`](crate::columns)) may be aliases of file
+//! columns: [`FlightTable::column`] resolves the alias first, then the plain
+//! column name. Rows are never dropped; readers keep every data row, and the
+//! file line of each row is kept compactly so that messages can name it.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::columns::MappedColumn;
+use crate::error::{IoError, Result};
+
+/// Why samples of a numeric column are missing (`NaN`), counted per reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Missing {
+    /// Empty (or whitespace-only) cells.
+    pub blank: usize,
+    /// Cells written as `NaN` (any case), and `NaN` values of in-memory columns.
+    pub nan: usize,
+    /// Dummy cells `*` (Geosoft XYZ convention, also accepted in CSV).
+    pub dummy: usize,
+}
+
+impl Missing {
+    /// Total number of missing samples.
+    pub fn total(&self) -> usize {
+        self.blank + self.nan + self.dummy
+    }
+}
+
+/// The values of one column.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColumnData {
+    /// Numbers; missing samples are `NaN`.
+    Numeric {
+        /// One value per row.
+        values: Vec<f64>,
+        /// Missing samples by reason; `missing.total()` equals the number of `NaN`s.
+        missing: Missing,
+    },
+    /// Text passed through unchanged (one string per row).
+    Text(Vec<String>),
+}
+
+/// A named column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Column {
+    name: String,
+    data: ColumnData,
+}
+
+impl Column {
+    /// Column name as in the file (or as added).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The values.
+    pub fn data(&self) -> &ColumnData {
+        &self.data
+    }
+
+    /// Numeric values, `None` for a text column.
+    pub fn values(&self) -> Option<&[f64]> {
+        match &self.data {
+            ColumnData::Numeric { values, .. } => Some(values),
+            ColumnData::Text(_) => None,
+        }
+    }
+
+    /// Text values, `None` for a numeric column.
+    pub fn text(&self) -> Option<&[String]> {
+        match &self.data {
+            ColumnData::Text(t) => Some(t),
+            ColumnData::Numeric { .. } => None,
+        }
+    }
+
+    /// Missing-sample counts (all zero for text columns).
+    pub fn missing(&self) -> Missing {
+        match &self.data {
+            ColumnData::Numeric { missing, .. } => *missing,
+            ColumnData::Text(_) => Missing::default(),
+        }
+    }
+
+    fn len(&self) -> usize {
+        match &self.data {
+            ColumnData::Numeric { values, .. } => values.len(),
+            ColumnData::Text(t) => t.len(),
+        }
+    }
+}
+
+/// Column-major table of flight data. See the module docs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FlightTable {
+    source: Option<PathBuf>,
+    n_rows: usize,
+    columns: Vec<Column>,
+    aliases: Vec<MappedColumn>,
+    /// Breakpoints `(row, line)`: from `row` on, row `r` is on file line
+    /// `line + (r - row)`, until the next breakpoint. Empty for in-memory tables.
+    row_lines: Vec<(usize, u64)>,
+}
+
+/// Name used in messages for tables that were not read from a file.
+pub const IN_MEMORY: &str = "<in-memory table>";
+
+impl FlightTable {
+    /// An empty in-memory table (no rows, no columns, no source file). The
+    /// first added column sets the number of rows.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the file the table is associated with (used in messages).
+    pub fn set_source(&mut self, path: impl Into<PathBuf>) {
+        self.source = Some(path.into());
+    }
+
+    /// The file the table was read from, if any.
+    pub fn source(&self) -> Option<&Path> {
+        self.source.as_deref()
+    }
+
+    /// The source file for messages, or `"<in-memory table>"`.
+    pub fn file_label(&self) -> String {
+        self.source
+            .as_ref()
+            .map_or_else(|| IN_MEMORY.to_string(), |p| p.display().to_string())
+    }
+
+    /// Number of rows.
+    pub fn n_rows(&self) -> usize {
+        self.n_rows
+    }
+
+    /// All columns in order.
+    pub fn columns(&self) -> &[Column] {
+        &self.columns
+    }
+
+    /// Column names in order (file names; aliases are not listed, see [`FlightTable::mapping`]).
+    pub fn column_names(&self) -> Vec<&str> {
+        self.columns.iter().map(|c| c.name.as_str()).collect()
+    }
+
+    /// The canonical aliases in effect (user map and MagNav preset).
+    pub fn mapping(&self) -> &[MappedColumn] {
+        &self.aliases
+    }
+
+    /// The column name in the table that `name` refers to: the file column of
+    /// an alias, else `name` itself if such a column exists.
+    pub fn resolve(&self, name: &str) -> Option<&str> {
+        if let Some(m) = self.aliases.iter().find(|m| m.canonical == name) {
+            return Some(m.file_column.as_str());
+        }
+        self.columns
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.name.as_str())
+    }
+
+    /// The column `name` (alias resolved), numeric or text.
+    pub fn get(&self, name: &str) -> Option<&Column> {
+        let target = self.resolve(name)?;
+        self.columns.iter().find(|c| c.name == target)
+    }
+
+    /// Numeric values of column `name` (alias resolved); `None` if absent or text.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.get(name).and_then(Column::values)
+    }
+
+    /// Text values of column `name` (alias resolved); `None` if absent or numeric.
+    pub fn text_column(&self, name: &str) -> Option<&[String]> {
+        self.get(name).and_then(Column::text)
+    }
+
+    /// Missing counts of column `name`; `None` if absent.
+    pub fn missing(&self, name: &str) -> Option<Missing> {
+        self.get(name).map(Column::missing)
+    }
+
+    /// Numeric values of a column a command cannot work without.
+    ///
+    /// Errors: [`IoError::MissingColumn`] naming the file, the column, the
+    /// columns present and how to map it; [`IoError::NotNumeric`] for a text column.
+    pub fn require(&self, name: &str) -> Result<&[f64]> {
+        match self.get(name) {
+            Some(c) => c.values().ok_or_else(|| IoError::NotNumeric {
+                file: self.file_label(),
+                column: name.to_string(),
+            }),
+            None => Err(IoError::MissingColumn {
+                file: self.file_label(),
+                column: name.to_string(),
+                present: self.column_names().join(", "),
+                hint: format!(" (map a column onto it with --columns {name}=NAME)"),
+            }),
+        }
+    }
+
+    /// Adds a numeric column; `NaN` values count as missing (`Missing::nan`).
+    /// Errors if the name exists or the length differs from [`FlightTable::n_rows`]
+    /// (any length is accepted for the first column).
+    pub fn add_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        let missing = Missing {
+            nan: values.iter().filter(|v| v.is_nan()).count(),
+            ..Missing::default()
+        };
+        self.push_column(Column {
+            name: name.to_string(),
+            data: ColumnData::Numeric { values, missing },
+        })
+    }
+
+    /// Adds a text column (errors as [`FlightTable::add_column`]).
+    pub fn add_text_column(&mut self, name: &str, values: Vec<String>) -> Result<()> {
+        self.push_column(Column {
+            name: name.to_string(),
+            data: ColumnData::Text(values),
+        })
+    }
+
+    /// Replaces the values of column `name` (no alias resolution) or adds it
+    /// when absent. Errors only on a length mismatch.
+    pub fn set_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        match self.columns.iter().position(|c| c.name == name) {
+            Some(i) => {
+                self.check_len(name, values.len())?;
+                let missing = Missing {
+                    nan: values.iter().filter(|v| v.is_nan()).count(),
+                    ..Missing::default()
+                };
+                self.columns[i].data = ColumnData::Numeric { values, missing };
+                Ok(())
+            }
+            None => self.add_column(name, values),
+        }
+    }
+
+    /// 1-based file line of data row `row` (0-based); `None` for in-memory
+    /// tables or out-of-range rows.
+    pub fn line_of_row(&self, row: usize) -> Option<u64> {
+        if row >= self.n_rows {
+            return None;
+        }
+        let k = self.row_lines.partition_point(|(r, _)| *r <= row);
+        let (r0, l0) = *self.row_lines.get(k.checked_sub(1)?)?;
+        Some(l0 + (row - r0) as u64)
+    }
+
+    fn check_len(&self, name: &str, len: usize) -> Result<()> {
+        if !self.columns.is_empty() && len != self.n_rows {
+            return Err(IoError::LengthMismatch {
+                column: name.to_string(),
+                expected: self.n_rows,
+                found: len,
+            });
+        }
+        Ok(())
+    }
+
+    fn push_column(&mut self, column: Column) -> Result<()> {
+        if self.columns.iter().any(|c| c.name == column.name) {
+            return Err(IoError::ColumnExists {
+                column: column.name,
+            });
+        }
+        self.check_len(&column.name, column.len())?;
+        self.n_rows = column.len();
+        self.columns.push(column);
+        Ok(())
+    }
+
+    /// Assembles a table read from a file (used by the readers).
+    pub(crate) fn from_parts(
+        source: PathBuf,
+        n_rows: usize,
+        columns: Vec<(String, ColumnData)>,
+        aliases: Vec<MappedColumn>,
+        row_lines: Vec<(usize, u64)>,
+    ) -> Self {
+        FlightTable {
+            source: Some(source),
+            n_rows,
+            columns: columns
+                .into_iter()
+                .map(|(name, data)| Column { name, data })
+                .collect(),
+            aliases,
+            row_lines,
+        }
+    }
+
+    /// Multiplies the numeric column `name` (alias resolved) by `factor` in place.
+    pub(crate) fn scale_column(&mut self, name: &str, factor: f64) -> bool {
+        let Some(target) = self.resolve(name).map(str::to_string) else {
+            return false;
+        };
+        match self
+            .columns
+            .iter_mut()
+            .find(|c| c.name == target)
+            .map(|c| &mut c.data)
+        {
+            Some(ColumnData::Numeric { values, .. }) => {
+                values.iter_mut().for_each(|v| *v *= factor);
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::columns::MapOrigin;
+
+    #[test]
+    fn add_and_access_columns() {
+        let mut t = FlightTable::new();
+        t.add_column("time", vec![0.0, 0.1, 0.2]).unwrap();
+        t.add_column("mag", vec![1.0, f64::NAN, 3.0]).unwrap();
+        t.add_text_column("id", vec!["a".into(), "b".into(), "c".into()])
+            .unwrap();
+        assert_eq!(t.n_rows(), 3);
+        assert_eq!(t.column_names(), vec!["time", "mag", "id"]);
+        assert_eq!(t.missing("mag").unwrap().total(), 1);
+        assert!(t.column("id").is_none());
+        assert_eq!(t.text_column("id").unwrap()[2], "c");
+        assert!(matches!(
+            t.add_column("x", vec![1.0]),
+            Err(IoError::LengthMismatch {
+                expected: 3,
+                found: 1,
+                ..
+            })
+        ));
+        assert!(matches!(
+            t.add_column("mag", vec![0.0; 3]),
+            Err(IoError::ColumnExists { .. })
+        ));
+        t.set_column("mag", vec![f64::NAN; 3]).unwrap();
+        assert_eq!(t.missing("mag").unwrap().nan, 3);
+        assert!(matches!(t.require("id"), Err(IoError::NotNumeric { .. })));
+        assert_eq!(t.line_of_row(0), None);
+    }
+
+    #[test]
+    fn require_names_file_column_and_present_columns() {
+        let mut t = FlightTable::new();
+        t.set_source("/data/f.csv");
+        t.add_column("time", vec![0.0]).unwrap();
+        let e = t.require("mag").unwrap_err().to_string();
+        assert!(
+            e.contains("/data/f.csv") && e.contains("'mag'") && e.contains("columns present: time"),
+            "{e}"
+        );
+        assert!(e.contains("--columns mag="), "{e}");
+    }
+
+    #[test]
+    fn aliases_and_row_lines() {
+        let cols = vec![
+            (
+                "tt".to_string(),
+                ColumnData::Numeric {
+                    values: vec![1.0, 2.0, 3.0, 4.0],
+                    missing: Missing::default(),
+                },
+            ),
+            (
+                "mag".to_string(),
+                ColumnData::Numeric {
+                    values: vec![9.0; 4],
+                    missing: Missing::default(),
+                },
+            ),
+        ];
+        let aliases = vec![MappedColumn {
+            canonical: "time".into(),
+            file_column: "tt".into(),
+            origin: MapOrigin::User,
+        }];
+        // rows 0,1 on lines 3,4; a comment on line 5; rows 2,3 on lines 6,7.
+        let t = FlightTable::from_parts("f.csv".into(), 4, cols, aliases, vec![(0, 3), (2, 6)]);
+        assert_eq!(t.column("time").unwrap(), &[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(t.resolve("time"), Some("tt"));
+        assert_eq!(t.resolve("mag"), Some("mag"));
+        let lines: Vec<_> = (0..5).map(|r| t.line_of_row(r)).collect();
+        assert_eq!(lines, vec![Some(3), Some(4), Some(6), Some(7), None]);
+    }
+}

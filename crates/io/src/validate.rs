@@ -1,0 +1,414 @@
+//! Checks that every command runs on its input table.
+//!
+//! - [`check_time`]: `time` (s) must be strictly increasing and never missing
+//!   (spec `data-formats.md`: "a duplicate or a step back is an error that
+//!   names the row").
+//! - [`check_units`]: plausibility of units. Errors for values that cannot
+//!   be in the expected unit, [`Warning`]s for values that are merely
+//!   suspicious. Statistics use the finite values only; medians are taken
+//!   over at most [`MEDIAN_SAMPLES`] evenly strided samples (deterministic).
+//!
+//! Rules of [`check_units`] (Earth's total field is about 22 000–67 000 nT):
+//!
+//! | columns | error | warning |
+//! |---|---|---|
+//! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 10 000–100 000 nT |
+//! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 10 000–100 000 nT |
+//! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
+//! | `lat` | \|lat\| > 90 | all \|lat\| ≤ π/2 and \|lon\| ≤ π (radians?) |
+//! | `lon` | \|lon\| > 360 | (see `lat`) |
+//! | `roll`, `pitch` | \|roll\| > 180, \|pitch\| > 90 | |
+//! | `yaw` | — | outside ±360 |
+//! | `roll`, `pitch`, `yaw` | — | radians: \|roll\|, \|pitch\| ≤ π/2 while yaw stays in [−π, 2π] and spans more than π (a turn of over 180° in radians; in degrees that would be a heading range of 3–9° without a single roll above 1.6°) |
+//! | `alt` | — | median > 20 000 m (feet or km?) |
+//!
+//! A single flux component is tested by its maximum rather than its median,
+//! because one body-frame component can legitimately stay near zero (e.g. the
+//! vertical component at the magnetic equator).
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::columns::MAGNETIC_COLUMNS;
+use crate::error::{IoError, Result};
+use crate::table::FlightTable;
+
+/// Medians are computed over at most this many samples.
+pub const MEDIAN_SAMPLES: usize = 100_000;
+
+/// A suspicion about the input that does not stop a command.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Warning {
+    /// File (or `"<in-memory table>"`).
+    pub file: String,
+    /// Column concerned, if one.
+    pub column: Option<String>,
+    /// 0-based data row concerned, if one.
+    pub row: Option<usize>,
+    /// 1-based file line of that row, when known.
+    pub line: Option<u64>,
+    /// What looks wrong.
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "'{}'", self.file)?;
+        if let Some(c) = &self.column {
+            write!(f, ": column '{c}'")?;
+        }
+        if let Some(r) = self.row {
+            write!(f, " at data row {}", r + 1)?;
+        }
+        if let Some(l) = self.line {
+            write!(f, " (line {l})")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+/// Checks that `time` exists, has no missing value and strictly increases.
+///
+/// Errors: [`IoError::MissingColumn`], [`IoError::MissingValue`] (a NaN time,
+/// naming the row and line), [`IoError::NotIncreasing`] (a repeat or a step
+/// back, naming both rows, their lines and values).
+pub fn check_time(table: &FlightTable) -> Result<()> {
+    let t = table.require("time")?;
+    for (i, &v) in t.iter().enumerate() {
+        if v.is_nan() {
+            return Err(IoError::MissingValue {
+                file: table.file_label(),
+                column: "time".into(),
+                row: i,
+                line: table.line_of_row(i),
+            });
+        }
+        if i > 0 && v <= t[i - 1] {
+            return Err(IoError::NotIncreasing {
+                file: table.file_label(),
+                column: "time".into(),
+                row_a: i - 1,
+                line_a: table.line_of_row(i - 1),
+                value_a: t[i - 1],
+                row_b: i,
+                line_b: table.line_of_row(i),
+                value_b: v,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks the units of magnetic, position and attitude columns (rules in
+/// the module docs). Absent columns are skipped.
+pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
+    let mut warnings = Vec::new();
+    let ctx = Ctx { table };
+    for name in ["mag", "igrf"] {
+        if let Some(v) = table.column(name) {
+            ctx.total_field(name, v.iter().map(|x| x.abs()), &mut warnings)?;
+        }
+    }
+    let flux: Vec<&[f64]> = ["flux_x", "flux_y", "flux_z"]
+        .iter()
+        .filter_map(|n| table.column(n))
+        .collect();
+    for name in ["flux_x", "flux_y", "flux_z", "diurnal"] {
+        if let Some(v) = table.column(name) {
+            ctx.component(name, v)?;
+        }
+    }
+    if let [x, y, z] = flux[..] {
+        let norm = (0..table.n_rows()).map(|i| (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt());
+        ctx.total_field("flux_x/flux_y/flux_z", norm, &mut warnings)?;
+    }
+    ctx.position(&mut warnings)?;
+    ctx.attitude(&mut warnings)?;
+    if let Some(alt) = table.column("alt")
+        && let Some(m) = median(alt.iter().copied())
+        && m > 20_000.0
+    {
+        warnings.push(ctx.warn(
+            "alt",
+            None,
+            format!("median altitude {m} m is above 20 km: feet or another unit? expected m"),
+        ));
+    }
+    Ok(warnings)
+}
+
+/// Multiplies the magnetic columns present (`mag`, `flux_*`, `diurnal`,
+/// `igrf`) by 1e9, converting tesla to nT (for `--mag-units T`). Returns the
+/// names converted.
+pub fn convert_tesla_to_nt(table: &mut FlightTable) -> Vec<String> {
+    MAGNETIC_COLUMNS
+        .iter()
+        .filter(|n| table.scale_column(n, 1e9))
+        .map(|n| n.to_string())
+        .collect()
+}
+
+struct Ctx<'a> {
+    table: &'a FlightTable,
+}
+
+impl Ctx<'_> {
+    fn units(&self, column: &str, message: String) -> IoError {
+        IoError::Units {
+            file: self.table.file_label(),
+            column: column.to_string(),
+            message,
+        }
+    }
+
+    fn warn(&self, column: &str, row: Option<usize>, message: String) -> Warning {
+        Warning {
+            file: self.table.file_label(),
+            column: Some(column.to_string()),
+            row,
+            line: row.and_then(|r| self.table.line_of_row(r)),
+            message,
+        }
+    }
+
+    /// A total-field magnitude (nT): errors for tesla/gauss/pT-like medians, warning outside Earth's range.
+    fn total_field(
+        &self,
+        name: &str,
+        abs: impl Iterator<Item = f64>,
+        w: &mut Vec<Warning>,
+    ) -> Result<()> {
+        let Some(m) = median(abs) else { return Ok(()) };
+        let fix = "expected nT";
+        if m < 1.0 {
+            let guess = if (1e-6..1e-3).contains(&m) {
+                format!(
+                    "looks like tesla (Earth's field is 2e-5 to 7e-5 T), {fix} (multiply by 1e9 or pass --mag-units T)"
+                )
+            } else if (0.05..1.0).contains(&m) {
+                format!("looks like gauss (Earth's field is 0.2 to 0.7 G), {fix} (multiply by 1e5)")
+            } else {
+                format!("is far below Earth's field (22 000 to 67 000 nT): wrong units? {fix}")
+            };
+            return Err(self.units(name, format!("median |value| = {m:e}: {guess}")));
+        }
+        if m > 1e6 {
+            return Err(self.units(
+                name,
+                format!("median |value| = {m:e} is far above Earth's field in nT (22 000 to 67 000 nT): picotesla? {fix} (divide by 1000)"),
+            ));
+        }
+        if !(10_000.0..=100_000.0).contains(&m) {
+            w.push(self.warn(
+                name,
+                None,
+                format!("median |value| = {m} nT is outside Earth's total field (22 000 to 67 000 nT): anomaly or corrected data, or other units?"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// One field component (nT), which may be small: tested by its maximum.
+    fn component(&self, name: &str, v: &[f64]) -> Result<()> {
+        let max = v
+            .iter()
+            .filter(|x| x.is_finite())
+            .fold(None, |m: Option<f64>, x| {
+                Some(m.map_or(x.abs(), |m| m.max(x.abs())))
+            });
+        let Some(max) = max else { return Ok(()) };
+        if max > 0.0 && max < 1e-3 {
+            return Err(self.units(
+                name,
+                format!("all values are below 1e-3 in magnitude (max |value| = {max:e}): looks like tesla, expected nT (multiply by 1e9 or pass --mag-units T)"),
+            ));
+        }
+        if let Some(m) = median(v.iter().map(|x| x.abs()))
+            && m > 1e6
+        {
+            return Err(self.units(
+                    name,
+                    format!("median |value| = {m:e} is far too large for nT: picotesla? expected nT (divide by 1000)"),
+                ));
+        }
+        Ok(())
+    }
+
+    fn position(&self, w: &mut Vec<Warning>) -> Result<()> {
+        let lat = self.table.column("lat");
+        let lon = self.table.column("lon");
+        if let Some(lat) = lat
+            && let Some((i, v)) = first_where(lat, |v| v.abs() > 90.0)
+        {
+            return Err(self.units(
+                    "lat",
+                    format!("latitude {v} at data row {}{} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", i + 1, at_line(self.table, i)),
+                ));
+        }
+        if let Some(lon) = lon
+            && let Some((i, v)) = first_where(lon, |v| v.abs() > 360.0)
+        {
+            return Err(self.units(
+                    "lon",
+                    format!(
+                        "longitude {v} at data row {}{} is outside ±360°: projected coordinates? expected degrees",
+                        i + 1,
+                        at_line(self.table, i)
+                    ),
+                ));
+        }
+        if let (Some(lat), Some(lon)) = (lat, lon) {
+            let (Some(a), Some(o)) = (max_abs(lat), max_abs(lon)) else {
+                return Ok(());
+            };
+            if a <= std::f64::consts::FRAC_PI_2 && o <= std::f64::consts::PI && (a > 0.0 || o > 0.0)
+            {
+                w.push(self.warn(
+                    "lat",
+                    None,
+                    format!(
+                        "all |lat| ≤ π/2 and |lon| ≤ π (max {a}, {o}): radians? expected degrees"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn attitude(&self, w: &mut Vec<Warning>) -> Result<()> {
+        let t = self.table;
+        for (name, limit) in [("roll", 180.0), ("pitch", 90.0)] {
+            if let Some(v) = t.column(name)
+                && let Some((i, x)) = first_where(v, |x| x.abs() > limit)
+            {
+                return Err(self.units(
+                    name,
+                    format!(
+                        "{name} {x} at data row {}{} is outside ±{limit}°: expected degrees",
+                        i + 1,
+                        at_line(t, i)
+                    ),
+                ));
+            }
+        }
+        if let Some(yaw) = t.column("yaw")
+            && let Some((i, x)) = first_where(yaw, |x| x.abs() > 360.0)
+        {
+            w.push(self.warn(
+                "yaw",
+                Some(i),
+                format!("yaw {x} is outside ±360°: expected degrees"),
+            ));
+        }
+        let (Some(roll), Some(pitch), Some(yaw)) =
+            (t.column("roll"), t.column("pitch"), t.column("yaw"))
+        else {
+            return Ok(());
+        };
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let (Some(r), Some(p)) = (max_abs(roll), max_abs(pitch)) else {
+            return Ok(());
+        };
+        let finite = || yaw.iter().copied().filter(|x| x.is_finite());
+        let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+        let eps = 1e-9;
+        if r <= FRAC_PI_2
+            && p <= FRAC_PI_2
+            && lo >= -PI - eps
+            && hi <= 2.0 * PI + eps
+            && hi - lo > PI
+        {
+            w.push(self.warn(
+                "yaw",
+                None,
+                format!(
+                    "attitude looks like radians: yaw spans {lo}..{hi} (more than π) while |roll| ≤ {r} and |pitch| ≤ {p}; expected degrees"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// " (line N)" for a row of a table read from a file.
+fn at_line(table: &FlightTable, row: usize) -> String {
+    table
+        .line_of_row(row)
+        .map(|l| format!(" (line {l})"))
+        .unwrap_or_default()
+}
+
+fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {
+    v.iter()
+        .copied()
+        .enumerate()
+        .find(|(_, x)| x.is_finite() && pred(*x))
+}
+
+fn max_abs(v: &[f64]) -> Option<f64> {
+    v.iter()
+        .filter(|x| x.is_finite())
+        .map(|x| x.abs())
+        .fold(None, |m, x| Some(m.map_or(x, |m: f64| m.max(x))))
+}
+
+/// Median of the finite values among at most [`MEDIAN_SAMPLES`] evenly
+/// strided samples of `values`; `None` when there is none.
+pub(crate) fn median(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let all: Vec<f64> = values.collect();
+    let stride = all.len().div_ceil(MEDIAN_SAMPLES).max(1);
+    let mut v: Vec<f64> = all
+        .into_iter()
+        .step_by(stride)
+        .filter(|x| x.is_finite())
+        .collect();
+    median_in_place(&mut v)
+}
+
+/// Median of a vector of finite values (reorders it); mean of the two middle values for even lengths.
+pub(crate) fn median_in_place(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    let n = v.len();
+    let (_, &mut hi, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    if n % 2 == 1 {
+        return Some(hi);
+    }
+    let lo = v[..n / 2].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Some(0.5 * (lo + hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median_in_place(&mut [3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median_in_place(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.5));
+        assert_eq!(median_in_place(&mut []), None);
+        assert_eq!(
+            median([f64::NAN, 5.0, f64::INFINITY].into_iter()),
+            Some(5.0)
+        );
+    }
+
+    #[test]
+    fn warning_display_names_everything() {
+        let w = Warning {
+            file: "f.csv".into(),
+            column: Some("yaw".into()),
+            row: Some(4),
+            line: Some(7),
+            message: "odd".into(),
+        };
+        assert_eq!(
+            w.to_string(),
+            "'f.csv': column 'yaw' at data row 5 (line 7): odd"
+        );
+    }
+}

@@ -1,0 +1,422 @@
+//! Geosoft XYZ reader (and whitespace-separated tables).
+//!
+//! Geosoft XYZ is the column text format of airborne geophysics:
+//!
+//! ```text
+//! / XYZ EXPORT [06/20/2020]
+//! / DATABASE   [survey.gdb]
+//! /
+//! /   time        lat         lon        alt      mag
+//! Line 1010
+//!   0.0    45.001    -75.002    300.0   53210.4
+//!   0.1    45.002    -75.002    300.1        *
+//! Tie 2010
+//!   ...
+//! ```
+//!
+//! Rules of this reader:
+//!
+//! - Lines starting with `/` are comments (anywhere). Blank lines are skipped.
+//!   A UTF-8 byte-order mark and `\r\n` line ends are accepted.
+//! - Data lines are whitespace separated; `*` is the dummy (missing) value, as
+//!   are empty-looking `NaN` tokens (see `cell.rs`). Every data line must have
+//!   as many values as the header has names (else [`IoError::FieldCount`]).
+//! - **Header rule.** The column names are taken from the *last* comment line
+//!   before the first data line whose number of names equals the number of
+//!   values on that first data line and whose names all start with a letter
+//!   or `_`. The names are what follows the leading slashes, separated by
+//!   whitespace and/or commas, so `/ time lat lon` and `/time,lat,lon` are
+//!   both accepted. Lines starting with `//` (Geosoft's metadata lines) are
+//!   used only when no single-`/` line qualifies. A units line written after
+//!   the names line must therefore start with `//` (or contain a token that
+//!   does not start with a letter). No qualifying line is an
+//!   [`IoError::XyzHeader`] error.
+//! - **Line records.** A line whose first word is `Line` or `Tie` (any case)
+//!   starts a survey line or tie line; its number is the next word, with
+//!   leading letters dropped (`Line 1010`, `LINE L1010`, `Tie 2010.1`). If the
+//!   file has at least one record, two columns are added after the file's
+//!   columns: `line` (the number as written; ties keep their own number;
+//!   missing before the first record) and `line_type` (0 for `Line`, 1 for
+//!   `Tie`). If the header already has a column of that name, the added
+//!   column is called `xyz_line` (resp. `xyz_line_type`) instead.
+//!
+//! The same tokenizer reads whitespace-separated tables with a plain header
+//! (`time lat lon` as the first line that is not a `#` comment), which
+//! [`read_csv`](crate::read_csv) hands over when it detects them.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+use crate::ReadOptions;
+use crate::builder::{Layout, RowSource, TableBuilder};
+use crate::error::{IoError, Result};
+use crate::sniff::{BOM, read_prefix};
+use crate::table::FlightTable;
+
+/// Reads a Geosoft XYZ file. See the module docs for the header rule and the
+/// `line`/`line_type` columns.
+pub fn read_xyz(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
+    read_tokens(path, opts, Dialect::Geosoft)
+}
+
+/// Reads a whitespace-separated table with a plain header line and `#` comments.
+pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
+    read_tokens(path, opts, Dialect::Whitespace)
+}
+
+fn read_tokens(path: &Path, opts: &ReadOptions, dialect: Dialect) -> Result<FlightTable> {
+    let prefix = read_prefix(path)?;
+    let (mut src, names) = TokenSource::open(path, dialect)?;
+    let layout = Layout {
+        path: path.to_path_buf(),
+        names,
+        header_line: src.header_line,
+        file_size: prefix.file_size,
+        header_bytes: src.bytes,
+        decimal_comma_hint: false,
+    };
+    let mut builder = TableBuilder::new(layout, opts)?;
+    let header = builder.names().to_vec();
+    while src.next_row()? {
+        builder.push_row(&src)?;
+    }
+    let mut table = builder.finish(|| TokenSource::open(path, dialect).map(|(s, _)| s))?;
+    if src.any_record {
+        let free = |name: &str| {
+            if header.iter().any(|h| h == name) {
+                format!("xyz_{name}")
+            } else {
+                name.to_string()
+            }
+        };
+        table.add_column(&free("line"), std::mem::take(&mut src.line_values))?;
+        table.add_column(&free("line_type"), std::mem::take(&mut src.line_types))?;
+    }
+    Ok(table)
+}
+
+/// Which text layout is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Dialect {
+    /// Geosoft XYZ: `/` comments, header in a comment, `Line`/`Tie` records.
+    Geosoft,
+    /// Plain whitespace table: `#` comments, first content line is the header.
+    Whitespace,
+}
+
+/// What a physical line is.
+enum Kind {
+    Blank,
+    Comment,
+    Record { number: f64, tie: bool },
+    Data,
+}
+
+/// Whitespace-separated rows (see [`RowSource`]).
+struct TokenSource {
+    reader: BufReader<File>,
+    buf: Vec<u8>,
+    spans: Vec<(usize, usize)>,
+    file: String,
+    dialect: Dialect,
+    line: u64,
+    bytes: u64,
+    n_fields: usize,
+    header_line: u64,
+    row: usize,
+    replay: bool,
+    current_line: f64,
+    current_type: f64,
+    any_record: bool,
+    line_values: Vec<f64>,
+    line_types: Vec<f64>,
+}
+
+impl TokenSource {
+    /// Opens the file and reads up to the first data line; returns the source
+    /// (positioned so that the first `next_row` yields that line) and the header names.
+    fn open(path: &Path, dialect: Dialect) -> Result<(Self, Vec<String>)> {
+        let file = path.display().to_string();
+        let f = File::open(path).map_err(|source| IoError::Open {
+            file: file.clone(),
+            source,
+        })?;
+        let mut src = TokenSource {
+            reader: BufReader::with_capacity(256 * 1024, f),
+            buf: Vec::with_capacity(1024),
+            spans: Vec::new(),
+            file,
+            dialect,
+            line: 0,
+            bytes: 0,
+            n_fields: 0,
+            header_line: 0,
+            row: 0,
+            replay: false,
+            current_line: f64::NAN,
+            current_type: f64::NAN,
+            any_record: false,
+            line_values: Vec::new(),
+            line_types: Vec::new(),
+        };
+        let names = match dialect {
+            Dialect::Geosoft => src.geosoft_header()?,
+            Dialect::Whitespace => src.plain_header()?,
+        };
+        src.n_fields = names.len();
+        Ok((src, names))
+    }
+
+    /// Scans comments and records up to the first data line and applies the header rule.
+    fn geosoft_header(&mut self) -> Result<Vec<String>> {
+        let mut comments: Vec<(u64, bool, Vec<String>)> = Vec::new();
+        loop {
+            if !self.read_line()? {
+                return Err(match comments.last() {
+                    Some((line, _, _)) => IoError::NoData {
+                        file: self.file.clone(),
+                        header_line: *line,
+                    },
+                    None => IoError::Empty {
+                        file: self.file.clone(),
+                    },
+                });
+            }
+            match self.classify()? {
+                Kind::Blank => {}
+                Kind::Comment => {
+                    if let Ok(text) = std::str::from_utf8(&self.buf) {
+                        let double = text.starts_with("//");
+                        let names: Vec<String> = text
+                            .trim_start_matches('/')
+                            .split(|c: char| c.is_whitespace() || c == ',')
+                            .filter(|t| !t.is_empty())
+                            .map(str::to_string)
+                            .collect();
+                        comments.push((self.line, double, names));
+                    }
+                }
+                Kind::Record { number, tie } => self.set_record(number, tie),
+                Kind::Data => break,
+            }
+        }
+        self.tokenize();
+        let n = self.spans.len();
+        let name_like = |t: &String| t.starts_with(|c: char| c.is_alphabetic() || c == '_');
+        let fits = |double: bool| {
+            comments.iter().rev().find(|(_, d, names)| {
+                *d == double && names.len() == n && names.iter().all(name_like)
+            })
+        };
+        let Some((line, _, names)) = fits(false).or_else(|| fits(true)) else {
+            return Err(IoError::XyzHeader {
+                file: self.file.clone(),
+                line: self.line,
+                message: format!(
+                    "no column-name header: the first data line has {n} values, but no '/' comment line before it has {n} names; add a line '/ name1 name2 …' before the data"
+                ),
+            });
+        };
+        self.header_line = *line;
+        self.replay = true;
+        Ok(names.clone())
+    }
+
+    /// The first content line (not blank, not `#`) is the header.
+    fn plain_header(&mut self) -> Result<Vec<String>> {
+        loop {
+            if !self.read_line()? {
+                return Err(IoError::Empty {
+                    file: self.file.clone(),
+                });
+            }
+            if matches!(self.classify()?, Kind::Data) {
+                break;
+            }
+        }
+        self.header_line = self.line;
+        let text = std::str::from_utf8(&self.buf).map_err(|_| IoError::Binary {
+            file: self.file.clone(),
+            line: self.line,
+            what: "invalid bytes in the header row".to_string(),
+        })?;
+        Ok(text.split_whitespace().map(str::to_string).collect())
+    }
+
+    /// Reads the next physical line into `buf` without its line end; `false` at the end.
+    fn read_line(&mut self) -> Result<bool> {
+        self.buf.clear();
+        let n = self
+            .reader
+            .read_until(b'\n', &mut self.buf)
+            .map_err(|source| IoError::Read {
+                file: self.file.clone(),
+                line: self.line + 1,
+                source,
+            })?;
+        if n == 0 {
+            return Ok(false);
+        }
+        self.bytes += n as u64;
+        self.line += 1;
+        if self.line == 1 && self.buf.starts_with(BOM) {
+            self.buf.drain(..BOM.len());
+        }
+        while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
+            self.buf.pop();
+        }
+        Ok(true)
+    }
+
+    fn classify(&self) -> Result<Kind> {
+        let t = self.buf.trim_ascii_start();
+        if t.trim_ascii_end().is_empty() {
+            return Ok(Kind::Blank);
+        }
+        match self.dialect {
+            Dialect::Whitespace => Ok(if t.starts_with(b"#") {
+                Kind::Comment
+            } else {
+                Kind::Data
+            }),
+            Dialect::Geosoft => {
+                if t.starts_with(b"/") {
+                    return Ok(Kind::Comment);
+                }
+                let mut words = t
+                    .split(|b| b.is_ascii_whitespace())
+                    .filter(|w| !w.is_empty());
+                let first = words.next().unwrap_or_default();
+                let tie = first.eq_ignore_ascii_case(b"tie");
+                if !tie && !first.eq_ignore_ascii_case(b"line") {
+                    return Ok(Kind::Data);
+                }
+                let word = words.next().unwrap_or_default();
+                match record_number(word) {
+                    Some(number) => Ok(Kind::Record { number, tie }),
+                    None => Err(IoError::XyzHeader {
+                        file: self.file.clone(),
+                        line: self.line,
+                        message: format!(
+                            "line record '{}' has no line number (expected e.g. 'Line 1010' or 'Tie 2010')",
+                            String::from_utf8_lossy(t)
+                        ),
+                    }),
+                }
+            }
+        }
+    }
+
+    fn set_record(&mut self, number: f64, tie: bool) {
+        self.current_line = number;
+        self.current_type = if tie { 1.0 } else { 0.0 };
+        self.any_record = true;
+    }
+
+    fn tokenize(&mut self) {
+        self.spans.clear();
+        let b = &self.buf;
+        let mut i = 0;
+        while i < b.len() {
+            while i < b.len() && b[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            let start = i;
+            while i < b.len() && !b[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            if i > start {
+                self.spans.push((start, i));
+            }
+        }
+    }
+
+    /// Checks the field count of the current data line and counts the row.
+    fn accept_row(&mut self) -> Result<()> {
+        if self.spans.len() != self.n_fields {
+            return Err(IoError::FieldCount {
+                file: self.file.clone(),
+                line: self.line,
+                row: self.row,
+                expected: self.n_fields,
+                found: self.spans.len(),
+                header_line: self.header_line,
+                delimiter: "whitespace".to_string(),
+            });
+        }
+        self.row += 1;
+        if self.dialect == Dialect::Geosoft {
+            self.line_values.push(self.current_line);
+            self.line_types.push(self.current_type);
+        }
+        Ok(())
+    }
+}
+
+impl RowSource for TokenSource {
+    fn next_row(&mut self) -> Result<bool> {
+        if self.replay {
+            self.replay = false;
+            self.tokenize();
+            self.accept_row()?;
+            return Ok(true);
+        }
+        loop {
+            if !self.read_line()? {
+                return Ok(false);
+            }
+            match self.classify()? {
+                Kind::Blank | Kind::Comment => {}
+                Kind::Record { number, tie } => self.set_record(number, tie),
+                Kind::Data => {
+                    self.tokenize();
+                    self.accept_row()?;
+                    return Ok(true);
+                }
+            }
+        }
+    }
+
+    fn line(&self) -> u64 {
+        self.line
+    }
+
+    #[inline]
+    fn field(&self, i: usize) -> &[u8] {
+        let (a, b) = self.spans[i];
+        &self.buf[a..b]
+    }
+
+    fn bytes_read(&self) -> u64 {
+        self.bytes
+    }
+}
+
+/// The number of a `Line`/`Tie` record word: leading letters dropped, then
+/// the leading digits and dots (`L1010` → 1010, `1010.1` → 1010.1, `10:2` → 10).
+fn record_number(word: &[u8]) -> Option<f64> {
+    let digits = word.trim_ascii_start();
+    let start = digits.iter().position(|b| !b.is_ascii_alphabetic())?;
+    let rest = &digits[start..];
+    let end = rest
+        .iter()
+        .position(|b| !(b.is_ascii_digit() || *b == b'.'))
+        .unwrap_or(rest.len());
+    std::str::from_utf8(&rest[..end]).ok()?.parse().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn record_numbers() {
+        assert_eq!(record_number(b"1010"), Some(1010.0));
+        assert_eq!(record_number(b"L1010"), Some(1010.0));
+        assert_eq!(record_number(b"1010.1"), Some(1010.1));
+        assert_eq!(record_number(b"10:2"), Some(10.0));
+        assert_eq!(record_number(b"abc"), None);
+        assert_eq!(record_number(b""), None);
+    }
+}

@@ -1,0 +1,235 @@
+//! check_time / check_units on files: errors name file, rows, lines, columns.
+
+mod common;
+
+use aeromag_io::{FlightTable, IoError, check_time, check_units, convert_tesla_to_nt};
+use common::{Fixtures, assert_mentions};
+
+#[test]
+fn increasing_time_passes() {
+    let fx = Fixtures::new();
+    let t = fx.read("ok.csv", "time,mag\n0,1\n0.1,2\n0.2,3\n").unwrap();
+    check_time(&t).unwrap();
+}
+
+#[test]
+fn repeated_time_names_both_rows_and_lines() {
+    let fx = Fixtures::new();
+    let t = fx
+        .read("rep.csv", "# c\ntime,mag\n0,1\n0.1,2\n# gap\n0.1,3\n")
+        .unwrap();
+    let e = check_time(&t).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::NotIncreasing {
+                row_a: 1,
+                row_b: 2,
+                line_a: Some(4),
+                line_b: Some(6),
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_mentions(
+        &e.to_string(),
+        &[
+            "rep.csv",
+            "'time'",
+            "data row 3 (line 6) has 0.1",
+            "data row 2 (line 4) has 0.1",
+        ],
+    );
+}
+
+#[test]
+fn step_back_is_an_error() {
+    let fx = Fixtures::new();
+    let t = fx.read("back.csv", "time\n5\n6\n5.5\n").unwrap();
+    let e = check_time(&t).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::NotIncreasing {
+                row_a: 1,
+                row_b: 2,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_mentions(&e.to_string(), &["5.5", "6", "line 4", "line 3"]);
+}
+
+#[test]
+fn missing_time_is_an_error() {
+    let fx = Fixtures::new();
+    let t = fx.read("nan.csv", "time,mag\n0,1\n,2\n").unwrap();
+    let e = check_time(&t).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IoError::MissingValue {
+                row: 1,
+                line: Some(3),
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_mentions(
+        &e.to_string(),
+        &["nan.csv", "'time'", "data row 2", "line 3"],
+    );
+    let t = fx.read("notime.csv", "mag\n1\n").unwrap();
+    assert!(matches!(check_time(&t), Err(IoError::MissingColumn { .. })));
+}
+
+fn table(cols: &[(&str, Vec<f64>)]) -> FlightTable {
+    let mut t = FlightTable::new();
+    for (n, v) in cols {
+        t.add_column(n, v.clone()).unwrap();
+    }
+    t
+}
+
+#[test]
+fn tesla_gauss_and_picotesla_are_errors() {
+    let cases = [
+        (5.2e-5, "looks like tesla"),
+        (0.52, "looks like gauss"),
+        (5.2e7, "picotesla"),
+        (0.003, "far below"),
+    ];
+    for (v, what) in cases {
+        let t = table(&[("mag", vec![v, v * 1.01, f64::NAN])]);
+        let e = check_units(&t).unwrap_err();
+        assert!(matches!(e, IoError::Units { .. }), "{v}: {e:?}");
+        assert_mentions(&e.to_string(), &["'mag'", what]);
+    }
+    let t = table(&[("igrf", vec![5.2e-5; 3])]);
+    assert_mentions(
+        &check_units(&t).unwrap_err().to_string(),
+        &["'igrf'", "multiply by 1e9 or pass --mag-units T"],
+    );
+}
+
+#[test]
+fn flux_components_and_diurnal_in_tesla() {
+    let t = table(&[
+        ("flux_x", vec![1e-5, -2e-5]),
+        ("flux_y", vec![0.0, 3e-6]),
+        ("flux_z", vec![4e-5, 4e-5]),
+    ]);
+    let e = check_units(&t).unwrap_err();
+    assert_mentions(&e.to_string(), &["'flux_x'", "tesla"]);
+    let t = table(&[("diurnal", vec![1e-9, -2e-9])]);
+    assert_mentions(
+        &check_units(&t).unwrap_err().to_string(),
+        &["'diurnal'", "tesla"],
+    );
+    // Small diurnal values in nT and an all-zero column are fine.
+    let t = table(&[
+        ("diurnal", vec![0.3, -0.2, 0.0]),
+        ("flux_z", vec![0.0, 0.0, 0.0]),
+    ]);
+    assert!(check_units(&t).unwrap().is_empty());
+}
+
+#[test]
+fn earth_field_in_nt_passes_and_odd_magnitudes_warn() {
+    let t = table(&[
+        ("mag", vec![53_000.0, 53_010.0]),
+        ("flux_x", vec![20_000.0, 20_100.0]),
+        ("flux_y", vec![-3_000.0, 2_000.0]),
+        ("flux_z", vec![48_000.0, 48_100.0]),
+        ("diurnal", vec![3.0, -4.0]),
+    ]);
+    assert!(check_units(&t).unwrap().is_empty());
+    let t = table(&[("mag", vec![120.0, -80.0, 30.0])]);
+    let w = check_units(&t).unwrap();
+    assert_eq!(w.len(), 1);
+    assert_eq!(w[0].column.as_deref(), Some("mag"));
+    assert!(
+        w[0].message.contains("outside Earth's total field"),
+        "{}",
+        w[0]
+    );
+}
+
+#[test]
+fn position_checks() {
+    let fx = Fixtures::new();
+    let t = fx
+        .read("swap.csv", "time,lat,lon\n0,45,-75\n1,-100.5,45\n")
+        .unwrap();
+    let e = check_units(&t).unwrap_err();
+    assert!(matches!(e, IoError::Units { .. }), "{e:?}");
+    assert_mentions(
+        &e.to_string(),
+        &["swap.csv", "'lat'", "-100.5", "data row 2", "line 3"],
+    );
+    let t = table(&[("lat", vec![0.0, 1.0]), ("lon", vec![5e5, 6e5])]);
+    assert_mentions(
+        &check_units(&t).unwrap_err().to_string(),
+        &["'lon'", "500000"],
+    );
+    let t = table(&[("lat", vec![0.78, 0.79]), ("lon", vec![-1.3, -1.31])]);
+    let w = check_units(&t).unwrap();
+    assert!(w.len() == 1 && w[0].message.contains("radians"), "{w:?}");
+    let t = table(&[("lat", vec![45.0, 45.1]), ("lon", vec![-75.0, -75.1])]);
+    assert!(check_units(&t).unwrap().is_empty());
+}
+
+#[test]
+fn attitude_checks() {
+    // Degrees through a 270° turn: no warning.
+    let n = 200;
+    let yaw_deg: Vec<f64> = (0..n).map(|i| i as f64 * 270.0 / n as f64).collect();
+    let roll_deg: Vec<f64> = (0..n).map(|i| 25.0 * (i as f64 * 0.05).sin()).collect();
+    let pitch_deg = vec![2.0; n];
+    let t = table(&[
+        ("roll", roll_deg.clone()),
+        ("pitch", pitch_deg.clone()),
+        ("yaw", yaw_deg.clone()),
+    ]);
+    assert!(check_units(&t).unwrap().is_empty());
+    // The same flight in radians: warning.
+    let rad = |v: &Vec<f64>| v.iter().map(|x| x.to_radians()).collect::<Vec<_>>();
+    let t = table(&[
+        ("roll", rad(&roll_deg)),
+        ("pitch", rad(&pitch_deg)),
+        ("yaw", rad(&yaw_deg)),
+    ]);
+    let w = check_units(&t).unwrap();
+    assert!(w.len() == 1 && w[0].message.contains("radians"), "{w:?}");
+    // Impossible degrees: errors.
+    let t = table(&[("pitch", vec![0.0, 95.0])]);
+    assert_mentions(
+        &check_units(&t).unwrap_err().to_string(),
+        &["'pitch'", "95", "data row 2"],
+    );
+    let t = table(&[("roll", vec![-190.0])]);
+    assert!(check_units(&t).is_err());
+    let t = table(&[("yaw", vec![0.0, 400.0])]);
+    let w = check_units(&t).unwrap();
+    assert!(w.len() == 1 && w[0].row == Some(1), "{w:?}");
+}
+
+#[test]
+fn altitude_warning_and_tesla_conversion() {
+    let t = table(&[("alt", vec![30_000.0, 31_000.0])]);
+    assert_eq!(check_units(&t).unwrap().len(), 1);
+    let mut t = table(&[
+        ("mag", vec![5.3e-5, 5.31e-5]),
+        ("time", vec![0.0, 1.0]),
+        ("igrf", vec![5.2e-5, 5.2e-5]),
+    ]);
+    assert!(check_units(&t).is_err());
+    let converted = convert_tesla_to_nt(&mut t);
+    assert_eq!(converted, vec!["mag", "igrf"]);
+    assert!((t.column("mag").unwrap()[0] - 53_000.0).abs() < 1e-6);
+    assert_eq!(t.column("time").unwrap(), &[0.0, 1.0]);
+    check_units(&t).unwrap();
+}

@@ -1,0 +1,3 @@
+//! The single-file HTML report.
+
+pub mod report;
