@@ -66,6 +66,10 @@ pub struct TlModel {
     pub coefficients: Vec<Coefficient>,
     /// Fit statistics.
     pub fit: FitStats,
+    /// Known external-field channels subtracted from `mag` before the fit
+    /// (e.g. `diurnal`, `igrf`); empty when the raw reading was fitted.
+    #[serde(default)]
+    pub reference: Vec<String>,
     /// Input columns used (canonical name → file column name).
     pub columns: std::collections::BTreeMap<String, String>,
     /// Version of aeromag that wrote the file.
@@ -138,6 +142,7 @@ mod tests {
             lambda: 0.0,
             fit: FitStats::default(),
             columns: Default::default(),
+            reference: vec![],
             software_version: "test".into(),
         }
     }

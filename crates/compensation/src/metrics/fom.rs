@@ -4,8 +4,14 @@
 //! (normally 4 headings × roll, pitch, yaw = 12 windows), of the peak-to-peak
 //! amplitude of the (compensated) signal within each window after removing
 //! the window's least-squares linear trend (spec `compensation.md`,
-//! "Metrics"; the industry definition, e.g. the FOM of compensation
-//! acceptance tests). Units: those of the signal (nT).
+//! "Metrics"). Units: those of the signal (nT).
+//!
+//! What goes in matters: the compensated reading still contains the external
+//! field, whose variation within a 20 s window (micropulsations, the main
+//! field's vertical gradient during pitch manoeuvres, geology) is not
+//! interference. As in acceptance practice, callers pass the signal reduced
+//! by the known external channels (base station, IGRF) and band-passed with
+//! the fit's band ([`super::band_pass_segments`]); the CLI does so.
 
 use super::maneuvers::{Axis, Maneuver};
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,65 @@
+//! Levelling at line/tie-line crossovers and the survey-altitude `k·d|B0|/dt`
+//! term (spec `compensation.md`, "Survey altitude: the d|B0|/dt term and
+//! levelling"; seed `000_…` §9).
+//!
+//! ## Why
+//!
+//! Seed §9: at survey altitude (~100 m) the horizontal gradients of the
+//! anomalous field are large, and the scalar measurement model acquires an
+//! extra term of order ε⁶ proportional to the time derivative of the field
+//! modulus, `k·d|B0|/dt`. It is too small to be estimated on the calibration
+//! flight (~1000 m and more), so the thesis estimates it on the survey itself
+//! by re-adjustment (переуравнивание) at crossovers of survey lines and tie
+//! lines. Physically the same term is produced by any time lag of the
+//! scalar channel: a first-order lag `τ` reads `B(t − τ) ≈ B − τ·dB/dt`, so
+//! `k = −τ` (s).
+//!
+//! ## The model (units: nT, s)
+//!
+//! For a sample at time `t` on line `L` the compensated reading is
+//!
+//! ```text
+//! m(t) = B(x(t)) + k·Ḃ(t) + o_L + s_L·(t − t_L)/h_L + noise
+//! ```
+//!
+//! * `B(x)` the true field at the position `x` (the same for every pass);
+//! * `Ḃ = dm/dt` the along-track time derivative of the measured series,
+//!   nT/s, estimated from the data themselves ([`track_derivative`]);
+//! * `k` (s) the coefficient of the derivative term;
+//! * `o_L` (nT) the level offset of line `L`, and optionally a linear drift
+//!   `s_L` (nT at the ends of the line's crossover time span, `t_L` its
+//!   middle and `h_L` its half-length, s).
+//!
+//! At a crossover of lines `a` and `b` (`a` the smaller label) the field
+//! `B` cancels:
+//!
+//! ```text
+//! d = m_a − m_b = k (Ḃ_a − Ḃ_b) + (o_a − o_b) + (s_a τ_a − s_b τ_b) + noise,   τ = (t − t_L)/h_L
+//! ```
+//!
+//! and `k`, `o`, `s` are found by regularised least squares ([`fit_levelling`]):
+//! the offsets are only determined up to a common constant (the datum: their
+//! mean is zero, or one line is held fixed) and a ridge `λ` keeps lines
+//! without enough crossovers at zero. With `k` fixed at 0 and no drift this
+//! is ordinary tie-line levelling. The corrected series is
+//! `m − k·Ḃ − o_L − s_L τ` ([`apply_levelling`]); rows outside lines keep
+//! their value and are flagged.
+//!
+//! ## Files
+//!
+//! | file | algorithm |
+//! |---|---|
+//! | [`tracks`] | the survey samples, track segmentation, along-track derivative |
+//! | [`crossovers`] | intersections of tracks of different lines (grid buckets, `O(N log N)`) |
+//! | [`fit`] | the joint least-squares fit of `k`, offsets and drifts |
+//! | [`apply`] | the corrected series, row flags, and the one-call [`level_survey`] |
+
+pub mod apply;
+pub mod crossovers;
+pub mod fit;
+pub mod tracks;
+
+pub use apply::{Levelled, RowFlag, SurveyLevelling, apply_levelling, level_survey};
+pub use crossovers::{Crossover, CrossoverSet, CrossoverSide, find_crossovers};
+pub use fit::{Datum, LevellingConfig, LevellingFit, LineLevel, fit_levelling};
+pub use tracks::{SurveyTracks, TrackConfig, track_derivative};
