@@ -1,1 +1,56 @@
-fn main() {}
+//! `aeromag`: the command-line program.
+//!
+//! Every command returns `anyhow::Result`; [`exit::classify`] maps errors to
+//! exit codes: 2 for bad input (files, columns, arguments, scenario files),
+//! 1 for everything else. Nothing panics on user input.
+
+mod analysis;
+mod commands;
+mod exit;
+mod flight;
+mod input;
+mod progress;
+
+use clap::{Parser, Subcommand};
+
+/// Processing of magnetic and low-frequency EM measurements from moving
+/// platforms: simulation, inspection, IGRF, interference compensation.
+///
+/// Files use nT for magnetic induction, metres, seconds and degrees; frames are
+/// NED (x north, y east, z down) and body (x forward, y right wing, z down).
+/// Exit codes: 0 success, 2 bad input (the message names file, row, column),
+/// 1 other failures.
+#[derive(Debug, Parser)]
+#[command(name = "aeromag", version, about, long_about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Demo(commands::demo::Args),
+    Simulate(commands::simulate::Args),
+    Inspect(commands::inspect::Args),
+    Igrf(commands::igrf::Args),
+    Calibrate(commands::calibrate::Args),
+    Compensate(commands::compensate::Args),
+    Report(commands::report::Args),
+}
+
+fn main() {
+    let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
+    let result = match cli.command {
+        Command::Demo(a) => commands::demo::run(a),
+        Command::Simulate(a) => commands::simulate::run(a),
+        Command::Inspect(a) => commands::inspect::run(a),
+        Command::Igrf(a) => commands::igrf::run(a),
+        Command::Calibrate(a) => commands::calibrate::run(a),
+        Command::Compensate(a) => commands::compensate::run(a),
+        Command::Report(a) => commands::report::run(a),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(exit::classify(&e));
+    }
+}

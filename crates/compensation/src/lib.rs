@@ -9,6 +9,7 @@
 //! | [`tolles_lawson`] | the Tolles-Lawson/Leliak design matrix and its fits |
 
 pub mod error;
+pub mod kalman;
 pub mod levelling;
 pub mod metrics;
 pub mod model_file;

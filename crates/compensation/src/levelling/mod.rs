@@ -62,4 +62,4 @@ pub mod tracks;
 pub use apply::{Levelled, RowFlag, SurveyLevelling, apply_levelling, level_survey};
 pub use crossovers::{Crossover, CrossoverSet, CrossoverSide, find_crossovers};
 pub use fit::{Datum, LevellingConfig, LevellingFit, LineLevel, fit_levelling};
-pub use tracks::{SurveyTracks, TrackConfig, track_derivative};
+pub use tracks::{SurveyTracks, TrackConfig, sensor_positions, track_derivative};

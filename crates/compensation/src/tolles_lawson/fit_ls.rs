@@ -35,7 +35,7 @@ use super::segments::median_step;
 use super::terms::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
-use aeromag_core::filter::{butter, sosfiltfilt, Band};
+use aeromag_core::filter::{butter, sosfiltfilt_in_place, Band};
 use aeromag_estimation::least_squares::{LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +59,10 @@ pub struct LsConfig {
     /// Variance inflation factor above which a term is reported as poorly
     /// determined (default 1e4: its standard deviation is inflated 100×).
     pub max_vif: f64,
+    /// Longest stretch filtered at once, samples (default 2¹⁷); longer
+    /// segments are filtered in overlapping blocks with bounded memory and
+    /// the same result (see `for_each_filtered_block`).
+    pub block_len: usize,
 }
 
 impl Default for LsConfig {
@@ -72,6 +76,7 @@ impl Default for LsConfig {
             trim: 20,
             lambda: 0.0,
             max_vif: 1e4,
+            block_len: 1 << 17,
         }
     }
 }
@@ -111,25 +116,60 @@ pub struct LsFit {
     pub warnings: Vec<String>,
 }
 
-/// Zero-phase filtering of every non-constant column and of `y`, then trim.
-fn filtered_segment(seg: &Segment, cfg: &LsConfig, sos: Option<&Sos>) -> Result<(Vec<Vec<f64>>, Vec<f64>)> {
-    let mut cols = design_columns(&cfg.terms, cfg.convention, cfg.bt_scale_nt, seg.time, seg.flux);
-    let mut y = seg.mag.to_vec();
-    let n = y.len();
-    let (a, b) = match sos {
-        Some(sos) => {
+/// Relative accuracy to which block-wise filtering reproduces whole-segment
+/// filtering (the overlap is the filter's settling length for this decay).
+const BLOCK_TOLERANCE: f64 = 1e-15;
+
+/// Design the segment's columns, zero-phase filter every non-constant column
+/// and `y`, drop `trim` samples at each end, and hand the result to `sink`
+/// in blocks of at most `cfg.block_len` rows.
+///
+/// A segment longer than `block_len` is processed in overlapping blocks:
+/// each block is extended on both sides by the filter's settling length `P`
+/// (impulse response below [`BLOCK_TOLERANCE`]), filtered on its own, and only
+/// its core is kept. Inside the core the result equals whole-segment
+/// filtering to that tolerance (the transients of the block's artificial
+/// ends have decayed), so memory is `O(block_len × columns)` whatever the
+/// segment's length.
+fn for_each_filtered_block(
+    seg: &Segment,
+    cfg: &LsConfig,
+    sos: Option<&Sos>,
+    mut sink: impl FnMut(&[&[f64]], &[f64]) -> Result<()>,
+) -> Result<()> {
+    let n = seg.time.len();
+    let (keep_lo, keep_hi) = if sos.is_some() { (cfg.trim, n - cfg.trim) } else { (0, n) };
+    let overlap = match sos {
+        Some(s) => s.settling_samples(BLOCK_TOLERANCE).ok_or_else(|| CompError::BadData("unstable band-pass filter".into()))?,
+        None => 1, // the central-difference derivative needs one neighbour
+    };
+    let block = cfg.block_len.max(1);
+    let mut start = keep_lo;
+    while start < keep_hi {
+        let end = (start + block).min(keep_hi);
+        let (a, b) = if keep_lo == 0 && keep_hi == n && block >= n {
+            (0, n)
+        } else {
+            (start.saturating_sub(overlap), (end + overlap).min(n))
+        };
+        let time = &seg.time[a..b];
+        let flux = [&seg.flux[0][a..b], &seg.flux[1][a..b], &seg.flux[2][a..b]];
+        let mut cols = design_columns(&cfg.terms, cfg.convention, cfg.bt_scale_nt, time, flux);
+        let mut y = seg.mag[a..b].to_vec();
+        if let Some(sos) = sos {
             for c in cols.iter_mut() {
                 if std_dev(c) > f64::EPSILON {
-                    *c = sosfiltfilt(sos, c)?;
+                    sosfiltfilt_in_place(sos, c)?;
                 }
             }
-            y = sosfiltfilt(sos, &y)?;
-            (cfg.trim, n - cfg.trim)
+            sosfiltfilt_in_place(sos, &mut y)?;
         }
-        None => (0, n),
-    };
-    let cols = cols.into_iter().map(|c| c[a..b].to_vec()).collect();
-    Ok((cols, y[a..b].to_vec()))
+        let (ca, cb) = (start - a, end - a);
+        let refs: Vec<&[f64]> = cols.iter().map(|c| &c[ca..cb]).collect();
+        sink(&refs, &y[ca..cb])?;
+        start = end;
+    }
+    Ok(())
 }
 
 /// Fit the Tolles-Lawson coefficients to calibration segments.
@@ -160,9 +200,9 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
             warnings.push(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"));
             continue;
         }
-        let (cols, y) = filtered_segment(seg, cfg, sos.as_ref())?;
-        let refs: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();
-        ne.add_columns(&refs, &y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))?;
+        for_each_filtered_block(seg, cfg, sos.as_ref(), |cols, y| {
+            ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
+        })?;
         used += 1;
         fs_used.push(fs);
     }
@@ -254,14 +294,18 @@ mod tests {
     /// through the design row itself (a solver test, not a physics test),
     /// plus a slow external variation and white noise.
     fn leg(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+        leg_n(yaw0, coef, terms, t0, maneuvers, 1800)
+    }
+
+    fn leg_n(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool, n: usize) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
         let b_ned = Vector3::new(17_000.0, 1_500.0, 48_000.0);
         let dt = 0.1;
-        let n = 1800;
         let (mut t, mut fx, mut fy, mut fz) = (vec![], vec![], vec![], vec![]);
         for i in 0..n {
             let s = i as f64 * dt;
             let (r, p, y) = if maneuvers {
                 let w = |period: f64, start: f64, amp: f64| {
+                    let s = s % 180.0; // the manoeuvre sequence repeats every 180 s
                     if s >= start && s < start + 50.0 { amp * (std::f64::consts::TAU * (s - start) / period).sin() } else { 0.0 }
                 };
                 (w(5.0, 10.0, 10.0), w(4.5, 70.0, 5.0), w(5.5, 125.0, 5.0))
@@ -329,6 +373,26 @@ mod tests {
                 assert!(text.contains("e_") && text.contains("i_"), "{text}");
             }
             Err(e) => assert!(e.to_string().contains("singular"), "{e}"),
+        }
+    }
+
+    #[test]
+    fn block_wise_filtering_equals_whole_segment_filtering() {
+        let terms = TermSet::observable16();
+        let coef = coef16();
+        // Long legs (9000 samples) so that blocks have true interior edges.
+        let legs: Vec<_> = [0.0, 90.0, 180.0, 270.0]
+            .iter()
+            .enumerate()
+            .map(|(k, h)| leg_n(*h, &coef, &terms, k as f64 * 1000.0, true, 9000))
+            .collect();
+        let segs: Vec<Segment> =
+            legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect();
+        let whole = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
+        let blocked = fit_band_pass_ls(&segs, &LsConfig { block_len: 1000, ..LsConfig::default() }).unwrap();
+        assert_eq!(whole.rows, blocked.rows);
+        for (a, b) in whole.coef.iter().zip(&blocked.coef) {
+            assert!((a - b).abs() <= 1e-9 * a.abs().max(1e-3), "{a} vs {b}");
         }
     }
 

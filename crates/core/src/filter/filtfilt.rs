@@ -215,22 +215,6 @@ mod invariants {
         x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
     }
 
-    /// Largest pole radius of the sections (roots of z² + a1 z + a2).
-    fn pole_radius(sos: &Sos) -> f64 {
-        sos.sections()
-            .iter()
-            .map(|s| {
-                let (a1, a2) = (s[4], s[5]);
-                let disc = a1 * a1 - 4.0 * a2;
-                if disc < 0.0 {
-                    a2.sqrt()
-                } else {
-                    ((-a1).abs() + disc.sqrt()) / 2.0
-                }
-            })
-            .fold(0.0, f64::max)
-    }
-
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -279,7 +263,7 @@ mod invariants {
             xr.reverse();
             let mut yr = sosfiltfilt(&sos, &xr).unwrap();
             yr.reverse();
-            let rho = pole_radius(&sos);
+            let rho = sos.pole_radius();
             prop_assert!(rho < 1.0);
             // distance from the ends beyond which ρ^k < 1e-13
             let settle = ((1e-13f64).ln() / rho.ln()).ceil() as usize;

@@ -82,6 +82,34 @@ impl Sos {
         3 * (2 * self.sections.len() + 1 - bz.min(az))
     }
 
+    /// Largest pole radius ρ of the sections (roots of `z² + a1 z + a2`);
+    /// below 1 for a stable filter. The impulse response decays as `ρᵏ`.
+    pub fn pole_radius(&self) -> f64 {
+        self.sections
+            .iter()
+            .map(|s| {
+                let (a1, a2) = (s[4], s[5]);
+                let disc = a1 * a1 - 4.0 * a2;
+                if disc < 0.0 { a2.sqrt() } else { (a1.abs() + disc.sqrt()) / 2.0 }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Samples after which the impulse response has decayed below `tol`
+    /// relative (`ρᵏ < tol`); `None` for an unstable or marginal filter.
+    /// Zero-phase filtering of overlapping blocks that share this many
+    /// samples on each side reproduces whole-series filtering to `tol`.
+    pub fn settling_samples(&self, tol: f64) -> Option<usize> {
+        let rho = self.pole_radius();
+        if !(rho < 1.0) || !(tol > 0.0 && tol < 1.0) {
+            return None;
+        }
+        if rho == 0.0 {
+            return Some(2);
+        }
+        Some((tol.ln() / rho.ln()).ceil() as usize)
+    }
+
     /// Magnitude response `|H(e^{iΩ})|`, `Ω = 2π f/fs`, at frequency `f_hz`
     /// for sampling rate `fs_hz` (both Hz).
     pub fn gain(&self, f_hz: f64, fs_hz: f64) -> f64 {

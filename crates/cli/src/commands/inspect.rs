@@ -1,0 +1,99 @@
+//! `aeromag inspect`: what a processor checks first in a flight file.
+
+use crate::input::InputArgs;
+use aeromag_io::{summarize, Summary};
+
+/// Summarise a flight file: columns found and mapped, rows, duration, sample
+/// rate and its jitter, gaps, lines, missing values per column, and the range
+/// of the field magnitude with a units plausibility check.
+///
+/// Malformed files (empty, truncated rows, text in a number column, time
+/// going backwards or repeated) stop with a message naming the file, line
+/// and column, and exit code 2.
+///
+/// Example: `aeromag inspect --input flight.csv --columns mag=mag_1_uc`
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let table = a.input.load()?;
+    let s = summarize(&table);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&s)?);
+    } else {
+        print!("{}", render(&s));
+    }
+    Ok(())
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.abs() >= 1e5 || (x != 0.0 && x.abs() < 1e-3) => format!("{x:.4e}"),
+        Some(x) => format!("{x:.4}"),
+        None => "—".into(),
+    }
+}
+
+/// The human-readable summary.
+pub fn render(s: &Summary) -> String {
+    use std::fmt::Write;
+    let mut o = String::new();
+    let _ = writeln!(o, "file     {}", s.file);
+    let _ = writeln!(o, "rows     {}", s.rows);
+    if let Some(t) = &s.time {
+        let _ = writeln!(o, "time     {:.3} … {:.3} s  (duration {:.1} s = {:.2} h)", t.start_s, t.end_s, t.duration_s, t.duration_s / 3600.0);
+        let _ = writeln!(
+            o,
+            "sampling interval {:.6} s, rate {} Hz, jitter std {:.2e} s (max {:.2e} s)",
+            t.sample_interval_s,
+            fmt_opt(t.rate_hz),
+            t.jitter_std_s,
+            t.jitter_max_s
+        );
+        match (t.largest_gap_s, t.largest_gap_row) {
+            (Some(g), Some(r)) => {
+                let _ = writeln!(o, "gaps     {} longer than {:.3} s; largest {:.3} s before data row {}", t.gaps, t.gap_threshold_s, g, r + 1);
+            }
+            _ => {
+                let _ = writeln!(o, "gaps     none longer than {:.3} s", t.gap_threshold_s);
+            }
+        }
+    } else {
+        let _ = writeln!(o, "time     no `time` column (map one with --columns time=NAME)");
+    }
+    if let Some(lines) = &s.lines {
+        let shown: Vec<String> = lines.iter().take(20).map(|l| format!("{} ({} samples)", l.line, l.samples)).collect();
+        let more = if lines.len() > 20 { format!(" … and {} more", lines.len() - 20) } else { String::new() };
+        let _ = writeln!(o, "lines    {}: {}{}", lines.len(), shown.join(", "), more);
+    }
+    if let Some(r) = &s.mag_range_nt {
+        let _ = writeln!(o, "mag      {:.1} … {:.1} nT", r.min, r.max);
+    }
+    if let Some(r) = &s.flux_magnitude_range_nt {
+        let _ = writeln!(o, "|flux|   {:.1} … {:.1} nT", r.min, r.max);
+    }
+    if !s.mapping.is_empty() {
+        let _ = writeln!(o, "mapped   {}", s.mapping.iter().map(|m| format!("{}={}", m.canonical, m.file_column)).collect::<Vec<_>>().join(", "));
+    }
+    let _ = writeln!(o, "\n{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}", "column", "canonical", "missing", "min", "max", "mean");
+    for c in &s.columns {
+        let _ = writeln!(
+            o,
+            "{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}",
+            c.name,
+            c.canonical.as_deref().unwrap_or(""),
+            c.missing_total,
+            fmt_opt(c.min),
+            fmt_opt(c.max),
+            fmt_opt(c.mean)
+        );
+    }
+    o
+}

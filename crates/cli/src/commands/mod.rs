@@ -1,0 +1,9 @@
+//! One module per subcommand.
+
+pub mod calibrate;
+pub mod compensate;
+pub mod demo;
+pub mod igrf;
+pub mod inspect;
+pub mod report;
+pub mod simulate;

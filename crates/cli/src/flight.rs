@@ -1,0 +1,92 @@
+//! Glue between flight tables (aeromag-io) and the compensation library:
+//! required columns, segmentation, and writing results back as columns.
+
+use crate::exit::bad_input;
+use aeromag_compensation::tolles_lawson::segments::split_segments;
+use aeromag_io::FlightTable;
+use std::ops::Range;
+
+/// The columns a Tolles-Lawson fit or compensation needs.
+pub struct TlColumns<'a> {
+    pub time: &'a [f64],
+    pub flux: [&'a [f64]; 3],
+    pub mag: &'a [f64],
+    pub line: Option<&'a [f64]>,
+}
+
+/// Which known external-field channels are subtracted from `mag` before a
+/// fit and before scoring (FOM, IR): `auto` takes `diurnal` (base station)
+/// and `igrf` (main field at the recorded position) when the file has them —
+/// the usual reduction to the anomaly field, which keeps external variations
+/// out of the band-pass fit; `none` uses `mag` as it is (MagNav.jl's way);
+/// or a comma-separated list of column names.
+pub fn reference_columns(table: &FlightTable, spec: &str) -> anyhow::Result<Vec<String>> {
+    match spec.trim() {
+        "auto" => Ok(["diurnal", "igrf"].iter().filter(|c| table.column(c).is_some()).map(|c| c.to_string()).collect()),
+        "none" | "" => Ok(Vec::new()),
+        list => {
+            let cols: Vec<String> = list.split(',').map(|c| c.trim().to_string()).filter(|c| !c.is_empty()).collect();
+            for c in &cols {
+                table.require(c)?;
+            }
+            Ok(cols)
+        }
+    }
+}
+
+/// The sum of the named reference channels (zeros if none).
+pub fn reference_sum(table: &FlightTable, cols: &[String]) -> anyhow::Result<Vec<f64>> {
+    let mut r = vec![0.0; table.n_rows()];
+    for c in cols {
+        for (a, b) in r.iter_mut().zip(table.require(c)?) {
+            *a += b;
+        }
+    }
+    Ok(r)
+}
+
+impl<'a> TlColumns<'a> {
+    /// Take `time`, `flux_x/y/z`, `mag` (and `line` if numeric) from a table;
+    /// a missing column is a bad-input error naming the file.
+    pub fn from_table(t: &'a FlightTable) -> anyhow::Result<Self> {
+        Ok(Self {
+            time: t.require("time")?,
+            flux: [t.require("flux_x")?, t.require("flux_y")?, t.require("flux_z")?],
+            mag: t.require("mag")?,
+            line: t.column("line"),
+        })
+    }
+
+    /// Rows where every needed value is finite.
+    pub fn usable(&self) -> Vec<bool> {
+        (0..self.time.len())
+            .map(|i| {
+                self.time[i].is_finite()
+                    && self.mag[i].is_finite()
+                    && self.flux.iter().all(|f| f[i].is_finite())
+                    && (self.flux[0][i] != 0.0 || self.flux[1][i] != 0.0 || self.flux[2][i] != 0.0)
+            })
+            .collect()
+    }
+
+    /// Contiguous segments (split at line changes if `by_line`, gaps and
+    /// unusable rows) of at least `min_len` rows, and the rows left out.
+    pub fn segments(&self, by_line: bool, min_len: usize) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+        split_segments(self.time, if by_line { self.line } else { None }, &self.usable(), 1.5, min_len)
+    }
+}
+
+/// A parsed `LO,HI` pass band in Hz.
+pub fn parse_band(s: &str) -> anyhow::Result<(f64, f64)> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let bad = || bad_input!("--band `{s}`: expected LO,HI in Hz, e.g. 0.1,0.9");
+    if parts.len() != 2 {
+        return Err(bad());
+    }
+    let lo: f64 = parts[0].parse().map_err(|_| bad())?;
+    let hi: f64 = parts[1].parse().map_err(|_| bad())?;
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Err(bad_input!("--band {lo},{hi}: need 0 < LO < HI"));
+    }
+    Ok((lo, hi))
+}

@@ -1,0 +1,34 @@
+//! Helpers shared by the CLI integration tests.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Run the `aeromag` binary with arguments.
+pub fn aeromag(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_aeromag")).args(args).output().expect("spawn aeromag")
+}
+
+/// Run in a working directory.
+pub fn aeromag_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_aeromag")).current_dir(dir).args(args).output().expect("spawn aeromag")
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Assert the exit code, showing the output on failure.
+pub fn assert_code(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "expected exit code {code}\nstdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+}

@@ -1,0 +1,133 @@
+//! `aeromag calibrate` + `compensate` + `report` + `demo` end to end.
+
+mod common;
+use common::*;
+
+fn simulate(dir: &std::path::Path, scenario: &str, seed: &str) -> std::path::PathBuf {
+    let out = dir.join(scenario);
+    assert_code(&aeromag(&["simulate", scenario, "--seed", seed, "--out", out.to_str().unwrap()]), 0);
+    out.join(format!("{}.csv", scenario.replace('-', "_")))
+}
+
+#[test]
+fn calibrate_compensate_report_keep_every_row() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration", "5");
+    let model = d.path().join("m.json");
+    let o = aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", model.to_str().unwrap()]);
+    assert_code(&o, 0);
+    assert!(!stderr(&o).contains("poorly determined"), "{}", stderr(&o));
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(m["format"], "aeromag-model/1");
+    assert_eq!(m["coefficients"].as_array().unwrap().len(), 16);
+
+    // Blank out some flux values: those rows stay, flagged.
+    let text = std::fs::read_to_string(&cal).unwrap();
+    let mut lines: Vec<String> = text.lines().filter(|l| !l.starts_with('#')).map(String::from).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let fx = header.iter().position(|h| *h == "flux_x").unwrap();
+    let n_in = lines.len() - 1;
+    for row in [100usize, 101, 2000] {
+        let mut cells: Vec<String> = lines[row + 1].split(',').map(String::from).collect();
+        cells[fx] = String::new();
+        lines[row + 1] = cells.join(",");
+    }
+    let holed = d.path().join("holed.csv");
+    std::fs::write(&holed, lines.join("\n")).unwrap();
+    let out = d.path().join("comp.csv");
+    let o = aeromag(&["compensate", "--model", model.to_str().unwrap(), "--input", holed.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_code(&o, 0);
+    assert!(stderr(&o).contains("3 of"), "{}", stderr(&o));
+    let comp = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<&str> = comp.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows.len() - 1, n_in, "one output row per input row");
+    let h: Vec<&str> = rows[0].split(',').collect();
+    let flag = h.iter().position(|c| *c == "comp_flag").unwrap();
+    let flagged: Vec<usize> = (1..rows.len()).filter(|&i| rows[i].split(',').nth(flag).and_then(|v| v.parse::<f64>().ok()) == Some(1.0)).map(|i| i - 1).collect();
+    assert_eq!(flagged, vec![100, 101, 2000]);
+
+    let rep = d.path().join("rep");
+    let o = aeromag(&["report", "--input", out.to_str().unwrap(), "--model", model.to_str().unwrap(), "--out", rep.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    for k in ["<svg", "Figure of merit", "coefficient", "Power spectral density"] {
+        assert!(html.contains(k), "{k} missing in the report");
+    }
+}
+
+#[test]
+fn a_single_heading_without_manoeuvres_is_reported() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration", "6");
+    // Keep only straight flight on the first leg (no manoeuvres).
+    let text = std::fs::read_to_string(&cal).unwrap();
+    let mut it = text.lines().filter(|l| !l.starts_with('#'));
+    let header = it.next().unwrap();
+    let h: Vec<&str> = header.split(',').collect();
+    let (li, mi) = (h.iter().position(|c| *c == "line").unwrap(), h.iter().position(|c| *c == "manoeuvre").unwrap());
+    let kept: Vec<&str> = it.filter(|l| {
+        let c: Vec<&str> = l.split(',').collect();
+        c[li].parse::<f64>().ok() == Some(1.0) && c[mi].parse::<f64>().ok() == Some(0.0)
+    }).collect();
+    assert!(kept.len() > 300);
+    let one = d.path().join("one.csv");
+    std::fs::write(&one, format!("{header}\n{}", kept.join("\n"))).unwrap();
+    let model = d.path().join("m.json");
+    let o = aeromag(&["calibrate", "--input", one.to_str().unwrap(), "--model", model.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert!(!e.contains("panicked"), "{e}");
+    // Either a warning naming the undetermined terms, or a clear refusal.
+    assert!(e.contains("poorly determined terms") || o.status.code() == Some(2), "{e}");
+    if o.status.code() == Some(0) {
+        assert!(e.contains("e_") || e.contains("i_"), "{e}");
+    }
+}
+
+#[test]
+fn model_and_argument_errors_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration-truncated", "7");
+    let p = cal.to_str().unwrap();
+    let model = d.path().join("m.json");
+    let m = model.to_str().unwrap();
+    for args in [
+        vec!["calibrate", "--input", p, "--model", m, "--terms", "p3,i6,i5"],
+        vec!["calibrate", "--input", p, "--model", m, "--band", "0.9,0.1"],
+        vec!["calibrate", "--input", p, "--model", m, "--convention", "fancy"],
+        vec!["calibrate", "--input", p, "--model", m, "--lambda", "-1"],
+    ] {
+        let o = aeromag(&args);
+        assert_code(&o, 2);
+    }
+    assert_code(&aeromag(&["calibrate", "--input", p, "--model", m]), 0);
+    // A model file that is not one.
+    let junk = d.path().join("junk.json");
+    std::fs::write(&junk, "{\"format\":\"other\"}").unwrap();
+    let o = aeromag(&["compensate", "--model", junk.to_str().unwrap(), "--input", p, "--out", d.path().join("o.csv").to_str().unwrap()]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("junk.json"));
+    // Data without the vector magnetometer: the message names what is missing.
+    let text = std::fs::read_to_string(&cal).unwrap();
+    let stripped = text.replace("flux_x", "fx");
+    let nofx = d.path().join("nofx.csv");
+    std::fs::write(&nofx, stripped).unwrap();
+    let o = aeromag(&["compensate", "--model", m, "--input", nofx.to_str().unwrap(), "--out", d.path().join("o.csv").to_str().unwrap()]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("flux_x"), "{}", stderr(&o));
+}
+
+#[test]
+fn demo_meets_the_compensation_figures() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("demo");
+    let o = aeromag(&["demo", "--out", out.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let c = &s["compensation"];
+    let g = |k: &str| c[k].as_f64().unwrap_or_else(|| panic!("summary key compensation.{k}"));
+    let (res, floor) = (g("residual_rms_ls_nt"), g("noise_floor_nt"));
+    assert!(res <= 2.0 * floor, "residual {res} nT > 2 × noise floor {floor} nT");
+    assert!(g("ir") >= 20.0, "IR {}", g("ir"));
+    assert!(g("fom_after_nt") < g("fom_before_nt") / 20.0);
+    assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
+}

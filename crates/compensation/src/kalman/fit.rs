@@ -1,0 +1,473 @@
+//! Method 2 end to end: runs, tuning, pass 1 (coefficients), pass 2 (the
+//! smoothed external field), outputs and diagnostics.
+
+use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior, X2_DIM};
+use super::field_smoother::{smooth_field, FieldModel};
+use super::joint_filter::JointFilter;
+use super::rows::{for_each_design_row, RowSpec};
+use super::track::step_length;
+use super::tuning::{tune, Subset, TuningConfig, TuningReport};
+use crate::error::{CompError, Result};
+use crate::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
+use crate::tolles_lawson::fit_ls::{diagnose, LsFit, Segment};
+use crate::tolles_lawson::segments::split_segments;
+use crate::tolles_lawson::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
+use aeromag_estimation::least_squares::NormalEquations;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// One contiguous piece of a calibration flight with what the field model
+/// needs besides the Tolles-Lawson inputs (equal-length slices).
+#[derive(Debug, Clone, Copy)]
+pub struct KalmanSegment<'a> {
+    /// Time (s, increasing), vector magnetometer (nT, body), scalar reading (nT).
+    pub data: Segment<'a>,
+    /// Altitude of the sensor or the navigation point, m (only its
+    /// variation matters: `Δz = alt − z0`).
+    pub alt_m: &'a [f64],
+    /// Ground speed, m/s ([`super::track`]).
+    pub speed_m_s: &'a [f64],
+}
+
+/// Settings of the Kalman fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct KalmanConfig {
+    /// Term groups `X1` (default `p3,i5,e8`).
+    pub terms: TermSet,
+    /// Derivative convention of the eddy columns.
+    pub convention: Convention,
+    /// Scale of the induced and eddy columns, nT (default 50 000).
+    pub bt_scale_nt: f64,
+    /// Noise intensities (the start point when tuning).
+    pub noise: NoiseModel,
+    /// Maximum-likelihood tuning of the intensities.
+    pub tuning: TuningConfig,
+    /// Prior of the field states at every run start.
+    pub field_prior: X2Prior,
+    /// Prior standard deviation of every coefficient (mean 0), in its own
+    /// units (nT for `p`, `i`, `bias`; nT·s for physical-convention eddy
+    /// terms). Default 1000: effectively diffuse, finite so that
+    /// `μ_i = √(P_post,ii / P_prior,ii)` is defined.
+    pub coef_prior_std: f64,
+    /// Reference altitude `z0`, m; `None` = the mean altitude of the flight.
+    pub z0_m: Option<f64>,
+    /// Whether to compute the per-sample series (compensated reading,
+    /// smoothed field, innovations); `false` gives only the coefficients
+    /// and their covariances (pass 1).
+    pub compute_series: bool,
+    /// Checkpoint block of the smoother (0 = `max(64, ⌈√N⌉)`).
+    pub smoother_block_len: usize,
+    /// Variance inflation factor above which a term is reported as poorly
+    /// determined (default 1e4).
+    pub max_vif: f64,
+}
+
+impl Default for KalmanConfig {
+    fn default() -> Self {
+        Self {
+            terms: TermSet::observable16(),
+            convention: Convention::Physical,
+            bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            noise: NoiseModel::calibration_default(),
+            tuning: TuningConfig::default(),
+            field_prior: X2Prior::default(),
+            coef_prior_std: 1000.0,
+            z0_m: None,
+            compute_series: true,
+            smoother_block_len: 0,
+            max_vif: 1e4,
+        }
+    }
+}
+
+/// Per-sample outputs of one input segment (same length; NaN at samples the
+/// fit could not use).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct KalmanSeries {
+    /// `mag − H1 X̂1`, nT.
+    pub compensated_nt: Vec<f64>,
+    /// Smoothed external field `B^h + Δz B_z` (plus the removed constant), nT.
+    pub external_nt: Vec<f64>,
+    /// Pass-1 innovation `ν_k`, nT.
+    pub innovation_nt: Vec<f64>,
+    /// Its predicted standard deviation `σ_k`, nT.
+    pub innovation_std_nt: Vec<f64>,
+}
+
+/// The result of [`fit_kalman`].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct KalmanFit {
+    /// Coefficient names (column order).
+    pub names: Vec<String>,
+    /// Coefficients `X̂1` (final filtered = smoothed).
+    pub coef: Vec<f64>,
+    /// Their standard deviations `√diag(P1)`.
+    pub std: Vec<f64>,
+    /// Prior covariance of `X1` (diagonal, `coef_prior_std²`).
+    pub prior_covariance: DMatrix<f64>,
+    /// Posterior covariance `P1` of `X1` (from the final factor).
+    pub posterior_covariance: DMatrix<f64>,
+    /// Variance inflation factor of each coefficient in the posterior
+    /// information `P1⁻¹` (the analogue of the least-squares VIF).
+    pub vif: Vec<f64>,
+    /// Scaled condition number of `P1⁻¹`.
+    pub condition: f64,
+    /// Noise intensities used.
+    pub noise: NoiseModel,
+    /// The tuning, when it ran.
+    pub tuning: Option<TuningReport>,
+    /// Reference altitude `z0`, m.
+    pub z0_m: f64,
+    /// The constant removed from the reading before filtering, nT.
+    pub y_ref_nt: f64,
+    /// Log-likelihood of all innovations of pass 1.
+    pub log_likelihood: f64,
+    /// Mean of `ν²/σ²` over the samples after the first five of each run
+    /// (≈ 1 when the noise model fits).
+    pub normalized_innovation_variance: f64,
+    /// RMS of the innovations over the same samples, nT.
+    pub innovation_rms_nt: f64,
+    /// RMS of `compensated − smoothed field` (the estimated sensor-level
+    /// residual), nT; NaN without series.
+    pub residual_rms_nt: f64,
+    /// Samples used.
+    pub rows: usize,
+    /// Contiguous runs (the field model restarts at each).
+    pub runs: usize,
+    /// Input segments with at least one run.
+    pub segments_used: usize,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+    /// Per-segment series (empty without [`KalmanConfig::compute_series`]).
+    pub series: Vec<KalmanSeries>,
+}
+
+#[derive(Debug, Clone)]
+struct Run {
+    seg: usize,
+    range: Range<usize>,
+}
+
+/// Runs shorter than this are skipped (the eddy derivatives need 3 samples).
+const MIN_RUN: usize = 3;
+
+/// Fit the Tolles-Lawson coefficients jointly with the stochastic field
+/// model (spec `compensation.md`, Method 2; module docs of [`super`]).
+pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<KalmanFit> {
+    validate(cfg)?;
+    let m = cfg.terms.n_columns();
+    let names = cfg.terms.column_names();
+    let spec = RowSpec { terms: &cfg.terms, convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt };
+    let mut warnings = Vec::new();
+
+    // ---- runs: maximal stretches of usable samples.
+    let mut runs = Vec::new();
+    let mut unusable = 0usize;
+    let mut short = 0usize;
+    for (si, s) in segments.iter().enumerate() {
+        let n = s.data.time.len();
+        let d = &s.data;
+        if d.mag.len() != n || d.flux.iter().any(|f| f.len() != n) || s.alt_m.len() != n || s.speed_m_s.len() != n {
+            return Err(CompError::BadData(format!("segment {si}: columns of unequal length")));
+        }
+        let usable: Vec<bool> = (0..n)
+            .map(|i| {
+                let f = [d.flux[0][i], d.flux[1][i], d.flux[2][i]];
+                d.time[i].is_finite()
+                    && d.mag[i].is_finite()
+                    && f.iter().all(|v| v.is_finite())
+                    && f.iter().any(|v| *v != 0.0)
+                    && s.alt_m[i].is_finite()
+                    && s.speed_m_s[i].is_finite()
+                    && s.speed_m_s[i] >= 0.0
+            })
+            .collect();
+        unusable += usable.iter().filter(|u| !**u).count();
+        let (kept, _) = split_segments(d.time, None, &usable, f64::INFINITY, 1);
+        for r in kept {
+            if let Some(k) = (r.start + 1..r.end).find(|&k| !(d.time[k] > d.time[k - 1])) {
+                return Err(CompError::BadData(format!("segment {si}: time does not increase at row {k}")));
+            }
+            if r.len() < MIN_RUN {
+                short += r.len();
+                continue;
+            }
+            runs.push(Run { seg: si, range: r });
+        }
+    }
+    if unusable > 0 {
+        warnings.push(format!("{unusable} samples have missing or invalid values (mag, flux, alt, speed) and are not used"));
+    }
+    if short > 0 {
+        warnings.push(format!("{short} samples in runs shorter than {MIN_RUN} samples are not used"));
+    }
+    let rows: usize = runs.iter().map(|r| r.range.len()).sum();
+    if rows < m + X2_DIM {
+        return Err(CompError::BadData(format!("{rows} usable samples are too few for {m} coefficients")));
+    }
+
+    // ---- reference altitude and reading.
+    let mean_over = |pick: fn(&KalmanSegment<'_>, Range<usize>) -> f64| {
+        runs.iter().map(|r| pick(&segments[r.seg], r.range.clone())).sum::<f64>() / rows as f64
+    };
+    let z0 = cfg.z0_m.unwrap_or_else(|| mean_over(|s, r| s.alt_m[r].iter().sum()));
+    let y_ref = mean_over(|s, r| s.data.mag[r].iter().sum());
+    let coef_mean = vec![0.0; m];
+    let coef_std = vec![cfg.coef_prior_std; m];
+
+    // ---- maximum-likelihood tuning on a decimated copy.
+    let mut noise = cfg.noise;
+    let mut tuning = None;
+    if cfg.tuning.enabled {
+        let dec = rows.div_ceil(cfg.tuning.max_rows.max(1)).max(1);
+        let subset = decimated_subset(segments, &runs, spec, dec, z0, y_ref);
+        let rep = tune(&subset, &coef_mean, &coef_std, &cfg.field_prior, noise, &cfg.tuning, dec)?;
+        if !rep.converged {
+            warnings.push(format!(
+                "noise tuning stopped after {} evaluations without meeting its tolerance; using the best values found",
+                rep.evaluations
+            ));
+        }
+        noise = rep.tuned;
+        tuning = Some(rep);
+    }
+
+    // ---- pass 1: the joint filter over every run.
+    let mut series: Vec<KalmanSeries> = if cfg.compute_series {
+        segments
+            .iter()
+            .map(|s| {
+                let n = s.data.time.len();
+                KalmanSeries {
+                    compensated_nt: vec![f64::NAN; n],
+                    external_nt: vec![f64::NAN; n],
+                    innovation_nt: vec![f64::NAN; n],
+                    innovation_std_nt: vec![f64::NAN; n],
+                }
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mut jf = JointFilter::new(&coef_mean, &coef_std, &cfg.field_prior, noise)?;
+    let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
+    for run in &runs {
+        let s = &segments[run.seg];
+        jf.start_run()?;
+        let mut err = None;
+        let out = series.get_mut(run.seg);
+        let (mut inn_out, mut std_out) = match out {
+            Some(o) => (Some(&mut o.innovation_nt), Some(&mut o.innovation_std_nt)),
+            None => (None, None),
+        };
+        for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
+            if err.is_some() {
+                return;
+            }
+            let d = if i == run.range.start { 0.0 } else { step_length(s.data.time, s.speed_m_s, i) };
+            match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
+                Ok(inn) => {
+                    log_lik += inn.log_likelihood();
+                    if i - run.range.start >= X2_DIM {
+                        chi2 += inn.value * inn.value / inn.variance;
+                        ss += inn.value * inn.value;
+                        n_stat += 1;
+                    }
+                    if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut()) {
+                        a[i] = inn.value;
+                        b[i] = inn.std();
+                    }
+                }
+                Err(e) => err = Some(CompError::BadData(format!("segment {}, row {i}: {e}", run.seg))),
+            }
+        });
+        if let Some(e) = err {
+            return Err(e);
+        }
+    }
+    let coef = jf.coefficients().to_vec();
+    let posterior_covariance = jf.coefficient_covariance();
+    let std: Vec<f64> = (0..m).map(|j| posterior_covariance[(j, j)].max(0.0).sqrt()).collect();
+    let (vif, condition, diag_warnings) = information_diagnostics(&jf.coefficient_factor(), &names, cfg.max_vif)?;
+    warnings.extend(diag_warnings);
+
+    // ---- compensated series and pass 2: the smoothed field.
+    let mut residual_rms_nt = f64::NAN;
+    if cfg.compute_series {
+        let transition = AnomalyTransition::new();
+        let mut res2 = 0.0;
+        for run in &runs {
+            let s = &segments[run.seg];
+            let out = &mut series[run.seg];
+            for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
+                let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
+                out.compensated_nt[i] = s.data.mag[i] - a;
+            });
+            let model = FieldModel {
+                time: s.data.time,
+                speed_m_s: s.speed_m_s,
+                alt_m: s.alt_m,
+                compensated_nt: &out.compensated_nt,
+                offset: run.range.start,
+                len: run.range.len(),
+                y_ref_nt: y_ref,
+                z0_m: z0,
+                noise,
+                prior: cfg.field_prior,
+                transition: transition.clone(),
+            };
+            let mut external = std::mem::take(&mut out.external_nt);
+            smooth_field(&model, cfg.smoother_block_len, &mut external)?;
+            for i in run.range.clone() {
+                let e = out.compensated_nt[i] - external[i];
+                res2 += e * e;
+            }
+            out.external_nt = external;
+        }
+        residual_rms_nt = (res2 / rows as f64).sqrt();
+    }
+    let n_stat_f = n_stat.max(1) as f64;
+    Ok(KalmanFit {
+        names,
+        coef,
+        std,
+        prior_covariance: jf.coefficient_prior_covariance().clone(),
+        posterior_covariance,
+        vif,
+        condition,
+        noise,
+        tuning,
+        z0_m: z0,
+        y_ref_nt: y_ref,
+        log_likelihood: log_lik,
+        normalized_innovation_variance: chi2 / n_stat_f,
+        innovation_rms_nt: (ss / n_stat_f).sqrt(),
+        residual_rms_nt,
+        rows,
+        runs: runs.len(),
+        segments_used: {
+            let mut s: Vec<usize> = runs.iter().map(|r| r.seg).collect();
+            s.dedup();
+            s.len()
+        },
+        warnings,
+        series,
+    })
+}
+
+/// Every `dec`-th sample of every run, for the likelihood.
+fn decimated_subset(segments: &[KalmanSegment], runs: &[Run], spec: RowSpec, dec: usize, z0: f64, y_ref: f64) -> Subset {
+    let m = spec.terms.n_columns();
+    let mut sub = Subset { m, ..Subset::default() };
+    for run in runs {
+        let s = &segments[run.seg];
+        let mut dist = 0.0;
+        for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
+            if i > run.range.start {
+                dist += step_length(s.data.time, s.speed_m_s, i);
+            }
+            if (i - run.range.start) % dec == 0 {
+                sub.rows.extend_from_slice(row);
+                sub.y.push(s.data.mag[i] - y_ref);
+                sub.dz.push(s.alt_m[i] - z0);
+                sub.d.push(dist);
+                sub.start.push(i == run.range.start);
+                dist = 0.0;
+            }
+        });
+    }
+    sub
+}
+
+/// VIF, scaled condition number and plain-language warnings from the
+/// posterior information `J = P1⁻¹ = AᵀA`, `A = U_c⁻¹` (`P1 = U_c U_cᵀ`),
+/// through the least-squares diagnostics ([`diagnose`]).
+fn information_diagnostics(u: &DMatrix<f64>, names: &[String], max_vif: f64) -> Result<(Vec<f64>, f64, Vec<String>)> {
+    let m = u.nrows();
+    let a = u
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| CompError::BadData("the coefficient covariance is singular".into()))?;
+    let mut ne = NormalEquations::new(m);
+    for i in 0..m {
+        let row: Vec<f64> = a.row(i).iter().copied().collect();
+        ne.add_row(&row, 0.0, 1.0).map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+    }
+    let sol = ne.solve(0.0).map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+    let warnings = diagnose(&sol, names, max_vif);
+    Ok((sol.vif.iter().copied().collect(), sol.condition, warnings))
+}
+
+fn validate(cfg: &KalmanConfig) -> Result<()> {
+    if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
+        return Err(CompError::BadData(format!("bt_scale {} must be positive", cfg.bt_scale_nt)));
+    }
+    if !(cfg.coef_prior_std > 0.0 && cfg.coef_prior_std.is_finite()) {
+        return Err(CompError::BadData(format!("coefficient prior std {} must be positive", cfg.coef_prior_std)));
+    }
+    if let Some(z) = cfg.z0_m {
+        if !z.is_finite() {
+            return Err(CompError::BadData("reference altitude z0 must be finite".into()));
+        }
+    }
+    Ok(())
+}
+
+impl KalmanFit {
+    /// The fit in the shape of the band-pass least-squares result, so
+    /// callers can report and store both the same way (VIF and condition are
+    /// those of the posterior information; the residual is
+    /// [`KalmanFit::residual_rms_nt`], or the innovation RMS without series).
+    pub fn to_ls_fit(&self) -> LsFit {
+        LsFit {
+            names: self.names.clone(),
+            coef: self.coef.clone(),
+            std: self.std.clone(),
+            vif: self.vif.clone(),
+            condition: self.condition,
+            residual_rms_nt: self.model_residual(),
+            rows: self.rows,
+            segments_used: self.segments_used,
+            warnings: self.warnings.clone(),
+        }
+    }
+
+    fn model_residual(&self) -> f64 {
+        if self.residual_rms_nt.is_finite() { self.residual_rms_nt } else { self.innovation_rms_nt }
+    }
+
+    /// A model file (`method: "kalman"`; no band, order, trim or ridge). The
+    /// caller fills [`TlModel::columns`] (and `reference` if it subtracted
+    /// known channels).
+    pub fn to_model(&self, cfg: &KalmanConfig) -> TlModel {
+        TlModel {
+            format: MODEL_FORMAT.into(),
+            kind: "tolles-lawson".into(),
+            method: "kalman".into(),
+            terms: cfg.terms.clone(),
+            convention: cfg.convention,
+            bt_scale_nt: cfg.bt_scale_nt,
+            band_hz: None,
+            filter_order: 0,
+            trim: 0,
+            lambda: 0.0,
+            coefficients: self
+                .names
+                .iter()
+                .zip(self.coef.iter().zip(&self.std))
+                .map(|(n, (v, s))| Coefficient { name: n.clone(), value: *v, std: *s })
+                .collect(),
+            fit: FitStats {
+                rows: self.rows,
+                segments: self.segments_used,
+                condition: self.condition,
+                residual_rms_nt: self.model_residual(),
+                warnings: self.warnings.clone(),
+            },
+            reference: Vec::new(),
+            columns: Default::default(),
+            software_version: env!("CARGO_PKG_VERSION").into(),
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! Pass 1: the forward square-root Kalman filter of the joint state
+//! `X = (X2, X1)` — the field model first, the constant Tolles-Lawson
+//! coefficients last.
+//!
+//! ```text
+//! X2_k = Φ(d_k) X2_{k−1} + G(d_k) w_k           (field model, super::anomaly_model)
+//! X1_k = X1_{k−1}                                (coefficients: no process noise)
+//! y_k  = H1_k X1 + B^h_k + Δz_k B_z,k + v_k,   v_k ~ N(0, r)
+//! ```
+//!
+//! with `y = mag − y_ref` (a constant removed for numerical range; `B^h`
+//! absorbs it), `H1_k` the design row and `Δz = alt − z0`. Ordering the
+//! constant states last makes the time update touch only the 5 field rows
+//! of the factor ([`SqrtKalmanFilter::predict_leading`]): a step costs
+//! `O(n²)` for the Carlson update plus `O(5 n)` for the prediction, and the
+//! memory is `O(n²)` whatever the flight length.
+//!
+//! At the start of every contiguous run of data the field states are
+//! re-initialised from their diffuse prior, independent of everything else
+//! ([`SqrtKalmanFilter::reset_leading`]); the coefficients and their
+//! covariance carry over. After the last sample, `X1` and its covariance
+//! `P1 = U_c U_cᵀ` are the estimate from the whole flight (a constant's
+//! filtered estimate at the end is also its smoothed estimate).
+
+use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior, B_H, B_Z, X2_DIM};
+use crate::error::{CompError, Result};
+use aeromag_estimation::kalman::{Innovation, SqrtKalmanFilter};
+use nalgebra::{DMatrix, DVector};
+
+/// The pass-1 filter (module docs).
+#[derive(Debug, Clone)]
+pub struct JointFilter {
+    filter: SqrtKalmanFilter,
+    m: usize,
+    noise: NoiseModel,
+    x2_factor: DMatrix<f64>,
+    x1_prior_cov: DMatrix<f64>,
+    transition: AnomalyTransition,
+    phi: DMatrix<f64>,
+    g: DMatrix<f64>,
+    h: Vec<f64>,
+    fresh: bool,
+}
+
+impl JointFilter {
+    /// A filter for `m = coef_prior_mean.len()` coefficients with prior mean
+    /// `coef_prior_mean` and independent prior standard deviations
+    /// `coef_prior_std` (coefficient units, > 0), the field prior `x2_prior`
+    /// and the noise intensities `noise`.
+    pub fn new(coef_prior_mean: &[f64], coef_prior_std: &[f64], x2_prior: &X2Prior, noise: NoiseModel) -> Result<Self> {
+        let m = coef_prior_mean.len();
+        if coef_prior_std.len() != m || coef_prior_std.iter().any(|s| !(*s > 0.0 && s.is_finite())) {
+            return Err(CompError::BadData("coefficient prior: one finite positive standard deviation per coefficient".into()));
+        }
+        if !noise.is_valid() {
+            return Err(CompError::BadData(format!("invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)")));
+        }
+        if !x2_prior.is_valid() {
+            return Err(CompError::BadData(format!("invalid field prior {x2_prior:?} (positive, finite)")));
+        }
+        let n = X2_DIM + m;
+        let mut x0 = vec![0.0; n];
+        x0[X2_DIM..].copy_from_slice(coef_prior_mean);
+        let mut s0 = DMatrix::zeros(n, n);
+        let x2_factor = x2_prior.factor();
+        s0.view_mut((0, 0), (X2_DIM, X2_DIM)).copy_from(&x2_factor);
+        for (j, s) in coef_prior_std.iter().enumerate() {
+            s0[(X2_DIM + j, X2_DIM + j)] = *s;
+        }
+        let filter = SqrtKalmanFilter::new(&x0, &s0).map_err(est)?;
+        Ok(Self {
+            filter,
+            m,
+            noise,
+            x2_factor,
+            x1_prior_cov: DMatrix::from_diagonal(&DVector::from_iterator(m, coef_prior_std.iter().map(|s| s * s))),
+            transition: AnomalyTransition::new(),
+            phi: DMatrix::zeros(X2_DIM, X2_DIM),
+            g: DMatrix::zeros(X2_DIM, X2_DIM),
+            h: vec![0.0; n],
+            fresh: true,
+        })
+    }
+
+    /// Number of coefficients `m`.
+    pub fn n_coefficients(&self) -> usize {
+        self.m
+    }
+
+    /// Start a new contiguous run: the field states get their prior again,
+    /// independent of the coefficients; the next step is not predicted.
+    pub fn start_run(&mut self) -> Result<()> {
+        self.filter.reset_leading(&[0.0; X2_DIM], &self.x2_factor).map_err(est)?;
+        self.fresh = true;
+        Ok(())
+    }
+
+    /// One sample: predict over the path length `d_m` (m, ignored on the
+    /// first sample of a run), then update with the design row `h1` (length
+    /// `m`), the altitude offset `dz_m = alt − z0` (m) and the centred
+    /// reading `y_nt` (nT). Returns the innovation.
+    pub fn step(&mut self, d_m: f64, h1: &[f64], dz_m: f64, y_nt: f64) -> Result<Innovation> {
+        if h1.len() != self.m {
+            return Err(CompError::BadData(format!("design row of length {} for {} coefficients", h1.len(), self.m)));
+        }
+        if !self.fresh {
+            if !(d_m >= 0.0 && d_m.is_finite()) {
+                return Err(CompError::BadData(format!("along-track step {d_m} m must be finite and ≥ 0")));
+            }
+            self.transition.fill(d_m, &self.noise, &mut self.phi, &mut self.g);
+            self.filter.predict_leading(&self.phi, &self.g).map_err(est)?;
+        }
+        self.fresh = false;
+        self.h[..X2_DIM].fill(0.0);
+        self.h[B_H] = 1.0;
+        self.h[B_Z] = dz_m;
+        self.h[X2_DIM..].copy_from_slice(h1);
+        self.filter.update(&self.h, y_nt, self.noise.r_nt2).map_err(est)
+    }
+
+    /// The current coefficient estimate `X1`.
+    pub fn coefficients(&self) -> &[f64] {
+        &self.filter.state().as_slice()[X2_DIM..]
+    }
+
+    /// The current field-state estimate `X2`.
+    pub fn field_state(&self) -> &[f64] {
+        &self.filter.state().as_slice()[..X2_DIM]
+    }
+
+    /// The covariance of the coefficients, `U_c U_cᵀ` (`m × m`).
+    pub fn coefficient_covariance(&self) -> DMatrix<f64> {
+        self.filter.trailing_covariance(X2_DIM)
+    }
+
+    /// The upper-triangular factor `U_c` of the coefficient covariance.
+    pub fn coefficient_factor(&self) -> DMatrix<f64> {
+        self.filter.factor().view((X2_DIM, X2_DIM), (self.m, self.m)).into_owned()
+    }
+
+    /// The prior covariance of the coefficients (diagonal).
+    pub fn coefficient_prior_covariance(&self) -> &DMatrix<f64> {
+        &self.x1_prior_cov
+    }
+}
+
+/// Map an estimation error into this crate's error.
+pub(crate) fn est(e: aeromag_estimation::EstError) -> CompError {
+    CompError::BadData(format!("Kalman filter: {e}"))
+}

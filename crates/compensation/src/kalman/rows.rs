@@ -1,0 +1,88 @@
+//! Streaming Tolles-Lawson design rows over a run of samples, in chunks, so
+//! that a 10⁷-sample flight never holds its `N × n` design matrix.
+//!
+//! Row `i` is [`TermSet::row`] of the vector field and its derivative under
+//! the [`Convention`], exactly as [`crate::tolles_lawson::design::design_columns`]
+//! builds it over the same run: the derivatives come from
+//! [`crate::tolles_lawson::terms::derivative`] applied to each chunk extended
+//! by one neighbour on each side (at least three samples), so interior
+//! samples get the central difference and the run's two ends the one-sided
+//! one.
+
+use crate::tolles_lawson::terms::derivative;
+use crate::tolles_lawson::{Convention, TermSet};
+use std::ops::Range;
+
+/// Samples per chunk.
+const CHUNK: usize = 4096;
+
+/// The settings that define a design row.
+#[derive(Debug, Clone, Copy)]
+pub struct RowSpec<'a> {
+    /// Term groups.
+    pub terms: &'a TermSet,
+    /// Derivative convention.
+    pub convention: Convention,
+    /// Scale of the induced and eddy columns, nT.
+    pub bt_scale_nt: f64,
+}
+
+/// Call `f(i, row)` for every sample `i` of `run` (indices into `time` and
+/// `flux`, in increasing order); derivatives are taken over `run` alone.
+pub fn for_each_design_row(spec: RowSpec, time: &[f64], flux: [&[f64]; 3], run: Range<usize>, mut f: impl FnMut(usize, &[f64])) {
+    let ncol = spec.terms.n_columns();
+    let mut row = vec![0.0; ncol];
+    let eddy = spec.terms.has_eddy();
+    let (s, e) = (run.start, run.end);
+    let mut a = s;
+    while a < e {
+        let b = (a + CHUNK).min(e);
+        // Slice with one neighbour each side, at least three samples.
+        let mut lo = if a > s { a - 1 } else { s };
+        let hi = (b + 1).min(e);
+        if hi - lo < 3 {
+            lo = hi.saturating_sub(3).max(s);
+        }
+        let db: [Vec<f64>; 3] = if eddy {
+            [0, 1, 2].map(|c| derivative(&flux[c][lo..hi], &time[lo..hi], spec.convention))
+        } else {
+            [vec![0.0; hi - lo], vec![0.0; hi - lo], vec![0.0; hi - lo]]
+        };
+        for i in a..b {
+            let j = i - lo;
+            spec.terms.row([flux[0][i], flux[1][i], flux[2][i]], [db[0][j], db[1][j], db[2][j]], spec.bt_scale_nt, &mut row);
+            f(i, &row);
+        }
+        a = b;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tolles_lawson::design::design_columns;
+
+    #[test]
+    fn streamed_rows_equal_the_design_columns() {
+        let n = 2 * CHUNK + 1; // last chunk of one sample
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1 + 1e-3 * (k % 3) as f64).collect();
+        let fx: Vec<f64> = (0..n).map(|k| 20_000.0 + 300.0 * (k as f64 * 0.05).sin()).collect();
+        let fy: Vec<f64> = (0..n).map(|k| 2_000.0 + 500.0 * (k as f64 * 0.031).cos()).collect();
+        let fz: Vec<f64> = (0..n).map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin()).collect();
+        for conv in [Convention::Physical, Convention::MagNav] {
+            let terms = TermSet::parse("p3,i6,e9,bias").unwrap();
+            let spec = RowSpec { terms: &terms, convention: conv, bt_scale_nt: 50_000.0 };
+            for run in [0..n, 5..CHUNK + 7, 10..13, 100..101] {
+                let cols = design_columns(&terms, conv, 50_000.0, &time[run.clone()], [&fx[run.clone()], &fy[run.clone()], &fz[run.clone()]]);
+                let mut count = 0;
+                for_each_design_row(spec, &time, [&fx, &fy, &fz], run.clone(), |i, row| {
+                    for (c, v) in row.iter().enumerate() {
+                        assert_eq!(*v, cols[c][i - run.start], "run {run:?} row {i} col {c}");
+                    }
+                    count += 1;
+                });
+                assert_eq!(count, run.len());
+            }
+        }
+    }
+}

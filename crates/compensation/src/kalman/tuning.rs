@@ -1,0 +1,150 @@
+//! Automatic tuning of the noise intensities `q₁, q₂, r` by maximum
+//! likelihood of the innovations.
+//!
+//! The pass-1 filter ([`super::joint_filter`]) gives the exact Gaussian
+//! log-likelihood of the readings as the sum of the innovation terms
+//! `−½(ln 2πσ_k² + ν_k²/σ_k²)` ([`aeromag_estimation::kalman::Innovation`]).
+//! It is maximised over `θ = (ln q₁, ln q₂, ln r)` with the derivative-free
+//! Nelder–Mead method ([`aeromag_estimation::optimize::nelder_mead`]),
+//! starting from the configured intensities with steps of one decade, within
+//! ±8 decades of the start (±6 for `r`).
+//!
+//! For speed the likelihood is evaluated on a *decimated* copy of the flight:
+//! every `D`-th sample (`D = ⌈N / max_rows⌉`), design rows taken from the
+//! full-rate data, the path length summed over the skipped samples. The field
+//! model is continuous in the path length, so the decimated record is an
+//! exact sub-sampling of the same model; `r` stays a per-sample variance
+//! (the noise is white). The values found are reported and used for the
+//! full-rate passes.
+
+use super::anomaly_model::{NoiseModel, X2Prior};
+use super::joint_filter::JointFilter;
+use crate::error::{CompError, Result};
+use aeromag_estimation::optimize::{nelder_mead, NelderMeadOptions};
+use serde::{Deserialize, Serialize};
+
+/// Settings of the maximum-likelihood tuning.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TuningConfig {
+    /// Whether to tune (default true).
+    pub enabled: bool,
+    /// Largest number of samples the likelihood is evaluated on (the flight
+    /// is decimated to at most this many; default 20 000).
+    pub max_rows: usize,
+    /// Evaluation budget of Nelder–Mead (default 200).
+    pub max_evaluations: usize,
+}
+
+impl Default for TuningConfig {
+    fn default() -> Self {
+        Self { enabled: true, max_rows: 20_000, max_evaluations: 200 }
+    }
+}
+
+/// What the tuning did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TuningReport {
+    /// The starting intensities.
+    pub initial: NoiseModel,
+    /// The maximum-likelihood intensities (used for the fit).
+    pub tuned: NoiseModel,
+    /// Log-likelihood of the decimated record at the start.
+    pub log_likelihood_initial: f64,
+    /// Log-likelihood at the optimum.
+    pub log_likelihood: f64,
+    /// Function evaluations (filter runs).
+    pub evaluations: usize,
+    /// Whether Nelder–Mead met its tolerances (0.01 in log-likelihood, 0.02
+    /// in each `ln` parameter).
+    pub converged: bool,
+    /// Decimation factor `D`.
+    pub decimation: usize,
+    /// Samples in the decimated record.
+    pub rows: usize,
+}
+
+/// A decimated copy of the flight: design rows, centred readings, altitude
+/// offsets, path length since the previous kept sample, run starts.
+#[derive(Debug, Clone, Default)]
+pub struct Subset {
+    /// Coefficients per row.
+    pub m: usize,
+    /// Row-major design rows.
+    pub rows: Vec<f64>,
+    /// Centred readings `mag − y_ref`, nT.
+    pub y: Vec<f64>,
+    /// `alt − z0`, m.
+    pub dz: Vec<f64>,
+    /// Path length from the previous kept sample of the same run, m.
+    pub d: Vec<f64>,
+    /// Whether the sample starts a run.
+    pub start: Vec<bool>,
+}
+
+impl Subset {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Whether the subset is empty.
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty()
+    }
+
+    /// Log-likelihood of the subset under `noise` (pass-1 filter).
+    pub fn log_likelihood(&self, coef_mean: &[f64], coef_std: &[f64], x2_prior: &X2Prior, noise: NoiseModel) -> Result<f64> {
+        let mut f = JointFilter::new(coef_mean, coef_std, x2_prior, noise)?;
+        let mut ll = 0.0;
+        for k in 0..self.len() {
+            if self.start[k] {
+                f.start_run()?;
+            }
+            ll += f.step(self.d[k], &self.rows[k * self.m..(k + 1) * self.m], self.dz[k], self.y[k])?.log_likelihood();
+        }
+        Ok(ll)
+    }
+}
+
+/// Maximise the likelihood of `subset` over `(ln q₁, ln q₂, ln r)` from `start`.
+pub fn tune(
+    subset: &Subset,
+    coef_mean: &[f64],
+    coef_std: &[f64],
+    x2_prior: &X2Prior,
+    start: NoiseModel,
+    cfg: &TuningConfig,
+    decimation: usize,
+) -> Result<TuningReport> {
+    if subset.len() < 10 {
+        return Err(CompError::BadData(format!("{} samples are too few to tune the noise intensities", subset.len())));
+    }
+    let floor = 1e-30;
+    let theta0 = [start.q1_nt2_per_m5.max(floor).ln(), start.q2_nt2_per_m5.max(floor).ln(), start.r_nt2.ln()];
+    let dec = std::f64::consts::LN_10;
+    let span = [8.0 * dec, 8.0 * dec, 6.0 * dec];
+    let to_noise = |t: &[f64]| NoiseModel { q1_nt2_per_m5: t[0].exp(), q2_nt2_per_m5: t[1].exp(), r_nt2: t[2].exp() };
+    let ll0 = subset.log_likelihood(coef_mean, coef_std, x2_prior, start)?;
+    let objective = |t: &[f64]| {
+        if (0..3).any(|i| (t[i] - theta0[i]).abs() > span[i]) {
+            return f64::INFINITY;
+        }
+        match subset.log_likelihood(coef_mean, coef_std, x2_prior, to_noise(t)) {
+            Ok(ll) => -ll,
+            Err(_) => f64::INFINITY,
+        }
+    };
+    let opts = NelderMeadOptions { initial_step: vec![dec; 3], f_tol: 1e-2, x_tol: 0.02, max_evaluations: cfg.max_evaluations };
+    let res = nelder_mead(objective, &theta0, &opts).map_err(|e| CompError::BadData(format!("noise tuning: {e}")))?;
+    let (tuned, ll) = if -res.f >= ll0 { (to_noise(&res.x), -res.f) } else { (start, ll0) };
+    Ok(TuningReport {
+        initial: start,
+        tuned,
+        log_likelihood_initial: ll0,
+        log_likelihood: ll,
+        evaluations: res.evaluations + 1,
+        converged: res.converged,
+        decimation,
+        rows: subset.len(),
+    })
+}

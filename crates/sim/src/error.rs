@@ -1,0 +1,98 @@
+//! The error type of `aeromag-sim`.
+//!
+//! Every fallible public function returns [`SimError`]; the simulator never
+//! panics on bad input (a scenario file with a typo, an impossible number, a
+//! date outside IGRF-14, an unwritable output directory).
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while configuring, running or writing a
+/// simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The scenario TOML could not be parsed (syntax, unknown field, wrong
+    /// type). The message of the TOML parser names the line and column.
+    #[error("scenario file: {0}")]
+    ConfigParse(String),
+    /// A configuration value is outside its valid range.
+    #[error("scenario value `{field}` is invalid: {reason}")]
+    InvalidConfig {
+        /// Dotted path of the field, e.g. `scalar.lag_s`.
+        field: String,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
+    /// An error of the core library (IGRF date range, dates, …).
+    #[error(transparent)]
+    Core(#[from] aeromag_core::CoreError),
+    /// The trajectory generator could not realise the requested pattern.
+    #[error("trajectory: {0}")]
+    Trajectory(String),
+    /// A numerical routine failed (an FFT length mismatch: a bug, reported
+    /// instead of a panic).
+    #[error("numerics: {0}")]
+    Numerics(String),
+    /// Writing an output file failed.
+    #[error("cannot write `{path}`: {source}")]
+    Write {
+        /// The file that could not be written.
+        path: PathBuf,
+        /// The underlying I/O error.
+        source: std::io::Error,
+    },
+    /// Building the flight table of `aeromag-io` failed.
+    #[error(transparent)]
+    Io(#[from] aeromag_io::IoError),
+    /// Serialising the scenario or the truth metadata failed.
+    #[error("cannot serialise {what}: {reason}")]
+    Serialize {
+        /// What was being serialised.
+        what: &'static str,
+        /// The serialiser's message.
+        reason: String,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, SimError>;
+
+/// Shorthand for [`SimError::InvalidConfig`].
+pub(crate) fn invalid(field: impl Into<String>, reason: impl Into<String>) -> SimError {
+    SimError::InvalidConfig {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+/// Check that a configuration number is finite and strictly positive.
+pub(crate) fn require_positive(field: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            format!("{value} must be a finite number > 0"),
+        ))
+    }
+}
+
+/// Check that a configuration number is finite and non-negative.
+pub(crate) fn require_non_negative(field: &str, value: f64) -> Result<()> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            format!("{value} must be a finite number ≥ 0"),
+        ))
+    }
+}
+
+/// Check that a configuration number is finite.
+pub(crate) fn require_finite(field: &str, value: f64) -> Result<()> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(field, format!("{value} must be finite")))
+    }
+}

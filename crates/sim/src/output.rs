@@ -1,0 +1,348 @@
+//! The result of a simulation: named columns, the scenario file and the
+//! truth metadata, and writing them to a directory.
+//!
+//! Files written by [`Simulation::write_to_dir`] (stem = scenario name):
+//!
+//! * `<stem>.csv` — `#` comment lines (scenario, seed, units, altitude
+//!   reference), then the table written by `aeromag-io`'s CSV writer: header
+//!   row of column names (the canonical names of `data-formats.md` and the
+//!   `true_…` truth columns, see the crate docs), values in the shortest
+//!   representation that round-trips.
+//! * `<stem>.toml` — the scenario with every default filled in.
+//! * `<stem>.truth.json` — the truth metadata (aircraft parts and their
+//!   field at each sensor, noise levels, anomaly and diurnal parameters,
+//!   column list with units).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Result, SimError};
+use crate::scenario::ScenarioKind;
+
+/// One output column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    /// Column name.
+    pub name: String,
+    /// Unit (`"nT"`, `"deg"`, `"m"`, `"m/s"`, `"s"`, `"A"`, `"-"`).
+    pub unit: &'static str,
+    /// What the column holds.
+    pub description: String,
+    /// One value per sample.
+    pub values: Vec<f64>,
+}
+
+/// A finished simulation.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    /// Which scenario produced it.
+    pub kind: ScenarioKind,
+    /// The seed used.
+    pub seed: u64,
+    /// The columns, all of the same length, in output order.
+    pub columns: Vec<Column>,
+    /// The scenario file with every default filled in.
+    pub scenario_toml: String,
+    /// Truth metadata (JSON text).
+    pub truth_json: String,
+}
+
+/// Paths of the files written by [`Simulation::write_to_dir`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct WrittenFiles {
+    /// The data table.
+    pub csv: PathBuf,
+    /// The filled-in scenario file.
+    pub scenario: PathBuf,
+    /// The truth metadata.
+    pub truth: PathBuf,
+}
+
+impl Simulation {
+    /// Number of samples.
+    pub fn n_rows(&self) -> usize {
+        self.columns.first().map_or(0, |c| c.values.len())
+    }
+
+    /// The values of column `name`.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
+    /// The column names in order.
+    pub fn column_names(&self) -> Vec<&str> {
+        self.columns.iter().map(|c| c.name.as_str()).collect()
+    }
+
+    /// The columns as an [`aeromag_io::FlightTable`] (in memory, numeric
+    /// columns in output order), for processing without a file.
+    pub fn to_flight_table(&self) -> Result<aeromag_io::FlightTable> {
+        let mut t = aeromag_io::FlightTable::new();
+        for c in &self.columns {
+            t.add_column(&c.name, c.values.clone())?;
+        }
+        Ok(t)
+    }
+
+    /// Write the CSV text to `w`: `#` comment lines (scenario, seed, altitude
+    /// reference, units), then the table by [`aeromag_io::write_csv_to`]
+    /// (header row, shortest round-trip numbers).
+    pub fn write_csv<W: Write>(&self, mut w: W) -> Result<()> {
+        let table = self.to_flight_table()?;
+        let werr = |e| SimError::Write {
+            path: PathBuf::from("<csv stream>"),
+            source: e,
+        };
+        writeln!(
+            w,
+            "# aeromag-sim {} scenario `{}`, seed {}",
+            env!("CARGO_PKG_VERSION"),
+            self.kind.name(),
+            self.seed
+        )
+        .map_err(werr)?;
+        writeln!(
+            w,
+            "# alt: WGS84 ellipsoidal height; columns prefixed true_ are simulation truth"
+        )
+        .map_err(werr)?;
+        let units: Vec<String> = self
+            .columns
+            .iter()
+            .map(|c| format!("{}[{}]", c.name, c.unit))
+            .collect();
+        writeln!(w, "# units: {}", units.join(" ")).map_err(werr)?;
+        aeromag_io::write_csv_to(&table, &mut w).map_err(werr)
+    }
+
+    /// Write `<stem>.csv`, `<stem>.toml` and `<stem>.truth.json` into `dir`
+    /// (created if missing), `stem` being the scenario name.
+    pub fn write_to_dir(&self, dir: &Path) -> Result<WrittenFiles> {
+        std::fs::create_dir_all(dir).map_err(|e| SimError::Write {
+            path: dir.to_path_buf(),
+            source: e,
+        })?;
+        let stem = self.kind.name();
+        let files = WrittenFiles {
+            csv: dir.join(format!("{stem}.csv")),
+            scenario: dir.join(format!("{stem}.toml")),
+            truth: dir.join(format!("{stem}.truth.json")),
+        };
+        let werr = |p: &Path| {
+            let p = p.to_path_buf();
+            move |e| SimError::Write {
+                path: p.clone(),
+                source: e,
+            }
+        };
+        let f = std::fs::File::create(&files.csv).map_err(werr(&files.csv))?;
+        let mut bw = std::io::BufWriter::with_capacity(1 << 20, f);
+        self.write_csv(&mut bw).map_err(|e| match e {
+            SimError::Write { source, .. } => SimError::Write {
+                path: files.csv.clone(),
+                source,
+            },
+            other => other,
+        })?;
+        bw.flush().map_err(werr(&files.csv))?;
+        std::fs::write(&files.scenario, &self.scenario_toml).map_err(werr(&files.scenario))?;
+        std::fs::write(&files.truth, &self.truth_json).map_err(werr(&files.truth))?;
+        Ok(files)
+    }
+}
+
+/// Units and descriptions of the fixed columns (current channels are added
+/// per loop). The crate docs list the same table.
+pub const COLUMN_CATALOGUE: &[(&str, &str, &str)] = &[
+    (
+        "time",
+        "s",
+        "time, seconds after 00:00 UTC of the flight date",
+    ),
+    (
+        "lat",
+        "deg",
+        "latitude of the navigation reference point (GNSS/INS, with errors)",
+    ),
+    (
+        "lon",
+        "deg",
+        "longitude of the navigation reference point (with errors)",
+    ),
+    (
+        "alt",
+        "m",
+        "WGS84 ellipsoidal height of the navigation reference point (with errors)",
+    ),
+    ("vn", "m/s", "velocity north (with errors)"),
+    ("ve", "m/s", "velocity east (with errors)"),
+    ("vd", "m/s", "velocity down (with errors)"),
+    ("roll", "deg", "roll φ (INS, with errors)"),
+    ("pitch", "deg", "pitch θ (INS, with errors)"),
+    ("yaw", "deg", "yaw ψ in (−180, 180] (INS, with errors)"),
+    ("mag", "nT", "scalar magnetometer, uncompensated"),
+    ("flux_x", "nT", "fluxgate x (body axes, with sensor errors)"),
+    ("flux_y", "nT", "fluxgate y"),
+    ("flux_z", "nT", "fluxgate z"),
+    (
+        "line",
+        "-",
+        "line label: calibration leg 1..n, survey line/tie label, 0 in turns and transits",
+    ),
+    (
+        "manoeuvre",
+        "-",
+        "manoeuvre code: 0 none, 1 roll, 2 pitch, 3 yaw",
+    ),
+    (
+        "diurnal",
+        "nT",
+        "base-station record of the diurnal variation (relative to take-off, with noise)",
+    ),
+    (
+        "igrf",
+        "nT",
+        "IGRF-14 total field at the recorded position and time",
+    ),
+    (
+        "true_lat",
+        "deg",
+        "true latitude of the navigation reference point",
+    ),
+    ("true_lon", "deg", "true longitude"),
+    ("true_alt", "m", "true ellipsoidal height"),
+    (
+        "true_sensor_alt",
+        "m",
+        "true ellipsoidal height of the scalar sensor",
+    ),
+    ("true_vn", "m/s", "true velocity north"),
+    ("true_ve", "m/s", "true velocity east"),
+    ("true_vd", "m/s", "true velocity down"),
+    ("true_roll", "deg", "true roll"),
+    ("true_pitch", "deg", "true pitch"),
+    ("true_yaw", "deg", "true yaw in (−180, 180]"),
+    (
+        "true_external",
+        "nT",
+        "|B_ext| at the scalar sensor: what a perfect compensation yields",
+    ),
+    (
+        "true_interf",
+        "nT",
+        "|B_ext + ΔB| − |B_ext| at the scalar sensor (exact)",
+    ),
+    ("true_igrf", "nT", "|B_IGRF| at the scalar sensor"),
+    (
+        "true_anomaly",
+        "nT",
+        "|B_IGRF + B_anom| − |B_IGRF| at the scalar sensor",
+    ),
+    (
+        "true_diurnal",
+        "nT",
+        "|B_ext| − |B_IGRF + B_anom|: true_igrf + true_anomaly + true_diurnal = true_external",
+    ),
+    (
+        "true_heading_error",
+        "nT",
+        "heading error of the scalar sensor",
+    ),
+    (
+        "true_lag",
+        "nT",
+        "lag contribution y − x of the scalar sensor (≈ −τ d|B|/dt)",
+    ),
+    (
+        "true_mag_noise",
+        "nT",
+        "white noise of the scalar sensor: mag = true_external + true_interf + true_heading_error + true_lag + true_mag_noise",
+    ),
+    (
+        "true_interf_perm",
+        "nT",
+        "projection on B_ext/|B_ext| of the permanent parts' field at the scalar sensor",
+    ),
+    (
+        "true_interf_induced",
+        "nT",
+        "projection of the induced parts' field",
+    ),
+    (
+        "true_interf_eddy",
+        "nT",
+        "projection of the eddy currents' field",
+    ),
+    (
+        "true_interf_current",
+        "nT",
+        "projection of the on-board currents' field",
+    ),
+    (
+        "true_ext_x",
+        "nT",
+        "external field at the scalar sensor, body x",
+    ),
+    (
+        "true_ext_y",
+        "nT",
+        "external field at the scalar sensor, body y",
+    ),
+    (
+        "true_ext_z",
+        "nT",
+        "external field at the scalar sensor, body z",
+    ),
+    (
+        "true_interf_x",
+        "nT",
+        "aircraft field ΔB at the scalar sensor, body x",
+    ),
+    (
+        "true_interf_y",
+        "nT",
+        "aircraft field ΔB at the scalar sensor, body y",
+    ),
+    (
+        "true_interf_z",
+        "nT",
+        "aircraft field ΔB at the scalar sensor, body z",
+    ),
+    (
+        "true_flux_x",
+        "nT",
+        "true total field at the fluxgate (external + aircraft), body x, before sensor errors",
+    ),
+    (
+        "true_flux_y",
+        "nT",
+        "true total field at the fluxgate, body y",
+    ),
+    (
+        "true_flux_z",
+        "nT",
+        "true total field at the fluxgate, body z",
+    ),
+];
+
+/// Unit and description of a column name (current channels included).
+pub fn describe(name: &str) -> Option<(&'static str, String)> {
+    if let Some(&(_, u, d)) = COLUMN_CATALOGUE.iter().find(|(n, _, _)| *n == name) {
+        return Some((u, d.to_string()));
+    }
+    if let Some(loop_name) = name.strip_prefix("true_current_") {
+        return Some((
+            "A",
+            format!("true current of the on-board loop `{loop_name}`"),
+        ));
+    }
+    name.strip_prefix("current_").map(|loop_name| {
+        (
+            "A",
+            format!("recorded current of the on-board loop `{loop_name}`"),
+        )
+    })
+}

@@ -1,0 +1,13 @@
+//! Platforms and their magnetic interference truth.
+//!
+//! * [`aircraft`] — the fixed-wing aircraft: permanent, induced and
+//!   eddy-current parts and on-board current loops, evaluated with the exact
+//!   dipole formula at each sensor.
+//! * [`currents`] — the time series of the on-board currents (random
+//!   switching and fluctuation) and their recorded channels.
+//!
+//! Later platforms (helicopter fuselage and rotor, towed pod) belong here,
+//! one model per file.
+
+pub mod aircraft;
+pub mod currents;

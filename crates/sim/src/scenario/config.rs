@@ -1,0 +1,289 @@
+//! Scenario files: the TOML configuration shared by the fixed-wing
+//! scenarios, its defaults and its parsing.
+//!
+//! A scenario file may set any subset of the fields; everything else takes
+//! the scenario's default (documented on each field). Parsing is two-pass:
+//!
+//! 1. the user's text is parsed into the configuration type with
+//!    `deny_unknown_fields`, so that a typo or a wrong type is reported with
+//!    the TOML parser's line and column;
+//! 2. the user's tables are merged over the scenario's full default
+//!    configuration (tables merge key by key, arrays and values replace), and
+//!    the result is the configuration used. It is written back, with every
+//!    default filled in, next to the simulated data.
+//!
+//! One special rule: a file that sets `anomaly.area` but not
+//! `anomaly.gradient_rms_nt_per_100m` gets the area preset's gradient.
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use super::ScenarioKind;
+use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};
+use crate::environment::diurnal::DiurnalConfig;
+use crate::error::{Result, SimError, invalid, require_finite, require_positive};
+use crate::platform::aircraft::AircraftConfig;
+use crate::sensor::base_station::BaseStationConfig;
+use crate::sensor::fluxgate::FluxgateConfig;
+use crate::sensor::nav::NavConfig;
+use crate::sensor::scalar::ScalarSensorConfig;
+use crate::trajectory::{FlightPlan, KinematicsConfig, TurbulenceConfig};
+
+/// Date, time, place and sampling of a flight.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FlightConfig {
+    /// Date of the flight, `YYYY-MM-DD` (UTC). Default `2025-06-15`.
+    pub date: String,
+    /// Start time, seconds after 00:00 UTC; the `time` column starts here.
+    /// Default 36 000 (10:00 UTC).
+    pub start_time_utc_s: f64,
+    /// Sample rate of every channel, Hz. Default 10.
+    pub sample_rate_hz: f64,
+    /// Latitude of the local origin, deg. Default 56.30 (calibration), 56.00
+    /// (survey).
+    pub origin_lat_deg: f64,
+    /// Longitude of the local origin, deg. Default 37.60 (calibration), 38.00
+    /// (survey).
+    pub origin_lon_deg: f64,
+    /// Height of the (flat) terrain above the WGS84 ellipsoid, m. Default 150.
+    pub terrain_alt_m: f64,
+}
+
+impl Default for FlightConfig {
+    fn default() -> Self {
+        Self {
+            date: "2025-06-15".into(),
+            start_time_utc_s: 36_000.0,
+            sample_rate_hz: 10.0,
+            origin_lat_deg: 56.0,
+            origin_lon_deg: 38.0,
+            terrain_alt_m: 150.0,
+        }
+    }
+}
+
+impl FlightConfig {
+    /// Check the values.
+    pub fn validate(&self) -> Result<()> {
+        aeromag_core::time::Date::parse(&self.date)
+            .map_err(|e| invalid("flight.date", e.to_string()))?;
+        require_finite("flight.start_time_utc_s", self.start_time_utc_s)?;
+        require_positive("flight.sample_rate_hz", self.sample_rate_hz)?;
+        if self.sample_rate_hz > 10_000.0 {
+            return Err(invalid("flight.sample_rate_hz", "must be ≤ 10 000 Hz"));
+        }
+        if !self.origin_lat_deg.is_finite() || self.origin_lat_deg.abs() >= 89.0 {
+            return Err(invalid(
+                "flight.origin_lat_deg",
+                "must be within ±89° (the local frame is undefined at the poles)",
+            ));
+        }
+        require_finite("flight.origin_lon_deg", self.origin_lon_deg)?;
+        require_finite("flight.terrain_alt_m", self.terrain_alt_m)
+    }
+}
+
+/// The flight pattern of a scenario (calibration box, survey lines).
+pub trait Pattern: Serialize + DeserializeOwned + Clone + Default + std::fmt::Debug {
+    /// Check the values.
+    fn validate(&self, flight: &FlightConfig, kin: &KinematicsConfig) -> Result<()>;
+    /// The flight plan in the local frame (origin at `flight.origin_*`).
+    fn plan(&self, flight: &FlightConfig, kin: &KinematicsConfig) -> Result<FlightPlan>;
+}
+
+/// The configuration of a fixed-wing scenario with pattern `P`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+#[serde(bound(
+    serialize = "P: Serialize",
+    deserialize = "P: DeserializeOwned + Default"
+))]
+pub struct FixedWingConfig<P> {
+    /// Seed of every random process (ChaCha8 streams). Default 1. Must be
+    /// < 2⁶³ (TOML integers are signed 64-bit).
+    pub seed: u64,
+    /// Date, time, origin and sampling.
+    pub flight: FlightConfig,
+    /// The flight pattern.
+    pub pattern: P,
+    /// Aircraft performance and autopilot.
+    pub kinematics: KinematicsConfig,
+    /// Turbulence.
+    pub turbulence: TurbulenceConfig,
+    /// Crustal anomaly.
+    pub anomaly: AnomalyConfig,
+    /// Diurnal variation.
+    pub diurnal: DiurnalConfig,
+    /// The aircraft's magnetic parts.
+    pub aircraft: AircraftConfig,
+    /// Scalar magnetometer.
+    pub scalar: ScalarSensorConfig,
+    /// Fluxgate.
+    pub fluxgate: FluxgateConfig,
+    /// GNSS/INS.
+    pub nav: NavConfig,
+    /// Base-station magnetometer.
+    pub base_station: BaseStationConfig,
+}
+
+impl<P: Default> Default for FixedWingConfig<P> {
+    fn default() -> Self {
+        Self {
+            seed: 1,
+            flight: FlightConfig::default(),
+            pattern: P::default(),
+            kinematics: KinematicsConfig::default(),
+            turbulence: TurbulenceConfig::default(),
+            anomaly: AnomalyConfig::default(),
+            diurnal: DiurnalConfig::default(),
+            aircraft: AircraftConfig::default(),
+            scalar: ScalarSensorConfig::default(),
+            fluxgate: FluxgateConfig::default(),
+            nav: NavConfig::default(),
+            base_station: BaseStationConfig::default(),
+        }
+    }
+}
+
+impl<P: Pattern> FixedWingConfig<P> {
+    /// Check every value.
+    pub fn validate(&self) -> Result<()> {
+        if self.seed > i64::MAX as u64 {
+            return Err(invalid(
+                "seed",
+                "must be < 2^63 (TOML integers are signed 64-bit)",
+            ));
+        }
+        self.flight.validate()?;
+        self.kinematics.validate("kinematics")?;
+        self.pattern.validate(&self.flight, &self.kinematics)?;
+        self.turbulence.validate("turbulence")?;
+        self.anomaly.validate("anomaly")?;
+        self.diurnal.validate("diurnal")?;
+        self.aircraft.validate("aircraft")?;
+        self.scalar.validate("scalar")?;
+        self.fluxgate.validate("fluxgate")?;
+        self.nav.validate("nav")?;
+        self.base_station.validate("base_station")
+    }
+
+    /// Parse a scenario file over `defaults` (module docs); `seed` overrides
+    /// the file's seed.
+    pub fn parse_over(
+        defaults: Self,
+        kind: ScenarioKind,
+        text: Option<&str>,
+        seed: Option<u64>,
+    ) -> Result<Self> {
+        let mut cfg = match text {
+            None => defaults,
+            Some(text) => {
+                // Pass 1: syntax, unknown fields and types, with line numbers.
+                let _: Self =
+                    toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+                let mut user: toml::Table =
+                    toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+                apply_area_preset(&mut user);
+                // Pass 2: merge over the scenario defaults.
+                let mut base =
+                    toml::Table::try_from(&defaults).map_err(|e| SimError::Serialize {
+                        what: "default scenario",
+                        reason: e.to_string(),
+                    })?;
+                merge(&mut base, user);
+                toml::Value::Table(base)
+                    .try_into()
+                    .map_err(|e: toml::de::Error| {
+                        SimError::ConfigParse(format!("{} scenario: {e}", kind.name()))
+                    })?
+            }
+        };
+        if let Some(s) = seed {
+            cfg.seed = s;
+        }
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// The configuration as TOML, every default filled in, with a header.
+    pub fn to_toml(&self, kind: ScenarioKind) -> Result<String> {
+        let body = toml::to_string(self).map_err(|e| SimError::Serialize {
+            what: "scenario",
+            reason: e.to_string(),
+        })?;
+        Ok(format!(
+            "# aeromag-sim scenario `{}` (aeromag-sim {}), every default filled in.\n\
+             # Re-running `aeromag simulate {} --config <this file>` reproduces the data.\n\n{body}",
+            kind.name(),
+            env!("CARGO_PKG_VERSION"),
+            kind.name()
+        ))
+    }
+}
+
+/// If `[anomaly]` sets `area` but not the gradient, insert the preset.
+fn apply_area_preset(user: &mut toml::Table) {
+    let Some(toml::Value::Table(an)) = user.get_mut("anomaly") else {
+        return;
+    };
+    if an.contains_key("gradient_rms_nt_per_100m") {
+        return;
+    }
+    let area = match an.get("area").and_then(|v| v.as_str()) {
+        Some("quiet") => AnomalyArea::Quiet,
+        Some("realistic") => AnomalyArea::Realistic,
+        _ => return,
+    };
+    an.insert(
+        "gradient_rms_nt_per_100m".into(),
+        toml::Value::Float(area.gradient_rms_nt_per_100m()),
+    );
+}
+
+/// Merge `over` into `base`: tables recursively, everything else replaced.
+fn merge(base: &mut toml::Table, over: toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(&k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, v) => {
+                base.insert(k, v);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_keeps_unset_fields_and_replaces_arrays() {
+        let mut base: toml::Table =
+            toml::from_str("a = 1\n[t]\nx = 1\ny = 2\nlist = [1, 2]\n").unwrap();
+        let over: toml::Table = toml::from_str("[t]\ny = 5\nlist = [3]\n").unwrap();
+        merge(&mut base, over);
+        assert_eq!(base["a"].as_integer(), Some(1));
+        assert_eq!(base["t"]["x"].as_integer(), Some(1));
+        assert_eq!(base["t"]["y"].as_integer(), Some(5));
+        assert_eq!(base["t"]["list"].as_array().unwrap().len(), 1);
+    }
+
+    #[test]
+    fn area_preset_fills_the_gradient_only_when_absent() {
+        let mut u: toml::Table = toml::from_str("[anomaly]\narea = \"realistic\"\n").unwrap();
+        apply_area_preset(&mut u);
+        assert_eq!(
+            u["anomaly"]["gradient_rms_nt_per_100m"].as_float(),
+            Some(3.0)
+        );
+        let mut u: toml::Table =
+            toml::from_str("[anomaly]\narea = \"realistic\"\ngradient_rms_nt_per_100m = 1.5\n")
+                .unwrap();
+        apply_area_preset(&mut u);
+        assert_eq!(
+            u["anomaly"]["gradient_rms_nt_per_100m"].as_float(),
+            Some(1.5)
+        );
+    }
+}
