@@ -157,12 +157,9 @@ fn for_each_filtered_block(
         let mut cols = design_columns(&cfg.terms, cfg.convention, cfg.bt_scale_nt, time, flux);
         let mut y = seg.mag[a..b].to_vec();
         if let Some(sos) = sos {
-            for c in cols.iter_mut() {
-                if std_dev(c) > f64::EPSILON {
-                    sosfiltfilt_in_place(sos, c)?;
-                }
-            }
-            sosfiltfilt_in_place(sos, &mut y)?;
+            cols.push(std::mem::take(&mut y));
+            filter_columns(sos, &mut cols)?;
+            y = cols.pop().unwrap_or_default();
         }
         let (ca, cb) = (start - a, end - a);
         let refs: Vec<&[f64]> = cols.iter().map(|c| &c[ca..cb]).collect();
@@ -272,6 +269,31 @@ fn validate(cfg: &LsConfig) -> Result<()> {
         return Err(CompError::BadData(format!("ridge λ = {} must be ≥ 0", cfg.lambda)));
     }
     Ok(())
+}
+
+/// Zero-phase filter every non-constant column in place (MagNav's rule:
+/// standard deviation ≤ ε means constant), spread over the available cores.
+/// Each column is filtered independently, so the result does not depend on
+/// the number of threads.
+fn filter_columns(sos: &Sos, cols: &mut [Vec<f64>]) -> Result<()> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 8);
+    let per = cols.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = cols
+            .chunks_mut(per)
+            .map(|chunk| {
+                scope.spawn(move || -> Result<()> {
+                    for c in chunk.iter_mut() {
+                        if std_dev(c) > f64::EPSILON {
+                            sosfiltfilt_in_place(sos, c)?;
+                        }
+                    }
+                    Ok(())
+                })
+            })
+            .collect();
+        handles.into_iter().try_for_each(|h| h.join().unwrap_or_else(|_| Err(CompError::BadData("filter thread failed".into()))))
+    })
 }
 
 fn std_dev(x: &[f64]) -> f64 {
