@@ -2,6 +2,8 @@
 # The whole test suite, as CI runs it. Heavy numerics are tested in release mode.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# insta locates snapshots from the workspace root; say it rather than have it ask cargo.
+export INSTA_WORKSPACE_ROOT="$PWD"
 if ! cargo nextest --version >/dev/null 2>&1; then
     echo "cargo-nextest not found; installing it from crates.io" >&2
     cargo install --locked cargo-nextest

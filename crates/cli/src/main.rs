@@ -36,9 +36,22 @@ enum Command {
     Calibrate(commands::calibrate::Args),
     Compensate(commands::compensate::Args),
     Report(commands::report::Args),
+    Level(commands::level::Args),
+}
+
+/// Let a closed pipe (`aeromag … | head`) end the program quietly, as Unix
+/// tools do, instead of failing on the next `println!`.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default at start-up,
+    // before any thread exists, has no memory-safety implications.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }
 
 fn main() {
+    restore_sigpipe();
     let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Demo(a) => commands::demo::run(a),
@@ -48,6 +61,7 @@ fn main() {
         Command::Calibrate(a) => commands::calibrate::run(a),
         Command::Compensate(a) => commands::compensate::run(a),
         Command::Report(a) => commands::report::run(a),
+        Command::Level(a) => commands::level::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -5,5 +5,6 @@ pub mod compensate;
 pub mod demo;
 pub mod igrf;
 pub mod inspect;
+pub mod level;
 pub mod report;
 pub mod simulate;

@@ -55,17 +55,30 @@ pub struct SurveyLevelling {
 
 /// Apply `fit` to every row of `tracks` (module docs). `derivative` is the
 /// along-track derivative used for the fit (nT/s, one per row).
-pub fn apply_levelling(fit: &LevellingFit, tracks: &SurveyTracks, derivative: &[f64]) -> Result<Levelled> {
+pub fn apply_levelling(
+    fit: &LevellingFit,
+    tracks: &SurveyTracks,
+    derivative: &[f64],
+) -> Result<Levelled> {
     tracks.validate()?;
     if derivative.len() != tracks.len() {
-        return Err(bad(format!("derivative has {} rows, the tracks {}", derivative.len(), tracks.len())));
+        return Err(bad(format!(
+            "derivative has {} rows, the tracks {}",
+            derivative.len(),
+            tracks.len()
+        )));
     }
     let n = tracks.len();
-    let mut out = Levelled { value_nt: tracks.value.to_vec(), flag: vec![RowFlag::NotOnLine; n] };
-    for i in 0..n {
-        let Some(label) = tracks.label(i) else { continue };
+    let mut out = Levelled {
+        value_nt: tracks.value.to_vec(),
+        flag: vec![RowFlag::NotOnLine; n],
+    };
+    for (i, &bdot) in derivative.iter().enumerate() {
+        let Some(label) = tracks.label(i) else {
+            continue;
+        };
         let m = tracks.value[i];
-        let kb = if fit.k_s == 0.0 { 0.0 } else { fit.k_s * derivative[i] };
+        let kb = if fit.k_s == 0.0 { 0.0 } else { fit.k_s * bdot };
         let level = fit.line(label).map(|l| l.level_nt(tracks.time[i]));
         let corrected = m - kb - level.unwrap_or(0.0);
         if !corrected.is_finite() {
@@ -73,18 +86,31 @@ pub fn apply_levelling(fit: &LevellingFit, tracks: &SurveyTracks, derivative: &[
             continue;
         }
         out.value_nt[i] = corrected;
-        out.flag[i] = if level.is_some() { RowFlag::Levelled } else { RowFlag::NoCrossovers };
+        out.flag[i] = if level.is_some() {
+            RowFlag::Levelled
+        } else {
+            RowFlag::NoCrossovers
+        };
     }
     Ok(out)
 }
 
 /// Level a survey in one call: derivative, crossovers, fit, corrected series.
-pub fn level_survey(tracks: &SurveyTracks, track: &TrackConfig, fit: &LevellingConfig) -> Result<SurveyLevelling> {
+pub fn level_survey(
+    tracks: &SurveyTracks,
+    track: &TrackConfig,
+    fit: &LevellingConfig,
+) -> Result<SurveyLevelling> {
     let derivative_nt_per_s = track_derivative(tracks, track)?;
     let crossovers = find_crossovers(tracks, &derivative_nt_per_s, track)?;
     let fit = fit_levelling(&crossovers.crossovers, fit)?;
     let levelled = apply_levelling(&fit, tracks, &derivative_nt_per_s)?;
-    Ok(SurveyLevelling { derivative_nt_per_s, crossovers, fit, levelled })
+    Ok(SurveyLevelling {
+        derivative_nt_per_s,
+        crossovers,
+        fit,
+        levelled,
+    })
 }
 
 #[cfg(test)]
@@ -103,13 +129,29 @@ mod tests {
             let [n, e, _] = o.ned_offset_to(&aeromag_core::frames::Geodetic::new(lat, lon, 0.0));
             20.0 * (n / 90.0).sin() * (e / 130.0).cos() + 0.01 * e
         };
-        let offset = |l: f64| if l > 0.0 { ((l as i64 * 13) % 7) as f64 - 3.0 } else { 0.0 };
+        let offset = |l: f64| {
+            if l > 0.0 {
+                ((l as i64 * 13) % 7) as f64 - 3.0
+            } else {
+                0.0
+            }
+        };
         let truth: Vec<f64> = (0..b.t.len()).map(|i| field(b.lat[i], b.lon[i])).collect();
         let zeros = vec![0.0; truth.len()];
-        let tr = SurveyTracks { value: &truth, alt: &zeros, ..b.tracks() };
+        let tr = SurveyTracks {
+            value: &truth,
+            alt: &zeros,
+            ..b.tracks()
+        };
         let bdot = track_derivative(&tr, &TrackConfig::default()).unwrap();
         for i in 0..b.t.len() {
-            b.v[i] = truth[i] + offset(b.line[i]) + if bdot[i].is_finite() { k * bdot[i] } else { 0.0 };
+            b.v[i] = truth[i]
+                + offset(b.line[i])
+                + if bdot[i].is_finite() {
+                    k * bdot[i]
+                } else {
+                    0.0
+                };
         }
         (b, truth)
     }
@@ -118,15 +160,30 @@ mod tests {
     fn levelling_restores_the_field_on_lines_and_keeps_turns() {
         let (mut b, truth) = levelled_block(-0.1);
         b.v[5] = f64::NAN;
-        let r = level_survey(&b.tracks(), &TrackConfig::default(), &LevellingConfig::default()).unwrap();
+        let r = level_survey(
+            &b.tracks(),
+            &TrackConfig::default(),
+            &LevellingConfig::default(),
+        )
+        .unwrap();
         assert_eq!(r.crossovers.crossovers.len(), 36);
         assert!((r.fit.k_s + 0.1).abs() < 0.01, "k = {}", r.fit.k_s);
-        assert!(r.fit.rms_after_nt < r.fit.rms_before_nt / 10.0, "{} → {}", r.fit.rms_before_nt, r.fit.rms_after_nt);
+        assert!(
+            r.fit.rms_after_nt < r.fit.rms_before_nt / 10.0,
+            "{} → {}",
+            r.fit.rms_before_nt,
+            r.fit.rms_after_nt
+        );
         assert_eq!(r.levelled.value_nt.len(), b.t.len());
         // On lines: corrected − truth is one common constant (the datum).
-        let on: Vec<usize> = (0..b.t.len()).filter(|&i| r.levelled.flag[i] == RowFlag::Levelled).collect();
+        let on: Vec<usize> = (0..b.t.len())
+            .filter(|&i| r.levelled.flag[i] == RowFlag::Levelled)
+            .collect();
         let c = r.levelled.value_nt[on[0]] - truth[on[0]];
-        let worst = on.iter().map(|&i| (r.levelled.value_nt[i] - truth[i] - c).abs()).fold(0.0, f64::max);
+        let worst = on
+            .iter()
+            .map(|&i| (r.levelled.value_nt[i] - truth[i] - c).abs())
+            .fold(0.0, f64::max);
         assert!(worst < 0.15, "worst {worst}");
         for i in 0..b.t.len() {
             match r.levelled.flag[i] {
@@ -149,7 +206,12 @@ mod tests {
         for &i in &rows[..5] {
             b.line[i] = 77.0;
         }
-        let r = level_survey(&b.tracks(), &TrackConfig::default(), &LevellingConfig::default()).unwrap();
+        let r = level_survey(
+            &b.tracks(),
+            &TrackConfig::default(),
+            &LevellingConfig::default(),
+        )
+        .unwrap();
         assert!(r.fit.line(77).is_none());
         for &i in &rows[..5] {
             assert_eq!(r.levelled.flag[i], RowFlag::NoCrossovers);

@@ -118,14 +118,26 @@ struct Edge {
 /// Find the crossovers of `tracks` (module docs). `derivative` is the
 /// along-track derivative of `tracks.value` (nT/s, one per row, normally
 /// from [`super::track_derivative`]).
-pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackConfig) -> Result<CrossoverSet> {
+pub fn find_crossovers(
+    tracks: &SurveyTracks,
+    derivative: &[f64],
+    cfg: &TrackConfig,
+) -> Result<CrossoverSet> {
     tracks.validate()?;
     cfg.validate()?;
     if derivative.len() != tracks.len() {
-        return Err(bad(format!("derivative has {} rows, the tracks {}", derivative.len(), tracks.len())));
+        return Err(bad(format!(
+            "derivative has {} rows, the tracks {}",
+            derivative.len(),
+            tracks.len()
+        )));
     }
-    let positioned = |i: usize| tracks.time[i].is_finite() && tracks.lat[i].is_finite() && tracks.lon[i].is_finite();
-    let origin = (0..tracks.len()).find(|&i| positioned(i)).map(|i| Geodetic::new(tracks.lat[i], tracks.lon[i], 0.0));
+    let positioned = |i: usize| {
+        tracks.time[i].is_finite() && tracks.lat[i].is_finite() && tracks.lon[i].is_finite()
+    };
+    let origin = (0..tracks.len())
+        .find(|&i| positioned(i))
+        .map(|i| Geodetic::new(tracks.lat[i], tracks.lon[i], 0.0));
     let Some(origin) = origin else {
         return Ok(CrossoverSet {
             crossovers: Vec::new(),
@@ -143,7 +155,11 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
     // Edges: consecutive positioned rows of one label, never across another label.
     let max_gap = {
         let dt = median_step(tracks.time);
-        if dt > 0.0 { dt * cfg.max_gap_factor } else { f64::INFINITY }
+        if dt > 0.0 {
+            dt * cfg.max_gap_factor
+        } else {
+            f64::INFINITY
+        }
     };
     let has_data = |i: usize| tracks.value[i].is_finite() && derivative[i].is_finite();
     let mut edges: Vec<Edge> = Vec::new();
@@ -154,7 +170,9 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
             prev = None; // a turn or transit ends the run
             continue;
         }
-        let Some(label) = tracks.label(i) else { continue };
+        let Some(label) = tracks.label(i) else {
+            continue;
+        };
         if !positioned(i) {
             continue;
         }
@@ -170,7 +188,14 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
             } else {
                 EdgeState::Usable
             };
-            edges.push(Edge { i: j, j: i, label, p0: pj, p1: p, state });
+            edges.push(Edge {
+                i: j,
+                j: i,
+                label,
+                p0: pj,
+                p1: p,
+                state,
+            });
         }
         prev = Some((i, label, p));
     }
@@ -187,7 +212,11 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
     }
 
     // Grid: cell = 4 × the median edge length.
-    let mut lengths: Vec<f64> = edges.iter().map(|e| dist(e.p0, e.p1)).filter(|&d| d > 0.0).collect();
+    let mut lengths: Vec<f64> = edges
+        .iter()
+        .map(|e| dist(e.p0, e.p1))
+        .filter(|&d| d > 0.0)
+        .collect();
     let cell = if lengths.is_empty() {
         1.0
     } else {
@@ -229,13 +258,16 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
                 if e.label == f.label {
                     continue;
                 }
-                let Some((s, u)) = intersect(e, f) else { continue };
+                let Some((s, u)) = intersect(e, f) else {
+                    continue;
+                };
                 let at = lerp2(e.p0, e.p1, s);
                 if key(at[0]) != cx || key(at[1]) != cy {
                     continue; // reported by the cell that holds the point
                 }
                 let (de, df) = (sub(e.p1, e.p0), sub(f.p1, f.p0));
-                let cos = (de[0] * df[0] + de[1] * df[1]).abs() / (dist(e.p0, e.p1) * dist(f.p0, f.p1));
+                let cos =
+                    (de[0] * df[0] + de[1] * df[1]).abs() / (dist(e.p0, e.p1) * dist(f.p0, f.p1));
                 let skip = if e.state == EdgeState::Gap || f.state == EdgeState::Gap {
                     Some(Skip::Gap)
                 } else if e.state == EdgeState::Missing || f.state == EdgeState::Missing {
@@ -245,16 +277,34 @@ pub fn find_crossovers(tracks: &SurveyTracks, derivative: &[f64], cfg: &TrackCon
                 } else {
                     None
                 };
-                let (sa, sb) = (side(tracks, derivative, e, s), side(tracks, derivative, f, u));
-                let (a, b) = if e.label < f.label { (sa, sb) } else { (sb, sa) };
+                let (sa, sb) = (
+                    side(tracks, derivative, e, s),
+                    side(tracks, derivative, f, u),
+                );
+                let (a, b) = if e.label < f.label {
+                    (sa, sb)
+                } else {
+                    (sb, sa)
+                };
                 let angle_deg = cos.min(1.0).acos().to_degrees();
-                found.push((Crossover { a, b, north_m: at[0], east_m: at[1], angle_deg }, skip));
+                found.push((
+                    Crossover {
+                        a,
+                        b,
+                        north_m: at[0],
+                        east_m: at[1],
+                        angle_deg,
+                    },
+                    skip,
+                ));
             }
         }
         start = end;
     }
     found.sort_by(|(x, _), (y, _)| {
-        (x.a.label, x.b.label).cmp(&(y.a.label, y.b.label)).then(x.a.time_s.total_cmp(&y.a.time_s))
+        (x.a.label, x.b.label)
+            .cmp(&(y.a.label, y.b.label))
+            .then(x.a.time_s.total_cmp(&y.a.time_s))
     });
     // A crossing at a shared vertex is found on both adjacent edges: keep one
     // (a usable one if there is).
@@ -349,7 +399,14 @@ pub(crate) mod tests {
 
     pub(crate) fn block(nl: usize, nt: usize, spacing: f64, step: f64) -> Block {
         let o = Geodetic::new(50.0, 10.0, 0.0);
-        let mut b = Block { t: vec![], lat: vec![], lon: vec![], alt: vec![], line: vec![], v: vec![] };
+        let mut b = Block {
+            t: vec![],
+            lat: vec![],
+            lon: vec![],
+            alt: vec![],
+            line: vec![],
+            v: vec![],
+        };
         let len_l = spacing * (nt as f64 + 1.0);
         let len_t = spacing * (nl as f64 + 1.0);
         let mut time = 0.0;
@@ -384,7 +441,14 @@ pub(crate) mod tests {
 
     impl Block {
         pub(crate) fn tracks(&self) -> SurveyTracks<'_> {
-            SurveyTracks { time: &self.t, lat: &self.lat, lon: &self.lon, alt: &self.alt, line: &self.line, value: &self.v }
+            SurveyTracks {
+                time: &self.t,
+                lat: &self.lat,
+                lon: &self.lon,
+                alt: &self.alt,
+                line: &self.line,
+                value: &self.v,
+            }
         }
     }
 
@@ -395,13 +459,19 @@ pub(crate) mod tests {
         let d = track_derivative(&b.tracks(), &cfg).unwrap();
         let set = find_crossovers(&b.tracks(), &d, &cfg).unwrap();
         assert_eq!(set.crossovers.len(), 28);
-        assert_eq!((set.skipped_gap, set.skipped_missing, set.skipped_shallow), (0, 0, 0));
+        assert_eq!(
+            (set.skipped_gap, set.skipped_missing, set.skipped_shallow),
+            (0, 0, 0)
+        );
         for (k, c) in set.crossovers.iter().enumerate() {
             let (l, tl) = (k / 4, k % 4);
             assert_eq!((c.a.label, c.b.label), (l as i64 + 1, 101 + tl as i64));
             // Position of the grid node relative to the first row (n 0.11, e 100.37).
             assert!((c.east_m - 200.0 * l as f64).abs() < 0.05, "{c:?}");
-            assert!((c.north_m - (200.0 * (tl as f64 + 0.5) + 0.12)).abs() < 0.05, "{c:?}");
+            assert!(
+                (c.north_m - (200.0 * (tl as f64 + 0.5) + 0.12)).abs() < 0.05,
+                "{c:?}"
+            );
             assert!((c.angle_deg - 90.0).abs() < 0.1);
             // A linear field: both sides agree to the projection error.
             assert!(c.difference_nt().abs() < 2e-3, "{}", c.difference_nt());
@@ -421,8 +491,9 @@ pub(crate) mod tests {
         // run west from e = 800; remove the positions of 3 rows around e = 100.
         let tie_rows: Vec<usize> = (0..b.t.len()).filter(|&i| b.line[i] == 101.0).collect();
         let o = Geodetic::new(50.0, 10.0, 0.0);
-        let east: Vec<f64> =
-            (0..b.t.len()).map(|i| o.ned_offset_to(&Geodetic::new(b.lat[i], b.lon[i], 0.0))[1]).collect();
+        let east: Vec<f64> = (0..b.t.len())
+            .map(|i| o.ned_offset_to(&Geodetic::new(b.lat[i], b.lon[i], 0.0))[1])
+            .collect();
         let near = |i: usize, e: f64| (east[i] - e).abs() < 15.0;
         for &i in &tie_rows {
             if near(i, 100.37) {
@@ -449,7 +520,10 @@ pub(crate) mod tests {
         // The turn rows (label 0, at the origin) must not form edges.
         let set = find_crossovers(&b.tracks(), &d, &TrackConfig::default()).unwrap();
         assert!(set.crossovers.is_empty());
-        assert_eq!(set.skipped_gap + set.skipped_missing + set.skipped_shallow, 0);
+        assert_eq!(
+            set.skipped_gap + set.skipped_missing + set.skipped_shallow,
+            0
+        );
     }
 
     #[test]
@@ -459,17 +533,32 @@ pub(crate) mod tests {
         let o = Geodetic::new(-30.0, 140.0, 0.0);
         let mut rows: Vec<(f64, f64, f64)> = (0..200).map(|k| (k as f64 * 5.0, 0.0, 1.0)).collect();
         rows.push((0.0, 0.0, 0.0));
-        for (n, e) in [(0.0, -300.0), (250.0, 300.0), (500.0, -300.0), (750.0, 300.0)] {
+        for (n, e) in [
+            (0.0, -300.0),
+            (250.0, 300.0),
+            (500.0, -300.0),
+            (750.0, 300.0),
+        ] {
             rows.push((n, e, 2.0));
         }
-        let g: Vec<Geodetic> = rows.iter().map(|&(n, e, _)| o.offset_by(n, e, 0.0)).collect();
+        let g: Vec<Geodetic> = rows
+            .iter()
+            .map(|&(n, e, _)| o.offset_by(n, e, 0.0))
+            .collect();
         let t: Vec<f64> = (0..rows.len()).map(|k| k as f64).collect();
         let lat: Vec<f64> = g.iter().map(|p| p.lat_deg).collect();
         let lon: Vec<f64> = g.iter().map(|p| p.lon_deg).collect();
         let line: Vec<f64> = rows.iter().map(|r| r.2).collect();
         let v: Vec<f64> = rows.iter().map(|r| r.0).collect();
         let alt = vec![f64::NAN; rows.len()];
-        let tr = SurveyTracks { time: &t, lat: &lat, lon: &lon, alt: &alt, line: &line, value: &v };
+        let tr = SurveyTracks {
+            time: &t,
+            lat: &lat,
+            lon: &lon,
+            alt: &alt,
+            line: &line,
+            value: &v,
+        };
         // Time steps of line 2 equal those of line 1: no gap.
         let d = vec![0.0; rows.len()];
         let set = find_crossovers(&tr, &d, &TrackConfig::default()).unwrap();
@@ -482,7 +571,10 @@ pub(crate) mod tests {
             // The zigzag legs run at atan(600/250) = 67.4° to the line.
             assert!((c.angle_deg - (600.0f64 / 250.0).atan().to_degrees()).abs() < 0.01);
         }
-        let steep = TrackConfig { min_crossing_angle_deg: 70.0, ..TrackConfig::default() };
+        let steep = TrackConfig {
+            min_crossing_angle_deg: 70.0,
+            ..TrackConfig::default()
+        };
         let set = find_crossovers(&tr, &d, &steep).unwrap();
         assert_eq!((set.crossovers.len(), set.skipped_shallow), (0, 3));
     }

@@ -86,7 +86,12 @@ pub struct LevellingConfig {
 
 impl Default for LevellingConfig {
     fn default() -> Self {
-        Self { estimate_k: true, drift: false, lambda: 1e-3, datum: Datum::ZeroMean }
+        Self {
+            estimate_k: true,
+            drift: false,
+            lambda: 1e-3,
+            datum: Datum::ZeroMean,
+        }
     }
 }
 
@@ -156,7 +161,10 @@ pub struct LevellingFit {
 impl LevellingFit {
     /// The level of line `label`, if it has crossovers.
     pub fn line(&self, label: i64) -> Option<&LineLevel> {
-        self.lines.binary_search_by_key(&label, |l| l.label).ok().map(|k| &self.lines[k])
+        self.lines
+            .binary_search_by_key(&label, |l| l.label)
+            .ok()
+            .map(|k| &self.lines[k])
     }
 }
 
@@ -170,21 +178,35 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
         return Err(bad("no crossovers to level".into()));
     }
     if !(cfg.lambda.is_finite() && cfg.lambda >= 0.0) {
-        return Err(bad(format!("ridge λ = {} must be finite and ≥ 0", cfg.lambda)));
+        return Err(bad(format!(
+            "ridge λ = {} must be finite and ≥ 0",
+            cfg.lambda
+        )));
     }
     if let Some((k, _)) = crossovers.iter().enumerate().find(|(_, x)| {
-        ![x.a.value_nt, x.b.value_nt, x.a.derivative_nt_per_s, x.b.derivative_nt_per_s, x.a.time_s, x.b.time_s]
-            .iter()
-            .all(|v| v.is_finite())
+        ![
+            x.a.value_nt,
+            x.b.value_nt,
+            x.a.derivative_nt_per_s,
+            x.b.derivative_nt_per_s,
+            x.a.time_s,
+            x.b.time_s,
+        ]
+        .iter()
+        .all(|v| v.is_finite())
     }) {
-        return Err(bad(format!("crossover {k} has a non-finite value, derivative or time")));
+        return Err(bad(format!(
+            "crossover {k} has a non-finite value, derivative or time"
+        )));
     }
 
     // Lines, their crossover time spans and the unknowns' layout.
     let mut spans: BTreeMap<i64, (f64, f64, usize)> = BTreeMap::new();
     for x in crossovers {
         for s in [&x.a, &x.b] {
-            let e = spans.entry(s.label).or_insert((f64::INFINITY, f64::NEG_INFINITY, 0));
+            let e = spans
+                .entry(s.label)
+                .or_insert((f64::INFINITY, f64::NEG_INFINITY, 0));
             e.0 = e.0.min(s.time_s);
             e.1 = e.1.max(s.time_s);
             e.2 += 1;
@@ -201,7 +223,11 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     let mut p = usize::from(cfg.estimate_k);
     for (&label, &(t0, t1, count)) in &spans {
         let fixed = cfg.datum == Datum::Fixed(label);
-        let half = if cfg.drift && !fixed { 0.5 * (t1 - t0) } else { 0.0 };
+        let half = if cfg.drift && !fixed {
+            0.5 * (t1 - t0)
+        } else {
+            0.0
+        };
         let oi = (!fixed).then(|| {
             p += 1;
             p - 1
@@ -240,7 +266,10 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     }
 
     // Design rows.
-    let line_index: Vec<(usize, usize)> = crossovers.iter().map(|x| (pos(x.a.label), pos(x.b.label))).collect();
+    let line_index: Vec<(usize, usize)> = crossovers
+        .iter()
+        .map(|x| (pos(x.a.label), pos(x.b.label)))
+        .collect();
     let row_of = |x: &Crossover, &(ia, ib): &(usize, usize), row: &mut [f64]| {
         row.fill(0.0);
         if cfg.estimate_k {
@@ -260,14 +289,16 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     let mut row = vec![0.0; p];
     for (x, li) in crossovers.iter().zip(&line_index) {
         row_of(x, li, &mut row);
-        data.add_row(&row, x.difference_nt(), 1.0).map_err(|e| bad(e.to_string()))?;
+        data.add_row(&row, x.difference_nt(), 1.0)
+            .map_err(|e| bad(e.to_string()))?;
     }
     let mut all = data.clone();
     if cfg.lambda > 0.0 {
         for j in usize::from(cfg.estimate_k)..p {
             row.fill(0.0);
             row[j] = 1.0;
-            all.add_row(&row, 0.0, cfg.lambda).map_err(|e| bad(e.to_string()))?;
+            all.add_row(&row, 0.0, cfg.lambda)
+                .map_err(|e| bad(e.to_string()))?;
         }
     }
     if cfg.datum == Datum::ZeroMean {
@@ -277,10 +308,18 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
                 row[*oi] = 1.0;
             }
         }
-        all.add_row(&row, 0.0, 1.0).map_err(|e| bad(e.to_string()))?;
+        all.add_row(&row, 0.0, 1.0)
+            .map_err(|e| bad(e.to_string()))?;
     }
     let sol = all.solve(0.0).map_err(|e| {
-        bad(format!("{e}{}", if cfg.lambda == 0.0 { " (use a ridge λ > 0)" } else { "" }))
+        bad(format!(
+            "{e}{}",
+            if cfg.lambda == 0.0 {
+                " (use a ridge λ > 0)"
+            } else {
+                ""
+            }
+        ))
     })?;
     let c = &sol.coef;
 
@@ -317,7 +356,11 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
             line.drift_std_nt = std[si];
         }
     }
-    let (k_s, k_std_s) = if cfg.estimate_k { (c[0], std[0]) } else { (0.0, 0.0) };
+    let (k_s, k_std_s) = if cfg.estimate_k {
+        (c[0], std[0])
+    } else {
+        (0.0, 0.0)
+    };
     Ok(LevellingFit {
         config: cfg.clone(),
         k_s,
@@ -345,12 +388,17 @@ fn count_components(crossovers: &[Crossover], labels: &[i64]) -> usize {
         i
     }
     for x in crossovers {
-        let (ra, rb) = (root(&mut parent, idx(x.a.label)), root(&mut parent, idx(x.b.label)));
+        let (ra, rb) = (
+            root(&mut parent, idx(x.a.label)),
+            root(&mut parent, idx(x.b.label)),
+        );
         if ra != rb {
             parent[ra.max(rb)] = ra.min(rb);
         }
     }
-    (0..labels.len()).filter(|&i| root(&mut parent, i) == i).count()
+    (0..labels.len())
+        .filter(|&i| root(&mut parent, i) == i)
+        .count()
 }
 
 #[cfg(test)]
@@ -392,7 +440,13 @@ pub(crate) mod tests {
                 let tb = 20_000.0 + 1000.0 * t as f64 + 50.0 * l as f64;
                 let a = side(1 + l as i64, ta, field, ba, sigma * g.sample(&mut rng));
                 let b = side(101 + t as i64, tb, field, bb, sigma * g.sample(&mut rng));
-                out.push(Crossover { a, b, north_m: 0.0, east_m: 0.0, angle_deg: 90.0 });
+                out.push(Crossover {
+                    a,
+                    b,
+                    north_m: 0.0,
+                    east_m: 0.0,
+                    angle_deg: 90.0,
+                });
             }
         }
         out
@@ -411,14 +465,23 @@ pub(crate) mod tests {
         assert!(z.abs() < 4.0, "k = {} ± {}", fit.k_s, fit.k_std_s);
         assert!(fit.k_std_s < 0.002, "σ_k {}", fit.k_std_s);
         // Offsets equal the truth minus its mean, within their σ.
-        let mean = fit.lines.iter().map(|l| zero_mean_offsets(l.label)).sum::<f64>() / fit.lines.len() as f64;
+        let mean = fit
+            .lines
+            .iter()
+            .map(|l| zero_mean_offsets(l.label))
+            .sum::<f64>()
+            / fit.lines.len() as f64;
         let sum: f64 = fit.lines.iter().map(|l| l.offset_nt).sum();
         assert!(sum.abs() < 1e-9, "datum: Σo = {sum}");
         for l in &fit.lines {
             let z = (l.offset_nt - (zero_mean_offsets(l.label) - mean)) / l.offset_std_nt;
             assert!(z.abs() < 4.5, "line {}: z = {z}", l.label);
         }
-        assert!((fit.sigma_nt / (0.02 * 2f64.sqrt()) - 1.0).abs() < 0.2, "σ̂ {}", fit.sigma_nt);
+        assert!(
+            (fit.sigma_nt / (0.02 * 2f64.sqrt()) - 1.0).abs() < 0.2,
+            "σ̂ {}",
+            fit.sigma_nt
+        );
         assert!(fit.rms_after_nt < fit.rms_before_nt / 20.0);
         assert_eq!(fit.components, 1);
         assert_eq!(fit.dof, 48 - (1 + 16 - 1));
@@ -441,7 +504,12 @@ pub(crate) mod tests {
     #[test]
     fn fixed_tie_datum_and_plain_levelling() {
         let x = synthetic(8, 3, 0.0, &zero_mean_offsets, &|_, _| 0.0, 0.0, 3);
-        let cfg = LevellingConfig { estimate_k: false, datum: Datum::Fixed(102), lambda: 0.0, ..Default::default() };
+        let cfg = LevellingConfig {
+            estimate_k: false,
+            datum: Datum::Fixed(102),
+            lambda: 0.0,
+            ..Default::default()
+        };
         let fit = fit_levelling(&x, &cfg).unwrap();
         assert_eq!((fit.k_s, fit.k_std_s), (0.0, 0.0));
         let tie = fit.line(102).unwrap();
@@ -459,13 +527,21 @@ pub(crate) mod tests {
         let drift = |label: i64, t: f64| 3e-3 * ((label % 5) as f64 - 2.0) * (t - 10_000.0);
         let x = synthetic(12, 4, -0.1, &zero_mean_offsets, &drift, 0.01, 11);
         let off = fit_levelling(&x, &LevellingConfig::default()).unwrap();
-        let cfg = LevellingConfig { drift: true, ..Default::default() };
+        let cfg = LevellingConfig {
+            drift: true,
+            ..Default::default()
+        };
         let fit = fit_levelling(&x, &cfg).unwrap();
         // Offsets alone cannot absorb the drifts; with drifts the residual is
         // at the noise level (σ√2 per difference, less the fitted share).
         assert!(off.rms_after_nt > 0.1, "{}", off.rms_after_nt);
         assert!(fit.rms_after_nt < 0.02, "{}", fit.rms_after_nt);
-        assert!((fit.k_s + 0.1).abs() < 4.0 * fit.k_std_s, "k {} ± {}", fit.k_s, fit.k_std_s);
+        assert!(
+            (fit.k_s + 0.1).abs() < 4.0 * fit.k_std_s,
+            "k {} ± {}",
+            fit.k_s,
+            fit.k_std_s
+        );
         assert!(fit.lines.iter().all(|l| l.half_span_s > 0.0));
         assert_eq!(fit.dof, 48 - (1 + 32 - 1));
     }
@@ -479,7 +555,11 @@ pub(crate) mod tests {
             c.b.label += 50;
         }
         x.extend(y);
-        let cfg = LevellingConfig { estimate_k: false, lambda: 1e-8, ..Default::default() };
+        let cfg = LevellingConfig {
+            estimate_k: false,
+            lambda: 1e-8,
+            ..Default::default()
+        };
         let fit = fit_levelling(&x, &cfg).unwrap();
         assert_eq!(fit.components, 2);
         assert!(fit.rms_after_nt < 1e-6, "{}", fit.rms_after_nt);
@@ -499,14 +579,43 @@ pub(crate) mod tests {
     fn bad_input_is_an_error() {
         assert!(fit_levelling(&[], &LevellingConfig::default()).is_err());
         let x = synthetic(3, 2, 0.0, &zero_mean_offsets, &|_, _| 0.0, 0.01, 1);
-        let cfg = LevellingConfig { datum: Datum::Fixed(999), ..Default::default() };
-        assert!(fit_levelling(&x, &cfg).unwrap_err().to_string().contains("999"));
-        assert!(fit_levelling(&x, &LevellingConfig { lambda: -1.0, ..Default::default() }).is_err());
+        let cfg = LevellingConfig {
+            datum: Datum::Fixed(999),
+            ..Default::default()
+        };
+        assert!(
+            fit_levelling(&x, &cfg)
+                .unwrap_err()
+                .to_string()
+                .contains("999")
+        );
+        assert!(
+            fit_levelling(
+                &x,
+                &LevellingConfig {
+                    lambda: -1.0,
+                    ..Default::default()
+                }
+            )
+            .is_err()
+        );
         // 6 crossovers, 1 + 10 drifts/offsets − 1: underdetermined.
-        let e = fit_levelling(&x, &LevellingConfig { drift: true, ..Default::default() }).unwrap_err();
+        let e = fit_levelling(
+            &x,
+            &LevellingConfig {
+                drift: true,
+                ..Default::default()
+            },
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("cannot determine"), "{e}");
         let mut y = x.clone();
         y[2].b.derivative_nt_per_s = f64::NAN;
-        assert!(fit_levelling(&y, &LevellingConfig::default()).unwrap_err().to_string().contains("crossover 2"));
+        assert!(
+            fit_levelling(&y, &LevellingConfig::default())
+                .unwrap_err()
+                .to_string()
+                .contains("crossover 2")
+        );
     }
 }

@@ -45,11 +45,15 @@
 //! `m − k·Ḃ − o_L − s_L τ` ([`apply_levelling`]); rows outside lines keep
 //! their value and are flagged.
 //!
+//! Positions must be those of the scalar sensor, not of the navigation
+//! reference point: a lever arm along the track acts like a time shift and
+//! would be absorbed in `k` ([`sensor_positions`] converts them).
+//!
 //! ## Files
 //!
 //! | file | algorithm |
 //! |---|---|
-//! | [`tracks`] | the survey samples, track segmentation, along-track derivative |
+//! | [`tracks`] | the survey samples, sensor positions, track segmentation, along-track derivative |
 //! | [`crossovers`] | intersections of tracks of different lines (grid buckets, `O(N log N)`) |
 //! | [`fit`] | the joint least-squares fit of `k`, offsets and drifts |
 //! | [`apply`] | the corrected series, row flags, and the one-call [`level_survey`] |

@@ -67,14 +67,21 @@ pub struct TrackConfig {
 
 impl Default for TrackConfig {
     fn default() -> Self {
-        Self { max_gap_factor: 5.0, derivative_half_window_s: 0.2, min_crossing_angle_deg: 20.0 }
+        Self {
+            max_gap_factor: 5.0,
+            derivative_half_window_s: 0.2,
+            min_crossing_angle_deg: 20.0,
+        }
     }
 }
 
 impl TrackConfig {
     pub(crate) fn validate(&self) -> Result<()> {
         if !(self.max_gap_factor.is_finite() && self.max_gap_factor > 1.0) {
-            return Err(bad(format!("max_gap_factor {} must be finite and > 1", self.max_gap_factor)));
+            return Err(bad(format!(
+                "max_gap_factor {} must be finite and > 1",
+                self.max_gap_factor
+            )));
         }
         if !(self.derivative_half_window_s.is_finite() && self.derivative_half_window_s >= 0.0) {
             return Err(bad(format!(
@@ -83,7 +90,10 @@ impl TrackConfig {
             )));
         }
         if !(0.0..90.0).contains(&self.min_crossing_angle_deg) {
-            return Err(bad(format!("min_crossing_angle_deg {} must be in [0, 90)", self.min_crossing_angle_deg)));
+            return Err(bad(format!(
+                "min_crossing_angle_deg {} must be in [0, 90)",
+                self.min_crossing_angle_deg
+            )));
         }
         Ok(())
     }
@@ -112,11 +122,21 @@ impl SurveyTracks<'_> {
             ("value", self.value),
         ] {
             if s.len() != n {
-                return Err(bad(format!("column `{name}` has {} rows, `time` has {n}", s.len())));
+                return Err(bad(format!(
+                    "column `{name}` has {} rows, `time` has {n}",
+                    s.len()
+                )));
             }
         }
-        if let Some(i) = self.line.iter().position(|&l| l.is_finite() && (l.fract() != 0.0 || l.abs() > 9.0e15)) {
-            return Err(bad(format!("row {i}: line label {} is not an integer", self.line[i])));
+        if let Some(i) = self
+            .line
+            .iter()
+            .position(|&l| l.is_finite() && (l.fract() != 0.0 || l.abs() > 9.0e15))
+        {
+            return Err(bad(format!(
+                "row {i}: line label {} is not an integer",
+                self.line[i]
+            )));
         }
         Ok(())
     }
@@ -130,7 +150,9 @@ impl SurveyTracks<'_> {
     /// Track segments (see module docs): row ranges on one line each.
     pub fn segments(&self, cfg: &TrackConfig) -> Vec<Range<usize>> {
         let usable: Vec<bool> = (0..self.len())
-            .map(|i| self.time[i].is_finite() && self.value[i].is_finite() && self.label(i).is_some())
+            .map(|i| {
+                self.time[i].is_finite() && self.value[i].is_finite() && self.label(i).is_some()
+            })
             .collect();
         split_segments(self.time, Some(self.line), &usable, cfg.max_gap_factor, 1).0
     }
@@ -157,9 +179,18 @@ pub fn sensor_positions(
     lever_arm_m: [f64; 3],
 ) -> Result<[Vec<f64>; 3]> {
     let n = lat.len();
-    for (name, c) in [("lon", lon), ("alt", alt), ("roll", roll_deg), ("pitch", pitch_deg), ("yaw", yaw_deg)] {
+    for (name, c) in [
+        ("lon", lon),
+        ("alt", alt),
+        ("roll", roll_deg),
+        ("pitch", pitch_deg),
+        ("yaw", yaw_deg),
+    ] {
         if c.len() != n {
-            return Err(bad(format!("column `{name}` has {} rows, `lat` has {n}", c.len())));
+            return Err(bad(format!(
+                "column `{name}` has {} rows, `lat` has {n}",
+                c.len()
+            )));
         }
     }
     if lever_arm_m.iter().any(|v| !v.is_finite()) {
@@ -233,8 +264,20 @@ pub(crate) fn bad(msg: String) -> CompError {
 mod tests {
     use super::*;
 
-    fn tracks<'a>(t: &'a [f64], line: &'a [f64], v: &'a [f64], zeros: &'a [f64]) -> SurveyTracks<'a> {
-        SurveyTracks { time: t, lat: zeros, lon: zeros, alt: zeros, line, value: v }
+    fn tracks<'a>(
+        t: &'a [f64],
+        line: &'a [f64],
+        v: &'a [f64],
+        zeros: &'a [f64],
+    ) -> SurveyTracks<'a> {
+        SurveyTracks {
+            time: t,
+            lat: zeros,
+            lon: zeros,
+            alt: zeros,
+            line,
+            value: v,
+        }
     }
 
     #[test]
@@ -266,7 +309,11 @@ mod tests {
         for i in 0..t.len() {
             let interior = [2..28, 32..58, 72..98].iter().any(|r| r.contains(&i));
             if interior {
-                assert!((d[i] - (3.0 + 0.8 * t[i])).abs() < 1e-9, "row {i}: {}", d[i]);
+                assert!(
+                    (d[i] - (3.0 + 0.8 * t[i])).abs() < 1e-9,
+                    "row {i}: {}",
+                    d[i]
+                );
             }
         }
         // Turn rows have no derivative; segment ends are one-sided but finite.
@@ -281,7 +328,8 @@ mod tests {
         for x in &mut v2[30..60] {
             *x += 100.0;
         }
-        let d2 = track_derivative(&tracks(&t, &line, &v2, &zeros), &TrackConfig::default()).unwrap();
+        let d2 =
+            track_derivative(&tracks(&t, &line, &v2, &zeros), &TrackConfig::default()).unwrap();
         assert!((d[29] - d2[29]).abs() < 1e-9 && (d[30] - d2[30]).abs() < 1e-9);
     }
 
@@ -291,7 +339,10 @@ mod tests {
         let v: Vec<f64> = t.iter().map(|&x| x.powi(3)).collect();
         let line = vec![5.0; 20];
         let zeros = vec![0.0; 20];
-        let cfg = TrackConfig { derivative_half_window_s: 0.0, ..TrackConfig::default() };
+        let cfg = TrackConfig {
+            derivative_half_window_s: 0.0,
+            ..TrackConfig::default()
+        };
         let d = track_derivative(&tracks(&t, &line, &v, &zeros), &cfg).unwrap();
         for i in 1..19 {
             let c = (v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]);
@@ -304,16 +355,45 @@ mod tests {
     fn sensor_positions_follow_the_lever_arm() {
         // Flying east, level: a sensor 9.5 m behind and 0.6 m above (z up is −z).
         let (lat, lon, alt) = ([56.0, 56.0], [38.0, f64::NAN], [100.0, 100.0]);
-        let [sl, so, sa] = sensor_positions(&lat, &lon, &alt, &[0.0; 2], &[0.0; 2], &[90.0; 2], [-9.5, 0.0, -0.6]).unwrap();
+        let [sl, so, sa] = sensor_positions(
+            &lat,
+            &lon,
+            &alt,
+            &[0.0; 2],
+            &[0.0; 2],
+            &[90.0; 2],
+            [-9.5, 0.0, -0.6],
+        )
+        .unwrap();
         let o = Geodetic::new(56.0, 38.0, 100.0);
         let [n, e, _] = o.ned_offset_to(&Geodetic::new(sl[0], so[0], 100.0));
         assert!(n.abs() < 1e-6 && (e + 9.5).abs() < 1e-6, "{n} {e}");
         assert!((sa[0] - 100.6).abs() < 1e-9);
         assert!(sl[1].is_nan() && so[1].is_nan() && sa[1].is_nan());
         // Nose up 90°: the stinger points down.
-        let [_, _, sa] = sensor_positions(&lat, &lon, &alt, &[0.0; 2], &[90.0; 2], &[0.0; 2], [-9.5, 0.0, 0.0]).unwrap();
+        let [_, _, sa] = sensor_positions(
+            &lat,
+            &lon,
+            &alt,
+            &[0.0; 2],
+            &[90.0; 2],
+            &[0.0; 2],
+            [-9.5, 0.0, 0.0],
+        )
+        .unwrap();
         assert!((sa[0] - 90.5).abs() < 1e-9);
-        assert!(sensor_positions(&lat, &lon[..1], &alt, &[0.0; 2], &[0.0; 2], &[0.0; 2], [0.0; 3]).is_err());
+        assert!(
+            sensor_positions(
+                &lat,
+                &lon[..1],
+                &alt,
+                &[0.0; 2],
+                &[0.0; 2],
+                &[0.0; 2],
+                [0.0; 3]
+            )
+            .is_err()
+        );
     }
 
     #[test]
@@ -325,7 +405,10 @@ mod tests {
         let frac = [1.0, 1.5];
         let e = track_derivative(&tracks(&t, &frac, &z, &z), &TrackConfig::default()).unwrap_err();
         assert!(e.to_string().contains("row 1"), "{e}");
-        let cfg = TrackConfig { max_gap_factor: f64::NAN, ..TrackConfig::default() };
+        let cfg = TrackConfig {
+            max_gap_factor: f64::NAN,
+            ..TrackConfig::default()
+        };
         assert!(track_derivative(&tracks(&t, &z, &z, &z), &cfg).is_err());
     }
 }

@@ -1,0 +1,134 @@
+//! `aeromag level`: levelling at line/tie-line crossovers with the
+//! survey-altitude `k·d|B0|/dt` term.
+
+use crate::exit::bad_input;
+use crate::input::InputArgs;
+use aeromag_compensation::levelling::{level_survey, sensor_positions, LevellingConfig, RowFlag, SurveyTracks, TrackConfig};
+use std::path::PathBuf;
+
+/// Level a (compensated) survey: find the crossovers of lines and tie lines,
+/// fit the coefficient k (s) of the d|B0|/dt term jointly with a level offset
+/// per line (regularised least squares; the offsets have zero mean), apply
+/// them, and report the crossover differences before and after.
+///
+/// Lines are told apart by the `line` column (label 0 = not on a line, e.g.
+/// turns). Crossovers are computed at the scalar sensor's position: give the
+/// sensor's lever arm from the navigation reference point with --lever-arm
+/// (body frame x forward, y right, z down; m), otherwise a stinger's offset
+/// along the track is mistaken for a time lag.
+///
+/// Writes every input column plus `<value>_level` and `level_flag`
+/// (0 levelled, 1 line without crossovers, 2 not on a line, 3 missing value).
+///
+/// Examples:
+///   aeromag level --input survey_comp.csv --out survey_level.csv
+///   aeromag level --input s.csv --out o.csv --value mag --lever-arm -9.5,0,-0.6 --tie-only
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output CSV file.
+    #[arg(long, value_name = "OUT.csv")]
+    out: PathBuf,
+    /// Column to level (default `mag_comp`, else `mag`).
+    #[arg(long)]
+    value: Option<String>,
+    /// Sensor lever arm X,Y,Z from the navigation point, body frame, m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    lever_arm: Option<String>,
+    /// Plain tie-line levelling: offsets only, no d|B0|/dt term.
+    #[arg(long)]
+    tie_only: bool,
+    /// Also fit a linear drift per line.
+    #[arg(long)]
+    drift: bool,
+    /// Ridge penalty on the offsets (and drifts).
+    #[arg(long, default_value_t = 1e-3)]
+    lambda: f64,
+}
+
+fn parse_lever(s: &str) -> anyhow::Result<[f64; 3]> {
+    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad_input!("--lever-arm `{s}`: expected X,Y,Z in metres"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(bad_input!("--lever-arm `{s}`: expected three numbers X,Y,Z in metres")),
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let mut table = a.input.load()?;
+    let value_name = match &a.value {
+        Some(v) => v.clone(),
+        None if table.column("mag_comp").is_some() => "mag_comp".into(),
+        None => "mag".into(),
+    };
+    let out_name = format!("{value_name}_level");
+    if table.get(&out_name).is_some() || table.get("level_flag").is_some() {
+        return Err(bad_input!("{}: already has `{out_name}` or `level_flag`", table.file_label()));
+    }
+    if !(a.lambda >= 0.0 && a.lambda.is_finite()) {
+        return Err(bad_input!("--lambda {} must be ≥ 0", a.lambda));
+    }
+    let (lat, lon, alt) = (table.require("lat")?, table.require("lon")?, table.require("alt")?);
+    let positions = match &a.lever_arm {
+        Some(s) => {
+            let lever = parse_lever(s)?;
+            let (r, p, y) = (table.require("roll")?, table.require("pitch")?, table.require("yaw")?);
+            Some(sensor_positions(lat, lon, alt, r, p, y, lever).map_err(|e| bad_input!("{}: {e}", table.file_label()))?)
+        }
+        None => None,
+    };
+    let (lat, lon, alt) = match &positions {
+        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
+        None => (lat, lon, alt),
+    };
+    let tracks = SurveyTracks {
+        time: table.require("time")?,
+        lat,
+        lon,
+        alt,
+        line: table.require("line")?,
+        value: table.require(&value_name)?,
+    };
+    let cfg = LevellingConfig { estimate_k: !a.tie_only, drift: a.drift, lambda: a.lambda, ..LevellingConfig::default() };
+    let spinner = crate::progress::spinner("levelling");
+    let lev = level_survey(&tracks, &TrackConfig::default(), &cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    spinner.finish_and_clear();
+    let f = &lev.fit;
+    let flags: Vec<f64> = lev
+        .levelled
+        .flag
+        .iter()
+        .map(|fl| match fl {
+            RowFlag::Levelled => 0.0,
+            RowFlag::NoCrossovers => 1.0,
+            RowFlag::NotOnLine => 2.0,
+            RowFlag::Missing => 3.0,
+        })
+        .collect();
+    let n = table.n_rows();
+    table.add_column(&out_name, lev.levelled.value_nt.clone())?;
+    table.add_column("level_flag", flags)?;
+    aeromag_io::write_csv(&table, &a.out)?;
+    println!(
+        "{} crossovers ({} skipped in gaps, {} with missing values, {} too shallow)",
+        lev.crossovers.crossovers.len(),
+        lev.crossovers.skipped_gap,
+        lev.crossovers.skipped_missing,
+        lev.crossovers.skipped_shallow
+    );
+    if cfg.estimate_k {
+        println!("k (d|B0|/dt term) = {:.4} ± {:.4} s", f.k_s, f.k_std_s);
+    }
+    println!("crossover differences RMS: {:.4} nT before, {:.4} nT after levelling", f.rms_before_nt, f.rms_after_nt);
+    if f.components > 1 {
+        eprintln!("warning: the lines form {} groups that never cross; their relative levels rest on the penalty, not the data", f.components);
+    }
+    println!("{:>10} {:>11} {:>12} {:>10}", "line", "crossovers", "offset (nT)", "std (nT)");
+    for l in &f.lines {
+        println!("{:>10} {:>11} {:>12.4} {:>10.4}", l.label, l.crossovers, l.offset_nt, l.offset_std_nt);
+    }
+    println!("{n} rows written to {} (column {out_name})", a.out.display());
+    Ok(())
+}

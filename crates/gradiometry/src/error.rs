@@ -1,0 +1,50 @@
+//! The crate's error type.
+
+use thiserror::Error;
+
+/// Errors of the gradiometry library (bad configuration or input; never a panic).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum GradiometryError {
+    /// A length, noise level or count that must be positive and finite is not.
+    #[error("{name} must be positive and finite, got {value}")]
+    NotPositive {
+        /// Name of the parameter.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A value that must be finite is NaN or infinite.
+    #[error("{name} must be finite")]
+    NotFinite {
+        /// Name of the parameter.
+        name: &'static str,
+    },
+    /// The four sensor offsets do not span three dimensions or are too close.
+    #[error("degenerate gradiometer geometry: {0}")]
+    DegenerateGeometry(String),
+    /// A covariance square root or information matrix is singular.
+    #[error("singular matrix in {0}")]
+    Singular(&'static str),
+    /// Inconsistent input lengths.
+    #[error("length mismatch: {what} has {got}, expected {expected}")]
+    LengthMismatch {
+        /// What was measured.
+        what: &'static str,
+        /// Actual length.
+        got: usize,
+        /// Expected length.
+        expected: usize,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, GradiometryError>;
+
+/// `Ok(v)` when `v` is finite and > 0, else [`GradiometryError::NotPositive`].
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(GradiometryError::NotPositive { name, value })
+    }
+}

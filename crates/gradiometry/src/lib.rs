@@ -1,0 +1,31 @@
+//! # aeromag-gradiometry
+//!
+//! Magnetic parameters of an object (a dipole moment `M`, A·m², at position
+//! `r`, m) from remote gradiometer differences — spec `gradiometry.md`, seed
+//! `004_…` (Pavlov, Karshakov, Goldin).
+//!
+//! - [`geometry`] — four-sensor layouts (tetrahedron, cross, planar);
+//! - [`decorrelate`] — the orthonormal contrasts that whiten the differences;
+//! - [`forward`] — `ForwardMT` / `ForwardMV` with analytic Jacobians;
+//! - [`sr_iekf`] — square-root IEKF (`PrognosisFK`, `ProcessingFK`, per-epoch iteration);
+//! - [`motion`] — `MotionMT` / `MotionMV`;
+//! - [`estimability`] — `MeasureS`;
+//! - [`crlb`] — Cramér–Rao bound and Monte-Carlo efficiency;
+//! - [`convergence`] — the seed's fig. 2 convergence map and a multi-start initialisation;
+//! - [`sim`] — the simulator scenario `gradiometer`.
+
+#![warn(missing_docs)]
+
+pub mod decorrelate;
+pub mod error;
+pub mod forward;
+pub mod geometry;
+
+pub use error::{GradiometryError, Result};
+pub mod convergence;
+pub mod crlb;
+pub mod estimability;
+pub mod motion;
+pub mod pass;
+pub mod sim;
+pub mod sr_iekf;
