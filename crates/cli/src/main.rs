@@ -37,6 +37,7 @@ enum Command {
     Compensate(commands::compensate::Args),
     Report(commands::report::Args),
     Level(commands::level::Args),
+    Dipole(commands::dipole::Args),
 }
 
 /// Let a closed pipe (`aeromag … | head`) end the program quietly, as Unix
@@ -62,6 +63,7 @@ fn main() {
         Command::Compensate(a) => commands::compensate::run(a),
         Command::Report(a) => commands::report::run(a),
         Command::Level(a) => commands::level::run(a),
+        Command::Dipole(a) => commands::dipole::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -3,6 +3,7 @@
 pub mod calibrate;
 pub mod compensate;
 pub mod demo;
+pub mod dipole;
 pub mod igrf;
 pub mod inspect;
 pub mod level;
