@@ -1,0 +1,103 @@
+//! Three-stage calibration and its run-time application (seed `001_…`
+//! part II, eqs. 5–6; spec `em-positioning.md`, "Calibration in three
+//! stages").
+//!
+//! 1. [`linear_polarisation`]: detection phases and the imaginary couplings
+//!    that make the field linearly polarised (no external information).
+//! 2. [`transmitter_geometry`]: symmetric real transmitter distortion `S`,
+//!    effective moments `M' = (I + S) M`, from known ranges and directions.
+//! 3. [`attitude`]: small rotation `Q` from a point of known attitude.
+//!
+//! At run time ([`Calibration::locate`]) the stages are applied in the same
+//! order: stage 1 gives the real field matrix, positioning uses `M'`, and
+//! the rotation is corrected to `Q R'`. The whole set is saved as JSON.
+
+pub mod attitude;
+pub mod linear_polarisation;
+pub mod transmitter_geometry;
+
+pub use attitude::fit_attitude_correction;
+pub use linear_polarisation::{PolarisationCalibration, uncalibrated};
+pub use transmitter_geometry::fit_transmitter_geometry;
+
+use crate::detection::Complex64;
+use crate::positioning::{Hemisphere, PolishOptions, Pose, closed_form, polish};
+use crate::{EmError, Result};
+use nalgebra::Matrix3;
+
+/// The calibration file: all three stages.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Calibration {
+    /// Stage 1: linear-polarisation reduction.
+    pub polarisation: PolarisationCalibration,
+    /// Stage 2: symmetric transmitter distortion `S` (dimensionless).
+    pub transmitter_s: Matrix3<f64>,
+    /// Stage 3: attitude correction `Q` (rotation).
+    pub attitude_q: Matrix3<f64>,
+}
+
+impl Default for Calibration {
+    /// The identity calibration (no correction).
+    fn default() -> Self {
+        Self {
+            polarisation: PolarisationCalibration::default(),
+            transmitter_s: Matrix3::zeros(),
+            attitude_q: Matrix3::identity(),
+        }
+    }
+}
+
+/// One located epoch.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Located {
+    /// Calibrated pose.
+    pub pose: Pose,
+    /// Polarisation ratio per frequency after stage 1 (dimensionless).
+    pub polarisation_ratio: [f64; 3],
+    /// RMS relative residual of the LM polish (dimensionless).
+    pub rms_residual: f64,
+}
+
+impl Calibration {
+    /// Serialise to JSON.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData(e.to_string()))
+    }
+
+    /// Read from JSON.
+    pub fn from_json(s: &str) -> Result<Self> {
+        serde_json::from_str(s).map_err(|e| EmError::InvalidData(e.to_string()))
+    }
+
+    /// Effective moments `M' = (I + S) M` (A·m²).
+    pub fn effective_moments(&self, moments: &Matrix3<f64>) -> Matrix3<f64> {
+        (Matrix3::identity() + self.transmitter_s) * moments
+    }
+
+    /// Apply stages 1–3 to one epoch of three complex vectors (one per
+    /// frequency, receiver axes, pilot-corrected) and locate the receiver:
+    /// closed form, LM polish, then `R ← Q R`.
+    pub fn locate(
+        &self,
+        epoch: &[[Complex64; 3]; 3],
+        moments: &Matrix3<f64>,
+        hemisphere: &mut Hemisphere,
+    ) -> Result<Located> {
+        let (h, ratios) = self.polarisation.apply(epoch);
+        let m = self.effective_moments(moments);
+        let cf = closed_form(&h, &m, hemisphere)?;
+        let p = polish(&h, &m, &cf.pose, &PolishOptions::default())?;
+        let pose = Pose {
+            position_m: p.pose.position_m,
+            rotation: self.attitude_q * p.pose.rotation,
+        };
+        Ok(Located {
+            pose,
+            polarisation_ratio: ratios,
+            rms_residual: p.rms_residual,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,610 @@
+//! FIR-weighted synchronous detection (seed `001_…` part II, eq. 2; spec
+//! `em-positioning.md`, "Signal chain" item 1).
+//!
+//! For a block of `N` samples `u[n]` starting at absolute sample index `n₀`,
+//! at each frequency `ω = 2π f`:
+//!
+//! ```text
+//! U = (2/Σf) Σ_n f[n] u[n] e^{iω (n₀+n)/f_s}
+//! ```
+//!
+//! so that `u(t) = a cos ωt + b sin ωt` gives `U = a + ib` (i.e.
+//! `u = Re(U e^{−iωt})`); the seed's `U_c + iU_s` with the `1/l` scaling
+//! replaced by the window sum. Blocks do not overlap: the output rate is
+//! `f_s/N` (6.25 Hz for the default 16 000 samples at 100 kHz; the seed uses
+//! 6.6 Hz).
+//!
+//! ## Frequency response
+//!
+//! For a unit input `cos(ω't + θ)` the output is
+//! `A(ω−ω') e^{−iθ} + A(ω+ω') e^{iθ}` with `A(Δ) = Σ f[n] e^{iΔn/f_s}/Σf`;
+//! [`SyncDetector::frequency_response`] returns the worst case over `θ`,
+//! `|A(ω−ω')| + |A(ω+ω')|`.
+//!
+//! ## Implementation
+//!
+//! `f[n] e^{iωn/f_s}·2/Σf` is tabulated once per frequency (f32); a block is
+//! two dot products per frequency and channel, accumulated in 32 f32 lanes
+//! (AVX2 when available, same arithmetic otherwise) and flushed into f64
+//! every 1024 samples, followed by the phase factor `e^{iω n₀/f_s}` (f64) of
+//! the block start. Three channels share each kernel load.
+
+use super::Complex64;
+use crate::{EmError, Result};
+use aeromag_core::filter::{Symmetry, Window};
+use std::f64::consts::TAU;
+
+/// Configuration of the synchronous detector.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DetectorConfig {
+    /// ADC sampling rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Window (block) length `N`, samples.
+    pub window_len: usize,
+    /// Weighting window `f` (periodic variant is used).
+    pub window: Window,
+    /// Detection frequencies, Hz (working and pilot).
+    pub frequencies_hz: Vec<f64>,
+}
+
+impl DetectorConfig {
+    /// The three-frequency plan of the EM system: for each working
+    /// frequency `f_i`, the detectors `f_i`, `f_i − δ`, `f_i + δ` (the layout
+    /// [`super::FieldChain`] expects), Blackman–Harris weighting.
+    ///
+    /// Default of the seed-like system: `f_s` = 100 kHz, `N` = 16 000
+    /// (6.25 Hz bins and output rate), `f_i` = 1025, 2075, 3125 Hz,
+    /// `δ` = 25 Hz (4 bins): every working, pilot and odd 400 Hz harmonic
+    /// frequency is on a bin ≥ 4 bins from every detector, so cross-talk is
+    /// exactly zero.
+    pub fn three_frequency_plan(
+        sample_rate_hz: f64,
+        window_len: usize,
+        working_hz: [f64; 3],
+        pilot_offset_hz: f64,
+    ) -> Self {
+        let frequencies_hz = working_hz
+            .iter()
+            .flat_map(|&f| [f, f - pilot_offset_hz, f + pilot_offset_hz])
+            .collect();
+        Self {
+            sample_rate_hz,
+            window_len,
+            window: Window::BlackmanHarris,
+            frequencies_hz,
+        }
+    }
+
+    /// Bin width `f_s/N`, Hz: frequencies on multiples of it are exact zeros
+    /// of the other detectors' responses (≥ 4 bins apart for 4-term windows).
+    pub fn bin_hz(&self) -> f64 {
+        self.sample_rate_hz / self.window_len as f64
+    }
+}
+
+/// One detected block: amplitudes for every frequency and channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Epoch {
+    /// Absolute index of the block's first sample.
+    pub start_index: u64,
+    /// Time of the block centre, s from sample 0.
+    pub centre_time_s: f64,
+    /// `values[k * channels + c]`: frequency `k`, channel `c`, in input units.
+    pub values: Vec<Complex64>,
+}
+
+/// FIR-weighted synchronous detector with precomputed kernels.
+#[derive(Debug, Clone)]
+pub struct SyncDetector {
+    config: DetectorConfig,
+    weights: Vec<f64>,
+    kernels_re: Vec<Vec<f32>>,
+    kernels_im: Vec<Vec<f32>>,
+    avx2: bool,
+}
+
+const LANES: usize = 32;
+const FLUSH: usize = 1024;
+
+/// `(Σ u·re, Σ u·im)` with f32 lanes flushed into f64 every [`FLUSH`]
+/// samples. Separate multiply and add (no FMA), so every code path gives
+/// bit-identical results.
+#[inline(always)]
+fn dot2_body(u: &[f32], re: &[f32], im: &[f32]) -> (f64, f64) {
+    let mut sr = 0.0f64;
+    let mut si = 0.0f64;
+    for ((uc, rc), ic) in u.chunks(FLUSH).zip(re.chunks(FLUSH)).zip(im.chunks(FLUSH)) {
+        let mut ar = [0.0f32; LANES];
+        let mut ai = [0.0f32; LANES];
+        let nl = uc.len() / LANES * LANES;
+        for ((ul, rl), il) in uc[..nl]
+            .chunks_exact(LANES)
+            .zip(rc[..nl].chunks_exact(LANES))
+            .zip(ic[..nl].chunks_exact(LANES))
+        {
+            for j in 0..LANES {
+                ar[j] += ul[j] * rl[j];
+                ai[j] += ul[j] * il[j];
+            }
+        }
+        for j in nl..uc.len() {
+            ar[j - nl] += uc[j] * rc[j];
+            ai[j - nl] += uc[j] * ic[j];
+        }
+        sr += ar.iter().map(|&v| f64::from(v)).sum::<f64>();
+        si += ai.iter().map(|&v| f64::from(v)).sum::<f64>();
+    }
+    (sr, si)
+}
+
+/// [`dot2_body`] compiled for AVX2 (8-wide f32 vectors).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn dot2_avx2(u: &[f32], re: &[f32], im: &[f32]) -> (f64, f64) {
+    dot2_body(u, re, im)
+}
+
+/// Three channels against one kernel: `[(Σ u_c·re, Σ u_c·im); 3]`, the
+/// kernel loaded once for all three (same arithmetic as [`dot2_body`] per
+/// channel, so results are bit-identical to it).
+#[inline(always)]
+fn dot2x3_body(u: [&[f32]; 3], re: &[f32], im: &[f32]) -> [(f64, f64); 3] {
+    let mut out = [(0.0f64, 0.0f64); 3];
+    let n = re.len();
+    let mut start = 0;
+    while start < n {
+        let end = (start + FLUSH).min(n);
+        let mut ar = [[0.0f32; LANES]; 3];
+        let mut ai = [[0.0f32; LANES]; 3];
+        let nl = start + (end - start) / LANES * LANES;
+        let mut j0 = start;
+        while j0 < nl {
+            let rl = &re[j0..j0 + LANES];
+            let il = &im[j0..j0 + LANES];
+            for c in 0..3 {
+                let ul = &u[c][j0..j0 + LANES];
+                for j in 0..LANES {
+                    ar[c][j] += ul[j] * rl[j];
+                    ai[c][j] += ul[j] * il[j];
+                }
+            }
+            j0 += LANES;
+        }
+        for j in nl..end {
+            for c in 0..3 {
+                ar[c][j - nl] += u[c][j] * re[j];
+                ai[c][j - nl] += u[c][j] * im[j];
+            }
+        }
+        for c in 0..3 {
+            out[c].0 += ar[c].iter().map(|&v| f64::from(v)).sum::<f64>();
+            out[c].1 += ai[c].iter().map(|&v| f64::from(v)).sum::<f64>();
+        }
+        start = end;
+    }
+    out
+}
+
+/// [`dot2x3_body`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn dot2x3_avx2(u: [&[f32]; 3], re: &[f32], im: &[f32]) -> [(f64, f64); 3] {
+    dot2x3_body(u, re, im)
+}
+
+/// Dispatch of [`dot2x3_body`] (see [`dot2`]).
+fn dot2x3(u: [&[f32]; 3], re: &[f32], im: &[f32], avx2: bool) -> [(f64, f64); 3] {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is true only if the CPU reported AVX2 (see `SyncDetector::new`).
+        return unsafe { dot2x3_avx2(u, re, im) };
+    }
+    let _ = avx2;
+    dot2x3_body(u, re, im)
+}
+
+/// Dispatch to the AVX2 build of the dot product when the CPU has it.
+fn dot2(u: &[f32], re: &[f32], im: &[f32], avx2: bool) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is true only if `is_x86_feature_detected!("avx2")`
+        // returned true when the detector was built (see `SyncDetector::new`).
+        return unsafe { dot2_avx2(u, re, im) };
+    }
+    let _ = avx2;
+    dot2_body(u, re, im)
+}
+
+/// `e^{iω n₀/f_s}`: phase of the reference at the block start.
+fn block_phase(f_hz: f64, fs: f64, start_index: u64) -> Complex64 {
+    let cycles = (f_hz / fs) * start_index as f64;
+    let ph = TAU * cycles.fract();
+    Complex64::new(ph.cos(), ph.sin())
+}
+
+impl SyncDetector {
+    /// Build the detector.
+    ///
+    /// Errors ([`EmError::InvalidArgument`]): non-positive rate, window shorter
+    /// than 8 samples, no frequencies, or a frequency outside `(0, f_s/2)`.
+    pub fn new(config: DetectorConfig) -> Result<Self> {
+        let fs = config.sample_rate_hz;
+        if !crate::positive_finite(fs) {
+            return Err(EmError::InvalidArgument(format!("sample rate {fs} Hz")));
+        }
+        if config.window_len < 8 {
+            return Err(EmError::InvalidArgument(
+                "window shorter than 8 samples".into(),
+            ));
+        }
+        if config.frequencies_hz.is_empty() {
+            return Err(EmError::InvalidArgument("no detection frequencies".into()));
+        }
+        if let Some(f) = config
+            .frequencies_hz
+            .iter()
+            .find(|&&f| !(f > 0.0 && f < fs / 2.0))
+        {
+            return Err(EmError::InvalidArgument(format!(
+                "frequency {f} Hz outside (0, fs/2)"
+            )));
+        }
+        let weights = config
+            .window
+            .samples(config.window_len, Symmetry::Periodic)?;
+        let sum: f64 = weights.iter().sum();
+        if !crate::positive_finite(sum) {
+            return Err(EmError::InvalidArgument("window sums to zero".into()));
+        }
+        let mut kernels_re = Vec::with_capacity(config.frequencies_hz.len());
+        let mut kernels_im = Vec::with_capacity(config.frequencies_hz.len());
+        for &f in &config.frequencies_hz {
+            let (re, im): (Vec<f32>, Vec<f32>) = weights
+                .iter()
+                .enumerate()
+                .map(|(n, w)| {
+                    let ph = TAU * (f * n as f64 / fs).fract();
+                    let s = 2.0 * w / sum;
+                    ((s * ph.cos()) as f32, (s * ph.sin()) as f32)
+                })
+                .unzip();
+            kernels_re.push(re);
+            kernels_im.push(im);
+        }
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
+        Ok(Self {
+            config,
+            weights,
+            kernels_re,
+            kernels_im,
+            avx2,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &DetectorConfig {
+        &self.config
+    }
+
+    /// `A(Δf) = Σ f[n] e^{i2πΔf n/f_s} / Σ f[n]` (dimensionless), `Δf` in Hz.
+    fn window_transform(&self, delta_hz: f64) -> Complex64 {
+        let fs = self.config.sample_rate_hz;
+        let mut acc = Complex64::new(0.0, 0.0);
+        let mut sum = 0.0;
+        for (n, &w) in self.weights.iter().enumerate() {
+            let ph = TAU * (delta_hz * n as f64 / fs).fract();
+            acc += Complex64::new(w * ph.cos(), w * ph.sin());
+            sum += w;
+        }
+        acc / sum
+    }
+
+    /// Worst-case output amplitude of detector `k` for a unit-amplitude
+    /// sinusoid of frequency `f_hz` (any phase):
+    /// `|A(f_k − f)| + |A(f_k + f)|` (dimensionless; ≈ 1 at `f = f_k`).
+    ///
+    /// Errors if `k` is out of range.
+    pub fn frequency_response(&self, k: usize, f_hz: f64) -> Result<f64> {
+        let fk = *self
+            .config
+            .frequencies_hz
+            .get(k)
+            .ok_or_else(|| EmError::InvalidArgument(format!("detector index {k}")))?;
+        Ok(self.window_transform(fk - f_hz).norm() + self.window_transform(fk + f_hz).norm())
+    }
+
+    /// Cross-talk matrix `C[k][j]` = response of detector `k` to a unit
+    /// sinusoid at detector `j`'s frequency (diagonal ≈ 1); the frequency plan
+    /// is clean when every off-diagonal entry is below the noise.
+    pub fn cross_talk(&self) -> Vec<Vec<f64>> {
+        let f = &self.config.frequencies_hz;
+        (0..f.len())
+            .map(|k| {
+                f.iter()
+                    .map(|&fj| self.frequency_response(k, fj).unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The response of detector `k` on `points` frequencies evenly spaced
+    /// over `[f_lo_hz, f_hi_hz]`: pairs `(f Hz, response)` for plotting (the
+    /// seed's fig. 1).
+    ///
+    /// Errors for a bad index, fewer than 2 points or an empty interval.
+    pub fn response_curve(
+        &self,
+        k: usize,
+        f_lo_hz: f64,
+        f_hi_hz: f64,
+        points: usize,
+    ) -> Result<Vec<(f64, f64)>> {
+        if points < 2 || f_hi_hz.partial_cmp(&f_lo_hz) != Some(std::cmp::Ordering::Greater) {
+            return Err(EmError::InvalidArgument(
+                "need ≥ 2 points over a non-empty interval".into(),
+            ));
+        }
+        (0..points)
+            .map(|j| {
+                let f = f_lo_hz + (f_hi_hz - f_lo_hz) * j as f64 / (points - 1) as f64;
+                self.frequency_response(k, f).map(|g| (f, g))
+            })
+            .collect()
+    }
+
+    /// Detect one block of one channel (`samples.len() == N`) whose first
+    /// sample has absolute index `start_index`; one value per frequency.
+    ///
+    /// Errors if the block length differs from the window length.
+    pub fn detect_block(&self, samples: &[f32], start_index: u64) -> Result<Vec<Complex64>> {
+        if samples.len() != self.config.window_len {
+            return Err(EmError::InvalidArgument(format!(
+                "block of {} samples, window is {}",
+                samples.len(),
+                self.config.window_len
+            )));
+        }
+        let fs = self.config.sample_rate_hz;
+        Ok(self
+            .config
+            .frequencies_hz
+            .iter()
+            .zip(self.kernels_re.iter().zip(&self.kernels_im))
+            .map(|(&f, (re, im))| {
+                let (sr, si) = dot2(samples, re, im, self.avx2);
+                Complex64::new(sr, si) * block_phase(f, fs, start_index)
+            })
+            .collect())
+    }
+
+    /// Detect every complete block of channel-interleaved samples
+    /// (`data[i * channels + c]`), the first sample having absolute index
+    /// `start_index`. A trailing partial block is ignored.
+    ///
+    /// Errors for `channels == 0`.
+    pub fn detect_interleaved(
+        &self,
+        data: &[f32],
+        channels: usize,
+        start_index: u64,
+    ) -> Result<Vec<Epoch>> {
+        if channels == 0 {
+            return Err(EmError::InvalidArgument("zero channels".into()));
+        }
+        let n = self.config.window_len;
+        let nf = self.config.frequencies_hz.len();
+        let fs = self.config.sample_rate_hz;
+        let mut buf = vec![vec![0.0f32; n]; channels];
+        let mut sums = vec![(0.0f64, 0.0f64); nf * channels];
+        let mut out = Vec::with_capacity(data.len() / (n * channels));
+        for (b, block) in data.chunks_exact(n * channels).enumerate() {
+            for (i, frame) in block.chunks_exact(channels).enumerate() {
+                for (c, &v) in frame.iter().enumerate() {
+                    buf[c][i] = v;
+                }
+            }
+            sums.iter_mut().for_each(|s| *s = (0.0, 0.0));
+            // Tile over samples so that one tile of every kernel and channel
+            // stays in L1 while all frequency × channel products are formed.
+            for off in (0..n).step_by(FLUSH) {
+                let end = (off + FLUSH).min(n);
+                for k in 0..nf {
+                    let re = &self.kernels_re[k][off..end];
+                    let im = &self.kernels_im[k][off..end];
+                    if channels == 3 {
+                        let u = [&buf[0][off..end], &buf[1][off..end], &buf[2][off..end]];
+                        for (c, (sr, si)) in dot2x3(u, re, im, self.avx2).into_iter().enumerate() {
+                            let acc = &mut sums[k * 3 + c];
+                            acc.0 += sr;
+                            acc.1 += si;
+                        }
+                    } else {
+                        for (c, ch) in buf.iter().enumerate() {
+                            let (sr, si) = dot2(&ch[off..end], re, im, self.avx2);
+                            let acc = &mut sums[k * channels + c];
+                            acc.0 += sr;
+                            acc.1 += si;
+                        }
+                    }
+                }
+            }
+            let first = start_index + (b * n) as u64;
+            let mut values = Vec::with_capacity(nf * channels);
+            for (k, &f) in self.config.frequencies_hz.iter().enumerate() {
+                let rot = block_phase(f, fs, first);
+                values.extend(
+                    sums[k * channels..(k + 1) * channels]
+                        .iter()
+                        .map(|&(sr, si)| Complex64::new(sr, si) * rot),
+                );
+            }
+            let centre = (first as f64 + (n as f64 - 1.0) / 2.0) / fs;
+            out.push(Epoch {
+                start_index: first,
+                centre_time_s: centre,
+                values,
+            });
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Default plan: 100 kHz, N = 16 000 (6.25 Hz bins), working 1025/2075/3125 Hz,
+    /// pilots ±25 Hz (4 bins).
+    fn plan() -> DetectorConfig {
+        DetectorConfig::three_frequency_plan(100_000.0, 16_000, [1025.0, 2075.0, 3125.0], 25.0)
+    }
+
+    fn tone(fs: f64, n: usize, start: u64, f: f64, a: f64, b: f64) -> Vec<f32> {
+        (0..n)
+            .map(|i| {
+                let t = (start + i as u64) as f64 / fs;
+                (a * (TAU * f * t).cos() + b * (TAU * f * t).sin()) as f32
+            })
+            .collect()
+    }
+
+    #[test]
+    fn recovers_amplitude_and_phase_at_any_block() {
+        let d = SyncDetector::new(plan()).unwrap();
+        for start in [0u64, 16_000, 123_457] {
+            let u = tone(1e5, 16_000, start, 2075.0, 0.7, -0.3);
+            let v = d.detect_block(&u, start).unwrap();
+            assert!(
+                (v[3] - Complex64::new(0.7, -0.3)).norm() < 1e-6,
+                "{start}: {}",
+                v[3]
+            );
+        }
+    }
+
+    #[test]
+    fn cross_talk_of_plan_frequencies_and_power_harmonics_is_below_noise() {
+        let cfg = plan();
+        let d = SyncDetector::new(cfg.clone()).unwrap();
+        let ct = d.cross_talk();
+        for (k, row) in ct.iter().enumerate() {
+            for (j, &v) in row.iter().enumerate() {
+                assert!(
+                    if j == k {
+                        (v - 1.0).abs() < 1e-6
+                    } else {
+                        v < 1e-10
+                    },
+                    "C[{k}][{j}] = {v}"
+                );
+            }
+        }
+        let mut others: Vec<f64> = cfg.frequencies_hz.clone();
+        others.extend((1..=12).map(|h| 400.0 * h as f64));
+        for k in 0..cfg.frequencies_hz.len() {
+            let own = d.frequency_response(k, cfg.frequencies_hz[k]).unwrap();
+            assert!((own - 1.0).abs() < 1e-6, "own response {own}");
+            for &f in others.iter().filter(|&&f| f != cfg.frequencies_hz[k]) {
+                let g = d.frequency_response(k, f).unwrap();
+                // Exact zeros up to rounding (f64 DTFT of 16 000 samples).
+                assert!(g < 1e-10, "detector {k} at {f} Hz: {g}");
+            }
+        }
+        // Between bins the Blackman–Harris sidelobes are below −90 dB far away...
+        let far = d.frequency_response(0, 1025.0 + 103.1).unwrap();
+        assert!(far < 3.2e-5, "{far}");
+        // ...and a rectangular window leaks orders of magnitude more there.
+        let rect = SyncDetector::new(DetectorConfig {
+            window: Window::Rectangular,
+            ..cfg
+        })
+        .unwrap();
+        assert!(rect.frequency_response(0, 1025.0 + 103.1).unwrap() > 100.0 * far);
+        // The curve has its maximum at the detector frequency and ≥ 4 exact nulls nearby.
+        let curve = d.response_curve(0, 975.0, 1075.0, 401).unwrap();
+        let peak = curve
+            .iter()
+            .cloned()
+            .fold((0.0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        assert_eq!(peak.0, 1025.0);
+        assert!(curve.iter().filter(|p| p.1 < 1e-10).count() >= 4);
+        assert!(d.response_curve(0, 1.0, 1.0, 10).is_err());
+    }
+
+    #[test]
+    fn measured_cross_talk_matches_response_bound() {
+        let d = SyncDetector::new(plan()).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..10 {
+            let f = rng.random_range(900.0..1150.0);
+            let th: f64 = rng.random_range(0.0..TAU);
+            let u = tone(1e5, 16_000, 0, f, th.cos(), th.sin());
+            let v = d.detect_block(&u, 0).unwrap()[0].norm();
+            let bound = d.frequency_response(0, f).unwrap();
+            assert!(v <= bound * (1.0 + 1e-6) + 2e-7, "f {f}: {v} > {bound}");
+        }
+    }
+
+    #[test]
+    fn interleaved_matches_per_channel_and_rejects_bad_input() {
+        let d = SyncDetector::new(plan()).unwrap();
+        let chans: Vec<Vec<f32>> = (0..3)
+            .map(|c| tone(1e5, 32_000, 0, 3125.0, 0.1 * (c + 1) as f64, 0.05))
+            .collect();
+        let data: Vec<f32> = (0..32_000)
+            .flat_map(|i| chans.iter().map(move |ch| ch[i]))
+            .collect();
+        let ep = d.detect_interleaved(&data, 3, 0).unwrap();
+        assert_eq!(ep.len(), 2);
+        for c in 0..3 {
+            let v = ep[1].values[6 * 3 + c];
+            assert!((v - Complex64::new(0.1 * (c + 1) as f64, 0.05)).norm() < 1e-6);
+        }
+        assert!(d.detect_block(&[0.0; 10], 0).is_err());
+        assert!(d.detect_interleaved(&data, 0, 0).is_err());
+        assert!(
+            SyncDetector::new(DetectorConfig {
+                frequencies_hz: vec![60_000.0],
+                ..plan()
+            })
+            .is_err()
+        );
+        assert!(
+            SyncDetector::new(DetectorConfig {
+                window_len: 2,
+                ..plan()
+            })
+            .is_err()
+        );
+    }
+
+    /// Frequency response against SciPy (`tools/reference/em_detector_response.py`).
+    #[test]
+    fn frequency_response_matches_scipy_reference() {
+        let v: serde_json::Value =
+            serde_json::from_str(include_str!("../../tests/data/detector_response.json")).unwrap();
+        let d = SyncDetector::new(DetectorConfig {
+            sample_rate_hz: v["fs_hz"].as_f64().unwrap(),
+            window_len: v["n"].as_u64().unwrap() as usize,
+            window: Window::BlackmanHarris,
+            frequencies_hz: vec![v["fk_hz"].as_f64().unwrap()],
+        })
+        .unwrap();
+        let rows = v["rows"].as_array().unwrap();
+        assert!(rows.len() >= 10);
+        for row in rows {
+            let f = row["f_hz"].as_f64().unwrap();
+            let want = row["response"].as_f64().unwrap();
+            let got = d.frequency_response(0, f).unwrap();
+            assert!(
+                (got - want).abs() < 1e-12 + 1e-9 * want,
+                "{f} Hz: {got} vs {want}"
+            );
+        }
+    }
+}

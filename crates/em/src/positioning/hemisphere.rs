@@ -1,0 +1,68 @@
+//! Resolution of the `±r` ambiguity (seed `001_…` part I; spec
+//! `em-positioning.md`: "resolve the hemisphere from a prior half-space (a
+//! towed bird is behind and below) and continuity").
+//!
+//! `Ω(r) = Ω(−r)`, so the data fix the direction only up to sign. The sign
+//! is chosen so that `e · n > 0` for the configured half-space normal `n`;
+//! when `|e · n|` falls below `margin` (the direction is nearly in the
+//! dividing plane) the sign closest to the previous epoch's direction wins.
+
+use nalgebra::Vector3;
+
+/// Half-space prior plus continuity memory for the sign of the direction.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Hemisphere {
+    /// Normal of the half-space the receiver is assumed in (transmitter frame).
+    pub normal: Vector3<f64>,
+    /// Below this `|e·n|/|n|` the previous direction decides (dimensionless).
+    pub margin: f64,
+    /// Direction of the previous epoch (unit), if any.
+    pub previous: Option<Vector3<f64>>,
+}
+
+impl Hemisphere {
+    /// A prior half-space `e · normal > 0` with a continuity margin of 0.2
+    /// (≈ 11.5° from the dividing plane).
+    pub fn new(normal: Vector3<f64>) -> Self {
+        Self {
+            normal,
+            margin: 0.2,
+            previous: None,
+        }
+    }
+
+    /// Orient `e` (unit) and remember it for the next epoch.
+    pub fn resolve(&mut self, e: &Vector3<f64>) -> Vector3<f64> {
+        let n = self.normal.norm();
+        let s = if n > 0.0 {
+            e.dot(&self.normal) / n
+        } else {
+            0.0
+        };
+        let flip = match self.previous {
+            Some(p) if s.abs() < self.margin => e.dot(&p) < 0.0,
+            _ => s < 0.0,
+        };
+        let out = if flip { -e } else { *e };
+        self.previous = Some(out);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_space_then_continuity() {
+        // Bird behind (−x) and below (+z, NED-like): normal (−1, 0, 1).
+        let mut h = Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0));
+        let e = Vector3::new(-0.8, 0.0, 0.6).normalize();
+        assert!(h.resolve(&(-e)).dot(&e) > 0.99);
+        // Nearly in the dividing plane: continuity wins over the weak prior.
+        let e2 = Vector3::new(0.68, 0.1, 0.72).normalize(); // e·n ≈ +0.03
+        let mut h2 = Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0));
+        h2.previous = Some(-e2);
+        assert!(h2.resolve(&e2).dot(&e2) < 0.0);
+    }
+}
