@@ -32,7 +32,10 @@
 //! Scenarios ([`ScenarioKind`]): `calibration` (four-heading box at 3000 m
 //! with roll/pitch/yaw manoeuvres), `calibration_truncated` (the thesis'
 //! truncated pattern, ≈ 73 % of the time), `survey` (12 lines + 3 ties at
-//! 100 m above ground with turbulence). Scenario files are TOML; every field
+//! 100 m above ground with turbulence), `helicopter` (the box at 40 m/s and
+//! 100 Hz with a fuselage and a main rotor of magnetised, conducting blades
+//! with coning and tip-path-plane tilt, [`scenario::helicopter`],
+//! [`platform::rotor`]). Scenario files are TOML; every field
 //! has a documented default (see the `*Config` types and
 //! [`scenario::config`]); unknown fields are errors.
 //!
@@ -101,6 +104,12 @@
 //! | `true_interf_x`, `true_interf_y`, `true_interf_z` | nT | aircraft field ΔB at the scalar sensor, body axes |
 //! | `true_flux_x`, `true_flux_y`, `true_flux_z` | nT | true total field at the fluxgate, body axes, before sensor errors |
 //! | `true_current_<name>` | A | true current of an on-board loop |
+//!
+//! The `helicopter` scenario adds `rotor_phase` (deg, recorded),
+//! `true_rotor_phase` (deg), `true_rotor_hz` (Hz), `true_coning`,
+//! `true_tilt_lon`, `true_tilt_lat` (deg), `true_rotor`, `true_fuselage`
+//! and `true_rotor_x`, `true_rotor_y`, `true_rotor_z` (nT); there
+//! `true_interf = true_fuselage + true_rotor` (see [`scenario::helicopter`]).
 //!
 //! ## Determinism and speed
 //!

@@ -547,5 +547,9 @@ fn files_are_written_and_documented() {
         "calibration-truncated".parse::<ScenarioKind>().unwrap(),
         ScenarioKind::CalibrationTruncated
     );
-    assert!("helicopter".parse::<ScenarioKind>().is_err());
+    assert_eq!(
+        "helicopter".parse::<ScenarioKind>().unwrap(),
+        ScenarioKind::Helicopter
+    );
+    assert!("no-such-scenario".parse::<ScenarioKind>().is_err());
 }

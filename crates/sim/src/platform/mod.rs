@@ -6,8 +6,12 @@
 //! * [`currents`] — the time series of the on-board currents (random
 //!   switching and fluctuation) and their recorded channels.
 //!
-//! Later platforms (helicopter fuselage and rotor, towed pod) belong here,
-//! one model per file.
+//! * [`rotor`] — a helicopter's main rotor: magnetised, conducting thin
+//!   blades with coning and tip-path-plane tilt, dipole integral along each
+//!   blade (the fuselage of the `helicopter` scenario is an [`aircraft`]).
+//!
+//! Later platforms (towed pod) belong here, one model per file.
 
 pub mod aircraft;
 pub mod currents;
+pub mod rotor;

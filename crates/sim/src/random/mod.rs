@@ -43,6 +43,10 @@ pub enum Stream {
     BaseStation = 7,
     /// On-board electric currents.
     Currents = 8,
+    /// Helicopter rotor speed and initial phase.
+    HelicopterRotor = 16,
+    /// Noise of the recorded rotor phase.
+    HelicopterRotorPhase = 17,
 }
 
 /// A generator for `stream` of the scenario `seed`.

@@ -6,6 +6,7 @@
 //! | `calibration` | full four-heading box with roll/pitch/yaw manoeuvres at 3000 m ([`calibration`]) | quiet |
 //! | `calibration_truncated` | the truncated box (≈ 73 % of the time) | quiet |
 //! | `survey` | 12 lines + 3 tie lines at 100 m above ground, turbulence ([`survey`]) | realistic gradients, two dipoles |
+//! | `helicopter` | the box at 40 m/s, 150 m above ground, 100 Hz, fuselage + main rotor ([`helicopter`]) | realistic |
 //!
 //! All fixed-wing scenarios share the configuration of [`config`] and the
 //! pipeline of [`fixed_wing`] (the same aircraft and sensors; only the
@@ -18,6 +19,7 @@
 pub mod calibration;
 pub mod config;
 pub mod fixed_wing;
+pub mod helicopter;
 pub mod survey;
 
 use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};
@@ -39,12 +41,18 @@ pub enum ScenarioKind {
     CalibrationTruncated,
     /// Survey lines and tie lines.
     Survey,
+    /// Helicopter with a main rotor ([`helicopter`]).
+    Helicopter,
 }
 
 impl ScenarioKind {
     /// Every scenario.
-    pub const ALL: [ScenarioKind; 3] =
-        [Self::Calibration, Self::CalibrationTruncated, Self::Survey];
+    pub const ALL: [ScenarioKind; 4] = [
+        Self::Calibration,
+        Self::CalibrationTruncated,
+        Self::Survey,
+        Self::Helicopter,
+    ];
 
     /// The name used on the command line and in file names.
     pub fn name(self) -> &'static str {
@@ -52,6 +60,7 @@ impl ScenarioKind {
             Self::Calibration => "calibration",
             Self::CalibrationTruncated => "calibration_truncated",
             Self::Survey => "survey",
+            Self::Helicopter => "helicopter",
         }
     }
 }
@@ -160,6 +169,14 @@ pub fn simulate(
             let cfg = FixedWingConfig::parse_over(survey_defaults(), kind, config_toml, seed)?;
             fixed_wing::run(&cfg, kind)
         }
+        ScenarioKind::Helicopter => {
+            let cfg = helicopter::HelicopterConfig::parse_over(
+                helicopter::helicopter_defaults(),
+                config_toml,
+                seed,
+            )?;
+            helicopter::run(&cfg)
+        }
     }
 }
 
@@ -171,5 +188,6 @@ pub fn default_config_toml(kind: ScenarioKind) -> Result<String> {
             calibration_defaults(kind == ScenarioKind::CalibrationTruncated).to_toml(kind)
         }
         ScenarioKind::Survey => survey_defaults().to_toml(kind),
+        ScenarioKind::Helicopter => helicopter::helicopter_defaults().to_toml(),
     }
 }

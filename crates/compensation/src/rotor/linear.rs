@@ -1,0 +1,250 @@
+//! The linear rotor model fitted by least squares (spec `helicopter.md`
+//! part A; seed `000_…` §16, "simplified model", extended).
+//!
+//! With the blade axes `R_j = [r_p e_l e_u]` known from the geometry, the
+//! rotor phase `ψ(t)` and the flap angles ([`super::blade`]), the field of
+//! blade `j` projected on the field direction `e = B/|B|` is linear in the
+//! blade's magnetic parameters:
+//!
+//! `ΔT_j = eᵀ D_I,j [ λk0_j r_p + (λ_j/μ0) r_p (r_pᵀ B) + γ_j (ω × B) + …]`
+//!
+//! * [`BladeTerms::Simplified`] — the thesis' model: hard magnetisation
+//!   along the blade (`Q_K = k0 I`, parameter `h_∥ = λk0`, A·m), soft
+//!   magnetisation along the blade (`χA_∥`, m²), eddy currents
+//!   `ΔB_i ≈ γ D_I (ω × B)` (`γ`, A·m per T/s; the thesis writes
+//!   `−γ D_I [ω×] B`, the sign is absorbed in `γ`): 3 parameters per blade.
+//! * [`BladeTerms::Full`] — adds the hard magnetisation across the blade
+//!   (lead and flap directions: a general `Q_K`) and the soft magnetisation
+//!   across it (`χA_l e_l e_lᵀ B`, `χA_u e_u e_uᵀ B`; the latter also absorb
+//!   the quadrature part of lagging eddy currents): 7 parameters per blade.
+//!
+//! Per-blade parameters give the once-per-revolution component of
+//! dissimilar blades. The fit uses the data and the regressors high-passed
+//! by the same zero-phase Butterworth filter (so the slow fuselage
+//! interference, the anomaly and the diurnal variation do not enter), and
+//! the prediction uses the unfiltered regressors (so the slow part of the
+//! rotor field is predicted too).
+
+use aeromag_core::MU0_OVER_4PI;
+use aeromag_core::filter::{Band, butter, sosfiltfilt};
+use aeromag_estimation::least_squares::NormalEquations;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::blade::{FlapAngles, RotorGeometry, blade_axes, dipole_integral};
+use crate::error::{CompError, Result};
+
+const MU0: f64 = 4.0 * std::f64::consts::PI * MU0_OVER_4PI;
+
+/// Which blade parameters the model has (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BladeTerms {
+    /// Hard along, soft along, eddy: 3 per blade.
+    Simplified,
+    /// Plus hard lead/flap and soft lead/flap: 7 per blade.
+    Full,
+}
+
+impl BladeTerms {
+    /// Parameters per blade.
+    pub fn per_blade(self) -> usize {
+        match self {
+            Self::Simplified => 3,
+            Self::Full => 7,
+        }
+    }
+}
+
+/// The time series the model needs (all of length `n`).
+#[derive(Debug, Clone, Copy)]
+pub struct RotorInput<'a> {
+    /// External field in body axes (e.g. the fluxgate), nT.
+    pub b_body_nt: &'a [Vector3<f64>],
+    /// Unwrapped rotor phase (azimuth of blade 0), rad.
+    pub phase_rad: &'a [f64],
+    /// Rotor angular speed `dψ/dt`, rad/s.
+    pub omega_rad_s: &'a [f64],
+    /// Flap angles per sample (length `n`), or one set for all (length 1).
+    pub angles: &'a [FlapAngles],
+}
+
+impl RotorInput<'_> {
+    fn len(&self) -> Result<usize> {
+        let n = self.b_body_nt.len();
+        if self.phase_rad.len() != n
+            || self.omega_rad_s.len() != n
+            || !(self.angles.len() == n || self.angles.len() == 1)
+        {
+            return Err(CompError::BadData(
+                "rotor input: series of different lengths".into(),
+            ));
+        }
+        Ok(n)
+    }
+
+    fn angles_at(&self, k: usize) -> &FlapAngles {
+        &self.angles[if self.angles.len() == 1 { 0 } else { k }]
+    }
+}
+
+/// Regressor columns (nT per unit of each parameter; blade-major order,
+/// within a blade: hard along, soft along, eddy, then for
+/// [`BladeTerms::Full`] hard lead, hard up, soft lead, soft up).
+pub fn regressors(
+    geom: &RotorGeometry,
+    terms: BladeTerms,
+    input: &RotorInput,
+) -> Result<Vec<Vec<f64>>> {
+    geom.validate()?;
+    let n = input.len()?;
+    let nb = geom.blades;
+    let pb = terms.per_blade();
+    let a = geom.sensor_from_hub();
+    let mut cols = vec![vec![0.0; n]; nb * pb];
+    for k in 0..n {
+        let b = input.b_body_nt[k] * 1e-9;
+        let bn = b.norm();
+        if !(bn.is_finite() && bn > 0.0) {
+            return Err(CompError::BadData(format!(
+                "rotor input: field at sample {k} is zero or not finite"
+            )));
+        }
+        let e = b / bn;
+        let w = Vector3::new(0.0, 0.0, input.omega_rad_s[k]);
+        let wb = w.cross(&b);
+        for j in 0..nb {
+            let psi = input.phase_rad[k] + std::f64::consts::TAU * j as f64 / nb as f64;
+            let r = blade_axes(psi, input.angles_at(k));
+            let (rp, el, eu) = (
+                r.column(0).into_owned(),
+                r.column(1).into_owned(),
+                r.column(2).into_owned(),
+            );
+            let g = dipole_integral(&a, &rp, geom.root_m, geom.tip_m)?.transpose() * e * 1e9;
+            let c = j * pb;
+            cols[c][k] = g.dot(&rp);
+            cols[c + 1][k] = g.dot(&rp) * rp.dot(&b) / MU0;
+            cols[c + 2][k] = g.dot(&wb);
+            if terms == BladeTerms::Full {
+                cols[c + 3][k] = g.dot(&el);
+                cols[c + 4][k] = g.dot(&eu);
+                cols[c + 5][k] = g.dot(&el) * el.dot(&b) / MU0;
+                cols[c + 6][k] = g.dot(&eu) * eu.dot(&b) / MU0;
+            }
+        }
+    }
+    Ok(cols)
+}
+
+/// Options of the least-squares fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RotorFitOptions {
+    /// Cutoff of the 4th-order zero-phase high-pass applied to the data and
+    /// the regressors, Hz (below the rotor frequency, above the manoeuvres
+    /// and the anomaly). Default 2.
+    pub highpass_hz: f64,
+    /// Samples within this time of either end are not fitted, s. Default 2.
+    pub edge_s: f64,
+    /// Ridge parameter of the normal equations. Default 1e-9.
+    pub ridge: f64,
+}
+
+impl Default for RotorFitOptions {
+    fn default() -> Self {
+        Self {
+            highpass_hz: 2.0,
+            edge_s: 2.0,
+            ridge: 1e-9,
+        }
+    }
+}
+
+/// A fitted rotor model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RotorFit {
+    /// The terms.
+    pub terms: BladeTerms,
+    /// Parameters in regressor order (units in [`regressors`]).
+    pub params: Vec<f64>,
+    /// RMS of the high-passed fit residual, nT.
+    pub residual_rms_nt: f64,
+}
+
+/// Zero-phase high-pass of `x` (4th order Butterworth).
+pub fn highpass(x: &[f64], fs_hz: f64, cutoff_hz: f64) -> Result<Vec<f64>> {
+    let sos = butter(4, Band::Highpass { cutoff_hz }, fs_hz)?;
+    Ok(sosfiltfilt(&sos, x)?)
+}
+
+/// Fit the parameters to `mag_nt` (the scalar reading, any slow parts
+/// included) sampled at `fs_hz`.
+pub fn fit(
+    geom: &RotorGeometry,
+    terms: BladeTerms,
+    input: &RotorInput,
+    mag_nt: &[f64],
+    fs_hz: f64,
+    opts: &RotorFitOptions,
+) -> Result<RotorFit> {
+    let cols = regressors(geom, terms, input)?;
+    fit_columns(&cols, terms, mag_nt, fs_hz, opts)
+}
+
+/// Fit given precomputed regressor columns.
+pub fn fit_columns(
+    cols: &[Vec<f64>],
+    terms: BladeTerms,
+    mag_nt: &[f64],
+    fs_hz: f64,
+    opts: &RotorFitOptions,
+) -> Result<RotorFit> {
+    let n = mag_nt.len();
+    if cols.iter().any(|c| c.len() != n) {
+        return Err(CompError::BadData(
+            "rotor fit: regressors and data differ in length".into(),
+        ));
+    }
+    let edge = (opts.edge_s * fs_hz).round() as usize;
+    if n <= 2 * edge + 10 * cols.len() {
+        return Err(CompError::BadData("rotor fit: too few samples".into()));
+    }
+    let hp: Vec<Vec<f64>> = cols
+        .iter()
+        .map(|c| highpass(c, fs_hz, opts.highpass_hz))
+        .collect::<Result<_>>()?;
+    let y = highpass(mag_nt, fs_hz, opts.highpass_hz)?;
+    let mut ne = NormalEquations::new(cols.len());
+    let slices: Vec<&[f64]> = hp.iter().map(|c| &c[edge..n - edge]).collect();
+    ne.add_columns(&slices, &y[edge..n - edge])
+        .map_err(|e| CompError::BadData(format!("rotor fit: {e}")))?;
+    let sol = ne
+        .solve(opts.ridge)
+        .map_err(|e| CompError::BadData(format!("rotor fit failed: {e}")))?;
+    let rows = (n - 2 * edge) as f64;
+    Ok(RotorFit {
+        terms,
+        params: sol.coef.iter().copied().collect(),
+        residual_rms_nt: (sol.rss.max(0.0) / rows).sqrt(),
+    })
+}
+
+impl RotorFit {
+    /// The rotor interference `Σ params · regressors`, nT.
+    pub fn predict(&self, geom: &RotorGeometry, input: &RotorInput) -> Result<Vec<f64>> {
+        let cols = regressors(geom, self.terms, input)?;
+        self.predict_columns(&cols)
+    }
+
+    /// Prediction from precomputed columns.
+    pub fn predict_columns(&self, cols: &[Vec<f64>]) -> Result<Vec<f64>> {
+        if cols.len() != self.params.len() {
+            return Err(CompError::BadData(
+                "rotor model: wrong number of regressors".into(),
+            ));
+        }
+        let n = cols.first().map_or(0, |c| c.len());
+        Ok((0..n)
+            .map(|k| cols.iter().zip(&self.params).map(|(c, p)| c[k] * p).sum())
+            .collect())
+    }
+}
