@@ -6,6 +6,9 @@ use crate::input::InputArgs;
 use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
+use aeromag_compensation::kalman::{
+    fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment,
+};
 use aeromag_io::FlightTable;
 use std::path::PathBuf;
 
@@ -30,9 +33,15 @@ pub struct Args {
     /// Where to write the model file (JSON).
     #[arg(long, value_name = "MODEL.json")]
     model: PathBuf,
-    /// Fitting method: ls (band-pass least squares).
+    /// Fitting method: `ls` (band-pass least squares) or `kalman` (Kalman
+    /// filter and smoother with a stochastic model of the external field;
+    /// needs `alt` and ground speed from `vn`,`ve` or positions).
     #[arg(long, default_value = "ls")]
     method: String,
+    /// With --method kalman: tune the noise intensities q1, q2, r by maximum
+    /// likelihood of the innovations (otherwise the documented defaults).
+    #[arg(long)]
+    tune: bool,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
     #[arg(long, default_value = "p3,i5,e8")]
     terms: String,
@@ -140,19 +149,89 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, split_lines: bool, referen
     })
 }
 
-pub fn run(a: Args) -> anyhow::Result<()> {
-    if a.method != "ls" {
-        return Err(bad_input!("--method {}: only `ls` is available in this version", a.method));
+/// Ground speed (m/s) from `vn`, `ve` when present, else from the positions.
+fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
+    Ok(match (table.column("vn"), table.column("ve")) {
+        (Some(vn), Some(ve)) => ground_speed_from_velocity(vn, ve),
+        _ => ground_speed_from_positions(table.require("time")?, table.require("lat")?, table.require("lon")?),
+    })
+}
+
+/// Fit a model with the Kalman method on a loaded calibration table.
+pub fn fit_model_kalman(
+    table: &FlightTable,
+    cfg: &KalmanConfig,
+    split_lines: bool,
+    reference: &str,
+) -> anyhow::Result<(TlModel, KalmanFit)> {
+    let cols = TlColumns::from_table(table)?;
+    let ref_cols = reference_columns(table, reference)?;
+    let ref_sum = reference_sum(table, &ref_cols)?;
+    let y: Vec<f64> = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
+    let alt = table.require("alt")?;
+    let speed = ground_speed(table)?;
+    let cols = TlColumns { mag: &y, ..cols };
+    let (segs, _) = cols.segments(split_lines, 1);
+    let segments: Vec<KalmanSegment> = segs
+        .iter()
+        .map(|r| KalmanSegment {
+            data: Segment {
+                time: &cols.time[r.clone()],
+                flux: [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]],
+                mag: &cols.mag[r.clone()],
+            },
+            alt_m: &alt[r.clone()],
+            speed_m_s: &speed[r.clone()],
+        })
+        .collect();
+    let spinner = crate::progress::spinner("Kalman filter and smoother");
+    let fit = fit_kalman(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    spinner.finish_and_clear();
+    for w in &fit.warnings {
+        eprintln!("warning: {w}");
     }
-    let cfg = config(&a)?;
+    let mut model = fit.to_model(cfg);
+    model.reference = ref_cols.clone();
+    model.columns = ["time", "flux_x", "flux_y", "flux_z", "mag", "alt"]
+        .iter()
+        .map(|c| c.to_string())
+        .chain(ref_cols)
+        .map(|c| {
+            let file = table.resolve(&c).unwrap_or(&c).to_string();
+            (c, file)
+        })
+        .collect();
+    Ok((model, fit))
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
     let table = a.input.load()?;
-    let model = fit_model(&table, &cfg, !a.no_split_lines, &a.reference)?;
+    let model = match a.method.as_str() {
+        "ls" => fit_model(&table, &config(&a)?, !a.no_split_lines, &a.reference)?,
+        "kalman" => {
+            let ls = config(&a)?;
+            let mut cfg = KalmanConfig { terms: ls.terms, convention: ls.convention, bt_scale_nt: ls.bt_scale_nt, ..KalmanConfig::default() };
+            cfg.tuning.enabled = a.tune;
+            let (model, fit) = fit_model_kalman(&table, &cfg, !a.no_split_lines, &a.reference)?;
+            println!(
+                "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
+                fit.noise.q1_nt2_per_m5,
+                fit.noise.q2_nt2_per_m5,
+                fit.noise.r_nt2,
+                if fit.tuning.is_some() { "tuned by maximum likelihood" } else { "defaults" }
+            );
+            model
+        }
+        m => return Err(bad_input!("--method {m}: use `ls` or `kalman`")),
+    };
+    let cfg_terms = model.terms.clone();
     std::fs::write(&a.model, model.to_json()?)
         .map_err(|e| anyhow::anyhow!("cannot write model file '{}': {e}", a.model.display()))?;
     println!(
-        "fitted {} terms ({}) on {} rows in {} legs: residual {:.4} nT RMS (band-passed), condition {:.2e}",
+        "fitted {} terms ({}, method {}) on {} rows in {} legs: residual {:.4} nT RMS, condition {:.2e}",
         model.coefficients.len(),
-        cfg.terms,
+        cfg_terms,
+        model.method,
         model.fit.rows,
         model.fit.segments,
         model.fit.residual_rms_nt,

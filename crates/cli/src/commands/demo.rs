@@ -1,10 +1,13 @@
 //! `aeromag demo`: the whole chain on built-in simulated data.
 
 use crate::analysis::{add_to_report, figures, Figures};
-use crate::commands::calibrate::fit_model;
+use crate::commands::calibrate::{fit_model, fit_model_kalman};
 use crate::commands::compensate::compensate_table;
 use crate::input::load;
+use aeromag_compensation::kalman::KalmanConfig;
+use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
+use aeromag_io::FlightTable;
 use aeromag_report::Report;
 use aeromag_sim::{simulate, ScenarioKind};
 use serde_json::json;
@@ -14,9 +17,10 @@ use std::time::Instant;
 /// Run aeromag end to end on simulated data with known truth.
 ///
 /// Simulates a calibration box (four headings with roll, pitch and yaw
-/// manoeuvres, quiet area) and an independent survey flight with the same
-/// aircraft, fits the Tolles-Lawson model on the calibration flight by
-/// band-pass least squares, compensates both flights, scores the result
+/// manoeuvres) over a quiet area and over realistic geology, and an
+/// independent survey flight with the same aircraft; fits the Tolles-Lawson
+/// model on each calibration flight by band-pass least squares and by the
+/// Kalman method, compensates the survey, scores the result
 /// against the simulator's truth, prints a summary table, and writes
 /// DIR/summary.json, DIR/index.html (single-file report, plots inline), the
 /// model file and the simulated and compensated data.
@@ -45,26 +49,45 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let data = a.out.join("data");
     std::fs::create_dir_all(&data)?;
     let bar = crate::progress::bar(5, "demo");
+    if a.quick {
+        eprintln!("--quick: the truncated calibration pattern is used");
+    }
 
-    // 1. Simulate.
+    // 1. Simulate: a quiet calibration area (the default), the same aircraft
+    //    calibrated over realistic geology, and an independent survey.
     bar.set_message("simulating");
     let cal_kind = if a.quick { ScenarioKind::CalibrationTruncated } else { ScenarioKind::Calibration };
     let cal_files = simulate(cal_kind, None, Some(a.seed))?.write_to_dir(&data)?;
+    let grad_dir = data.join("gradient_area");
+    let grad_files =
+        simulate(cal_kind, Some("[anomaly]\narea = \"realistic\"\n"), Some(a.seed))?.write_to_dir(&grad_dir)?;
     let survey_files = simulate(ScenarioKind::Survey, None, Some(a.seed + 1))?.write_to_dir(&data)?;
     bar.inc(1);
 
-    // 2. Calibrate (read back the files, as a user would).
+    // 2. Calibrate by both methods (reading the files back, as a user would).
     bar.set_message("calibrating");
-    let mut cal = load(&cal_files.csv, None)?;
-    let model = fit_model(&cal, &LsConfig::default(), true, "auto")?;
+    let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel)> {
+        let t = load(path, None)?;
+        let ls = fit_model(&t, &LsConfig::default(), true, "auto")?;
+        let (kf, _) = fit_model_kalman(&t, &KalmanConfig::default(), true, "auto")?;
+        Ok((t, ls, kf))
+    };
+    let (mut cal, model, model_kf) = fit_both(&cal_files.csv)?;
+    let (_, grad_ls, grad_kf) = fit_both(&grad_files.csv)?;
     std::fs::write(a.out.join("model_ls.json"), model.to_json()?)?;
+    std::fs::write(a.out.join("model_kalman.json"), model_kf.to_json()?)?;
     bar.inc(1);
 
-    // 3. Compensate both flights.
+    // 3. Compensate.
     bar.set_message("compensating");
-    let mut survey = load(&survey_files.csv, None)?;
+    let survey_raw = load(&survey_files.csv, None)?;
+    let compensated = |m: &TlModel| -> anyhow::Result<FlightTable> {
+        let mut t = survey_raw.clone();
+        compensate_table(m, &mut t)?;
+        Ok(t)
+    };
     compensate_table(&model, &mut cal)?;
-    compensate_table(&model, &mut survey)?;
+    let survey = compensated(&model)?;
     aeromag_io::write_csv(&cal, &a.out.join("calibration_comp.csv"))?;
     aeromag_io::write_csv(&survey, &a.out.join("survey_comp.csv"))?;
     bar.inc(1);
@@ -73,6 +96,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.set_message("scoring");
     let fc: Figures = figures(&cal, &model.reference)?;
     let fsv: Figures = figures(&survey, &model.reference)?;
+    let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> { Ok(figures(&compensated(m)?, &m.reference)?.residual_rms_nt) };
+    let res_kf = residual(&model_kf)?;
+    let (grad_res_ls, grad_res_kf) = (residual(&grad_ls)?, residual(&grad_kf)?);
     bar.inc(1);
 
     // 5. Report.
@@ -80,6 +106,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let summary = json!({
         "compensation": {
             "residual_rms_ls_nt": fsv.residual_rms_nt,
+            "residual_rms_kalman_nt": res_kf,
             "noise_floor_nt": fsv.noise_floor_nt,
             "fom_before_nt": fc.fom_before_nt,
             "fom_after_nt": fc.fom_after_nt,
@@ -87,6 +114,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "fom_windows": fc.fom_windows,
             "calibration_residual_rms_ls_nt": fc.residual_rms_nt,
             "survey_ir": fsv.ir,
+        },
+        "compensation_gradient": {
+            "residual_rms_ls_nt": grad_res_ls,
+            "residual_rms_kalman_nt": grad_res_kf,
+            "noise_floor_nt": fsv.noise_floor_nt,
         },
         "seed": a.seed,
         "software_version": env!("CARGO_PKG_VERSION"),
@@ -96,19 +128,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     r.section("Summary").paragraph(format!(
         "A simulated aircraft (magnetised and conducting parts, exact dipole fields) flies a {} and an \
          independent survey (seed {}). The Tolles-Lawson model ({} terms) is fitted on the calibration flight \
-         by band-pass least squares and applied to both. Residuals are scored against the simulator's truth.",
+         by band-pass least squares (LS) and by the Kalman filter and smoother with a stochastic field model, \
+         and applied to the survey. Residuals are scored against the simulator's truth (per survey line, mean \
+         removed). The same aircraft is also calibrated over realistic geology (gradient area).",
         if a.quick { "truncated calibration box" } else { "four-heading calibration box" },
         a.seed,
         model.terms
     ));
+    r.table(aeromag_report::Table::new(
+        ["calibration area", "LS residual (nT)", "Kalman residual (nT)", "noise floor (nT)"].map(String::from).to_vec(),
+        vec![
+            vec!["quiet".into(), fmt(fsv.residual_rms_nt, 4), fmt(res_kf, 4), fmt(fsv.noise_floor_nt, 4)],
+            vec!["realistic gradients".into(), fmt(grad_res_ls, 4), fmt(grad_res_kf, 4), fmt(fsv.noise_floor_nt, 4)],
+        ],
+        "Residual versus truth on the independent survey.",
+    ));
     r.key_values(vec![
-        ("residual vs truth on the survey, LS (nT)".into(), fmt(fsv.residual_rms_nt, 4)),
-        ("scalar sensor noise floor (nT)".into(), fmt(fsv.noise_floor_nt, 4)),
         ("FOM before / after (nT)".into(), format!("{} / {}", fmt(fc.fom_before_nt, 3), fmt(fc.fom_after_nt, 3))),
         ("improvement ratio (calibration)".into(), fmt(fc.ir, 1)),
     ]);
-    add_to_report(&mut r, "Calibration flight", &cal, &fc, Some(&model))?;
-    add_to_report(&mut r, "Survey flight (independent)", &survey, &fsv, None)?;
+    add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
+    add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
     r.write_html(a.out.join("index.html"))?;
     bar.inc(1);
     bar.finish_and_clear();
@@ -117,10 +157,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     println!("{:<44} {:>12}", "figure", "value");
     let rows = [
         ("compensation.residual_rms_ls_nt", fmt(fsv.residual_rms_nt, 4)),
+        ("compensation.residual_rms_kalman_nt", fmt(res_kf, 4)),
         ("compensation.noise_floor_nt", fmt(fsv.noise_floor_nt, 4)),
         ("compensation.fom_before_nt", fmt(fc.fom_before_nt, 3)),
         ("compensation.fom_after_nt", fmt(fc.fom_after_nt, 3)),
         ("compensation.ir", fmt(fc.ir, 1)),
+        ("compensation_gradient.residual_rms_ls_nt", fmt(grad_res_ls, 4)),
+        ("compensation_gradient.residual_rms_kalman_nt", fmt(grad_res_kf, 4)),
     ];
     for (k, v) in rows {
         println!("{k:<44} {v:>12}");
