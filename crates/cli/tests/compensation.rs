@@ -131,3 +131,34 @@ fn demo_meets_the_compensation_figures() {
     assert!(g("fom_after_nt") < g("fom_before_nt") / 20.0);
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
 }
+
+#[test]
+fn observability_tells_a_full_box_from_a_single_heading() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration", "8");
+    let o = aeromag(&["observability", "--input", cal.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("rank 16 of 16") && !s.contains("cannot determine"), "{s}");
+    // One straight leg: the permanent and induced terms are not determined.
+    let text = std::fs::read_to_string(&cal).unwrap();
+    let mut it = text.lines().filter(|l| !l.starts_with('#'));
+    let header = it.next().unwrap();
+    let h: Vec<&str> = header.split(',').collect();
+    let (li, mi) = (h.iter().position(|c| *c == "line").unwrap(), h.iter().position(|c| *c == "manoeuvre").unwrap());
+    let kept: Vec<&str> = it
+        .filter(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            c[li].parse::<f64>().ok() == Some(1.0) && c[mi].parse::<f64>().ok() == Some(0.0)
+        })
+        .collect();
+    let one = d.path().join("one.csv");
+    std::fs::write(&one, format!("{header}\n{}", kept.join("\n"))).unwrap();
+    let o = aeromag(&["observability", "--input", one.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("this flight cannot determine:") && s.contains("p_x") && s.contains("i_xx"), "{s}");
+    let j = aeromag(&["observability", "--input", one.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    assert_eq!(v["estimability"].as_array().unwrap().len(), 16);
+}
