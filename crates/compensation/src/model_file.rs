@@ -31,12 +31,19 @@ pub struct FitStats {
     pub rows: usize,
     /// Segments used.
     pub segments: usize,
-    /// Scaled condition number.
+    /// Scaled condition number (∞ for a singular fit: written as JSON `null`,
+    /// which JSON numbers cannot express, and read back as ∞).
+    #[serde(deserialize_with = "null_as_infinity")]
     pub condition: f64,
     /// RMS fit residual (filtered for `ls`), nT.
     pub residual_rms_nt: f64,
     /// Warnings raised while fitting.
     pub warnings: Vec<String>,
+}
+
+/// JSON has no ∞: `serde_json` writes it as `null`; read `null` back as ∞.
+fn null_as_infinity<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
 /// A Tolles-Lawson compensation model.
@@ -152,6 +159,14 @@ mod tests {
         let m = sample();
         let back = TlModel::from_json(&m.to_json().unwrap(), "m.json").unwrap();
         assert_eq!(m, back);
+    }
+
+    #[test]
+    fn an_infinite_condition_number_survives_the_round_trip() {
+        let mut m = sample();
+        m.fit.condition = f64::INFINITY;
+        let back = TlModel::from_json(&m.to_json().unwrap(), "m.json").unwrap();
+        assert_eq!(back.fit.condition, f64::INFINITY);
     }
 
     #[test]

@@ -15,6 +15,14 @@ pub enum EstError {
     /// The system cannot be solved (singular even with the ridge term).
     #[error("singular system: {0}")]
     Singular(String),
+    /// An error at one step of a sequential estimator (filter, smoother).
+    #[error("step {step}: {source}")]
+    AtStep {
+        /// The step (sample index) where it happened.
+        step: usize,
+        /// What went wrong.
+        source: Box<EstError>,
+    },
 }
 
 /// Result alias of this crate.

@@ -5,8 +5,12 @@
 //! | module | contents |
 //! |---|---|
 //! | [`least_squares`] | streaming (chunked) ridge least squares with scaling, diagnostics |
+//! | [`kalman`] | square-root Kalman filter (scalar updates), RTS smoother, innovations and likelihood |
+//! | [`optimize`] | derivative-free minimisation (Nelder–Mead) |
 
 pub mod error;
+pub mod kalman;
 pub mod least_squares;
+pub mod optimize;
 
 pub use error::{EstError, Result};

@@ -50,14 +50,17 @@
 //! `H` has `q₁ ≈ σ_xx²/H`, and `σ_xx ≈ σ_x/H` with `σ_x` the RMS along-track
 //! gradient: `q₁ ≈ σ_x²/H³`. A realistic area (3 nT/100 m at 100 m above
 //! ground) gives `σ_x ≈ 3·10⁻³ nT/m` at `H ≈ 3 km` above the sources,
-//! `q₁ ≈ 3·10⁻¹⁶ nT²/m⁵`; the vertical gradient has the same spectrum up to a
-//! factor (`q₂ ≈ q₁`). The diurnal variation adds to `B^h`: micropulsations
-//! of 0.3 nT with periods of minutes (wavelengths ~10 km at 90 m/s) have a
-//! second derivative of ~10⁻⁷ nT/m², comparable. The defaults
-//! [`NoiseModel::calibration_default`] are `q₁ = q₂ = 10⁻¹⁵ nT²/m⁵` and
-//! `r = (0.03 nT)²` (scalar-sensor noise, heading error and unmodelled
-//! interference); maximum-likelihood tuning ([`super::tuning`]) adjusts them
-//! to the flight.
+//! `q₁ ≈ 3·10⁻¹⁶ nT²/m⁵`. The *path* adds curvature: in a turn of radius
+//! `R` the along-track second derivative of a field with horizontal
+//! gradient `g` jumps by `g/R` (main field: `g ≈ 3·10⁻³ nT/m`, `R ≈ 1.7 km`
+//! at 90 m/s and 3°/s, so `≈ 2·10⁻⁶ nT/m²` per turn entry or exit); eight
+//! such jumps over a 56 km box give `q₁ ≈ 8 (2·10⁻⁶)² / 56 km ≈ 6·10⁻¹⁶`.
+//! The default is `q₁ = 10⁻¹⁵ nT²/m⁵`, which is also the maximum-likelihood
+//! value of the true main field plus anomaly along the simulator's
+//! calibration box (both areas). The vertical gradient has the same spectrum
+//! up to a factor: `q₂ = 10⁻¹⁵`. `r = 4·10⁻⁴ nT²` (0.02 nT RMS: scalar
+//! sensor noise, heading error and what the Tolles-Lawson model leaves).
+//! [`super::tuning`] adjusts them by maximum likelihood on request.
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -88,9 +91,13 @@ pub struct NoiseModel {
 
 impl NoiseModel {
     /// Defaults for a calibration flight at ~3 km (module docs):
-    /// `q₁ = q₂ = 10⁻¹⁵ nT²/m⁵`, `r = 9·10⁻⁴ nT²` (0.03 nT RMS).
+    /// `q₁ = q₂ = 10⁻¹⁵ nT²/m⁵`, `r = 4·10⁻⁴ nT²` (0.02 nT RMS).
     pub fn calibration_default() -> Self {
-        Self { q1_nt2_per_m5: 1e-15, q2_nt2_per_m5: 1e-15, r_nt2: 9e-4 }
+        Self {
+            q1_nt2_per_m5: 1e-15,
+            q2_nt2_per_m5: 1e-15,
+            r_nt2: 4e-4,
+        }
     }
 
     /// Whether every intensity is finite, `q ≥ 0` and `r > 0`.
@@ -131,14 +138,26 @@ pub struct X2Prior {
 
 impl Default for X2Prior {
     fn default() -> Self {
-        Self { b_nt: 1000.0, b_x_nt_per_m: 0.1, b_xx_nt_per_m2: 1e-4, b_z_nt_per_m: 0.1, b_zx_nt_per_m2: 1e-4 }
+        Self {
+            b_nt: 1000.0,
+            b_x_nt_per_m: 0.1,
+            b_xx_nt_per_m2: 1e-4,
+            b_z_nt_per_m: 0.1,
+            b_zx_nt_per_m2: 1e-4,
+        }
     }
 }
 
 impl X2Prior {
     /// The standard deviations in state order.
     pub fn stds(&self) -> [f64; X2_DIM] {
-        [self.b_nt, self.b_x_nt_per_m, self.b_xx_nt_per_m2, self.b_z_nt_per_m, self.b_zx_nt_per_m2]
+        [
+            self.b_nt,
+            self.b_x_nt_per_m,
+            self.b_xx_nt_per_m2,
+            self.b_z_nt_per_m,
+            self.b_zx_nt_per_m2,
+        ]
     }
 
     /// The prior factor (diagonal), `X2_DIM × X2_DIM`.
@@ -152,23 +171,20 @@ impl X2Prior {
     }
 }
 
-/// Exact transition over an along-track step (module docs), with the
-/// Cholesky factors of `M₁`, `M₂` computed once.
+/// Exact transition over an along-track step (module docs) for given noise
+/// intensities, with the Cholesky factors of `M₁`, `M₂` and `√q₁`, `√q₂`
+/// computed once.
 #[derive(Debug, Clone)]
 pub struct AnomalyTransition {
     l1: [[f64; 3]; 3],
     l2: [[f64; 2]; 2],
-}
-
-impl Default for AnomalyTransition {
-    fn default() -> Self {
-        Self::new()
-    }
+    s1: f64,
+    s2: f64,
 }
 
 impl AnomalyTransition {
-    /// Precompute the constant factors.
-    pub fn new() -> Self {
+    /// Precompute the constant factors for `noise`.
+    pub fn new(noise: &NoiseModel) -> Self {
         // Lower Cholesky factor of M₁ = [[1/20, 1/8, 1/6], [1/8, 1/3, 1/2], [1/6, 1/2, 1]].
         let l00 = (1.0f64 / 20.0).sqrt();
         let l10 = (1.0 / 8.0) / l00;
@@ -180,34 +196,45 @@ impl AnomalyTransition {
         let m00 = (1.0f64 / 3.0).sqrt();
         let m10 = 0.5 / m00;
         let m11 = (1.0 - m10 * m10).sqrt();
-        Self { l1: [[l00, 0.0, 0.0], [l10, l11, 0.0], [l20, l21, l22]], l2: [[m00, 0.0], [m10, m11]] }
+        Self {
+            l1: [[l00, 0.0, 0.0], [l10, l11, 0.0], [l20, l21, l22]],
+            l2: [[m00, 0.0], [m10, m11]],
+            s1: noise.q1_nt2_per_m5.max(0.0).sqrt(),
+            s2: noise.q2_nt2_per_m5.max(0.0).sqrt(),
+        }
     }
 
     /// Fill `phi` (5×5) and `g` (5×5, `Q = G Gᵀ`) for a step of `d ≥ 0` m.
-    pub fn fill(&self, d: f64, noise: &NoiseModel, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
-        phi.fill(0.0);
-        for i in 0..X2_DIM {
-            phi[(i, i)] = 1.0;
-        }
-        phi[(B_H, B_H_X)] = d;
-        phi[(B_H, B_H_XX)] = 0.5 * d * d;
-        phi[(B_H_X, B_H_XX)] = d;
-        phi[(B_Z, B_Z_X)] = d;
-        g.fill(0.0);
+    /// Panics if the matrices are not 5×5 (a programming error).
+    pub fn fill(&self, d: f64, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
+        assert!(
+            phi.shape() == (X2_DIM, X2_DIM) && g.shape() == (X2_DIM, X2_DIM),
+            "field transition matrices must be 5×5"
+        );
         let d = d.max(0.0);
+        // Column-major: entry (i, j) at i + 5 j.
+        let p = phi.as_mut_slice();
+        p.fill(0.0);
+        for i in 0..X2_DIM {
+            p[i + X2_DIM * i] = 1.0;
+        }
+        p[B_H + X2_DIM * B_H_X] = d;
+        p[B_H + X2_DIM * B_H_XX] = 0.5 * d * d;
+        p[B_H_X + X2_DIM * B_H_XX] = d;
+        p[B_Z + X2_DIM * B_Z_X] = d;
+        let gs = g.as_mut_slice();
+        gs.fill(0.0);
         let sd = d.sqrt();
         let t1 = [d * d * sd, d * sd, sd];
-        let s1 = noise.q1_nt2_per_m5.sqrt();
         for i in 0..3 {
             for j in 0..=i {
-                g[(i, j)] = s1 * t1[i] * self.l1[i][j];
+                gs[i + X2_DIM * j] = self.s1 * t1[i] * self.l1[i][j];
             }
         }
         let t2 = [d * sd, sd];
-        let s2 = noise.q2_nt2_per_m5.sqrt();
         for i in 0..2 {
             for j in 0..=i {
-                g[(B_Z + i, B_Z + j)] = s2 * t2[i] * self.l2[i][j];
+                gs[(B_Z + i) + X2_DIM * (B_Z + j)] = self.s2 * t2[i] * self.l2[i][j];
             }
         }
     }
@@ -221,12 +248,16 @@ mod tests {
     /// triple integrator, against G Gᵀ.
     #[test]
     fn noise_factor_reproduces_the_integrated_covariance() {
-        let tr = AnomalyTransition::new();
-        let noise = NoiseModel { q1_nt2_per_m5: 2.5e-15, q2_nt2_per_m5: 7e-16, r_nt2: 1.0 };
+        let noise = NoiseModel {
+            q1_nt2_per_m5: 2.5e-15,
+            q2_nt2_per_m5: 7e-16,
+            r_nt2: 1.0,
+        };
+        let tr = AnomalyTransition::new(&noise);
         let d = 9.0;
         let mut phi = DMatrix::zeros(5, 5);
         let mut g = DMatrix::zeros(5, 5);
-        tr.fill(d, &noise, &mut phi, &mut g);
+        tr.fill(d, &mut phi, &mut g);
         let q = &g * g.transpose();
         // e^{Aσ} b for the triple integrator with b = e₃: (σ²/2, σ, 1); double: (σ, 1).
         let n = 2000;
@@ -234,7 +265,13 @@ mod tests {
         let mut qn = DMatrix::<f64>::zeros(5, 5);
         for k in 0..=n {
             let s = k as f64 * h;
-            let w = if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 };
+            let w = if k == 0 || k == n {
+                1.0
+            } else if k % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             let u = [s * s / 2.0, s, 1.0];
             let v = [s, 1.0];
             for i in 0..3 {
@@ -250,7 +287,12 @@ mod tests {
         }
         for i in 0..5 {
             for j in 0..5 {
-                assert!((q[(i, j)] - qn[(i, j)]).abs() <= 1e-10 * qn[(i, j)].abs().max(1e-30), "Q[{i},{j}] {} vs {}", q[(i, j)], qn[(i, j)]);
+                assert!(
+                    (q[(i, j)] - qn[(i, j)]).abs() <= 1e-10 * qn[(i, j)].abs().max(1e-30),
+                    "Q[{i},{j}] {} vs {}",
+                    q[(i, j)],
+                    qn[(i, j)]
+                );
             }
         }
         assert_eq!(phi[(0, 2)], 40.5);
@@ -259,10 +301,10 @@ mod tests {
 
     #[test]
     fn zero_step_is_the_identity_without_noise() {
-        let tr = AnomalyTransition::new();
+        let tr = AnomalyTransition::new(&NoiseModel::default());
         let mut phi = DMatrix::zeros(5, 5);
         let mut g = DMatrix::from_element(5, 5, 3.0);
-        tr.fill(0.0, &NoiseModel::default(), &mut phi, &mut g);
+        tr.fill(0.0, &mut phi, &mut g);
         assert_eq!(phi, DMatrix::identity(5, 5));
         assert!(g.iter().all(|v| *v == 0.0));
     }

@@ -1,7 +1,15 @@
 //! Pass 2: the smoothed external field of one run, given the coefficient
 //! estimate — a 5-state square-root filter and RTS smoother
-//! ([`aeromag_estimation::kalman::fixed_interval_smooth`], checkpointed, so
-//! memory is `O(√N)` beyond the output).
+//! ([`aeromag_estimation::kalman::smooth_from_checkpoints`], so memory is
+//! `O(√N)` beyond the output).
+//!
+//! The smoother restarts the 5-state filter from checkpoints every `L`
+//! samples. They come from pass 1 at no extra filtering cost: the joint
+//! filter's conditional distribution of `X2` given `X1`
+//! (`E[X2 | X1] = x̂2 + U_b U_c⁻¹ (X1 − x̂1)`, factor `U_a`,
+//! [`super::JointFilter::field_conditional`]) evaluated at the final `X̂1`
+//! *is* the filtered estimate of pass 2 at that sample. So pass 2 re-runs
+//! the 5-state filter once, block by block, and smooths backward.
 //!
 //! Why this equals the joint smoother (module docs of [`super`]): the field
 //! states of different runs are independent given `X1`, and within a run
@@ -14,11 +22,11 @@
 //! compensated reading; the output is the external field at the sensor,
 //! `y_ref + B^h_k + Δz_k B_z,k` (nT).
 
-use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior, B_H, B_Z, X2_DIM};
+use super::anomaly_model::{AnomalyTransition, B_H, B_Z, NoiseModel, X2_DIM, X2Prior};
 use super::joint_filter::est;
 use super::track::step_length;
 use crate::error::Result;
-use aeromag_estimation::kalman::{fixed_interval_smooth, SmootherOptions, StateSpaceModel};
+use aeromag_estimation::kalman::{Checkpoint, StateSpaceModel, smooth_from_checkpoints};
 use nalgebra::DMatrix;
 
 /// The field model of one run (indices `offset..offset+len` of the slices).
@@ -43,7 +51,7 @@ pub struct FieldModel<'a> {
     pub noise: NoiseModel,
     /// Field prior.
     pub prior: X2Prior,
-    /// Transition helper.
+    /// Transition helper (built for `noise`).
     pub transition: AnomalyTransition,
 }
 
@@ -63,7 +71,7 @@ impl StateSpaceModel for FieldModel<'_> {
     }
     fn transition(&self, k: usize, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
         let d = step_length(self.time, self.speed_m_s, self.offset + k);
-        self.transition.fill(d, &self.noise, phi, g);
+        self.transition.fill(d, phi, g);
     }
     fn measurement(&self, k: usize, h: &mut [f64]) -> Option<(f64, f64)> {
         let i = self.offset + k;
@@ -74,19 +82,17 @@ impl StateSpaceModel for FieldModel<'_> {
     }
 }
 
-/// Smooth the run and write the external field (nT) into
-/// `external[offset..offset+len]`. `block_len` as in [`SmootherOptions`].
-pub fn smooth_field(model: &FieldModel, block_len: usize, external: &mut [f64]) -> Result<()> {
-    let opts = SmootherOptions { block_len, covariance: false };
-    fixed_interval_smooth(
-        model,
-        &opts,
-        |_, _| {},
-        |k, x, _| {
-            let i = model.offset + k;
-            external[i] = model.y_ref_nt + x[B_H] + (model.alt_m[i] - model.z0_m) * x[B_Z];
-        },
-    )
-    .map_err(est)?;
-    Ok(())
+/// Smooth the run from the filtered `checkpoints` (run-local steps; see
+/// [`smooth_from_checkpoints`]) and write the external field (nT) into
+/// `external[offset..offset+len]`.
+pub fn smooth_field(
+    model: &FieldModel,
+    checkpoints: &[Checkpoint],
+    external: &mut [f64],
+) -> Result<()> {
+    smooth_from_checkpoints(model, checkpoints, false, |k, x, _| {
+        let i = model.offset + k;
+        external[i] = model.y_ref_nt + x[B_H] + (model.alt_m[i] - model.z0_m) * x[B_Z];
+    })
+    .map_err(est)
 }

@@ -1,17 +1,18 @@
 //! Method 2 end to end: runs, tuning, pass 1 (coefficients), pass 2 (the
 //! smoothed external field), outputs and diagnostics.
 
-use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior, X2_DIM};
-use super::field_smoother::{smooth_field, FieldModel};
+use super::anomaly_model::{AnomalyTransition, NoiseModel, X2_DIM, X2Prior};
+use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::JointFilter;
-use super::rows::{for_each_design_row, RowSpec};
+use super::rows::{RowSpec, for_each_design_row};
 use super::track::step_length;
-use super::tuning::{tune, Subset, TuningConfig, TuningReport};
+use super::tuning::{Subset, TuningConfig, TuningReport, tune};
 use crate::error::{CompError, Result};
-use crate::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
-use crate::tolles_lawson::fit_ls::{diagnose, LsFit, Segment};
+use crate::model_file::{Coefficient, FitStats, MODEL_FORMAT, TlModel};
+use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
-use crate::tolles_lawson::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
+use crate::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
+use aeromag_estimation::kalman::{Checkpoint, LeadingConditional, default_block_len};
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -108,10 +109,11 @@ pub struct KalmanFit {
     pub prior_covariance: DMatrix<f64>,
     /// Posterior covariance `P1` of `X1` (from the final factor).
     pub posterior_covariance: DMatrix<f64>,
-    /// Variance inflation factor of each coefficient in the posterior
-    /// information `P1⁻¹` (the analogue of the least-squares VIF).
+    /// Variance inflation factor of each coefficient in the information
+    /// the data gave, `P1⁻¹ − P0⁻¹` (the analogue of the least-squares VIF;
+    /// ∞ when that matrix is singular).
     pub vif: Vec<f64>,
-    /// Scaled condition number of `P1⁻¹`.
+    /// Scaled condition number of `P1⁻¹ − P0⁻¹` (∞ when singular).
     pub condition: f64,
     /// Noise intensities used.
     pub noise: NoiseModel,
@@ -158,7 +160,11 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     validate(cfg)?;
     let m = cfg.terms.n_columns();
     let names = cfg.terms.column_names();
-    let spec = RowSpec { terms: &cfg.terms, convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt };
+    let spec = RowSpec {
+        terms: &cfg.terms,
+        convention: cfg.convention,
+        bt_scale_nt: cfg.bt_scale_nt,
+    };
     let mut warnings = Vec::new();
 
     // ---- runs: maximal stretches of usable samples.
@@ -168,8 +174,14 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     for (si, s) in segments.iter().enumerate() {
         let n = s.data.time.len();
         let d = &s.data;
-        if d.mag.len() != n || d.flux.iter().any(|f| f.len() != n) || s.alt_m.len() != n || s.speed_m_s.len() != n {
-            return Err(CompError::BadData(format!("segment {si}: columns of unequal length")));
+        if d.mag.len() != n
+            || d.flux.iter().any(|f| f.len() != n)
+            || s.alt_m.len() != n
+            || s.speed_m_s.len() != n
+        {
+            return Err(CompError::BadData(format!(
+                "segment {si}: columns of unequal length"
+            )));
         }
         let usable: Vec<bool> = (0..n)
             .map(|i| {
@@ -187,7 +199,9 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         let (kept, _) = split_segments(d.time, None, &usable, f64::INFINITY, 1);
         for r in kept {
             if let Some(k) = (r.start + 1..r.end).find(|&k| !(d.time[k] > d.time[k - 1])) {
-                return Err(CompError::BadData(format!("segment {si}: time does not increase at row {k}")));
+                return Err(CompError::BadData(format!(
+                    "segment {si}: time does not increase at row {k}"
+                )));
             }
             if r.len() < MIN_RUN {
                 short += r.len();
@@ -200,18 +214,27 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         warnings.push(format!("{unusable} samples have missing or invalid values (mag, flux, alt, speed) and are not used"));
     }
     if short > 0 {
-        warnings.push(format!("{short} samples in runs shorter than {MIN_RUN} samples are not used"));
+        warnings.push(format!(
+            "{short} samples in runs shorter than {MIN_RUN} samples are not used"
+        ));
     }
     let rows: usize = runs.iter().map(|r| r.range.len()).sum();
     if rows < m + X2_DIM {
-        return Err(CompError::BadData(format!("{rows} usable samples are too few for {m} coefficients")));
+        return Err(CompError::BadData(format!(
+            "{rows} usable samples are too few for {m} coefficients"
+        )));
     }
 
     // ---- reference altitude and reading.
     let mean_over = |pick: fn(&KalmanSegment<'_>, Range<usize>) -> f64| {
-        runs.iter().map(|r| pick(&segments[r.seg], r.range.clone())).sum::<f64>() / rows as f64
+        runs.iter()
+            .map(|r| pick(&segments[r.seg], r.range.clone()))
+            .sum::<f64>()
+            / rows as f64
     };
-    let z0 = cfg.z0_m.unwrap_or_else(|| mean_over(|s, r| s.alt_m[r].iter().sum()));
+    let z0 = cfg
+        .z0_m
+        .unwrap_or_else(|| mean_over(|s, r| s.alt_m[r].iter().sum()));
     let y_ref = mean_over(|s, r| s.data.mag[r].iter().sum());
     let coef_mean = vec![0.0; m];
     let coef_std = vec![cfg.coef_prior_std; m];
@@ -222,7 +245,15 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     if cfg.tuning.enabled {
         let dec = rows.div_ceil(cfg.tuning.max_rows.max(1)).max(1);
         let subset = decimated_subset(segments, &runs, spec, dec, z0, y_ref);
-        let rep = tune(&subset, &coef_mean, &coef_std, &cfg.field_prior, noise, &cfg.tuning, dec)?;
+        let rep = tune(
+            &subset,
+            &coef_mean,
+            &coef_std,
+            &cfg.field_prior,
+            noise,
+            &cfg.tuning,
+            dec,
+        )?;
         if !rep.converged {
             warnings.push(format!(
                 "noise tuning stopped after {} evaluations without meeting its tolerance; using the best values found",
@@ -252,58 +283,112 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     };
     let mut jf = JointFilter::new(&coef_mean, &coef_std, &cfg.field_prior, noise)?;
     let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
+    // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
+    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = Vec::with_capacity(runs.len());
     for run in &runs {
         let s = &segments[run.seg];
         jf.start_run()?;
         let mut err = None;
+        let len = run.range.len();
+        let every = if cfg.smoother_block_len > 0 {
+            cfg.smoother_block_len
+        } else {
+            default_block_len(len)
+        };
+        let mut cps = Vec::new();
         let out = series.get_mut(run.seg);
         let (mut inn_out, mut std_out) = match out {
             Some(o) => (Some(&mut o.innovation_nt), Some(&mut o.innovation_std_nt)),
             None => (None, None),
         };
-        for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
-            if err.is_some() {
-                return;
-            }
-            let d = if i == run.range.start { 0.0 } else { step_length(s.data.time, s.speed_m_s, i) };
-            match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
-                Ok(inn) => {
-                    log_lik += inn.log_likelihood();
-                    if i - run.range.start >= X2_DIM {
-                        chi2 += inn.value * inn.value / inn.variance;
-                        ss += inn.value * inn.value;
-                        n_stat += 1;
+        for_each_design_row(
+            spec,
+            s.data.time,
+            s.data.flux,
+            run.range.clone(),
+            |i, row| {
+                if err.is_some() {
+                    return;
+                }
+                let d = if i == run.range.start {
+                    0.0
+                } else {
+                    step_length(s.data.time, s.speed_m_s, i)
+                };
+                match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
+                    Ok(inn) => {
+                        log_lik += inn.log_likelihood();
+                        if i - run.range.start >= X2_DIM {
+                            chi2 += inn.value * inn.value / inn.variance;
+                            ss += inn.value * inn.value;
+                            n_stat += 1;
+                        }
+                        if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut())
+                        {
+                            a[i] = inn.value;
+                            b[i] = inn.std();
+                        }
+                        let local = i - run.range.start;
+                        if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                            match jf.field_conditional() {
+                                Ok(c) => cps.push((local, c)),
+                                Err(e) => err = Some(e),
+                            }
+                        }
                     }
-                    if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut()) {
-                        a[i] = inn.value;
-                        b[i] = inn.std();
+                    Err(e) => {
+                        err = Some(CompError::BadData(format!(
+                            "segment {}, row {i}: {e}",
+                            run.seg
+                        )))
                     }
                 }
-                Err(e) => err = Some(CompError::BadData(format!("segment {}, row {i}: {e}", run.seg))),
-            }
-        });
+            },
+        );
         if let Some(e) = err {
             return Err(e);
         }
+        conditionals.push(cps);
     }
     let coef = jf.coefficients().to_vec();
     let posterior_covariance = jf.coefficient_covariance();
-    let std: Vec<f64> = (0..m).map(|j| posterior_covariance[(j, j)].max(0.0).sqrt()).collect();
-    let (vif, condition, diag_warnings) = information_diagnostics(&jf.coefficient_factor(), &names, cfg.max_vif)?;
+    let std: Vec<f64> = (0..m)
+        .map(|j| posterior_covariance[(j, j)].max(0.0).sqrt())
+        .collect();
+    let (vif, condition, diag_warnings) = information_diagnostics(
+        &jf.coefficient_factor(),
+        cfg.coef_prior_std * cfg.coef_prior_std,
+        &names,
+        cfg.max_vif,
+    )?;
     warnings.extend(diag_warnings);
 
     // ---- compensated series and pass 2: the smoothed field.
     let mut residual_rms_nt = f64::NAN;
     if cfg.compute_series {
-        let transition = AnomalyTransition::new();
+        let transition = AnomalyTransition::new(&noise);
         let mut res2 = 0.0;
-        for run in &runs {
+        for (run, cps) in runs.iter().zip(&conditionals) {
             let s = &segments[run.seg];
             let out = &mut series[run.seg];
-            for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
-                let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
-                out.compensated_nt[i] = s.data.mag[i] - a;
-            });
+            let checkpoints: Vec<Checkpoint> = cps
+                .iter()
+                .map(|(step, c)| Checkpoint {
+                    step: *step,
+                    mean: c.mean_given(&coef),
+                    factor: c.factor.clone(),
+                })
+                .collect();
+            for_each_design_row(
+                spec,
+                s.data.time,
+                s.data.flux,
+                run.range.clone(),
+                |i, row| {
+                    let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
+                    out.compensated_nt[i] = s.data.mag[i] - a;
+                },
+            );
             let model = FieldModel {
                 time: s.data.time,
                 speed_m_s: s.speed_m_s,
@@ -318,7 +403,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
                 transition: transition.clone(),
             };
             let mut external = std::mem::take(&mut out.external_nt);
-            smooth_field(&model, cfg.smoother_block_len, &mut external)?;
+            smooth_field(&model, &checkpoints, &mut external)?;
             for i in run.range.clone() {
                 let e = out.compensated_nt[i] - external[i];
                 res2 += e * e;
@@ -328,6 +413,16 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         residual_rms_nt = (res2 / rows as f64).sqrt();
     }
     let n_stat_f = n_stat.max(1) as f64;
+    let niv = chi2 / n_stat_f;
+    if n_stat > 0 && !(0.25..=4.0).contains(&niv) {
+        warnings.push(format!(
+            "the innovations are {:.1}× {} than the noise model predicts (mean ν²/σ² = {niv:.2}): the noise \
+             intensities do not fit this flight; subtract a base-station diurnal record, or tune them \
+             (standard deviations of the coefficients are unreliable)",
+            niv.sqrt().max(1.0 / niv.sqrt()),
+            if niv > 1.0 { "larger" } else { "smaller" }
+        ));
+    }
     Ok(KalmanFit {
         names,
         coef,
@@ -341,7 +436,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         z0_m: z0,
         y_ref_nt: y_ref,
         log_likelihood: log_lik,
-        normalized_innovation_variance: chi2 / n_stat_f,
+        normalized_innovation_variance: niv,
         innovation_rms_nt: (ss / n_stat_f).sqrt(),
         residual_rms_nt,
         rows,
@@ -357,59 +452,102 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
 }
 
 /// Every `dec`-th sample of every run, for the likelihood.
-fn decimated_subset(segments: &[KalmanSegment], runs: &[Run], spec: RowSpec, dec: usize, z0: f64, y_ref: f64) -> Subset {
+fn decimated_subset(
+    segments: &[KalmanSegment],
+    runs: &[Run],
+    spec: RowSpec,
+    dec: usize,
+    z0: f64,
+    y_ref: f64,
+) -> Subset {
     let m = spec.terms.n_columns();
-    let mut sub = Subset { m, ..Subset::default() };
+    let mut sub = Subset {
+        m,
+        ..Subset::default()
+    };
     for run in runs {
         let s = &segments[run.seg];
         let mut dist = 0.0;
-        for_each_design_row(spec, s.data.time, s.data.flux, run.range.clone(), |i, row| {
-            if i > run.range.start {
-                dist += step_length(s.data.time, s.speed_m_s, i);
-            }
-            if (i - run.range.start) % dec == 0 {
-                sub.rows.extend_from_slice(row);
-                sub.y.push(s.data.mag[i] - y_ref);
-                sub.dz.push(s.alt_m[i] - z0);
-                sub.d.push(dist);
-                sub.start.push(i == run.range.start);
-                dist = 0.0;
-            }
-        });
+        for_each_design_row(
+            spec,
+            s.data.time,
+            s.data.flux,
+            run.range.clone(),
+            |i, row| {
+                if i > run.range.start {
+                    dist += step_length(s.data.time, s.speed_m_s, i);
+                }
+                if (i - run.range.start) % dec == 0 {
+                    sub.rows.extend_from_slice(row);
+                    sub.y.push(s.data.mag[i] - y_ref);
+                    sub.dz.push(s.alt_m[i] - z0);
+                    sub.d.push(dist);
+                    sub.start.push(i == run.range.start);
+                    dist = 0.0;
+                }
+            },
+        );
     }
     sub
 }
 
 /// VIF, scaled condition number and plain-language warnings from the
-/// posterior information `J = P1⁻¹ = AᵀA`, `A = U_c⁻¹` (`P1 = U_c U_cᵀ`),
-/// through the least-squares diagnostics ([`diagnose`]).
-fn information_diagnostics(u: &DMatrix<f64>, names: &[String], max_vif: f64) -> Result<(Vec<f64>, f64, Vec<String>)> {
+/// information the *data* gave about the coefficients (with the field
+/// marginalised), `J = P1⁻¹ − P0⁻¹` (`P1 = U_c U_cᵀ` posterior, `P0` prior),
+/// through the least-squares diagnostics ([`diagnose`]): `J` is written as
+/// `RᵀR` (eigenvalues clipped at 0) and accumulated as normal equations. The
+/// prior is excluded so that a flight that determines nothing is reported
+/// as such (its posterior merely equals the prior).
+fn information_diagnostics(
+    u: &DMatrix<f64>,
+    prior_var: f64,
+    names: &[String],
+    max_vif: f64,
+) -> Result<(Vec<f64>, f64, Vec<String>)> {
     let m = u.nrows();
     let a = u
         .clone()
         .try_inverse()
         .ok_or_else(|| CompError::BadData("the coefficient covariance is singular".into()))?;
-    let mut ne = NormalEquations::new(m);
+    let mut j = a.transpose() * &a;
     for i in 0..m {
-        let row: Vec<f64> = a.row(i).iter().copied().collect();
-        ne.add_row(&row, 0.0, 1.0).map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+        j[(i, i)] -= 1.0 / prior_var;
     }
-    let sol = ne.solve(0.0).map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+    let eig = nalgebra::SymmetricEigen::new(j);
+    let mut ne = NormalEquations::new(m);
+    for k in 0..m {
+        let lam = eig.eigenvalues[k].max(0.0).sqrt();
+        let row: Vec<f64> = eig.eigenvectors.column(k).iter().map(|v| v * lam).collect();
+        ne.add_row(&row, 0.0, 1.0)
+            .map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+    }
+    // The prior as ridge keeps the solve defined; VIF and condition are of the data part.
+    let sol = ne
+        .solve(1.0 / prior_var)
+        .map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
     let warnings = diagnose(&sol, names, max_vif);
     Ok((sol.vif.iter().copied().collect(), sol.condition, warnings))
 }
 
 fn validate(cfg: &KalmanConfig) -> Result<()> {
     if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
-        return Err(CompError::BadData(format!("bt_scale {} must be positive", cfg.bt_scale_nt)));
+        return Err(CompError::BadData(format!(
+            "bt_scale {} must be positive",
+            cfg.bt_scale_nt
+        )));
     }
     if !(cfg.coef_prior_std > 0.0 && cfg.coef_prior_std.is_finite()) {
-        return Err(CompError::BadData(format!("coefficient prior std {} must be positive", cfg.coef_prior_std)));
+        return Err(CompError::BadData(format!(
+            "coefficient prior std {} must be positive",
+            cfg.coef_prior_std
+        )));
     }
-    if let Some(z) = cfg.z0_m {
-        if !z.is_finite() {
-            return Err(CompError::BadData("reference altitude z0 must be finite".into()));
-        }
+    if let Some(z) = cfg.z0_m
+        && !z.is_finite()
+    {
+        return Err(CompError::BadData(
+            "reference altitude z0 must be finite".into(),
+        ));
     }
     Ok(())
 }
@@ -434,7 +572,11 @@ impl KalmanFit {
     }
 
     fn model_residual(&self) -> f64 {
-        if self.residual_rms_nt.is_finite() { self.residual_rms_nt } else { self.innovation_rms_nt }
+        if self.residual_rms_nt.is_finite() {
+            self.residual_rms_nt
+        } else {
+            self.innovation_rms_nt
+        }
     }
 
     /// A model file (`method: "kalman"`; no band, order, trim or ridge). The
@@ -456,7 +598,11 @@ impl KalmanFit {
                 .names
                 .iter()
                 .zip(self.coef.iter().zip(&self.std))
-                .map(|(n, (v, s))| Coefficient { name: n.clone(), value: *v, std: *s })
+                .map(|(n, (v, s))| Coefficient {
+                    name: n.clone(),
+                    value: *v,
+                    std: *s,
+                })
                 .collect(),
             fit: FitStats {
                 rows: self.rows,

@@ -22,9 +22,9 @@
 //! `P1 = U_c U_cᵀ` are the estimate from the whole flight (a constant's
 //! filtered estimate at the end is also its smoothed estimate).
 
-use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior, B_H, B_Z, X2_DIM};
+use super::anomaly_model::{AnomalyTransition, B_H, B_Z, NoiseModel, X2_DIM, X2Prior};
 use crate::error::{CompError, Result};
-use aeromag_estimation::kalman::{Innovation, SqrtKalmanFilter};
+use aeromag_estimation::kalman::{Innovation, LeadingConditional, SqrtKalmanFilter};
 use nalgebra::{DMatrix, DVector};
 
 /// The pass-1 filter (module docs).
@@ -40,6 +40,8 @@ pub struct JointFilter {
     g: DMatrix<f64>,
     h: Vec<f64>,
     fresh: bool,
+    /// The step length `phi`, `g` currently hold (NaN: none).
+    last_d: f64,
 }
 
 impl JointFilter {
@@ -47,16 +49,28 @@ impl JointFilter {
     /// `coef_prior_mean` and independent prior standard deviations
     /// `coef_prior_std` (coefficient units, > 0), the field prior `x2_prior`
     /// and the noise intensities `noise`.
-    pub fn new(coef_prior_mean: &[f64], coef_prior_std: &[f64], x2_prior: &X2Prior, noise: NoiseModel) -> Result<Self> {
+    pub fn new(
+        coef_prior_mean: &[f64],
+        coef_prior_std: &[f64],
+        x2_prior: &X2Prior,
+        noise: NoiseModel,
+    ) -> Result<Self> {
         let m = coef_prior_mean.len();
-        if coef_prior_std.len() != m || coef_prior_std.iter().any(|s| !(*s > 0.0 && s.is_finite())) {
-            return Err(CompError::BadData("coefficient prior: one finite positive standard deviation per coefficient".into()));
+        if coef_prior_std.len() != m || coef_prior_std.iter().any(|s| !(*s > 0.0 && s.is_finite()))
+        {
+            return Err(CompError::BadData(
+                "coefficient prior: one finite positive standard deviation per coefficient".into(),
+            ));
         }
         if !noise.is_valid() {
-            return Err(CompError::BadData(format!("invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)")));
+            return Err(CompError::BadData(format!(
+                "invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)"
+            )));
         }
         if !x2_prior.is_valid() {
-            return Err(CompError::BadData(format!("invalid field prior {x2_prior:?} (positive, finite)")));
+            return Err(CompError::BadData(format!(
+                "invalid field prior {x2_prior:?} (positive, finite)"
+            )));
         }
         let n = X2_DIM + m;
         let mut x0 = vec![0.0; n];
@@ -73,12 +87,16 @@ impl JointFilter {
             m,
             noise,
             x2_factor,
-            x1_prior_cov: DMatrix::from_diagonal(&DVector::from_iterator(m, coef_prior_std.iter().map(|s| s * s))),
-            transition: AnomalyTransition::new(),
+            x1_prior_cov: DMatrix::from_diagonal(&DVector::from_iterator(
+                m,
+                coef_prior_std.iter().map(|s| s * s),
+            )),
+            transition: AnomalyTransition::new(&noise),
             phi: DMatrix::zeros(X2_DIM, X2_DIM),
             g: DMatrix::zeros(X2_DIM, X2_DIM),
             h: vec![0.0; n],
             fresh: true,
+            last_d: f64::NAN,
         })
     }
 
@@ -90,7 +108,9 @@ impl JointFilter {
     /// Start a new contiguous run: the field states get their prior again,
     /// independent of the coefficients; the next step is not predicted.
     pub fn start_run(&mut self) -> Result<()> {
-        self.filter.reset_leading(&[0.0; X2_DIM], &self.x2_factor).map_err(est)?;
+        self.filter
+            .reset_leading(&[0.0; X2_DIM], &self.x2_factor)
+            .map_err(est)?;
         self.fresh = true;
         Ok(())
     }
@@ -101,21 +121,34 @@ impl JointFilter {
     /// reading `y_nt` (nT). Returns the innovation.
     pub fn step(&mut self, d_m: f64, h1: &[f64], dz_m: f64, y_nt: f64) -> Result<Innovation> {
         if h1.len() != self.m {
-            return Err(CompError::BadData(format!("design row of length {} for {} coefficients", h1.len(), self.m)));
+            return Err(CompError::BadData(format!(
+                "design row of length {} for {} coefficients",
+                h1.len(),
+                self.m
+            )));
         }
         if !self.fresh {
             if !(d_m >= 0.0 && d_m.is_finite()) {
-                return Err(CompError::BadData(format!("along-track step {d_m} m must be finite and ≥ 0")));
+                return Err(CompError::BadData(format!(
+                    "along-track step {d_m} m must be finite and ≥ 0"
+                )));
             }
-            self.transition.fill(d_m, &self.noise, &mut self.phi, &mut self.g);
-            self.filter.predict_leading(&self.phi, &self.g).map_err(est)?;
+            if d_m != self.last_d {
+                self.transition.fill(d_m, &mut self.phi, &mut self.g);
+                self.last_d = d_m;
+            }
+            self.filter
+                .predict_leading(&self.phi, &self.g)
+                .map_err(est)?;
         }
         self.fresh = false;
         self.h[..X2_DIM].fill(0.0);
         self.h[B_H] = 1.0;
         self.h[B_Z] = dz_m;
         self.h[X2_DIM..].copy_from_slice(h1);
-        self.filter.update(&self.h, y_nt, self.noise.r_nt2).map_err(est)
+        self.filter
+            .update(&self.h, y_nt, self.noise.r_nt2)
+            .map_err(est)
     }
 
     /// The current coefficient estimate `X1`.
@@ -135,7 +168,18 @@ impl JointFilter {
 
     /// The upper-triangular factor `U_c` of the coefficient covariance.
     pub fn coefficient_factor(&self) -> DMatrix<f64> {
-        self.filter.factor().view((X2_DIM, X2_DIM), (self.m, self.m)).into_owned()
+        self.filter
+            .factor()
+            .view((X2_DIM, X2_DIM), (self.m, self.m))
+            .into_owned()
+    }
+
+    /// The field states given the coefficients, from the current joint
+    /// estimate ([`SqrtKalmanFilter::leading_conditional`]): with `X1 = X̂1`
+    /// of the whole flight it is the filtered estimate of pass 2 at this
+    /// sample, a restart point for the smoother.
+    pub fn field_conditional(&self) -> Result<LeadingConditional> {
+        self.filter.leading_conditional(X2_DIM).map_err(est)
     }
 
     /// The prior covariance of the coefficients (diagonal).

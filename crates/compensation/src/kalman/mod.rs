@@ -50,7 +50,9 @@
 //! which is that 5-state smoother run on `y_k − H1_k X̂1`. **Pass 2**
 //! ([`field_smoother`]) does exactly this, run by run, with the checkpointed
 //! square-root RTS smoother of `aeromag-estimation` (memory `O(√N · 5²)`
-//! beyond the outputs). Its covariances would be conditional on `X1`; the
+//! beyond the outputs). Its restart points come from pass 1 for free: the
+//! joint filter's conditional of `X2` given `X1`, evaluated at `X̂1`, is the
+//! 5-state filter's estimate at that sample. Its covariances would be conditional on `X1`; the
 //! unconditional ones add `B_k P1 B_kᵀ` (not computed: only the means are
 //! output). The equality with a full-state RTS smoother is tested.
 //!
@@ -66,8 +68,9 @@
 //!
 //! [`KalmanFit`]: the coefficients with standard deviations `√diag(P1)`, the
 //! prior and posterior covariances of `X1` (for estimability measures
-//! `μ_i = √(P_post,ii / P_prior,ii)`), the noise intensities used (tuned by
-//! maximum likelihood, [`tuning`]), per-sample compensated reading, smoothed
+//! `μ_i = √(P_post,ii / P_prior,ii)`), the noise intensities used (the
+//! documented defaults, or tuned by maximum likelihood on request,
+//! [`tuning`]), per-sample compensated reading, smoothed
 //! external field and innovations, and the same diagnostics as the
 //! least-squares fit; [`KalmanFit::to_model`] writes the model file.
 //!
@@ -92,7 +95,7 @@ pub mod track;
 pub mod tuning;
 
 pub use anomaly_model::{NoiseModel, X2Prior};
-pub use fit::{fit_kalman, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries};
+pub use fit::{KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman};
 pub use joint_filter::JointFilter;
 pub use track::{ground_speed_from_positions, ground_speed_from_velocity};
 pub use tuning::{TuningConfig, TuningReport};

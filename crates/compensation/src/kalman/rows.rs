@@ -29,7 +29,13 @@ pub struct RowSpec<'a> {
 
 /// Call `f(i, row)` for every sample `i` of `run` (indices into `time` and
 /// `flux`, in increasing order); derivatives are taken over `run` alone.
-pub fn for_each_design_row(spec: RowSpec, time: &[f64], flux: [&[f64]; 3], run: Range<usize>, mut f: impl FnMut(usize, &[f64])) {
+pub fn for_each_design_row(
+    spec: RowSpec,
+    time: &[f64],
+    flux: [&[f64]; 3],
+    run: Range<usize>,
+    mut f: impl FnMut(usize, &[f64]),
+) {
     let ncol = spec.terms.n_columns();
     let mut row = vec![0.0; ncol];
     let eddy = spec.terms.has_eddy();
@@ -50,7 +56,12 @@ pub fn for_each_design_row(spec: RowSpec, time: &[f64], flux: [&[f64]; 3], run: 
         };
         for i in a..b {
             let j = i - lo;
-            spec.terms.row([flux[0][i], flux[1][i], flux[2][i]], [db[0][j], db[1][j], db[2][j]], spec.bt_scale_nt, &mut row);
+            spec.terms.row(
+                [flux[0][i], flux[1][i], flux[2][i]],
+                [db[0][j], db[1][j], db[2][j]],
+                spec.bt_scale_nt,
+                &mut row,
+            );
             f(i, &row);
         }
         a = b;
@@ -65,15 +76,33 @@ mod tests {
     #[test]
     fn streamed_rows_equal_the_design_columns() {
         let n = 2 * CHUNK + 1; // last chunk of one sample
-        let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1 + 1e-3 * (k % 3) as f64).collect();
-        let fx: Vec<f64> = (0..n).map(|k| 20_000.0 + 300.0 * (k as f64 * 0.05).sin()).collect();
-        let fy: Vec<f64> = (0..n).map(|k| 2_000.0 + 500.0 * (k as f64 * 0.031).cos()).collect();
-        let fz: Vec<f64> = (0..n).map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin()).collect();
+        let time: Vec<f64> = (0..n)
+            .map(|k| k as f64 * 0.1 + 1e-3 * (k % 3) as f64)
+            .collect();
+        let fx: Vec<f64> = (0..n)
+            .map(|k| 20_000.0 + 300.0 * (k as f64 * 0.05).sin())
+            .collect();
+        let fy: Vec<f64> = (0..n)
+            .map(|k| 2_000.0 + 500.0 * (k as f64 * 0.031).cos())
+            .collect();
+        let fz: Vec<f64> = (0..n)
+            .map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin())
+            .collect();
         for conv in [Convention::Physical, Convention::MagNav] {
             let terms = TermSet::parse("p3,i6,e9,bias").unwrap();
-            let spec = RowSpec { terms: &terms, convention: conv, bt_scale_nt: 50_000.0 };
+            let spec = RowSpec {
+                terms: &terms,
+                convention: conv,
+                bt_scale_nt: 50_000.0,
+            };
             for run in [0..n, 5..CHUNK + 7, 10..13, 100..101] {
-                let cols = design_columns(&terms, conv, 50_000.0, &time[run.clone()], [&fx[run.clone()], &fy[run.clone()], &fz[run.clone()]]);
+                let cols = design_columns(
+                    &terms,
+                    conv,
+                    50_000.0,
+                    &time[run.clone()],
+                    [&fx[run.clone()], &fy[run.clone()], &fz[run.clone()]],
+                );
                 let mut count = 0;
                 for_each_design_row(spec, &time, [&fx, &fy, &fz], run.clone(), |i, row| {
                     for (c, v) in row.iter().enumerate() {

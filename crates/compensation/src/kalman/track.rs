@@ -26,7 +26,11 @@ pub fn ground_speed_from_positions(time: &[f64], lat_deg: &[f64], lon_deg: &[f64
         let pb = Geodetic::new(lat_deg[b], lon_deg[b], 0.0);
         let [dn, de, _] = pa.ned_offset_to(&pb);
         let dt = time[b] - time[a];
-        if dt > 0.0 { dn.hypot(de) / dt } else { f64::NAN }
+        if dt > 0.0 {
+            dn.hypot(de) / dt
+        } else {
+            f64::NAN
+        }
     };
     (0..n)
         .map(|k| {
@@ -58,7 +62,10 @@ mod tests {
         let origin = Geodetic::new(56.0, 38.0, 0.0);
         let (v, hdg) = (80.0f64, 30f64.to_radians());
         let t: Vec<f64> = (0..50).map(|k| k as f64 * 0.1).collect();
-        let pos: Vec<Geodetic> = t.iter().map(|s| origin.offset_by(v * s * hdg.cos(), v * s * hdg.sin(), 0.0)).collect();
+        let pos: Vec<Geodetic> = t
+            .iter()
+            .map(|s| origin.offset_by(v * s * hdg.cos(), v * s * hdg.sin(), 0.0))
+            .collect();
         let lat: Vec<f64> = pos.iter().map(|p| p.lat_deg).collect();
         let lon: Vec<f64> = pos.iter().map(|p| p.lon_deg).collect();
         let s = ground_speed_from_positions(&t, &lat, &lon);

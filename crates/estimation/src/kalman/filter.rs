@@ -1,0 +1,495 @@
+//! The square-root covariance Kalman filter: state `x`, upper-triangular
+//! factor `S` with `P = S Sᵀ`, scalar sequential measurement updates
+//! (Carlson) and time updates by re-triangularisation (Householder RQ).
+//!
+//! ## Model
+//!
+//! ```text
+//! x_k = Φ_k x_{k−1} + G_k w_k,      w_k ~ N(0, I_q)       (Q_k = G_k G_kᵀ)
+//! y_k = h_kᵀ x_k + v_k,             v_k ~ N(0, r_k)       (one or more scalars per step)
+//! ```
+//!
+//! `Φ_k` and `G_k` come from the caller's exact discretisation of the
+//! continuous model (e.g. `Φ = e^{AΔ}`, `Q = ∫₀^Δ e^{As} B Bᵀ e^{Aᵀs} ds`, and
+//! `G` any factor of `Q`, such as its Cholesky factor). Correlated vector
+//! measurements are decorrelated by the caller (or processed as scalars when
+//! their noises are independent), so only scalar updates are needed: no
+//! matrix is ever inverted (Bierman 1977, ch. V).
+//!
+//! ## Steps
+//!
+//! * [`SqrtKalmanFilter::update`]: Carlson's triangular update
+//!   ([`super::carlson`]), `O(n²)`.
+//! * [`SqrtKalmanFilter::predict`]: `x ← Φx`, `S ← tri([G, ΦS])`
+//!   ([`super::triangularize`]), `O(n³)`.
+//! * [`SqrtKalmanFilter::predict_leading`]: when only the first `k` states
+//!   evolve and the others are constant parameters (`Φ = diag(Φ_a, I)`,
+//!   `G = [G_a; 0]`), the time update is exact and cheap *because the constant
+//!   states are ordered last*: with `S = [[U_a, U_b], [0, U_c]]`,
+//!
+//!   ```text
+//!   [G, Φ S] = [[G_a, Φ_a U_a, Φ_a U_b], [0, 0, U_c]]  →  S⁺ = [[tri([G_a, Φ_a U_a]), Φ_a U_b], [0, U_c]]
+//!   ```
+//!
+//!   since the columns `[G_a, Φ_a U_a]` are zero in the rows of the constant
+//!   states, rotating them among themselves leaves those rows alone. Cost
+//!   `O(k²(n − k) + k³)` instead of `O(n³)` (Bierman 1977, §VI.4, "bias"
+//!   states last). The covariance of the trailing constant block is
+//!   `U_c U_cᵀ` ([`SqrtKalmanFilter::trailing_covariance`]).
+//! * [`SqrtKalmanFilter::reset_leading`]: replace the leading states by a
+//!   fresh prior independent of everything else (set `U_a`, zero `U_b`); the
+//!   marginal of the trailing block is unchanged.
+//!
+//! Work buffers are allocated on construction (and grown once if a larger
+//! noise dimension appears); steps do not allocate.
+
+use super::carlson::carlson_update;
+use super::innovation::Innovation;
+use super::triangularize::triangularize_upper;
+use crate::error::{EstError, Result};
+use nalgebra::{DMatrix, DVector};
+
+/// A square-root covariance Kalman filter (see the module docs).
+#[derive(Debug, Clone)]
+pub struct SqrtKalmanFilter {
+    x: DVector<f64>,
+    s: DMatrix<f64>,
+    gain: Vec<f64>,
+    work: Vec<f64>,
+    wide: Vec<f64>,
+    v: Vec<f64>,
+    tmp: Vec<f64>,
+    nz: Vec<(usize, usize, f64)>,
+}
+
+impl SqrtKalmanFilter {
+    /// A filter with prior mean `x0` and upper-triangular factor `s0`
+    /// (`P0 = S0 S0ᵀ`; the strictly lower part of `s0` is ignored).
+    pub fn new(x0: &[f64], s0: &DMatrix<f64>) -> Result<Self> {
+        let n = x0.len();
+        if s0.nrows() != n || s0.ncols() != n {
+            return Err(EstError::Dimension(format!(
+                "prior factor {}×{} for {n} states",
+                s0.nrows(),
+                s0.ncols()
+            )));
+        }
+        if x0.iter().any(|v| !v.is_finite()) || s0.iter().any(|v| !v.is_finite()) {
+            return Err(EstError::NonFinite {
+                what: "prior mean or factor",
+            });
+        }
+        let s = DMatrix::from_fn(n, n, |i, j| if i <= j { s0[(i, j)] } else { 0.0 });
+        Ok(Self {
+            x: DVector::from_column_slice(x0),
+            s,
+            gain: vec![0.0; n],
+            work: vec![0.0; 3 * n],
+            wide: vec![0.0; n * 2 * n.max(1)],
+            v: vec![0.0; 2 * n.max(1)],
+            tmp: vec![0.0; n],
+            nz: Vec::with_capacity(n * n),
+        })
+    }
+
+    /// A filter with prior mean `x0` and covariance `p0` (symmetric positive
+    /// definite; factored with [`upper_cholesky`]).
+    pub fn from_covariance(x0: &[f64], p0: &DMatrix<f64>) -> Result<Self> {
+        Self::new(x0, &upper_cholesky(p0)?)
+    }
+
+    /// Number of states `n`.
+    pub fn dim(&self) -> usize {
+        self.x.len()
+    }
+
+    /// The state estimate.
+    pub fn state(&self) -> &DVector<f64> {
+        &self.x
+    }
+
+    /// The upper-triangular factor `S` (`P = S Sᵀ`).
+    pub fn factor(&self) -> &DMatrix<f64> {
+        &self.s
+    }
+
+    /// The covariance `P = S Sᵀ` (allocates).
+    pub fn covariance(&self) -> DMatrix<f64> {
+        &self.s * self.s.transpose()
+    }
+
+    /// The variance `P_ii = Σ_{j ≥ i} S_ij²`.
+    pub fn variance(&self, i: usize) -> f64 {
+        (i..self.dim())
+            .map(|j| self.s[(i, j)] * self.s[(i, j)])
+            .sum()
+    }
+
+    /// The covariance of the trailing states `from..n`, `U_c U_cᵀ` (exact:
+    /// those rows of `S` vanish left of column `from`).
+    pub fn trailing_covariance(&self, from: usize) -> DMatrix<f64> {
+        let u = self
+            .s
+            .view((from, from), (self.dim() - from, self.dim() - from));
+        u * u.transpose()
+    }
+
+    /// Replace the state and factor (same dimension; lower part ignored).
+    pub fn set(&mut self, x: &[f64], s: &DMatrix<f64>) -> Result<()> {
+        let n = self.dim();
+        if x.len() != n || s.nrows() != n || s.ncols() != n {
+            return Err(EstError::Dimension(
+                "set: state or factor of another size".into(),
+            ));
+        }
+        self.x.copy_from_slice(x);
+        for j in 0..n {
+            for i in 0..n {
+                self.s[(i, j)] = if i <= j { s[(i, j)] } else { 0.0 };
+            }
+        }
+        Ok(())
+    }
+
+    /// Scalar measurement update with row `h`, value `y` and noise variance
+    /// `r > 0` (Carlson). Returns the innovation; on error nothing changes.
+    pub fn update(&mut self, h: &[f64], y: f64, r: f64) -> Result<Innovation> {
+        carlson_update(
+            self.s.as_mut_slice(),
+            self.x.as_mut_slice(),
+            h,
+            y,
+            r,
+            &mut self.gain,
+            &mut self.work,
+        )
+    }
+
+    /// The Kalman gain `P⁻h/α` of the last [`update`](Self::update).
+    pub fn last_gain(&self) -> &[f64] {
+        &self.gain
+    }
+
+    /// Time update with transition `Φ` (`n × n`) and noise factor `G`
+    /// (`n × q`, `Q = G Gᵀ`, `q` may be 0): `x ← Φx`, `S ← tri([G, ΦS])`.
+    pub fn predict(&mut self, phi: &DMatrix<f64>, g: &DMatrix<f64>) -> Result<()> {
+        let n = self.dim();
+        if phi.nrows() != n || phi.ncols() != n || g.nrows() != n {
+            return Err(EstError::Dimension(format!(
+                "predict: Φ {}×{}, G {}×{} for {n} states",
+                phi.nrows(),
+                phi.ncols(),
+                g.nrows(),
+                g.ncols()
+            )));
+        }
+        self.collect_nonzeros(phi);
+        self.propagate_block(n, g);
+        Ok(())
+    }
+
+    /// Time update when only the first `k` states evolve (`Φ_a`, `k × k`;
+    /// `G_a`, `k × q`) and the states `k..n` are constant (module docs).
+    pub fn predict_leading(&mut self, phi_a: &DMatrix<f64>, g_a: &DMatrix<f64>) -> Result<()> {
+        let n = self.dim();
+        let k = phi_a.nrows();
+        if k > n || phi_a.ncols() != k || g_a.nrows() != k {
+            return Err(EstError::Dimension(format!(
+                "predict_leading: Φ_a {}×{}, G_a {}×{} for {n} states",
+                phi_a.nrows(),
+                phi_a.ncols(),
+                g_a.nrows(),
+                g_a.ncols()
+            )));
+        }
+        self.collect_nonzeros(phi_a);
+        // U_b ← Φ_a U_b over the non-zeros of Φ_a only (transition matrices
+        // of integrators are mostly zeros). When Φ_a is upper triangular the
+        // rows are updated in place in increasing order, each from rows not
+        // yet updated: row_i ← Φ_ii row_i + Σ_{l>i} Φ_il row_l.
+        let s = self.s.as_mut_slice();
+        if self.nz.iter().all(|&(i, l, _)| i <= l) {
+            // self.nz is in column-major order; apply by rows i ascending.
+            for i in 0..k {
+                let mut diag = 1.0;
+                for &(r, l, p) in &self.nz {
+                    if r == i && l == i {
+                        diag = p;
+                    }
+                }
+                if diag != 1.0 {
+                    for j in k..n {
+                        s[i + j * n] *= diag;
+                    }
+                }
+                for &(r, l, p) in &self.nz {
+                    if r == i && l > i {
+                        for j in k..n {
+                            s[i + j * n] += p * s[l + j * n];
+                        }
+                    }
+                }
+            }
+        } else {
+            let tmp = &mut self.tmp[..k];
+            for j in k..n {
+                let col = &mut s[j * n..j * n + k];
+                tmp.fill(0.0);
+                for &(i, l, p) in &self.nz {
+                    tmp[i] += p * col[l];
+                }
+                col.copy_from_slice(tmp);
+            }
+        }
+        self.propagate_block(k, g_a);
+        Ok(())
+    }
+
+    /// The non-zero entries `(i, l, Φ_il)` of `phi` into `self.nz`.
+    fn collect_nonzeros(&mut self, phi: &DMatrix<f64>) {
+        self.nz.clear();
+        let k = phi.nrows();
+        for (idx, &p) in phi.as_slice().iter().enumerate() {
+            if p != 0.0 {
+                self.nz.push((idx % k, idx / k, p));
+            }
+        }
+    }
+
+    /// `x_a ← Φ_a x_a`, `U_a ← tri([G_a, Φ_a U_a])` on the leading `k`
+    /// states, with `Φ_a` given by its non-zeros in `self.nz`.
+    fn propagate_block(&mut self, k: usize, g: &DMatrix<f64>) {
+        let c = g.ncols() + k;
+        if self.wide.len() < k * c {
+            self.wide.resize(k * c, 0.0);
+        }
+        if self.v.len() < c {
+            self.v.resize(c, 0.0);
+        }
+        // The same code, specialised by the compiler for the 5-state field model.
+        if k == 5 && g.ncols() == 5 {
+            self.propagate_impl(5, 5, g.as_slice());
+        } else {
+            self.propagate_impl(k, g.ncols(), g.as_slice());
+        }
+    }
+
+    #[inline(always)]
+    fn propagate_impl(&mut self, k: usize, q: usize, g: &[f64]) {
+        let n = self.dim();
+        let c = q + k;
+        let tmp = &mut self.tmp[..k];
+        // x_a ← Φ x_a.
+        tmp.fill(0.0);
+        let x = self.x.as_mut_slice();
+        for &(i, l, p) in &self.nz {
+            tmp[i] += p * x[l];
+        }
+        x[..k].copy_from_slice(tmp);
+        // wide (row-major k × (q+k)) = [G, Φ U_a]; U_a upper triangular.
+        let w = &mut self.wide[..k * c];
+        w.fill(0.0);
+        let g = &g[..k * q];
+        for i in 0..k {
+            for j in 0..q {
+                w[i * c + j] = g[i + j * k];
+            }
+        }
+        let s = self.s.as_mut_slice();
+        for &(i, l, p) in &self.nz {
+            for j in l..k {
+                w[i * c + q + j] += p * s[l + j * n];
+            }
+        }
+        triangularize_upper(w, k, c, &mut self.v[..c]);
+        for j in 0..k {
+            for i in 0..=j {
+                s[i + j * n] = w[i * c + q + j];
+            }
+            for i in j + 1..k {
+                s[i + j * n] = 0.0;
+            }
+        }
+    }
+
+    /// Replace the first `k = x_a.len()` states by a fresh prior (mean
+    /// `x_a`, upper factor `s_a`, lower part ignored) independent of the
+    /// other states: `U_a ← s_a`, `U_b ← 0`. The trailing block's marginal
+    /// is unchanged.
+    pub fn reset_leading(&mut self, x_a: &[f64], s_a: &DMatrix<f64>) -> Result<()> {
+        let n = self.dim();
+        let k = x_a.len();
+        if k > n || s_a.nrows() != k || s_a.ncols() != k {
+            return Err(EstError::Dimension(format!(
+                "reset_leading: {k} states, factor {}×{}",
+                s_a.nrows(),
+                s_a.ncols()
+            )));
+        }
+        if x_a.iter().any(|v| !v.is_finite()) || s_a.iter().any(|v| !v.is_finite()) {
+            return Err(EstError::NonFinite {
+                what: "reset prior",
+            });
+        }
+        self.x.as_mut_slice()[..k].copy_from_slice(x_a);
+        for j in 0..n {
+            for i in 0..k {
+                self.s[(i, j)] = if j < k && i <= j { s_a[(i, j)] } else { 0.0 };
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The distribution of the leading `k` states given the trailing ones
+/// (module docs of [`SqrtKalmanFilter::leading_conditional`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeadingConditional {
+    /// `x̂_a`, the current estimate of the leading states.
+    pub mean: Vec<f64>,
+    /// `U_a`: `Cov(x_a | x_b) = U_a U_aᵀ` (upper triangular, `k × k`).
+    pub factor: DMatrix<f64>,
+    /// `W = U_b U_c⁻¹` (`k × (n−k)`).
+    pub weight: DMatrix<f64>,
+    /// `x̂_b`, the current estimate of the trailing states.
+    pub trailing_mean: Vec<f64>,
+}
+
+impl LeadingConditional {
+    /// `E[x_a | x_b] = x̂_a + W (x_b − x̂_b)`.
+    pub fn mean_given(&self, x_b: &[f64]) -> Vec<f64> {
+        let mut m = self.mean.clone();
+        for (j, (xb, mb)) in x_b.iter().zip(&self.trailing_mean).enumerate() {
+            let d = xb - mb;
+            for (i, mi) in m.iter_mut().enumerate() {
+                *mi += self.weight[(i, j)] * d;
+            }
+        }
+        m
+    }
+}
+
+impl SqrtKalmanFilter {
+    /// The conditional distribution of the first `k` states given the others.
+    ///
+    /// With `S = [[U_a, U_b], [0, U_c]]`: `Cov(x_a, x_b) = U_b U_cᵀ`,
+    /// `Cov(x_b) = U_c U_cᵀ`, so
+    ///
+    /// ```text
+    /// E[x_a | x_b] = x̂_a + U_b U_c⁻¹ (x_b − x̂_b),    Cov(x_a | x_b) = U_a U_aᵀ
+    /// ```
+    ///
+    /// (the Schur complement is the leading block of the triangular factor).
+    /// When the trailing states are constant parameters, this is what a
+    /// filter of the leading states alone would give if the parameters were
+    /// known — a restart point ([`super::Checkpoint`]) for smoothing the
+    /// leading states once the parameters are estimated. Error if `U_c` is
+    /// singular.
+    pub fn leading_conditional(&self, k: usize) -> Result<LeadingConditional> {
+        let n = self.dim();
+        if k > n {
+            return Err(EstError::Dimension(format!(
+                "leading_conditional: {k} of {n} states"
+            )));
+        }
+        let u_b = self.s.view((0, k), (k, n - k));
+        let u_c = self.s.view((k, k), (n - k, n - k)).into_owned();
+        // W U_c = U_b  ⇔  U_cᵀ Wᵀ = U_bᵀ.
+        let wt = u_c
+            .tr_solve_upper_triangular(&u_b.transpose())
+            .ok_or_else(|| EstError::Singular("trailing covariance factor is singular".into()))?;
+        Ok(LeadingConditional {
+            mean: self.x.as_slice()[..k].to_vec(),
+            factor: self.s.view((0, 0), (k, k)).into_owned(),
+            weight: wt.transpose(),
+            trailing_mean: self.x.as_slice()[k..].to_vec(),
+        })
+    }
+}
+
+/// The upper-triangular factor `U` of a symmetric positive definite `P`,
+/// `P = U Uᵀ` (the "reverse" Cholesky factor: Cholesky of `P` with rows and
+/// columns in reverse order, then reversed back).
+pub fn upper_cholesky(p: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    let n = p.nrows();
+    if p.ncols() != n {
+        return Err(EstError::Dimension(format!(
+            "covariance {}×{} is not square",
+            n,
+            p.ncols()
+        )));
+    }
+    if p.iter().any(|v| !v.is_finite()) {
+        return Err(EstError::NonFinite { what: "covariance" });
+    }
+    let rev = DMatrix::from_fn(n, n, |i, j| {
+        0.5 * (p[(n - 1 - i, n - 1 - j)] + p[(n - 1 - j, n - 1 - i)])
+    });
+    let l = rev
+        .cholesky()
+        .ok_or_else(|| EstError::Singular("covariance is not positive definite".into()))?
+        .unpack();
+    Ok(DMatrix::from_fn(n, n, |i, j| l[(n - 1 - i, n - 1 - j)]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn upper_cholesky_factors() {
+        let p = DMatrix::from_row_slice(3, 3, &[4.0, 1.0, 0.5, 1.0, 3.0, -0.2, 0.5, -0.2, 2.0]);
+        let u = upper_cholesky(&p).unwrap();
+        assert!((&u * u.transpose() - &p).abs().max() < 1e-14);
+        assert_eq!(u[(1, 0)], 0.0);
+        assert_eq!(u[(2, 1)], 0.0);
+        assert!(upper_cholesky(&DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0])).is_err());
+    }
+
+    #[test]
+    fn leading_prediction_equals_the_full_one() {
+        let p0 = DMatrix::from_fn(5, 5, |i, j| {
+            if i == j {
+                2.0 + i as f64
+            } else {
+                0.3 / (1.0 + (i + j) as f64)
+            }
+        });
+        let x0 = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let mut a = SqrtKalmanFilter::from_covariance(&x0, &p0).unwrap();
+        let mut b = a.clone();
+        a.update(&[1.0, 0.2, 0.0, -0.4, 0.7], 0.3, 0.5).unwrap();
+        b.update(&[1.0, 0.2, 0.0, -0.4, 0.7], 0.3, 0.5).unwrap();
+        let phi_a = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 1.0]);
+        let g_a = DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.05, 0.2]);
+        a.predict_leading(&phi_a, &g_a).unwrap();
+        let mut phi = DMatrix::identity(5, 5);
+        phi.view_mut((0, 0), (2, 2)).copy_from(&phi_a);
+        let mut g = DMatrix::zeros(5, 2);
+        g.view_mut((0, 0), (2, 2)).copy_from(&g_a);
+        b.predict(&phi, &g).unwrap();
+        assert!((a.covariance() - b.covariance()).abs().max() < 1e-13);
+        assert!((a.state() - b.state()).abs().max() < 1e-15);
+        assert!(
+            (a.trailing_covariance(2) - b.covariance().view((2, 2), (3, 3)))
+                .abs()
+                .max()
+                < 1e-13
+        );
+    }
+
+    #[test]
+    fn reset_leading_keeps_the_trailing_marginal() {
+        let p0 = DMatrix::from_fn(4, 4, |i, j| if i == j { 1.0 } else { 0.4 });
+        let mut f = SqrtKalmanFilter::from_covariance(&[0.0; 4], &p0).unwrap();
+        f.update(&[1.0, 1.0, 0.5, 0.2], 1.0, 0.1).unwrap();
+        let before = f.trailing_covariance(2);
+        f.reset_leading(&[5.0, 6.0], &DMatrix::from_diagonal_element(2, 2, 10.0))
+            .unwrap();
+        let p = f.covariance();
+        assert!((p.view((2, 2), (2, 2)) - &before).abs().max() < 1e-15);
+        assert_eq!(p.view((0, 2), (2, 2)).abs().max(), 0.0);
+        assert!((p[(0, 0)] - 100.0).abs() < 1e-12);
+        assert_eq!(f.state()[1], 6.0);
+    }
+}
