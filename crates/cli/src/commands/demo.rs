@@ -6,6 +6,7 @@ use crate::commands::compensate::compensate_table;
 use crate::input::load;
 use aeromag_compensation::kalman::KalmanConfig;
 use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::observability::{observability, Observability};
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag_io::FlightTable;
 use aeromag_report::Report;
@@ -98,6 +99,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let fsv: Figures = figures(&survey, &model.reference)?;
     let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> { Ok(figures(&compensated(m)?, &m.reference)?.residual_rms_nt) };
     let res_kf = residual(&model_kf)?;
+
+    // Calibration planning (thesis fig. 2): the truncated pattern against the
+    // full one — flight time, estimability of every coefficient, and the
+    // residual each leaves on the independent survey.
+    let plan = if a.quick {
+        None
+    } else {
+        let trunc_files = simulate(ScenarioKind::CalibrationTruncated, None, Some(a.seed))?.write_to_dir(&data)?;
+        let (trunc, trunc_ls, trunc_kf) = fit_both(&trunc_files.csv)?;
+        let cfg = KalmanConfig { compute_series: false, ..KalmanConfig::default() };
+        let obs = |t: &FlightTable| -> anyhow::Result<Observability> {
+            let (_, f) = fit_model_kalman(t, &cfg, true, "auto")?;
+            Ok(observability(&f.names, &f.prior_covariance, &f.posterior_covariance, 1e6)?)
+        };
+        let duration = |t: &FlightTable| -> anyhow::Result<f64> {
+            let time = t.require("time")?;
+            Ok(time.last().copied().unwrap_or(0.0) - time.first().copied().unwrap_or(0.0))
+        };
+        let full_table = load(&cal_files.csv, None)?;
+        Some((
+            [duration(&full_table)?, duration(&trunc)?],
+            [obs(&full_table)?, obs(&trunc)?],
+            [fsv.residual_rms_nt, residual(&trunc_ls)?],
+            [res_kf, residual(&trunc_kf)?],
+        ))
+    };
     let (grad_res_ls, grad_res_kf) = (residual(&grad_ls)?, residual(&grad_kf)?);
     bar.inc(1);
 
@@ -115,6 +142,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "calibration_residual_rms_ls_nt": fc.residual_rms_nt,
             "survey_ir": fsv.ir,
         },
+        "planning": plan.as_ref().map(|(d, o, ls, kf)| json!({
+            "duration_full_s": d[0],
+            "duration_truncated_s": d[1],
+            "residual_rms_ls_full_nt": ls[0],
+            "residual_rms_ls_truncated_nt": ls[1],
+            "residual_rms_kalman_full_nt": kf[0],
+            "residual_rms_kalman_truncated_nt": kf[1],
+            "estimability_full": o[0].estimability,
+            "estimability_truncated": o[1].estimability,
+        })),
         "compensation_gradient": {
             "residual_rms_ls_nt": grad_res_ls,
             "residual_rms_kalman_nt": grad_res_kf,
@@ -147,6 +184,39 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("FOM before / after (nT)".into(), format!("{} / {}", fmt(fc.fom_before_nt, 3), fmt(fc.fom_after_nt, 3))),
         ("improvement ratio (calibration)".into(), fmt(fc.ir, 1)),
     ]);
+    if let Some((d, o, ls, kf)) = &plan {
+        r.section("Calibration planning: full and truncated patterns");
+        r.paragraph(format!(
+            "The truncated pattern takes {:.0} s against {:.0} s ({:.0} % less flight time). The estimability \
+             measure μ = sqrt(P_post/P_prior) of each coefficient (0: determined by the flight, 1: not) and the \
+             residual each calibration leaves on the independent survey show what the shorter flight costs.",
+            d[1],
+            d[0],
+            100.0 * (1.0 - d[1] / d[0])
+        ));
+        r.table(aeromag_report::Table::new(
+            ["pattern", "duration (s)", "LS residual (nT)", "Kalman residual (nT)", "max μ", "information rank"].map(String::from).to_vec(),
+            (0..2)
+                .map(|k| {
+                    vec![
+                        ["full", "truncated"][k].to_string(),
+                        format!("{:.0}", d[k]),
+                        fmt(ls[k], 4),
+                        fmt(kf[k], 4),
+                        format!("{:.2e}", o[k].estimability.iter().cloned().fold(0.0, f64::max)),
+                        format!("{} of {}", o[k].rank, o[k].names.len()),
+                    ]
+                })
+                .collect(),
+            "Full versus truncated calibration pattern.",
+        ));
+        let x: Vec<f64> = (0..o[0].names.len()).map(|i| i as f64).collect();
+        let svg = aeromag_report::LinePlot::new("Estimability per coefficient (index in p3, i5, e8 order)", "coefficient index", "μ")
+            .with_series(aeromag_report::Series::points("full pattern", x.clone(), o[0].estimability.clone()))
+            .with_series(aeromag_report::Series::points("truncated pattern", x, o[1].estimability.clone()))
+            .to_svg()?;
+        r.figure(svg, format!("Estimability measures, coefficients {}.", o[0].names.join(", ")));
+    }
     add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
     add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
     r.write_html(a.out.join("index.html"))?;
