@@ -13,6 +13,7 @@ pub mod kalman;
 pub mod levelling;
 pub mod metrics;
 pub mod model_file;
+pub mod pod;
 pub mod observability;
 pub mod rotor;
 pub mod tolles_lawson;

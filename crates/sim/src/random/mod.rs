@@ -47,6 +47,12 @@ pub enum Stream {
     HelicopterRotor = 16,
     /// Noise of the recorded rotor phase.
     HelicopterRotorPhase = 17,
+    /// Wind forcing of the towed pod's swing.
+    PodWind = 18,
+    /// Altitude and speed wander of the towed-pod flight.
+    PodTrack = 19,
+    /// Pod magnetometer and cable-angle noise.
+    PodNoise = 20,
 }
 
 /// A generator for `stream` of the scenario `seed`.

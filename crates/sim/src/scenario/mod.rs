@@ -7,6 +7,7 @@
 //! | `calibration_truncated` | the truncated box (≈ 73 % of the time) | quiet |
 //! | `survey` | 12 lines + 3 tie lines at 100 m above ground, turbulence ([`survey`]) | realistic gradients, two dipoles |
 //! | `helicopter` | the box at 40 m/s, 150 m above ground, 100 Hz, fuselage + main rotor ([`helicopter`]) | realistic |
+//! | towed pod | straight headings with pitch/roll/yaw manoeuvres, pod on a 40 m cable under a dipole-array helicopter ([`pod::simulate_pod`]; a library function, not yet a [`ScenarioKind`]) | gradients 5.91 / −25.91 nT/km |
 //!
 //! All fixed-wing scenarios share the configuration of [`config`] and the
 //! pipeline of [`fixed_wing`] (the same aircraft and sensors; only the
@@ -20,6 +21,7 @@ pub mod calibration;
 pub mod config;
 pub mod fixed_wing;
 pub mod helicopter;
+pub mod pod;
 pub mod survey;
 
 use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};

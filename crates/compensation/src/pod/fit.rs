@@ -1,0 +1,325 @@
+//! Fitting and applying the pod model: the seed's two-step solve, the joint
+//! solve, and the compensation rate per heading (spec `helicopter.md` part
+//! B "Fit", seed `002_…` §4, eqs. 19–20).
+//!
+//! High-pass: every series of a heading is detrended (its least-squares
+//! straight line removed). This removes the trends of the track term
+//! (`V t` along north) and the steady interference, like the seed's
+//! high-pass FIR, without edge transients.
+//!
+//! * **Two-step** ([`fit_two_step`]): on each heading `k` solve the 7
+//!   heading coefficients `W_k` from the normal equations of
+//!   `s0 = s − s3` on `D = (v1, v2, v1', v2', x, y, z)` (eq. 20); then solve
+//!   `θ` from `W_k = M(U_k) θ` stacked over the headings (eqs. 6, 10–12).
+//!   Compensation uses the small-signal model with the heading's `U`.
+//! * **Joint** ([`fit_joint`]): one least-squares fit of `θ` on every
+//!   sample of every heading with the regressors of
+//!   [`super::model::large_signal_row`] (instantaneous `u`, no
+//!   linearisation in `u`, every sample weighted equally instead of every
+//!   heading coefficient); [`predict_joint`] applies it. On the simulated
+//!   seed scenario it is no better than the two-step solve: both are
+//!   limited by the linearisation in the pod displacement, which the
+//!   equivalent-dipole-array joint solve of [`super::dipole_array`] removes.
+//!
+//! Both least-squares problems are solved by a column-scaled SVD with
+//! truncation ([`RCOND`]): level flights at one site leave some parameter
+//! combinations unobservable (e.g. `U3` is nearly the same on every
+//! heading); the minimum-norm solution predicts the observable ones.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::model::{N_HEADING, N_PARAMS, heading_coefficients, heading_design, large_signal_row};
+use crate::{CompError, Result};
+
+/// Relative singular-value cut-off of the least-squares solves.
+pub const RCOND: f64 = 1e-9;
+
+/// One straight heading of pod data (one value per sample).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PodHeading {
+    /// Scalar field at the pod, nT.
+    pub total_nt: Vec<f64>,
+    /// Track term `s3 = k_x x_N + k_h h`, nT (known gradients times the
+    /// pod's north position and altitude; trends are removed later).
+    pub track_nt: Vec<f64>,
+    /// Direction cosines of the Earth field in the body frame.
+    pub u: Vec<[f64; 3]>,
+    /// Pod position in the body frame, m (from [`super::trajectory`]).
+    pub pod_body_m: Vec<[f64; 3]>,
+    /// Sample interval, s.
+    pub dt_s: f64,
+}
+
+/// Result of [`fit_two_step`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoStepFit {
+    /// Heading coefficients `W1..W7` per learning heading (step 1).
+    pub heading_coefficients: Vec<[f64; N_HEADING]>,
+    /// Model parameters `θ` (step 2), see [`super::model`].
+    pub theta: Vec<f64>,
+}
+
+/// Remove the least-squares straight line from `x` (the high-pass).
+pub fn detrend(x: &[f64]) -> Vec<f64> {
+    let n = x.len() as f64;
+    if x.len() < 2 {
+        return vec![0.0; x.len()];
+    }
+    let tm = (n - 1.0) / 2.0;
+    let xm = x.iter().sum::<f64>() / n;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (i, v) in x.iter().enumerate() {
+        let t = i as f64 - tm;
+        sxy += t * (v - xm);
+        sxx += t * t;
+    }
+    let slope = sxy / sxx;
+    x.iter()
+        .enumerate()
+        .map(|(i, v)| v - xm - slope * (i as f64 - tm))
+        .collect()
+}
+
+fn rms(x: &[f64]) -> f64 {
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
+}
+
+/// Per-heading quantities: steady `U`, rates `u'`, displacements `δp`.
+pub(super) struct Prepared {
+    pub(super) u0: [f64; 3],
+    pub(super) du: Vec<[f64; 3]>,
+    pub(super) dp: Vec<[f64; 3]>,
+    /// High-passed `s0 = s − s3`.
+    pub(super) s0: Vec<f64>,
+}
+
+pub(super) fn prepare(h: &PodHeading) -> Result<Prepared> {
+    let n = h.total_nt.len();
+    if n < 16 || h.track_nt.len() != n || h.u.len() != n || h.pod_body_m.len() != n {
+        return Err(CompError::BadData(format!(
+            "pod heading needs ≥ 16 samples and equal lengths (total {n}, track {}, u {}, pod {})",
+            h.track_nt.len(),
+            h.u.len(),
+            h.pod_body_m.len()
+        )));
+    }
+    if !(h.dt_s.is_finite() && h.dt_s > 0.0) {
+        return Err(CompError::BadData(
+            "pod heading: dt_s must be positive".into(),
+        ));
+    }
+    let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+    if h.total_nt.iter().chain(&h.track_nt).any(|x| !x.is_finite())
+        || !h.u.iter().all(finite)
+        || !h.pod_body_m.iter().all(finite)
+    {
+        return Err(CompError::BadData("pod heading: non-finite input".into()));
+    }
+    let mean3 = |v: &[[f64; 3]]| {
+        let mut m = [0.0; 3];
+        v.iter()
+            .for_each(|p| (0..3).for_each(|i| m[i] += p[i] / n as f64));
+        m
+    };
+    let u0 = mean3(&h.u);
+    let pm = mean3(&h.pod_body_m);
+    let du = (0..n)
+        .map(|k| {
+            let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+            let span = (b - a) as f64 * h.dt_s;
+            [0, 1, 2].map(|i| (h.u[b][i] - h.u[a][i]) / span)
+        })
+        .collect();
+    let dp = h
+        .pod_body_m
+        .iter()
+        .map(|p| [p[0] - pm[0], p[1] - pm[1], p[2] - pm[2]])
+        .collect();
+    let s: Vec<f64> = h
+        .total_nt
+        .iter()
+        .zip(&h.track_nt)
+        .map(|(a, b)| a - b)
+        .collect();
+    Ok(Prepared {
+        u0,
+        du,
+        dp,
+        s0: detrend(&s),
+    })
+}
+
+/// Column-scaled, truncated-SVD least squares `min |A x − y|`.
+pub(super) fn lstsq(a: DMatrix<f64>, y: &DVector<f64>) -> Result<DVector<f64>> {
+    // Columns that are zero up to rounding (e.g. a `U1 = 0` heading set)
+    // are dropped, not blown up to unit norm.
+    let norms: Vec<f64> = (0..a.ncols()).map(|j| a.column(j).norm()).collect();
+    let big = norms.iter().copied().fold(0.0, f64::max);
+    let scale: Vec<f64> = norms
+        .iter()
+        .map(|&s| if s > 1e-12 * big { 1.0 / s } else { 0.0 })
+        .collect();
+    let mut a = a;
+    for (j, s) in scale.iter().enumerate() {
+        a.column_mut(j).scale_mut(*s);
+    }
+    let svd = a.svd(true, true);
+    let smax = svd.singular_values.max();
+    let x = svd
+        .solve(y, RCOND * smax)
+        .map_err(|e| CompError::BadData(format!("pod least squares: {e}")))?;
+    Ok(DVector::from_iterator(
+        x.len(),
+        x.iter().zip(&scale).map(|(v, s)| v * s),
+    ))
+}
+
+/// The 7 regressor columns `D` of eq. 19 (high-passed): `v1, v2, v1', v2',
+/// x, y, z`.
+fn small_signal_columns(h: &PodHeading, p: &Prepared) -> Vec<Vec<f64>> {
+    let col = |f: &dyn Fn(usize) -> f64| detrend(&(0..h.u.len()).map(f).collect::<Vec<_>>());
+    vec![
+        col(&|k| h.u[k][0] - p.u0[0]),
+        col(&|k| h.u[k][1] - p.u0[1]),
+        col(&|k| p.du[k][0]),
+        col(&|k| p.du[k][1]),
+        col(&|k| p.dp[k][0]),
+        col(&|k| p.dp[k][1]),
+        col(&|k| p.dp[k][2]),
+    ]
+}
+
+/// Step 1 of the seed: heading coefficients `W1..W7` of one heading from
+/// the normal equations of eq. 20. Errors: bad data.
+pub fn fit_heading_coefficients(h: &PodHeading) -> Result<[f64; N_HEADING]> {
+    let p = prepare(h)?;
+    let cols = small_signal_columns(h, &p);
+    let n = p.s0.len();
+    let a = DMatrix::from_fn(n, N_HEADING, |r, c| cols[c][r]);
+    let w = lstsq(a, &DVector::from_column_slice(&p.s0))?;
+    Ok([0, 1, 2, 3, 4, 5, 6].map(|i| w[i]))
+}
+
+/// The seed's two-step solve over the learning `headings`: step 1 on each
+/// heading, step 2 `θ` from `W_k = M(U_k) θ`. Errors: bad data, `|U3|`
+/// too small on a heading.
+pub fn fit_two_step(headings: &[PodHeading]) -> Result<TwoStepFit> {
+    if headings.is_empty() {
+        return Err(CompError::BadData("two-step pod fit needs headings".into()));
+    }
+    let mut ws = Vec::with_capacity(headings.len());
+    let mut rows: Vec<[f64; N_PARAMS]> = Vec::new();
+    let mut y = Vec::new();
+    for h in headings {
+        let w = fit_heading_coefficients(h)?;
+        let m = heading_design(&prepare(h)?.u0)?;
+        for (i, wi) in w.iter().enumerate() {
+            rows.push(std::array::from_fn(|k| m[k][i]));
+            y.push(*wi);
+        }
+        ws.push(w);
+    }
+    let a = DMatrix::from_fn(rows.len(), N_PARAMS, |r, c| rows[r][c]);
+    let theta = lstsq(a, &DVector::from_vec(y))?;
+    Ok(TwoStepFit {
+        heading_coefficients: ws,
+        theta: theta.iter().copied().collect(),
+    })
+}
+
+fn joint_columns(h: &PodHeading, p: &Prepared) -> Vec<Vec<f64>> {
+    let rows: Vec<[f64; N_PARAMS]> = (0..h.u.len())
+        .map(|k| large_signal_row(&h.u[k], &p.du[k], &p.dp[k]))
+        .collect();
+    (0..N_PARAMS)
+        .map(|c| detrend(&rows.iter().map(|r| r[c]).collect::<Vec<_>>()))
+        .collect()
+}
+
+/// The joint solve of `θ`: one least-squares fit of the high-passed
+/// large-signal model on all samples of all `headings`. Errors: bad data.
+pub fn fit_joint(headings: &[PodHeading]) -> Result<Vec<f64>> {
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); N_PARAMS];
+    let mut y = Vec::new();
+    for h in headings {
+        let p = prepare(h)?;
+        for (c, col) in joint_columns(h, &p).into_iter().enumerate() {
+            cols[c].extend(col);
+        }
+        y.extend(p.s0);
+    }
+    if y.is_empty() {
+        return Err(CompError::BadData("joint pod fit needs headings".into()));
+    }
+    let a = DMatrix::from_fn(y.len(), N_PARAMS, |r, c| cols[c][r]);
+    Ok(lstsq(a, &DVector::from_vec(y))?.iter().copied().collect())
+}
+
+/// High-passed small-signal prediction `Σ W_i(U) D_i` on heading `h`, nT.
+pub fn predict_small_signal(theta: &[f64], h: &PodHeading) -> Result<Vec<f64>> {
+    let p = prepare(h)?;
+    let w = heading_coefficients(theta, &p.u0)?;
+    let cols = small_signal_columns(h, &p);
+    Ok((0..p.s0.len())
+        .map(|k| (0..N_HEADING).map(|i| w[i] * cols[i][k]).sum())
+        .collect())
+}
+
+/// High-passed large-signal prediction on heading `h` for the
+/// [`N_PARAMS`] parameters `θ` (of [`fit_joint`] or [`fit_two_step`]), nT.
+pub fn predict_joint(theta: &[f64], h: &PodHeading) -> Result<Vec<f64>> {
+    if theta.len() != N_PARAMS {
+        return Err(CompError::BadData(format!(
+            "pod model needs {N_PARAMS} parameters"
+        )));
+    }
+    let p = prepare(h)?;
+    let cols = joint_columns(h, &p);
+    Ok((0..p.s0.len())
+        .map(|k| (0..N_PARAMS).map(|i| theta[i] * cols[i][k]).sum())
+        .collect())
+}
+
+/// Compensation rate of heading `h` with the high-passed model prediction
+/// `pred` (nT): `1 − RMS(after)/RMS(before)`, `before` the high-passed
+/// field, `after` the high-passed `s − s3 − pred` (spec `helicopter.md`
+/// part B). Errors: bad data, length mismatch, zero `before`.
+pub fn compensation_rate(h: &PodHeading, pred: &[f64]) -> Result<f64> {
+    let p = prepare(h)?;
+    if pred.len() != p.s0.len() {
+        return Err(CompError::BadData(
+            "prediction length differs from the heading".into(),
+        ));
+    }
+    let before = rms(&detrend(&h.total_nt));
+    if before <= 0.0 {
+        return Err(CompError::BadData("heading without interference".into()));
+    }
+    let after: Vec<f64> = p.s0.iter().zip(pred).map(|(s, m)| s - m).collect();
+    Ok(1.0 - rms(&after) / before)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn detrend_removes_lines_only() {
+        let x: Vec<f64> = (0..50).map(|i| 3.0 + 0.2 * i as f64).collect();
+        assert!(detrend(&x).iter().all(|v| v.abs() < 1e-12));
+        let s: Vec<f64> = (0..50).map(|i| (i as f64 * 0.7).sin()).collect();
+        assert!(rms(&detrend(&s)) > 0.5);
+    }
+
+    #[test]
+    fn bad_headings_are_errors() {
+        let h = PodHeading {
+            total_nt: vec![1.0; 20],
+            dt_s: 0.05,
+            ..PodHeading::default()
+        };
+        assert!(fit_heading_coefficients(&h).is_err());
+        assert!(fit_two_step(&[]).is_err());
+        assert!(fit_joint(&[]).is_err());
+    }
+}
