@@ -10,6 +10,7 @@ mod exit;
 mod flight;
 mod input;
 mod progress;
+mod report_section;
 
 use clap::{Parser, Subcommand};
 
@@ -38,6 +39,9 @@ enum Command {
     Report(commands::report::Args),
     Level(commands::level::Args),
     Dipole(commands::dipole::Args),
+    Em(commands::em::Args),
+    Rotor(commands::rotor::Args),
+    Observability(commands::observability::Args),
 }
 
 /// Let a closed pipe (`aeromag … | head`) end the program quietly, as Unix
@@ -64,6 +68,9 @@ fn main() {
         Command::Report(a) => commands::report::run(a),
         Command::Level(a) => commands::level::run(a),
         Command::Dipole(a) => commands::dipole::run(a),
+        Command::Em(a) => commands::em::run(a),
+        Command::Rotor(a) => commands::rotor::run(a),
+        Command::Observability(a) => commands::observability::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -130,6 +130,17 @@ fn demo_meets_the_compensation_figures() {
     assert!(g("ir") >= 20.0, "IR {}", g("ir"));
     assert!(g("fom_after_nt") < g("fom_before_nt") / 20.0);
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
+    // Every key of data-formats.md that this version computes is present and numeric.
+    for (group, keys) in [
+        ("compensation", &["residual_rms_kalman_nt"][..]),
+        ("compensation_gradient", &["residual_rms_ls_nt", "residual_rms_kalman_nt", "noise_floor_nt"][..]),
+        ("rotor", &["rotor_rms_nt", "residual_model_nt", "residual_best_filter_nt"][..]),
+        ("em", &["range_err_rel", "angle_err_deg", "polarization_ratio_before", "polarization_ratio_after"][..]),
+    ] {
+        for k in keys {
+            assert!(s[group][k].as_f64().is_some(), "summary key {group}.{k}");
+        }
+    }
 }
 
 #[test]

@@ -27,6 +27,7 @@
 //! | [`detection`] | FIR-weighted synchronous detection, its frequency response, pilot correction, polarisation ellipse |
 //! | [`calibration`] | three-stage calibration (polarisation, transmitter geometry, attitude), JSON, run-time application |
 //! | [`sim`] | the `em` scenario: ADC-level three-channel coil voltages with all distortions, binary raw format |
+//! | [`study`] | the full-chain flight study (simulation → detection → calibration → positioning) shared by tests, CLI and demo |
 
 //!
 //! ## Pipeline (what `aeromag em detect|calibrate|locate` wires together)
@@ -49,6 +50,7 @@ pub mod detection;
 pub mod error;
 pub mod positioning;
 pub mod sim;
+pub mod study;
 
 pub use error::EmError;
 

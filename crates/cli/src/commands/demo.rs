@@ -41,6 +41,11 @@ pub struct Args {
     quick: bool,
 }
 
+/// A small number from a JSON object, in scientific notation.
+fn sci(v: &serde_json::Value, key: &str) -> String {
+    v[key].as_f64().map_or("—".into(), |x| format!("{x:.3e}"))
+}
+
 fn fmt(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
@@ -49,7 +54,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let start = Instant::now();
     let data = a.out.join("data");
     std::fs::create_dir_all(&data)?;
-    let bar = crate::progress::bar(5, "demo");
+    let bar = crate::progress::bar(6, "demo");
     if a.quick {
         eprintln!("--quick: the truncated calibration pattern is used");
     }
@@ -128,6 +133,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (grad_res_ls, grad_res_kf) = (residual(&grad_ls)?, residual(&grad_kf)?);
     bar.inc(1);
 
+    // Helicopter rotor and EM bird positioning.
+    bar.set_message("rotor and EM studies");
+    let (rotor_keys, rotor_section) = crate::commands::rotor::demo_rotor(a.quick)?;
+    let (em_keys, em_section) = crate::commands::em::demo_em(a.quick)?;
+    bar.inc(1);
+
     // 5. Report.
     bar.set_message("writing report");
     let summary = json!({
@@ -157,6 +168,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "residual_rms_kalman_nt": grad_res_kf,
             "noise_floor_nt": fsv.noise_floor_nt,
         },
+        "rotor": rotor_keys,
+        "em": em_keys,
         "seed": a.seed,
         "software_version": env!("CARGO_PKG_VERSION"),
     });
@@ -219,6 +232,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
     add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
+    for section in [rotor_section, em_section].into_iter().flatten() {
+        section.append_to(&mut r);
+    }
     r.write_html(a.out.join("index.html"))?;
     bar.inc(1);
     bar.finish_and_clear();
@@ -234,6 +250,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("compensation.ir", fmt(fc.ir, 1)),
         ("compensation_gradient.residual_rms_ls_nt", fmt(grad_res_ls, 4)),
         ("compensation_gradient.residual_rms_kalman_nt", fmt(grad_res_kf, 4)),
+        ("rotor.rotor_rms_nt", fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3)),
+        ("rotor.residual_model_nt", fmt(rotor_keys["residual_model_nt"].as_f64(), 4)),
+        ("rotor.residual_best_filter_nt", fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4)),
+        ("em.range_err_rel", sci(&em_keys, "range_err_rel")),
+        ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
+        ("em.polarization_ratio_before", sci(&em_keys, "polarization_ratio_before")),
+        ("em.polarization_ratio_after", sci(&em_keys, "polarization_ratio_after")),
     ];
     for (k, v) in rows {
         println!("{k:<44} {v:>12}");

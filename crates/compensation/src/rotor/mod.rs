@@ -19,7 +19,8 @@
 //!
 //! Baselines for comparison: low-pass below the blade-passing frequency
 //! ([`lowpass`]), notches at the harmonics ([`notch`]), rotor-phase
-//! synchronous averaging ([`synchronous`]).
+//! synchronous averaging ([`synchronous`]). [`study`] runs the whole
+//! comparison on a record with known truth.
 //!
 //! ## Measured on the `helicopter` scenario of `aeromag-sim`
 //!
@@ -65,6 +66,7 @@ pub mod notch;
 pub mod phase;
 #[cfg(test)]
 mod sim_tests;
+pub mod study;
 pub mod synchronous;
 
 pub use blade::{FlapAngles, RotorGeometry, blade_axes, dipole_integral};

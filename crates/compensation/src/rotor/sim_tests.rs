@@ -1,25 +1,14 @@
 //! The rotor model and the baselines on the `helicopter` scenario of
 //! `aeromag-sim` (spec `helicopter.md` part A, "What to show").
 //!
-//! Metrics (all RMS about the mean, nT, samples within 3 s of the ends
-//! excluded):
-//! * residual rotor interference: `true_rotor − prediction` for the model
-//!   (fitted to the full scalar record: fuselage, anomaly, noise included);
-//!   for the linear baselines the part of `true_rotor` they let through;
-//! * signal removed: the part of an anomaly signal each method takes away,
-//!   by linearity (the method applied to the signal alone with the same
-//!   phase, field and angles), relative to the signal's RMS. Two signals:
-//!   the scenario's `true_anomaly` (150 m above ground, smooth) and a train
-//!   of Gaussian bumps of 0.5 s standard width (a shallow source passed at
-//!   40 m/s), which is what low-pass filters hurt.
+//! The comparison itself (metrics, methods) is [`super::study::evaluate`];
+//! edges of 3 s (300 samples) are excluded.
 
 use aeromag_sim::{ScenarioKind, Simulation, simulate};
 use nalgebra::Vector3;
 
 use super::*;
-use crate::rotor::lowpass::lowpass;
-use crate::rotor::notch::{NotchOptions, notch_harmonics};
-use crate::rotor::synchronous::synchronous_template;
+use crate::rotor::study::{StudyInput, evaluate, scenario_geometry, std_mid};
 
 struct Case {
     sim: Simulation,
@@ -36,13 +25,7 @@ fn case(seed: u64, cfg: Option<&str>) -> Case {
     let b = (0..x.len())
         .map(|k| Vector3::new(x[k], y[k], z[k]))
         .collect();
-    let geom = RotorGeometry {
-        hub_m: [0.0, 0.0, -2.6],
-        sensor_m: [5.0, 0.0, 0.6],
-        root_m: 0.8,
-        tip_m: 7.5,
-        blades: 4,
-    };
+    let geom = scenario_geometry();
     Case {
         sim,
         fs: 100.0,
@@ -52,147 +35,52 @@ fn case(seed: u64, cfg: Option<&str>) -> Case {
     }
 }
 
-fn std_mid(x: &[f64], edge: usize) -> f64 {
-    let s = &x[edge..x.len() - edge];
-    let m = s.iter().sum::<f64>() / s.len() as f64;
-    (s.iter().map(|v| (v - m).powi(2)).sum::<f64>() / s.len() as f64).sqrt()
-}
-
 fn diff(a: &[f64], b: &[f64]) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x - y).collect()
-}
-
-fn bumps(n: usize, fs: f64, sigma_s: f64) -> Vec<f64> {
-    (0..n)
-        .map(|k| {
-            let t = k as f64 / fs;
-            (0..(n as f64 / fs / 25.0) as usize)
-                .map(|i| {
-                    let t0 = 12.5 + 25.0 * i as f64;
-                    let amp = if i % 2 == 0 { 5.0 } else { -3.0 };
-                    amp * (-(t - t0).powi(2) / (2.0 * sigma_s * sigma_s)).exp()
-                })
-                .sum()
-        })
-        .collect()
 }
 
 #[test]
 fn model_beats_the_filters() {
     let cs = case(11, None);
-    let (fs, edge) = (cs.fs, cs.edge);
-    let col = |n: &str| cs.sim.column(n).unwrap().to_vec();
-    let mag = col("mag");
-    let rot = col("true_rotor");
-    let anom = col("true_anomaly");
-    let bump = bumps(mag.len(), fs, 0.5);
-    let sharp = bumps(mag.len(), fs, 0.1);
-    let phase = unwrap_deg(&col("rotor_phase"));
-    let omega = rotor_speed(&phase, fs, 1.0).unwrap();
-    let f_r = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
-    let nominal = [FlapAngles {
-        coning_rad: 4f64.to_radians(),
-        tilt_lon_rad: (-1.5f64).to_radians(),
-        tilt_lat_rad: 0.0,
-    }];
-    let input = RotorInput {
-        b_body_nt: &cs.b,
-        phase_rad: &phase,
-        omega_rad_s: &omega,
-        angles: &nominal,
-    };
-    let opts = RotorFitOptions::default();
-    let r_rms = std_mid(&rot, edge);
-
-    let mut report = Vec::new();
-    // Models.
-    for terms in [BladeTerms::Simplified, BladeTerms::Full] {
-        let f = fit(&cs.geom, terms, &input, &mag, fs, &opts).unwrap();
-        let p = f.predict(&cs.geom, &input).unwrap();
-        report.push((
-            format!("model {terms:?}"),
-            std_mid(&diff(&rot, &p), edge),
-            f64::NAN,
-            f64::NAN,
-            f64::NAN,
-        ));
-    }
-    let slow = fit_slow_angles(
+    let col = |n: &str| cs.sim.column(n).unwrap();
+    let st = evaluate(
         &cs.geom,
-        BladeTerms::Full,
-        &input,
-        &mag,
-        fs,
-        &opts,
-        &SlowAngleOptions::default(),
+        &StudyInput {
+            mag_nt: col("mag"),
+            b_body_nt: &cs.b,
+            rotor_phase_deg: col("rotor_phase"),
+            true_rotor_nt: col("true_rotor"),
+            true_anomaly_nt: col("true_anomaly"),
+            fs_hz: cs.fs,
+            edge: cs.edge,
+        },
     )
     .unwrap();
-    let inp_s = RotorInput {
-        angles: &slow.angles,
-        ..input
-    };
-    let cols = regressors(&cs.geom, BladeTerms::Full, &inp_s).unwrap();
-    let pred = slow.fit.predict_columns(&cols).unwrap();
-    let model_res = std_mid(&diff(&rot, &pred), edge);
-    // The estimated coning follows the true one.
+    let r_rms = st.rotor_rms_nt;
+    // The estimated coning against the true one.
     let true_cone: Vec<f64> = col("true_coning").iter().map(|d| d.to_radians()).collect();
-    let est_cone: Vec<f64> = slow.angles.iter().map(|a| a.coning_rad).collect();
-    let cone_err = std_mid(&diff(&est_cone, &true_cone), edge);
-    let cone_var = std_mid(&true_cone, edge);
     eprintln!(
         "coning: true variation {:.4} deg RMS, estimation error {:.4} deg RMS",
-        cone_var.to_degrees(),
-        cone_err.to_degrees()
+        std_mid(&true_cone, cs.edge).to_degrees(),
+        std_mid(&diff(&st.coning_rad, &true_cone), cs.edge).to_degrees()
     );
-    let removed = |sig: &[f64]| {
-        let f = linear::fit_columns(&cols, BladeTerms::Full, sig, fs, &opts).unwrap();
-        std_mid(&f.predict_columns(&cols).unwrap(), edge) / std_mid(sig, edge)
-    };
-    let (m_a, m_b, m_c) = (removed(&anom), removed(&bump), removed(&sharp));
-    report.push(("model Full + slow cone".into(), model_res, m_a, m_b, m_c));
-    // Baselines.
-    let lin = |name: String, f: &dyn Fn(&[f64]) -> Vec<f64>| {
-        let res = std_mid(&f(&rot), edge);
-        let ra = std_mid(&diff(&anom, &f(&anom)), edge) / std_mid(&anom, edge);
-        let rb = std_mid(&diff(&bump, &f(&bump)), edge) / std_mid(&bump, edge);
-        let rc = std_mid(&diff(&sharp, &f(&sharp)), edge) / std_mid(&sharp, edge);
-        (name, res, ra, rb, rc)
-    };
-    let bp = 4.0 * f_r;
-    report.push(lin(
-        format!("low-pass {:.1} Hz (0.8 f_bp)", 0.8 * bp),
-        &|x| lowpass(x, fs, 0.8 * bp, 6).unwrap(),
-    ));
-    report.push(lin(
-        format!("low-pass {:.1} Hz (0.8 f_r)", 0.8 * f_r),
-        &|x| lowpass(x, fs, 0.8 * f_r, 6).unwrap(),
-    ));
-    report.push(lin("notches 1..16 f_r".into(), &|x| {
-        notch_harmonics(x, fs, f_r, &NotchOptions::default()).unwrap()
-    }));
-    report.push(lin("synchronous avg 10 s".into(), &|x| {
-        diff(
-            x,
-            &synchronous_template(x, &phase, fs, 64, 10.0, 2.0).unwrap(),
-        )
-    }));
     eprintln!(
         "rotor interference RMS {r_rms:.3} nT, anomaly RMS {:.3} nT",
-        std_mid(&anom, edge)
+        st.anomaly_rms_nt
     );
-    for (name, res, a, b, c) in &report {
+    for m in &st.methods {
         eprintln!(
-            "{name:32} residual {res:.4} nT ({:.2} %), removes anomaly {:.2} %, 0.5 s bumps {:.2} %, 0.1 s bumps {:.2} %",
-            100.0 * res / r_rms,
-            100.0 * a,
-            100.0 * b,
-            100.0 * c
+            "{:44} residual {:.4} nT ({:.2} %), removes anomaly {:.2} %, 0.5 s bumps {:.2} %, 0.1 s bumps {:.2} %",
+            m.name,
+            m.residual_nt,
+            100.0 * m.residual_nt / r_rms,
+            100.0 * m.removed_anomaly,
+            100.0 * m.removed_bumps_05,
+            100.0 * m.removed_bumps_01
         );
     }
-    let best_filter = report[3..]
-        .iter()
-        .map(|r| r.1)
-        .fold(f64::INFINITY, f64::min);
+    let (model_res, best_filter) = (st.residual_model_nt, st.residual_best_filter_nt);
+    assert_eq!(st.methods.iter().filter(|m| m.is_filter).count(), 4);
     assert!(
         model_res <= 0.10 * r_rms,
         "model leaves {model_res} of {r_rms}"
@@ -201,9 +89,10 @@ fn model_beats_the_filters() {
         best_filter >= 3.0 * model_res,
         "best filter {best_filter} vs model {model_res}"
     );
+    let m = &st.methods[1];
     assert!(
-        m_a <= 0.05 && m_b <= 0.05 && m_c <= 0.05,
-        "model removes {m_a} / {m_b} / {m_c} of the signal"
+        m.removed_anomaly <= 0.05 && m.removed_bumps_05 <= 0.05 && m.removed_bumps_01 <= 0.05,
+        "model removes {m:?} of the signal"
     );
 }
 
@@ -230,11 +119,7 @@ fn works_without_a_phase_channel() {
         est.rotor_hz
     );
     let omega = rotor_speed(&est.phase_rad, fs, 1.0).unwrap();
-    let nominal = [FlapAngles {
-        coning_rad: 4f64.to_radians(),
-        tilt_lon_rad: (-1.5f64).to_radians(),
-        tilt_lat_rad: 0.0,
-    }];
+    let nominal = [crate::rotor::study::nominal_angles()];
     let input = RotorInput {
         b_body_nt: &cs.b,
         phase_rad: &est.phase_rad,

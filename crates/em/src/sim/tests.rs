@@ -2,39 +2,16 @@
 //! correction and positioning.
 
 use super::*;
-use crate::detection::{DetectorConfig, FieldChain, FieldEpoch, SyncDetector, major_axis};
+use crate::detection::{FieldEpoch, major_axis};
 use crate::positioning::{
     Hemisphere, PolishOptions, angle_between, closed_form, polish, rotation_angle_between,
 };
+use crate::study::{FlightStudyConfig, epochs_at, rms, run_flight_study, simulate_and_detect};
 use aeromag_core::field::dipole::dipole_matrix;
 use nalgebra::{Matrix3, Vector3};
 
-fn chain(sc: &EmScenario, use_pilot: bool) -> FieldChain {
-    let c = &sc.config;
-    let plan = DetectorConfig::three_frequency_plan(
-        c.sample_rate_hz,
-        16_000,
-        c.frequencies_hz,
-        c.pilot_offset_hz,
-    );
-    let det = SyncDetector::new(plan).unwrap();
-    FieldChain::new(
-        det,
-        &sc.chi,
-        c.coil_gain_v_per_t_s,
-        &c.pilot_field_t,
-        use_pilot,
-    )
-    .unwrap()
-}
-
 fn run(config: EmSimConfig, use_pilot: bool) -> (EmScenario, Vec<FieldEpoch>) {
-    let sc = EmScenario::new(config).unwrap();
-    let rec = synthesize(&sc).unwrap();
-    let ep = chain(&sc, use_pilot)
-        .process(&rec.samples, rec.header.start_index)
-        .unwrap();
-    (sc, ep)
+    simulate_and_detect(config, use_pilot).unwrap()
 }
 
 /// Relative error of the detected complex field against the truth `R Ω M'`.
@@ -178,90 +155,15 @@ fn end_to_end_positioning_without_transmitter_distortion() {
     assert!(worst[3] < 1e-3, "{worst:?}");
 }
 
-/// One 16 000-sample block at each flight time of `times_s`.
-fn epochs_at(
-    base: &EmSimConfig,
-    times_s: &[f64],
-    use_pilot: bool,
-) -> (EmScenario, Vec<FieldEpoch>) {
-    let mut out = Vec::with_capacity(times_s.len());
-    let mut scenario = None;
-    for &t in times_s {
-        let cfg = EmSimConfig {
-            start_time_s: t,
-            duration_s: 0.16,
-            ..base.clone()
-        };
-        let (sc, ep) = run(cfg, use_pilot);
-        out.extend(ep);
-        scenario = Some(sc);
-    }
-    (scenario.expect("at least one time"), out)
-}
-
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
-}
-
 #[test]
 fn three_stage_calibration_over_a_five_hour_flight() {
-    use crate::calibration::{
-        Calibration, PolarisationCalibration, fit_attitude_correction, fit_transmitter_geometry,
-        uncalibrated,
-    };
-    let base = EmSimConfig::default();
-    let flight = 5.0 * 3600.0;
-    let cal_times: Vec<f64> = (0..120)
-        .map(|k| flight * (k as f64 + 0.37) / 120.0)
-        .collect();
-    let eval_times: Vec<f64> = (0..40).map(|k| flight * (k as f64 + 0.81) / 40.0).collect();
-    let (sc, cal_ep) = epochs_at(&base, &cal_times, true);
-    let m = sc.config.moments_am2;
-    let data: Vec<[[crate::detection::Complex64; 3]; 3]> = cal_ep.iter().map(|e| e.h).collect();
-
-    // Stage 1 (no external information).
-    let pol = PolarisationCalibration::fit(&data).unwrap();
-    // Stage 2 (known positions of 40 epochs).
-    let fields: Vec<Matrix3<f64>> = data[..40].iter().map(|e| pol.apply(e).0).collect();
-    let pos: Vec<Vector3<f64>> = cal_ep[..40]
-        .iter()
-        .map(|e| sc.pose_at(e.time_s).position_m)
-        .collect();
-    let s = fit_transmitter_geometry(&fields, &pos, &m).unwrap();
-    // Stage 3 (one known attitude).
-    let mut cal = Calibration {
-        polarisation: pol,
-        transmitter_s: s,
-        attitude_q: Matrix3::identity(),
-    };
-    let mut hemi = Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0));
-    let l0 = cal.locate(&data[0], &m, &mut hemi).unwrap();
-    cal.attitude_q = fit_attitude_correction(
-        &[sc.pose_at(cal_ep[0].time_s).rotation],
-        &[l0.pose.rotation],
-    )
-    .unwrap();
-
-    // Evaluation on other epochs, with and without pilot correction.
-    let (_, with) = epochs_at(&base, &eval_times, true);
-    let (_, without) = epochs_at(&base, &eval_times, false);
-    let mut ratio_before = Vec::new();
-    let mut ratio_after = Vec::new();
-    let mut ratio_no_pilot = Vec::new();
-    let mut err = [Vec::new(), Vec::new(), Vec::new()];
-    for (e, e_np) in with.iter().zip(&without) {
-        ratio_before.extend(uncalibrated(&e.h, &pol.phase_rad).1);
-        let mut hemi = Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0));
-        let l = cal.locate(&e.h, &m, &mut hemi).unwrap();
-        ratio_after.extend(l.polarisation_ratio);
-        ratio_no_pilot.extend(pol.apply(&e_np.h).1);
-        let t = sc.pose_at(e.time_s);
-        err[0].push((l.pose.range_m() - t.range_m()) / t.range_m());
-        err[1].push(angle_between(&l.pose.position_m, &t.position_m).to_degrees());
-        err[2].push(rotation_angle_between(&l.pose.rotation, &t.rotation).to_degrees());
-    }
-    let (rb, ra, rn) = (rms(&ratio_before), rms(&ratio_after), rms(&ratio_no_pilot));
-    let e = err.map(|v| rms(&v));
+    let st = run_flight_study(&EmSimConfig::default(), &FlightStudyConfig::default()).unwrap();
+    let (rb, ra, rn) = (
+        st.polarization_ratio_before,
+        st.polarization_ratio_after,
+        st.ratio_without_pilot,
+    );
+    let e = [st.range_err_rel, st.angle_err_deg, st.attitude_err_deg];
     eprintln!(
         "polarisation ratio RMS: before {rb:.3e}, after {ra:.3e} ({:.0}×), after without pilot {rn:.3e}",
         rb / ra
@@ -271,11 +173,23 @@ fn three_stage_calibration_over_a_five_hour_flight() {
         e[0], e[1], e[2]
     );
     // Stable over the flight: the last hour is no worse than the first.
-    let n = ratio_after.len();
-    let (first, last) = (rms(&ratio_after[..n / 5]), rms(&ratio_after[n - n / 5..]));
+    let s = &st.ratio_after_series;
+    let n = s.len();
+    let (first, last) = (rms(&s[..n / 5]), rms(&s[n - n / 5..]));
     eprintln!("after-calibration ratio RMS first hour {first:.3e}, last hour {last:.3e}");
+    assert_eq!(n, 40);
     assert!(rb / ra >= 100.0, "reduction {}", rb / ra);
     assert!(rn > 10.0 * ra, "without pilot {rn} vs {ra}");
     assert!(last < 3.0 * first && first < 3.0 * last);
     assert!(e[0] <= 1e-3 && e[1] <= 0.1 && e[2] <= 0.1, "{e:?}");
+}
+
+#[test]
+fn flight_study_rejects_bad_sizes() {
+    let bad = FlightStudyConfig {
+        known_positions: 2,
+        ..FlightStudyConfig::quick()
+    };
+    assert!(run_flight_study(&EmSimConfig::default(), &bad).is_err());
+    assert!(epochs_at(&EmSimConfig::default(), &[], true).is_err());
 }
