@@ -1,0 +1,44 @@
+//! `aeromag level` and `aeromag dipole convergence` end to end.
+
+mod common;
+use common::*;
+
+#[test]
+fn level_keeps_every_row_and_reports_k() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("s");
+    assert_code(&aeromag(&["simulate", "survey", "--seed", "4", "--out", out.to_str().unwrap()]), 0);
+    let input = out.join("survey.csv");
+    let lev = d.path().join("lev.csv");
+    let o = aeromag(&[
+        "level", "--input", input.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--lever-arm", "-9.5,0,-0.6", "--drift",
+    ]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("crossovers") && s.contains("k (d|B0|/dt term)"), "{s}");
+    // Without a base-station correction the crossover differences are dominated by the
+    // diurnal drift, which per-line offsets and drifts remove.
+    let line = s.lines().find(|l| l.starts_with("crossover differences RMS")).unwrap();
+    let nums: Vec<f64> = line.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+    assert!(nums.len() >= 2 && nums[1] < nums[0] / 5.0, "{line}");
+    let rows = |p: &std::path::Path| std::fs::read_to_string(p).unwrap().lines().filter(|l| !l.starts_with('#')).count();
+    assert_eq!(rows(&input), rows(&lev), "one output row per input row");
+    let header = std::fs::read_to_string(&lev).unwrap().lines().find(|l| !l.starts_with('#')).unwrap().to_string();
+    assert!(header.contains("mag_level") && header.contains("level_flag"));
+    let bad = aeromag(&["level", "--input", input.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--lever-arm", "1,2"]);
+    assert_code(&bad, 2);
+}
+
+#[test]
+fn dipole_convergence_map_multistart_converges_everywhere() {
+    let d = tempfile::tempdir().unwrap();
+    let o = aeromag(&["dipole", "convergence", "--grid", "9", "--out", d.path().to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    let multi = s.lines().find(|l| l.starts_with("multi-start")).unwrap();
+    assert!(multi.contains("100.00 % of 729 starts"), "{multi}");
+    let plain = s.lines().find(|l| l.starts_with("plain IEKF")).unwrap();
+    assert!(!plain.contains("100.00 % of"), "{plain}");
+    assert!(std::fs::read_to_string(d.path().join("index.html")).unwrap().contains("<svg"));
+    assert_code(&aeromag(&["dipole", "convergence", "--grid", "1", "--out", d.path().to_str().unwrap()]), 2);
+}
