@@ -90,12 +90,7 @@ impl RotorGeometry {
 /// (module docs).
 pub fn blade_axes(psi_rad: f64, f: &FlapAngles) -> Matrix3<f64> {
     let beta = f.coning_rad + f.tilt_lon_rad * psi_rad.cos() + f.tilt_lat_rad * psi_rad.sin();
-    let (sp, cp) = psi_rad.sin_cos();
-    let (sb, cb) = beta.sin_cos();
-    let r = Vector3::new(cb * cp, cb * sp, -sb);
-    let l = Vector3::new(-sp, cp, 0.0);
-    let u = l.cross(&r);
-    Matrix3::from_columns(&[r, l, u])
+    aeromag_core::frames::blade::blade_axes(psi_rad, beta)
 }
 
 /// The dipole integral `D_I` (T per A·m of moment density) of a rod from

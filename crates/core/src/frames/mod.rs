@@ -1,6 +1,7 @@
 //! Reference frames and rotations.
 
 pub mod attitude;
+pub mod blade;
 pub mod geodetic;
 
 pub use attitude::Attitude;

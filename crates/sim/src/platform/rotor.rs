@@ -310,12 +310,7 @@ impl RotorState {
         let beta = self.coning_rad[k]
             + self.tilt_lon_rad[k] * psi.cos()
             + self.tilt_lat_rad[k] * psi.sin();
-        let (sp, cp) = psi.sin_cos();
-        let (sb, cb) = beta.sin_cos();
-        let r = Vector3::new(cb * cp, cb * sp, -sb);
-        let l = Vector3::new(-sp, cp, 0.0);
-        let u = l.cross(&r);
-        Matrix3::from_columns(&[r, l, u])
+        aeromag_core::frames::blade::blade_axes(psi, beta)
     }
 }
 
