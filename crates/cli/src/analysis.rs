@@ -9,6 +9,7 @@
 //! compute them.
 
 use crate::flight::reference_sum;
+use aeromag_compensation::reference_field::LeverArm;
 use aeromag_compensation::metrics::{
     band_pass_segments, detect_maneuvers, figure_of_merit, improvement_ratio, residual_by_line, FomReport, LineResidual,
     ManeuverDetection,
@@ -62,10 +63,11 @@ fn segments(t: &FlightTable, comp: &[f64]) -> anyhow::Result<Vec<Range<usize>>> 
 /// measure the aircraft's interference, not the geology or the diurnal
 /// variation. The residual versus truth is pooled over survey lines: rows
 /// whose `line` label is 0 (turns, in the simulator's convention) are not
-/// survey data and are left out.
-pub fn figures(t: &FlightTable, reference: &[String]) -> anyhow::Result<Figures> {
+/// survey data and are left out. With a lever arm the `igrf` reference is
+/// moved to the sensor ([`reference_sum`]).
+pub fn figures(t: &FlightTable, reference: &[String], lever: Option<&LeverArm>) -> anyhow::Result<Figures> {
     let time = t.require("time")?;
-    let ref_sum = reference_sum(t, reference)?;
+    let ref_sum = reference_sum(t, reference, lever)?;
     let mag: Vec<f64> = t.require("mag")?.iter().zip(&ref_sum).map(|(a, b)| a - b).collect();
     let comp_raw = t.require("mag_comp")?;
     let comp: Vec<f64> = comp_raw.iter().zip(&ref_sum).map(|(a, b)| a - b).collect();

@@ -2,6 +2,7 @@
 //! required columns, segmentation, and writing results back as columns.
 
 use crate::exit::bad_input;
+use aeromag_compensation::reference_field::{lever_arm_correction_nt, LeverArm};
 use aeromag_compensation::tolles_lawson::segments::split_segments;
 use aeromag_io::FlightTable;
 use std::ops::Range;
@@ -34,15 +35,43 @@ pub fn reference_columns(table: &FlightTable, spec: &str) -> anyhow::Result<Vec<
     }
 }
 
-/// The sum of the named reference channels (zeros if none).
-pub fn reference_sum(table: &FlightTable, cols: &[String]) -> anyhow::Result<Vec<f64>> {
+/// The sum of the named reference channels (zeros if none). With a lever
+/// arm, the `igrf` channel is moved from the navigation point to the sensor
+/// (needs `lat`, `lon`, `alt`, `roll`, `pitch`, `yaw`).
+pub fn reference_sum(table: &FlightTable, cols: &[String], lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
     let mut r = vec![0.0; table.n_rows()];
     for c in cols {
         for (a, b) in r.iter_mut().zip(table.require(c)?) {
             *a += b;
         }
     }
+    if let (Some(lever), true) = (lever, cols.iter().any(|c| c == "igrf")) {
+        let col = |n: &str| table.require(n);
+        let corr = lever_arm_correction_nt(
+            lever,
+            col("lat")?,
+            col("lon")?,
+            col("alt")?,
+            col("roll")?,
+            col("pitch")?,
+            col("yaw")?,
+        )
+        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+        for (a, c) in r.iter_mut().zip(corr) {
+            *a += c;
+        }
+    }
     Ok(r)
+}
+
+/// A parsed `X,Y,Z` lever arm in metres (body frame).
+pub fn parse_lever_arm(s: &str) -> anyhow::Result<[f64; 3]> {
+    let bad = || bad_input!("--lever-arm `{s}`: expected three numbers X,Y,Z in metres (body frame: x forward, y right, z down)");
+    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(bad()),
+    }
 }
 
 impl<'a> TlColumns<'a> {

@@ -19,7 +19,19 @@ fn calibrate_compensate_report_keep_every_row() {
     assert!(!stderr(&o).contains("poorly determined"), "{}", stderr(&o));
     let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(m["format"], "aeromag-model/1");
-    assert_eq!(m["coefficients"].as_array().unwrap().len(), 16);
+    // The simulated airframe's eddy currents lag (τ 0.15–0.6 s): `auto`
+    // adds one or two lagged groups of nine columns to the 16 classical ones.
+    let lags = m["terms"]["eddy_lags_s"].as_array().map_or(0, |a| a.len());
+    assert!((1..=2).contains(&lags), "{}", m["terms"]);
+    assert_eq!(m["coefficients"].as_array().unwrap().len(), 16 + 9 * lags);
+    assert!(stderr(&o).contains("chosen (likelihood-ratio test)"), "{}", stderr(&o));
+    let classical = d.path().join("m16.json");
+    let o16 = aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", classical.to_str().unwrap(), "--eddy-lag", "none"]);
+    assert_code(&o16, 0);
+    let m16: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&classical).unwrap()).unwrap();
+    assert_eq!(m16["coefficients"].as_array().unwrap().len(), 16);
+    let rms = |m: &serde_json::Value| m["fit"]["residual_rms_nt"].as_f64().unwrap();
+    assert!(rms(&m) < 0.8 * rms(&m16), "lagged {} vs classical {}", rms(&m), rms(&m16));
 
     // Blank out some flux values: those rows stay, flagged.
     let text = std::fs::read_to_string(&cal).unwrap();
@@ -95,6 +107,11 @@ fn model_and_argument_errors_exit_2() {
         vec!["calibrate", "--input", p, "--model", m, "--band", "0.9,0.1"],
         vec!["calibrate", "--input", p, "--model", m, "--convention", "fancy"],
         vec!["calibrate", "--input", p, "--model", m, "--lambda", "-1"],
+        vec!["calibrate", "--input", p, "--model", m, "--eddy-lag", "0,0.5"],
+        vec!["calibrate", "--input", p, "--model", m, "--eddy-lag", "fast"],
+        vec!["calibrate", "--input", p, "--model", m, "--terms", "p3,i5", "--eddy-lag", "0.3"],
+        vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "1,2"],
+        vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "-9.5,0,-0.6", "--date", "2025-13-01"],
     ] {
         let o = aeromag(&args);
         assert_code(&o, 2);
@@ -129,6 +146,7 @@ fn demo_meets_the_compensation_figures() {
     assert!(res <= 2.0 * floor, "residual {res} nT > 2 × noise floor {floor} nT");
     assert!(g("ir") >= 20.0, "IR {}", g("ir"));
     assert!(g("fom_after_nt") < g("fom_before_nt") / 20.0);
+    assert!(g("fom_after_nt") <= 0.5, "FOM after {} nT", g("fom_after_nt"));
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
     // Every key of data-formats.md that this version computes is present and numeric.
     for (group, keys) in [

@@ -66,6 +66,7 @@ fn flight(n: usize) -> Flight {
         terms.row(
             [f.flux[0][i], f.flux[1][i], f.flux[2][i]],
             [db[0][i], db[1][i], db[2][i]],
+            &[],
             DEFAULT_BT_SCALE_NT,
             &mut row,
         );

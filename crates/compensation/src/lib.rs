@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod model_file;
 pub mod pod;
 pub mod observability;
+pub mod reference_field;
 pub mod rotor;
 pub mod tolles_lawson;
 

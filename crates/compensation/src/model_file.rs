@@ -77,6 +77,11 @@ pub struct TlModel {
     /// (e.g. `diurnal`, `igrf`); empty when the raw reading was fitted.
     #[serde(default)]
     pub reference: Vec<String>,
+    /// Lever arm of the scalar sensor from the navigation point: when set,
+    /// the `igrf` reference channel is moved to the sensor
+    /// ([`crate::reference_field`]) before the fit and before scoring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lever_arm: Option<crate::reference_field::LeverArm>,
     /// Input columns used (canonical name → file column name).
     pub columns: std::collections::BTreeMap<String, String>,
     /// Version of aeromag that wrote the file.
@@ -109,6 +114,7 @@ impl TlModel {
         }
         let m: TlModel =
             serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
+        m.terms.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
         let expect = m.terms.column_names();
         let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
         if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
@@ -150,6 +156,7 @@ mod tests {
             fit: FitStats::default(),
             columns: Default::default(),
             reference: vec![],
+            lever_arm: None,
             software_version: "test".into(),
         }
     }

@@ -12,5 +12,6 @@ pub mod error;
 pub mod kalman;
 pub mod least_squares;
 pub mod optimize;
+pub mod stats;
 
 pub use error::{EstError, Result};

@@ -1,10 +1,12 @@
 //! `aeromag calibrate`: fit a Tolles-Lawson model on a calibration flight.
 
 use crate::exit::bad_input;
-use crate::flight::{parse_band, reference_columns, reference_sum, TlColumns};
+use crate::flight::{parse_band, parse_lever_arm, reference_columns, reference_sum, TlColumns};
+use aeromag_compensation::reference_field::LeverArm;
 use crate::input::InputArgs;
 use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
+use aeromag_compensation::tolles_lawson::lag_select::{select_eddy_lags, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S};
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
 use aeromag_compensation::kalman::{
     fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment,
@@ -21,6 +23,14 @@ use std::path::PathBuf;
 /// of the `line` column, at time gaps and at missing values; each leg is
 /// filtered on its own. Terms not determined by the flight (one heading,
 /// missing manoeuvres) are named in a warning.
+///
+/// Eddy currents with a time constant (--eddy-lag, default `auto`): aircraft
+/// skins and frames carry eddy currents that follow dB/dt through a lag of
+/// 0.1–1 s, which the classical eddy terms (e8/e9) cannot represent. `auto`
+/// tries lagged eddy groups (l9) with τ from 0.1 to 2 s and keeps up to two
+/// lags only when a likelihood-ratio test on the band-passed residual
+/// finds them significant (1 % false-selection probability); otherwise the classical model is kept. `none` keeps
+/// the classical model (MagNav.jl's); a list such as `0.3,0.8` fixes the lags.
 ///
 /// Example:
 ///   aeromag calibrate --input cal.csv --model model.json
@@ -69,6 +79,75 @@ pub struct Args {
     /// (MagNav.jl's way), or a comma-separated list of columns.
     #[arg(long, default_value = "auto")]
     reference: String,
+    /// Eddy-current lags of the lagged eddy terms (l9): `auto` (chosen
+    /// from the flight by a likelihood-ratio test), `none` (classical Tolles-Lawson), or lags in
+    /// seconds, e.g. `0.3,0.8`.
+    #[arg(long, default_value = "auto", value_name = "auto|none|TAU,…")]
+    eddy_lag: String,
+    /// Scalar sensor position X,Y,Z (m, body frame: x forward, y right,
+    /// z down) from the navigation point whose position the `igrf` column
+    /// was computed at; the reference is then moved to the sensor with the
+    /// main field's gradient (needs lat, lon, alt, roll, pitch, yaw).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    lever_arm: Option<String>,
+    /// Date of the flight (YYYY-MM-DD) for the main-field gradient used with
+    /// --lever-arm (the gradient changes < 0.3 % per year).
+    #[arg(long, default_value = "2025-01-01")]
+    date: String,
+}
+
+/// How a model is fitted on a table, besides the term configuration.
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    /// Lagged eddy-current terms.
+    pub eddy_lag: EddyLag,
+    /// Split the flight into legs at changes of `line`.
+    pub split_lines: bool,
+    /// Reference channels: `auto`, `none` or a list (see --reference).
+    pub reference: String,
+    /// Sensor lever arm for the `igrf` reference.
+    pub lever_arm: Option<LeverArm>,
+}
+
+impl FitOptions {
+    /// `auto` lags and references, legs split at line changes, no lever arm.
+    pub fn auto() -> Self {
+        Self { eddy_lag: EddyLag::Auto, split_lines: true, reference: "auto".into(), lever_arm: None }
+    }
+}
+
+/// A `YYYY-MM-DD` date as a decimal year.
+fn parse_decimal_year(s: &str) -> anyhow::Result<f64> {
+    aeromag_core::time::Date::parse(s).map(|d| d.decimal_year()).map_err(|e| bad_input!("--date `{s}`: {e}"))
+}
+
+/// How the lagged eddy-current terms are chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EddyLag {
+    /// Classical model, no lagged terms.
+    None,
+    /// Up to two lags from [`DEFAULT_LAG_GRID_S`], kept if significant.
+    Auto,
+    /// These lags, s.
+    Fixed(Vec<f64>),
+}
+
+impl std::str::FromStr for EddyLag {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> anyhow::Result<Self> {
+        match s.trim() {
+            "auto" => Ok(EddyLag::Auto),
+            "none" | "" => Ok(EddyLag::None),
+            list => list
+                .split(',')
+                .map(|t| match t.trim().parse::<f64>() {
+                    Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+                    _ => Err(bad_input!("--eddy-lag `{s}`: expected auto, none or lags in seconds > 0 such as 0.3,0.8")),
+                })
+                .collect::<anyhow::Result<Vec<f64>>>()
+                .map(EddyLag::Fixed),
+        }
+    }
 }
 
 /// Build the LS configuration from the command-line flags.
@@ -86,10 +165,11 @@ fn config(a: &Args) -> anyhow::Result<LsConfig> {
 }
 
 /// Fit a model on a loaded calibration table; warnings go to stderr.
-pub fn fit_model(table: &FlightTable, cfg: &LsConfig, split_lines: bool, reference: &str) -> anyhow::Result<TlModel> {
+pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyhow::Result<TlModel> {
+    let (lag, split_lines) = (&opts.eddy_lag, opts.split_lines);
     let cols = TlColumns::from_table(table)?;
-    let ref_cols = reference_columns(table, reference)?;
-    let ref_sum = reference_sum(table, &ref_cols)?;
+    let ref_cols = reference_columns(table, &opts.reference)?;
+    let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
     let y: Vec<f64> = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
     let cols = TlColumns { mag: &y, ..cols };
     let (segs, _) = cols.segments(split_lines, 1);
@@ -105,6 +185,34 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, split_lines: bool, referen
             mag: &cols.mag[r.clone()],
         })
         .collect();
+    let chosen;
+    let cfg = match lag {
+        EddyLag::None if cfg.terms.eddy_lags_s().is_empty() => cfg,
+        EddyLag::None | EddyLag::Fixed(_) => {
+            let taus = if let EddyLag::Fixed(t) = lag { t.as_slice() } else { &[] };
+            let terms = cfg.terms.with_eddy_lags(taus).map_err(|e| bad_input!("--eddy-lag: {e}"))?;
+            chosen = LsConfig { terms, ..cfg.clone() };
+            &chosen
+        }
+        EddyLag::Auto if !cfg.terms.has_eddy() => cfg,
+        EddyLag::Auto => {
+            let spinner = crate::progress::spinner("choosing eddy-current lags");
+            let sel = select_eddy_lags(&segments, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
+                .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+            spinner.finish_and_clear();
+            let terms = cfg.terms.with_eddy_lags(&sel.taus_s).map_err(|e| bad_input!("--eddy-lag: {e}"))?;
+            if sel.taus_s.is_empty() {
+                eprintln!("note: eddy-current lags: no lag is significant; classical eddy terms kept");
+            } else {
+                eprintln!(
+                    "note: eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
+                    sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt
+                );
+            }
+            chosen = LsConfig { terms, ..cfg.clone() };
+            &chosen
+        }
+    };
     let spinner = crate::progress::spinner("fitting");
     let fit = fit_band_pass_ls(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     spinner.finish_and_clear();
@@ -145,6 +253,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, split_lines: bool, referen
             })
             .collect(),
         reference: ref_cols,
+        lever_arm: opts.lever_arm,
         software_version: env!("CARGO_PKG_VERSION").into(),
     })
 }
@@ -158,15 +267,22 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
 }
 
 /// Fit a model with the Kalman method on a loaded calibration table.
-pub fn fit_model_kalman(
-    table: &FlightTable,
-    cfg: &KalmanConfig,
-    split_lines: bool,
-    reference: &str,
-) -> anyhow::Result<(TlModel, KalmanFit)> {
+pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit)> {
+    let (lag, split_lines, reference) = (&opts.eddy_lag, opts.split_lines, opts.reference.as_str());
+    // `auto` chooses the lags with the band-pass LS machinery.
+    let terms = match lag {
+        EddyLag::Auto if cfg.terms.has_eddy() => {
+            let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
+            fit_model(table, &ls, opts)?.terms
+        }
+        EddyLag::Auto => cfg.terms.clone(),
+        EddyLag::None => cfg.terms.with_eddy_lags(&[]).map_err(|e| bad_input!("--eddy-lag: {e}"))?,
+        EddyLag::Fixed(t) => cfg.terms.with_eddy_lags(t).map_err(|e| bad_input!("--eddy-lag: {e}"))?,
+    };
+    let cfg = &KalmanConfig { terms, ..cfg.clone() };
     let cols = TlColumns::from_table(table)?;
     let ref_cols = reference_columns(table, reference)?;
-    let ref_sum = reference_sum(table, &ref_cols)?;
+    let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
     let y: Vec<f64> = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
     let alt = table.require("alt")?;
     let speed = ground_speed(table)?;
@@ -192,6 +308,7 @@ pub fn fit_model_kalman(
     }
     let mut model = fit.to_model(cfg);
     model.reference = ref_cols.clone();
+    model.lever_arm = opts.lever_arm;
     model.columns = ["time", "flux_x", "flux_y", "flux_z", "mag", "alt"]
         .iter()
         .map(|c| c.to_string())
@@ -206,13 +323,22 @@ pub fn fit_model_kalman(
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let table = a.input.load()?;
+    let opts = FitOptions {
+        eddy_lag: a.eddy_lag.parse()?,
+        split_lines: !a.no_split_lines,
+        reference: a.reference.clone(),
+        lever_arm: match &a.lever_arm {
+            Some(s) => Some(LeverArm { arm_m: parse_lever_arm(s)?, decimal_year: parse_decimal_year(&a.date)? }),
+            None => None,
+        },
+    };
     let model = match a.method.as_str() {
-        "ls" => fit_model(&table, &config(&a)?, !a.no_split_lines, &a.reference)?,
+        "ls" => fit_model(&table, &config(&a)?, &opts)?,
         "kalman" => {
             let ls = config(&a)?;
             let mut cfg = KalmanConfig { terms: ls.terms, convention: ls.convention, bt_scale_nt: ls.bt_scale_nt, ..KalmanConfig::default() };
             cfg.tuning.enabled = a.tune;
-            let (model, fit) = fit_model_kalman(&table, &cfg, !a.no_split_lines, &a.reference)?;
+            let (model, fit) = fit_model_kalman(&table, &cfg, &opts)?;
             println!(
                 "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
                 fit.noise.q1_nt2_per_m5,
@@ -237,6 +363,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         model.fit.residual_rms_nt,
         model.fit.condition
     );
+    if !cfg_terms.eddy_lags_s().is_empty() {
+        println!("eddy-current lags: {:?} s", cfg_terms.eddy_lags_s());
+    }
     println!("{:<8} {:>14} {:>12}", "term", "coefficient", "std");
     for c in &model.coefficients {
         println!("{:<8} {:>14.6} {:>12.3e}", c.name, c.value, c.std);

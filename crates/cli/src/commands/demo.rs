@@ -1,7 +1,8 @@
 //! `aeromag demo`: the whole chain on built-in simulated data.
 
 use crate::analysis::{add_to_report, figures, Figures};
-use crate::commands::calibrate::{fit_model, fit_model_kalman};
+use crate::commands::calibrate::{fit_model, fit_model_kalman, EddyLag, FitOptions};
+use aeromag_compensation::reference_field::LeverArm;
 use crate::commands::compensate::compensate_table;
 use crate::input::load;
 use aeromag_compensation::kalman::KalmanConfig;
@@ -50,6 +51,25 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
+/// The scalar sensor's lever arm (`scalar.position_m`, body frame, m) and
+/// the flight date (`flight.date`) from a scenario file.
+fn installation(scenario: &std::path::Path) -> anyhow::Result<LeverArm> {
+    let v: toml::Value = toml::from_str(&std::fs::read_to_string(scenario)?)?;
+    let arm = v
+        .get("scalar")
+        .and_then(|s| s.get("position_m"))
+        .and_then(|p| p.as_array())
+        .and_then(|a| a.iter().map(|x| x.as_float()).collect::<Option<Vec<f64>>>())
+        .and_then(|a| <[f64; 3]>::try_from(a).ok())
+        .ok_or_else(|| anyhow::anyhow!("{}: no scalar.position_m", scenario.display()))?;
+    let date = v
+        .get("flight")
+        .and_then(|f| f.get("date"))
+        .and_then(|d| d.as_str())
+        .ok_or_else(|| anyhow::anyhow!("{}: no flight.date", scenario.display()))?;
+    Ok(LeverArm { arm_m: arm, decimal_year: aeromag_core::time::Date::parse(date)?.decimal_year() })
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let start = Instant::now();
     let data = a.out.join("data");
@@ -72,10 +92,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
     // 2. Calibrate by both methods (reading the files back, as a user would).
     bar.set_message("calibrating");
+    // The installation, as the user knows it: the scalar sensor's lever arm
+    // from the navigation point and the flight date (scenario file).
+    let opts = FitOptions { lever_arm: Some(installation(&cal_files.scenario)?), ..FitOptions::auto() };
     let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel)> {
         let t = load(path, None)?;
-        let ls = fit_model(&t, &LsConfig::default(), true, "auto")?;
-        let (kf, _) = fit_model_kalman(&t, &KalmanConfig::default(), true, "auto")?;
+        let ls = fit_model(&t, &LsConfig::default(), &opts)?;
+        // The Kalman model uses the lags the LS fit chose (no second search).
+        let lags = ls.terms.eddy_lags_s();
+        let lag = if lags.is_empty() { EddyLag::None } else { EddyLag::Fixed(lags.to_vec()) };
+        let kf_cfg = KalmanConfig { terms: ls.terms.with_eddy_lags(&[])?, ..KalmanConfig::default() };
+        let (kf, _) = fit_model_kalman(&t, &kf_cfg, &FitOptions { eddy_lag: lag, ..opts.clone() })?;
         Ok((t, ls, kf))
     };
     let (mut cal, model, model_kf) = fit_both(&cal_files.csv)?;
@@ -100,9 +127,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
     // 4. Score.
     bar.set_message("scoring");
-    let fc: Figures = figures(&cal, &model.reference)?;
-    let fsv: Figures = figures(&survey, &model.reference)?;
-    let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> { Ok(figures(&compensated(m)?, &m.reference)?.residual_rms_nt) };
+    let fc: Figures = figures(&cal, &model.reference, model.lever_arm.as_ref())?;
+    let fsv: Figures = figures(&survey, &model.reference, model.lever_arm.as_ref())?;
+    let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> {
+        Ok(figures(&compensated(m)?, &m.reference, m.lever_arm.as_ref())?.residual_rms_nt)
+    };
     let res_kf = residual(&model_kf)?;
 
     // Calibration planning (thesis fig. 2): the truncated pattern against the
@@ -115,7 +144,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let (trunc, trunc_ls, trunc_kf) = fit_both(&trunc_files.csv)?;
         let cfg = KalmanConfig { compute_series: false, ..KalmanConfig::default() };
         let obs = |t: &FlightTable| -> anyhow::Result<Observability> {
-            let (_, f) = fit_model_kalman(t, &cfg, true, "auto")?;
+            let (_, f) = fit_model_kalman(t, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..opts.clone() })?;
             Ok(observability(&f.names, &f.prior_covariance, &f.posterior_covariance, 1e6)?)
         };
         let duration = |t: &FlightTable| -> anyhow::Result<f64> {

@@ -48,14 +48,6 @@ pub struct Args {
     lambda: f64,
 }
 
-fn parse_lever(s: &str) -> anyhow::Result<[f64; 3]> {
-    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad_input!("--lever-arm `{s}`: expected X,Y,Z in metres"))?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
-        _ => Err(bad_input!("--lever-arm `{s}`: expected three numbers X,Y,Z in metres")),
-    }
-}
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     let mut table = a.input.load()?;
     let value_name = match &a.value {
@@ -73,7 +65,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (lat, lon, alt) = (table.require("lat")?, table.require("lon")?, table.require("alt")?);
     let positions = match &a.lever_arm {
         Some(s) => {
-            let lever = parse_lever(s)?;
+            let lever = crate::flight::parse_lever_arm(s)?;
             let (r, p, y) = (table.require("roll")?, table.require("pitch")?, table.require("yaw")?);
             Some(sensor_positions(lat, lon, alt, r, p, y, lever).map_err(|e| bad_input!("{}: {e}", table.file_label()))?)
         }

@@ -566,6 +566,7 @@ impl KalmanFit {
             condition: self.condition,
             residual_rms_nt: self.model_residual(),
             rows: self.rows,
+            effective_dof: self.rows as f64,
             segments_used: self.segments_used,
             warnings: self.warnings.clone(),
         }
@@ -612,6 +613,7 @@ impl KalmanFit {
                 warnings: self.warnings.clone(),
             },
             reference: Vec::new(),
+            lever_arm: None,
             columns: Default::default(),
             software_version: env!("CARGO_PKG_VERSION").into(),
         }

@@ -7,8 +7,10 @@
 //! [`crate::tolles_lawson::terms::derivative`] applied to each chunk extended
 //! by one neighbour on each side (at least three samples), so interior
 //! samples get the central difference and the run's two ends the one-sided
-//! one.
+//! one. The lagged derivatives of the `l9` group run through the whole
+//! run sample by sample, as over one segment.
 
+use crate::tolles_lawson::eddy_lag::LagBank;
 use crate::tolles_lawson::terms::derivative;
 use crate::tolles_lawson::{Convention, TermSet};
 use std::ops::Range;
@@ -38,6 +40,7 @@ pub fn for_each_design_row(
 ) {
     let ncol = spec.terms.n_columns();
     let mut row = vec![0.0; ncol];
+    let mut lags = LagBank::new(spec.terms.eddy_lags_s());
     let eddy = spec.terms.has_eddy();
     let (s, e) = (run.start, run.end);
     let mut a = s;
@@ -56,12 +59,9 @@ pub fn for_each_design_row(
         };
         for i in a..b {
             let j = i - lo;
-            spec.terms.row(
-                [flux[0][i], flux[1][i], flux[2][i]],
-                [db[0][j], db[1][j], db[2][j]],
-                spec.bt_scale_nt,
-                &mut row,
-            );
+            let d = [db[0][j], db[1][j], db[2][j]];
+            let lagged = lags.step(time[i], d);
+            spec.terms.row([flux[0][i], flux[1][i], flux[2][i]], d, lagged, spec.bt_scale_nt, &mut row);
             f(i, &row);
         }
         a = b;
@@ -89,7 +89,7 @@ mod tests {
             .map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin())
             .collect();
         for conv in [Convention::Physical, Convention::MagNav] {
-            let terms = TermSet::parse("p3,i6,e9,bias").unwrap();
+            let terms = TermSet::parse("p3,i6,e9,bias").unwrap().with_eddy_lags(&[0.2, 0.7]).unwrap();
             let spec = RowSpec {
                 terms: &terms,
                 convention: conv,

@@ -1,5 +1,6 @@
 //! Building the Tolles-Lawson design matrix over a segment.
 
+use super::eddy_lag::LagBank;
 use super::terms::{derivative, Convention, TermSet};
 
 /// The design-matrix columns (column-major, `n_columns` vectors of the
@@ -14,16 +15,35 @@ pub fn design_columns(
 ) -> Vec<Vec<f64>> {
     let n = time.len();
     let ncol = terms.n_columns();
-    let db = derivatives(terms, convention, time, flux);
     let mut cols = vec![vec![0.0; n]; ncol];
-    let mut row = vec![0.0; ncol];
-    for i in 0..n {
-        terms.row([flux[0][i], flux[1][i], flux[2][i]], [db[0][i], db[1][i], db[2][i]], bt_scale_nt, &mut row);
-        for (c, v) in cols.iter_mut().zip(&row) {
+    for_each_row(terms, convention, bt_scale_nt, time, flux, |i, row| {
+        for (c, v) in cols.iter_mut().zip(row) {
             c[i] = *v;
         }
-    }
+    });
     cols
+}
+
+/// Call `f(i, row)` for every sample of one contiguous segment, in order:
+/// derivatives over the segment ([`derivative`]), lagged derivatives started
+/// at its first sample ([`LagBank`]).
+fn for_each_row(
+    terms: &TermSet,
+    convention: Convention,
+    bt_scale_nt: f64,
+    time: &[f64],
+    flux: [&[f64]; 3],
+    mut f: impl FnMut(usize, &[f64]),
+) {
+    let db = derivatives(terms, convention, time, flux);
+    let mut lags = LagBank::new(terms.eddy_lags_s());
+    let mut row = vec![0.0; terms.n_columns()];
+    for i in 0..time.len() {
+        let d = [db[0][i], db[1][i], db[2][i]];
+        let lagged = lags.step(time[i], d);
+        terms.row([flux[0][i], flux[1][i], flux[2][i]], d, lagged, bt_scale_nt, &mut row);
+        f(i, &row);
+    }
 }
 
 /// Field derivatives for the eddy columns (zeros when no eddy group is used).
@@ -45,13 +65,9 @@ pub fn interference(
     time: &[f64],
     flux: [&[f64]; 3],
 ) -> Vec<f64> {
-    let ncol = terms.n_columns();
-    let db = derivatives(terms, convention, time, flux);
-    let mut row = vec![0.0; ncol];
-    (0..time.len())
-        .map(|i| {
-            terms.row([flux[0][i], flux[1][i], flux[2][i]], [db[0][i], db[1][i], db[2][i]], bt_scale_nt, &mut row);
-            row.iter().zip(coef).map(|(a, c)| a * c).sum()
-        })
-        .collect()
+    let mut out = vec![0.0; time.len()];
+    for_each_row(terms, convention, bt_scale_nt, time, flux, |i, row| {
+        out[i] = row.iter().zip(coef).map(|(a, c)| a * c).sum();
+    });
+    out
 }

@@ -31,6 +31,7 @@
 //! or missing manoeuvres), and near-null combinations are spelled out.
 
 use super::design::design_columns;
+use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use super::terms::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
 use crate::error::{CompError, Result};
@@ -109,6 +110,10 @@ pub struct LsFit {
     pub residual_rms_nt: f64,
     /// Rows used (after trimming).
     pub rows: usize,
+    /// Effective degrees of freedom of the residual: the rows times the
+    /// fraction of independent samples of the band-passed signal,
+    /// `min(1, 2 (f_hi − f_lo)/f_s)`.
+    pub effective_dof: f64,
     /// Segments used.
     pub segments_used: usize,
     /// Warnings for the user (ill-conditioning, poorly determined terms,
@@ -139,10 +144,21 @@ fn for_each_filtered_block(
 ) -> Result<()> {
     let n = seg.time.len();
     let (keep_lo, keep_hi) = if sos.is_some() { (cfg.trim, n - cfg.trim) } else { (0, n) };
-    let overlap = match sos {
+    let filter_overlap = match sos {
         Some(s) => s.settling_samples(BLOCK_TOLERANCE).ok_or_else(|| CompError::BadData("unstable band-pass filter".into()))?,
         None => 1, // the central-difference derivative needs one neighbour
     };
+    // The lagged eddy columns start at rest at each block's first sample:
+    // their start-up transient must also have decayed inside the core.
+    let dt = median_step(seg.time);
+    let lag_overlap = cfg
+        .terms
+        .eddy_lags_s()
+        .iter()
+        .map(|&tau| FirstOrderLag::settling_samples(tau, dt, BLOCK_TOLERANCE))
+        .max()
+        .unwrap_or(0);
+    let overlap = filter_overlap + lag_overlap;
     let block = cfg.block_len.max(1);
     let mut start = keep_lo;
     while start < keep_hi {
@@ -213,8 +229,9 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
         }
         None => 1.0,
     };
+    let effective_dof = ne.rows() as f64 * independent_fraction;
     let sol = ne
-        .solve_with_dof(cfg.lambda, ne.rows() as f64 * independent_fraction)
+        .solve_with_dof(cfg.lambda, effective_dof)
         .map_err(|e| CompError::BadData(format!("least-squares fit failed: {e}")))?;
     let names = cfg.terms.column_names();
     warnings.extend(diagnose(&sol, &names, cfg.max_vif));
@@ -225,6 +242,7 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
         condition: sol.condition,
         residual_rms_nt: (sol.rss / sol.rows as f64).sqrt(),
         rows: sol.rows,
+        effective_dof,
         segments_used: used,
         names,
         warnings,
@@ -268,7 +286,7 @@ fn validate(cfg: &LsConfig) -> Result<()> {
     if !(cfg.lambda >= 0.0 && cfg.lambda.is_finite()) {
         return Err(CompError::BadData(format!("ridge λ = {} must be ≥ 0", cfg.lambda)));
     }
-    Ok(())
+    cfg.terms.validate()
 }
 
 /// Zero-phase filter every non-constant column in place (MagNav's rule:
@@ -306,7 +324,7 @@ fn std_dev(x: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use aeromag_core::frames::Attitude;
     use nalgebra::Vector3;
@@ -319,7 +337,14 @@ mod tests {
         leg_n(yaw0, coef, terms, t0, maneuvers, 1800)
     }
 
-    fn leg_n(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool, n: usize) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+    pub(crate) fn leg_n(
+        yaw0: f64,
+        coef: &[f64],
+        terms: &TermSet,
+        t0: f64,
+        maneuvers: bool,
+        n: usize,
+    ) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
         let b_ned = Vector3::new(17_000.0, 1_500.0, 48_000.0);
         let dt = 0.1;
         let (mut t, mut fx, mut fy, mut fz) = (vec![], vec![], vec![], vec![]);
@@ -341,12 +366,9 @@ mod tests {
             fz.push(b.z);
         }
         let mut mag = Vec::with_capacity(n);
-        let db = [0, 1, 2].map(|k| super::super::terms::derivative([&fx, &fy, &fz][k], &t, Convention::Physical));
-        let mut row = vec![0.0; terms.n_columns()];
+        let interf = super::super::design::interference(terms, Convention::Physical, DEFAULT_BT_SCALE_NT, coef, &t, [&fx, &fy, &fz]);
         let mut noise = 12345u64;
-        for i in 0..n {
-            terms.row([fx[i], fy[i], fz[i]], [db[0][i], db[1][i], db[2][i]], DEFAULT_BT_SCALE_NT, &mut row);
-            let interf: f64 = row.iter().zip(coef).map(|(a, c)| a * c).sum();
+        for (i, interf) in interf.into_iter().enumerate() {
             noise = noise.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             let u = ((noise >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
             let bt = (fx[i] * fx[i] + fy[i] * fy[i] + fz[i] * fz[i]).sqrt();
@@ -355,7 +377,7 @@ mod tests {
         (t, [fx, fy, fz], mag)
     }
 
-    fn coef16() -> Vec<f64> {
+    pub(crate) fn coef16() -> Vec<f64> {
         vec![30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0, 2.0, -1.5, 0.5, 1.0, -0.7, 0.3, 1.2, -0.4]
     }
 
@@ -398,10 +420,17 @@ mod tests {
         }
     }
 
+    /// Nine lagged-eddy coefficients for the synthetic legs.
+    pub(crate) fn coef_lag9() -> Vec<f64> {
+        vec![1.5, -0.8, 0.6, 0.9, -1.2, 0.4, -0.5, 0.7, 1.1]
+    }
+
     #[test]
     fn block_wise_filtering_equals_whole_segment_filtering() {
-        let terms = TermSet::observable16();
-        let coef = coef16();
+        // With a lagged eddy group too: its start-up transient at each
+        // block's first sample must have decayed inside the block's core.
+        let terms = TermSet::observable16().with_eddy_lags(&[0.6]).unwrap();
+        let coef: Vec<f64> = coef16().into_iter().chain(coef_lag9()).collect();
         // Long legs (9000 samples) so that blocks have true interior edges.
         let legs: Vec<_> = [0.0, 90.0, 180.0, 270.0]
             .iter()

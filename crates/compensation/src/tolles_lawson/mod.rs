@@ -1,7 +1,9 @@
 //! The Tolles-Lawson / Leliak interference model.
 
 pub mod design;
+pub mod eddy_lag;
 pub mod fit_ls;
+pub mod lag_select;
 pub mod segments;
 pub mod terms;
 

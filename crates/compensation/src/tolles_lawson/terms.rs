@@ -14,12 +14,28 @@
 //! | `i5` | `i6` without zz | 5 |
 //! | `e9` eddy | `e_i dB_j` for i, j in x, y, z, row-major | 9 |
 //! | `e8` | `e9` without zz | 8 |
+//! | `l9` lagged eddy | `e_i g_j` for each lag `τ`, row-major | 9 per `τ` |
 //! | `bias` | 1 | 1 |
 //!
 //! (`e_i B_j = Bt e_i e_j`.) Because `eᵀe = 1` and `eᵀde = 0`, `p3+i6+e9` has two
 //! near-exact collinearities; `p3+i5+e8` are the 16 observable parameters of
 //! the thesis. Columns always come in the order of the table, whatever order
 //! the user names the groups in.
+//!
+//! The lagged eddy groups are aeromag's extension of the Leliak model (not in
+//! the seed): an eddy-current loop with inductance `L` and resistance `R`
+//! obeys `L di/dt + R i = −A n·dB/dt`, so its current — and its field at the
+//! sensor — follows `dB/dt` through a first-order lag of time constant
+//! `τ = L/R`. The classical `e9` columns assume `τ → 0`; for aircraft skins
+//! and frames `τ` is 0.1–1 s, which at the 0.1–0.9 Hz calibration band is a
+//! phase lag of 4–80° that `e9` cannot represent. `g_j = L_τ[dB_j]` is that
+//! lag applied to the derivative ([`super::eddy_lag::FirstOrderLag`]); the
+//! projection on `e` stays instantaneous, as the field of the current is. The
+//! lags `τ` (s) are part of the [`TermSet`] ([`TermSet::with_eddy_lags`]).
+//! There is no lagged `zz`-less variant: `eᵀde = 0` holds at one instant,
+//! but `e(t)ᵀ L_τ[dB](t)` mixes `e` at `t` with `dB` over the past `τ`, so
+//! `e_z g_z` carries information the other eight columns do not (on a
+//! simulated box, dropping it leaves 4× more of the eddy field unexplained).
 //!
 //! Derivative conventions ([`Convention`]):
 //! * `Physical` (default): `dB_j` is the time derivative in nT/s, a central
@@ -49,6 +65,8 @@ pub enum TermGroup {
     E9,
     /// Eddy currents without `zz`.
     E8,
+    /// Lagged eddy currents, all nine products, one block per lag.
+    L9,
     /// A constant column.
     Bias,
 }
@@ -62,6 +80,7 @@ impl TermGroup {
             TermGroup::I5 => "i5",
             TermGroup::E9 => "e9",
             TermGroup::E8 => "e8",
+            TermGroup::L9 => "l9",
             TermGroup::Bias => "bias",
         }
     }
@@ -73,10 +92,11 @@ impl TermGroup {
             "i5" => TermGroup::I5,
             "e9" | "e" | "eddy" => TermGroup::E9,
             "e8" => TermGroup::E8,
+            "l9" => TermGroup::L9,
             "bias" | "b" => TermGroup::Bias,
             other => {
                 return Err(CompError::InvalidTerms(format!(
-                    "unknown term group `{other}` (use p3, i6, i5, e9, e8, bias)"
+                    "unknown term group `{other}` (use p3, i6, i5, e9, e8, l9, bias)"
                 )));
             }
         })
@@ -105,10 +125,15 @@ impl std::str::FromStr for Convention {
     }
 }
 
-/// A validated, ordered set of term groups.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+/// A validated, ordered set of term groups, with the eddy-current lags of
+/// the `l9`/`l8` groups.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TermSet {
     groups: Vec<TermGroup>,
+    /// Time constants `τ` (s, ascending) of the lagged eddy groups; empty
+    /// without them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    eddy_lags_s: Vec<f64>,
 }
 
 const XYZ: [&str; 3] = ["x", "y", "z"];
@@ -117,16 +142,17 @@ const PAIRS6: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2,
 impl TermSet {
     /// The thesis' 16 observable parameters: `p3, i5, e8`.
     pub fn observable16() -> Self {
-        Self { groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8] }
+        Self { groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8], eddy_lags_s: Vec::new() }
     }
 
     /// All 18 classical terms `p3, i6, e9` (two near-collinearities).
     pub fn full18() -> Self {
-        Self { groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9] }
+        Self { groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9], eddy_lags_s: Vec::new() }
     }
 
     /// A set from groups; sorted into the canonical order. Rejects an empty
     /// set, duplicates, and both variants of one family (`i6`+`i5`, `e9`+`e8`).
+    /// The lagged group needs its lags: [`TermSet::with_eddy_lags`].
     pub fn new(groups: &[TermGroup]) -> Result<Self> {
         let mut g = groups.to_vec();
         g.sort();
@@ -140,7 +166,46 @@ impl TermSet {
         if g.contains(&TermGroup::E9) && g.contains(&TermGroup::E8) {
             return Err(CompError::InvalidTerms("choose one of e9 and e8".into()));
         }
-        Ok(Self { groups: g })
+        Ok(Self { groups: g, eddy_lags_s: Vec::new() })
+    }
+
+    /// This set with the lagged eddy group `l9` for the lags `taus_s` (s,
+    /// each finite and > 0; sorted, duplicates removed). An empty `taus_s`
+    /// removes the lagged group. Errors without an eddy group (`e8`/`e9`).
+    pub fn with_eddy_lags(&self, taus_s: &[f64]) -> Result<Self> {
+        let mut groups: Vec<TermGroup> =
+            self.groups.iter().copied().filter(|g| *g != TermGroup::L9).collect();
+        if taus_s.is_empty() {
+            return Ok(Self { groups, eddy_lags_s: Vec::new() });
+        }
+        if let Some(t) = taus_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+            return Err(CompError::InvalidTerms(format!("eddy-current lag {t} s: must be finite and > 0")));
+        }
+        if !groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8)) {
+            return Err(CompError::InvalidTerms("eddy-current lags need an eddy group (e8 or e9)".into()));
+        }
+        groups.push(TermGroup::L9);
+        groups.sort();
+        let mut taus = taus_s.to_vec();
+        taus.sort_by(f64::total_cmp);
+        taus.dedup();
+        Ok(Self { groups, eddy_lags_s: taus })
+    }
+
+    /// The lags `τ` (s) of the lagged eddy groups (empty without them).
+    pub fn eddy_lags_s(&self) -> &[f64] {
+        &self.eddy_lags_s
+    }
+
+    /// Check the lags against the groups (a set read from a file).
+    pub fn validate(&self) -> Result<()> {
+        if self.groups.contains(&TermGroup::L9) == self.eddy_lags_s.is_empty() {
+            return Err(CompError::InvalidTerms("the lagged eddy group l9 and the eddy lags must be given together".into()));
+        }
+        if let Some(t) = self.eddy_lags_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+            return Err(CompError::InvalidTerms(format!("eddy-current lag {t} s: must be finite and > 0")));
+        }
+        Ok(())
     }
 
     /// Parse a comma-separated list such as `p3,i5,e8,bias`.
@@ -156,7 +221,7 @@ impl TermSet {
 
     /// Whether any eddy-current group is present (needs derivatives).
     pub fn has_eddy(&self) -> bool {
-        self.groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8))
+        self.groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8 | TermGroup::L9))
     }
 
     /// Column names, e.g. `p_x`, `i_xy`, `e_zy`, `bias`, in column order.
@@ -172,6 +237,13 @@ impl TermSet {
                 TermGroup::E9 | TermGroup::E8 => {
                     let n = if *g == TermGroup::E9 { 9 } else { 8 };
                     names.extend((0..n).map(|k| format!("e_{}{}", XYZ[k / 3], XYZ[k % 3])));
+                }
+                TermGroup::L9 => {
+                    let many = self.eddy_lags_s.len() > 1;
+                    for lag in 1..=self.eddy_lags_s.len() {
+                        let prefix = if many { format!("l{lag}") } else { "l".into() };
+                        names.extend((0..9).map(|k| format!("{prefix}_{}{}", XYZ[k / 3], XYZ[k % 3])));
+                    }
                 }
                 TermGroup::Bias => names.push("bias".into()),
             }
@@ -189,6 +261,7 @@ impl TermSet {
                 TermGroup::I5 => 5,
                 TermGroup::E9 => 9,
                 TermGroup::E8 => 8,
+                TermGroup::L9 => 9 * self.eddy_lags_s.len(),
                 TermGroup::Bias => 1,
             })
             .sum()
@@ -200,9 +273,11 @@ impl TermSet {
     }
 
     /// One design-matrix row into `out` (length [`TermSet::n_columns`]) from
-    /// the vector field `b` (nT, body frame) and its derivative `db` (units of
-    /// the convention). Non-finite inputs give non-finite rows, never a panic.
-    pub fn row(&self, b: [f64; 3], db: [f64; 3], bt_scale: f64, out: &mut [f64]) {
+    /// the vector field `b` (nT, body frame), its derivative `db` (units of
+    /// the convention) and the lagged derivatives `lagged[k] = L_τk[db]`, one
+    /// per [`TermSet::eddy_lags_s`] (missing ones give NaN columns).
+    /// Non-finite inputs give non-finite rows, never a panic.
+    pub fn row(&self, b: [f64; 3], db: [f64; 3], lagged: &[[f64; 3]], bt_scale: f64, out: &mut [f64]) {
         let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
         let e = [b[0] / bt, b[1] / bt, b[2] / bt];
         let mut k = 0;
@@ -224,6 +299,15 @@ impl TermSet {
                     for m in 0..n {
                         out[k] = e[m / 3] * db[m % 3] / bt_scale;
                         k += 1;
+                    }
+                }
+                TermGroup::L9 => {
+                    for lag in 0..self.eddy_lags_s.len() {
+                        let g = lagged.get(lag).copied().unwrap_or([f64::NAN; 3]);
+                        for m in 0..9 {
+                            out[k] = e[m / 3] * g[m % 3] / bt_scale;
+                            k += 1;
+                        }
                     }
                 }
                 TermGroup::Bias => {
@@ -302,13 +386,45 @@ mod tests {
         let b = [20_000.0, -3_000.0, 45_000.0];
         let db = [1.5, -0.7, 0.2];
         let mut row = vec![0.0; 18];
-        t.row(b, db, DEFAULT_BT_SCALE_NT, &mut row);
+        t.row(b, db, &[], DEFAULT_BT_SCALE_NT, &mut row);
         let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
         let ind = row[3] + row[6] + row[8];
         assert!((ind - bt / DEFAULT_BT_SCALE_NT).abs() < 1e-15);
         let e = [b[0] / bt, b[1] / bt, b[2] / bt];
         let dbt = e[0] * db[0] + e[1] * db[1] + e[2] * db[2];
         assert!((row[9] + row[13] + row[17] - dbt / DEFAULT_BT_SCALE_NT).abs() < 1e-18);
+    }
+
+    #[test]
+    fn lagged_groups() {
+        let t = TermSet::observable16().with_eddy_lags(&[0.8, 0.2, 0.8]).unwrap();
+        assert_eq!(t.eddy_lags_s(), &[0.2, 0.8]);
+        assert_eq!(t.to_spec_string(), "p3,i5,e8,l9");
+        assert_eq!(t.n_columns(), 16 + 18);
+        let names = t.column_names();
+        assert_eq!((names[16].as_str(), names[24].as_str(), names[25].as_str(), names[33].as_str()), ("l1_xx", "l1_zz", "l2_xx", "l2_zz"));
+        let one = TermSet::full18().with_eddy_lags(&[0.3]).unwrap();
+        assert_eq!(one.column_names()[18], "l_xx");
+        assert_eq!(one.with_eddy_lags(&[]).unwrap(), TermSet::full18());
+        // Row: e_i g_j / bt_scale; a missing lagged input gives NaN, not a panic.
+        let b: [f64; 3] = [20_000.0, -3_000.0, 45_000.0];
+        let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        let mut row = vec![0.0; one.n_columns()];
+        one.row(b, [1.0, 2.0, 3.0], &[[0.5, -0.25, 2.0]], DEFAULT_BT_SCALE_NT, &mut row);
+        assert!((row[18 + 5] - b[1] / bt * 2.0 / DEFAULT_BT_SCALE_NT).abs() < 1e-18);
+        one.row(b, [1.0, 2.0, 3.0], &[], DEFAULT_BT_SCALE_NT, &mut row);
+        assert!(row[18..].iter().all(|v| v.is_nan()) && row[..18].iter().all(|v| v.is_finite()));
+        // Bad lags and sets.
+        assert!(TermSet::parse("p3,i5").unwrap().with_eddy_lags(&[0.3]).is_err());
+        assert!(TermSet::observable16().with_eddy_lags(&[0.0]).is_err());
+        assert!(TermSet::observable16().with_eddy_lags(&[f64::NAN]).is_err());
+        assert!(TermSet::parse("p3,e8,l9").unwrap().validate().is_err());
+        assert!(t.validate().is_ok());
+        // Serialised with its lags; a set without lags stays as before.
+        let json = serde_json::to_string(&t).unwrap();
+        assert_eq!(json, r#"{"groups":["p3","i5","e8","l9"],"eddy_lags_s":[0.2,0.8]}"#);
+        assert_eq!(serde_json::from_str::<TermSet>(&json).unwrap(), t);
+        assert_eq!(serde_json::to_string(&TermSet::observable16()).unwrap(), r#"{"groups":["p3","i5","e8"]}"#);
     }
 
     #[test]
