@@ -30,6 +30,11 @@ fn calibrate_compensate_report_keep_every_row() {
     assert_code(&o16, 0);
     let m16: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&classical).unwrap()).unwrap();
     assert_eq!(m16["coefficients"].as_array().unwrap().len(), 16);
+    // MagNav's convention keeps MagNav's model unless lags are asked for.
+    let mn = d.path().join("mn.json");
+    assert_code(&aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", mn.to_str().unwrap(), "--convention", "magnav"]), 0);
+    let mn: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&mn).unwrap()).unwrap();
+    assert_eq!(mn["coefficients"].as_array().unwrap().len(), 16);
     let rms = |m: &serde_json::Value| m["fit"]["residual_rms_nt"].as_f64().unwrap();
     assert!(rms(&m) < 0.8 * rms(&m16), "lagged {} vs classical {}", rms(&m), rms(&m16));
 

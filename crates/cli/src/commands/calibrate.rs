@@ -28,9 +28,15 @@ use std::path::PathBuf;
 /// skins and frames carry eddy currents that follow dB/dt through a lag of
 /// 0.1–1 s, which the classical eddy terms (e8/e9) cannot represent. `auto`
 /// tries lagged eddy groups (l9) with τ from 0.1 to 2 s and keeps up to two
-/// lags only when a likelihood-ratio test on the band-passed residual
-/// finds them significant (1 % false-selection probability); otherwise the classical model is kept. `none` keeps
-/// the classical model (MagNav.jl's); a list such as `0.3,0.8` fixes the lags.
+/// lags only when a likelihood-ratio test on the band-passed residual finds
+/// them significant (1 % false-selection probability); otherwise the
+/// classical model is kept. `none` keeps the classical model (MagNav.jl's,
+/// the default with --convention magnav); a list such as `0.3,0.8` fixes the
+/// lags. On large files `auto` costs ~18 fits: give the lags there.
+///
+/// --lever-arm X,Y,Z: the scalar sensor's position from the navigation point
+/// (body frame, m); the `igrf` reference, computed at the navigation point,
+/// is then moved to the sensor with the main field's gradient.
 ///
 /// Example:
 ///   aeromag calibrate --input cal.csv --model model.json
@@ -80,10 +86,11 @@ pub struct Args {
     #[arg(long, default_value = "auto")]
     reference: String,
     /// Eddy-current lags of the lagged eddy terms (l9): `auto` (chosen
-    /// from the flight by a likelihood-ratio test), `none` (classical Tolles-Lawson), or lags in
-    /// seconds, e.g. `0.3,0.8`.
-    #[arg(long, default_value = "auto", value_name = "auto|none|TAU,…")]
-    eddy_lag: String,
+    /// from the flight by a likelihood-ratio test), `none` (classical
+    /// Tolles-Lawson), or lags in seconds, e.g. `0.3,0.8`. Default: `auto`,
+    /// but `none` with --convention magnav (MagNav.jl's model exactly).
+    #[arg(long, value_name = "auto|none|TAU,…")]
+    eddy_lag: Option<String>,
     /// Scalar sensor position X,Y,Z (m, body frame: x forward, y right,
     /// z down) from the navigation point whose position the `igrf` column
     /// was computed at; the reference is then moved to the sensor with the
@@ -324,7 +331,11 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
 pub fn run(a: Args) -> anyhow::Result<()> {
     let table = a.input.load()?;
     let opts = FitOptions {
-        eddy_lag: a.eddy_lag.parse()?,
+        eddy_lag: match &a.eddy_lag {
+            Some(s) => s.parse()?,
+            None if a.convention.trim().eq_ignore_ascii_case("magnav") => EddyLag::None,
+            None => EddyLag::Auto,
+        },
         split_lines: !a.no_split_lines,
         reference: a.reference.clone(),
         lever_arm: match &a.lever_arm {
