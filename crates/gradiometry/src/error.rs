@@ -25,6 +25,10 @@ pub enum GradiometryError {
     /// A covariance square root or information matrix is singular.
     #[error("singular matrix in {0}")]
     Singular(&'static str),
+    /// A scenario file that does not parse or holds an invalid value (the
+    /// message names the field, and the line and column for syntax errors).
+    #[error("scenario file: {0}")]
+    Config(String),
     /// Inconsistent input lengths.
     #[error("length mismatch: {what} has {got}, expected {expected}")]
     LengthMismatch {

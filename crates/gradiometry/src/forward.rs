@@ -32,7 +32,9 @@ use crate::decorrelate::contrast_matrix;
 use crate::geometry::Geometry;
 use aeromag_core::NT_PER_T;
 use aeromag_core::field::dipole::{dipole_field, dipole_gradient, dipole_matrix};
+use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
+use aeromag_core::frames::geodetic::Geodetic;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// A measurement model `z = h(x)` with Jacobian `H = ∂h/∂x`, state
@@ -74,6 +76,16 @@ impl Background {
             field_nt: c_bn * field_ned_nt,
             gradient_nt_per_m: c_bn * gradient_ned * c_bn.transpose(),
         }
+    }
+
+    /// The IGRF field and gradient at `pos`, rotated into the body frame of
+    /// attitude `att` ([`Background::from_ned`]).
+    pub fn from_igrf(igrf: &IgrfModel, pos: &Geodetic, att: &Attitude) -> Self {
+        Self::from_ned(
+            &igrf.field_geodetic(pos).ned_nt(),
+            &igrf.gradient_ned_nt_per_m(pos),
+            att,
+        )
     }
 
     /// Background at sensor offset `d` (m), nT.

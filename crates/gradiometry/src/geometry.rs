@@ -19,8 +19,10 @@
 use crate::error::{GradiometryError, Result, positive};
 use nalgebra::{Matrix3, Vector3};
 
-/// The arrangement of the four sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The arrangement of the four sensors (`"tetrahedron"`, `"cross"`,
+/// `"planar"` in scenario files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Layout {
     /// Regular tetrahedron, edge = baseline.
     Tetrahedron,

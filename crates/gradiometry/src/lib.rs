@@ -10,7 +10,10 @@
 //! - [`sr_iekf`] — square-root IEKF (`PrognosisFK`, `ProcessingFK`, per-epoch iteration);
 //! - [`motion`] — `MotionMT` / `MotionMV`;
 //! - [`estimability`] — `MeasureS`;
-//! - [`crlb`] — Cramér–Rao bound and Monte-Carlo efficiency;
+//! - [`crlb`] — Cramér–Rao bound;
+//! - [`efficiency`] — Monte-Carlo efficiency RMS/CRLB of the pass estimator;
+//! - [`locate`] — detection, initialisation and the filter over a pass;
+//! - [`config`] — the `gradiometer` scenario file (TOML);
 //! - [`convergence`] — the seed's fig. 2 convergence map and a multi-start initialisation;
 //! - [`sim`] — the simulator scenario `gradiometer`.
 
@@ -22,9 +25,12 @@ pub mod forward;
 pub mod geometry;
 
 pub use error::{GradiometryError, Result};
+pub mod config;
 pub mod convergence;
 pub mod crlb;
+pub mod efficiency;
 pub mod estimability;
+pub mod locate;
 pub mod motion;
 pub mod pass;
 pub mod sim;

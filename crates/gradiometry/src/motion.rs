@@ -19,7 +19,9 @@
 //! `(σ_M + κ |ω_o| |M|) √Δt` for the moment, the term in `|ω_o|` standing
 //! for the induced part that changes with the object's orientation.
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use aeromag_core::frames::Attitude;
+use aeromag_core::frames::attitude::wrap_pi;
+use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 /// Known relative motion over one step (system frame, SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +36,54 @@ pub struct Motion {
     pub w_system: Vector3<f64>,
     /// Step, s.
     pub dt_s: f64,
+}
+
+/// Navigation of both bodies at one epoch: what a measuring system knows
+/// about the motion (the system's own navigation and the object's track).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NavFix {
+    /// System position, local NED, m.
+    pub system_position_ned_m: Vector3<f64>,
+    /// System attitude.
+    pub system_attitude: Attitude,
+    /// Object position, local NED, m.
+    pub object_position_ned_m: Vector3<f64>,
+    /// Object heading, rad.
+    pub object_yaw_rad: f64,
+}
+
+impl Motion {
+    /// The motion over the step `dt_s` (s) from fix `prev` to fix `next`,
+    /// in the body frame of `next`'s attitude `C_bn`:
+    ///
+    /// ```text
+    /// V_m = C_bn Δp_m/Δt,  V_o = C_bn Δp_o/Δt,  ω_o = C_bn (0, 0, Δψ_o/Δt),
+    /// exp([ω_m×] Δt) = C_nb(prev)ᵀ C_nb(next)  (body rate, rotation vector / Δt)
+    /// ```
+    ///
+    /// Exact for constant velocities and rates. `dt_s ≤ 0` (the first epoch)
+    /// gives zero motion with `dt_s = 0`.
+    pub fn between(prev: &NavFix, next: &NavFix, dt_s: f64) -> Self {
+        if dt_s.is_nan() || dt_s <= 0.0 {
+            return Self {
+                v_object: Vector3::zeros(),
+                v_system: Vector3::zeros(),
+                w_object: Vector3::zeros(),
+                w_system: Vector3::zeros(),
+                dt_s: 0.0,
+            };
+        }
+        let c_bn = next.system_attitude.c_bn();
+        let turn = prev.system_attitude.c_nb().transpose() * next.system_attitude.c_nb();
+        let yaw_rate = wrap_pi(next.object_yaw_rad - prev.object_yaw_rad) / dt_s;
+        Self {
+            v_object: c_bn * (next.object_position_ned_m - prev.object_position_ned_m) / dt_s,
+            v_system: c_bn * (next.system_position_ned_m - prev.system_position_ned_m) / dt_s,
+            w_object: c_bn * Vector3::new(0.0, 0.0, yaw_rate),
+            w_system: Rotation3::from_matrix(&turn).scaled_axis() / dt_s,
+            dt_s,
+        }
+    }
 }
 
 /// Random-walk intensities of the model noise.
@@ -119,5 +169,33 @@ mod tests {
         };
         let (_, _, q2) = motion_mt(&w, &noise, &Vector3::new(10.0, 0.0, 0.0));
         assert!((q2[3] - 2.0 * 0.5 * 10.0 * 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn motion_between_fixes_recovers_velocities_and_rates() {
+        let dt = 0.1;
+        let att0 = Attitude::from_degrees(2.0, -3.0, 40.0);
+        let w_b = Vector3::new(0.01, -0.02, 0.05); // body rate, rad/s
+        let c1 = att0.c_nb() * Rotation3::from_scaled_axis(w_b * dt).into_inner();
+        let att1 = Attitude::from_c_nb(&c1);
+        let a = NavFix {
+            system_position_ned_m: Vector3::new(1.0, 2.0, 3.0),
+            system_attitude: att0,
+            object_position_ned_m: Vector3::new(10.0, 0.0, 0.0),
+            object_yaw_rad: 3.1,
+        };
+        let b = NavFix {
+            system_position_ned_m: a.system_position_ned_m + Vector3::new(0.5, -0.2, 0.0),
+            system_attitude: att1,
+            object_position_ned_m: a.object_position_ned_m + Vector3::new(0.0, 0.3, 0.1),
+            object_yaw_rad: 3.1 + 0.1 - std::f64::consts::TAU, // wraps
+        };
+        let m = Motion::between(&a, &b, dt);
+        assert!((m.w_system - w_b).norm() < 1e-9, "{}", m.w_system);
+        let c_bn = att1.c_bn();
+        assert!((m.v_system - c_bn * Vector3::new(5.0, -2.0, 0.0)).norm() < 1e-9);
+        assert!((m.v_object - c_bn * Vector3::new(0.0, 3.0, 1.0)).norm() < 1e-9);
+        assert!((m.w_object - c_bn * Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-9);
+        assert_eq!(Motion::between(&a, &b, 0.0).dt_s, 0.0);
     }
 }

@@ -47,13 +47,24 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
-/// Which body moves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which body moves (`"stationary"`, `"mobile"` in scenario files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SystemMotion {
     /// Fixed gradiometer, moving object.
     Stationary,
     /// Moving gradiometer, fixed object.
     Mobile,
+}
+
+/// Which gradiometer (`"tensor"`, `"scalar"` in scenario files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Gradiometer {
+    /// Four vector sensors: 9 contrasts, state `(r, M)`.
+    Tensor,
+    /// Four scalar sensors: 3 contrasts of the moduli, state `M` (position known).
+    Scalar,
 }
 
 /// Noise and bias of one sensor type, nT.
@@ -143,7 +154,9 @@ impl Scenario {
         }
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Check the values: positive step, speed, epochs; non-negative noise,
+    /// bias and variation amplitudes.
+    pub fn validate(&self) -> Result<()> {
         positive("dt_s", self.dt_s)?;
         positive("speed_m_s", self.speed_m_s)?;
         for (name, v) in [
@@ -184,6 +197,16 @@ pub struct SimEpoch {
     pub background: Background,
     /// Known motion over the step into this epoch (body frame).
     pub motion: Motion,
+    /// System position in the local NED frame, m (navigation).
+    pub system_position_ned_m: Vector3<f64>,
+    /// System position, WGS84 (navigation).
+    pub system_geodetic: Geodetic,
+    /// System attitude (navigation).
+    pub system_attitude: Attitude,
+    /// Object position in the local NED frame, m (its known track).
+    pub object_position_ned_m: Vector3<f64>,
+    /// Object heading, rad (its known track).
+    pub object_yaw_rad: f64,
 }
 
 fn local_to_geodetic(origin: &Geodetic, p_ned: &Vector3<f64>) -> Geodetic {
@@ -245,6 +268,8 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
         let geo_s = local_to_geodetic(&s.origin, &p_s);
         let b_e = igrf.field_geodetic(&geo_s).ned_nt();
         let g_e = igrf.gradient_ned_nt_per_m(&geo_s);
+        // the same as `Background::from_igrf`, which the estimator uses
+        let background = Background::from_ned(&b_e, &g_e, &s.system_attitude);
         let b_at_object = igrf
             .field_geodetic(&local_to_geodetic(&s.origin, &p_o))
             .ned_nt();
@@ -275,7 +300,7 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
             scalar_nt,
             true_position_m: c_bn * (p_o - p_s),
             true_moment_am2: c_bn * m_ned,
-            background: Background::from_ned(&b_e, &g_e, &s.system_attitude),
+            background,
             motion: Motion {
                 v_object: c_bn * v_o,
                 v_system: c_bn * v_s,
@@ -283,6 +308,11 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
                 w_system: Vector3::zeros(),
                 dt_s: if j == 0 { 0.0 } else { s.dt_s },
             },
+            system_position_ned_m: p_s,
+            system_geodetic: geo_s,
+            system_attitude: s.system_attitude,
+            object_position_ned_m: p_o,
+            object_yaw_rad: yaw,
         });
     }
     Ok(out)

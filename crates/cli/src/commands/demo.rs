@@ -166,6 +166,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.set_message("rotor and EM studies");
     let (rotor_keys, rotor_section) = crate::commands::rotor::demo_rotor(a.quick)?;
     let (em_keys, em_section) = crate::commands::em::demo_em(a.quick)?;
+    let (grad_keys, grad_section) = crate::commands::dipole::demo_gradiometry(a.quick)?;
     bar.inc(1);
 
     // 5. Report.
@@ -199,6 +200,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         },
         "rotor": rotor_keys,
         "em": em_keys,
+        "gradiometry": grad_keys,
         "seed": a.seed,
         "software_version": env!("CARGO_PKG_VERSION"),
     });
@@ -261,7 +263,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
     add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
-    for section in [rotor_section, em_section].into_iter().flatten() {
+    for section in [rotor_section, em_section, grad_section].into_iter().flatten() {
         section.append_to(&mut r);
     }
     r.write_html(a.out.join("index.html"))?;
@@ -286,6 +288,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
         ("em.polarization_ratio_before", sci(&em_keys, "polarization_ratio_before")),
         ("em.polarization_ratio_after", sci(&em_keys, "polarization_ratio_after")),
+        ("gradiometry.efficiency_tensor", fmt(grad_keys["efficiency_tensor"].as_f64(), 3)),
+        ("gradiometry.efficiency_scalar", fmt(grad_keys["efficiency_scalar"].as_f64(), 3)),
+        ("gradiometry.convergence_fraction", fmt(grad_keys["convergence_fraction"].as_f64(), 4)),
     ];
     for (k, v) in rows {
         println!("{k:<44} {v:>12}");

@@ -8,7 +8,8 @@ use std::path::PathBuf;
 ///
 /// Scenarios: `calibration` (four-heading box at 3000 m with roll, pitch and
 /// yaw manoeuvres), `calibration-truncated` (the thesis' shorter pattern),
-/// `survey` (lines and tie lines at 100 m above ground). The folder gets
+/// `survey` (lines and tie lines at 100 m above ground), `gradiometer`
+/// (a dipole passing a gradiometer: see `aeromag dipole simulate`). The folder gets
 /// `<scenario>.csv` (canonical columns plus `true_…` truth columns),
 /// `<scenario>.toml` (the scenario with every default filled in: edit it and
 /// pass it back with --config) and `<scenario>.truth.json`.
@@ -38,6 +39,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    if a.scenario == "gradiometer" {
+        let (config, seed, out, print_config) = (a.config, a.seed, a.out, a.print_config);
+        return super::dipole::simulate_scenario(super::dipole::SimulateArgs { config, seed, out, print_config });
+    }
     let kind: ScenarioKind = a.scenario.parse()?;
     if a.print_config {
         print!("{}", default_config_toml(kind)?);
