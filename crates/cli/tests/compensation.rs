@@ -159,6 +159,7 @@ fn demo_meets_the_compensation_figures() {
         ("compensation_gradient", &["residual_rms_ls_nt", "residual_rms_kalman_nt", "noise_floor_nt"][..]),
         ("rotor", &["rotor_rms_nt", "residual_model_nt", "residual_best_filter_nt"][..]),
         ("em", &["range_err_rel", "angle_err_deg", "polarization_ratio_before", "polarization_ratio_after"][..]),
+        ("gradiometry", &["efficiency_tensor", "efficiency_scalar", "convergence_fraction"][..]),
     ] {
         for k in keys {
             assert!(s[group][k].as_f64().is_some(), "summary key {group}.{k}");
