@@ -47,3 +47,503 @@ fn em_study_meets_the_issue_figures() {
 fn em_study_requires_out() {
     assert_code(&aeromag(&["em", "study"]), 2);
 }
+
+// ---------------------------------------------------------------------------
+// The file chain: em simulate → detect → calibrate → locate, scored here
+// against the truth CSV (the commands never read it).
+
+use aeromag_core::frames::Attitude;
+use nalgebra::{Matrix3, Vector3};
+use std::path::{Path, PathBuf};
+
+/// Numeric CSV: header names and rows (empty cells → NaN).
+fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| {
+                    if v.is_empty() {
+                        f64::NAN
+                    } else {
+                        v.parse().unwrap()
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+fn col(h: &[String], name: &str) -> usize {
+    h.iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+}
+
+fn rotation(roll_deg: f64, pitch_deg: f64, yaw_deg: f64) -> Matrix3<f64> {
+    Attitude::new(
+        roll_deg.to_radians(),
+        pitch_deg.to_radians(),
+        yaw_deg.to_radians(),
+    )
+    .c_nb()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Simulate into `dir/sim` with extra arguments; returns the folder.
+fn simulate(dir: &Path, extra: &[&str]) -> PathBuf {
+    let sim = dir.join("sim");
+    let mut args = vec!["em", "simulate", "--out", s(&sim)];
+    args.extend_from_slice(extra);
+    assert_code(&aeromag(&args), 0);
+    sim
+}
+
+#[test]
+fn em_file_chain_reaches_the_issue_figures_against_the_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path(), &[]);
+    for f in [
+        "em.raw",
+        "em.system.json",
+        "em.known.csv",
+        "em.truth.csv",
+        "em.toml",
+    ] {
+        assert!(sim.join(f).is_file(), "{f}");
+    }
+    let det = dir.path().join("detected.csv");
+    let cal = dir.path().join("cal.json");
+    let poses = dir.path().join("poses.csv");
+    let o = aeromag(&[
+        "em",
+        "detect",
+        "--input",
+        s(&sim.join("em.raw")),
+        "--out",
+        s(&det),
+    ]);
+    assert_code(&o, 0);
+    let o = aeromag(&[
+        "em",
+        "calibrate",
+        "--input",
+        s(&det),
+        "--known",
+        s(&sim.join("em.known.csv")),
+        "--system",
+        s(&sim.join("em.system.json")),
+        "--out",
+        s(&cal),
+    ]);
+    assert_code(&o, 0);
+    let c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    assert_eq!(c["format"], "aeromag-em-calibration");
+    assert_eq!(c["version"], 1);
+    let o = aeromag(&[
+        "em",
+        "locate",
+        "--input",
+        s(&det),
+        "--calibration",
+        s(&cal),
+        "--out",
+        s(&poses),
+    ]);
+    assert_code(&o, 0);
+
+    let (th, truth) = read_csv(&sim.join("em.truth.csv"));
+    let (ph, est) = read_csv(&poses);
+    let (kh, known) = read_csv(&sim.join("em.known.csv"));
+    let (_, detected) = read_csv(&det);
+    assert_eq!(truth.len(), 64);
+    assert_eq!(est.len(), truth.len());
+    assert_eq!(detected.len(), truth.len());
+    let known_times: Vec<f64> = known.iter().map(|r| r[col(&kh, "time_s")]).collect();
+    let (mut range, mut dir_deg, mut att_deg, mut ratio) = (vec![], vec![], vec![], vec![]);
+    for (t, e) in truth.iter().zip(&est) {
+        let time = t[col(&th, "time_s")];
+        assert!((e[col(&ph, "time_s")] - time).abs() < 1e-9);
+        assert_eq!(e[col(&ph, "status")], 0.0);
+        // Score only epochs the calibration was not given.
+        if known_times.iter().any(|k| (k - time).abs() < 1e-9) {
+            continue;
+        }
+        let v = |h: &[String], r: &[f64], n: [&str; 3]| {
+            Vector3::new(r[col(h, n[0])], r[col(h, n[1])], r[col(h, n[2])])
+        };
+        let rt = v(&th, t, ["true_x_m", "true_y_m", "true_z_m"]);
+        let re = v(&ph, e, ["x_m", "y_m", "z_m"]);
+        range.push(
+            (e[col(&ph, "range_m")] - t[col(&th, "true_range_m")]) / t[col(&th, "true_range_m")],
+        );
+        dir_deg.push(
+            rt.normalize()
+                .dot(&re.normalize())
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees(),
+        );
+        let at = v(&th, t, ["true_roll_deg", "true_pitch_deg", "true_yaw_deg"]);
+        let ae = v(&ph, e, ["roll_deg", "pitch_deg", "yaw_deg"]);
+        let d = rotation(ae[0], ae[1], ae[2]) * rotation(at[0], at[1], at[2]).transpose();
+        att_deg.push(
+            nalgebra::Rotation3::from_matrix_unchecked(d)
+                .angle()
+                .to_degrees(),
+        );
+        for i in 1..=3 {
+            ratio.push(e[col(&ph, &format!("pol_ratio_{i}"))]);
+        }
+    }
+    let before: Vec<f64> = detected
+        .iter()
+        .flat_map(|r| (1..=3).map(move |i| (i, r)))
+        .map(|(i, r)| r[37 + i - 1])
+        .collect();
+    let (r, d, a) = (rms(&range), rms(&dir_deg), rms(&att_deg));
+    let (rb, ra) = (rms(&before), rms(&ratio));
+    eprintln!(
+        "{} scored epochs: range {r:.3e} (rel), direction {d:.4}°, attitude {a:.4}°; polarisation ratio {rb:.3e} → {ra:.3e}",
+        range.len()
+    );
+    assert_eq!(range.len(), 64 - 8);
+    // The prior half-space decides the sign of r: the opposite prior mirrors
+    // every position (attitudes unchanged, since Ω(r) = Ω(−r)).
+    let flipped = dir.path().join("flipped.csv");
+    let o = aeromag(&[
+        "em",
+        "locate",
+        "--input",
+        s(&det),
+        "--calibration",
+        s(&cal),
+        "--out",
+        s(&flipped),
+        "--half-space",
+        "1,0,-1",
+    ]);
+    assert_code(&o, 0);
+    let (fh, fl) = read_csv(&flipped);
+    for (a, b) in est.iter().zip(&fl) {
+        for c in ["x_m", "y_m", "z_m"] {
+            assert!((a[col(&ph, c)] + b[col(&fh, c)]).abs() < 1e-9 * a[col(&ph, "range_m")]);
+        }
+        assert_eq!(a[col(&ph, "yaw_deg")], b[col(&fh, "yaw_deg")]);
+    }
+    assert!(r <= 1e-3, "range error {r}");
+    assert!(d <= 0.1 && a <= 0.1, "direction {d}°, attitude {a}°");
+    assert!(rb >= 100.0 * ra, "ratio {rb} → {ra}");
+}
+
+#[test]
+fn simulate_em_is_the_same_command_and_fills_in_defaults() {
+    let a = aeromag(&["simulate", "em", "--print-config"]);
+    let b = aeromag(&["em", "simulate", "--print-config"]);
+    assert_code(&a, 0);
+    assert_eq!(stdout(&a), stdout(&b));
+    assert!(stdout(&a).contains("duration_s = 10.24"));
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("short.toml");
+    std::fs::write(&cfg, "duration_s = 1.28\nrange_min_m = 60.0\n").unwrap();
+    let out = dir.path().join("s");
+    let o = aeromag(&[
+        "simulate",
+        "em",
+        "--config",
+        s(&cfg),
+        "--seed",
+        "7",
+        "--out",
+        s(&out),
+    ]);
+    assert_code(&o, 0);
+    let toml = std::fs::read_to_string(out.join("em.toml")).unwrap();
+    assert!(
+        toml.contains("seed = 7")
+            && toml.contains("duration_s = 1.28")
+            && toml.contains("range_max_m = 100.0"),
+        "{toml}"
+    );
+    // 1.28 s = 8 epochs of 0.16 s; the raw file is exactly header + 128 000 × 3 f32.
+    assert_eq!(read_csv(&out.join("em.truth.csv")).1.len(), 8);
+    let raw = std::fs::read(out.join("em.raw")).unwrap();
+    let hl = u32::from_le_bytes([raw[8], raw[9], raw[10], raw[11]]) as usize;
+    assert_eq!(&raw[..8], b"AEMRAW1\n");
+    assert_eq!(raw.len(), 12 + hl + 128_000 * 3 * 4);
+    // Deterministic: the same seed gives the same bytes.
+    let out2 = dir.path().join("s2");
+    assert_code(
+        &aeromag(&[
+            "em",
+            "simulate",
+            "--config",
+            s(&cfg),
+            "--seed",
+            "7",
+            "--out",
+            s(&out2),
+        ]),
+        0,
+    );
+    assert_eq!(raw, std::fs::read(out2.join("em.raw")).unwrap());
+}
+
+#[test]
+fn pilot_correction_measures_the_drifted_channel_sensitivity() {
+    // 1.25 h into the flight the channel gains have drifted by per cents.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("late.toml");
+    std::fs::write(&cfg, "duration_s = 1.28\nstart_time_s = 4500.0\n").unwrap();
+    let sim = simulate(dir.path(), &["--config", s(&cfg)]);
+    let raw = sim.join("em.raw");
+    let (with, without) = (dir.path().join("with.csv"), dir.path().join("without.csv"));
+    assert_code(
+        &aeromag(&["em", "detect", "--input", s(&raw), "--out", s(&with)]),
+        0,
+    );
+    assert_code(
+        &aeromag(&[
+            "em",
+            "detect",
+            "--input",
+            s(&raw),
+            "--out",
+            s(&without),
+            "--no-pilot",
+        ]),
+        0,
+    );
+    let (h, w) = read_csv(&with);
+    let (_, n) = read_csv(&without);
+    let mut worst = 0.0f64;
+    for (rw, rn) in w.iter().zip(&n) {
+        for i in 1..=3 {
+            for a in ["x", "y", "z"] {
+                let (re, im) = (
+                    col(&h, &format!("xi{i}_{a}_re")),
+                    col(&h, &format!("xi{i}_{a}_im")),
+                );
+                assert_eq!((rn[re], rn[im]), (1.0, 0.0));
+                worst = worst.max((rw[re] - 1.0).hypot(rw[im]));
+            }
+        }
+    }
+    // ±5 % gain, ±3° phase drift and up to 5 µs group delay (≤ 5.6° at
+    // 3125 Hz): per cents off, bounded by 0.05 + 0.052 + 0.098 ≈ 0.2.
+    eprintln!("largest |ξ − 1| = {worst:.4}");
+    assert!(worst > 0.01 && worst < 0.2, "largest |ξ − 1| = {worst}");
+}
+
+/// Expect exit code 2 and every fragment in stderr.
+fn bad(args: &[&str], fragments: &[&str]) {
+    let o = aeromag(args);
+    assert_code(&o, 2);
+    let e = stderr(&o);
+    for f in fragments {
+        assert!(e.contains(f), "stderr lacks '{f}':\n{e}");
+    }
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn em_commands_reject_bad_input_with_file_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cfg = d.join("short.toml");
+    std::fs::write(&cfg, "duration_s = 1.28\n").unwrap();
+    let sim = simulate(d, &["--config", s(&cfg)]);
+    let raw = sim.join("em.raw");
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&["em", "detect", "--input", s(&raw), "--out", s(&det)]),
+        0,
+    );
+    let known = sim.join("em.known.csv");
+    let system = sim.join("em.system.json");
+    let cal = d.join("cal.json");
+    let calib = |input: &Path, known: &Path| {
+        vec![
+            "em".to_string(),
+            "calibrate".into(),
+            "--input".into(),
+            s(input).into(),
+            "--known".into(),
+            s(known).into(),
+            "--system".into(),
+            s(&system).into(),
+            "--out".into(),
+            s(&cal).into(),
+        ]
+    };
+    let run = |v: Vec<String>, frags: &[&str]| {
+        bad(&v.iter().map(String::as_str).collect::<Vec<_>>(), frags)
+    };
+    assert_code(
+        &aeromag(
+            &calib(&det, &known)
+                .iter()
+                .map(String::as_str)
+                .collect::<Vec<_>>(),
+        ),
+        0,
+    );
+
+    // Raw record: truncated, wrong magic, broken header, NaN sample, short window.
+    let bytes = std::fs::read(&raw).unwrap();
+    let w = |name: &str, b: &[u8]| {
+        let p = d.join(name);
+        std::fs::write(&p, b).unwrap();
+        p
+    };
+    let out = d.join("o.csv");
+    let detect = |p: &Path| {
+        vec![
+            "em".to_string(),
+            "detect".into(),
+            "--input".into(),
+            s(p).into(),
+            "--out".into(),
+            s(&out).into(),
+        ]
+    };
+    let p = w("trunc.raw", &bytes[..bytes.len() - 3]);
+    run(detect(&p), &["trunc.raw", "truncated"]);
+    let mut m = bytes.clone();
+    m[0] = b'X';
+    let p = w("magic.raw", &m);
+    run(detect(&p), &["magic.raw", "not an aeromag EM raw file"]);
+    let mut m = bytes.clone();
+    m[14] = b'#';
+    let p = w("header.raw", &m);
+    run(detect(&p), &["header.raw", "JSON header"]);
+    let hl = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+    let mut m = bytes.clone();
+    let k = 12 + hl + 4 * (3 * 500 + 2);
+    m[k..k + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let p = w("nan.raw", &m);
+    run(detect(&p), &["nan.raw", "frame 500 channel 2", "NaN"]);
+    let p = w("empty.raw", b"");
+    run(detect(&p), &["empty.raw"]);
+    let mut v = detect(&raw);
+    v.extend(["--window-len".into(), "999999999".into()]);
+    run(v, &["--window-len"]);
+    let mut v = detect(&raw);
+    v.extend(["--window".into(), "hann".into()]);
+    run(v, &["--window 'hann'"]);
+    run(detect(&d.join("missing.raw")), &["missing.raw"]);
+
+    // Detected CSV: empty, missing column, NaN cell, text cell.
+    let text = std::fs::read_to_string(&det).unwrap();
+    let p = w("empty.csv", b"");
+    run(calib(&p, &known), &["empty.csv", "empty"]);
+    let p = w(
+        "nocol.csv",
+        text.replacen("h2_y_im_t", "h2_y_imag", 1).as_bytes(),
+    );
+    run(calib(&p, &known), &["nocol.csv", "h2_y_im_t"]);
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[3].split(',').map(String::from).collect();
+    cells[4] = "NaN".into(); // column 5 = h1_y_im_t
+    lines[3] = cells.join(",");
+    let p = w("nan.csv", (lines.join("\n") + "\n").as_bytes());
+    run(
+        calib(&p, &known),
+        &["nan.csv", "line 4", "data row 3", "h1_y_im_t"],
+    );
+    let loc = |p: &Path, c: &Path| {
+        vec![
+            "em".to_string(),
+            "locate".into(),
+            "--input".into(),
+            s(p).into(),
+            "--calibration".into(),
+            s(c).into(),
+            "--out".into(),
+            s(&out).into(),
+        ]
+    };
+    run(loc(&p, &cal), &["nan.csv", "line 4", "h1_y_im_t"]);
+    cells[4] = "abc".into();
+    lines[3] = cells.join(",");
+    let p = w("text.csv", (lines.join("\n") + "\n").as_bytes());
+    run(calib(&p, &known), &["text.csv", "line 4"]);
+
+    // KNOWN CSV: partial position, unmatched time, no attitude, missing column.
+    let ktext = std::fs::read_to_string(&known).unwrap();
+    let mut kl: Vec<String> = ktext.lines().map(String::from).collect();
+    let mut kc: Vec<String> = kl[2].split(',').map(String::from).collect();
+    kc[2] = String::new(); // y_m
+    kl[2] = kc.join(",");
+    let p = w("k_partial.csv", (kl.join("\n") + "\n").as_bytes());
+    run(
+        calib(&det, &p),
+        &["k_partial.csv", "line 3", "data row 2", "y_m"],
+    );
+    let p = w(
+        "k_time.csv",
+        ktext.replacen("\n0.239995,", "\n99.5,", 1).as_bytes(),
+    );
+    run(calib(&det, &p), &["k_time.csv", "line 3", "time_s", "99.5"]);
+    let no_att: String = ktext
+        .lines()
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(","))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let p = w("k_noatt.csv", no_att.as_bytes());
+    run(calib(&det, &p), &["k_noatt.csv", "attitude"]);
+    let p = w("k_nocol.csv", ktext.replacen("z_m", "depth", 1).as_bytes());
+    run(calib(&det, &p), &["k_nocol.csv", "z_m"]);
+
+    // Calibration file: malformed JSON, wrong version, NaN.
+    let ctext = std::fs::read_to_string(&cal).unwrap();
+    let p = w("cal_trunc.json", &ctext.as_bytes()[..ctext.len() / 2]);
+    run(loc(&det, &p), &["cal_trunc.json", "line"]);
+    let p = w(
+        "cal_v9.json",
+        ctext
+            .replacen("\"version\": 1", "\"version\": 9", 1)
+            .as_bytes(),
+    );
+    run(loc(&det, &p), &["cal_v9.json", "version"]);
+    let mut v = loc(&det, &cal);
+    v.extend(["--half-space".into(), "1,2".into()]);
+    run(v, &["--half-space"]);
+
+    // Scenario file: unknown key, invalid value.
+    let p = w("bad.toml", b"durration_s = 1.0\n");
+    run(
+        vec![
+            "em".into(),
+            "simulate".into(),
+            "--config".into(),
+            s(&p).into(),
+            "--out".into(),
+            s(&d.join("x")).into(),
+        ],
+        &["bad.toml", "durration_s"],
+    );
+    let p = w("neg.toml", b"range_min_m = -5.0\n");
+    run(
+        vec![
+            "simulate".into(),
+            "em".into(),
+            "--config".into(),
+            s(&p).into(),
+            "--out".into(),
+            s(&d.join("x")).into(),
+        ],
+        &["neg.toml"],
+    );
+}

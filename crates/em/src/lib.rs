@@ -27,23 +27,25 @@
 //! | [`detection`] | FIR-weighted synchronous detection, its frequency response, pilot correction, polarisation ellipse |
 //! | [`calibration`] | three-stage calibration (polarisation, transmitter geometry, attitude), JSON, run-time application |
 //! | [`sim`] | the `em` scenario: ADC-level three-channel coil voltages with all distortions, binary raw format |
-//! | [`study`] | the full-chain flight study (simulation → detection → calibration → positioning) shared by tests, CLI and demo |
-
+//! | [`study`] | the full-chain flight study (simulation → detection → calibration → positioning) shared by tests, CLI and demo; error curves versus range and noise |
 //!
-//! ## Pipeline (what `aeromag em detect|calibrate|locate` wires together)
+//! ## Pipeline (what `aeromag em simulate|detect|calibrate|locate` wires together)
 //!
 //! 1. `sim::synthesize(&EmScenario::new(cfg)?)` → interleaved f32 volts
-//!    (`sim::write_raw` / `sim::read_raw` for the binary file).
-//! 2. `detection::FieldChain::new(SyncDetector::new(DetectorConfig::three_frequency_plan(..))?, χ, g, P, use_pilot)?
-//!    .process(samples, start_index)?` → `FieldEpoch`s (complex fields, T);
-//!    `sim::detected_csv` writes them with `true_` columns.
-//! 3. `calibration::PolarisationCalibration::fit`, then
-//!    `fit_transmitter_geometry` (known positions), then
-//!    `fit_attitude_correction` (one known attitude) → `Calibration`
-//!    (`to_json` / `from_json`).
+//!    (`sim::write_raw` / `sim::read_raw` for the binary file, whose header
+//!    carries the instrument constants [`detection::EmSystem`], never truth;
+//!    `sim::truth_csv` / `sim::known_csv` write the truth and the
+//!    calibration information apart).
+//! 2. `EmSystem::chain(rate, N, window, use_pilot)?.process(samples, start_index)?`
+//!    → `FieldEpoch`s (complex fields, T); `sim::detected_csv` writes them.
+//! 3. `calibration::Calibration::fit(epochs, &KnownPoints, &M, &hemisphere)`:
+//!    stage 1 on all epochs, stage 2 from known positions, stage 3 from
+//!    known attitudes; `calibration::CalibrationFile` is the versioned JSON.
 //! 4. `Calibration::locate(&epoch.h, &M, &mut Hemisphere::new(n))` per epoch
 //!    → pose, range, Euler angles (`Pose::attitude`), polarisation ratios,
-//!    residual. `positioning::error_study` gives error versus range/noise.
+//!    residual, hemisphere flag. `positioning::error_study` gives the
+//!    closed-form errors versus range/noise on ideal fields,
+//!    `study::error_curves` those of the whole calibrated chain.
 
 pub mod calibration;
 pub mod detection;

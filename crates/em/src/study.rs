@@ -9,10 +9,9 @@
 //! 1. one 16 000-sample block (0.16 s at 100 kHz) at each of
 //!    `calibration_epochs` times evenly spread over the flight, detected with
 //!    pilot correction;
-//! 2. stage 1, [`PolarisationCalibration::fit`] on all of them (no external
-//!    information); stage 2, [`fit_transmitter_geometry`] from the first
-//!    `known_positions` epochs with their true positions; stage 3,
-//!    [`fit_attitude_correction`] from the first epoch's true attitude;
+//! 2. [`Calibration::fit`]: stage 1 on all of them (no external
+//!    information); stage 2 from the first `known_positions` epochs with
+//!    their true positions; stage 3 from the first epoch's true attitude;
 //! 3. at `evaluation_epochs` other times, detected with and without pilot
 //!    correction: range error `(|r̂| − |r|)/|r|`, direction error
 //!    `∠(r̂, r)` (deg), attitude error (rotation angle of `R̂ Rᵀ`, deg) and the
@@ -21,48 +20,43 @@
 //!    after it, and after it without pilot correction.
 //!
 //! Summary figures are RMS over the evaluation epochs (and the three dipoles
-//! for the ratios).
+//! for the ratios). [`curves`] gives the errors of the same chain versus range
+//! and noise level.
+
+pub mod curves;
+
+pub use curves::{CurveConfig, CurvePoint, ErrorCurves, error_curves};
 
 use crate::Result;
-use crate::calibration::{
-    Calibration, PolarisationCalibration, fit_attitude_correction, fit_transmitter_geometry,
-    uncalibrated,
-};
-use crate::detection::{Complex64, DetectorConfig, FieldChain, FieldEpoch, SyncDetector};
+use crate::calibration::{Calibration, KnownPoints, uncalibrated};
+use crate::detection::{Complex64, FieldChain, FieldEpoch};
 use crate::error::EmError;
 use crate::positioning::{Hemisphere, angle_between, rotation_angle_between};
 use crate::sim::{EmScenario, EmSimConfig, synthesize};
-use nalgebra::{Matrix3, Vector3};
+use aeromag_core::filter::Window;
+use nalgebra::Vector3;
 
 /// Detector window `N` of the study, samples (0.16 s at 100 kHz; spec
 /// `em-positioning.md`, 6.25 Hz output rate).
 pub const STUDY_WINDOW_LEN: usize = 16_000;
 
-/// Expected mean bird direction for the hemisphere choice (behind and below
-/// the aircraft, transmitter frame).
-fn hemisphere() -> Hemisphere {
+/// Prior half-space of the study (bird behind and below the aircraft,
+/// transmitter frame x forward, z down: `r · (−1, 0, 1) > 0`).
+pub fn prior_hemisphere() -> Hemisphere {
     Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0))
 }
 
 /// The detection chain of a scenario: the three-frequency plan of
-/// [`DetectorConfig::three_frequency_plan`] with window [`STUDY_WINDOW_LEN`],
+/// [`crate::detection::DetectorConfig::three_frequency_plan`] with window [`STUDY_WINDOW_LEN`],
 /// the scenario's coupling `χ`, coil gain and pilot field; pilot correction
 /// on or off.
 ///
 /// Errors if the scenario's frequency plan is rejected by the detector.
 pub fn field_chain(sc: &EmScenario, use_pilot: bool) -> Result<FieldChain> {
-    let c = &sc.config;
-    let plan = DetectorConfig::three_frequency_plan(
-        c.sample_rate_hz,
+    sc.system().chain(
+        sc.config.sample_rate_hz,
         STUDY_WINDOW_LEN,
-        c.frequencies_hz,
-        c.pilot_offset_hz,
-    );
-    FieldChain::new(
-        SyncDetector::new(plan)?,
-        &sc.chi,
-        c.coil_gain_v_per_t_s,
-        &c.pilot_field_t,
+        Window::BlackmanHarris,
         use_pilot,
     )
 }
@@ -218,27 +212,18 @@ pub fn run_flight_study(base: &EmSimConfig, study: &FlightStudyConfig) -> Result
     let m = sc.config.moments_am2;
     let data: Vec<[[Complex64; 3]; 3]> = cal_ep.iter().map(|e| e.h).collect();
 
-    // Stage 1 (no external information).
-    let pol = PolarisationCalibration::fit(&data)?;
-    // Stage 2 (known positions).
-    let k = study.known_positions.min(data.len());
-    let fields: Vec<Matrix3<f64>> = data[..k].iter().map(|e| pol.apply(e).0).collect();
-    let pos: Vec<Vector3<f64>> = cal_ep[..k]
-        .iter()
-        .map(|e| sc.pose_at(e.time_s).position_m)
-        .collect();
-    let s = fit_transmitter_geometry(&fields, &pos, &m)?;
-    // Stage 3 (one known attitude).
-    let mut cal = Calibration {
-        polarisation: pol,
-        transmitter_s: s,
-        attitude_q: Matrix3::identity(),
+    // The three stages: stage 1 on every epoch, stage 2 from the first
+    // `known_positions` true positions, stage 3 from the first true attitude.
+    let known = KnownPoints {
+        positions: cal_ep[..study.known_positions]
+            .iter()
+            .enumerate()
+            .map(|(k, e)| (k, sc.pose_at(e.time_s).position_m))
+            .collect(),
+        attitudes: vec![(0, sc.pose_at(cal_ep[0].time_s).rotation)],
     };
-    let l0 = cal.locate(&data[0], &m, &mut hemisphere())?;
-    cal.attitude_q = fit_attitude_correction(
-        &[sc.pose_at(cal_ep[0].time_s).rotation],
-        &[l0.pose.rotation],
-    )?;
+    let cal = Calibration::fit(&data, &known, &m, &prior_hemisphere())?;
+    let pol = cal.polarisation;
 
     // Evaluation, with and without pilot correction.
     let (_, with) = epochs_at(base, &eval_times, true)?;
@@ -262,7 +247,7 @@ pub fn run_flight_study(base: &EmSimConfig, study: &FlightStudyConfig) -> Result
         calibration: cal,
     };
     for (e, e_np) in with.iter().zip(&without) {
-        let l = cal.locate(&e.h, &m, &mut hemisphere())?;
+        let l = cal.locate(&e.h, &m, &mut prior_hemisphere())?;
         let t = sc.pose_at(e.time_s);
         out.eval_time_s.push(e.time_s);
         out.range_series_m.push(t.range_m());

@@ -9,7 +9,9 @@ use std::path::PathBuf;
 /// Scenarios: `calibration` (four-heading box at 3000 m with roll, pitch and
 /// yaw manoeuvres), `calibration-truncated` (the thesis' shorter pattern),
 /// `survey` (lines and tie lines at 100 m above ground), `gradiometer`
-/// (a dipole passing a gradiometer: see `aeromag dipole simulate`). The folder gets
+/// (a dipole passing a gradiometer: see `aeromag dipole simulate`), `em`
+/// (ADC-level EM positioning record: same as `aeromag em simulate`). The
+/// folder gets
 /// `<scenario>.csv` (canonical columns plus `true_…` truth columns),
 /// `<scenario>.toml` (the scenario with every default filled in: edit it and
 /// pass it back with --config) and `<scenario>.truth.json`.
@@ -22,7 +24,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Scenario: calibration, calibration-truncated, survey.
+    /// Scenario: calibration, calibration-truncated, survey, em.
     scenario: String,
     /// Scenario file (TOML); fields not given take the scenario's defaults.
     #[arg(long, value_name = "FILE.toml")]
@@ -42,6 +44,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.scenario == "gradiometer" {
         let (config, seed, out, print_config) = (a.config, a.seed, a.out, a.print_config);
         return super::dipole::simulate_scenario(super::dipole::SimulateArgs { config, seed, out, print_config });
+    }
+    if a.scenario == "em" {
+        return crate::commands::em::simulate_em(a.config.as_deref(), a.seed, a.out.as_deref(), a.print_config, crate::commands::em::DEFAULT_KNOWN);
     }
     let kind: ScenarioKind = a.scenario.parse()?;
     if a.print_config {

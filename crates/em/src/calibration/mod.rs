@@ -10,14 +10,19 @@
 //!
 //! At run time ([`Calibration::locate`]) the stages are applied in the same
 //! order: stage 1 gives the real field matrix, positioning uses `M'`, and
-//! the rotation is corrected to `Q R'`. The whole set is saved as JSON.
+//! the rotation is corrected to `Q R'`. [`three_stage`] fits all three in
+//! order; [`file`](mod@file) is the versioned JSON file of the command line.
 
 pub mod attitude;
+pub mod file;
 pub mod linear_polarisation;
+pub mod three_stage;
 pub mod transmitter_geometry;
 
 pub use attitude::fit_attitude_correction;
+pub use file::{CALIBRATION_FORMAT, CALIBRATION_VERSION, CalibrationFile, FitCounts};
 pub use linear_polarisation::{PolarisationCalibration, uncalibrated};
+pub use three_stage::KnownPoints;
 pub use transmitter_geometry::fit_transmitter_geometry;
 
 use crate::detection::Complex64;

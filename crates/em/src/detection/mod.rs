@@ -7,7 +7,9 @@
 //! 2. [`pilot`]: the bi-harmonic pilot at `ω0 ± δ` measures the channel
 //!    sensitivity `ξ(ω0) ≈ G (U_R + U_L)/2` (eq. 4) and divides it out.
 //! 3. [`chain`]: the whole chain to complex field vectors `χ⁻¹ ξ⁻¹ U0/(−iωg)`.
-//! 4. [`polarisation`]: the real field vector is the major axis of the
+//! 4. [`system`]: the instrument constants (plan, gain, pilot, bench `χ`,
+//!    nominal moments) the chain is built from.
+//! 5. [`polarisation`]: the real field vector is the major axis of the
 //!    polarisation ellipse; the minor/major ratio is the quality figure.
 //!
 //! ## Frequency plan
@@ -23,11 +25,13 @@ pub mod chain;
 pub mod pilot;
 pub mod polarisation;
 pub mod synchronous;
+pub mod system;
 
 pub use chain::{FieldChain, FieldEpoch};
 pub use pilot::PilotCorrection;
 pub use polarisation::{PolarisationEllipse, major_axis};
-pub use synchronous::{DetectorConfig, Epoch, SyncDetector};
+pub use synchronous::{DetectorConfig, Epoch, SyncDetector, block_centre_time_s};
+pub use system::EmSystem;
 
 /// Complex number type used for detected amplitudes.
 pub type Complex64 = nalgebra::Complex<f64>;

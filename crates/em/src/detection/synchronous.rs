@@ -215,6 +215,13 @@ fn dot2(u: &[f32], re: &[f32], im: &[f32], avx2: bool) -> (f64, f64) {
     dot2_body(u, re, im)
 }
 
+/// Time of the centre of a block of `window_len` samples whose first sample
+/// has absolute index `first_index`, at `sample_rate_hz`:
+/// `(n₀ + (N − 1)/2)/f_s`, s (the [`Epoch::centre_time_s`] of every block).
+pub fn block_centre_time_s(first_index: u64, window_len: usize, sample_rate_hz: f64) -> f64 {
+    (first_index as f64 + (window_len as f64 - 1.0) / 2.0) / sample_rate_hz
+}
+
 /// `e^{iω n₀/f_s}`: phase of the reference at the block start.
 fn block_phase(f_hz: f64, fs: f64, start_index: u64) -> Complex64 {
     let cycles = (f_hz / fs) * start_index as f64;
@@ -441,7 +448,7 @@ impl SyncDetector {
                         .map(|&(sr, si)| Complex64::new(sr, si) * rot),
                 );
             }
-            let centre = (first as f64 + (n as f64 - 1.0) / 2.0) / fs;
+            let centre = block_centre_time_s(first, n, fs);
             out.push(Epoch {
                 start_index: first,
                 centre_time_s: centre,

@@ -18,6 +18,11 @@ pub struct Hemisphere {
     pub margin: f64,
     /// Direction of the previous epoch (unit), if any.
     pub previous: Option<Vector3<f64>>,
+    /// Whether the last [`Hemisphere::resolve`] was decided by continuity
+    /// (direction within `margin` of the dividing plane) rather than by the
+    /// half-space: a quality flag of the epoch.
+    #[serde(default)]
+    pub by_continuity: bool,
 }
 
 impl Hemisphere {
@@ -28,6 +33,7 @@ impl Hemisphere {
             normal,
             margin: 0.2,
             previous: None,
+            by_continuity: false,
         }
     }
 
@@ -40,8 +46,14 @@ impl Hemisphere {
             0.0
         };
         let flip = match self.previous {
-            Some(p) if s.abs() < self.margin => e.dot(&p) < 0.0,
-            _ => s < 0.0,
+            Some(p) if s.abs() < self.margin => {
+                self.by_continuity = true;
+                e.dot(&p) < 0.0
+            }
+            _ => {
+                self.by_continuity = false;
+                s < 0.0
+            }
         };
         let out = if flip { -e } else { *e };
         self.previous = Some(out);
@@ -64,5 +76,7 @@ mod tests {
         let mut h2 = Hemisphere::new(Vector3::new(-1.0, 0.0, 1.0));
         h2.previous = Some(-e2);
         assert!(h2.resolve(&e2).dot(&e2) < 0.0);
+        assert!(h2.by_continuity);
+        assert!(h2.resolve(&e).dot(&e) > 0.99 && !h2.by_continuity);
     }
 }

@@ -8,9 +8,9 @@
 //! then           frames × channels f32 LE, interleaved: sample n, channel c at index n·channels + c
 //! ```
 
-use super::scenario::EmScenario;
+use crate::detection::EmSystem;
 use crate::{EmError, Result};
-use std::io::Write;
+use std::io::{Read, Write};
 
 /// The 8-byte magic at the start of a raw file.
 pub const MAGIC: &[u8; 8] = b"AEMRAW1\n";
@@ -28,10 +28,10 @@ pub struct RawHeader {
     pub frames: u64,
     /// Absolute index of the first frame (flight time × rate).
     pub start_index: u64,
-    /// The scenario that produced the record (truth and distortions). The
-    /// drawn matrices are informational (JSON may round their last ulp);
-    /// `EmScenario::new(scenario.config)` reproduces them exactly.
-    pub scenario: EmScenario,
+    /// The instrument constants (frequency plan, coil gain, pilot field,
+    /// bench cross-coupling, nominal moments): what the detector needs. No
+    /// truth of the flight is stored in a raw file.
+    pub system: EmSystem,
 }
 
 impl RawHeader {
@@ -41,7 +41,7 @@ impl RawHeader {
         channels: usize,
         frames: u64,
         start_index: u64,
-        scenario: EmScenario,
+        system: EmSystem,
     ) -> Self {
         Self {
             layout: "f32le-interleaved".into(),
@@ -49,7 +49,7 @@ impl RawHeader {
             channels,
             frames,
             start_index,
-            scenario,
+            system,
         }
     }
 }
@@ -79,32 +79,152 @@ pub fn write_raw<W: Write>(mut w: W, header: &RawHeader, samples: &[f32]) -> Res
     w.write_all(&buf).map_err(io)
 }
 
-/// Parse a raw file's bytes into header and samples.
+/// Streaming reader of a raw record: the header first, then the body in
+/// chunks of frames, so that a long record is detected in constant memory.
+#[derive(Debug)]
+pub struct RawReader<R: Read> {
+    inner: R,
+    header: RawHeader,
+    body_offset: u64,
+    frames_read: u64,
+    bytes: Vec<u8>,
+}
+
+fn bad(m: String) -> EmError {
+    EmError::InvalidData(m)
+}
+
+/// Read exactly `buf.len()` bytes or report how many were there.
+fn read_full<R: Read>(r: &mut R, buf: &mut [u8]) -> Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match r.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(n) => got += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(bad(format!("read error: {e}"))),
+        }
+    }
+    Ok(got)
+}
+
+impl<R: Read> RawReader<R> {
+    /// Read and check magic and header.
+    ///
+    /// Errors ([`EmError::InvalidData`]): wrong magic, truncated or malformed
+    /// JSON header, a layout other than `f32le-interleaved`, zero channels or
+    /// a non-positive rate.
+    pub fn new(mut inner: R) -> Result<Self> {
+        let mut pre = [0u8; 12];
+        let n = read_full(&mut inner, &mut pre)?;
+        if n < 12 || &pre[..8] != MAGIC {
+            return Err(bad(
+                "not an aeromag EM raw file (the first 8 bytes are not \"AEMRAW1\\n\")".into(),
+            ));
+        }
+        let len = u32::from_le_bytes([pre[8], pre[9], pre[10], pre[11]]) as usize;
+        let mut json = vec![0u8; len];
+        let got = read_full(&mut inner, &mut json)?;
+        if got < len {
+            return Err(bad(format!(
+                "truncated header: bytes 8..12 announce {len} header bytes, the file has {got} after them"
+            )));
+        }
+        let body_offset = 12 + len as u64;
+        let header: RawHeader = serde_json::from_slice(&json)
+            .map_err(|e| bad(format!("JSON header (bytes 12..{body_offset}): {e}")))?;
+        if header.layout != "f32le-interleaved" {
+            return Err(bad(format!(
+                "header field 'layout' is \"{}\", expected \"f32le-interleaved\"",
+                header.layout
+            )));
+        }
+        if header.channels == 0 || !crate::positive_finite(header.sample_rate_hz) {
+            return Err(bad(format!(
+                "header fields 'channels' = {} and 'sample_rate_hz' = {} must be positive",
+                header.channels, header.sample_rate_hz
+            )));
+        }
+        Ok(Self {
+            inner,
+            header,
+            body_offset,
+            frames_read: 0,
+            bytes: Vec::new(),
+        })
+    }
+
+    /// The header.
+    pub fn header(&self) -> &RawHeader {
+        &self.header
+    }
+
+    /// Byte offset of the first sample in the file.
+    pub fn body_offset(&self) -> u64 {
+        self.body_offset
+    }
+
+    /// Frames read so far.
+    pub fn frames_read(&self) -> u64 {
+        self.frames_read
+    }
+
+    /// Read up to `max_frames` frames into `out` (replacing its contents);
+    /// returns the number read, 0 at the end. After the last frame the
+    /// stream must end.
+    ///
+    /// Errors ([`EmError::InvalidData`]): the body ends before the header's
+    /// frame count (truncated file) or continues after it (trailing bytes).
+    pub fn read_frames(&mut self, max_frames: usize, out: &mut Vec<f32>) -> Result<usize> {
+        out.clear();
+        let left = self.header.frames - self.frames_read;
+        let frames = (max_frames as u64).min(left) as usize;
+        let ch = self.header.channels;
+        if frames == 0 {
+            if read_full(&mut self.inner, &mut [0u8; 1])? != 0 {
+                return Err(bad(format!(
+                    "trailing bytes after the header's {} frames (from byte {})",
+                    self.header.frames,
+                    self.body_offset + self.header.frames * ch as u64 * 4
+                )));
+            }
+            return Ok(0);
+        }
+        self.bytes.resize(frames * ch * 4, 0);
+        let got = read_full(&mut self.inner, &mut self.bytes)?;
+        if got < self.bytes.len() {
+            let at = self.frames_read + (got / (4 * ch)) as u64;
+            return Err(bad(format!(
+                "truncated body: the header says {} frames × {ch} channels, the file ends in frame {at} (byte {})",
+                self.header.frames,
+                self.body_offset + self.frames_read * ch as u64 * 4 + got as u64
+            )));
+        }
+        out.extend(
+            self.bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        );
+        self.frames_read += frames as u64;
+        Ok(frames)
+    }
+}
+
+/// Parse a raw file's bytes into header and samples ([`RawReader`] over the
+/// whole body).
 ///
-/// Errors ([`EmError::InvalidData`]) for a wrong magic, a malformed header or
-/// a truncated body.
+/// Errors as [`RawReader::new`] and [`RawReader::read_frames`].
 pub fn read_raw(bytes: &[u8]) -> Result<(RawHeader, Vec<f32>)> {
-    let bad = |m: &str| EmError::InvalidData(m.into());
-    if bytes.len() < 12 || &bytes[..8] != MAGIC {
-        return Err(bad("not an aeromag EM raw file"));
+    let mut r = RawReader::new(bytes)?;
+    let frames = usize::try_from(r.header().frames)
+        .map_err(|_| bad("header field 'frames' too large".into()))?;
+    if frames.checked_mul(r.header().channels * 4) != Some(bytes.len() - r.body_offset() as usize) {
+        // Same errors as streaming, without allocating a wrong-sized buffer.
+        let mut out = Vec::new();
+        while r.read_frames(1 << 16, &mut out)? > 0 {}
     }
-    let len = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
-    let body_start = 12usize
-        .checked_add(len)
-        .filter(|&e| e <= bytes.len())
-        .ok_or_else(|| bad("truncated header"))?;
-    let header: RawHeader = serde_json::from_slice(&bytes[12..body_start])
-        .map_err(|e| EmError::InvalidData(e.to_string()))?;
-    let n = (header.frames as usize)
-        .checked_mul(header.channels)
-        .ok_or_else(|| bad("header sizes overflow"))?;
-    let body = &bytes[body_start..];
-    if body.len() != n * 4 {
-        return Err(bad("body length does not match the header"));
-    }
-    let samples = body
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
-    Ok((header, samples))
+    let mut samples = Vec::new();
+    r.read_frames(frames, &mut samples)?;
+    r.read_frames(1, &mut Vec::new())?;
+    Ok((r.header.clone(), samples))
 }

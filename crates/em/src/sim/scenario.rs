@@ -1,7 +1,7 @@
 //! Configuration, drawn distortions and the bird's truth motion of the `em`
 //! scenario (see [`super`] for the signal model).
 
-use crate::detection::Complex64;
+use crate::detection::{Complex64, EmSystem};
 use crate::positioning::Pose;
 use crate::{EmError, Result};
 use aeromag_core::frames::Attitude;
@@ -15,6 +15,7 @@ pub type CMatrix3 = Matrix3<Complex64>;
 
 /// User configuration of the `em` scenario (units in the names).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct EmSimConfig {
     /// ChaCha seed of every random draw.
     pub seed: u64,
@@ -28,7 +29,8 @@ pub struct EmSimConfig {
     pub frequencies_hz: [f64; 3],
     /// Pilot offset `δ`, Hz (pilots at `f ± δ`).
     pub pilot_offset_hz: f64,
-    /// Transmitter moments (columns), A·m².
+    /// Transmitter moments (columns = dipoles), A·m²; in TOML a flat
+    /// column-major list of 9 (dipole 1's x, y, z, then dipole 2's, …).
     pub moments_am2: Matrix3<f64>,
     /// Coil gain `g`, V per (T/s).
     pub coil_gain_v_per_t_s: f64,
@@ -213,6 +215,21 @@ impl EmScenario {
         Pose {
             position_m: pos,
             rotation: c_nb.transpose(),
+        }
+    }
+
+    /// The instrument constants a crew would know: frequency plan, coil
+    /// gain, pilot field, the cross-coupling `χ` (as if measured exactly on
+    /// the bench) and the nominal moments.
+    pub fn system(&self) -> EmSystem {
+        let c = &self.config;
+        EmSystem {
+            frequencies_hz: c.frequencies_hz,
+            pilot_offset_hz: c.pilot_offset_hz,
+            coil_gain_v_per_t_s: c.coil_gain_v_per_t_s,
+            pilot_field_t: c.pilot_field_t,
+            chi: self.chi,
+            moments_am2: c.moments_am2,
         }
     }
 

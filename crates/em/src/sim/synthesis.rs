@@ -163,6 +163,6 @@ pub fn synthesize(scenario: &EmScenario) -> Result<EmRecording> {
             t += gap.sample(&mut rng);
         }
     }
-    let header = RawHeader::new(fs, 3, frames as u64, start_index, scenario.clone());
+    let header = RawHeader::new(fs, 3, frames as u64, start_index, scenario.system());
     Ok(EmRecording { header, samples })
 }

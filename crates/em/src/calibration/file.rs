@@ -1,0 +1,141 @@
+//! The calibration file written by `aeromag em calibrate` and read by
+//! `aeromag em locate`: JSON, versioned, self-contained (it carries the
+//! nominal moments the stages were fitted with).
+//!
+//! ```json
+//! { "format": "aeromag-em-calibration", "version": 1,
+//!   "moments_am2": [9 numbers, column-major],
+//!   "calibration": { "polarisation": {...}, "transmitter_s": [...], "attitude_q": [...] },
+//!   "fit": { "epochs": 120, "known_positions": 8, "known_attitudes": 1 } }
+//! ```
+//!
+//! The stages are applied in the order they were fitted
+//! ([`Calibration::locate`]).
+
+use super::Calibration;
+use crate::{EmError, Result};
+use nalgebra::Matrix3;
+
+/// Value of the `format` field.
+pub const CALIBRATION_FORMAT: &str = "aeromag-em-calibration";
+/// Current `version` (readers reject other versions).
+pub const CALIBRATION_VERSION: u32 = 1;
+
+/// How many epochs and known points the stages were fitted from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct FitCounts {
+    /// Epochs of stage 1.
+    pub epochs: usize,
+    /// Known positions of stage 2.
+    pub known_positions: usize,
+    /// Known attitudes of stage 3.
+    pub known_attitudes: usize,
+}
+
+/// The versioned calibration file.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationFile {
+    /// Always [`CALIBRATION_FORMAT`].
+    pub format: String,
+    /// Always [`CALIBRATION_VERSION`].
+    pub version: u32,
+    /// Nominal transmitter moments (columns = dipoles), A·m².
+    pub moments_am2: Matrix3<f64>,
+    /// The three stages.
+    pub calibration: Calibration,
+    /// Fit sizes (informational).
+    pub fit: FitCounts,
+}
+
+impl CalibrationFile {
+    /// Wrap a fitted calibration.
+    pub fn new(calibration: Calibration, moments_am2: Matrix3<f64>, fit: FitCounts) -> Self {
+        Self {
+            format: CALIBRATION_FORMAT.into(),
+            version: CALIBRATION_VERSION,
+            moments_am2,
+            calibration,
+            fit,
+        }
+    }
+
+    /// Pretty JSON text.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData(e.to_string()))
+    }
+
+    /// Parse and check format, version and finiteness.
+    ///
+    /// Errors ([`EmError::InvalidData`]) with serde's line and column for
+    /// malformed JSON, or naming the offending field.
+    pub fn from_json(s: &str) -> Result<Self> {
+        let f: Self = serde_json::from_str(s).map_err(|e| EmError::InvalidData(e.to_string()))?;
+        if f.format != CALIBRATION_FORMAT {
+            return Err(EmError::InvalidData(format!(
+                "field 'format' is \"{}\", expected \"{CALIBRATION_FORMAT}\"",
+                f.format
+            )));
+        }
+        if f.version != CALIBRATION_VERSION {
+            return Err(EmError::InvalidData(format!(
+                "field 'version' is {}, this program reads version {CALIBRATION_VERSION}",
+                f.version
+            )));
+        }
+        let c = &f.calibration;
+        let finite = |m: &Matrix3<f64>| m.iter().all(|v| v.is_finite());
+        if !(finite(&f.moments_am2)
+            && finite(&c.transmitter_s)
+            && finite(&c.attitude_q)
+            && finite(&c.polarisation.b)
+            && c.polarisation.p.iter().all(finite)
+            && c.polarisation.phase_rad.iter().all(|v| v.is_finite()))
+        {
+            return Err(EmError::InvalidData(
+                "non-finite number in the calibration".into(),
+            ));
+        }
+        if f.moments_am2.determinant().abs() == 0.0 {
+            return Err(EmError::InvalidData(
+                "field 'moments_am2' is singular".into(),
+            ));
+        }
+        Ok(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file() -> CalibrationFile {
+        CalibrationFile::new(
+            Calibration::default(),
+            Matrix3::from_diagonal_element(2.0e4),
+            FitCounts {
+                epochs: 64,
+                known_positions: 8,
+                known_attitudes: 1,
+            },
+        )
+    }
+
+    #[test]
+    fn round_trip_and_rejections() {
+        let f = file();
+        let text = f.to_json().unwrap();
+        assert_eq!(CalibrationFile::from_json(&text).unwrap(), f);
+        let err = |t: &str| CalibrationFile::from_json(t).unwrap_err().to_string();
+        assert!(err(&text.replace("\"version\": 1", "\"version\": 2")).contains("version"));
+        assert!(err(&text.replace("aeromag-em-calibration", "something-else")).contains("format"));
+        assert!(err(&text[..text.len() / 2]).contains("line"));
+        let mut singular = f.clone();
+        singular.moments_am2 = Matrix3::zeros();
+        assert!(err(&singular.to_json().unwrap()).contains("moments_am2"));
+        let mut nan = f;
+        nan.calibration.attitude_q[(0, 1)] = f64::NAN;
+        // serde_json writes NaN as null, which does not parse as a number.
+        assert!(CalibrationFile::from_json(&nan.to_json().unwrap()).is_err());
+    }
+}
