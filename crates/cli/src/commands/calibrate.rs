@@ -27,7 +27,7 @@ use std::path::PathBuf;
 /// Eddy currents with a time constant (--eddy-lag, default `auto`): aircraft
 /// skins and frames carry eddy currents that follow dB/dt through a lag of
 /// 0.1–1 s, which the classical eddy terms (e8/e9) cannot represent. `auto`
-/// tries lagged eddy groups (l9) with τ from 0.1 to 2 s and keeps up to two
+/// tries lagged eddy groups (l9) with τ from 0.1 to 1 s and keeps up to two
 /// lags only when a likelihood-ratio test on the band-passed residual finds
 /// them significant (1 % false-selection probability); otherwise the
 /// classical model is kept. `none` keeps the classical model (MagNav.jl's,
