@@ -41,6 +41,7 @@ enum Command {
     Dipole(commands::dipole::Args),
     Em(commands::em::Args),
     Rotor(commands::rotor::Args),
+    Pod(commands::pod::Args),
     Observability(commands::observability::Args),
 }
 
@@ -70,6 +71,7 @@ fn main() {
         Command::Dipole(a) => commands::dipole::run(a),
         Command::Em(a) => commands::em::run(a),
         Command::Rotor(a) => commands::rotor::run(a),
+        Command::Pod(a) => commands::pod::run(a),
         Command::Observability(a) => commands::observability::run(a),
     };
     if let Err(e) = result {

@@ -160,6 +160,7 @@ fn demo_meets_the_compensation_figures() {
         ("rotor", &["rotor_rms_nt", "residual_model_nt", "residual_best_filter_nt"][..]),
         ("em", &["range_err_rel", "angle_err_deg", "polarization_ratio_before", "polarization_ratio_after"][..]),
         ("gradiometry", &["efficiency_tensor", "efficiency_scalar", "convergence_fraction"][..]),
+        ("pod", &["rate_train", "rate_test"][..]),
     ] {
         for k in keys {
             assert!(s[group][k].as_f64().is_some(), "summary key {group}.{k}");

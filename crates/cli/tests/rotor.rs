@@ -35,3 +35,228 @@ fn rotor_study_meets_the_issue_figures() {
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("<svg") && html.contains("low-pass"));
 }
+
+/// Rows of a CSV written by aeromag: header and the named columns (NaN for
+/// empty cells).
+fn columns(p: &std::path::Path, names: &[&str]) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let idx: Vec<usize> = names
+        .iter()
+        .map(|n| {
+            header
+                .iter()
+                .position(|h| h == n)
+                .unwrap_or_else(|| panic!("no column {n}"))
+        })
+        .collect();
+    let mut out = vec![Vec::new(); names.len()];
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        for (o, i) in out.iter_mut().zip(&idx) {
+            o.push(f[*i].parse().unwrap_or(f64::NAN));
+        }
+    }
+    out
+}
+
+/// Standard deviation without 3 s (300 samples) at each end.
+fn std_mid(x: &[f64]) -> f64 {
+    let s = &x[300..x.len() - 300];
+    let m = s.iter().sum::<f64>() / s.len() as f64;
+    (s.iter().map(|v| (v - m).powi(2)).sum::<f64>() / s.len() as f64).sqrt()
+}
+
+/// Share of the true rotor interference RMS the applied model leaves
+/// (scored against `true_rotor`, which the commands never read).
+fn residual_share(out: &std::path::Path) -> f64 {
+    let c = columns(out, &["true_rotor", "rotor_interf"]);
+    let res: Vec<f64> = c[0].iter().zip(&c[1]).map(|(a, b)| a - b).collect();
+    std_mid(&res) / std_mid(&c[0])
+}
+
+fn simulate_heli(
+    d: &std::path::Path,
+    name: &str,
+    seed: &str,
+    config: Option<&str>,
+) -> std::path::PathBuf {
+    let dir = d.join(name);
+    let mut args = vec![
+        "simulate",
+        "helicopter",
+        "--seed",
+        seed,
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    let cfg = d.join(format!("{name}.toml"));
+    if let Some(text) = config {
+        std::fs::write(&cfg, text).unwrap();
+        args.extend(["--config", cfg.to_str().unwrap()]);
+    }
+    assert_code(&aeromag(&args), 0);
+    dir.join("helicopter.csv")
+}
+
+#[test]
+fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
+    let d = tempfile::tempdir().unwrap();
+    let learn = simulate_heli(d.path(), "a", "11", None);
+    let other = simulate_heli(d.path(), "b", "12", None);
+    let model = d.path().join("rotor.json");
+    let o = aeromag(&[
+        "rotor",
+        "fit",
+        "--input",
+        learn.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("from `rotor_phase`"), "{}", stdout(&o));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(m["format"], "aeromag-model/1");
+    assert_eq!(m["kind"], "helicopter-rotor");
+    let out = d.path().join("out.csv");
+    let o = aeromag(&[
+        "rotor",
+        "apply",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        other.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let share = residual_share(&out);
+    eprintln!(
+        "rotor model with phase channel leaves {:.2} % of the rotor RMS on an independent flight",
+        100.0 * share
+    );
+    assert!(share <= 0.10, "{share}");
+    // One row per input row; a missing `mag` value is kept and flagged.
+    let text = std::fs::read_to_string(&other).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let hdr = lines.iter().position(|l| !l.starts_with('#')).unwrap();
+    let mag_i = lines[hdr].split(',').position(|c| c == "mag").unwrap();
+    let edit = |row: usize, value: &str| -> String {
+        let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        let mut f: Vec<String> = out[hdr + row].split(',').map(String::from).collect();
+        f[mag_i] = value.into();
+        out[hdr + row] = f.join(",");
+        out.join("\n") + "\n"
+    };
+    let gap = d.path().join("gap.csv");
+    std::fs::write(&gap, edit(20_000, "")).unwrap();
+    let o = aeromag(&[
+        "rotor",
+        "apply",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        gap.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let c = columns(&out, &["rotor_flag", "mag_comp", "rotor_interf"]);
+    assert_eq!(c[0].len(), lines.len() - hdr - 1);
+    assert_eq!(c[0][19_999], 1.0);
+    assert!(c[1][19_999].is_nan());
+    assert_eq!(c[0][0], 0.0);
+    assert!(c[2][0].is_finite());
+    // Bad input: a cell that is not a number, a truth column as phase, a
+    // model of another kind.
+    let bad = d.path().join("bad.csv");
+    std::fs::write(&bad, edit(77, "x1")).unwrap();
+    let o = aeromag(&[
+        "rotor",
+        "apply",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    let e = stderr(&o);
+    assert!(
+        e.contains("bad.csv") && e.contains("mag") && e.contains("data row 77"),
+        "{e}"
+    );
+    let o = aeromag(&[
+        "rotor",
+        "fit",
+        "--input",
+        learn.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--phase-column",
+        "true_rotor_phase",
+    ]);
+    assert_code(&o, 2);
+    std::fs::write(
+        &bad,
+        "{\"format\": \"aeromag-model/1\", \"kind\": \"towed-pod\"}",
+    )
+    .unwrap();
+    let o = aeromag(&[
+        "rotor",
+        "apply",
+        "--model",
+        bad.to_str().unwrap(),
+        "--input",
+        other.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+}
+
+#[test]
+fn rotor_fit_without_a_phase_channel_estimates_the_phase() {
+    let d = tempfile::tempdir().unwrap();
+    let cfg = "[rotor]\nphase_channel = false\n";
+    let learn = simulate_heli(d.path(), "a", "13", Some(cfg));
+    let other = simulate_heli(d.path(), "b", "14", Some(cfg));
+    let model = d.path().join("rotor.json");
+    let o = aeromag(&[
+        "rotor",
+        "fit",
+        "--input",
+        learn.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--rotor-hz",
+        "4.5,5.2",
+    ]);
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).contains("estimated from the data"),
+        "{}",
+        stdout(&o)
+    );
+    let out = d.path().join("out.csv");
+    let o = aeromag(&[
+        "rotor",
+        "apply",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        other.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let share = residual_share(&out);
+    eprintln!(
+        "rotor model, phase estimated from the data, leaves {:.2} % of the rotor RMS on an independent flight",
+        100.0 * share
+    );
+    assert!(share <= 0.10, "{share}");
+}

@@ -35,7 +35,9 @@
 //! 100 m above ground with turbulence), `helicopter` (the box at 40 m/s and
 //! 100 Hz with a fuselage and a main rotor of magnetised, conducting blades
 //! with coning and tip-path-plane tilt, [`scenario::helicopter`],
-//! [`platform::rotor`]). Scenario files are TOML; every field
+//! [`platform::rotor`]), `pod` (a magnetometer pod towed on a 40 m cable
+//! under a dipole-array helicopter, seed `002_…`'s parameters, 20 Hz,
+//! [`scenario::pod`]). Scenario files are TOML; every field
 //! has a documented default (see the `*Config` types and
 //! [`scenario::config`]); unknown fields are errors.
 //!
@@ -110,6 +112,9 @@
 //! `true_tilt_lon`, `true_tilt_lat` (deg), `true_rotor`, `true_fuselage`
 //! and `true_rotor_x`, `true_rotor_y`, `true_rotor_z` (nT); there
 //! `true_interf = true_fuselage + true_rotor` (see [`scenario::helicopter`]).
+//! The `pod` scenario has its own columns (`cable_inclination`,
+//! `cable_azimuth` in deg, `true_interf` at the pod, `true_pod_x/y/z` …,
+//! listed on [`scenario::pod::run`]).
 //!
 //! ## Determinism and speed
 //!

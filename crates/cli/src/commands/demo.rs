@@ -169,10 +169,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.inc(1);
 
     // Helicopter rotor and EM bird positioning.
-    bar.set_message("rotor and EM studies");
+    bar.set_message("rotor, pod, EM and gradiometry studies");
     let (rotor_keys, rotor_section) = crate::commands::rotor::demo_rotor(a.quick)?;
     let (em_keys, em_section) = crate::commands::em::demo_em(a.quick)?;
     let (grad_keys, grad_section) = crate::commands::dipole::demo_gradiometry(a.quick)?;
+    let (pod_keys, pod_section) = crate::commands::pod::demo_pod(a.quick)?;
     bar.inc(1);
 
     // 5. Report.
@@ -205,6 +206,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "noise_floor_nt": fsv.noise_floor_nt,
         },
         "rotor": rotor_keys,
+        "pod": pod_keys,
         "em": em_keys,
         "gradiometry": grad_keys,
         "seed": a.seed,
@@ -269,7 +271,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
     add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
-    for section in [rotor_section, em_section, grad_section].into_iter().flatten() {
+    for section in [rotor_section, pod_section, em_section, grad_section].into_iter().flatten() {
         section.append_to(&mut r);
     }
     r.write_html(a.out.join("index.html"))?;
@@ -290,6 +292,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("rotor.rotor_rms_nt", fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3)),
         ("rotor.residual_model_nt", fmt(rotor_keys["residual_model_nt"].as_f64(), 4)),
         ("rotor.residual_best_filter_nt", fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4)),
+        ("pod.rate_train (fraction)", fmt(pod_keys["rate_train"].as_f64(), 4)),
+        ("pod.rate_test (fraction)", fmt(pod_keys["rate_test"].as_f64(), 4)),
         ("em.range_err_rel", sci(&em_keys, "range_err_rel")),
         ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
         ("em.polarization_ratio_before", sci(&em_keys, "polarization_ratio_before")),

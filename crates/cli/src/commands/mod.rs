@@ -10,5 +10,7 @@ pub mod inspect;
 pub mod level;
 pub mod observability;
 pub mod report;
+pub mod pod;
 pub mod rotor;
+pub mod rotor_fit;
 pub mod simulate;

@@ -19,6 +19,8 @@ pub struct Args {
 #[derive(Debug, clap::Subcommand)]
 enum Sub {
     Study(StudyArgs),
+    Fit(FitArgs),
+    Apply(ApplyArgs),
 }
 
 /// Simulates the `helicopter` scenario (4 headings with manoeuvres, 290 rpm,
@@ -44,15 +46,23 @@ struct StudyArgs {
 pub fn run(a: Args) -> anyhow::Result<()> {
     match a.command {
         Sub::Study(s) => study(s),
+        Sub::Fit(f) => super::rotor_fit::fit(f),
+        Sub::Apply(x) => super::rotor_fit::apply(x),
     }
 }
+
+pub use super::rotor_fit::{ApplyArgs, FitArgs};
 
 /// Samples excluded at each end (3 s at 100 Hz: filter transients).
 const EDGE: usize = 300;
 
+/// The study, time (s), true rotor interference (nT), scalar reading (nT).
+type StudyRun = (RotorStudy, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// Simulate the scenario with `seed` and run the comparison; also returns
-/// time (s) and the true rotor interference (nT) for the plot.
-fn run_study(seed: u64) -> anyhow::Result<(RotorStudy, Vec<f64>, Vec<f64>)> {
+/// time (s), the true rotor interference (nT) and the scalar reading (nT)
+/// for the plots.
+fn run_study(seed: u64) -> anyhow::Result<StudyRun> {
     let sim = simulate(ScenarioKind::Helicopter, None, Some(seed))?;
     let col = |n: &str| {
         sim.column(n)
@@ -80,7 +90,12 @@ fn run_study(seed: u64) -> anyhow::Result<(RotorStudy, Vec<f64>, Vec<f64>)> {
             edge: EDGE,
         },
     )?;
-    Ok((st, t.to_vec(), col("true_rotor")?.to_vec()))
+    Ok((
+        st,
+        t.to_vec(),
+        col("true_rotor")?.to_vec(),
+        col("mag")?.to_vec(),
+    ))
 }
 
 /// The `rotor.*` keys of `aeromag demo`'s summary (data-formats.md).
@@ -102,7 +117,76 @@ fn pct(x: f64) -> String {
     }
 }
 
-fn section(s: &RotorStudy, t: &[f64], rotor: &[f64]) -> anyhow::Result<ReportSection> {
+/// Waveforms of the scalar reading (high-passed at 2 Hz) before and after
+/// the model over a 5 s excerpt, and their Welch spectra (10 s segments).
+fn before_after(s: &RotorStudy, t: &[f64], mag: &[f64]) -> anyhow::Result<Vec<Block>> {
+    use aeromag_compensation::rotor::linear::highpass;
+    use aeromag_core::spectrum::welch::{WelchConfig, welch};
+    let fs = (t.len() - 1) as f64 / (t[t.len() - 1] - t[0]);
+    let after: Vec<f64> = mag
+        .iter()
+        .zip(&s.prediction_nt)
+        .map(|(m, p)| m - p)
+        .collect();
+    let (hb, ha) = (highpass(mag, fs, 2.0)?, highpass(&after, fs, 2.0)?);
+    let mid = t.len() / 2;
+    let r = mid..(mid + (5.0 * fs) as usize).min(t.len());
+    let wave = LinePlot::new(
+        "Scalar reading above 2 Hz before and after the rotor model (5 s excerpt)",
+        "time (s)",
+        "nT",
+    )
+    .with_series(Series::line(
+        "before",
+        t[r.clone()].to_vec(),
+        hb[r.clone()].to_vec(),
+    ))
+    .with_series(Series::line(
+        "after the model",
+        t[r.clone()].to_vec(),
+        ha[r].to_vec(),
+    ));
+    let cfg = WelchConfig::new(fs, ((10.0 * fs) as usize).min(mag.len()));
+    let (pb, pa) = (
+        welch(&hb[EDGE..hb.len() - EDGE], &cfg)?,
+        welch(&ha[EDGE..ha.len() - EDGE], &cfg)?,
+    );
+    let keep = |f: &[f64], v: &[f64]| -> (Vec<f64>, Vec<f64>) {
+        f.iter()
+            .zip(v)
+            .filter(|(f, _)| **f > 0.0)
+            .map(|(f, v)| (*f, *v))
+            .unzip()
+    };
+    let (fb, vb) = keep(&pb.freqs_hz, &pb.values);
+    let (fa, va) = keep(&pa.freqs_hz, &pa.values);
+    let spec = LinePlot::new(
+        "Power spectral density before and after the rotor model",
+        "frequency (Hz)",
+        "nT²/Hz",
+    )
+    .with_series(Series::line("before", fb, vb))
+    .with_series(Series::line("after the model", fa, va))
+    .log_log();
+    Ok(vec![
+        Block::Figure {
+            svg: wave.to_svg()?,
+            caption: "Measured scalar field above 2 Hz (rotor interference, anomaly edges, noise) before and after \
+                      subtracting the modelled rotor interference."
+                .into(),
+        },
+        Block::Figure {
+            svg: spec.to_svg()?,
+            caption: format!(
+                "Welch spectra (10 s Hann segments) of the high-passed reading: the peaks at f_r = {:.2} Hz, the \
+                 blade-passing frequency and their harmonics disappear after the model.",
+                s.rotor_hz
+            ),
+        },
+    ])
+}
+
+fn section(s: &RotorStudy, t: &[f64], rotor: &[f64], mag: &[f64]) -> anyhow::Result<ReportSection> {
     let mut sec = ReportSection::new("Helicopter rotor interference (issue 5)");
     sec.blocks.push(Block::Paragraph(format!(
         "Rotor interference {:.3} nT RMS at the sensor (f_r = {:.3} Hz), anomaly {:.3} nT RMS. The physical model \
@@ -171,6 +255,7 @@ fn section(s: &RotorStudy, t: &[f64], rotor: &[f64]) -> anyhow::Result<ReportSec
         svg: p.to_svg()?,
         caption: "True rotor interference and what the model leaves.".into(),
     });
+    sec.blocks.extend(before_after(s, t, mag)?);
     Ok(sec)
 }
 
@@ -180,14 +265,14 @@ fn section(s: &RotorStudy, t: &[f64], rotor: &[f64]) -> anyhow::Result<ReportSec
 /// accepted for symmetry with [`super::em::demo_em`]; the study has one size.
 pub fn demo_rotor(quick: bool) -> anyhow::Result<(serde_json::Value, Option<ReportSection>)> {
     let _ = quick;
-    let (s, t, rotor) = run_study(11)?;
-    Ok((summary_json(&s), Some(section(&s, &t, &rotor)?)))
+    let (s, t, rotor, mag) = run_study(11)?;
+    Ok((summary_json(&s), Some(section(&s, &t, &rotor, &mag)?)))
 }
 
 fn study(a: StudyArgs) -> anyhow::Result<()> {
     let bar = crate::progress::bar(1, "rotor study");
     bar.set_message("simulating and fitting");
-    let (s, t, rotor) = run_study(a.seed)?;
+    let (s, t, rotor, mag) = run_study(a.seed)?;
     bar.inc(1);
     bar.finish_and_clear();
     println!(
@@ -211,7 +296,7 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
         serde_json::to_string_pretty(&json!({ "rotor": summary_json(&s) }))?,
     )?;
     let mut r = Report::new("aeromag — helicopter rotor interference study");
-    section(&s, &t, &rotor)?.append_to(&mut r);
+    section(&s, &t, &rotor, &mag)?.append_to(&mut r);
     let path = a.out.join("index.html");
     r.write_html(&path)?;
     println!("report written to {}", path.display());

@@ -8,10 +8,12 @@ use std::path::PathBuf;
 ///
 /// Scenarios: `calibration` (four-heading box at 3000 m with roll, pitch and
 /// yaw manoeuvres), `calibration-truncated` (the thesis' shorter pattern),
-/// `survey` (lines and tie lines at 100 m above ground), `gradiometer`
-/// (a dipole passing a gradiometer: see `aeromag dipole simulate`), `em`
-/// (ADC-level EM positioning record: same as `aeromag em simulate`). The
-/// folder gets
+/// `survey` (lines and tie lines at 100 m above ground), `helicopter` (the box
+/// at 40 m/s with a main rotor, 100 Hz, rotor phase channel), `pod` (a towed
+/// magnetometer pod under a helicopter, seed 002's parameters, 20 Hz, cable
+/// inclination and azimuth channels), `gradiometer` (a dipole passing a
+/// gradiometer: see `aeromag dipole simulate`), `em` (ADC-level EM
+/// positioning record: same as `aeromag em simulate`). The folder gets
 /// `<scenario>.csv` (canonical columns plus `true_…` truth columns),
 /// `<scenario>.toml` (the scenario with every default filled in: edit it and
 /// pass it back with --config) and `<scenario>.truth.json`.
@@ -21,10 +23,12 @@ use std::path::PathBuf;
 ///   aeromag simulate survey --seed 7 --out survey/
 ///   aeromag simulate calibration --print-config > my.toml
 ///   aeromag simulate calibration --config my.toml --out cal2/
+///   aeromag simulate pod --seed 3 --out pod/
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Scenario: calibration, calibration-truncated, survey, em.
+    /// Scenario: calibration, calibration-truncated, survey, helicopter, pod,
+    /// gradiometer, em.
     scenario: String,
     /// Scenario file (TOML); fields not given take the scenario's defaults.
     #[arg(long, value_name = "FILE.toml")]

@@ -63,14 +63,19 @@ fn row(sources: &[[f64; 3]], u: &[f64; 3], du: &[f64; 3], p: &[f64; 3]) -> Vec<f
     r
 }
 
-fn columns(sources: &[[f64; 3]], h: &PodHeading) -> Result<(Vec<Vec<f64>>, Vec<f64>)> {
+/// Regressor columns of heading `h` (high-passed when `hp`) and its
+/// high-passed `s0`.
+fn columns(sources: &[[f64; 3]], h: &PodHeading, hp: bool) -> Result<(Vec<Vec<f64>>, Vec<f64>)> {
     let p = prepare(h)?;
     let rows: Vec<Vec<f64>> = (0..h.u.len())
         .map(|k| row(sources, &h.u[k], &p.du[k], &h.pod_body_m[k]))
         .collect();
     let m = sources.len() * PER_SOURCE;
     let cols = (0..m)
-        .map(|c| detrend(&rows.iter().map(|r| r[c]).collect::<Vec<_>>()))
+        .map(|c| {
+            let col: Vec<f64> = rows.iter().map(|r| r[c]).collect();
+            if hp { detrend(&col) } else { col }
+        })
         .collect();
     Ok((cols, p.s0))
 }
@@ -90,7 +95,7 @@ pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); m];
     let mut y = Vec::new();
     for h in headings {
-        let (c, s0) = columns(sources, h)?;
+        let (c, s0) = columns(sources, h, true)?;
         for (dst, src) in cols.iter_mut().zip(c) {
             dst.extend(src);
         }
@@ -106,12 +111,23 @@ pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result
 
 /// High-passed prediction of `model` on heading `h`, nT.
 pub fn predict_dipole_array(model: &DipoleArrayModel, h: &PodHeading) -> Result<Vec<f64>> {
+    predict(model, h, true)
+}
+
+/// Prediction of `model` on heading `h` without the high-pass: the field of
+/// the equivalent array at the pod projected on `u`, nT (its constant is
+/// not determined by the high-passed fit).
+pub fn predict_dipole_array_raw(model: &DipoleArrayModel, h: &PodHeading) -> Result<Vec<f64>> {
+    predict(model, h, false)
+}
+
+fn predict(model: &DipoleArrayModel, h: &PodHeading, hp: bool) -> Result<Vec<f64>> {
     if model.coefficients.len() != model.sources_m.len() * PER_SOURCE {
         return Err(CompError::BadData(
             "dipole-array model: wrong coefficient count".into(),
         ));
     }
-    let (cols, s0) = columns(&model.sources_m, h)?;
+    let (cols, s0) = columns(&model.sources_m, h, hp)?;
     Ok((0..s0.len())
         .map(|k| {
             cols.iter()

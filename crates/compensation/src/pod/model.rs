@@ -10,14 +10,27 @@
 //! | `sd1` (0..8) | `P1 P2 P3 a11 a12 a13 a22 a23` | permanent and induced (`a` symmetric, `a33 = 0`: `Σu² = 1` makes it redundant) |
 //! | `sd2` (8..16) | `b11 b12 b13 b21 b22 b23 b31 b32` | eddy (`b33 = 0`: `b + κI` is unobservable) |
 //! | `sd3..5` (16..43) | `∂P1..3, ∂a11 ∂a12 ∂a13 ∂a22 ∂a23, g0` per axis x, y, z | field gradient at the pod |
+//! | `sd6` (43..67, joint solve only) | `∂b11 … ∂b32` per axis x, y, z | gradient of the eddy-current field |
 //!
 //! Correction to the seed: the gradient blocks carry a ninth term `g0`
 //! (a heading-independent gradient, the `∂a33` term that `Σu² = 1` turns
 //! into a constant); with `a33 = 0` and no constant, eqs. 10–12 cannot
 //! represent a field gradient that does not change with the heading.
 //!
+//! Second correction (found on the simulated seed scenario): eqs. 10–12
+//! differentiate only the permanent and induced parts in the pod position.
+//! The eddy-current part changes with the pod position too, by
+//! `δp_k Σ_ij ∂b_ij,k u_j u_i'`; in the small-signal view this is a product
+//! of two small quantities (`δp`, `v'`) and is dropped, but during a 5°
+//! manoeuvre at 0.1 Hz the field rate is ≈ 3000 nT/s, the eddy moments are
+//! as large as the permanent ones and the pod moves by metres, so the
+//! product is not small. The joint solve carries these 24 terms
+//! ([`N_JOINT`] parameters); the two-step solve, whose heading coefficients
+//! are first order, cannot.
+//!
 //! Large signal (the interference up to a constant per heading):
-//! `ΔB = P·u + uᵀAu + Σ_ij b_ij u_j u_i' + Σ_k δp_k (∂P_k·u + uᵀ∂A_k u + g0_k)`.
+//! `ΔB = P·u + uᵀAu + Σ_ij b_ij u_j u_i' + Σ_k δp_k (∂P_k·u + uᵀ∂A_k u + g0_k
+//! + Σ_ij ∂b_ij,k u_j u_i')`.
 //!
 //! Small signal on a heading with steady direction cosines `U` (seed eq. 4,
 //! corrected eq. 6): `c = P + 2AU`, `d = bU`,
@@ -27,8 +40,11 @@
 
 use crate::{CompError, Result};
 
-/// Number of model parameters (8 + 8 + 3 × 9).
+/// Number of model parameters of the small-signal model (8 + 8 + 3 × 9).
 pub const N_PARAMS: usize = 43;
+/// Number of parameters of the large-signal model of the joint solve:
+/// [`N_PARAMS`] plus the eddy-current gradient (3 × 8).
+pub const N_JOINT: usize = N_PARAMS + 24;
 /// Number of heading coefficients `W1..W7`.
 pub const N_HEADING: usize = 7;
 /// Smallest `|U3|` accepted (axes are not reordered).
@@ -103,11 +119,12 @@ pub fn heading_design(u0: &[f64; 3]) -> Result<Vec<[f64; N_HEADING]>> {
         .collect()
 }
 
-/// Large-signal regressors of one sample: the 43 functions multiplying `θ`
-/// in `ΔB(u, u', δp)` (module docs), for direction cosines `u`, their rate
-/// `du` (1/s) and pod displacement `dp` (m, body frame).
-pub fn large_signal_row(u: &[f64; 3], du: &[f64; 3], dp: &[f64; 3]) -> [f64; N_PARAMS] {
-    let mut r = [0.0; N_PARAMS];
+/// Large-signal regressors of one sample: the [`N_JOINT`] functions
+/// multiplying `θ` in `ΔB(u, u', δp)` (module docs), for direction cosines
+/// `u`, their rate `du` (1/s) and pod displacement `dp` (m, body frame).
+/// The first [`N_PARAMS`] are those of the seed's parameters.
+pub fn large_signal_row(u: &[f64; 3], du: &[f64; 3], dp: &[f64; 3]) -> [f64; N_JOINT] {
+    let mut r = [0.0; N_JOINT];
     let g = gradient_functions(u);
     r[..8].copy_from_slice(&g[..8]);
     let pairs = [
@@ -127,6 +144,9 @@ pub fn large_signal_row(u: &[f64; 3], du: &[f64; 3], dp: &[f64; 3]) -> [f64; N_P
         let o = 16 + 9 * axis;
         for k in 0..9 {
             r[o + k] = d * g[k];
+        }
+        for k in 0..8 {
+            r[N_PARAMS + 8 * axis + k] = d * r[8 + k];
         }
     }
     r

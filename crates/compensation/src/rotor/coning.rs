@@ -98,6 +98,71 @@ pub fn fit_slow_angles(
     fit_opts: &RotorFitOptions,
     opts: &SlowAngleOptions,
 ) -> Result<SlowAngleFit> {
+    slow_angles(geom, terms, input, mag_nt, fs_hz, fit_opts, opts, None)
+}
+
+/// Apply a fitted model to new data: the blade parameters of `model` stay
+/// fixed and only the slowly varying angles (and, with
+/// `opts.estimate_phase`, the phase correction) are estimated on `mag_nt`,
+/// window by window (the alternating step of the module docs; `opts.joint`
+/// is ignored). The returned [`SlowAngleFit::fit`] holds `model`'s
+/// parameters and the residual on this record.
+pub fn track_slow_angles(
+    geom: &RotorGeometry,
+    model: &RotorFit,
+    input: &RotorInput,
+    mag_nt: &[f64],
+    fs_hz: f64,
+    fit_opts: &RotorFitOptions,
+    opts: &SlowAngleOptions,
+) -> Result<SlowAngleFit> {
+    let opts = SlowAngleOptions {
+        joint: false,
+        ..*opts
+    };
+    slow_angles(
+        geom,
+        model.terms,
+        input,
+        mag_nt,
+        fs_hz,
+        fit_opts,
+        &opts,
+        Some(model),
+    )
+}
+
+/// RMS of the high-passed residual `y − HP[Σ θ G]` of fixed parameters
+/// (`edge_s` excluded at each end), nT.
+fn fixed_residual(
+    model: &RotorFit,
+    cols: &[Vec<f64>],
+    y_hp: &[f64],
+    fs_hz: f64,
+    fit_opts: &RotorFitOptions,
+) -> Result<f64> {
+    let n = y_hp.len();
+    let pred = highpass(&model.predict_columns(cols)?, fs_hz, fit_opts.highpass_hz)?;
+    let edge = ((fit_opts.edge_s * fs_hz).round() as usize).min(n / 4);
+    let m = (n - 2 * edge).max(1) as f64;
+    Ok(((edge..n - edge)
+        .map(|k| (y_hp[k] - pred[k]).powi(2))
+        .sum::<f64>()
+        / m)
+        .sqrt())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn slow_angles(
+    geom: &RotorGeometry,
+    terms: BladeTerms,
+    input: &RotorInput,
+    mag_nt: &[f64],
+    fs_hz: f64,
+    fit_opts: &RotorFitOptions,
+    opts: &SlowAngleOptions,
+    fixed: Option<&RotorFit>,
+) -> Result<SlowAngleFit> {
     let n = mag_nt.len();
     let win = (opts.window_s * fs_hz).round() as usize;
     if win < 10 || n < 2 * win {
@@ -126,7 +191,16 @@ pub fn fit_slow_angles(
     let eps = 1e-4;
     let mut phase = input.phase_rad.to_vec();
     let mut cols = regressors(geom, terms, &with(input, &angles, &phase))?;
-    let mut fit = fit_columns(&cols, terms, mag_nt, fs_hz, fit_opts)?;
+    let refit = |cols: &[Vec<f64>]| -> Result<RotorFit> {
+        match fixed {
+            None => fit_columns(cols, terms, mag_nt, fs_hz, fit_opts),
+            Some(m) => Ok(RotorFit {
+                residual_rms_nt: fixed_residual(m, cols, &y, fs_hz, fit_opts)?,
+                ..m.clone()
+            }),
+        }
+    };
+    let mut fit = refit(&cols)?;
     for _ in 0..opts.iterations {
         let pred = highpass(&fit.predict_columns(&cols)?, fs_hz, fit_opts.highpass_hz)?;
         let base = fit.predict_columns(&cols)?;
@@ -257,7 +331,7 @@ pub fn fit_slow_angles(
             *ph += s[3];
         }
         cols = regressors(geom, terms, &with(input, &angles, &phase))?;
-        fit = fit_columns(&cols, terms, mag_nt, fs_hz, fit_opts)?;
+        fit = refit(&cols)?;
     }
     Ok(SlowAngleFit {
         fit,

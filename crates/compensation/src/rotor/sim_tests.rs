@@ -175,3 +175,63 @@ fn works_without_a_phase_channel() {
     assert!(max_err_refined < max_err);
     assert!(res <= 0.10 * r_rms);
 }
+
+/// A model fitted on one flight (phase channel) applied to another flight
+/// whose phase is estimated from its scalar data: parameters fixed, phase
+/// aligned over a revolution, slowly varying angles and phase tracked.
+#[test]
+fn a_fitted_model_applies_to_another_flight() {
+    let a = case(11, None);
+    let b = case(12, None);
+    let (fs, edge) = (a.fs, a.edge);
+    let nominal = [crate::rotor::study::nominal_angles()];
+    let opts = RotorFitOptions::default();
+    let pa = unwrap_deg(a.sim.column("rotor_phase").unwrap());
+    let wa = rotor_speed(&pa, fs, 1.0).unwrap();
+    let ia = RotorInput {
+        b_body_nt: &a.b,
+        phase_rad: &pa,
+        omega_rad_s: &wa,
+        angles: &nominal,
+    };
+    let mag_a = a.sim.column("mag").unwrap();
+    let so = SlowAngleOptions::default();
+    let model = fit_slow_angles(&a.geom, BladeTerms::Full, &ia, mag_a, fs, &opts, &so)
+        .unwrap()
+        .fit;
+    let mag_b = b.sim.column("mag").unwrap();
+    let est = estimate_phase(mag_b, fs, 4, 4.5, 5.2).unwrap();
+    let wb = rotor_speed(&est.phase_rad, fs, 1.0).unwrap();
+    let ib = RotorInput {
+        b_body_nt: &b.b,
+        phase_rad: &est.phase_rad,
+        omega_rad_s: &wb,
+        angles: &nominal,
+    };
+    let c = align_phase_offset(&b.geom, &model, &ib, mag_b, fs, &opts).unwrap();
+    let phase: Vec<f64> = est.phase_rad.iter().map(|p| p + c).collect();
+    let ib = RotorInput {
+        phase_rad: &phase,
+        ..ib
+    };
+    let track = SlowAngleOptions {
+        estimate_phase: true,
+        iterations: 6,
+        ..so
+    };
+    let t = track_slow_angles(&b.geom, &model, &ib, mag_b, fs, &opts, &track).unwrap();
+    assert_eq!(t.fit.params, model.params);
+    let inp = RotorInput {
+        angles: &t.angles,
+        phase_rad: &t.phase_rad,
+        ..ib
+    };
+    let pred = model.predict(&b.geom, &inp).unwrap();
+    let rot = b.sim.column("true_rotor").unwrap();
+    let share = std_mid(&diff(rot, &pred), edge) / std_mid(rot, edge);
+    eprintln!(
+        "model of flight 11 on flight 12, phase from the data: {:.2} %",
+        100.0 * share
+    );
+    assert!(share <= 0.10, "{share}");
+}

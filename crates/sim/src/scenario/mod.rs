@@ -7,7 +7,7 @@
 //! | `calibration_truncated` | the truncated box (≈ 73 % of the time) | quiet |
 //! | `survey` | 12 lines + 3 tie lines at 100 m above ground, turbulence ([`survey`]) | realistic gradients, two dipoles |
 //! | `helicopter` | the box at 40 m/s, 150 m above ground, 100 Hz, fuselage + main rotor ([`helicopter`]) | realistic |
-//! | towed pod | straight headings with pitch/roll/yaw manoeuvres, pod on a 40 m cable under a dipole-array helicopter ([`pod::simulate_pod`]; a library function, not yet a [`ScenarioKind`]) | gradients 5.91 / −25.91 nT/km |
+//! | `pod` | straight headings with pitch/roll/yaw manoeuvres, pod on a 40 m cable under a dipole-array helicopter, 20 Hz ([`pod`]; its own flat configuration [`pod::PodConfig`]) | gradients 5.91 / −25.91 nT/km |
 //!
 //! All fixed-wing scenarios share the configuration of [`config`] and the
 //! pipeline of [`fixed_wing`] (the same aircraft and sensors; only the
@@ -45,15 +45,18 @@ pub enum ScenarioKind {
     Survey,
     /// Helicopter with a main rotor ([`helicopter`]).
     Helicopter,
+    /// Towed magnetometer pod under a helicopter ([`pod`]).
+    Pod,
 }
 
 impl ScenarioKind {
     /// Every scenario.
-    pub const ALL: [ScenarioKind; 4] = [
+    pub const ALL: [ScenarioKind; 5] = [
         Self::Calibration,
         Self::CalibrationTruncated,
         Self::Survey,
         Self::Helicopter,
+        Self::Pod,
     ];
 
     /// The name used on the command line and in file names.
@@ -63,6 +66,7 @@ impl ScenarioKind {
             Self::CalibrationTruncated => "calibration_truncated",
             Self::Survey => "survey",
             Self::Helicopter => "helicopter",
+            Self::Pod => "pod",
         }
     }
 }
@@ -77,7 +81,7 @@ impl std::str::FromStr for ScenarioKind {
     type Err = crate::error::SimError;
 
     /// Parse a scenario name (`calibration`, `calibration_truncated` or
-    /// `calibration-truncated`, `survey`).
+    /// `calibration-truncated`, `survey`, `helicopter`, `pod`).
     fn from_str(s: &str) -> Result<Self> {
         let norm = s.trim().to_ascii_lowercase().replace('-', "_");
         Self::ALL
@@ -179,6 +183,7 @@ pub fn simulate(
             )?;
             helicopter::run(&cfg)
         }
+        ScenarioKind::Pod => pod::run(&pod::PodConfig::parse_over(config_toml, seed)?),
     }
 }
 
@@ -191,5 +196,6 @@ pub fn default_config_toml(kind: ScenarioKind) -> Result<String> {
         }
         ScenarioKind::Survey => survey_defaults().to_toml(kind),
         ScenarioKind::Helicopter => helicopter::helicopter_defaults().to_toml(),
+        ScenarioKind::Pod => pod::PodConfig::default().to_toml(),
     }
 }

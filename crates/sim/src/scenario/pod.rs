@@ -32,10 +32,16 @@
 //! Defaults are the seed's: |B| = 55 000 nT, inclination 45°, 100 m/s, 20 Hz,
 //! `L = 40 m`, `I₀ = 70°`, swing 5°, learning headings 0, 90, 180, 270, 45,
 //! 135, 225, 315° (the independent set is [`TEST_HEADINGS_DEG`]).
+//!
+//! As a scenario (`aeromag simulate pod`): [`PodConfig`] is the scenario
+//! file (flat TOML, `[[dipoles]]` tables, optional `[anomaly]`), [`run`]
+//! lays the headings out as one table with the cable inclination and
+//! azimuth channels and the `true_…` columns listed on [`run`].
 
 use aeromag_core::field::dipole::dipole_field;
 use aeromag_core::frames::Attitude;
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, invalid};
 use crate::random::gauss_markov::gauss_markov;
@@ -51,7 +57,8 @@ pub const TEST_HEADINGS_DEG: [f64; 8] = [30.0, 120.0, 210.0, 300.0, 70.0, 160.0,
 
 /// One magnetic dipole of the helicopter's dipole array (body frame:
 /// x forward, y right, z down).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PodDipole {
     /// Position in the body frame, m.
     pub position_m: [f64; 3],
@@ -63,9 +70,36 @@ pub struct PodDipole {
     pub eddy_am2_s_per_nt: [[f64; 3]; 3],
 }
 
+/// An anomaly source of the pod scenario: a point dipole on or below the
+/// ground.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PodAnomaly {
+    /// Position `(north, east, down)` in the local frame, m (down from the
+    /// 0 m altitude level, so a buried source has a positive third value).
+    pub position_m: [f64; 3],
+    /// Moment in NED, A·m².
+    pub moment_am2: [f64; 3],
+}
+
 /// Configuration of the towed-pod simulation (defaults: seed `002_…` §5).
-#[derive(Debug, Clone, PartialEq)]
+/// It is also the scenario file of `aeromag simulate pod` (TOML, every field
+/// optional, unknown fields rejected; see [`PodConfig::parse_over`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct PodConfig {
+    /// Random seed (must be < 2⁶³, TOML integers are signed 64-bit).
+    pub seed: u64,
+    /// Latitude of the local origin (first heading's start), deg; used only
+    /// for the `lat`/`lon` columns. Default 55.8.
+    pub origin_lat_deg: f64,
+    /// Longitude of the local origin, deg. Default 37.9.
+    pub origin_lon_deg: f64,
+    /// Start of the `time` column, s (UTC seconds of the day). Default 36 000.
+    pub start_time_s: f64,
+    /// Time between two headings in the `time` column, s (the turn; not
+    /// simulated). Default 20.
+    pub heading_gap_s: f64,
     /// Earth field magnitude at the start, nT.
     pub field_nt: f64,
     /// Geomagnetic inclination, deg (positive down).
@@ -112,11 +146,8 @@ pub struct PodConfig {
     pub headings_deg: Vec<f64>,
     /// The helicopter's dipole array.
     pub dipoles: Vec<PodDipole>,
-    /// Optional anomaly: a dipole `(north, east, depth below 0 m altitude)`
-    /// m and its moment (NED, A·m²); `None` = no anomaly.
-    pub anomaly: Option<([f64; 3], [f64; 3])>,
-    /// Random seed.
-    pub seed: u64,
+    /// Optional anomaly (`None`, the default: no anomaly).
+    pub anomaly: Option<PodAnomaly>,
 }
 
 /// The default dipole array: engine/gearbox, tail boom, cabin equipment and
@@ -168,6 +199,11 @@ pub fn default_dipoles() -> Vec<PodDipole> {
 impl Default for PodConfig {
     fn default() -> Self {
         Self {
+            seed: 1,
+            origin_lat_deg: 55.8,
+            origin_lon_deg: 37.9,
+            start_time_s: 36_000.0,
+            heading_gap_s: 20.0,
             field_nt: 55_000.0,
             inclination_deg: 45.0,
             declination_deg: 0.0,
@@ -192,7 +228,6 @@ impl Default for PodConfig {
             headings_deg: LEARNING_HEADINGS_DEG.to_vec(),
             dipoles: default_dipoles(),
             anomaly: None,
-            seed: 1,
         }
     }
 }
@@ -274,6 +309,27 @@ fn check(cfg: &PodConfig) -> Result<()> {
     }
     if !(cfg.cable_inclination_deg > 0.0 && cfg.cable_inclination_deg < 90.0) {
         return Err(invalid("pod.cable_inclination_deg", "must be in (0, 90)"));
+    }
+    if cfg.seed > i64::MAX as u64 {
+        return Err(invalid(
+            "pod.seed",
+            "must be < 2^63 (TOML integers are signed 64-bit)",
+        ));
+    }
+    if !(cfg.origin_lat_deg.is_finite() && cfg.origin_lat_deg.abs() < 89.0) {
+        return Err(invalid("pod.origin_lat_deg", "must be within ±89°"));
+    }
+    if !(cfg.origin_lon_deg.is_finite() && cfg.start_time_s.is_finite()) {
+        return Err(invalid(
+            "pod.origin_lon_deg",
+            "origin longitude and start time must be finite",
+        ));
+    }
+    if !(cfg.heading_gap_s.is_finite() && cfg.heading_gap_s >= 0.0) {
+        return Err(invalid("pod.heading_gap_s", "must be ≥ 0"));
+    }
+    if !(cfg.inclination_deg.is_finite() && cfg.inclination_deg.abs() < 90.0) {
+        return Err(invalid("pod.inclination_deg", "must be in (−90, 90)"));
     }
     if cfg.headings_deg.is_empty() || cfg.headings_deg.iter().any(|h| !h.is_finite()) {
         return Err(invalid(
@@ -409,9 +465,9 @@ pub fn simulate_pod(cfg: &PodConfig) -> Result<Vec<PodSegment>> {
                 (body_field(&attitude(psi0, kp), f) - body_field(&attitude(psi0, km), f)) / span;
             let dbh = helicopter_field_nt(&cfg.dipoles, &p_b, &b_b, &db_b);
             let interf = (b_b + dbh).norm() - f;
-            let anomaly = cfg.anomaly.map_or(0.0, |(pos, m)| {
-                let r = p_n - Vector3::from(pos);
-                dipole_field(&Vector3::from(m), &r).dot(&dir) * 1e9
+            let anomaly = cfg.anomaly.map_or(0.0, |a| {
+                let r = p_n - Vector3::from(a.position_m);
+                dipole_field(&Vector3::from(a.moment_am2), &r).dot(&dir) * 1e9
             });
             seg.time_s.push(k as f64 * dt);
             seg.total_nt
@@ -436,6 +492,166 @@ pub fn simulate_pod(cfg: &PodConfig) -> Result<Vec<PodSegment>> {
         out.push(seg);
     }
     Ok(out)
+}
+
+impl PodConfig {
+    /// Parse a scenario file (TOML: any subset of the fields, the rest take
+    /// their defaults; unknown fields and wrong types are errors with the
+    /// parser's line and column). `seed` overrides the file's seed.
+    /// Errors: [`crate::SimError::ConfigParse`], invalid values
+    /// ([`crate::SimError::InvalidConfig`]).
+    pub fn parse_over(text: Option<&str>, seed: Option<u64>) -> Result<Self> {
+        let mut cfg = match text {
+            None => Self::default(),
+            Some(t) => toml::from_str::<Self>(t)
+                .map_err(|e| crate::error::SimError::ConfigParse(e.to_string()))?,
+        };
+        if let Some(s) = seed {
+            cfg.seed = s;
+        }
+        check(&cfg)?;
+        Ok(cfg)
+    }
+
+    /// The configuration as TOML, every default filled in, with a header.
+    pub fn to_toml(&self) -> Result<String> {
+        let body = toml::to_string(self).map_err(|e| crate::error::SimError::Serialize {
+            what: "pod scenario",
+            reason: e.to_string(),
+        })?;
+        Ok(format!(
+            "# aeromag-sim scenario `pod` (aeromag-sim {}), every default filled in.\n\
+             # Re-running `aeromag simulate pod --config <this file>` reproduces the data.\n\
+             # Independent test headings of the seed: {:?}\n\n{body}",
+            env!("CARGO_PKG_VERSION"),
+            TEST_HEADINGS_DEG
+        ))
+    }
+}
+
+/// Run the `pod` scenario: [`simulate_pod`] laid out as one table (module
+/// docs of [`super`]): headings one after the other, `heading_gap_s` apart
+/// in `time`, `line` = heading number (1, 2, …).
+///
+/// | column | unit | meaning |
+/// |---|---|---|
+/// | `time` | s | sample time |
+/// | `line` | – | heading number |
+/// | `lat`, `lon`, `alt` | deg, deg, m | helicopter position (flat-earth offsets from the origin; `alt` above the 0 m level of the field model) |
+/// | `roll`, `pitch`, `yaw` | deg | helicopter attitude (yaw = magnetic heading when the declination is 0) |
+/// | `mag` | nT | scalar reading at the pod |
+/// | `cable_inclination` | deg | recorded cable inclination below the horizontal |
+/// | `cable_azimuth` | deg | recorded cable azimuth from magnetic north, [0, 360) |
+/// | `true_interf` | nT | helicopter interference at the pod `|B_e + ΔB_h| − |B_e|` |
+/// | `true_external` | nT | Earth field magnitude at the pod (with the gradients) |
+/// | `true_anomaly` | nT | anomaly at the pod |
+/// | `true_pod_x/y/z` | m | pod position in the body frame |
+/// | `true_pod_north`, `true_pod_alt` | m | pod north position and altitude, local frame |
+///
+/// `mag = true_external + true_interf + true_anomaly + noise`.
+pub fn run(cfg: &PodConfig) -> Result<crate::output::Simulation> {
+    use crate::output::Column;
+    let segs = simulate_pod(cfg)?;
+    let origin = aeromag_core::frames::Geodetic::new(cfg.origin_lat_deg, cfg.origin_lon_deg, 0.0);
+    let names: [(&str, &'static str, &str); 20] = [
+        ("time", "s", "sample time"),
+        ("line", "-", "heading number"),
+        ("lat", "deg", "helicopter latitude"),
+        ("lon", "deg", "helicopter longitude"),
+        ("alt", "m", "helicopter altitude"),
+        ("roll", "deg", "helicopter roll"),
+        ("pitch", "deg", "helicopter pitch"),
+        ("yaw", "deg", "helicopter yaw (heading)"),
+        ("mag", "nT", "scalar magnetometer in the towed pod"),
+        (
+            "cable_inclination",
+            "deg",
+            "cable inclination below the horizontal",
+        ),
+        (
+            "cable_azimuth",
+            "deg",
+            "cable azimuth from magnetic north, [0, 360)",
+        ),
+        (
+            "true_interf",
+            "nT",
+            "helicopter interference at the pod |B_e+ΔB_h|−|B_e|",
+        ),
+        ("true_external", "nT", "Earth field magnitude at the pod"),
+        ("true_anomaly", "nT", "anomaly at the pod"),
+        ("true_pod_x", "m", "pod position, body x (forward)"),
+        ("true_pod_y", "m", "pod position, body y (right)"),
+        ("true_pod_z", "m", "pod position, body z (down)"),
+        ("true_pod_north", "m", "pod north position, local frame"),
+        ("true_pod_alt", "m", "pod altitude"),
+        ("true_noise", "nT", "magnetometer noise"),
+    ];
+    let mut cols: Vec<Column> = names
+        .iter()
+        .map(|(n, u, d)| Column {
+            name: (*n).into(),
+            unit: u,
+            description: (*d).into(),
+            values: Vec::new(),
+        })
+        .collect();
+    let mut t0 = cfg.start_time_s;
+    for (h, s) in segs.iter().enumerate() {
+        for k in 0..s.time_s.len() {
+            let pos = origin.offset_by(s.north_m[k], s.east_m[k], s.altitude_m[k]);
+            let noise =
+                s.total_nt[k] - s.true_earth_nt[k] - s.true_interf_nt[k] - s.true_anomaly_nt[k];
+            let row = [
+                t0 + s.time_s[k],
+                (h + 1) as f64,
+                pos.lat_deg,
+                pos.lon_deg,
+                s.altitude_m[k],
+                s.roll[k].to_degrees(),
+                s.pitch[k].to_degrees(),
+                s.yaw[k].to_degrees().rem_euclid(360.0),
+                s.total_nt[k],
+                s.cable_inclination[k].to_degrees(),
+                s.cable_azimuth[k].to_degrees().rem_euclid(360.0),
+                s.true_interf_nt[k],
+                s.true_earth_nt[k],
+                s.true_anomaly_nt[k],
+                s.pod_body_m[k][0],
+                s.pod_body_m[k][1],
+                s.pod_body_m[k][2],
+                s.pod_north_m[k],
+                s.pod_altitude_m[k],
+                noise,
+            ];
+            for (c, v) in cols.iter_mut().zip(row) {
+                c.values.push(v);
+            }
+        }
+        let dur = s.time_s.last().copied().unwrap_or(0.0) + 1.0 / cfg.sample_rate_hz;
+        t0 += dur + cfg.heading_gap_s;
+    }
+    let truth = serde_json::json!({
+        "scenario": "pod",
+        "seed": cfg.seed,
+        "config": cfg,
+        "headings_deg": cfg.headings_deg,
+        "learning_headings_deg": LEARNING_HEADINGS_DEG,
+        "test_headings_deg": TEST_HEADINGS_DEG,
+        "field_direction": "inclination/declination fixed, magnitude varying with the gradients",
+        "columns": cols.iter().map(|c| serde_json::json!({ "name": c.name, "unit": c.unit, "description": c.description })).collect::<Vec<_>>(),
+    });
+    let ser = |e: serde_json::Error| crate::error::SimError::Serialize {
+        what: "truth metadata",
+        reason: e.to_string(),
+    };
+    Ok(crate::output::Simulation {
+        kind: super::ScenarioKind::Pod,
+        seed: cfg.seed,
+        columns: cols,
+        scenario_toml: cfg.to_toml()?,
+        truth_json: serde_json::to_string_pretty(&truth).map_err(ser)?,
+    })
 }
 
 #[cfg(test)]
@@ -496,5 +712,53 @@ mod tests {
             ..cfg
         };
         assert!(simulate_pod(&bad).is_err());
+    }
+
+    #[test]
+    fn scenario_toml_round_trip_and_table() {
+        let short = "headings_deg = [30.0, 120.0]\nmanoeuvre_s = 5.0\n";
+        let cfg = PodConfig::parse_over(Some(short), Some(9)).unwrap();
+        assert_eq!(cfg.seed, 9);
+        assert_eq!(cfg.headings_deg, vec![30.0, 120.0]);
+        assert_eq!(cfg.cable_m, 40.0);
+        let sim = run(&cfg).unwrap();
+        let again = PodConfig::parse_over(Some(&sim.scenario_toml), None).unwrap();
+        assert_eq!(again, cfg);
+        // The full defaults round trip too (dipole array, no anomaly).
+        let d = PodConfig::default();
+        assert_eq!(
+            PodConfig::parse_over(Some(&d.to_toml().unwrap()), None).unwrap(),
+            d
+        );
+        let with_anomaly = PodConfig {
+            anomaly: Some(PodAnomaly {
+                position_m: [100.0, 0.0, 50.0],
+                moment_am2: [0.0, 0.0, 1e6],
+            }),
+            ..d
+        };
+        let txt = with_anomaly.to_toml().unwrap();
+        assert_eq!(
+            PodConfig::parse_over(Some(&txt), None).unwrap(),
+            with_anomaly
+        );
+        assert!(PodConfig::parse_over(Some("cable_mm = 3.0\n"), None).is_err());
+        assert!(PodConfig::parse_over(Some("cable_m = -3.0\n"), None).is_err());
+        // One row per sample, strictly increasing time, the sum rule.
+        let n = 2 * 3 * 100;
+        assert_eq!(sim.n_rows(), n);
+        let c = |name: &str| sim.column(name).unwrap();
+        assert!(c("time").windows(2).all(|w| w[1] > w[0]));
+        for k in 0..n {
+            let s = c("true_external")[k]
+                + c("true_interf")[k]
+                + c("true_anomaly")[k]
+                + c("true_noise")[k];
+            assert!((c("mag")[k] - s).abs() < 1e-6);
+        }
+        assert_eq!(c("line")[0], 1.0);
+        assert_eq!(c("line")[n - 1], 2.0);
+        let az = c("cable_azimuth")[0];
+        assert!((az - 210.0).abs() < 10.0, "{az}");
     }
 }

@@ -1,0 +1,631 @@
+//! `aeromag rotor fit` and `aeromag rotor apply`: the physical main-rotor
+//! model (spec `helicopter.md` part A, seed `000_…` ch. 3; library
+//! `aeromag_compensation::rotor`) fitted on a user's flight file, saved as a
+//! versioned JSON model and applied to other files.
+//!
+//! Fit: the full linear per-blade model (7 parameters per blade: hard and
+//! soft magnetisation along and across the blade, eddy currents) with the
+//! dipole integral along each blade, and the slowly varying coning and
+//! tip-path-plane tilt estimated jointly (`fit_slow_angles`). The rotor
+//! phase comes from a phase channel (deg) or, without one, from the data:
+//! the blade-passing peak of the spectrum, complex demodulation, a phase
+//! offset by minimising the fit residual, then a slowly varying phase
+//! correction estimated with the parameters.
+//!
+//! Apply: the blade parameters stay fixed; on the new record the phase is
+//! taken from its channel or estimated and aligned with the model over a
+//! whole revolution (`align_phase_offset`), and the slowly varying angles
+//! are tracked with the parameters fixed (`track_slow_angles`). Output:
+//! every input column plus `rotor_interf` (modelled rotor interference, nT,
+//! slow part included), `mag_comp = mag − rotor_interf` (nT) and
+//! `rotor_flag` (0 compensated, 1 not: a missing value in the row or a
+//! segment shorter than 10 s between gaps).
+
+use crate::exit::bad_input;
+use crate::input::InputArgs;
+use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
+use aeromag_compensation::rotor::{
+    BladeTerms, FlapAngles, RotorFit, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
+    align_phase_offset, estimate_phase, fit_slow_angles, refine_phase_offset, rotor_speed,
+    track_slow_angles, unwrap_deg,
+};
+use aeromag_compensation::tolles_lawson::segments::split_segments;
+use aeromag_io::FlightTable;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Format tag of the model file (`data-formats.md`, "Model files").
+pub const MODEL_FORMAT: &str = "aeromag-model/1";
+/// `kind` of a rotor model file.
+pub const ROTOR_KIND: &str = "helicopter-rotor";
+/// Shortest record processed between gaps, s.
+const MIN_SEGMENT_S: f64 = 10.0;
+
+/// Fit the physical main-rotor model on a helicopter flight file.
+///
+/// Needs `time` (s, uniform sampling ≥ 2.5 × the blade-passing frequency),
+/// `mag` (nT) and `flux_x/y/z` (nT, body axes: the field direction), and a
+/// rotor phase channel (deg, azimuth of a reference blade from the nose
+/// towards the right) if there is one: `--phase-column COL`, by default
+/// `rotor_phase` when the file has it. Without a phase channel (or with
+/// --estimate-phase) the rotor frequency and phase are estimated from the
+/// scalar data (search band --rotor-hz). The geometry defaults to the
+/// simulator's helicopter (hub 0,0,−2.6 m, sensor 5,0,0.6 m, blades 0.8 to
+/// 7.5 m, 4 blades, nominal coning 4°, tilt −1.5°). The longest stretch
+/// without gaps or missing values is fitted. Columns named `true_…` are
+/// never read.
+///
+/// Example:
+///   aeromag rotor fit --input heli.csv --model rotor.json
+///   aeromag rotor fit --input heli.csv --model rotor.json --estimate-phase --rotor-hz 4.5,5.2
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct FitArgs {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Model file to write (JSON).
+    #[arg(long, value_name = "ROTOR.json")]
+    model: PathBuf,
+    /// Rotor phase channel, deg (default `rotor_phase` if present).
+    #[arg(long, value_name = "COL")]
+    phase_column: Option<String>,
+    /// Estimate the rotor phase from the data even if a phase channel exists.
+    #[arg(long)]
+    estimate_phase: bool,
+    /// Search band of the rotor frequency when the phase is estimated, Hz.
+    #[arg(long, value_name = "LO,HI", default_value = "4,6")]
+    rotor_hz: String,
+    /// Rotor hub position, body axes (x forward, y right, z down), m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    hub_m: Option<String>,
+    /// Scalar sensor position, body axes, m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    sensor_m: Option<String>,
+    /// Magnetised span of a blade from the hub, m.
+    #[arg(long, value_name = "ROOT,TIP")]
+    blade_span_m: Option<String>,
+    /// Number of blades.
+    #[arg(long)]
+    blades: Option<usize>,
+    /// Nominal coning angle, deg (the start of the slowly varying estimate).
+    #[arg(long, allow_hyphen_values = true)]
+    coning_deg: Option<f64>,
+    /// Nominal longitudinal tilt of the tip-path plane, deg.
+    #[arg(long, allow_hyphen_values = true)]
+    tilt_lon_deg: Option<f64>,
+    /// Window over which the cone angles are taken as constant, s.
+    #[arg(long, default_value_t = 1.0)]
+    window_s: f64,
+}
+
+/// Apply a rotor model (from `aeromag rotor fit`) to a flight file.
+///
+/// Writes every input column plus `rotor_interf` (modelled rotor
+/// interference, nT), `mag_comp` (mag − rotor_interf, nT) and `rotor_flag`
+/// (0 compensated, 1 not: a missing value in the row, or a stretch shorter
+/// than 10 s between gaps). Every input row is written, in order.
+///
+/// Example:
+///   aeromag rotor apply --model rotor.json --input heli2.csv --out heli2_comp.csv
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct ApplyArgs {
+    /// Model file written by `aeromag rotor fit`.
+    #[arg(long, value_name = "ROTOR.json")]
+    model: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output CSV file.
+    #[arg(long, value_name = "OUT.csv")]
+    out: PathBuf,
+}
+
+/// Where the rotor phase comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseSource {
+    /// Phase channel (canonical name in the fitted file), or `null` when
+    /// the phase is estimated from the scalar data.
+    pub column: Option<String>,
+    /// Search band of the rotor frequency for the estimate, Hz.
+    pub rotor_hz_range: [f64; 2],
+}
+
+/// The rotor model file (versioned JSON).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RotorModelFile {
+    /// Always [`MODEL_FORMAT`].
+    pub format: String,
+    /// Always [`ROTOR_KIND`].
+    pub kind: String,
+    /// Rotor and sensor geometry.
+    pub geometry: RotorGeometry,
+    /// Nominal cone angles (start of the slowly varying estimate), rad.
+    pub nominal_angles: FlapAngles,
+    /// Blade terms, parameters (regressor order of
+    /// `aeromag_compensation::rotor::regressors`) and the RMS of the
+    /// high-passed fit residual (nT).
+    pub model: RotorFit,
+    /// High-pass and edge options of the fit.
+    pub fit_options: RotorFitOptions,
+    /// Options of the slowly varying angles (of the final fit, and of the
+    /// tracking on new data, where a phase estimated from the data is also
+    /// corrected slowly).
+    pub slow_angles: SlowAngleOptions,
+    /// Phase channel or estimate.
+    pub phase: PhaseSource,
+    /// Sample rate of the fitted record, Hz.
+    pub sample_rate_hz: f64,
+    /// Mean rotor frequency of the fitted record, Hz.
+    pub rotor_hz: f64,
+    /// Mean estimated coning of the fitted record, deg.
+    pub coning_mean_deg: f64,
+    /// Rows fitted.
+    pub rows: usize,
+    /// Input columns used (canonical name → file column name).
+    pub columns: BTreeMap<String, String>,
+    /// Version of aeromag that wrote the file.
+    pub software_version: String,
+}
+
+/// Parse `n` comma-separated numbers of option `flag`.
+pub(crate) fn parse_floats(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad_input!("{flag} `{s}`: expected {n} comma-separated numbers"))?;
+    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+        return Err(bad_input!(
+            "{flag} `{s}`: expected {n} comma-separated finite numbers"
+        ));
+    }
+    Ok(v)
+}
+
+/// Numeric column `name` of `t`; a text column is bad input naming the
+/// file, the first data row whose value is not a number, and the column.
+pub(crate) fn numeric<'a>(t: &'a FlightTable, name: &str) -> anyhow::Result<&'a [f64]> {
+    if let Some(text) = t.text_column(name) {
+        let missing = |v: &str| matches!(v.trim(), "" | "*" | "NaN" | "nan");
+        if let Some((k, v)) = text
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !missing(v) && v.trim().parse::<f64>().is_err())
+        {
+            return Err(bad_input!(
+                "{}: data row {}, column {}: '{v}' is not a number",
+                t.file_label(),
+                k + 1,
+                t.resolve(name).unwrap_or(name)
+            ));
+        }
+    }
+    Ok(t.require(name)?)
+}
+
+/// Sample rate from the median time step, Hz (bad input if not positive).
+pub(crate) fn sample_rate(table: &FlightTable, time: &[f64]) -> anyhow::Result<f64> {
+    let mut d: Vec<f64> = time
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|x| x.is_finite())
+        .collect();
+    if d.is_empty() {
+        return Err(bad_input!(
+            "{}: fewer than two time samples",
+            table.file_label()
+        ));
+    }
+    d.sort_by(f64::total_cmp);
+    let dt = d[d.len() / 2];
+    if dt > 0.0 {
+        Ok(1.0 / dt)
+    } else {
+        Err(bad_input!("{}: time does not increase", table.file_label()))
+    }
+}
+
+/// Rows where every listed column is finite, the segments of such rows
+/// (split at time gaps over 1.5 steps and at `line` changes when given) of
+/// at least `min_len` rows, and the short ones.
+pub(crate) fn usable_segments(
+    time: &[f64],
+    line: Option<&[f64]>,
+    cols: &[&[f64]],
+    min_len: usize,
+) -> (Vec<bool>, Vec<Range<usize>>, Vec<Range<usize>>) {
+    let usable: Vec<bool> = (0..time.len())
+        .map(|k| time[k].is_finite() && cols.iter().all(|c| c[k].is_finite()))
+        .collect();
+    let (segs, short) = split_segments(time, line, &usable, 1.5, min_len);
+    (usable, segs, short)
+}
+
+/// The columns a rotor fit or application reads.
+struct RotorColumns<'a> {
+    time: &'a [f64],
+    mag: &'a [f64],
+    flux: [&'a [f64]; 3],
+    phase: Option<&'a [f64]>,
+}
+
+impl<'a> RotorColumns<'a> {
+    fn from_table(t: &'a FlightTable, phase: Option<&str>) -> anyhow::Result<Self> {
+        Ok(Self {
+            time: numeric(t, "time")?,
+            mag: numeric(t, "mag")?,
+            flux: [
+                numeric(t, "flux_x")?,
+                numeric(t, "flux_y")?,
+                numeric(t, "flux_z")?,
+            ],
+            phase: phase.map(|p| numeric(t, p)).transpose()?,
+        })
+    }
+
+    fn all(&self) -> Vec<&'a [f64]> {
+        let mut v = vec![self.mag, self.flux[0], self.flux[1], self.flux[2]];
+        v.extend(self.phase);
+        v
+    }
+
+    fn field(&self, r: &Range<usize>) -> Vec<Vector3<f64>> {
+        r.clone()
+            .map(|k| Vector3::new(self.flux[0][k], self.flux[1][k], self.flux[2][k]))
+            .collect()
+    }
+}
+
+/// Phase (rad, unwrapped) and rotor speed (rad/s) of one segment: from the
+/// channel, or estimated from `mag` (steps 1–2 of the library's `phase`).
+fn segment_phase(
+    cols: &RotorColumns,
+    r: &Range<usize>,
+    fs: f64,
+    blades: usize,
+    band: [f64; 2],
+) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
+    let phase = match cols.phase {
+        Some(p) => unwrap_deg(&p[r.clone()]),
+        None => estimate_phase(&cols.mag[r.clone()], fs, blades, band[0], band[1])?.phase_rad,
+    };
+    let omega = rotor_speed(&phase, fs, 1.0)?;
+    Ok((phase, omega))
+}
+
+/// Options of the phase refinement of a phase estimated from the data:
+/// the tracked phase is biased by the heading-dependent phase of the
+/// harmonics, so it is refined jointly with the parameters (library docs of
+/// `coning`), coning only, over windows twice the final ones.
+fn phase_refinement(window_s: f64) -> SlowAngleOptions {
+    SlowAngleOptions {
+        estimate_phase: true,
+        estimate_tilt: false,
+        iterations: 6,
+        window_s: 2.0 * window_s,
+        joint: true,
+    }
+}
+
+/// Options of the tracking on new data with a phase estimated from it: the
+/// final options plus a slowly varying phase correction.
+fn tracking_with_phase(o: &SlowAngleOptions) -> SlowAngleOptions {
+    SlowAngleOptions {
+        estimate_phase: true,
+        iterations: o.iterations.max(6),
+        ..*o
+    }
+}
+
+fn check_column_name(t: &FlightTable, name: &str) -> anyhow::Result<()> {
+    if name.starts_with("true_") {
+        return Err(bad_input!(
+            "{}: `{name}` is a simulation truth column; the rotor model never reads truth",
+            t.file_label()
+        ));
+    }
+    Ok(())
+}
+
+pub fn fit(a: FitArgs) -> anyhow::Result<()> {
+    let table = a.input.load()?;
+    let file = table.file_label();
+    let base = scenario_geometry();
+    let hub = a
+        .hub_m
+        .as_deref()
+        .map(|s| parse_floats("--hub-m", s, 3))
+        .transpose()?;
+    let sensor = a
+        .sensor_m
+        .as_deref()
+        .map(|s| parse_floats("--sensor-m", s, 3))
+        .transpose()?;
+    let span = a
+        .blade_span_m
+        .as_deref()
+        .map(|s| parse_floats("--blade-span-m", s, 2))
+        .transpose()?;
+    let geom = RotorGeometry {
+        hub_m: hub.map_or(base.hub_m, |v| [v[0], v[1], v[2]]),
+        sensor_m: sensor.map_or(base.sensor_m, |v| [v[0], v[1], v[2]]),
+        root_m: span.as_ref().map_or(base.root_m, |v| v[0]),
+        tip_m: span.as_ref().map_or(base.tip_m, |v| v[1]),
+        blades: a.blades.unwrap_or(base.blades),
+    };
+    geom.validate().map_err(|e| bad_input!("{e}"))?;
+    let nom = nominal_angles();
+    let angles = FlapAngles {
+        coning_rad: a.coning_deg.map_or(nom.coning_rad, f64::to_radians),
+        tilt_lon_rad: a.tilt_lon_deg.map_or(nom.tilt_lon_rad, f64::to_radians),
+        tilt_lat_rad: nom.tilt_lat_rad,
+    };
+    let band = parse_floats("--rotor-hz", &a.rotor_hz, 2)?;
+    if !(band[0] > 0.0 && band[1] > band[0]) {
+        return Err(bad_input!("--rotor-hz {}: need 0 < LO < HI", a.rotor_hz));
+    }
+    if !(a.window_s.is_finite() && a.window_s > 0.0) {
+        return Err(bad_input!("--window-s {} must be positive", a.window_s));
+    }
+    let phase_col = match (&a.phase_column, a.estimate_phase) {
+        (_, true) => None,
+        (Some(c), false) => Some(c.clone()),
+        (None, false) => table.get("rotor_phase").map(|_| "rotor_phase".to_string()),
+    };
+    if let Some(c) = &phase_col {
+        check_column_name(&table, c)?;
+    }
+    let cols = RotorColumns::from_table(&table, phase_col.as_deref())?;
+    let fs = sample_rate(&table, cols.time)?;
+    let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
+    let (_, segs, _) = usable_segments(cols.time, None, &cols.all(), min_len);
+    let r = segs
+        .iter()
+        .max_by_key(|r| r.len())
+        .cloned()
+        .ok_or_else(|| {
+            bad_input!("{file}: no stretch of ≥ {MIN_SEGMENT_S} s without gaps or missing values")
+        })?;
+    if r.len() < table.n_rows() {
+        eprintln!(
+            "warning: fitting data rows {}–{} of {} (the longest stretch without gaps or missing values)",
+            r.start + 1,
+            r.end,
+            table.n_rows()
+        );
+    }
+    let fit_opts = RotorFitOptions::default();
+    let b = cols.field(&r);
+    let mag = &cols.mag[r.clone()];
+    let (mut phase, omega) = segment_phase(&cols, &r, fs, geom.blades, [band[0], band[1]])?;
+    let nominal = [angles];
+    let estimated = phase_col.is_none();
+    if estimated {
+        let inp = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &phase,
+            omega_rad_s: &omega,
+            angles: &nominal,
+        };
+        let c = refine_phase_offset(&geom, BladeTerms::Full, &inp, mag, fs, &fit_opts)?;
+        phase.iter_mut().for_each(|p| *p += c);
+    }
+    if estimated {
+        let inp = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &phase,
+            omega_rad_s: &omega,
+            angles: &nominal,
+        };
+        let o = phase_refinement(a.window_s);
+        phase = fit_slow_angles(&geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &o)?.phase_rad;
+    }
+    let slow_opts = SlowAngleOptions {
+        window_s: a.window_s,
+        ..SlowAngleOptions::default()
+    };
+    let inp = RotorInput {
+        b_body_nt: &b,
+        phase_rad: &phase,
+        omega_rad_s: &omega,
+        angles: &nominal,
+    };
+    let slow = fit_slow_angles(
+        &geom,
+        BladeTerms::Full,
+        &inp,
+        mag,
+        fs,
+        &fit_opts,
+        &slow_opts,
+    )?;
+    let rotor_hz = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
+    let coning_mean_deg =
+        slow.angles.iter().map(|x| x.coning_rad).sum::<f64>() / slow.angles.len() as f64 * 180.0
+            / std::f64::consts::PI;
+    let mut columns = BTreeMap::new();
+    for c in ["time", "mag", "flux_x", "flux_y", "flux_z"]
+        .into_iter()
+        .chain(phase_col.as_deref())
+    {
+        columns.insert(c.to_string(), table.resolve(c).unwrap_or(c).to_string());
+    }
+    let model = RotorModelFile {
+        format: MODEL_FORMAT.into(),
+        kind: ROTOR_KIND.into(),
+        geometry: geom,
+        nominal_angles: angles,
+        model: slow.fit,
+        fit_options: fit_opts,
+        slow_angles: slow_opts,
+        phase: PhaseSource {
+            column: phase_col.clone(),
+            rotor_hz_range: [band[0], band[1]],
+        },
+        sample_rate_hz: fs,
+        rotor_hz,
+        coning_mean_deg,
+        rows: r.len(),
+        columns,
+        software_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    std::fs::write(&a.model, serde_json::to_string_pretty(&model)?)
+        .map_err(|e| anyhow::anyhow!("cannot write '{}': {e}", a.model.display()))?;
+    println!(
+        "fitted the rotor model on {} rows of {file} ({:.3} Hz, f_r {rotor_hz:.4} Hz, phase {}): {} parameters, \
+         high-passed residual {:.4} nT, mean coning {coning_mean_deg:.2}°; written to {}",
+        r.len(),
+        fs,
+        phase_col
+            .as_deref()
+            .map_or("estimated from the data".to_string(), |c| format!(
+                "from `{c}`"
+            )),
+        model.model.params.len(),
+        model.model.residual_rms_nt,
+        a.model.display()
+    );
+    Ok(())
+}
+
+/// Read and check a rotor model file.
+pub fn load_model(path: &Path) -> anyhow::Result<RotorModelFile> {
+    let origin = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| bad_input!("{origin}: not a JSON model file ({e})"))?;
+    if v.get("format").and_then(|f| f.as_str()) != Some(MODEL_FORMAT) {
+        return Err(bad_input!("{origin}: not an `{MODEL_FORMAT}` model file"));
+    }
+    if v.get("kind").and_then(|f| f.as_str()) != Some(ROTOR_KIND) {
+        return Err(bad_input!(
+            "{origin}: model kind {} is not a rotor model (`{ROTOR_KIND}`, written by `aeromag rotor fit`)",
+            v.get("kind")
+                .map_or("missing".to_string(), |k| k.to_string())
+        ));
+    }
+    let m: RotorModelFile =
+        serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid rotor model: {e}"))?;
+    m.geometry
+        .validate()
+        .map_err(|e| bad_input!("{origin}: {e}"))?;
+    let expect = m.geometry.blades * m.model.terms.per_blade();
+    if m.model.params.len() != expect || m.model.params.iter().any(|p| !p.is_finite()) {
+        return Err(bad_input!(
+            "{origin}: expected {expect} finite rotor parameters, got {}",
+            m.model.params.len()
+        ));
+    }
+    Ok(m)
+}
+
+/// Modelled rotor interference for every row (NaN where not compensated)
+/// of `table` with `model`.
+pub fn rotor_interference(model: &RotorModelFile, table: &FlightTable) -> anyhow::Result<Vec<f64>> {
+    let phase_col = model.phase.column.as_deref();
+    let cols = RotorColumns::from_table(table, phase_col)?;
+    let fs = sample_rate(table, cols.time)?;
+    if (fs / model.sample_rate_hz - 1.0).abs() > 0.01 {
+        eprintln!(
+            "warning: {}: sample rate {fs:.3} Hz differs from the model's {:.3} Hz",
+            table.file_label(),
+            model.sample_rate_hz
+        );
+    }
+    let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
+    let (_, segs, _) = usable_segments(cols.time, None, &cols.all(), min_len);
+    let mut out = vec![f64::NAN; table.n_rows()];
+    let g = &model.geometry;
+    let nominal = [model.nominal_angles];
+    let band = model.phase.rotor_hz_range;
+    for r in segs {
+        let b = cols.field(&r);
+        let mag = &cols.mag[r.clone()];
+        let (mut phase, omega) = segment_phase(&cols, &r, fs, g.blades, band)?;
+        if phase_col.is_none() {
+            let inp = RotorInput {
+                b_body_nt: &b,
+                phase_rad: &phase,
+                omega_rad_s: &omega,
+                angles: &nominal,
+            };
+            let c = align_phase_offset(g, &model.model, &inp, mag, fs, &model.fit_options)?;
+            phase.iter_mut().for_each(|p| *p += c);
+        }
+        let inp = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &phase,
+            omega_rad_s: &omega,
+            angles: &nominal,
+        };
+        let opts = match phase_col {
+            None => tracking_with_phase(&model.slow_angles),
+            Some(_) => model.slow_angles,
+        };
+        let slow = track_slow_angles(g, &model.model, &inp, mag, fs, &model.fit_options, &opts)?;
+        let inp = RotorInput {
+            angles: &slow.angles,
+            phase_rad: &slow.phase_rad,
+            ..inp
+        };
+        let p = model.model.predict(g, &inp)?;
+        out[r].copy_from_slice(&p);
+    }
+    Ok(out)
+}
+
+/// Add `<prefix>_interf`, `mag_comp` and `<prefix>_flag` to `table` from
+/// the modelled interference `interf` (NaN = not compensated); returns the
+/// number of rows not compensated. Bad input if a column exists already.
+pub(crate) fn add_compensation(
+    table: &mut FlightTable,
+    prefix: &str,
+    interf: Vec<f64>,
+) -> anyhow::Result<usize> {
+    let (ni, nf) = (format!("{prefix}_interf"), format!("{prefix}_flag"));
+    for name in [ni.as_str(), "mag_comp", nf.as_str()] {
+        if table.get(name).is_some() {
+            return Err(bad_input!(
+                "{}: already has a column `{name}`; rename it first",
+                table.file_label()
+            ));
+        }
+    }
+    let mag = table.require("mag")?;
+    let comp: Vec<f64> = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
+    let flag: Vec<f64> = interf
+        .iter()
+        .map(|v| if v.is_finite() { 0.0 } else { 1.0 })
+        .collect();
+    let missing = flag.iter().filter(|f| **f > 0.0).count();
+    table.add_column(&ni, interf)?;
+    table.add_column("mag_comp", comp)?;
+    table.add_column(&nf, flag)?;
+    Ok(missing)
+}
+
+pub fn apply(a: ApplyArgs) -> anyhow::Result<()> {
+    let model = load_model(&a.model)?;
+    let mut table = a.input.load()?;
+    let n = table.n_rows();
+    let interf = rotor_interference(&model, &table)?;
+    let missing = add_compensation(&mut table, "rotor", interf)?;
+    aeromag_io::write_csv(&table, &a.out)?;
+    if missing > 0 {
+        eprintln!(
+            "warning: {missing} of {n} rows could not be compensated (missing values or stretches under \
+             {MIN_SEGMENT_S} s); they are kept with rotor_flag = 1"
+        );
+    }
+    println!(
+        "compensated {} of {n} rows with {}; written to {}",
+        n - missing,
+        a.model.display(),
+        a.out.display()
+    );
+    Ok(())
+}
