@@ -119,3 +119,24 @@ pub fn parse_band(s: &str) -> anyhow::Result<(f64, f64)> {
     }
     Ok((lo, hi))
 }
+
+/// Add the modelled interference `interf` (nT; NaN = not compensated) as
+/// column `interf_col`, `mag_comp = mag − interf`, and `flag_col` (0
+/// compensated, 1 not) to `table`; returns the number of rows not
+/// compensated. Bad input if one of the columns exists already. Used by
+/// `compensate`, `rotor apply` and `pod apply`.
+pub fn add_compensation(table: &mut FlightTable, interf_col: &str, flag_col: &str, interf: Vec<f64>) -> anyhow::Result<usize> {
+    for name in [interf_col, "mag_comp", flag_col] {
+        if table.get(name).is_some() {
+            return Err(bad_input!("{}: already has a column `{name}`; rename it first", table.file_label()));
+        }
+    }
+    let mag = table.require("mag")?;
+    let comp: Vec<f64> = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
+    let flag: Vec<f64> = interf.iter().map(|v| if v.is_finite() { 0.0 } else { 1.0 }).collect();
+    let missing = flag.iter().filter(|f| **f > 0.0).count();
+    table.add_column(interf_col, interf)?;
+    table.add_column("mag_comp", comp)?;
+    table.add_column(flag_col, flag)?;
+    Ok(missing)
+}

@@ -1,6 +1,7 @@
 //! `aeromag compensate`: apply a model file to flight data.
 
 use crate::exit::bad_input;
+use crate::flight::add_compensation;
 use crate::flight::TlColumns;
 use crate::input::InputArgs;
 use aeromag_compensation::model_file::TlModel;
@@ -58,19 +59,9 @@ pub fn model_interference(model: &TlModel, cols: &TlColumns) -> (Vec<f64>, usize
 /// Add `mag_interf`, `mag_comp`, `comp_flag` to a table; returns the number
 /// of rows that could not be compensated.
 pub fn compensate_table(model: &TlModel, table: &mut FlightTable) -> anyhow::Result<usize> {
-    for name in ["mag_interf", "mag_comp", "comp_flag"] {
-        if table.get(name).is_some() {
-            return Err(bad_input!("{}: already has a column `{name}`; rename it first", table.file_label()));
-        }
-    }
     let cols = TlColumns::from_table(table)?;
-    let (interf, missing) = model_interference(model, &cols);
-    let comp: Vec<f64> = cols.mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
-    let flag: Vec<f64> = interf.iter().map(|v| if v.is_finite() { 0.0 } else { 1.0 }).collect();
-    table.add_column("mag_interf", interf)?;
-    table.add_column("mag_comp", comp)?;
-    table.add_column("comp_flag", flag)?;
-    Ok(missing)
+    let (interf, _) = model_interference(model, &cols);
+    add_compensation(table, "mag_interf", "comp_flag", interf)
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

@@ -28,9 +28,10 @@
 //! pod_interf` (spec `helicopter.md` part B), reported as a fraction.
 
 use crate::commands::rotor_fit::{
-    add_compensation, numeric, parse_floats, sample_rate, usable_segments,
+    numeric, parse_floats, sample_rate, usable_segments,
 };
 use crate::exit::bad_input;
+use crate::flight::add_compensation;
 use crate::input::InputArgs;
 use crate::report_section::{Block, ReportSection};
 use aeromag_compensation::pod::{
@@ -636,7 +637,7 @@ fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     let mut t = a.input.load()?;
     let n = t.n_rows();
     let (interf, r) = apply_table(&model, &t)?;
-    let missing = add_compensation(&mut t, "pod", interf)?;
+    let missing = add_compensation(&mut t, "pod_interf", "pod_flag", interf)?;
     aeromag_io::write_csv(&t, &a.out)?;
     if missing > 0 {
         eprintln!(

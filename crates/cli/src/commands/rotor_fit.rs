@@ -22,6 +22,7 @@
 //! segment shorter than 10 s between gaps).
 
 use crate::exit::bad_input;
+use crate::flight::add_compensation;
 use crate::input::InputArgs;
 use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
 use aeromag_compensation::rotor::{
@@ -578,42 +579,13 @@ pub fn rotor_interference(model: &RotorModelFile, table: &FlightTable) -> anyhow
     Ok(out)
 }
 
-/// Add `<prefix>_interf`, `mag_comp` and `<prefix>_flag` to `table` from
-/// the modelled interference `interf` (NaN = not compensated); returns the
-/// number of rows not compensated. Bad input if a column exists already.
-pub(crate) fn add_compensation(
-    table: &mut FlightTable,
-    prefix: &str,
-    interf: Vec<f64>,
-) -> anyhow::Result<usize> {
-    let (ni, nf) = (format!("{prefix}_interf"), format!("{prefix}_flag"));
-    for name in [ni.as_str(), "mag_comp", nf.as_str()] {
-        if table.get(name).is_some() {
-            return Err(bad_input!(
-                "{}: already has a column `{name}`; rename it first",
-                table.file_label()
-            ));
-        }
-    }
-    let mag = table.require("mag")?;
-    let comp: Vec<f64> = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
-    let flag: Vec<f64> = interf
-        .iter()
-        .map(|v| if v.is_finite() { 0.0 } else { 1.0 })
-        .collect();
-    let missing = flag.iter().filter(|f| **f > 0.0).count();
-    table.add_column(&ni, interf)?;
-    table.add_column("mag_comp", comp)?;
-    table.add_column(&nf, flag)?;
-    Ok(missing)
-}
 
 pub fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     let model = load_model(&a.model)?;
     let mut table = a.input.load()?;
     let n = table.n_rows();
     let interf = rotor_interference(&model, &table)?;
-    let missing = add_compensation(&mut table, "rotor", interf)?;
+    let missing = add_compensation(&mut table, "rotor_interf", "rotor_flag", interf)?;
     aeromag_io::write_csv(&table, &a.out)?;
     if missing > 0 {
         eprintln!(
