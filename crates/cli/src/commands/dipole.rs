@@ -920,7 +920,7 @@ pub fn demo_gradiometry(quick: bool) -> anyhow::Result<(serde_json::Value, Optio
         "convergence_fraction_plain": plain,
         "trials": trials,
     });
-    let mut sec = ReportSection::new("Dipole parameters from gradiometers (issue 7)");
+    let mut sec = ReportSection::new("Dipole parameters from gradiometers (seed 004)");
     sec.blocks.push(Block::Paragraph(format!(
         "Monte-Carlo efficiency RMS/CRLB ({trials} trials per case, well-posed 20 m passes, tetrahedron of 1 m) of \
          the square-root IEKF with a windowed multi-start and re-linearised passes: worst {:.3} (tensor), {:.3} \

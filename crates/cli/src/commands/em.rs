@@ -144,7 +144,7 @@ fn section(
     s: &FlightStudy,
     curves: &ErrorCurves,
 ) -> anyhow::Result<ReportSection> {
-    let mut sec = ReportSection::new("EM relative positioning (issue 6)");
+    let mut sec = ReportSection::new("EM relative positioning of a towed bird (seed 001)");
     let hours: Vec<f64> = s.eval_time_s.iter().map(|t| t / 3600.0).collect();
     sec.blocks.push(Block::Paragraph(format!(
         "Simulated {:.1}-hour flight (seed {}), receiver gains and phases drifting; {} evaluation epochs of 0.16 s. \

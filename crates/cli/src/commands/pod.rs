@@ -722,7 +722,7 @@ type MethodRun = (PodMethod, Vec<HeadingRate>, Vec<HeadingRate>, Vec<f64>);
 
 fn pod_section(results: &[MethodRun], test: &FlightTable) -> anyhow::Result<ReportSection> {
     let mut sec =
-        ReportSection::new("Towed pod: compensation rate per heading (issue 5, seed 002)");
+        ReportSection::new("Towed pod: compensation rate per heading (seed 002)");
     sec.blocks.push(Block::Paragraph(
         "The seed's simulation (|B| = 55 000 nT, inclination 45°, gradients 5.91 / −25.91 nT/km, 100 m/s, \
          pitch, roll and yaw manoeuvres of 5° at 0.1 Hz, 20 Hz, 40 m cable at 70°, swing 5°): learned on the \

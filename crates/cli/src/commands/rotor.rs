@@ -187,7 +187,7 @@ fn before_after(s: &RotorStudy, t: &[f64], mag: &[f64]) -> anyhow::Result<Vec<Bl
 }
 
 fn section(s: &RotorStudy, t: &[f64], rotor: &[f64], mag: &[f64]) -> anyhow::Result<ReportSection> {
-    let mut sec = ReportSection::new("Helicopter rotor interference (issue 5)");
+    let mut sec = ReportSection::new("Helicopter rotor interference (seed 000, ch. 3)");
     sec.blocks.push(Block::Paragraph(format!(
         "Rotor interference {:.3} nT RMS at the sensor (f_r = {:.3} Hz), anomaly {:.3} nT RMS. The physical model \
          leaves {:.4} nT ({:.1} % of the rotor RMS); the best filter leaves {:.4} nT ({:.1}× the model's residual).",
