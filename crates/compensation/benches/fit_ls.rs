@@ -3,6 +3,9 @@
 //! Set AEROMAG_BENCH_N to change the length (default 10⁶ samples at 10 Hz).
 
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
+use aeromag_compensation::tolles_lawson::lag_select::{
+    select_eddy_lags, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
+};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// A long synthetic flight: the Earth's field seen from an aircraft that
@@ -37,6 +40,16 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("fit_band_pass_ls");
     g.sample_size(10);
     g.bench_function(format!("p3,i5,e8 n={n}"), |b| b.iter(|| fit_band_pass_ls(std::slice::from_ref(&seg), &cfg).unwrap()));
+    // `calibrate --eddy-lag auto`: the lag search on the row budget, then
+    // the final fit with the lags on every row.
+    g.bench_function(format!("auto eddy lags n={n}"), |b| {
+        b.iter(|| {
+            let sample = within_budget(std::slice::from_ref(&seg), DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
+            let sel = select_eddy_lags(&sample, &cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).unwrap();
+            let terms = cfg.terms.with_eddy_lags(&sel.taus_s).unwrap();
+            fit_band_pass_ls(std::slice::from_ref(&seg), &LsConfig { terms, ..cfg.clone() }).unwrap()
+        })
+    });
     g.finish();
 }
 

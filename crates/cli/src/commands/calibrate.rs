@@ -6,7 +6,9 @@ use aeromag_compensation::reference_field::LeverArm;
 use crate::input::InputArgs;
 use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
-use aeromag_compensation::tolles_lawson::lag_select::{select_eddy_lags, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S};
+use aeromag_compensation::tolles_lawson::lag_select::{
+    select_eddy_lags, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
+};
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
 use aeromag_compensation::kalman::{
     fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment,
@@ -32,7 +34,8 @@ use std::path::PathBuf;
 /// them significant (1 % false-selection probability); otherwise the
 /// classical model is kept. `none` keeps the classical model (MagNav.jl's,
 /// the default with --convention magnav); a list such as `0.3,0.8` fixes the
-/// lags. On large files `auto` costs ~18 fits: give the lags there.
+/// lags. `auto` runs about 15 extra fits on at most 200 000 rows (a longer
+/// record is sampled: blocks spread evenly over every leg).
 ///
 /// --lever-arm X,Y,Z: the scalar sensor's position from the navigation point
 /// (body frame, m); the `igrf` reference, computed at the navigation point,
@@ -204,7 +207,8 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
         EddyLag::Auto if !cfg.terms.has_eddy() => cfg,
         EddyLag::Auto => {
             let spinner = crate::progress::spinner("choosing eddy-current lags");
-            let sel = select_eddy_lags(&segments, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
+            let sample = within_budget(&segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
+            let sel = select_eddy_lags(&sample, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
                 .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
             spinner.finish_and_clear();
             let terms = cfg.terms.with_eddy_lags(&sel.taus_s).map_err(|e| bad_input!("--eddy-lag: {e}"))?;

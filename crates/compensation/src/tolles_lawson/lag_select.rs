@@ -84,9 +84,49 @@ fn rss(f: &LsFit) -> f64 {
 /// [`select_eddy_lags`].
 pub const DEFAULT_ALPHA: f64 = 0.01;
 
+/// Rows the selection fits at most (default budget): a calibration flight
+/// (10³–10⁵ rows) is used whole; a longer record is sampled
+/// ([`within_budget`]), so the ~15 selection fits cost what one fit of
+/// 3·10⁶ rows does, and the final fit still uses every row.
+pub const DEFAULT_SELECTION_ROWS: usize = 200_000;
+
+/// Length of the blocks [`within_budget`] samples, rows (default).
+pub const DEFAULT_SELECTION_BLOCK: usize = 3_000;
+
+/// At most about `max_rows` rows of `segments`: each segment gives the same
+/// fraction of its length, as blocks of about `block_rows` rows spread
+/// evenly over it (a calibration leg flies its manoeuvres one after the
+/// other, so a prefix would hold only the first). Each block is its own
+/// segment (filtered and trimmed on its own).
+pub fn within_budget<'a>(segments: &[Segment<'a>], max_rows: usize, block_rows: usize) -> Vec<Segment<'a>> {
+    let total: usize = segments.iter().map(|s| s.time.len()).sum();
+    if total <= max_rows {
+        return segments.to_vec();
+    }
+    let frac = max_rows as f64 / total as f64;
+    let mut out = Vec::new();
+    for s in segments {
+        let len = s.time.len();
+        let share = ((len as f64 * frac).ceil() as usize).min(len);
+        let blocks = share.div_ceil(block_rows.max(1)).max(1);
+        let blk = share / blocks;
+        for k in 0..blocks {
+            let a = if blocks > 1 { k * (len - blk) / (blocks - 1) } else { (len - blk) / 2 };
+            let r = a..a + blk;
+            out.push(Segment {
+                time: &s.time[r.clone()],
+                flux: [&s.flux[0][r.clone()], &s.flux[1][r.clone()], &s.flux[2][r.clone()]],
+                mag: &s.mag[r],
+            });
+        }
+    }
+    out
+}
+
 /// Choose up to `max_lags` lags from `grid_s` (s) for `cfg`'s term set (which
 /// must hold an eddy group; lagged groups already in it are replaced), each
-/// kept at the false-selection probability `alpha` (0 < α < 1).
+/// kept at the false-selection probability `alpha` (0 < α < 1). Pass
+/// [`within_budget`] segments to bound the cost on long records.
 pub fn select_eddy_lags(
     segments: &[Segment],
     cfg: &LsConfig,
@@ -177,6 +217,25 @@ mod tests {
         assert!(sel.taus_s.is_empty(), "{sel:?}");
         assert_eq!(sel.residual_rms_nt, sel.base_residual_rms_nt);
         assert!(sel.candidates.iter().all(|c| c.lr_statistic < c.threshold), "{sel:?}");
+    }
+
+    /// The budget samples every segment alike, and the lag is still found
+    /// from a third of the rows.
+    #[test]
+    fn a_row_budget_cuts_every_segment_alike() {
+        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
+        let coef: Vec<f64> = coef16().into_iter().chain(coef_lag9().into_iter().map(|c| 20.0 * c)).collect();
+        let legs = boxed(&truth, &coef);
+        let segs: Vec<Segment> = legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect();
+        // 4 legs of 1800 rows, a third of each: 4 blocks of 150 rows per leg,
+        // spread over the leg (first at its start, last at its end).
+        let cut = within_budget(&segs, 2400, 150);
+        assert_eq!(cut.len(), 16);
+        assert!(cut.iter().all(|s| s.time.len() == 150 && s.mag.len() == 150 && s.flux[2].len() == 150));
+        assert_eq!((cut[0].time[0], cut[3].time[149]), (segs[0].time[0], segs[0].time[1799]));
+        assert_eq!(within_budget(&segs, 10_000, 150).iter().map(|s| s.time.len()).sum::<usize>(), 7200);
+        let sel = select_eddy_lags(&cut, &LsConfig::default(), &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).unwrap();
+        assert!(sel.taus_s.contains(&0.5), "{sel:?}");
     }
 
     #[test]
