@@ -3,14 +3,14 @@
 //! compensate the independent 8 headings.
 
 use aeromag_compensation::pod::{
-    Cable, PodHeading, compensation_rate, default_source_points, direction_cosines,
-    fit_dipole_array, fit_joint, fit_two_step, pod_offset_ned, pod_position_exact,
-    pod_position_seed, predict_dipole_array, predict_dipole_array_raw, predict_joint,
-    predict_joint_raw, predict_small_signal, predict_small_signal_raw,
+    Cable, PodHeading, compensation_rate, compensation_rate_pooled, default_source_points,
+    direction_cosines, fit_dipole_array, fit_joint, fit_two_step, pod_offset_ned,
+    pod_position_exact, pod_position_seed, predict_dipole_array, predict_dipole_array_raw,
+    predict_joint, predict_joint_raw, predict_small_signal, predict_small_signal_raw,
 };
 use aeromag_core::frames::Attitude;
 use aeromag_sim::scenario::pod::{
-    LEARNING_HEADINGS_DEG, PodConfig, PodSegment, TEST_HEADINGS_DEG, simulate_pod,
+    LEARNING_HEADINGS_DEG, PodConfig, PodDipole, PodSegment, TEST_HEADINGS_DEG, simulate_pod,
 };
 
 #[derive(Clone, Copy, PartialEq)]
@@ -52,10 +52,13 @@ fn to_heading(cfg: &PodConfig, s: &PodSegment, traj: Trajectory) -> PodHeading {
     h
 }
 
+/// Per-test-heading rates and the pooled rate of the whole test set
+/// (`compensation_rate_pooled`) of each solve.
 struct Rates {
     two_step: Vec<f64>,
     joint: Vec<f64>,
     dipole: Vec<f64>,
+    pooled: [f64; 3],
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -91,7 +94,9 @@ fn run(cfg: &PodConfig, learn: &[f64], traj_two: Trajectory) -> Rates {
         two_step: vec![],
         joint: vec![],
         dipole: vec![],
+        pooled: [0.0; 3],
     };
+    let (mut hs2, mut hsj, mut preds) = (vec![], vec![], [vec![], vec![], vec![]]);
     for s in &ts {
         let h2 = to_heading(&tc, s, traj_two);
         let hj = to_heading(&tc, s, Trajectory::Exact);
@@ -101,9 +106,54 @@ fn run(cfg: &PodConfig, learn: &[f64], traj_two: Trajectory) -> Rates {
         r.joint.push(compensation_rate(&hj, &pj).unwrap());
         let pd = predict_dipole_array(&da, &hj).unwrap();
         r.dipole.push(compensation_rate(&hj, &pd).unwrap());
+        preds[0].push(p2);
+        preds[1].push(pj);
+        preds[2].push(pd);
+        hs2.push(h2);
+        hsj.push(hj);
     }
+    r.pooled = [
+        compensation_rate_pooled(&hs2, &preds[0]).unwrap(),
+        compensation_rate_pooled(&hsj, &preds[1]).unwrap(),
+        compensation_rate_pooled(&hsj, &preds[2]).unwrap(),
+    ];
     r
 }
+
+/// `cfg` with every eddy-current tensor of the dipole array times `f`.
+fn eddy_scaled(cfg: &PodConfig, f: f64) -> PodConfig {
+    PodConfig {
+        dipoles: cfg
+            .dipoles
+            .iter()
+            .map(|d| PodDipole {
+                eddy_am2_s_per_nt: d.eddy_am2_s_per_nt.map(|r| r.map(|x| x * f)),
+                ..d.clone()
+            })
+            .collect(),
+        ..cfg.clone()
+    }
+}
+
+/// RMS over the learning headings of the step-1 heading coefficients:
+/// `(rms(W3, W4) / rms(W1, W2)` in s, `rms(W5..7) / rms(W1, W2)` in 1/m).
+fn coefficient_ratios(cfg: &PodConfig) -> (f64, f64) {
+    let segs = simulate_pod(cfg).unwrap();
+    let hs: Vec<_> = segs
+        .iter()
+        .map(|s| to_heading(cfg, s, Trajectory::Seed))
+        .collect();
+    let ws = fit_two_step(&hs).unwrap().heading_coefficients;
+    let r = |i: std::ops::Range<usize>| {
+        let v: Vec<f64> = ws.iter().flat_map(|w| w[i.clone()].to_vec()).collect();
+        (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    (r(2..4) / r(0..2), r(4..7) / r(0..2))
+}
+
+/// The same two ratios of the seed's Table 1 (its 8 learning headings).
+const SEED_TABLE1_EDDY_RATIO_S: f64 = 0.2489;
+const SEED_TABLE1_GRADIENT_RATIO_PER_M: f64 = 0.0765;
 
 /// The seed's scenario (default [`PodConfig`]): the equivalent-dipole-array
 /// solve and the joint solve with the eddy-current gradient keep ≥ 97 % on
@@ -133,20 +183,86 @@ fn seed_scenario_two_step_and_dipole_array_joint_on_independent_headings() {
     assert!(mean(&r.two_step) >= 0.85, "two-step {:?}", r.two_step);
 }
 
+/// The seed's stated simulation conditions ([`PodConfig::seed_002`]: the
+/// defaults with the swing a 5° sinusoid), with our dipole array and with
+/// its eddy currents scaled so that the step-1 coefficients have the
+/// eddy-to-attitude ratio of the seed's Table 1. The improved solves keep
+/// ≥ 97 % on every independent heading in both. The seed's two-step solve
+/// stays below 90 % on its worst independent heading in both, and the
+/// reason is its first-order heading model, not step 2: fitted on a single
+/// learning heading and applied to that same heading (`fit_two_step` on one
+/// heading reproduces its 7 coefficients exactly), it already leaves more
+/// than 10 % on the worst heading.
+#[test]
+fn seed_002_conditions_two_step_is_limited_by_the_first_order_heading_model() {
+    let seed = PodConfig::seed_002();
+    let (eddy0, grad0) = coefficient_ratios(&seed);
+    let f = SEED_TABLE1_EDDY_RATIO_S / eddy0;
+    let scaled = eddy_scaled(&seed, f);
+    let (eddy1, grad1) = coefficient_ratios(&scaled);
+    println!(
+        "rms(W3,W4)/rms(W1,W2): seed Table 1 {SEED_TABLE1_EDDY_RATIO_S} s, ours {eddy0:.3} s, \
+         scaled ×{f:.4} {eddy1:.3} s; rms(W5..7)/rms(W1,W2): seed \
+         {SEED_TABLE1_GRADIENT_RATIO_PER_M} /m, ours {grad0:.4} /m, scaled {grad1:.4} /m"
+    );
+    assert!(
+        (eddy1 / SEED_TABLE1_EDDY_RATIO_S - 1.0).abs() < 0.1,
+        "{eddy1}"
+    );
+    for (name, cfg) in [("seed_002", &seed), ("seed_002 eddy scaled", &scaled)] {
+        let r = run(cfg, &LEARNING_HEADINGS_DEG, Trajectory::Seed);
+        // In-sample first-order limit: each learning heading alone.
+        let segs = simulate_pod(cfg).unwrap();
+        let own: Vec<f64> = segs
+            .iter()
+            .map(|s| {
+                let h = to_heading(cfg, s, Trajectory::Seed);
+                let one = fit_two_step(std::slice::from_ref(&h)).unwrap();
+                compensation_rate(&h, &predict_small_signal(&one.theta, &h).unwrap()).unwrap()
+            })
+            .collect();
+        println!(
+            "{name}: two-step test {:?} pooled {:.4}; own-heading first-order fit {own:?}; \
+             joint min {:.4} pooled {:.4}; dipole array min {:.4} pooled {:.4}",
+            r.two_step,
+            r.pooled[0],
+            min(&r.joint),
+            r.pooled[1],
+            min(&r.dipole),
+            r.pooled[2]
+        );
+        assert!(min(&r.joint) >= 0.97 && min(&r.dipole) >= 0.97, "{name}");
+        assert!(min(&own) < 0.90, "{name}: {own:?}");
+        assert!(
+            min(&r.two_step) < 0.90 && mean(&r.two_step) >= 0.85,
+            "{name}"
+        );
+    }
+}
+
 /// The degradation table of the module docs (`--nocapture` prints it).
 #[test]
 fn pod_degradation_table() {
     let base = PodConfig::default();
-    println!("| case | two-step min / mean % | joint θ min / mean % | dipole array min / mean % |");
+    println!(
+        "| case | two-step min / mean / pooled % | joint θ min / mean / pooled % | dipole array min / mean / pooled % |"
+    );
     println!("|---|---|---|---|");
     let row = |name: String, cfg: &PodConfig, learn: &[f64]| -> Rates {
         let r = run(cfg, learn, Trajectory::Seed);
-        let f = |v: &[f64]| format!("{:.1} / {:.1}", 100.0 * min(v), 100.0 * mean(v));
+        let f = |v: &[f64], p: f64| {
+            format!(
+                "{:.1} / {:.1} / {:.1}",
+                100.0 * min(v),
+                100.0 * mean(v),
+                100.0 * p
+            )
+        };
         println!(
             "| {name} | {} | {} | {} |",
-            f(&r.two_step),
-            f(&r.joint),
-            f(&r.dipole)
+            f(&r.two_step, r.pooled[0]),
+            f(&r.joint, r.pooled[1]),
+            f(&r.dipole, r.pooled[2])
         );
         r
     };
@@ -172,18 +288,23 @@ fn pod_degradation_table() {
     }
     // Diagnosis of the seed's solve: the same scenario without eddy
     // currents in the helicopter.
-    let no_eddy = PodConfig {
-        dipoles: base
-            .dipoles
-            .iter()
-            .map(|d| aeromag_sim::scenario::pod::PodDipole {
-                eddy_am2_s_per_nt: [[0.0; 3]; 3],
-                ..d.clone()
-            })
-            .collect(),
-        ..base.clone()
-    };
-    row("no eddy currents".into(), &no_eddy, &LEARNING_HEADINGS_DEG);
+    row(
+        "no eddy currents".into(),
+        &eddy_scaled(&base, 0.0),
+        &LEARNING_HEADINGS_DEG,
+    );
+    let seed = PodConfig::seed_002();
+    row(
+        "`PodConfig::seed_002()` (sine swing)".into(),
+        &seed,
+        &LEARNING_HEADINGS_DEG,
+    );
+    let f = SEED_TABLE1_EDDY_RATIO_S / coefficient_ratios(&seed).0;
+    row(
+        format!("seed_002, eddy × {f:.3} (Table 1 ratio)"),
+        &eddy_scaled(&seed, f),
+        &LEARNING_HEADINGS_DEG,
+    );
     for n in [4usize, 5, 6, 8] {
         row(
             format!("{n} learning headings"),

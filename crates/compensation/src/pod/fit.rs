@@ -367,6 +367,31 @@ pub fn compensation_rate(h: &PodHeading, pred: &[f64]) -> Result<f64> {
     Ok(1.0 - rms(&after) / before)
 }
 
+/// Compensation rate of a whole set of headings (the seed's §5 states one
+/// rate for its 8 independent headings, Fig. 7): `1 − √(Σ after² / Σ
+/// before²)` over all samples of all headings, `before` and `after` as in
+/// [`compensation_rate`] (each heading high-passed on its own). Headings
+/// with a large interference weigh more than in the per-heading minimum or
+/// mean. Errors: as [`compensation_rate`], count mismatch, no headings.
+pub fn compensation_rate_pooled(headings: &[PodHeading], preds: &[Vec<f64>]) -> Result<f64> {
+    if headings.is_empty() || headings.len() != preds.len() {
+        return Err(CompError::BadData(format!(
+            "pooled rate needs one prediction per heading ({} headings, {} predictions)",
+            headings.len(),
+            preds.len()
+        )));
+    }
+    let (mut before, mut after) = (0.0, 0.0);
+    for (h, pred) in headings.iter().zip(preds) {
+        let n = h.total_nt.len() as f64;
+        let b = rms(&detrend(&h.total_nt));
+        let r = compensation_rate(h, pred)?;
+        before += n * b * b;
+        after += n * (b * (1.0 - r)).powi(2);
+    }
+    Ok(1.0 - (after / before).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -377,6 +402,90 @@ mod tests {
         assert!(detrend(&x).iter().all(|v| v.abs() < 1e-12));
         let s: Vec<f64> = (0..50).map(|i| (i as f64 * 0.7).sin()).collect();
         assert!(rms(&detrend(&s)) > 0.5);
+    }
+
+    /// A level heading whose field is exactly the small-signal model of
+    /// `theta` (eq. 19 with `W = M(U) θ`): the seed's manoeuvres (5° at
+    /// 0.1 Hz, pitch, roll, yaw in turn) and a pod swinging by metres.
+    fn small_signal_heading(theta: &[f64], heading_deg: f64) -> PodHeading {
+        use super::super::trajectory::direction_cosines;
+        use aeromag_core::frames::Attitude;
+        let (n, dt) = (600, 0.05);
+        let psi0 = heading_deg.to_radians();
+        let mut h = PodHeading {
+            dt_s: dt,
+            total_nt: vec![0.0; n],
+            track_nt: vec![0.0; n],
+            ..PodHeading::default()
+        };
+        for k in 0..n {
+            let t = k as f64 * dt;
+            let a = 5f64.to_radians() * (0.2 * std::f64::consts::PI * t).sin();
+            let att = match k / 200 {
+                0 => Attitude::new(0.0, a, psi0),
+                1 => Attitude::new(a, 0.0, psi0),
+                _ => Attitude::new(0.0, 0.0, psi0 + a),
+            };
+            h.u.push(direction_cosines(45f64.to_radians(), 0.0, &att));
+            let w = 0.49 * t + psi0;
+            h.pod_body_m.push([
+                -13.7 + 3.0 * w.sin(),
+                1.2 * (0.31 * t).sin(),
+                38.8 + w.cos(),
+            ]);
+        }
+        let p = prepare(&h).unwrap();
+        let w = heading_coefficients(theta, &p.u0).unwrap();
+        let cols = small_signal_columns(&h, &p, false);
+        h.total_nt = (0..n)
+            .map(|k| (0..N_HEADING).map(|i| w[i] * cols[i][k]).sum())
+            .collect();
+        h
+    }
+
+    /// Implementation check of the seed's two-step solve: on data that are
+    /// exactly the small-signal model, step 1 recovers each heading's
+    /// `W1..W7` and step 2 maps them to parameters that give the true
+    /// heading coefficients and ≈ 100 % compensation on the seed's
+    /// independent headings (only the combinations of `θ` that level
+    /// flights observe are identified, and only those are needed).
+    #[test]
+    fn two_step_is_exact_on_small_signal_data() {
+        let theta: Vec<f64> = (0..N_PARAMS)
+            .map(|k| ((k * 37 % 11) as f64 - 5.0) * if k < 16 { 2.0 } else { 0.05 })
+            .collect();
+        let learn: Vec<PodHeading> = [0.0, 90.0, 180.0, 270.0, 45.0, 135.0, 225.0, 315.0]
+            .iter()
+            .map(|&d| small_signal_heading(&theta, d))
+            .collect();
+        let fit = fit_two_step(&learn).unwrap();
+        for (h, w) in learn.iter().zip(&fit.heading_coefficients) {
+            let truth = heading_coefficients(&theta, &prepare(h).unwrap().u0).unwrap();
+            for (a, b) in w.iter().zip(&truth) {
+                assert!((a - b).abs() < 1e-6 * (1.0 + b.abs()), "{w:?} {truth:?}");
+            }
+        }
+        for d in [30.0, 120.0, 210.0, 300.0, 70.0, 160.0, 250.0, 340.0] {
+            let h = small_signal_heading(&theta, d);
+            let u0 = prepare(&h).unwrap().u0;
+            let got = heading_coefficients(&fit.theta, &u0).unwrap();
+            let truth = heading_coefficients(&theta, &u0).unwrap();
+            for (a, b) in got.iter().zip(&truth) {
+                assert!(
+                    (a - b).abs() < 1e-6 * (1.0 + b.abs()),
+                    "{d}: {got:?} {truth:?}"
+                );
+            }
+            let pred = predict_small_signal(&fit.theta, &h).unwrap();
+            assert!(compensation_rate(&h, &pred).unwrap() > 0.9999);
+        }
+        // Pooled rate: a zero prediction leaves everything, a perfect one
+        // nothing; mismatched counts are errors.
+        let zero: Vec<Vec<f64>> = learn.iter().map(|h| vec![0.0; h.u.len()]).collect();
+        assert!(compensation_rate_pooled(&learn, &zero).unwrap().abs() < 1e-12);
+        let exact: Vec<Vec<f64>> = learn.iter().map(|h| detrend(&h.total_nt)).collect();
+        assert!((compensation_rate_pooled(&learn, &exact).unwrap() - 1.0).abs() < 1e-12);
+        assert!(compensation_rate_pooled(&learn, &exact[..3]).is_err());
     }
 
     #[test]
