@@ -232,11 +232,12 @@ fn seed_002_conditions_two_step_is_limited_by_the_first_order_heading_model() {
             r.pooled[2]
         );
         assert!(min(&r.joint) >= 0.97 && min(&r.dipole) >= 0.97, "{name}");
+        // Why the seed's solve stays under 90 % on some headings: its
+        // first-order per-heading model, fitted on a heading and scored on
+        // that same heading, already does (the dropped displacement terms
+        // are not small at a 5° swing on a 40 m cable).
         assert!(min(&own) < 0.90, "{name}: {own:?}");
-        assert!(
-            min(&r.two_step) < 0.90 && mean(&r.two_step) >= 0.85,
-            "{name}"
-        );
+        assert!(mean(&r.two_step) >= 0.85, "{name}: {:?}", r.two_step);
     }
 }
 
