@@ -117,11 +117,16 @@ fn model_and_argument_errors_exit_2() {
         vec!["calibrate", "--input", p, "--model", m, "--terms", "p3,i5", "--eddy-lag", "0.3"],
         vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "1,2"],
         vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "-9.5,0,-0.6", "--date", "2025-13-01"],
+        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,4e-4"],
+        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,1e-15,0"],
     ] {
         let o = aeromag(&args);
         assert_code(&o, 2);
     }
     assert_code(&aeromag(&["calibrate", "--input", p, "--model", m]), 0);
+    let o = aeromag(&["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "2e-15,1e-15,3e-4"]);
+    assert_code(&o, 0);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("q1 = 2.000e-15"), "{}", String::from_utf8_lossy(&o.stdout));
     // A model file that is not one.
     let junk = d.path().join("junk.json");
     std::fs::write(&junk, "{\"format\":\"other\"}").unwrap();

@@ -11,6 +11,7 @@ use aeromag_compensation::tolles_lawson::lag_select::{
 };
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
 use aeromag_compensation::kalman::{
+    NoiseModel,
     fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment,
 };
 use aeromag_io::FlightTable;
@@ -61,6 +62,12 @@ pub struct Args {
     /// likelihood of the innovations (otherwise the documented defaults).
     #[arg(long)]
     tune: bool,
+    /// With --method kalman: noise intensities Q1,Q2,R (q1, q2 in nT²/m⁵: the
+    /// spectral densities of d³B^h/ds³ and d²B_z/ds² along the path; r in nT²:
+    /// the measurement noise variance), e.g. from an earlier --tune. Default
+    /// 1e-15,1e-15,4e-4; with --tune, the starting point.
+    #[arg(long, value_name = "Q1,Q2,R")]
+    kalman_noise: Option<String>,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
     #[arg(long, default_value = "p3,i5,e8")]
     terms: String,
@@ -124,6 +131,15 @@ impl FitOptions {
     pub fn auto() -> Self {
         Self { eddy_lag: EddyLag::Auto, split_lines: true, reference: "auto".into(), lever_arm: None }
     }
+}
+
+/// `Q1,Q2,R` noise intensities of the Kalman method.
+fn parse_noise(s: &str) -> anyhow::Result<NoiseModel> {
+    let bad = || bad_input!("--kalman-noise `{s}`: expected Q1,Q2,R (q1, q2 ≥ 0 in nT²/m⁵, r > 0 in nT²)");
+    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+    let [q1, q2, r] = v.as_slice() else { return Err(bad()) };
+    let noise = NoiseModel { q1_nt2_per_m5: *q1, q2_nt2_per_m5: *q2, r_nt2: *r };
+    if noise.is_valid() { Ok(noise) } else { Err(bad()) }
 }
 
 /// A `YYYY-MM-DD` date as a decimal year.
@@ -353,6 +369,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let ls = config(&a)?;
             let mut cfg = KalmanConfig { terms: ls.terms, convention: ls.convention, bt_scale_nt: ls.bt_scale_nt, ..KalmanConfig::default() };
             cfg.tuning.enabled = a.tune;
+            if let Some(text) = &a.kalman_noise {
+                cfg.noise = parse_noise(text)?;
+            }
             let (model, fit) = fit_model_kalman(&table, &cfg, &opts)?;
             println!(
                 "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
