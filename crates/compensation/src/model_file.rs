@@ -13,6 +13,33 @@ use serde::{Deserialize, Serialize};
 /// The format tag of this version of the model file.
 pub const MODEL_FORMAT: &str = "aeromag-model/1";
 
+/// `kind` of a Tolles-Lawson model (both fitting methods).
+pub const TL_KIND: &str = "tolles-lawson";
+
+/// Parse a model file and check its `format` ([`MODEL_FORMAT`]) and `kind`
+/// (`writer` names the command that writes that kind, for the message).
+/// Every model file of aeromag (Tolles-Lawson, rotor, pod) goes through here.
+pub fn parse_model_json(text: &str, origin: &str, kind: &str, writer: &str) -> Result<serde_json::Value> {
+    let v: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| CompError::BadData(format!("{origin}: not a JSON model file ({e})")))?;
+    match v.get("format").and_then(|f| f.as_str()) {
+        Some(MODEL_FORMAT) => {}
+        Some(other) => {
+            return Err(CompError::BadData(format!(
+                "{origin}: model format `{other}` is not supported (expected `{MODEL_FORMAT}`)"
+            )));
+        }
+        None => return Err(CompError::BadData(format!("{origin}: no \"format\" key; not an aeromag model file"))),
+    }
+    match v.get("kind").and_then(|k| k.as_str()) {
+        Some(k) if k == kind => Ok(v),
+        found => Err(CompError::BadData(format!(
+            "{origin}: model kind `{}` is not a `{kind}` model (written by `{writer}`)",
+            found.unwrap_or("missing")
+        ))),
+    }
+}
+
 /// One named coefficient.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Coefficient {
@@ -101,17 +128,7 @@ impl TlModel {
 
     /// Parse and check a model file's text; `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
-        let v: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| CompError::BadData(format!("{origin}: not a JSON model file ({e})")))?;
-        match v.get("format").and_then(|f| f.as_str()) {
-            Some(MODEL_FORMAT) => {}
-            Some(other) => {
-                return Err(CompError::BadData(format!(
-                    "{origin}: model format `{other}` is not supported (expected `{MODEL_FORMAT}`)"
-                )));
-            }
-            None => return Err(CompError::BadData(format!("{origin}: no \"format\" key; not an aeromag model file"))),
-        }
+        let v = parse_model_json(text, origin, TL_KIND, "aeromag calibrate")?;
         let m: TlModel =
             serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
         m.terms.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
@@ -159,6 +176,20 @@ mod tests {
             lever_arm: None,
             software_version: "test".into(),
         }
+    }
+
+    #[test]
+    fn format_and_kind_are_checked() {
+        let rotor = r#"{"format":"aeromag-model/1","kind":"helicopter-rotor"}"#;
+        let e = TlModel::from_json(rotor, "r.json").unwrap_err().to_string();
+        assert!(e.contains("r.json") && e.contains("helicopter-rotor") && e.contains("aeromag calibrate"), "{e}");
+        assert!(parse_model_json(rotor, "r.json", "helicopter-rotor", "aeromag rotor fit").is_ok());
+        let e = parse_model_json(r#"{"format":"aeromag-model/9","kind":"x"}"#, "m", "x", "w").unwrap_err().to_string();
+        assert!(e.contains("aeromag-model/9"), "{e}");
+        assert!(parse_model_json(r#"{"kind":"x"}"#, "m", "x", "w").is_err());
+        assert!(parse_model_json("not json", "m", "x", "w").is_err());
+        let e = parse_model_json(r#"{"format":"aeromag-model/1"}"#, "m", "x", "w").unwrap_err().to_string();
+        assert!(e.contains("missing"), "{e}");
     }
 
     #[test]

@@ -4,7 +4,7 @@ use crate::exit::bad_input;
 use crate::flight::{parse_band, parse_lever_arm, reference_columns, reference_sum, TlColumns};
 use aeromag_compensation::reference_field::LeverArm;
 use crate::input::InputArgs;
-use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT};
+use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT, TL_KIND};
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::{
     select_eddy_lags, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
@@ -248,7 +248,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
     }
     Ok(TlModel {
         format: MODEL_FORMAT.into(),
-        kind: "tolles-lawson".into(),
+        kind: TL_KIND.into(),
         method: "ls".into(),
         terms: cfg.terms.clone(),
         convention: cfg.convention,

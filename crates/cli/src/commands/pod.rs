@@ -49,8 +49,7 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// Format tag of the model file.
-pub const MODEL_FORMAT: &str = "aeromag-model/1";
+use aeromag_compensation::model_file::{parse_model_json, MODEL_FORMAT};
 /// `kind` of a pod model file.
 pub const POD_KIND: &str = "towed-pod";
 /// Shortest heading processed, s.
@@ -538,16 +537,7 @@ pub fn load_model(path: &Path) -> anyhow::Result<PodModelFile> {
     let origin = path.display();
     let text = std::fs::read_to_string(path)
         .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| bad_input!("{origin}: not a JSON model file ({e})"))?;
-    if v.get("format").and_then(|f| f.as_str()) != Some(MODEL_FORMAT) {
-        return Err(bad_input!("{origin}: not an `{MODEL_FORMAT}` model file"));
-    }
-    if v.get("kind").and_then(|f| f.as_str()) != Some(POD_KIND) {
-        return Err(bad_input!(
-            "{origin}: not a pod model (`{POD_KIND}`, written by `aeromag pod fit`)"
-        ));
-    }
+    let v = parse_model_json(&text, &origin.to_string(), POD_KIND, "aeromag pod fit").map_err(|e| bad_input!("{e}"))?;
     let m: PodModelFile =
         serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid pod model: {e}"))?;
     if m.coefficients.len() != m.coefficient_names.len()

@@ -38,8 +38,7 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// Format tag of the model file (`data-formats.md`, "Model files").
-pub const MODEL_FORMAT: &str = "aeromag-model/1";
+use aeromag_compensation::model_file::{parse_model_json, MODEL_FORMAT};
 /// `kind` of a rotor model file.
 pub const ROTOR_KIND: &str = "helicopter-rotor";
 /// Shortest record processed between gaps, s.
@@ -497,18 +496,7 @@ pub fn load_model(path: &Path) -> anyhow::Result<RotorModelFile> {
     let origin = path.display();
     let text = std::fs::read_to_string(path)
         .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| bad_input!("{origin}: not a JSON model file ({e})"))?;
-    if v.get("format").and_then(|f| f.as_str()) != Some(MODEL_FORMAT) {
-        return Err(bad_input!("{origin}: not an `{MODEL_FORMAT}` model file"));
-    }
-    if v.get("kind").and_then(|f| f.as_str()) != Some(ROTOR_KIND) {
-        return Err(bad_input!(
-            "{origin}: model kind {} is not a rotor model (`{ROTOR_KIND}`, written by `aeromag rotor fit`)",
-            v.get("kind")
-                .map_or("missing".to_string(), |k| k.to_string())
-        ));
-    }
+    let v = parse_model_json(&text, &origin.to_string(), ROTOR_KIND, "aeromag rotor fit").map_err(|e| bad_input!("{e}"))?;
     let m: RotorModelFile =
         serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid rotor model: {e}"))?;
     m.geometry

@@ -586,7 +586,7 @@ impl KalmanFit {
     pub fn to_model(&self, cfg: &KalmanConfig) -> TlModel {
         TlModel {
             format: MODEL_FORMAT.into(),
-            kind: "tolles-lawson".into(),
+            kind: crate::model_file::TL_KIND.into(),
             method: "kalman".into(),
             terms: cfg.terms.clone(),
             convention: cfg.convention,
