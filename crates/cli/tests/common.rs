@@ -32,3 +32,18 @@ pub fn assert_code(o: &Output, code: i32) {
         stderr(o)
     );
 }
+
+/// `aeromag <family> apply --model MODEL --input INPUT --out OUT` (rotor,
+/// pod).
+pub fn apply(family: &str, model: &Path, input: &Path, out: &Path) -> Output {
+    aeromag(&[
+        family,
+        "apply",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}

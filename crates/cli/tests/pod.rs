@@ -115,16 +115,7 @@ fn fit_apply(d: &Path, learn: &Path, test: &Path, method: &str) -> std::path::Pa
     args.extend(SETUP);
     assert_code(&aeromag(&args), 0);
     let out = d.join(format!("{method}.csv"));
-    let o = aeromag(&[
-        "pod",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        test.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("pod", &model, &test, &out);
     assert_code(&o, 0);
     out
 }
@@ -191,16 +182,7 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     let gap = d.path().join("gap.csv");
     std::fs::write(&gap, edit(500, "mag", "")).unwrap();
     let out = d.path().join("out.csv");
-    let o = aeromag(&[
-        "pod",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        gap.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("pod", &model, &gap, &out);
     assert_code(&o, 0);
     let (h, rows) = read_csv(&out);
     assert_eq!(rows.len(), lines.len() - hdr - 1);
@@ -211,16 +193,7 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     // A cell that is not a number: exit 2 naming file, row and column.
     let bad = d.path().join("bad.csv");
     std::fs::write(&bad, edit(7, "cable_azimuth", "north")).unwrap();
-    let o = aeromag(&[
-        "pod",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        bad.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("pod", &model, &bad, &out);
     assert_code(&o, 2);
     let e = stderr(&o);
     assert!(
@@ -229,16 +202,7 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     );
     // A cable inclination outside (0, 90)°: exit 2 naming file, row and column.
     std::fs::write(&bad, edit(12, "cable_inclination", "95")).unwrap();
-    let o = aeromag(&[
-        "pod",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        bad.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("pod", &model, &bad, &out);
     assert_code(&o, 2);
     let e = stderr(&o);
     assert!(
@@ -251,15 +215,6 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
         "{\"format\": \"aeromag-model/1\", \"kind\": \"tolles-lawson\"}",
     )
     .unwrap();
-    let o = aeromag(&[
-        "pod",
-        "apply",
-        "--model",
-        bad.to_str().unwrap(),
-        "--input",
-        test.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("pod", &bad, &test, &out);
     assert_code(&o, 2);
 }

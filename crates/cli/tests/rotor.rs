@@ -121,16 +121,7 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
     assert_eq!(m["format"], "aeromag-model/1");
     assert_eq!(m["kind"], "helicopter-rotor");
     let out = d.path().join("out.csv");
-    let o = aeromag(&[
-        "rotor",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        other.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("rotor", &model, &other, &out);
     assert_code(&o, 0);
     let share = residual_share(&out);
     eprintln!(
@@ -152,16 +143,7 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
     };
     let gap = d.path().join("gap.csv");
     std::fs::write(&gap, edit(20_000, "")).unwrap();
-    let o = aeromag(&[
-        "rotor",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        gap.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("rotor", &model, &gap, &out);
     assert_code(&o, 0);
     let c = columns(&out, &["rotor_flag", "mag_comp", "rotor_interf"]);
     assert_eq!(c[0].len(), lines.len() - hdr - 1);
@@ -173,16 +155,7 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
     // model of another kind.
     let bad = d.path().join("bad.csv");
     std::fs::write(&bad, edit(77, "x1")).unwrap();
-    let o = aeromag(&[
-        "rotor",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        bad.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("rotor", &model, &bad, &out);
     assert_code(&o, 2);
     let e = stderr(&o);
     assert!(
@@ -205,16 +178,7 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
         "{\"format\": \"aeromag-model/1\", \"kind\": \"towed-pod\"}",
     )
     .unwrap();
-    let o = aeromag(&[
-        "rotor",
-        "apply",
-        "--model",
-        bad.to_str().unwrap(),
-        "--input",
-        other.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("rotor", &bad, &other, &out);
     assert_code(&o, 2);
 }
 
@@ -242,16 +206,7 @@ fn rotor_fit_without_a_phase_channel_estimates_the_phase() {
         stdout(&o)
     );
     let out = d.path().join("out.csv");
-    let o = aeromag(&[
-        "rotor",
-        "apply",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        other.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = apply("rotor", &model, &other, &out);
     assert_code(&o, 0);
     let share = residual_share(&out);
     eprintln!(
