@@ -397,8 +397,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         model.fit.residual_rms_nt,
         model.fit.condition
     );
-    if !cfg_terms.eddy_lags_s().is_empty() {
-        println!("eddy-current lags: {:?} s", cfg_terms.eddy_lags_s());
+    match cfg_terms.eddy_lags_s() {
+        [] => {}
+        [tau] => println!("eddy-current lag of the l_ terms: {tau} s"),
+        taus => println!(
+            "eddy-current lags: {}",
+            taus.iter().enumerate().map(|(k, t)| format!("l{}_ terms {t} s", k + 1)).collect::<Vec<_>>().join(", ")
+        ),
     }
     println!("{:<8} {:>14} {:>12}", "term", "coefficient", "std");
     for c in &model.coefficients {
