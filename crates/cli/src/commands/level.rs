@@ -46,6 +46,15 @@ pub struct Args {
     /// Ridge penalty on the offsets (and drifts).
     #[arg(long, default_value_t = 1e-3)]
     lambda: f64,
+    /// Known external-field channels subtracted from the value before the
+    /// crossovers are formed: `none` (default), `auto` (`diurnal` and `igrf`
+    /// when present) or a comma-separated list such as `diurnal`. With the
+    /// base station subtracted the micropulsations (0.1–1 nT at periods of
+    /// 10–300 s, which per-line offsets cannot follow) leave the crossovers,
+    /// and the d|B0|/dt coefficient k is determined far better. The levelled
+    /// column is then the reduced value, levelled.
+    #[arg(long, default_value = "none", value_name = "none|auto|COLS")]
+    reference: String,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -75,13 +84,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
         None => (lat, lon, alt),
     };
+    let ref_cols = crate::flight::reference_columns(&table, &a.reference)?;
+    let reference = crate::flight::reference_sum(&table, &ref_cols, None)?;
+    let value: Vec<f64> = table.require(&value_name)?.iter().zip(&reference).map(|(v, r)| v - r).collect();
+    if !ref_cols.is_empty() {
+        println!("levelling {value_name} − {}", ref_cols.join(" − "));
+    }
     let tracks = SurveyTracks {
         time: table.require("time")?,
         lat,
         lon,
         alt,
         line: table.require("line")?,
-        value: table.require(&value_name)?,
+        value: &value,
     };
     let cfg = LevellingConfig { estimate_k: !a.tie_only, drift: a.drift, lambda: a.lambda, ..LevellingConfig::default() };
     let spinner = crate::progress::spinner("levelling");
