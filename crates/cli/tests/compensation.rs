@@ -25,6 +25,11 @@ fn calibrate_compensate_report_keep_every_row() {
     assert!((1..=2).contains(&lags), "{}", m["terms"]);
     assert_eq!(m["coefficients"].as_array().unwrap().len(), 16 + 9 * lags);
     assert!(stderr(&o).contains("chosen (likelihood-ratio test)"), "{}", stderr(&o));
+    // The model file records the search: every candidate with Λ and its threshold.
+    let sel = &m["fit"]["eddy_lag_selection"];
+    let cands = sel["candidates"].as_array().expect("lag selection recorded");
+    assert!(cands.len() >= 7 && cands.iter().all(|c| c["lr_statistic"].is_number() && c["threshold"].is_number()), "{sel}");
+    assert_eq!(sel["taus_s"], m["terms"]["eddy_lags_s"]);
     let classical = d.path().join("m16.json");
     let o16 = aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", classical.to_str().unwrap(), "--eddy-lag", "none"]);
     assert_code(&o16, 0);

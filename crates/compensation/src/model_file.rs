@@ -66,6 +66,10 @@ pub struct FitStats {
     pub residual_rms_nt: f64,
     /// Warnings raised while fitting.
     pub warnings: Vec<String>,
+    /// How `--eddy-lag auto` chose the lags: every candidate with its
+    /// likelihood-ratio statistic and threshold (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eddy_lag_selection: Option<crate::tolles_lawson::lag_select::LagSelection>,
 }
 
 /// JSON has no ∞: `serde_json` writes it as `null`; read `null` back as ∞.

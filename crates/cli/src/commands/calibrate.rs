@@ -212,6 +212,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
         })
         .collect();
     let chosen;
+    let mut selection = None;
     let cfg = match lag {
         EddyLag::None if cfg.terms.eddy_lags_s().is_empty() => cfg,
         EddyLag::None | EddyLag::Fixed(_) => {
@@ -228,6 +229,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
                 .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
             spinner.finish_and_clear();
             let terms = cfg.terms.with_eddy_lags(&sel.taus_s).map_err(|e| bad_input!("--eddy-lag: {e}"))?;
+            selection = Some(sel.clone());
             if sel.taus_s.is_empty() {
                 eprintln!("note: eddy-current lags: no lag is significant; classical eddy terms kept");
             } else {
@@ -269,6 +271,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
             condition: fit.condition,
             residual_rms_nt: fit.residual_rms_nt,
             warnings: fit.warnings.clone(),
+            eddy_lag_selection: selection,
         },
         columns: ["time", "flux_x", "flux_y", "flux_z", "mag"]
             .iter()
@@ -297,10 +300,13 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
 pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit)> {
     let (lag, split_lines, reference) = (&opts.eddy_lag, opts.split_lines, opts.reference.as_str());
     // `auto` chooses the lags with the band-pass LS machinery.
+    let mut selection = None;
     let terms = match lag {
         EddyLag::Auto if cfg.terms.has_eddy() => {
             let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
-            fit_model(table, &ls, opts)?.terms
+            let ls_model = fit_model(table, &ls, opts)?;
+            selection = ls_model.fit.eddy_lag_selection;
+            ls_model.terms
         }
         EddyLag::Auto => cfg.terms.clone(),
         EddyLag::None => cfg.terms.with_eddy_lags(&[]).map_err(|e| bad_input!("--eddy-lag: {e}"))?,
@@ -336,6 +342,7 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     let mut model = fit.to_model(cfg);
     model.reference = ref_cols.clone();
     model.lever_arm = opts.lever_arm;
+    model.fit.eddy_lag_selection = selection;
     model.columns = ["time", "flux_x", "flux_y", "flux_z", "mag", "alt"]
         .iter()
         .map(|c| c.to_string())

@@ -611,6 +611,7 @@ impl KalmanFit {
                 condition: self.condition,
                 residual_rms_nt: self.model_residual(),
                 warnings: self.warnings.clone(),
+                eddy_lag_selection: None,
             },
             reference: Vec::new(),
             lever_arm: None,
