@@ -7,7 +7,7 @@ use crate::input::InputArgs;
 use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT, TL_KIND};
 use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::{
-    select_eddy_lags, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
+    select_eddy_lags, LagSelection, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
 };
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
 use aeromag_compensation::kalman::{
@@ -192,56 +192,17 @@ fn config(a: &Args) -> anyhow::Result<LsConfig> {
 
 /// Fit a model on a loaded calibration table; warnings go to stderr.
 pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyhow::Result<TlModel> {
-    let (lag, split_lines) = (&opts.eddy_lag, opts.split_lines);
     let cols = TlColumns::from_table(table)?;
-    let ref_cols = reference_columns(table, &opts.reference)?;
-    let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
-    let y: Vec<f64> = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
+    let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
     let cols = TlColumns { mag: &y, ..cols };
-    let (segs, _) = cols.segments(split_lines, 1);
+    let (segs, _) = cols.segments(opts.split_lines, 1);
     let left_out = cols.usable().iter().filter(|u| !**u).count();
     if left_out > 0 {
         eprintln!("warning: {} of {} rows have missing values and are not used by the fit", left_out, table.n_rows());
     }
-    let segments: Vec<Segment> = segs
-        .iter()
-        .map(|r| Segment {
-            time: &cols.time[r.clone()],
-            flux: [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]],
-            mag: &cols.mag[r.clone()],
-        })
-        .collect();
-    let chosen;
-    let mut selection = None;
-    let cfg = match lag {
-        EddyLag::None if cfg.terms.eddy_lags_s().is_empty() => cfg,
-        EddyLag::None | EddyLag::Fixed(_) => {
-            let taus = if let EddyLag::Fixed(t) = lag { t.as_slice() } else { &[] };
-            let terms = cfg.terms.with_eddy_lags(taus).map_err(|e| bad_input!("--eddy-lag: {e}"))?;
-            chosen = LsConfig { terms, ..cfg.clone() };
-            &chosen
-        }
-        EddyLag::Auto if !cfg.terms.has_eddy() => cfg,
-        EddyLag::Auto => {
-            let spinner = crate::progress::spinner("choosing eddy-current lags");
-            let sample = within_budget(&segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
-            let sel = select_eddy_lags(&sample, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
-                .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
-            spinner.finish_and_clear();
-            let terms = cfg.terms.with_eddy_lags(&sel.taus_s).map_err(|e| bad_input!("--eddy-lag: {e}"))?;
-            selection = Some(sel.clone());
-            if sel.taus_s.is_empty() {
-                eprintln!("note: eddy-current lags: no lag is significant; classical eddy terms kept");
-            } else {
-                eprintln!(
-                    "note: eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
-                    sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt
-                );
-            }
-            chosen = LsConfig { terms, ..cfg.clone() };
-            &chosen
-        }
-    };
+    let segments: Vec<Segment> = segs.iter().map(|r| segment(&cols, r.clone())).collect();
+    let (terms, selection) = choose_terms(table, &segments, cfg, &opts.eddy_lag)?;
+    let cfg = &LsConfig { terms, ..cfg.clone() };
     let spinner = crate::progress::spinner("fitting");
     let fit = fit_band_pass_ls(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     spinner.finish_and_clear();
@@ -273,19 +234,73 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
             warnings: fit.warnings.clone(),
             eddy_lag_selection: selection,
         },
-        columns: ["time", "flux_x", "flux_y", "flux_z", "mag"]
-            .iter()
-            .map(|c| c.to_string())
-            .chain(ref_cols.iter().cloned())
-            .map(|c| {
-                let file = table.resolve(&c).unwrap_or(&c).to_string();
-                (c, file)
-            })
-            .collect(),
+        columns: model_columns(table, &["time", "flux_x", "flux_y", "flux_z", "mag"], &ref_cols),
         reference: ref_cols,
         lever_arm: opts.lever_arm,
         software_version: env!("CARGO_PKG_VERSION").into(),
     })
+}
+
+/// The reference channels of `opts` and `mag` reduced by their sum.
+fn reduced_mag(table: &FlightTable, cols: &TlColumns, opts: &FitOptions) -> anyhow::Result<(Vec<String>, Vec<f64>)> {
+    let ref_cols = reference_columns(table, &opts.reference)?;
+    let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
+    let y = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
+    Ok((ref_cols, y))
+}
+
+/// The rows `r` of `cols` as a fitting segment.
+fn segment<'a>(cols: &TlColumns<'a>, r: std::ops::Range<usize>) -> Segment<'a> {
+    Segment {
+        time: &cols.time[r.clone()],
+        flux: [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]],
+        mag: &cols.mag[r],
+    }
+}
+
+/// Canonical column name → the file's column name, for the model file.
+fn model_columns(table: &FlightTable, base: &[&str], ref_cols: &[String]) -> std::collections::BTreeMap<String, String> {
+    base.iter()
+        .map(|c| c.to_string())
+        .chain(ref_cols.iter().cloned())
+        .map(|c| {
+            let file = table.resolve(&c).unwrap_or(&c).to_string();
+            (c, file)
+        })
+        .collect()
+}
+
+/// The term set with the eddy-current lags of `lag` (`auto`: chosen on
+/// `segments` by the band-pass LS likelihood-ratio search, on the row
+/// budget), and the search when one ran. Used by both fitting methods.
+fn choose_terms(
+    table: &FlightTable,
+    segments: &[Segment],
+    cfg: &LsConfig,
+    lag: &EddyLag,
+) -> anyhow::Result<(TermSet, Option<LagSelection>)> {
+    let with = |taus: &[f64]| cfg.terms.with_eddy_lags(taus).map_err(|e| bad_input!("--eddy-lag: {e}"));
+    match lag {
+        EddyLag::None => Ok((with(&[])?, None)),
+        EddyLag::Fixed(taus) => Ok((with(taus)?, None)),
+        EddyLag::Auto if !cfg.terms.has_eddy() => Ok((cfg.terms.clone(), None)),
+        EddyLag::Auto => {
+            let spinner = crate::progress::spinner("choosing eddy-current lags");
+            let sample = within_budget(segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
+            let sel = select_eddy_lags(&sample, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
+                .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+            spinner.finish_and_clear();
+            if sel.taus_s.is_empty() {
+                eprintln!("note: eddy-current lags: no lag is significant; classical eddy terms kept");
+            } else {
+                eprintln!(
+                    "note: eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
+                    sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt
+                );
+            }
+            Ok((with(&sel.taus_s)?, Some(sel)))
+        }
+    }
 }
 
 /// Ground speed (m/s) from `vn`, `ve` when present, else from the positions.
@@ -298,41 +313,21 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
 
 /// Fit a model with the Kalman method on a loaded calibration table.
 pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit)> {
-    let (lag, split_lines, reference) = (&opts.eddy_lag, opts.split_lines, opts.reference.as_str());
-    // `auto` chooses the lags with the band-pass LS machinery.
-    let mut selection = None;
-    let terms = match lag {
-        EddyLag::Auto if cfg.terms.has_eddy() => {
-            let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
-            let ls_model = fit_model(table, &ls, opts)?;
-            selection = ls_model.fit.eddy_lag_selection;
-            ls_model.terms
-        }
-        EddyLag::Auto => cfg.terms.clone(),
-        EddyLag::None => cfg.terms.with_eddy_lags(&[]).map_err(|e| bad_input!("--eddy-lag: {e}"))?,
-        EddyLag::Fixed(t) => cfg.terms.with_eddy_lags(t).map_err(|e| bad_input!("--eddy-lag: {e}"))?,
-    };
-    let cfg = &KalmanConfig { terms, ..cfg.clone() };
     let cols = TlColumns::from_table(table)?;
-    let ref_cols = reference_columns(table, reference)?;
-    let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
-    let y: Vec<f64> = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
+    let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
     let alt = table.require("alt")?;
     let speed = ground_speed(table)?;
     let cols = TlColumns { mag: &y, ..cols };
-    let (segs, _) = cols.segments(split_lines, 1);
+    let (segs, _) = cols.segments(opts.split_lines, 1);
     let segments: Vec<KalmanSegment> = segs
         .iter()
-        .map(|r| KalmanSegment {
-            data: Segment {
-                time: &cols.time[r.clone()],
-                flux: [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]],
-                mag: &cols.mag[r.clone()],
-            },
-            alt_m: &alt[r.clone()],
-            speed_m_s: &speed[r.clone()],
-        })
+        .map(|r| KalmanSegment { data: segment(&cols, r.clone()), alt_m: &alt[r.clone()], speed_m_s: &speed[r.clone()] })
         .collect();
+    // `auto` chooses the lags with the band-pass LS machinery on the same legs.
+    let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
+    let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
+    let (terms, selection) = choose_terms(table, &data, &ls, &opts.eddy_lag)?;
+    let cfg = &KalmanConfig { terms, ..cfg.clone() };
     let spinner = crate::progress::spinner("Kalman filter and smoother");
     let fit = fit_kalman(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     spinner.finish_and_clear();
@@ -340,18 +335,10 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
         eprintln!("warning: {w}");
     }
     let mut model = fit.to_model(cfg);
-    model.reference = ref_cols.clone();
+    model.columns = model_columns(table, &["time", "flux_x", "flux_y", "flux_z", "mag", "alt"], &ref_cols);
+    model.reference = ref_cols;
     model.lever_arm = opts.lever_arm;
     model.fit.eddy_lag_selection = selection;
-    model.columns = ["time", "flux_x", "flux_y", "flux_z", "mag", "alt"]
-        .iter()
-        .map(|c| c.to_string())
-        .chain(ref_cols)
-        .map(|c| {
-            let file = table.resolve(&c).unwrap_or(&c).to_string();
-            (c, file)
-        })
-        .collect();
     Ok((model, fit))
 }
 

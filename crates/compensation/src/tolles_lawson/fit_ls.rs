@@ -127,7 +127,8 @@ const BLOCK_TOLERANCE: f64 = 1e-15;
 
 /// Design the segment's columns, zero-phase filter every non-constant column
 /// and `y`, drop `trim` samples at each end, and hand the result to `sink`
-/// in blocks of at most `cfg.block_len` rows.
+/// in blocks of at most `cfg.block_len` rows (`dt_s`: the segment's median
+/// sampling interval, s).
 ///
 /// A segment longer than `block_len` is processed in overlapping blocks:
 /// each block is extended on both sides by the filter's settling length `P`
@@ -138,6 +139,7 @@ const BLOCK_TOLERANCE: f64 = 1e-15;
 /// segment's length.
 fn for_each_filtered_block(
     seg: &Segment,
+    dt_s: f64,
     cfg: &LsConfig,
     sos: Option<&Sos>,
     mut sink: impl FnMut(&[&[f64]], &[f64]) -> Result<()>,
@@ -150,12 +152,11 @@ fn for_each_filtered_block(
     };
     // The lagged eddy columns start at rest at each block's first sample:
     // their start-up transient must also have decayed inside the core.
-    let dt = median_step(seg.time);
     let lag_overlap = cfg
         .terms
         .eddy_lags_s()
         .iter()
-        .map(|&tau| FirstOrderLag::settling_samples(tau, dt, BLOCK_TOLERANCE))
+        .map(|&tau| FirstOrderLag::settling_samples(tau, dt_s, BLOCK_TOLERANCE))
         .max()
         .unwrap_or(0);
     let overlap = filter_overlap + lag_overlap;
@@ -213,7 +214,7 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
             warnings.push(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"));
             continue;
         }
-        for_each_filtered_block(seg, cfg, sos.as_ref(), |cols, y| {
+        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
             ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
         })?;
         used += 1;
