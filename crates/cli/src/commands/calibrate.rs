@@ -200,7 +200,7 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
     if left_out > 0 {
         eprintln!("warning: {} of {} rows have missing values and are not used by the fit", left_out, table.n_rows());
     }
-    let segments: Vec<Segment> = segs.iter().map(|r| segment(&cols, r.clone())).collect();
+    let segments: Vec<Segment> = segs.iter().map(|r| whole(&cols).slice(r.clone())).collect();
     let (terms, selection) = choose_terms(table, &segments, cfg, &opts.eddy_lag)?;
     let cfg = &LsConfig { terms, ..cfg.clone() };
     let spinner = crate::progress::spinner("fitting");
@@ -249,13 +249,9 @@ fn reduced_mag(table: &FlightTable, cols: &TlColumns, opts: &FitOptions) -> anyh
     Ok((ref_cols, y))
 }
 
-/// The rows `r` of `cols` as a fitting segment.
-fn segment<'a>(cols: &TlColumns<'a>, r: std::ops::Range<usize>) -> Segment<'a> {
-    Segment {
-        time: &cols.time[r.clone()],
-        flux: [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]],
-        mag: &cols.mag[r],
-    }
+/// All rows of `cols` as one fitting segment (to be sliced into legs).
+fn whole<'a>(cols: &TlColumns<'a>) -> Segment<'a> {
+    Segment { time: cols.time, flux: cols.flux, mag: cols.mag }
 }
 
 /// Canonical column name → the file's column name, for the model file.
@@ -321,7 +317,7 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     let (segs, _) = cols.segments(opts.split_lines, 1);
     let segments: Vec<KalmanSegment> = segs
         .iter()
-        .map(|r| KalmanSegment { data: segment(&cols, r.clone()), alt_m: &alt[r.clone()], speed_m_s: &speed[r.clone()] })
+        .map(|r| KalmanSegment { data: whole(&cols).slice(r.clone()), alt_m: &alt[r.clone()], speed_m_s: &speed[r.clone()] })
         .collect();
     // `auto` chooses the lags with the band-pass LS machinery on the same legs.
     let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();

@@ -93,6 +93,18 @@ pub struct Segment<'a> {
     pub mag: &'a [f64],
 }
 
+impl<'a> Segment<'a> {
+    /// The rows `r` of this segment (panics if `r` is out of its range,
+    /// like slicing).
+    pub fn slice(&self, r: std::ops::Range<usize>) -> Segment<'a> {
+        Segment {
+            time: &self.time[r.clone()],
+            flux: [&self.flux[0][r.clone()], &self.flux[1][r.clone()], &self.flux[2][r.clone()]],
+            mag: &self.mag[r],
+        }
+    }
+}
+
 /// Result of a fit.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct LsFit {
@@ -378,6 +390,11 @@ pub(crate) mod tests {
         (t, [fx, fy, fz], mag)
     }
 
+    /// Segments over synthetic legs.
+    pub(crate) fn segments_of(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> Vec<Segment<'_>> {
+        legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect()
+    }
+
     pub(crate) fn coef16() -> Vec<f64> {
         vec![30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0, 2.0, -1.5, 0.5, 1.0, -0.7, 0.3, 1.2, -0.4]
     }
@@ -389,7 +406,7 @@ pub(crate) mod tests {
         let legs: Vec<_> =
             [0.0, 90.0, 180.0, 270.0].iter().enumerate().map(|(k, h)| leg(*h, &coef, &terms, k as f64 * 1000.0, true)).collect();
         let segs: Vec<Segment> =
-            legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect();
+            segments_of(&legs);
         let fit = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
         assert_eq!(fit.segments_used, 4);
         // Compare the modelled interference (minus its mean) with the truth.
@@ -439,7 +456,7 @@ pub(crate) mod tests {
             .map(|(k, h)| leg_n(*h, &coef, &terms, k as f64 * 1000.0, true, 9000))
             .collect();
         let segs: Vec<Segment> =
-            legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect();
+            segments_of(&legs);
         let whole = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
         let blocked = fit_band_pass_ls(&segs, &LsConfig { block_len: 1000, ..LsConfig::default() }).unwrap();
         assert_eq!(whole.rows, blocked.rows);
@@ -452,7 +469,7 @@ pub(crate) mod tests {
     fn short_segments_are_skipped_with_a_warning_and_bad_config_rejected() {
         let terms = TermSet::observable16();
         let (t, f, m) = leg(0.0, &coef16(), &terms, 0.0, true);
-        let short = Segment { time: &t[..50], flux: [&f[0][..50], &f[1][..50], &f[2][..50]], mag: &m[..50] };
+        let short = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m }.slice(0..50);
         let e = fit_band_pass_ls(&[short], &LsConfig::default()).unwrap_err();
         assert!(e.to_string().contains("no segment"), "{e}");
         let cfg = LsConfig { band_hz: Some((0.9, 0.1)), ..LsConfig::default() };
