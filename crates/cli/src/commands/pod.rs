@@ -49,7 +49,7 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use aeromag_compensation::model_file::{parse_model_json, MODEL_FORMAT};
+use aeromag_compensation::model_file::MODEL_FORMAT;
 /// `kind` of a pod model file.
 pub const POD_KIND: &str = "towed-pod";
 /// Shortest heading processed, s.
@@ -535,9 +535,7 @@ pub fn apply_table(
 /// Read and check a pod model file.
 pub fn load_model(path: &Path) -> anyhow::Result<PodModelFile> {
     let origin = path.display();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
-    let v = parse_model_json(&text, &origin.to_string(), POD_KIND, "aeromag pod fit").map_err(|e| bad_input!("{e}"))?;
+    let v = crate::flight::read_model(path, POD_KIND, "aeromag pod fit")?;
     let m: PodModelFile =
         serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid pod model: {e}"))?;
     if m.coefficients.len() != m.coefficient_names.len()

@@ -38,7 +38,7 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use aeromag_compensation::model_file::{parse_model_json, MODEL_FORMAT};
+use aeromag_compensation::model_file::MODEL_FORMAT;
 /// `kind` of a rotor model file.
 pub const ROTOR_KIND: &str = "helicopter-rotor";
 /// Shortest record processed between gaps, s.
@@ -494,9 +494,7 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
 /// Read and check a rotor model file.
 pub fn load_model(path: &Path) -> anyhow::Result<RotorModelFile> {
     let origin = path.display();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
-    let v = parse_model_json(&text, &origin.to_string(), ROTOR_KIND, "aeromag rotor fit").map_err(|e| bad_input!("{e}"))?;
+    let v = crate::flight::read_model(path, ROTOR_KIND, "aeromag rotor fit")?;
     let m: RotorModelFile =
         serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid rotor model: {e}"))?;
     m.geometry
