@@ -148,12 +148,15 @@ pub enum IoError {
         hint: String,
     },
     /// A column is text where numbers are needed.
-    #[error("'{file}': column '{column}' holds text, but numbers are needed")]
+    #[error("'{file}': column '{column}' holds text, but numbers are needed{first}")]
     NotNumeric {
         /// File (or `"<in-memory table>"`).
         file: String,
         /// The column.
         column: String,
+        /// Where the first value that is not a number stands, e.g.
+        /// ` (data row 7, line 9: 'north')`; empty if unknown.
+        first: String,
     },
     /// `--columns` maps a canonical name onto a column the file does not have.
     #[error(

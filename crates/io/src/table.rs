@@ -200,6 +200,7 @@ impl FlightTable {
             Some(c) => c.values().ok_or_else(|| IoError::NotNumeric {
                 file: self.file_label(),
                 column: name.to_string(),
+                first: self.first_not_number(c),
             }),
             None => Err(IoError::MissingColumn {
                 file: self.file_label(),
@@ -258,6 +259,20 @@ impl FlightTable {
         let k = self.row_lines.partition_point(|(r, _)| *r <= row);
         let (r0, l0) = *self.row_lines.get(k.checked_sub(1)?)?;
         Some(l0 + (row - r0) as u64)
+    }
+
+    /// ` (data row R, line L: 'value')` for the first cell of a text column
+    /// that is neither a number nor a missing marker (the reader's rule),
+    /// data rows counted from 1; empty if there is none.
+    fn first_not_number(&self, c: &Column) -> String {
+        let Some(text) = c.text() else { return String::new() };
+        match text.iter().position(|v| crate::cell::parse_cell(v.as_bytes()).is_err()) {
+            Some(k) => {
+                let line = self.line_of_row(k).map_or(String::new(), |l| format!(", line {l}"));
+                format!(" (data row {}{line}: '{}')", k + 1, text[k])
+            }
+            None => String::new(),
+        }
     }
 
     fn check_len(&self, name: &str, len: usize) -> Result<()> {
@@ -355,6 +370,11 @@ mod tests {
         t.set_column("mag", vec![f64::NAN; 3]).unwrap();
         assert_eq!(t.missing("mag").unwrap().nan, 3);
         assert!(matches!(t.require("id"), Err(IoError::NotNumeric { .. })));
+        // The message points at the first value that is not a number;
+        // missing markers do not count.
+        t.add_text_column("az", vec!["".into(), "12.5".into(), "north".into()]).unwrap();
+        let e = t.require("az").unwrap_err().to_string();
+        assert!(e.contains("column 'az'") && e.contains("data row 3") && e.contains("'north'"), "{e}");
         assert_eq!(t.line_of_row(0), None);
     }
 

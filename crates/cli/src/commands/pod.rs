@@ -28,7 +28,7 @@
 //! pod_interf` (spec `helicopter.md` part B), reported as a fraction.
 
 use crate::commands::rotor_fit::{
-    numeric, parse_floats, sample_rate, usable_segments,
+    parse_floats, sample_rate, usable_segments,
 };
 use crate::exit::bad_input;
 use crate::flight::add_compensation;
@@ -308,23 +308,23 @@ fn headings(
     setup: &PodSetup,
     method: PodMethod,
 ) -> anyhow::Result<(Vec<Heading>, f64)> {
-    let time = numeric(t, "time")?;
-    let mag = numeric(t, "mag")?;
+    let time = t.require("time")?;
+    let mag = t.require("mag")?;
     let (roll, pitch, yaw) = (
-        numeric(t, "roll")?,
-        numeric(t, "pitch")?,
-        numeric(t, "yaw")?,
+        t.require("roll")?,
+        t.require("pitch")?,
+        t.require("yaw")?,
     );
     let (ci, ca) = (
-        numeric(t, "cable_inclination")?,
-        numeric(t, "cable_azimuth")?,
+        t.require("cable_inclination")?,
+        t.require("cable_azimuth")?,
     );
     check_range(t, "cable_inclination", ci, 0.0, 90.0)?;
     check_range(t, "roll", roll, -90.0, 90.0)?;
     check_range(t, "pitch", pitch, -90.0, 90.0)?;
     let track = setup.grad_north_nt_per_km != 0.0 || setup.grad_up_nt_per_km != 0.0;
     let (lat, alt) = if track {
-        (Some(numeric(t, "lat")?), Some(numeric(t, "alt")?))
+        (Some(t.require("lat")?), Some(t.require("alt")?))
     } else {
         (None, None)
     };

@@ -30,7 +30,7 @@ use aeromag_compensation::rotor::{
     align_phase_offset, estimate_phase, fit_slow_angles, refine_phase_offset, rotor_speed,
     track_slow_angles, unwrap_deg,
 };
-use aeromag_compensation::tolles_lawson::segments::split_segments;
+use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments};
 use aeromag_io::FlightTable;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -185,46 +185,14 @@ pub(crate) fn parse_floats(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<
     Ok(v)
 }
 
-/// Numeric column `name` of `t`; a text column is bad input naming the
-/// file, the first data row whose value is not a number, and the column.
-pub(crate) fn numeric<'a>(t: &'a FlightTable, name: &str) -> anyhow::Result<&'a [f64]> {
-    if let Some(text) = t.text_column(name) {
-        let missing = |v: &str| matches!(v.trim(), "" | "*" | "NaN" | "nan");
-        if let Some((k, v)) = text
-            .iter()
-            .enumerate()
-            .find(|(_, v)| !missing(v) && v.trim().parse::<f64>().is_err())
-        {
-            return Err(bad_input!(
-                "{}: data row {}, column {}: '{v}' is not a number",
-                t.file_label(),
-                k + 1,
-                t.resolve(name).unwrap_or(name)
-            ));
-        }
-    }
-    Ok(t.require(name)?)
-}
-
-/// Sample rate from the median time step, Hz (bad input if not positive).
+/// Sample rate from the median time step, Hz (bad input without two
+/// increasing time stamps).
 pub(crate) fn sample_rate(table: &FlightTable, time: &[f64]) -> anyhow::Result<f64> {
-    let mut d: Vec<f64> = time
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|x| x.is_finite())
-        .collect();
-    if d.is_empty() {
-        return Err(bad_input!(
-            "{}: fewer than two time samples",
-            table.file_label()
-        ));
-    }
-    d.sort_by(f64::total_cmp);
-    let dt = d[d.len() / 2];
+    let dt = median_step(time);
     if dt > 0.0 {
         Ok(1.0 / dt)
     } else {
-        Err(bad_input!("{}: time does not increase", table.file_label()))
+        Err(bad_input!("{}: fewer than two increasing time samples", table.file_label()))
     }
 }
 
@@ -255,14 +223,14 @@ struct RotorColumns<'a> {
 impl<'a> RotorColumns<'a> {
     fn from_table(t: &'a FlightTable, phase: Option<&str>) -> anyhow::Result<Self> {
         Ok(Self {
-            time: numeric(t, "time")?,
-            mag: numeric(t, "mag")?,
+            time: t.require("time")?,
+            mag: t.require("mag")?,
             flux: [
-                numeric(t, "flux_x")?,
-                numeric(t, "flux_y")?,
-                numeric(t, "flux_z")?,
+                t.require("flux_x")?,
+                t.require("flux_y")?,
+                t.require("flux_z")?,
             ],
-            phase: phase.map(|p| numeric(t, p)).transpose()?,
+            phase: phase.map(|p| t.require(p)).transpose()?,
         })
     }
 
