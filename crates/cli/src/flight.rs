@@ -64,14 +64,21 @@ pub fn reference_sum(table: &FlightTable, cols: &[String], lever: Option<&LeverA
     Ok(r)
 }
 
-/// A parsed `X,Y,Z` lever arm in metres (body frame).
-pub fn parse_lever_arm(s: &str) -> anyhow::Result<[f64; 3]> {
-    let bad = || bad_input!("--lever-arm `{s}`: expected three numbers X,Y,Z in metres (body frame: x forward, y right, z down)");
-    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|a| a.is_finite()) => Ok([*x, *y, *z]),
-        _ => Err(bad()),
+/// `n` comma-separated finite numbers given to option `flag`.
+pub fn parse_numbers(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> {
+    let bad = || bad_input!("{flag} `{s}`: expected {n} comma-separated finite numbers");
+    let v: Vec<f64> = s.split(',').map(|p| p.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+        return Err(bad());
     }
+    Ok(v)
+}
+
+/// A parsed `X,Y,Z` lever arm in metres (body frame: x forward, y right,
+/// z down).
+pub fn parse_lever_arm(s: &str) -> anyhow::Result<[f64; 3]> {
+    let v = parse_numbers("--lever-arm", s, 3)?;
+    Ok([v[0], v[1], v[2]])
 }
 
 impl<'a> TlColumns<'a> {

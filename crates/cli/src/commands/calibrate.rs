@@ -135,11 +135,13 @@ impl FitOptions {
 
 /// `Q1,Q2,R` noise intensities of the Kalman method.
 fn parse_noise(s: &str) -> anyhow::Result<NoiseModel> {
-    let bad = || bad_input!("--kalman-noise `{s}`: expected Q1,Q2,R (q1, q2 ≥ 0 in nT²/m⁵, r > 0 in nT²)");
-    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
-    let [q1, q2, r] = v.as_slice() else { return Err(bad()) };
-    let noise = NoiseModel { q1_nt2_per_m5: *q1, q2_nt2_per_m5: *q2, r_nt2: *r };
-    if noise.is_valid() { Ok(noise) } else { Err(bad()) }
+    let v = crate::flight::parse_numbers("--kalman-noise", s, 3)?;
+    let noise = NoiseModel { q1_nt2_per_m5: v[0], q2_nt2_per_m5: v[1], r_nt2: v[2] };
+    if noise.is_valid() {
+        Ok(noise)
+    } else {
+        Err(bad_input!("--kalman-noise `{s}`: need q1, q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)"))
+    }
 }
 
 /// A `YYYY-MM-DD` date as a decimal year.

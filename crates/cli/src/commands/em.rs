@@ -83,19 +83,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 /// Parse `NX,NY,NZ` (a non-zero half-space normal).
 fn parse_half_space(text: &str) -> anyhow::Result<nalgebra::Vector3<f64>> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| crate::exit::bad_input!("--half-space '{text}': {e}"))?;
-    match v.as_slice() {
-        &[x, y, z] if [x, y, z].iter().all(|c| c.is_finite()) && (x, y, z) != (0.0, 0.0, 0.0) => {
-            Ok(nalgebra::Vector3::new(x, y, z))
-        }
-        _ => Err(crate::exit::bad_input!(
-            "--half-space '{text}': expected three finite numbers NX,NY,NZ, not all zero"
-        )),
+    let n = nalgebra::Vector3::from_vec(crate::flight::parse_numbers("--half-space", text, 3)?);
+    if n == nalgebra::Vector3::zeros() {
+        return Err(crate::exit::bad_input!("--half-space '{text}': the normal NX,NY,NZ must not be zero"));
     }
+    Ok(n)
 }
 
 /// The `em.*` keys of `aeromag demo`'s summary (data-formats.md).

@@ -27,11 +27,9 @@
 //! RMS(before)` of the detrended (high-passed) series, `after = mag − s3 −
 //! pod_interf` (spec `helicopter.md` part B), reported as a fraction.
 
-use crate::commands::rotor_fit::{
-    parse_floats, sample_rate, usable_segments,
-};
+use crate::commands::rotor_fit::{sample_rate, usable_segments};
 use crate::exit::bad_input;
-use crate::flight::add_compensation;
+use crate::flight::{add_compensation, parse_numbers};
 use crate::input::InputArgs;
 use crate::report_section::{Block, ReportSection};
 use aeromag_compensation::pod::{
@@ -585,7 +583,7 @@ fn print_rates(label: &str, r: &[HeadingRate]) {
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<()> {
-    let attach = parse_floats("--attach-m", &a.attach_m, 3)?;
+    let attach = parse_numbers("--attach-m", &a.attach_m, 3)?;
     let setup = PodSetup {
         cable_length_m: a.cable_length_m,
         attach_m: [attach[0], attach[1], attach[2]],
@@ -600,7 +598,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|s| {
             s.split(';')
-                .map(|p| parse_floats("--source-points", p, 3).map(|v| [v[0], v[1], v[2]]))
+                .map(|p| parse_numbers("--source-points", p, 3).map(|v| [v[0], v[1], v[2]]))
                 .collect::<anyhow::Result<Vec<[f64; 3]>>>()
         })
         .transpose()?;

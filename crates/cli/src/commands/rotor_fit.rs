@@ -22,7 +22,7 @@
 //! segment shorter than 10 s between gaps).
 
 use crate::exit::bad_input;
-use crate::flight::add_compensation;
+use crate::flight::{add_compensation, parse_numbers};
 use crate::input::InputArgs;
 use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
 use aeromag_compensation::rotor::{
@@ -170,21 +170,6 @@ pub struct RotorModelFile {
     pub software_version: String,
 }
 
-/// Parse `n` comma-separated numbers of option `flag`.
-pub(crate) fn parse_floats(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| bad_input!("{flag} `{s}`: expected {n} comma-separated numbers"))?;
-    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
-        return Err(bad_input!(
-            "{flag} `{s}`: expected {n} comma-separated finite numbers"
-        ));
-    }
-    Ok(v)
-}
-
 /// Sample rate from the median time step, Hz (bad input without two
 /// increasing time stamps).
 pub(crate) fn sample_rate(table: &FlightTable, time: &[f64]) -> anyhow::Result<f64> {
@@ -305,17 +290,17 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     let hub = a
         .hub_m
         .as_deref()
-        .map(|s| parse_floats("--hub-m", s, 3))
+        .map(|s| parse_numbers("--hub-m", s, 3))
         .transpose()?;
     let sensor = a
         .sensor_m
         .as_deref()
-        .map(|s| parse_floats("--sensor-m", s, 3))
+        .map(|s| parse_numbers("--sensor-m", s, 3))
         .transpose()?;
     let span = a
         .blade_span_m
         .as_deref()
-        .map(|s| parse_floats("--blade-span-m", s, 2))
+        .map(|s| parse_numbers("--blade-span-m", s, 2))
         .transpose()?;
     let geom = RotorGeometry {
         hub_m: hub.map_or(base.hub_m, |v| [v[0], v[1], v[2]]),
@@ -331,7 +316,7 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
         tilt_lon_rad: a.tilt_lon_deg.map_or(nom.tilt_lon_rad, f64::to_radians),
         tilt_lat_rad: nom.tilt_lat_rad,
     };
-    let band = parse_floats("--rotor-hz", &a.rotor_hz, 2)?;
+    let band = parse_numbers("--rotor-hz", &a.rotor_hz, 2)?;
     if !(band[0] > 0.0 && band[1] > band[0]) {
         return Err(bad_input!("--rotor-hz {}: need 0 < LO < HI", a.rotor_hz));
     }
