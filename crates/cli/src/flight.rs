@@ -114,14 +114,9 @@ impl<'a> TlColumns<'a> {
 
 /// A parsed `LO,HI` pass band in Hz.
 pub fn parse_band(s: &str) -> anyhow::Result<(f64, f64)> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let bad = || bad_input!("--band `{s}`: expected LO,HI in Hz, e.g. 0.1,0.9");
-    if parts.len() != 2 {
-        return Err(bad());
-    }
-    let lo: f64 = parts[0].parse().map_err(|_| bad())?;
-    let hi: f64 = parts[1].parse().map_err(|_| bad())?;
-    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+    let v = parse_numbers("--band", s, 2)?;
+    let (lo, hi) = (v[0], v[1]);
+    if !(lo > 0.0 && hi > lo) {
         return Err(bad_input!("--band {lo},{hi}: need 0 < LO < HI"));
     }
     Ok((lo, hi))
