@@ -24,9 +24,10 @@
 //! (ties broken by order). The candidates do not depend on the start, so
 //! they are run once per data set and shared by every start of the map.
 //!
-//! Parallel over threads with `std::thread::scope`; each start is
+//! Parallel over threads ([`crate::parallel::parallel_map`]); each start is
 //! independent, so the map is identical for any thread count.
 
+use crate::parallel::parallel_map;
 use crate::error::{GradiometryError, Result, positive};
 use crate::forward::{Background, Forward, TensorForward};
 use crate::geometry::{Geometry, Layout};
@@ -334,38 +335,19 @@ pub fn convergence_map(
         }
     };
     let n = case.grid_n;
-    let total = n * n * n;
-    let threads = threads.max(1);
-    let chunk = total.div_ceil(threads);
-    let mut outcomes = vec![
+    let outcomes = parallel_map(n * n * n, threads, |idx| {
+        let s = case.start(idx % n, (idx / n) % n, idx / (n * n));
+        let mut run = run_from(case, &model, &z, &s);
+        if let Some(b) = best_candidate
+            && b.residual < run.residual
+        {
+            run = b;
+        }
+        let pos = run.x.fixed_rows::<3>(0).into_owned();
+        let ok = run.reached && (pos - case.position_m).norm() <= case.tolerance_m;
         StartOutcome {
-            iterations: 0,
-            converged: false
-        };
-        total
-    ];
-    std::thread::scope(|scope| {
-        for (c, out) in outcomes.chunks_mut(chunk).enumerate() {
-            let model = &model;
-            let z = &z;
-            scope.spawn(move || {
-                for (off, o) in out.iter_mut().enumerate() {
-                    let idx = c * chunk + off;
-                    let s = case.start(idx % n, (idx / n) % n, idx / (n * n));
-                    let mut run = run_from(case, model, z, &s);
-                    if let Some(b) = best_candidate
-                        && b.residual < run.residual
-                    {
-                        run = b;
-                    }
-                    let pos = run.x.fixed_rows::<3>(0).into_owned();
-                    let ok = run.reached && (pos - case.position_m).norm() <= case.tolerance_m;
-                    *o = StartOutcome {
-                        iterations: run.iterations,
-                        converged: ok,
-                    };
-                }
-            });
+            iterations: run.iterations,
+            converged: ok,
         }
     });
     Ok(ConvergenceMap { n, outcomes })

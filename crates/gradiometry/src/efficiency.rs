@@ -22,6 +22,7 @@
 //! seeded, and the errors are reduced in trial order, so the result is
 //! bit-identical for any thread count.
 
+use crate::parallel::parallel_map;
 use crate::crlb::{crlb, efficiency};
 use crate::error::{GradiometryError, Result};
 use crate::forward::Forward;
@@ -218,35 +219,10 @@ fn monte_carlo_n<const N: usize>(
     threads: usize,
 ) -> Result<Vec<SVector<f64, N>>> {
     let processing = deterministic_processing();
-    let threads = threads.clamp(1, trials.max(1));
-    let chunk = trials.div_ceil(threads).max(1);
-    let seeds: Vec<u64> = (0..trials as u64).map(|k| first_seed + k).collect();
-    let results: Vec<Result<Vec<SVector<f64, N>>>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = seeds
-            .chunks(chunk)
-            .map(|part| {
-                let processing = &processing;
-                scope.spawn(move || {
-                    part.iter()
-                        .map(|&seed| trial_error::<N>(base, gradiometer, processing, cfg, seed))
-                        .collect::<Result<Vec<_>>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join().unwrap_or(Err(GradiometryError::NotFinite {
-                    name: "Monte-Carlo worker",
-                }))
-            })
-            .collect()
+    let results = parallel_map(trials, threads, |k| {
+        trial_error::<N>(base, gradiometer, &processing, cfg, first_seed + k as u64)
     });
-    let mut errors = Vec::with_capacity(trials);
-    for r in results {
-        errors.extend(r?);
-    }
-    Ok(errors)
+    results.into_iter().collect()
 }
 
 fn summarise<const N: usize>(

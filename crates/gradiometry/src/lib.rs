@@ -32,6 +32,7 @@ pub mod efficiency;
 pub mod estimability;
 pub mod locate;
 pub mod motion;
+pub mod parallel;
 pub mod pass;
 pub mod sim;
 pub mod sr_iekf;

@@ -1,0 +1,39 @@
+//! Index-parallel map over scoped threads, for the convergence map and the
+//! Monte-Carlo efficiency.
+//!
+//! Item `i` is always computed by `f(i)` and stored at position `i`, so the
+//! result does not depend on the number of threads (the chunks only decide
+//! which thread computes what).
+
+/// `[f(0), f(1), …, f(n − 1)]`, computed on up to `threads` threads (≥ 1) in
+/// contiguous chunks.
+pub fn parallel_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = threads.clamp(1, n.max(1));
+    let chunk = n.div_ceil(threads).max(1);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..n)
+            .step_by(chunk)
+            .map(|start| scope.spawn(move || (start..(start + chunk).min(n)).map(f).collect::<Vec<T>>()))
+            .collect();
+        // A worker only panics if `f` does; pass that panic on.
+        handles.into_iter().flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p))).collect()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn same_result_for_any_thread_count() {
+        let f = |i: usize| (i as f64).sqrt() * 3.0;
+        let one = parallel_map(1001, 1, f);
+        assert_eq!(one.len(), 1001);
+        for t in [2, 3, 7, 64, 5000] {
+            assert_eq!(parallel_map(1001, t, f), one);
+        }
+        assert!(parallel_map(0, 4, f).is_empty());
+        assert_eq!(parallel_map(1, 0, f), vec![0.0]);
+    }
+}
