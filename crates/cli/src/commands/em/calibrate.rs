@@ -2,7 +2,7 @@
 //! vectors and a KNOWN file.
 
 use super::files::{at, finite_column, load_table, read_detected, read_system};
-use super::parse_half_space;
+use super::HalfSpaceArg;
 use crate::exit::bad_input;
 use aeromag_core::frames::Attitude;
 use aeromag_em::calibration::{Calibration, CalibrationFile, FitCounts, KnownPoints};
@@ -61,15 +61,8 @@ pub struct CalibrateArgs {
     /// Calibration file to write (JSON).
     #[arg(long, value_name = "CAL.json")]
     out: PathBuf,
-    /// Prior half-space normal (transmitter frame) for the ±r choice when
-    /// locating the attitude point: the bird is where r·n > 0.
-    #[arg(
-        long,
-        value_name = "NX,NY,NZ",
-        default_value = "-1,0,1",
-        allow_hyphen_values = true
-    )]
-    half_space: String,
+    #[command(flatten)]
+    half_space: HalfSpaceArg,
 }
 
 /// Parse KNOWN.csv against the detected epochs' times.
@@ -179,7 +172,7 @@ fn known_points(t: &FlightTable, epochs: &[FieldEpoch]) -> anyhow::Result<KnownP
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
-    let normal = parse_half_space(&a.half_space)?;
+    let normal = a.half_space.normal()?;
     let system = read_system(&a.system)?;
     let epochs = read_detected(&a.input)?;
     if epochs.len() < 8 {

@@ -1,7 +1,7 @@
 //! `aeromag em locate`: calibrated per-epoch pose of the bird.
 
 use super::files::read_detected;
-use super::parse_half_space;
+use super::HalfSpaceArg;
 use crate::exit::bad_input;
 use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::positioning::Hemisphere;
@@ -43,19 +43,12 @@ pub struct LocateArgs {
     /// Pose CSV to write.
     #[arg(long, value_name = "POSES.csv")]
     out: PathBuf,
-    /// Prior half-space normal (transmitter frame): the bird is where r·n > 0
-    /// (default: behind and below, x forward, z down).
-    #[arg(
-        long,
-        value_name = "NX,NY,NZ",
-        default_value = "-1,0,1",
-        allow_hyphen_values = true
-    )]
-    half_space: String,
+    #[command(flatten)]
+    half_space: HalfSpaceArg,
 }
 
 pub fn run(a: LocateArgs) -> anyhow::Result<()> {
-    let normal = parse_half_space(&a.half_space)?;
+    let normal = a.half_space.normal()?;
     let text = std::fs::read_to_string(&a.calibration)
         .map_err(|e| bad_input!("cannot read '{}': {e}", a.calibration.display()))?;
     let file = CalibrationFile::from_json(&text)
