@@ -15,6 +15,7 @@
 use super::crossovers::{CrossoverSet, find_crossovers};
 use super::fit::{LevellingConfig, LevellingFit, fit_levelling};
 use super::tracks::{SurveyTracks, TrackConfig, bad, track_derivative};
+use super::vertical_gradient::profile_gradient;
 use crate::error::Result;
 use serde::{Deserialize, Serialize};
 
@@ -102,7 +103,12 @@ pub fn level_survey(
     fit: &LevellingConfig,
 ) -> Result<SurveyLevelling> {
     let derivative_nt_per_s = track_derivative(tracks, track)?;
-    let crossovers = find_crossovers(tracks, &derivative_nt_per_s, track)?;
+    let gradient = if fit.altitude_term {
+        Some(profile_gradient(tracks, track)?)
+    } else {
+        None
+    };
+    let crossovers = find_crossovers(tracks, &derivative_nt_per_s, gradient.as_deref(), track)?;
     let fit = fit_levelling(&crossovers.crossovers, fit)?;
     let levelled = apply_levelling(&fit, tracks, &derivative_nt_per_s)?;
     Ok(SurveyLevelling {

@@ -59,6 +59,14 @@ pub struct CrossoverSide {
     pub derivative_nt_per_s: f64,
     /// Interpolated altitude, m (NaN if unknown).
     pub alt_m: f64,
+    /// Interpolated profile operator `S = F⁻¹[|κ_s| B̂]` of this line, nT/m
+    /// ([`super::vertical_gradient`]); NaN if not computed.
+    #[serde(default = "nan")]
+    pub profile_gradient_nt_per_m: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// A crossover of two lines.
@@ -117,10 +125,13 @@ struct Edge {
 
 /// Find the crossovers of `tracks` (module docs). `derivative` is the
 /// along-track derivative of `tracks.value` (nT/s, one per row, normally
-/// from [`super::track_derivative`]).
+/// from [`super::track_derivative`]); `profile_gradient`, if given, the
+/// profile operator of [`super::profile_gradient`] (nT/m, one per row),
+/// interpolated like the other channels (NaN sides where it is missing).
 pub fn find_crossovers(
     tracks: &SurveyTracks,
     derivative: &[f64],
+    profile_gradient: Option<&[f64]>,
     cfg: &TrackConfig,
 ) -> Result<CrossoverSet> {
     tracks.validate()?;
@@ -129,6 +140,15 @@ pub fn find_crossovers(
         return Err(bad(format!(
             "derivative has {} rows, the tracks {}",
             derivative.len(),
+            tracks.len()
+        )));
+    }
+    if let Some(g) = profile_gradient
+        && g.len() != tracks.len()
+    {
+        return Err(bad(format!(
+            "profile gradient has {} rows, the tracks {}",
+            g.len(),
             tracks.len()
         )));
     }
@@ -278,8 +298,8 @@ pub fn find_crossovers(
                     None
                 };
                 let (sa, sb) = (
-                    side(tracks, derivative, e, s),
-                    side(tracks, derivative, f, u),
+                    side(tracks, derivative, profile_gradient, e, s),
+                    side(tracks, derivative, profile_gradient, f, u),
                 );
                 let (a, b) = if e.label < f.label {
                     (sa, sb)
@@ -354,7 +374,13 @@ fn intersect(e: &Edge, f: &Edge) -> Option<(f64, f64)> {
     (inside(s) && inside(u)).then_some((s, u))
 }
 
-fn side(tracks: &SurveyTracks, derivative: &[f64], e: &Edge, s: f64) -> CrossoverSide {
+fn side(
+    tracks: &SurveyTracks,
+    derivative: &[f64],
+    profile_gradient: Option<&[f64]>,
+    e: &Edge,
+    s: f64,
+) -> CrossoverSide {
     let lerp = |x: &[f64]| x[e.i] + s * (x[e.j] - x[e.i]);
     CrossoverSide {
         label: e.label,
@@ -364,6 +390,7 @@ fn side(tracks: &SurveyTracks, derivative: &[f64], e: &Edge, s: f64) -> Crossove
         value_nt: lerp(tracks.value),
         derivative_nt_per_s: lerp(derivative),
         alt_m: lerp(tracks.alt),
+        profile_gradient_nt_per_m: profile_gradient.map_or(f64::NAN, lerp),
     }
 }
 
@@ -457,7 +484,7 @@ pub(crate) mod tests {
         let b = block(7, 4, 200.0, 9.0);
         let cfg = TrackConfig::default();
         let d = track_derivative(&b.tracks(), &cfg).unwrap();
-        let set = find_crossovers(&b.tracks(), &d, &cfg).unwrap();
+        let set = find_crossovers(&b.tracks(), &d, None, &cfg).unwrap();
         assert_eq!(set.crossovers.len(), 28);
         assert_eq!(
             (set.skipped_gap, set.skipped_missing, set.skipped_shallow),
@@ -507,7 +534,7 @@ pub(crate) mod tests {
             }
         }
         let d = track_derivative(&b.tracks(), &cfg).unwrap();
-        let set = find_crossovers(&b.tracks(), &d, &cfg).unwrap();
+        let set = find_crossovers(&b.tracks(), &d, None, &cfg).unwrap();
         assert_eq!(set.skipped_gap, 1);
         assert_eq!(set.skipped_missing, 1);
         assert_eq!(set.crossovers.len(), 4);
@@ -518,7 +545,7 @@ pub(crate) mod tests {
         let b = block(5, 0, 100.0, 5.0);
         let d = track_derivative(&b.tracks(), &TrackConfig::default()).unwrap();
         // The turn rows (label 0, at the origin) must not form edges.
-        let set = find_crossovers(&b.tracks(), &d, &TrackConfig::default()).unwrap();
+        let set = find_crossovers(&b.tracks(), &d, None, &TrackConfig::default()).unwrap();
         assert!(set.crossovers.is_empty());
         assert_eq!(
             set.skipped_gap + set.skipped_missing + set.skipped_shallow,
@@ -561,7 +588,7 @@ pub(crate) mod tests {
         };
         // Time steps of line 2 equal those of line 1: no gap.
         let d = vec![0.0; rows.len()];
-        let set = find_crossovers(&tr, &d, &TrackConfig::default()).unwrap();
+        let set = find_crossovers(&tr, &d, None, &TrackConfig::default()).unwrap();
         assert_eq!(set.crossovers.len(), 3);
         for (c, n) in set.crossovers.iter().zip([125.0, 375.0, 625.0]) {
             assert!((c.north_m - n).abs() < 0.1 && c.east_m.abs() < 0.1, "{c:?}");
@@ -575,7 +602,7 @@ pub(crate) mod tests {
             min_crossing_angle_deg: 70.0,
             ..TrackConfig::default()
         };
-        let set = find_crossovers(&tr, &d, &steep).unwrap();
+        let set = find_crossovers(&tr, &d, None, &steep).unwrap();
         assert_eq!((set.crossovers.len(), set.skipped_shallow), (0, 3));
     }
 }

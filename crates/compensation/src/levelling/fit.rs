@@ -39,6 +39,24 @@
 //! * With `estimate_k = false` and no drift this is plain tie-line
 //!   levelling (offsets only).
 //!
+//! **Altitude term** (`altitude_term`, on by default). The two passes of a
+//! crossover are flown at different heights `h_a ≠ h_b`, so the field they
+//! see differs by `∂B/∂h (h_a − h_b)`. With the profile operators `S_a`,
+//! `S_b` of the two lines ([`super::vertical_gradient`]), `∂B/∂h ≈
+//! −c (S_a + S_b)`, and the observation gains the term
+//!
+//! ```text
+//! d_x = … + c · g_x,        g_x = −(S_a + S_b)(h_a − h_b)      (nT)
+//! ```
+//!
+//! with one dimensionless scale `c` for the survey (≈ 0.78 for an isotropic
+//! field crossed at right angles), estimated with the rest. Crossovers
+//! without altitudes or profile operators get `g_x = 0`, and the term is
+//! dropped when no crossover has one. It only explains crossover
+//! differences: the levelled series is not moved to a common height, so
+//! [`LevellingFit::rms_levelled_nt`] (the differences of the levelled
+//! series) is reported beside the model residual.
+//!
 //! The normal equations are accumulated and solved with
 //! [`aeromag_estimation::least_squares::NormalEquations`] (equilibrated,
 //! eigen-decomposed; condition number reported). Cost `O(N_x p²) + O(p³)`
@@ -82,6 +100,14 @@ pub struct LevellingConfig {
     pub lambda: f64,
     /// The datum. Default [`Datum::ZeroMean`].
     pub datum: Datum,
+    /// Explain the altitude differences of the crossovers with the
+    /// vertical-gradient term (module docs). Default `true`.
+    #[serde(default = "yes")]
+    pub altitude_term: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for LevellingConfig {
@@ -91,6 +117,7 @@ impl Default for LevellingConfig {
             drift: false,
             lambda: 1e-3,
             datum: Datum::ZeroMean,
+            altitude_term: true,
         }
     }
 }
@@ -145,8 +172,22 @@ pub struct LevellingFit {
     pub residuals_nt: Vec<f64>,
     /// RMS of the crossover differences `d_x` before levelling, nT.
     pub rms_before_nt: f64,
-    /// RMS of the residuals after levelling, nT.
+    /// RMS of the residuals after levelling (the whole model, with the
+    /// altitude term), nT.
     pub rms_after_nt: f64,
+    /// RMS of the crossover differences of the levelled series,
+    /// `d − k ΔḂ − Δlevel` (without the altitude term, which explains but
+    /// does not remove the true field's difference between the heights), nT.
+    pub rms_levelled_nt: f64,
+    /// Whether the altitude term was fitted (on, and some crossover has it).
+    pub altitude_term_used: bool,
+    /// Scale `c` of the vertical gradient `∂B/∂h ≈ −c (S_a + S_b)`
+    /// (dimensionless; 0 if the term was not fitted).
+    pub vertical_scale: f64,
+    /// Its standard deviation.
+    pub vertical_scale_std: f64,
+    /// Crossovers with altitudes and profile operators on both sides.
+    pub altitude_corrected: usize,
     /// Estimated standard deviation of one crossover difference, `σ̂`, nT.
     pub sigma_nt: f64,
     /// Degrees of freedom `N_x − p_eff`.
@@ -217,10 +258,16 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     {
         return Err(bad(format!("the fixed datum line {l} has no crossovers")));
     }
+    // The altitude regressor g_x of each crossover (module docs).
+    let altitude: Vec<f64> = crossovers.iter().map(altitude_regressor).collect();
+    let altitude_corrected = altitude.iter().filter(|g| **g != 0.0).count();
+    let alt_used = cfg.altitude_term && altitude_corrected > 0;
+    let alt_index = usize::from(cfg.estimate_k);
+    let first_level = alt_index + usize::from(alt_used);
     let mut lines: Vec<LineLevel> = Vec::with_capacity(spans.len());
     // (offset index, drift index) of each line in the unknown vector.
     let mut index: Vec<(Option<usize>, Option<usize>)> = Vec::with_capacity(spans.len());
-    let mut p = usize::from(cfg.estimate_k);
+    let mut p = first_level;
     for (&label, &(t0, t1, count)) in &spans {
         let fixed = cfg.datum == Datum::Fixed(label);
         let half = if cfg.drift && !fixed {
@@ -259,7 +306,7 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     let p_eff = p - free_modes;
     if crossovers.len() <= p_eff {
         return Err(bad(format!(
-            "{} crossovers cannot determine {p_eff} parameters (k, offsets{}): fit fewer (no drift, no k) or fly more ties",
+            "{} crossovers cannot determine {p_eff} parameters (k, offsets{}): fit fewer (no drift, no k, no altitude term) or fly more ties",
             crossovers.len(),
             if cfg.drift { ", drifts" } else { "" }
         )));
@@ -270,10 +317,13 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
         .iter()
         .map(|x| (pos(x.a.label), pos(x.b.label)))
         .collect();
-    let row_of = |x: &Crossover, &(ia, ib): &(usize, usize), row: &mut [f64]| {
+    let row_of = |x: &Crossover, &(ia, ib): &(usize, usize), g: f64, row: &mut [f64]| {
         row.fill(0.0);
         if cfg.estimate_k {
             row[0] = x.a.derivative_nt_per_s - x.b.derivative_nt_per_s;
+        }
+        if alt_used {
+            row[alt_index] = g;
         }
         for (side, li, sign) in [(&x.a, ia, 1.0), (&x.b, ib, -1.0)] {
             let (oi, si) = index[li];
@@ -287,14 +337,14 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     };
     let mut data = NormalEquations::new(p);
     let mut row = vec![0.0; p];
-    for (x, li) in crossovers.iter().zip(&line_index) {
-        row_of(x, li, &mut row);
+    for ((x, li), &g) in crossovers.iter().zip(&line_index).zip(&altitude) {
+        row_of(x, li, g, &mut row);
         data.add_row(&row, x.difference_nt(), 1.0)
             .map_err(|e| bad(e.to_string()))?;
     }
     let mut all = data.clone();
     if cfg.lambda > 0.0 {
-        for j in usize::from(cfg.estimate_k)..p {
+        for j in first_level..p {
             row.fill(0.0);
             row[j] = 1.0;
             all.add_row(&row, 0.0, cfg.lambda)
@@ -327,15 +377,21 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     let residuals_nt: Vec<f64> = crossovers
         .iter()
         .zip(&line_index)
-        .map(|(x, li)| {
-            row_of(x, li, &mut row);
+        .zip(&altitude)
+        .map(|((x, li), &g)| {
+            row_of(x, li, g, &mut row);
             x.difference_nt() - row.iter().zip(c.iter()).map(|(a, b)| a * b).sum::<f64>()
         })
         .collect();
+    let vertical_scale = if alt_used { c[alt_index] } else { 0.0 };
     let n = crossovers.len() as f64;
     let rms = |v: &mut dyn Iterator<Item = f64>| (v.map(|r| r * r).sum::<f64>() / n).sqrt();
     let rms_before_nt = rms(&mut crossovers.iter().map(|x| x.difference_nt()));
     let rms_after_nt = rms(&mut residuals_nt.iter().copied());
+    let rms_levelled_nt = rms(&mut residuals_nt
+        .iter()
+        .zip(&altitude)
+        .map(|(r, g)| r + vertical_scale * g));
     let dof = crossovers.len() - p_eff;
     let sigma2 = residuals_nt.iter().map(|r| r * r).sum::<f64>() / dof as f64;
     let cinv = all
@@ -369,11 +425,23 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
         residuals_nt,
         rms_before_nt,
         rms_after_nt,
+        rms_levelled_nt,
+        altitude_term_used: alt_used,
+        vertical_scale,
+        vertical_scale_std: if alt_used { std[alt_index] } else { 0.0 },
+        altitude_corrected,
         sigma_nt: sigma2.sqrt(),
         dof,
         condition: sol.condition,
         components,
     })
+}
+
+/// The altitude regressor `g_x = −(S_a + S_b)(h_a − h_b)` (nT), 0 where a
+/// side has no altitude or profile operator.
+fn altitude_regressor(x: &Crossover) -> f64 {
+    let g = -(x.a.profile_gradient_nt_per_m + x.b.profile_gradient_nt_per_m) * (x.a.alt_m - x.b.alt_m);
+    if g.is_finite() { g } else { 0.0 }
 }
 
 /// Number of connected groups of lines (union–find over the crossovers).
@@ -431,6 +499,7 @@ pub(crate) mod tests {
             value_nt: field + k * bdot + offset(label) + drift(label, time_s) + noise,
             derivative_nt_per_s: bdot,
             alt_m: f64::NAN,
+            profile_gradient_nt_per_m: f64::NAN,
         };
         for l in 0..nl {
             for t in 0..nt {
@@ -455,6 +524,61 @@ pub(crate) mod tests {
     fn zero_mean_offsets(label: i64) -> f64 {
         // Deterministic, mean ≠ 0 before the datum.
         ((label * 37) % 11) as f64 * 0.7 - 1.0
+    }
+
+    /// Crossovers flown at different heights over a field with vertical
+    /// gradient `−c (S_a + S_b)`: the altitude term recovers `c` and keeps
+    /// `k` sharp; without it the height differences inflate σ_k.
+    #[test]
+    fn altitude_term_explains_height_differences() {
+        let mut x = synthetic(12, 4, -0.1, &zero_mean_offsets, &|_, _| 0.0, 0.02, 11);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let g = Normal::new(0.0, 1.0).unwrap();
+        let c_true = 0.8;
+        for xo in &mut x {
+            xo.a.alt_m = 100.0 + 6.0 * g.sample(&mut rng);
+            xo.b.alt_m = 100.0 + 6.0 * g.sample(&mut rng);
+            xo.a.profile_gradient_nt_per_m = 0.04 * g.sample(&mut rng);
+            xo.b.profile_gradient_nt_per_m = 0.04 * g.sample(&mut rng);
+            // Side a sees the field at its height relative to side b's.
+            xo.a.value_nt += -c_true
+                * (xo.a.profile_gradient_nt_per_m + xo.b.profile_gradient_nt_per_m)
+                * (xo.a.alt_m - xo.b.alt_m);
+        }
+        let with = fit_levelling(&x, &LevellingConfig::default()).unwrap();
+        assert!(with.altitude_term_used && with.altitude_corrected == x.len());
+        assert!(
+            (with.vertical_scale - c_true).abs() < 4.0 * with.vertical_scale_std
+                && with.vertical_scale_std < 0.05,
+            "c = {} ± {}",
+            with.vertical_scale,
+            with.vertical_scale_std
+        );
+        assert!((with.k_s + 0.1).abs() < 4.0 * with.k_std_s, "k = {} ± {}", with.k_s, with.k_std_s);
+        // The levelled series keeps the height differences; the model explains them.
+        assert!(with.rms_levelled_nt > 3.0 * with.rms_after_nt);
+        let without = fit_levelling(
+            &x,
+            &LevellingConfig {
+                altitude_term: false,
+                ..LevellingConfig::default()
+            },
+        )
+        .unwrap();
+        assert!(!without.altitude_term_used && without.vertical_scale == 0.0);
+        assert!(without.rms_levelled_nt == without.rms_after_nt);
+        assert!(
+            without.k_std_s > 3.0 * with.k_std_s,
+            "σ_k {} without vs {} with",
+            without.k_std_s,
+            with.k_std_s
+        );
+        // Sides without heights give no altitude regressor: the term drops out.
+        for xo in &mut x {
+            xo.a.alt_m = f64::NAN;
+        }
+        let none = fit_levelling(&x, &LevellingConfig::default()).unwrap();
+        assert!(!none.altitude_term_used && none.altitude_corrected == 0);
     }
 
     #[test]

@@ -37,7 +37,11 @@
 //! d = m_a − m_b = k (Ḃ_a − Ḃ_b) + (o_a − o_b) + (s_a τ_a − s_b τ_b) + noise,   τ = (t − t_L)/h_L
 //! ```
 //!
-//! and `k`, `o`, `s` are found by regularised least squares ([`fit_levelling`]):
+//! plus, when the two passes are flown at different heights, the altitude
+//! term `c·g_x` of [`fit`] (the true field differs by the vertical gradient
+//! times the height difference; the gradient comes from the two crossing
+//! profiles, [`vertical_gradient`]),
+//! and `k`, `o`, `s` (and `c`) are found by regularised least squares ([`fit_levelling`]):
 //! the offsets are only determined up to a common constant (the datum: their
 //! mean is zero, or one line is held fixed) and a ridge `λ` keeps lines
 //! without enough crossovers at zero. With `k` fixed at 0 and no drift this
@@ -55,15 +59,18 @@
 //! |---|---|
 //! | [`tracks`] | the survey samples, sensor positions, track segmentation, along-track derivative |
 //! | [`crossovers`] | intersections of tracks of different lines (grid buckets, `O(N log N)`) |
-//! | [`fit`] | the joint least-squares fit of `k`, offsets and drifts |
+//! | [`vertical_gradient`] | the profile operator behind the crossovers' altitude term |
+//! | [`fit`] | the joint least-squares fit of `k`, offsets, drifts and the altitude term |
 //! | [`apply`] | the corrected series, row flags, and the one-call [`level_survey`] |
 
 pub mod apply;
 pub mod crossovers;
 pub mod fit;
 pub mod tracks;
+pub mod vertical_gradient;
 
 pub use apply::{Levelled, RowFlag, SurveyLevelling, apply_levelling, level_survey};
 pub use crossovers::{Crossover, CrossoverSet, CrossoverSide, find_crossovers};
 pub use fit::{Datum, LevellingConfig, LevellingFit, LineLevel, fit_levelling};
 pub use tracks::{SurveyTracks, TrackConfig, sensor_positions, track_derivative};
+pub use vertical_gradient::profile_gradient;
