@@ -2,6 +2,7 @@
 
 use crate::exit::bad_input;
 use crate::flight::{parse_band, parse_lever_arm, reference_columns, reference_sum, TlColumns};
+use aeromag_compensation::levelling::sensor_positions;
 use aeromag_compensation::reference_field::LeverArm;
 use crate::input::InputArgs;
 use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT, TL_KIND};
@@ -59,13 +60,20 @@ pub struct Args {
     #[arg(long, default_value = "ls")]
     method: String,
     /// With --method kalman: tune the noise intensities q1, q2, r by maximum
-    /// likelihood of the innovations (otherwise the documented defaults).
-    #[arg(long)]
+    /// likelihood of the innovations, starting from --kalman-noise or the
+    /// documented defaults. This is the default unless --kalman-noise is
+    /// given; the flag makes it tune from the given values.
+    #[arg(long, conflicts_with = "no_tune")]
     tune: bool,
+    /// With --method kalman: use the noise intensities as given (the
+    /// documented defaults, or --kalman-noise), without tuning.
+    #[arg(long)]
+    no_tune: bool,
     /// With --method kalman: noise intensities Q1,Q2,R (q1, q2 in nT²/m⁵: the
     /// spectral densities of d³B^h/ds³ and d²B_z/ds² along the path; r in nT²:
-    /// the measurement noise variance), e.g. from an earlier --tune. Default
-    /// 1e-15,1e-15,4e-4; with --tune, the starting point.
+    /// the measurement noise variance), e.g. from an earlier calibration.
+    /// Default 1e-15,1e-15,4e-4. Given values are used as they are, unless
+    /// --tune is also given (then they are the starting point).
     #[arg(long, value_name = "Q1,Q2,R")]
     kalman_noise: Option<String>,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
@@ -301,6 +309,25 @@ fn choose_terms(
     }
 }
 
+/// Lags of the Kalman method's first pass (s): a pair that brackets the
+/// 0.1–1 s of aircraft skins and frames, so that the field model of that
+/// pass does not have to absorb lagged eddy currents.
+const PASS1_LAGS_S: [f64; 2] = [0.15, 0.5];
+
+/// The scalar sensor's altitude (m): with a lever arm, the navigation
+/// altitude moved to the sensor with the attitude (a pitch of 5° moves a
+/// sensor 9.5 m behind the reference point by 0.8 m, in step with the
+/// manoeuvre, where the vertical gradient of a low calibration makes it
+/// matter); without one, `alt` as recorded.
+fn sensor_altitude(table: &FlightTable, lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
+    let alt = table.require("alt")?;
+    let Some(lever) = lever else { return Ok(alt.to_vec()) };
+    let col = |n: &str| table.require(n);
+    let [_, _, sensor_alt] = sensor_positions(col("lat")?, col("lon")?, alt, col("roll")?, col("pitch")?, col("yaw")?, lever.arm_m)
+        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    Ok(sensor_alt)
+}
+
 /// Ground speed (m/s) from `vn`, `ve` when present, else from the positions.
 fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
     Ok(match (table.column("vn"), table.column("ve")) {
@@ -313,7 +340,7 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
 pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit)> {
     let cols = TlColumns::from_table(table)?;
     let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
-    let alt = table.require("alt")?;
+    let alt = sensor_altitude(table, opts.lever_arm.as_ref())?;
     let speed = ground_speed(table)?;
     let cols = TlColumns { mag: &y, ..cols };
     let (segs, _) = cols.segments(opts.split_lines, 1);
@@ -321,13 +348,38 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
         .iter()
         .map(|r| KalmanSegment { data: whole(&cols).slice(r.clone()), alt_m: &alt[r.clone()], speed_m_s: &speed[r.clone()] })
         .collect();
-    // `auto` chooses the lags with the band-pass LS machinery on the same legs.
-    let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
+    let fail = |e: aeromag_compensation::CompError| bad_input!("{}: {e}", table.file_label());
+    // `auto` chooses the lags with the band-pass LS machinery on the same
+    // legs, after a first Kalman pass without lags has removed its smoothed
+    // field: over geology the band-pass leaves part of the anomaly field in
+    // the band, where it hides lagged eddy currents (or buys a spurious slow
+    // lag); the field model takes it out first.
     let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
-    let (terms, selection) = choose_terms(table, &data, &ls, &opts.eddy_lag)?;
+    let (terms, selection) = match opts.eddy_lag {
+        EddyLag::Auto if cfg.terms.has_eddy() => {
+            let spinner = crate::progress::spinner("Kalman pass without lags");
+            let classical = KalmanConfig { terms: cfg.terms.with_eddy_lags(&PASS1_LAGS_S).map_err(fail)?, compute_series: true, ..cfg.clone() };
+            let first = fit_kalman(&segments, &classical).map_err(fail)?;
+            spinner.finish_and_clear();
+            let mut y_field_removed = vec![f64::NAN; y.len()];
+            for (r, series) in segs.iter().zip(&first.series) {
+                for (k, i) in r.clone().enumerate() {
+                    y_field_removed[i] = y[i] - series.external_nt[k];
+                }
+            }
+            let reduced = TlColumns { mag: &y_field_removed, ..cols };
+            let (rsegs, _) = reduced.segments(opts.split_lines, 1);
+            let data: Vec<Segment> = rsegs.iter().map(|r| whole(&reduced).slice(r.clone())).collect();
+            choose_terms(table, &data, &ls, &opts.eddy_lag)?
+        }
+        _ => {
+            let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
+            choose_terms(table, &data, &ls, &opts.eddy_lag)?
+        }
+    };
     let cfg = &KalmanConfig { terms, ..cfg.clone() };
     let spinner = crate::progress::spinner("Kalman filter and smoother");
-    let fit = fit_kalman(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let fit = fit_kalman(&segments, cfg).map_err(fail)?;
     spinner.finish_and_clear();
     for w in &fit.warnings {
         eprintln!("warning: {w}");
@@ -360,7 +412,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "kalman" => {
             let ls = config(&a)?;
             let mut cfg = KalmanConfig { terms: ls.terms, convention: ls.convention, bt_scale_nt: ls.bt_scale_nt, ..KalmanConfig::default() };
-            cfg.tuning.enabled = a.tune;
+            cfg.tuning.enabled = a.tune || !(a.no_tune || a.kalman_noise.is_some());
             if let Some(text) = &a.kalman_noise {
                 cfg.noise = parse_noise(text)?;
             }

@@ -104,11 +104,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel)> {
         let t = load(path, None)?;
         let ls = fit_model(&t, &LsConfig::default(), &opts)?;
-        // The Kalman model uses the lags the LS fit chose (no second search).
-        let lags = ls.terms.eddy_lags_s();
-        let lag = if lags.is_empty() { EddyLag::None } else { EddyLag::Fixed(lags.to_vec()) };
-        let kf_cfg = KalmanConfig { terms: ls.terms.with_eddy_lags(&[])?, ..KalmanConfig::default() };
-        let (kf, _) = fit_model_kalman(&t, &kf_cfg, &FitOptions { eddy_lag: lag, ..opts.clone() })?;
+        // The Kalman method as `calibrate --method kalman` runs it: its own
+        // lag choice (after a first pass has removed the field) and noise
+        // intensities tuned by maximum likelihood.
+        let mut kf_cfg = KalmanConfig::default();
+        kf_cfg.tuning.enabled = true;
+        let (kf, _) = fit_model_kalman(&t, &kf_cfg, &opts)?;
         Ok((t, ls, kf))
     };
     let (mut cal, model, model_kf) = fit_both(&cal_files.csv)?;

@@ -198,39 +198,96 @@ fn for_each_filtered_block(
     Ok(())
 }
 
-/// Fit the Tolles-Lawson coefficients to calibration segments.
-pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
+/// The filtered normal equations of each segment (`None` for a segment
+/// that is skipped, with a warning), and the sampling rates of those used.
+pub(crate) struct SegmentEquations {
+    pub(crate) per_segment: Vec<Option<NormalEquations>>,
+    pub(crate) warnings: Vec<String>,
+    pub(crate) fs_used: Vec<f64>,
+}
+
+/// Design, filter and accumulate every segment on its own.
+pub(crate) fn segment_equations(segments: &[Segment], cfg: &LsConfig) -> Result<SegmentEquations> {
     validate(cfg)?;
     let ncol = cfg.terms.n_columns();
-    let mut ne = NormalEquations::new(ncol);
+    let mut per_segment = Vec::with_capacity(segments.len());
     let mut warnings = Vec::new();
-    let mut used = 0;
     let mut fs_used = Vec::new();
     for (k, seg) in segments.iter().enumerate() {
-        let n = seg.time.len();
-        if seg.mag.len() != n || seg.flux.iter().any(|f| f.len() != n) {
-            return Err(CompError::BadData(format!("segment {k}: columns of unequal length")));
-        }
-        let dt = median_step(seg.time);
-        if !(dt > 0.0) {
-            warnings.push(format!("segment {k} ({n} samples) has no valid time step; skipped"));
-            continue;
-        }
-        let fs = 1.0 / dt;
-        let sos = match cfg.band_hz {
-            Some((lo, hi)) => Some(butter(cfg.filter_order, Band::Bandpass { low_hz: lo, high_hz: hi }, fs)?),
-            None => None,
+        per_segment.push(None);
+        let (dt, sos) = match segment_filter(k, seg, cfg)? {
+            Ok(f) => f,
+            Err(w) => {
+                warnings.push(w);
+                continue;
+            }
         };
-        let min_len = sos.as_ref().map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
-        if n < min_len {
-            warnings.push(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"));
-            continue;
-        }
+        let mut ne = NormalEquations::new(ncol);
         for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
             ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
         })?;
+        per_segment[k] = Some(ne);
+        fs_used.push(1.0 / dt);
+    }
+    Ok(SegmentEquations { per_segment, warnings, fs_used })
+}
+
+/// Segment `k`'s sampling interval (s) and band-pass filter, or the warning
+/// that says why it is skipped (no valid time step, too short to filter and
+/// trim); columns of unequal length are an error.
+fn segment_filter(k: usize, seg: &Segment, cfg: &LsConfig) -> Result<std::result::Result<(f64, Option<Sos>), String>> {
+    let n = seg.time.len();
+    if seg.mag.len() != n || seg.flux.iter().any(|f| f.len() != n) {
+        return Err(CompError::BadData(format!("segment {k}: columns of unequal length")));
+    }
+    let dt = median_step(seg.time);
+    if !(dt > 0.0) {
+        return Ok(Err(format!("segment {k} ({n} samples) has no valid time step; skipped")));
+    }
+    let sos = match cfg.band_hz {
+        Some((lo, hi)) => Some(butter(cfg.filter_order, Band::Bandpass { low_hz: lo, high_hz: hi }, 1.0 / dt)?),
+        None => None,
+    };
+    let ncol = cfg.terms.n_columns();
+    let min_len = sos.as_ref().map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
+    if n < min_len {
+        return Ok(Err(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped")));
+    }
+    Ok(Ok((dt, sos)))
+}
+
+/// The band-passed residual `y − A c` of every segment that
+/// [`segment_equations`] uses (trimmed like the fit), with its sampling
+/// rate (Hz); segments that are skipped are left out.
+pub(crate) fn band_passed_residuals(segments: &[Segment], cfg: &LsConfig, coef: &[f64]) -> Result<Vec<(Vec<f64>, f64)>> {
+    validate(cfg)?;
+    let ncol = cfg.terms.n_columns();
+    if coef.len() != ncol {
+        return Err(CompError::BadData(format!("{} coefficients for {ncol} columns", coef.len())));
+    }
+    let mut out = Vec::new();
+    for (k, seg) in segments.iter().enumerate() {
+        let Ok((dt, sos)) = segment_filter(k, seg, cfg)? else { continue };
+        let mut r = Vec::with_capacity(seg.time.len());
+        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
+            for (i, &yi) in y.iter().enumerate() {
+                r.push(yi - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>());
+            }
+            Ok(())
+        })?;
+        out.push((r, 1.0 / dt));
+    }
+    Ok(out)
+}
+
+/// Fit the Tolles-Lawson coefficients to calibration segments.
+pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
+    let SegmentEquations { per_segment, mut warnings, fs_used } = segment_equations(segments, cfg)?;
+    let mut ne = NormalEquations::new(cfg.terms.n_columns());
+    let mut used = 0;
+    for seg in per_segment.iter().flatten() {
+        ne.merge(seg).map_err(|e| CompError::BadData(e.to_string()))?;
         used += 1;
-        fs_used.push(fs);
     }
     if used == 0 {
         return Err(CompError::BadData("no segment is long enough to fit (see the warnings)".into()));
