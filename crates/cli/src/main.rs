@@ -9,6 +9,7 @@ mod commands;
 mod exit;
 mod flight;
 mod input;
+mod kalman_report;
 mod progress;
 mod report_section;
 

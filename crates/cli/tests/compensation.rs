@@ -124,6 +124,8 @@ fn model_and_argument_errors_exit_2() {
         vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "-9.5,0,-0.6", "--date", "2025-13-01"],
         vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,4e-4"],
         vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,1e-15,0"],
+        vec!["calibrate", "--input", p, "--model", m, "--series", "s.csv"],
+        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--tune", "--no-tune"],
     ] {
         let o = aeromag(&args);
         assert_code(&o, 2);
@@ -132,6 +134,31 @@ fn model_and_argument_errors_exit_2() {
     let o = aeromag(&["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "2e-15,1e-15,3e-4"]);
     assert_code(&o, 0);
     assert!(String::from_utf8_lossy(&o.stdout).contains("q1 = 2.000e-15"), "{}", String::from_utf8_lossy(&o.stdout));
+    // By default the Kalman method tunes its noise intensities, and --series
+    // writes the smoothed field and innovations on every input row.
+    let series = d.path().join("series.csv");
+    let o = aeromag(&["calibrate", "--input", p, "--model", m, "--method", "kalman", "--series", series.to_str().unwrap()]);
+    assert_code(&o, 0);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("tuned by maximum likelihood"), "{}", String::from_utf8_lossy(&o.stdout));
+    let out = std::fs::read_to_string(&series).unwrap();
+    let data = |t: &str| t.lines().filter(|l| !l.starts_with('#')).map(String::from).collect::<Vec<_>>();
+    let (rows_in, rows_out) = (data(&std::fs::read_to_string(&cal).unwrap()), data(&out));
+    assert_eq!(rows_in.len(), rows_out.len(), "one output row per input row");
+    let header: Vec<&str> = rows_out[0].split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap_or_else(|| panic!("no column {n}"));
+    let (field, innov, sd) = (col("kalman_field"), col("kalman_innovation"), col("kalman_innovation_std"));
+    let num = |r: &str, c: usize| r.split(',').nth(c).and_then(|v| v.parse::<f64>().ok());
+    let mut within = 0;
+    let mut n = 0;
+    for r in rows_out.iter().skip(100) {
+        if let (Some(f), Some(v), Some(s)) = (num(r, field), num(r, innov), num(r, sd)) {
+            assert!(f.is_finite() && s > 0.0);
+            n += 1;
+            within += usize::from(v.abs() <= s);
+        }
+    }
+    // A noise model that fits keeps about 68 % of the innovations within ±σ.
+    assert!(n > 1000 && (0.55..0.85).contains(&(within as f64 / n as f64)), "{within} of {n} within ±σ");
     // A model file that is not one.
     let junk = d.path().join("junk.json");
     std::fs::write(&junk, "{\"format\":\"other\"}").unwrap();

@@ -76,6 +76,12 @@ pub struct Args {
     /// --tune is also given (then they are the starting point).
     #[arg(long, value_name = "Q1,Q2,R")]
     kalman_noise: Option<String>,
+    /// With --method kalman: write every input row plus the series
+    /// kalman_reading (reference removed), kalman_compensated, kalman_field
+    /// (the smoothed external field), kalman_innovation and
+    /// kalman_innovation_std (nT; empty where a row was not used) to this CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    series: Option<PathBuf>,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
     #[arg(long, default_value = "p3,i5,e8")]
     terms: String,
@@ -336,8 +342,17 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
     })
 }
 
-/// Fit a model with the Kalman method on a loaded calibration table.
-pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit)> {
+/// Names of the per-row series of the Kalman method ([`fit_model_kalman`]).
+pub const KALMAN_SERIES: [&str; 5] =
+    ["kalman_reading", "kalman_compensated", "kalman_field", "kalman_innovation", "kalman_innovation_std"];
+
+/// Fit a model with the Kalman method on a loaded calibration table. With
+/// `cfg.compute_series`, also the per-row series named in
+/// [`KALMAN_SERIES`] on the table's rows (NaN where a row was not used): the
+/// reading with the reference channels removed (nT), the compensated reading
+/// `mag − H1 X̂1`, the smoothed external field, the pass-1 innovation and its
+/// predicted standard deviation.
+pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit, Vec<Vec<f64>>)> {
     let cols = TlColumns::from_table(table)?;
     let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
     let alt = sensor_altitude(table, opts.lever_arm.as_ref())?;
@@ -381,6 +396,18 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     let spinner = crate::progress::spinner("Kalman filter and smoother");
     let fit = fit_kalman(&segments, cfg).map_err(fail)?;
     spinner.finish_and_clear();
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    if !fit.series.is_empty() {
+        rows = vec![vec![f64::NAN; y.len()]; KALMAN_SERIES.len()];
+        for (r, s) in segs.iter().zip(&fit.series) {
+            for (k, i) in r.clone().enumerate() {
+                let v = [y[i], s.compensated_nt[k], s.external_nt[k], s.innovation_nt[k], s.innovation_std_nt[k]];
+                for (col, v) in rows.iter_mut().zip(v) {
+                    col[i] = v;
+                }
+            }
+        }
+    }
     for w in &fit.warnings {
         eprintln!("warning: {w}");
     }
@@ -389,7 +416,7 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     model.reference = ref_cols;
     model.lever_arm = opts.lever_arm;
     model.fit.eddy_lag_selection = selection;
-    Ok((model, fit))
+    Ok((model, fit, rows))
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -407,6 +434,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None => None,
         },
     };
+    if a.series.is_some() && a.method != "kalman" {
+        return Err(bad_input!("--series needs --method kalman"));
+    }
     let model = match a.method.as_str() {
         "ls" => fit_model(&table, &config(&a)?, &opts)?,
         "kalman" => {
@@ -416,7 +446,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             if let Some(text) = &a.kalman_noise {
                 cfg.noise = parse_noise(text)?;
             }
-            let (model, fit) = fit_model_kalman(&table, &cfg, &opts)?;
+            cfg.compute_series = a.series.is_some();
+            let (model, fit, rows) = fit_model_kalman(&table, &cfg, &opts)?;
+            if let Some(path) = &a.series {
+                let mut t = table.clone();
+                for (name, col) in KALMAN_SERIES.iter().zip(rows) {
+                    t.add_column(name, col)?;
+                }
+                aeromag_io::write_csv(&t, path)?;
+                println!("Kalman series (smoothed field, innovations) written to {}", path.display());
+            }
             println!(
                 "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
                 fit.noise.q1_nt2_per_m5,

@@ -5,6 +5,7 @@ use crate::commands::calibrate::{fit_model, fit_model_kalman, EddyLag, FitOption
 use aeromag_compensation::reference_field::LeverArm;
 use crate::commands::compensate::compensate_table;
 use crate::input::load;
+use crate::kalman_report::{kalman_section, KalmanRows};
 use aeromag_compensation::kalman::KalmanConfig;
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::observability::{observability, Observability};
@@ -101,7 +102,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // The installation, as the user knows it: the scalar sensor's lever arm
     // from the navigation point and the flight date (scenario file).
     let opts = FitOptions { lever_arm: Some(installation(&cal_files.scenario)?), ..FitOptions::auto() };
-    let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel)> {
+    let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel, KalmanRows)> {
         let t = load(path, None)?;
         let ls = fit_model(&t, &LsConfig::default(), &opts)?;
         // The Kalman method as `calibrate --method kalman` runs it: its own
@@ -109,11 +110,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         // intensities tuned by maximum likelihood.
         let mut kf_cfg = KalmanConfig::default();
         kf_cfg.tuning.enabled = true;
-        let (kf, _) = fit_model_kalman(&t, &kf_cfg, &opts)?;
-        Ok((t, ls, kf))
+        let (kf, fit, rows) = fit_model_kalman(&t, &kf_cfg, &opts)?;
+        Ok((t, ls, kf, KalmanRows { fit, rows }))
     };
-    let (mut cal, model, model_kf) = fit_both(&cal_files.csv)?;
-    let (_, grad_ls, grad_kf) = fit_both(&grad_files.csv)?;
+    let (mut cal, model, model_kf, _) = fit_both(&cal_files.csv)?;
+    let (grad_table, grad_ls, grad_kf, grad_rows) = fit_both(&grad_files.csv)?;
     std::fs::write(a.out.join("model_ls.json"), model.to_json()?)?;
     std::fs::write(a.out.join("model_kalman.json"), model_kf.to_json()?)?;
     bar.inc(1);
@@ -148,10 +149,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None
     } else {
         let trunc_files = simulate(ScenarioKind::CalibrationTruncated, None, Some(a.seed))?.write_to_dir(&data)?;
-        let (trunc, trunc_ls, trunc_kf) = fit_both(&trunc_files.csv)?;
+        let (trunc, trunc_ls, trunc_kf, _) = fit_both(&trunc_files.csv)?;
         let cfg = KalmanConfig { compute_series: false, ..KalmanConfig::default() };
         let obs = |t: &FlightTable| -> anyhow::Result<Observability> {
-            let (_, f) = fit_model_kalman(t, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..opts.clone() })?;
+            let (_, f, _) = fit_model_kalman(t, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..opts.clone() })?;
             Ok(observability(&f.names, &f.prior_covariance, &f.posterior_covariance, 1e6)?)
         };
         let duration = |t: &FlightTable| -> anyhow::Result<f64> {
@@ -271,6 +272,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         r.figure(svg, format!("Estimability measures, coefficients {}.", o[0].names.join(", ")));
     }
     add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
+    kalman_section(
+        "Kalman method over realistic geology (gradient area, 1000 m): smoothed field, innovations, uncertainties",
+        &grad_table,
+        &grad_ls,
+        &grad_kf,
+        &grad_rows,
+    )?
+    .append_to(&mut r);
     add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
     for section in [rotor_section, pod_section, em_section, grad_section].into_iter().flatten() {
         section.append_to(&mut r);

@@ -45,7 +45,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let terms = TermSet::parse(&a.terms).map_err(|e| bad_input!("--terms: {e}"))?;
     let table = a.input.load()?;
     let cfg = KalmanConfig { terms, compute_series: false, ..KalmanConfig::default() };
-    let (_, fit) = fit_model_kalman(&table, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..FitOptions::auto() })?;
+    let (_, fit, _) = fit_model_kalman(&table, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..FitOptions::auto() })?;
     let o = observability(&fit.names, &fit.prior_covariance, &fit.posterior_covariance, 1e6)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&o)?);
