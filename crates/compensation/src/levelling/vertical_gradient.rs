@@ -178,6 +178,13 @@ fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// The profile operator of one set of tracks (altitude unused).
+    fn gradient_of(time: &[f64], lat: &[f64], lon: &[f64], line: &[f64], value: &[f64]) -> Vec<f64> {
+        let alt = vec![0.0; time.len()];
+        let tracks = SurveyTracks { time, lat, lon, alt: &alt, line, value };
+        profile_gradient(&tracks, &TrackConfig::default()).unwrap()
+    }
+
     /// A 2-D harmonic field of a line source at depth `D` below the profile,
     /// `u(x) = D/(x² + D²)`: its profile operator is exactly `−∂u/∂h`
     /// `= (D² − x²)/(x² + D²)²` (the field's 1-D transform is `π e^{−|κ|D}`).
@@ -199,17 +206,7 @@ mod tests {
             value.push(1.0e4 * d / (x * x + d * d) + 0.002 * x + 50_000.0);
         }
         let time: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
-        let line = vec![1.0; n];
-        let alt = vec![100.0; n];
-        let tracks = SurveyTracks {
-            time: &time,
-            lat: &lat,
-            lon: &lon,
-            alt: &alt,
-            line: &line,
-            value: &value,
-        };
-        let g = profile_gradient(&tracks, &TrackConfig::default()).unwrap();
+        let g = gradient_of(&time, &lat, &lon, &vec![1.0; n], &value);
         let peak = 1.0e4 / (d * d);
         // The tapered operator applied to the exact transform:
         // 10⁴ ∫₀^∞ κ e^{−κD − (κℓ)²/2} cos κx dκ (trapezoid, ℓ = 2Δs).
@@ -253,18 +250,8 @@ mod tests {
         let time: Vec<f64> = (0..n).map(|i| i as f64).collect();
         let lat: Vec<f64> = (0..n).map(|i| 50.0 + i as f64 * 1e-4).collect();
         let lon = vec![10.0; n];
-        let alt = vec![0.0; n];
         let line: Vec<f64> = (0..n).map(|i| if i < 30 { 1.0 } else { 0.0 }).collect();
-        let value = vec![1.0; n];
-        let tracks = SurveyTracks {
-            time: &time,
-            lat: &lat,
-            lon: &lon,
-            alt: &alt,
-            line: &line,
-            value: &value,
-        };
-        let g = profile_gradient(&tracks, &TrackConfig::default()).unwrap();
+        let g = gradient_of(&time, &lat, &lon, &line, &vec![1.0; n]);
         assert!(g.iter().all(|v| v.is_nan()));
     }
 }
