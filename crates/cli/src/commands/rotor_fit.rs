@@ -27,8 +27,8 @@ use crate::input::InputArgs;
 use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
 use aeromag_compensation::rotor::{
     BladeTerms, FlapAngles, RotorFit, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
-    align_phase_offset, estimate_phase, fit_slow_angles, refine_phase_offset, rotor_speed,
-    track_slow_angles, unwrap_deg,
+    align_phase_offset, estimate_phase, fit_records, fit_slow_angles, refine_phase_offset, regressors,
+    rotor_speed, track_slow_angles, unwrap_deg,
 };
 use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments};
 use aeromag_io::FlightTable;
@@ -41,6 +41,55 @@ use std::path::{Path, PathBuf};
 use aeromag_compensation::model_file::MODEL_FORMAT;
 /// `kind` of a rotor model file.
 pub const ROTOR_KIND: &str = "helicopter-rotor";
+/// Longest dropout (consecutive rows with a missing value, time steps
+/// regular) that `rotor fit` bridges by linear interpolation, s.
+const MAX_FILL_S: f64 = 0.1;
+
+/// Alternations of tracking the angles on every stretch and refitting the
+/// parameters on all of them, when a record has several stretches between
+/// gaps. Measured on a 420 s simulated flight cut in two halves by a gap
+/// (share of the rotor interference left on an independent flight): the
+/// longest stretch alone 10.9 %, 1 alternation 9.8 %, 3 8.6 %, 6 8.0 %; the
+/// whole record without a gap 3.6 %.
+const REFINE_ITERATIONS: usize = 3;
+
+/// Bridge runs of at most `max_len` non-finite values between finite ones
+/// by linear interpolation in time (`period`: interpolate the shortest way
+/// round, for a phase in degrees), when the time steps across the run are
+/// regular (no time gap).
+fn bridge_dropouts(time: &[f64], x: &[f64], max_len: usize, period: Option<f64>) -> Vec<f64> {
+    let mut out = x.to_vec();
+    let dt = median_step(time);
+    let n = x.len();
+    let mut k = 0;
+    while k < n {
+        if x[k].is_finite() {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        while k < n && !x[k].is_finite() {
+            k += 1;
+        }
+        let (a, b) = (start.wrapping_sub(1), k);
+        if start == 0 || b >= n || b - start > max_len {
+            continue;
+        }
+        let span = time[b] - time[a];
+        if !(span > 0.0 && span <= (b - a) as f64 * dt * 1.5) {
+            continue;
+        }
+        let mut d = x[b] - x[a];
+        if let Some(p) = period {
+            d = (d + 0.5 * p).rem_euclid(p) - 0.5 * p;
+        }
+        for i in start..b {
+            out[i] = x[a] + d * (time[i] - time[a]) / span;
+        }
+    }
+    out
+}
+
 /// Shortest record processed between gaps, s.
 const MIN_SEGMENT_S: f64 = 10.0;
 
@@ -54,9 +103,11 @@ const MIN_SEGMENT_S: f64 = 10.0;
 /// --estimate-phase) the rotor frequency and phase are estimated from the
 /// scalar data (search band --rotor-hz). The geometry defaults to the
 /// simulator's helicopter (hub 0,0,−2.6 m, sensor 5,0,0.6 m, blades 0.8 to
-/// 7.5 m, 4 blades, nominal coning 4°, tilt −1.5°). The longest stretch
-/// without gaps or missing values is fitted. Columns named `true_…` are
-/// never read.
+/// 7.5 m, 4 blades, nominal coning 4°, tilt −1.5°). Dropouts of up to
+/// 0.1 s (missing values, regular time steps) are bridged by linear
+/// interpolation; across longer gaps the model is fitted on the longest
+/// stretch and its parameters refined on every stretch of at least 10 s.
+/// Columns named `true_…` are never read.
 ///
 /// Example:
 ///   aeromag rotor fit --input heli.csv --model rotor.json
@@ -331,8 +382,29 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     if let Some(c) = &phase_col {
         check_column_name(&table, c)?;
     }
-    let cols = RotorColumns::from_table(&table, phase_col.as_deref())?;
-    let fs = sample_rate(&table, cols.time)?;
+    let raw = RotorColumns::from_table(&table, phase_col.as_deref())?;
+    let fs = sample_rate(&table, raw.time)?;
+    // Short dropouts (missing cells, no time gap) are bridged so that the
+    // stretches on both sides are fitted as one record.
+    let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
+    let filled: Vec<Vec<f64>> = raw
+        .all()
+        .iter()
+        .enumerate()
+        .map(|(k, c)| bridge_dropouts(raw.time, c, max_fill, if k == 4 { Some(360.0) } else { None }))
+        .collect();
+    let bridged = (0..raw.time.len())
+        .filter(|&i| raw.all().iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite()))
+        .count();
+    let cols = RotorColumns {
+        time: raw.time,
+        mag: &filled[0],
+        flux: [&filled[1], &filled[2], &filled[3]],
+        phase: raw.phase.map(|_| filled[4].as_slice()),
+    };
+    if bridged > 0 {
+        eprintln!("note: {bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation for the fit");
+    }
     let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
     let (_, segs, _) = usable_segments(cols.time, None, &cols.all(), min_len);
     let r = segs
@@ -342,11 +414,11 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
         .ok_or_else(|| {
             bad_input!("{file}: no stretch of ≥ {MIN_SEGMENT_S} s without gaps or missing values")
         })?;
-    if r.len() < table.n_rows() {
+    let used: usize = segs.iter().map(|s| s.len()).sum();
+    if used < table.n_rows() {
         eprintln!(
-            "warning: fitting data rows {}–{} of {} (the longest stretch without gaps or missing values)",
-            r.start + 1,
-            r.end,
+            "warning: {} of {} rows are in stretches without gaps or missing values of at least {MIN_SEGMENT_S} s              and are fitted; the others are left out",
+            used,
             table.n_rows()
         );
     }
@@ -406,7 +478,7 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     {
         columns.insert(c.to_string(), table.resolve(c).unwrap_or(c).to_string());
     }
-    let model = RotorModelFile {
+    let mut model = RotorModelFile {
         format: MODEL_FORMAT.into(),
         kind: ROTOR_KIND.into(),
         geometry: geom,
@@ -425,12 +497,26 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
         columns,
         software_version: env!("CARGO_PKG_VERSION").into(),
     };
+    // Several stretches between gaps: the parameters found on the longest
+    // are refined on all of them, each with its own phase and slowly varying
+    // angles tracked as `rotor apply` would.
+    if segs.len() > 1 {
+        for _ in 0..REFINE_ITERATIONS {
+        let tracked: Vec<TrackedSegment> = segs.iter().map(|s| track_segment(&model, &cols, s, fs)).collect::<anyhow::Result<_>>()?;
+        let regs: Vec<Vec<Vec<f64>>> =
+            tracked.iter().map(|t| regressors(&model.geometry, model.model.terms, &t.input())).collect::<Result<_, _>>()?;
+        let records: Vec<(&[Vec<f64>], &[f64])> = regs.iter().zip(&segs).map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()])).collect();
+        model.model = fit_records(&records, model.model.terms, fs, &fit_opts)?;
+        }
+        model.rows = used;
+        eprintln!("note: parameters refined on all {} stretches ({used} rows)", segs.len());
+    }
     std::fs::write(&a.model, serde_json::to_string_pretty(&model)?)
         .map_err(|e| anyhow::anyhow!("cannot write '{}': {e}", a.model.display()))?;
     println!(
         "fitted the rotor model on {} rows of {file} ({:.3} Hz, f_r {rotor_hz:.4} Hz, phase {}): {} parameters, \
          high-passed residual {:.4} nT, mean coning {coning_mean_deg:.2}°; written to {}",
-        r.len(),
+        model.rows,
         fs,
         phase_col
             .as_deref()
@@ -479,43 +565,49 @@ pub fn rotor_interference(model: &RotorModelFile, table: &FlightTable) -> anyhow
     let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
     let (_, segs, _) = usable_segments(cols.time, None, &cols.all(), min_len);
     let mut out = vec![f64::NAN; table.n_rows()];
-    let g = &model.geometry;
-    let nominal = [model.nominal_angles];
-    let band = model.phase.rotor_hz_range;
     for r in segs {
-        let b = cols.field(&r);
-        let mag = &cols.mag[r.clone()];
-        let (mut phase, omega) = segment_phase(&cols, &r, fs, g.blades, band)?;
-        if phase_col.is_none() {
-            let inp = RotorInput {
-                b_body_nt: &b,
-                phase_rad: &phase,
-                omega_rad_s: &omega,
-                angles: &nominal,
-            };
-            let c = align_phase_offset(g, &model.model, &inp, mag, fs, &model.fit_options)?;
-            phase.iter_mut().for_each(|p| *p += c);
-        }
-        let inp = RotorInput {
-            b_body_nt: &b,
-            phase_rad: &phase,
-            omega_rad_s: &omega,
-            angles: &nominal,
-        };
-        let opts = match phase_col {
-            None => tracking_with_phase(&model.slow_angles),
-            Some(_) => model.slow_angles,
-        };
-        let slow = track_slow_angles(g, &model.model, &inp, mag, fs, &model.fit_options, &opts)?;
-        let inp = RotorInput {
-            angles: &slow.angles,
-            phase_rad: &slow.phase_rad,
-            ..inp
-        };
-        let p = model.model.predict(g, &inp)?;
+        let t = track_segment(model, &cols, &r, fs)?;
+        let p = model.model.predict(&model.geometry, &t.input())?;
         out[r].copy_from_slice(&p);
     }
     Ok(out)
+}
+
+/// One stretch of a record with the rotor phase, speed and slowly varying
+/// angles found for it with a fitted model.
+struct TrackedSegment {
+    b: Vec<Vector3<f64>>,
+    omega: Vec<f64>,
+    phase: Vec<f64>,
+    angles: Vec<FlapAngles>,
+}
+
+impl TrackedSegment {
+    fn input(&self) -> RotorInput<'_> {
+        RotorInput { b_body_nt: &self.b, phase_rad: &self.phase, omega_rad_s: &self.omega, angles: &self.angles }
+    }
+}
+
+/// Phase (from the channel, or estimated and aligned to `model`) and the
+/// slowly varying angles (tracked with `model`'s parameters fixed) of rows
+/// `r`: what `rotor apply` does to a stretch, and what `rotor fit` does to
+/// the stretches it refits on.
+fn track_segment(model: &RotorModelFile, cols: &RotorColumns, r: &Range<usize>, fs: f64) -> anyhow::Result<TrackedSegment> {
+    let g = &model.geometry;
+    let nominal = [model.nominal_angles];
+    let b = cols.field(r);
+    let mag = &cols.mag[r.clone()];
+    let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
+    let estimated = model.phase.column.is_none();
+    if estimated {
+        let inp = RotorInput { b_body_nt: &b, phase_rad: &phase, omega_rad_s: &omega, angles: &nominal };
+        let c = align_phase_offset(g, &model.model, &inp, mag, fs, &model.fit_options)?;
+        phase.iter_mut().for_each(|p| *p += c);
+    }
+    let inp = RotorInput { b_body_nt: &b, phase_rad: &phase, omega_rad_s: &omega, angles: &nominal };
+    let opts = if estimated { tracking_with_phase(&model.slow_angles) } else { model.slow_angles };
+    let slow = track_slow_angles(g, &model.model, &inp, mag, fs, &model.fit_options, &opts)?;
+    Ok(TrackedSegment { b, omega, phase: slow.phase_rad, angles: slow.angles })
 }
 
 
@@ -539,4 +631,26 @@ pub fn apply(a: ApplyArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dropouts_are_bridged_but_not_time_gaps_or_long_runs() {
+        let t: Vec<f64> = (0..10).map(|k| k as f64 * 0.01).collect();
+        let nan = f64::NAN;
+        let x = [0.0, 1.0, nan, 3.0, nan, nan, nan, 7.0, 8.0, nan];
+        let y = bridge_dropouts(&t, &x, 2, None);
+        assert_eq!(y[2], 2.0);
+        assert!(y[4].is_nan() && y[5].is_nan() && y[6].is_nan(), "a run of 3 > 2 stays");
+        assert!(y[9].is_nan(), "no value after the run");
+        // A phase in degrees is interpolated the short way round 360°.
+        let p = bridge_dropouts(&t[..3], &[350.0, nan, 10.0], 1, Some(360.0));
+        assert!((p[1] - 360.0).abs() < 1e-9, "{}", p[1]);
+        // A time gap across the run: left alone.
+        let tg = [0.0, 0.01, 0.02, 0.5, 0.51];
+        assert!(bridge_dropouts(&tg, &[0.0, 1.0, nan, 3.0, 4.0], 2, None)[2].is_nan());
+    }
 }

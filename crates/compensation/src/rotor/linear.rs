@@ -198,33 +198,58 @@ pub fn fit_columns(
     fs_hz: f64,
     opts: &RotorFitOptions,
 ) -> Result<RotorFit> {
-    let n = mag_nt.len();
-    if cols.iter().any(|c| c.len() != n) {
-        return Err(CompError::BadData(
-            "rotor fit: regressors and data differ in length".into(),
-        ));
+    fit_records(&[(cols, mag_nt)], terms, fs_hz, opts)
+}
+
+/// Fit one set of parameters to several records (stretches of a flight
+/// between gaps), each given as its regressor columns and reading: every
+/// record is high-passed on its own and loses `edge_s` at both ends, and
+/// the normal equations of all records are summed. The residual is the RMS
+/// over all the rows used.
+pub fn fit_records(
+    records: &[(&[Vec<f64>], &[f64])],
+    terms: BladeTerms,
+    fs_hz: f64,
+    opts: &RotorFitOptions,
+) -> Result<RotorFit> {
+    let p = records.first().map_or(0, |r| r.0.len());
+    if p == 0 {
+        return Err(CompError::BadData("rotor fit: no regressors".into()));
     }
     let edge = (opts.edge_s * fs_hz).round() as usize;
-    if n <= 2 * edge + 10 * cols.len() {
+    let mut ne = NormalEquations::new(p);
+    for (cols, mag_nt) in records {
+        let n = mag_nt.len();
+        if cols.len() != p || cols.iter().any(|c| c.len() != n) {
+            return Err(CompError::BadData(
+                "rotor fit: regressors and data differ in length".into(),
+            ));
+        }
+        if n <= 2 * edge + 10 * p {
+            if records.len() == 1 {
+                return Err(CompError::BadData("rotor fit: too few samples".into()));
+            }
+            continue;
+        }
+        let hp: Vec<Vec<f64>> = cols
+            .iter()
+            .map(|c| highpass(c, fs_hz, opts.highpass_hz))
+            .collect::<Result<_>>()?;
+        let y = highpass(mag_nt, fs_hz, opts.highpass_hz)?;
+        let slices: Vec<&[f64]> = hp.iter().map(|c| &c[edge..n - edge]).collect();
+        ne.add_columns(&slices, &y[edge..n - edge])
+            .map_err(|e| CompError::BadData(format!("rotor fit: {e}")))?;
+    }
+    if ne.rows() == 0 {
         return Err(CompError::BadData("rotor fit: too few samples".into()));
     }
-    let hp: Vec<Vec<f64>> = cols
-        .iter()
-        .map(|c| highpass(c, fs_hz, opts.highpass_hz))
-        .collect::<Result<_>>()?;
-    let y = highpass(mag_nt, fs_hz, opts.highpass_hz)?;
-    let mut ne = NormalEquations::new(cols.len());
-    let slices: Vec<&[f64]> = hp.iter().map(|c| &c[edge..n - edge]).collect();
-    ne.add_columns(&slices, &y[edge..n - edge])
-        .map_err(|e| CompError::BadData(format!("rotor fit: {e}")))?;
     let sol = ne
         .solve(opts.ridge)
         .map_err(|e| CompError::BadData(format!("rotor fit failed: {e}")))?;
-    let rows = (n - 2 * edge) as f64;
     Ok(RotorFit {
         terms,
         params: sol.coef.iter().copied().collect(),
-        residual_rms_nt: (sol.rss.max(0.0) / rows).sqrt(),
+        residual_rms_nt: (sol.rss.max(0.0) / ne.rows() as f64).sqrt(),
     })
 }
 

@@ -81,7 +81,7 @@ pub mod synchronous;
 
 pub use blade::{FlapAngles, RotorGeometry, blade_axes, dipole_integral};
 pub use coning::{SlowAngleFit, SlowAngleOptions, fit_slow_angles, track_slow_angles};
-pub use linear::{BladeTerms, RotorFit, RotorFitOptions, RotorInput, fit, regressors};
+pub use linear::{BladeTerms, RotorFit, RotorFitOptions, RotorInput, fit, fit_records, regressors};
 pub use phase::{PhaseEstimate, estimate_phase, rotor_speed, unwrap_deg};
 
 use crate::error::Result;
