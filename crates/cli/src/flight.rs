@@ -143,10 +143,13 @@ pub fn add_compensation(table: &mut FlightTable, interf_col: &str, flag_col: &st
     Ok(missing)
 }
 
-/// Read a model file and check its format and `kind` (`writer`: the command
-/// that writes that kind, for the message); bad input names the file.
-pub fn read_model(path: &std::path::Path, kind: &str, writer: &str) -> anyhow::Result<serde_json::Value> {
+/// Read a model file and parse it with `parse` (a `from_json(text, origin)`
+/// of the library's model types); any failure is bad input naming the file.
+pub fn load_model_file<T>(
+    path: &std::path::Path,
+    parse: impl FnOnce(&str, &str) -> Result<T, aeromag_compensation::CompError>,
+) -> anyhow::Result<T> {
     let origin = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
-    aeromag_compensation::model_file::parse_model_json(&text, &origin, kind, writer).map_err(|e| bad_input!("{e}"))
+    parse(&text, &origin).map_err(|e| bad_input!("{e}"))
 }

@@ -40,6 +40,13 @@ pub fn parse_model_json(text: &str, origin: &str, kind: &str, writer: &str) -> R
     }
 }
 
+/// A model file of `kind` parsed into `T` after the header check of
+/// [`parse_model_json`]; errors name `origin`.
+pub fn parse_model<T: serde::de::DeserializeOwned>(text: &str, origin: &str, kind: &str, writer: &str) -> Result<T> {
+    let v = parse_model_json(text, origin, kind, writer)?;
+    serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid `{kind}` model: {e}")))
+}
+
 /// One named coefficient.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Coefficient {

@@ -1,6 +1,5 @@
 //! `aeromag compensate`: apply a model file to flight data.
 
-use crate::exit::bad_input;
 use crate::flight::add_compensation;
 use crate::flight::TlColumns;
 use crate::input::InputArgs;
@@ -34,8 +33,7 @@ pub struct Args {
 
 /// Read and check a model file.
 pub fn load_model(path: &std::path::Path) -> anyhow::Result<TlModel> {
-    let text = std::fs::read_to_string(path).map_err(|e| bad_input!("cannot read model file '{}': {e}", path.display()))?;
-    TlModel::from_json(&text, &path.display().to_string()).map_err(|e| bad_input!("{e}"))
+    crate::flight::load_model_file(path, TlModel::from_json)
 }
 
 /// Modelled interference for every row (NaN where an input is missing) and

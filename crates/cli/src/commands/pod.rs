@@ -41,15 +41,13 @@ use aeromag_compensation::pod::{
 use aeromag_core::frames::{Attitude, Geodetic};
 use aeromag_io::FlightTable;
 use aeromag_report::{LinePlot, Series, Table};
-use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use aeromag_compensation::model_file::MODEL_FORMAT;
-/// `kind` of a pod model file.
-pub const POD_KIND: &str = "towed-pod";
+pub use aeromag_compensation::pod::model_file::{HeadingRate, PodMethod, PodModelFile, PodSetup, POD_KIND};
 /// Shortest heading processed, s.
 const MIN_HEADING_S: f64 = 10.0;
 
@@ -65,33 +63,6 @@ pub struct Args {
 enum Sub {
     Fit(FitArgs),
     Apply(ApplyArgs),
-}
-
-/// The solve of `aeromag pod fit`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum PodMethod {
-    /// The seed's two-step solve (heading coefficients, then parameters).
-    TwoStep,
-    /// One least-squares fit of the large-signal model (43 + 24 eddy
-    /// gradient parameters) over all samples.
-    Joint,
-    /// Equivalent dipole array, exact field at the pod.
-    DipoleArray,
-}
-
-impl PodMethod {
-    /// Every method, in report order.
-    pub const ALL: [PodMethod; 3] = [Self::TwoStep, Self::Joint, Self::DipoleArray];
-
-    /// Name on the command line and in the model file.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::TwoStep => "two-step",
-            Self::Joint => "joint",
-            Self::DipoleArray => "dipole-array",
-        }
-    }
 }
 
 /// Fit the pod interference model on a learning flight.
@@ -117,7 +88,7 @@ pub struct FitArgs {
     #[arg(long, value_name = "POD.json")]
     model: PathBuf,
     /// Solve: two-step (seed), joint, dipole-array.
-    #[arg(long, value_enum, default_value = "dipole-array")]
+    #[arg(long, default_value = "dipole-array", value_parser = str::parse::<PodMethod>)]
     method: PodMethod,
     /// Cable length, m.
     #[arg(long)]
@@ -169,70 +140,6 @@ pub struct ApplyArgs {
     /// Output CSV file.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
-}
-
-/// Installation and field parameters shared by fit and apply.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PodSetup {
-    /// Cable length, m.
-    pub cable_length_m: f64,
-    /// Attachment point, body axes, m.
-    pub attach_m: [f64; 3],
-    /// Field inclination, deg.
-    pub inclination_deg: f64,
-    /// Field declination from the yaw reference, deg.
-    pub declination_deg: f64,
-    /// North gradient `k_x`, nT/km.
-    pub grad_north_nt_per_km: f64,
-    /// Upward gradient `k_h`, nT/km.
-    pub grad_up_nt_per_km: f64,
-}
-
-/// Compensation rate of one heading (fraction).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct HeadingRate {
-    /// Mean heading (circular mean of yaw), deg in [0, 360).
-    pub heading_deg: f64,
-    /// First and one-past-last data row (0-based).
-    pub rows: [usize; 2],
-    /// `1 − RMS(after)/RMS(before)`, high-passed.
-    pub rate: f64,
-}
-
-/// The pod model file (versioned JSON).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PodModelFile {
-    /// Always [`MODEL_FORMAT`].
-    pub format: String,
-    /// Always [`POD_KIND`].
-    pub kind: String,
-    /// The solve.
-    pub method: PodMethod,
-    /// Pod trajectory: `seed-eq7-8` (two-step) or `exact`.
-    pub trajectory: String,
-    /// Installation and field.
-    pub setup: PodSetup,
-    /// Coefficient names (model parameters `θ`, or per source point
-    /// permanent `m`, induced `X` and eddy `E` moments).
-    pub coefficient_names: Vec<String>,
-    /// Coefficients: nT per direction cosine (and per m, per 1/s) for `θ`,
-    /// A·m² per direction cosine (and per 1/s) for the dipole array.
-    pub coefficients: Vec<f64>,
-    /// Equivalent source points (dipole array only), body axes, m.
-    pub sources_m: Vec<[f64; 3]>,
-    /// Reference pod position of the joint solve's expansion, body axes, m
-    /// (zeros for the other methods).
-    pub reference_m: [f64; 3],
-    /// Step 1 of the two-step solve: `W1..W7` per learning heading.
-    pub heading_coefficients: Vec<[f64; 7]>,
-    /// Compensation rate per learning heading.
-    pub learning: Vec<HeadingRate>,
-    /// Sample rate, Hz.
-    pub sample_rate_hz: f64,
-    /// Input columns used (canonical name → file column name).
-    pub columns: BTreeMap<String, String>,
-    /// Version of aeromag that wrote the file.
-    pub software_version: String,
 }
 
 /// Names of the 43 small-signal parameters (`aeromag_compensation::pod::
@@ -532,42 +439,7 @@ pub fn apply_table(
 
 /// Read and check a pod model file.
 pub fn load_model(path: &Path) -> anyhow::Result<PodModelFile> {
-    let origin = path.display();
-    let v = crate::flight::read_model(path, POD_KIND, "aeromag pod fit")?;
-    let m: PodModelFile =
-        serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid pod model: {e}"))?;
-    if m.coefficients.len() != m.coefficient_names.len()
-        || m.coefficients.iter().any(|c| !c.is_finite())
-    {
-        return Err(bad_input!(
-            "{origin}: coefficients and names differ in number or are not finite"
-        ));
-    }
-    Ok(m)
-}
-
-fn check_setup(s: &PodSetup) -> anyhow::Result<()> {
-    if !(s.cable_length_m.is_finite() && s.cable_length_m > 0.0) {
-        return Err(bad_input!(
-            "--cable-length-m {} must be positive",
-            s.cable_length_m
-        ));
-    }
-    if !(s.inclination_deg.is_finite() && s.inclination_deg.abs() < 90.0) {
-        return Err(bad_input!(
-            "--inclination-deg {} must be in (−90, 90)",
-            s.inclination_deg
-        ));
-    }
-    let rest = [
-        s.declination_deg,
-        s.grad_north_nt_per_km,
-        s.grad_up_nt_per_km,
-    ];
-    if rest.iter().any(|x| !x.is_finite()) {
-        return Err(bad_input!("declination and gradients must be finite"));
-    }
-    Ok(())
+    crate::flight::load_model_file(path, PodModelFile::from_json)
 }
 
 fn print_rates(label: &str, r: &[HeadingRate]) {
@@ -592,7 +464,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
         grad_north_nt_per_km: a.grad_north_nt_per_km,
         grad_up_nt_per_km: a.grad_up_nt_per_km,
     };
-    check_setup(&setup)?;
+    setup.validate().map_err(|e| bad_input!("{e}"))?;
     let sources = a
         .source_points
         .as_deref()

@@ -26,21 +26,19 @@ use crate::flight::{add_compensation, parse_numbers};
 use crate::input::InputArgs;
 use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
 use aeromag_compensation::rotor::{
-    BladeTerms, FlapAngles, RotorFit, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
+    BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
     align_phase_offset, estimate_phase, fit_records, fit_slow_angles, refine_phase_offset, regressors,
     rotor_speed, track_slow_angles, unwrap_deg,
 };
 use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments};
 use aeromag_io::FlightTable;
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use aeromag_compensation::model_file::MODEL_FORMAT;
-/// `kind` of a rotor model file.
-pub const ROTOR_KIND: &str = "helicopter-rotor";
+pub use aeromag_compensation::rotor::model_file::{PhaseSource, RotorModelFile, ROTOR_KIND};
 /// Longest dropout (consecutive rows with a missing value, time steps
 /// regular) that `rotor fit` bridges by linear interpolation, s.
 const MAX_FILL_S: f64 = 0.1;
@@ -172,53 +170,6 @@ pub struct ApplyArgs {
     /// Output CSV file.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
-}
-
-/// Where the rotor phase comes from.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PhaseSource {
-    /// Phase channel (canonical name in the fitted file), or `null` when
-    /// the phase is estimated from the scalar data.
-    pub column: Option<String>,
-    /// Search band of the rotor frequency for the estimate, Hz.
-    pub rotor_hz_range: [f64; 2],
-}
-
-/// The rotor model file (versioned JSON).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RotorModelFile {
-    /// Always [`MODEL_FORMAT`].
-    pub format: String,
-    /// Always [`ROTOR_KIND`].
-    pub kind: String,
-    /// Rotor and sensor geometry.
-    pub geometry: RotorGeometry,
-    /// Nominal cone angles (start of the slowly varying estimate), rad.
-    pub nominal_angles: FlapAngles,
-    /// Blade terms, parameters (regressor order of
-    /// `aeromag_compensation::rotor::regressors`) and the RMS of the
-    /// high-passed fit residual (nT).
-    pub model: RotorFit,
-    /// High-pass and edge options of the fit.
-    pub fit_options: RotorFitOptions,
-    /// Options of the slowly varying angles (of the final fit, and of the
-    /// tracking on new data, where a phase estimated from the data is also
-    /// corrected slowly).
-    pub slow_angles: SlowAngleOptions,
-    /// Phase channel or estimate.
-    pub phase: PhaseSource,
-    /// Sample rate of the fitted record, Hz.
-    pub sample_rate_hz: f64,
-    /// Mean rotor frequency of the fitted record, Hz.
-    pub rotor_hz: f64,
-    /// Mean estimated coning of the fitted record, deg.
-    pub coning_mean_deg: f64,
-    /// Rows fitted.
-    pub rows: usize,
-    /// Input columns used (canonical name → file column name).
-    pub columns: BTreeMap<String, String>,
-    /// Version of aeromag that wrote the file.
-    pub software_version: String,
 }
 
 /// Sample rate from the median time step, Hz (bad input without two
@@ -532,21 +483,7 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
 
 /// Read and check a rotor model file.
 pub fn load_model(path: &Path) -> anyhow::Result<RotorModelFile> {
-    let origin = path.display();
-    let v = crate::flight::read_model(path, ROTOR_KIND, "aeromag rotor fit")?;
-    let m: RotorModelFile =
-        serde_json::from_value(v).map_err(|e| bad_input!("{origin}: invalid rotor model: {e}"))?;
-    m.geometry
-        .validate()
-        .map_err(|e| bad_input!("{origin}: {e}"))?;
-    let expect = m.geometry.blades * m.model.terms.per_blade();
-    if m.model.params.len() != expect || m.model.params.iter().any(|p| !p.is_finite()) {
-        return Err(bad_input!(
-            "{origin}: expected {expect} finite rotor parameters, got {}",
-            m.model.params.len()
-        ));
-    }
-    Ok(m)
+    crate::flight::load_model_file(path, RotorModelFile::from_json)
 }
 
 /// Modelled rotor interference for every row (NaN where not compensated)

@@ -123,6 +123,7 @@
 pub mod dipole_array;
 pub mod fit;
 pub mod model;
+pub mod model_file;
 pub mod trajectory;
 
 pub use dipole_array::{

@@ -72,6 +72,7 @@ pub mod blade;
 pub mod coning;
 pub mod linear;
 pub mod lowpass;
+pub mod model_file;
 pub mod notch;
 pub mod phase;
 #[cfg(test)]

@@ -1,0 +1,205 @@
+//! The pod model file (`aeromag-model/1`, kind `towed-pod`): what `aeromag
+//! pod fit` writes and `pod apply` reads, so that library callers can read
+//! and write the same files.
+
+use crate::error::{CompError, Result};
+use crate::model_file::parse_model;
+#[cfg(test)]
+use crate::model_file::MODEL_FORMAT;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::str::FromStr;
+
+/// `kind` of a pod model file.
+pub const POD_KIND: &str = "towed-pod";
+
+/// The solve of `aeromag pod fit`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PodMethod {
+    /// The seed's two-step solve (heading coefficients, then parameters).
+    TwoStep,
+    /// One least-squares fit of the large-signal model (43 + 24 eddy
+    /// gradient parameters) over all samples.
+    Joint,
+    /// Equivalent dipole array, exact field at the pod.
+    DipoleArray,
+}
+
+impl PodMethod {
+    /// Every method, in report order.
+    pub const ALL: [PodMethod; 3] = [Self::TwoStep, Self::Joint, Self::DipoleArray];
+
+    /// Name on the command line and in the model file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::TwoStep => "two-step",
+            Self::Joint => "joint",
+            Self::DipoleArray => "dipole-array",
+        }
+    }
+}
+
+
+impl FromStr for PodMethod {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("`{s}`: use two-step, joint or dipole-array"))
+    }
+}
+
+/// Installation and field parameters shared by fit and apply.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PodSetup {
+    /// Cable length, m.
+    pub cable_length_m: f64,
+    /// Attachment point, body axes, m.
+    pub attach_m: [f64; 3],
+    /// Field inclination, deg.
+    pub inclination_deg: f64,
+    /// Field declination from the yaw reference, deg.
+    pub declination_deg: f64,
+    /// North gradient `k_x`, nT/km.
+    pub grad_north_nt_per_km: f64,
+    /// Upward gradient `k_h`, nT/km.
+    pub grad_up_nt_per_km: f64,
+}
+
+/// Compensation rate of one heading (fraction).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HeadingRate {
+    /// Mean heading (circular mean of yaw), deg in [0, 360).
+    pub heading_deg: f64,
+    /// First and one-past-last data row (0-based).
+    pub rows: [usize; 2],
+    /// `1 − RMS(after)/RMS(before)`, high-passed.
+    pub rate: f64,
+}
+
+/// The pod model file (versioned JSON).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PodModelFile {
+    /// Always [`MODEL_FORMAT`].
+    pub format: String,
+    /// Always [`POD_KIND`].
+    pub kind: String,
+    /// The solve.
+    pub method: PodMethod,
+    /// Pod trajectory: `seed-eq7-8` (two-step) or `exact`.
+    pub trajectory: String,
+    /// Installation and field.
+    pub setup: PodSetup,
+    /// Coefficient names (model parameters `θ`, or per source point
+    /// permanent `m`, induced `X` and eddy `E` moments).
+    pub coefficient_names: Vec<String>,
+    /// Coefficients: nT per direction cosine (and per m, per 1/s) for `θ`,
+    /// A·m² per direction cosine (and per 1/s) for the dipole array.
+    pub coefficients: Vec<f64>,
+    /// Equivalent source points (dipole array only), body axes, m.
+    pub sources_m: Vec<[f64; 3]>,
+    /// Reference pod position of the joint solve's expansion, body axes, m
+    /// (zeros for the other methods).
+    pub reference_m: [f64; 3],
+    /// Step 1 of the two-step solve: `W1..W7` per learning heading.
+    pub heading_coefficients: Vec<[f64; 7]>,
+    /// Compensation rate per learning heading.
+    pub learning: Vec<HeadingRate>,
+    /// Sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Input columns used (canonical name → file column name).
+    pub columns: BTreeMap<String, String>,
+    /// Version of aeromag that wrote the file.
+    pub software_version: String,
+}
+
+impl PodSetup {
+    /// Check the values: a positive cable length (m), an inclination in
+    /// (−90°, 90°), a finite declination and finite gradients.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(CompError::BadData(m));
+        if !(self.cable_length_m.is_finite() && self.cable_length_m > 0.0) {
+            return bad(format!("cable length {} m must be positive", self.cable_length_m));
+        }
+        if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
+            return bad(format!("inclination {}° must be in (−90, 90)", self.inclination_deg));
+        }
+        if [self.declination_deg, self.grad_north_nt_per_km, self.grad_up_nt_per_km].iter().any(|x| !x.is_finite()) {
+            return bad("declination and gradients must be finite".into());
+        }
+        Ok(())
+    }
+}
+
+impl PodModelFile {
+    /// Read a model file's text (`origin` names it in errors): header,
+    /// fields and [`Self::validate`].
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        let m: Self = parse_model(text, origin, POD_KIND, "aeromag pod fit")?;
+        m.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        Ok(m)
+    }
+
+    /// Check the content: as many finite coefficients as names, and the
+    /// setup.
+    pub fn validate(&self) -> Result<()> {
+        if self.coefficients.len() != self.coefficient_names.len()
+            || self.coefficients.iter().any(|c| !c.is_finite())
+        {
+            return Err(CompError::BadData(
+                "coefficients and names differ in number or are not finite".into(),
+            ));
+        }
+        self.setup.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn methods_parse_by_name_and_models_are_checked() {
+        for m in PodMethod::ALL {
+            assert_eq!(m.name().parse::<PodMethod>().unwrap(), m);
+            assert_eq!(serde_json::to_string(&m).unwrap(), format!("\"{}\"", m.name()));
+        }
+        assert!("three-step".parse::<PodMethod>().is_err());
+        let setup = PodSetup {
+            cable_length_m: 40.0,
+            attach_m: [0.0, 0.0, 1.2],
+            inclination_deg: 45.0,
+            declination_deg: 0.0,
+            grad_north_nt_per_km: 5.91,
+            grad_up_nt_per_km: -25.91,
+        };
+        let m = PodModelFile {
+            format: MODEL_FORMAT.into(),
+            kind: POD_KIND.into(),
+            method: PodMethod::Joint,
+            trajectory: "exact".into(),
+            setup,
+            coefficient_names: vec!["a".into(), "b".into()],
+            coefficients: vec![1.0, 2.0],
+            sources_m: vec![],
+            reference_m: [0.0; 3],
+            heading_coefficients: vec![],
+            learning: vec![],
+            sample_rate_hz: 20.0,
+            columns: BTreeMap::new(),
+            software_version: "test".into(),
+        };
+        m.validate().unwrap();
+        assert_eq!(PodModelFile::from_json(&serde_json::to_string(&m).unwrap(), "p.json").unwrap(), m);
+        let back: PodModelFile = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(back, m);
+        let mut bad = m.clone();
+        bad.coefficients.push(3.0);
+        assert!(bad.validate().is_err());
+        let mut bad = m;
+        bad.setup.cable_length_m = -1.0;
+        assert!(bad.validate().unwrap_err().to_string().contains("cable length"));
+    }
+}

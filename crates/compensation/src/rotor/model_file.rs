@@ -1,0 +1,134 @@
+//! The rotor model file (`aeromag-model/1`, kind `helicopter-rotor`): what
+//! `aeromag rotor fit` writes and `rotor apply` reads, so that library
+//! callers can read and write the same files.
+
+use super::blade::{FlapAngles, RotorGeometry};
+use super::coning::SlowAngleOptions;
+use super::linear::{RotorFit, RotorFitOptions};
+use crate::error::{CompError, Result};
+use crate::model_file::parse_model;
+#[cfg(test)]
+use crate::model_file::MODEL_FORMAT;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// `kind` of a rotor model file.
+pub const ROTOR_KIND: &str = "helicopter-rotor";
+
+/// Where the rotor phase comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PhaseSource {
+    /// Phase channel (canonical name in the fitted file), or `null` when
+    /// the phase is estimated from the scalar data.
+    pub column: Option<String>,
+    /// Search band of the rotor frequency for the estimate, Hz.
+    pub rotor_hz_range: [f64; 2],
+}
+
+/// The rotor model file (versioned JSON).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RotorModelFile {
+    /// Always [`MODEL_FORMAT`].
+    pub format: String,
+    /// Always [`ROTOR_KIND`].
+    pub kind: String,
+    /// Rotor and sensor geometry.
+    pub geometry: RotorGeometry,
+    /// Nominal cone angles (start of the slowly varying estimate), rad.
+    pub nominal_angles: FlapAngles,
+    /// Blade terms, parameters (regressor order of
+    /// `aeromag_compensation::rotor::regressors`) and the RMS of the
+    /// high-passed fit residual (nT).
+    pub model: RotorFit,
+    /// High-pass and edge options of the fit.
+    pub fit_options: RotorFitOptions,
+    /// Options of the slowly varying angles (of the final fit, and of the
+    /// tracking on new data, where a phase estimated from the data is also
+    /// corrected slowly).
+    pub slow_angles: SlowAngleOptions,
+    /// Phase channel or estimate.
+    pub phase: PhaseSource,
+    /// Sample rate of the fitted record, Hz.
+    pub sample_rate_hz: f64,
+    /// Mean rotor frequency of the fitted record, Hz.
+    pub rotor_hz: f64,
+    /// Mean estimated coning of the fitted record, deg.
+    pub coning_mean_deg: f64,
+    /// Rows fitted.
+    pub rows: usize,
+    /// Input columns used (canonical name → file column name).
+    pub columns: BTreeMap<String, String>,
+    /// Version of aeromag that wrote the file.
+    pub software_version: String,
+}
+
+impl RotorModelFile {
+    /// Read a model file's text (`origin` names it in errors): header,
+    /// fields and [`Self::validate`].
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        let m: Self = parse_model(text, origin, ROTOR_KIND, "aeromag rotor fit")?;
+        m.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        Ok(m)
+    }
+
+    /// Check the content: geometry, and `blades × per-blade` finite
+    /// parameters.
+    pub fn validate(&self) -> Result<()> {
+        self.geometry.validate()?;
+        let expect = self.geometry.blades * self.model.terms.per_blade();
+        if self.model.params.len() != expect || self.model.params.iter().any(|p| !p.is_finite()) {
+            return Err(CompError::BadData(format!(
+                "expected {expect} finite rotor parameters, got {}",
+                self.model.params.len()
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rotor::linear::BladeTerms;
+    use crate::rotor::study::{nominal_angles, scenario_geometry};
+
+    fn model() -> RotorModelFile {
+        let geometry = scenario_geometry();
+        let n = geometry.blades * BladeTerms::Full.per_blade();
+        RotorModelFile {
+            format: MODEL_FORMAT.into(),
+            kind: ROTOR_KIND.into(),
+            geometry,
+            nominal_angles: nominal_angles(),
+            model: RotorFit { terms: BladeTerms::Full, params: vec![0.5; n], residual_rms_nt: 0.1 },
+            fit_options: RotorFitOptions::default(),
+            slow_angles: SlowAngleOptions::default(),
+            phase: PhaseSource { column: None, rotor_hz_range: [4.0, 6.0] },
+            sample_rate_hz: 100.0,
+            rotor_hz: 4.8,
+            coning_mean_deg: 4.0,
+            rows: 1000,
+            columns: BTreeMap::new(),
+            software_version: "test".into(),
+        }
+    }
+
+    #[test]
+    fn round_trips_and_rejects_what_is_not_a_rotor_model() {
+        let m = model();
+        m.validate().unwrap();
+        let back: RotorModelFile = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(back, m);
+        let mut wrong = m.clone();
+        wrong.kind = "towed-pod".into();
+        let e = RotorModelFile::from_json(&serde_json::to_string(&wrong).unwrap(), "x.json").unwrap_err();
+        assert!(e.to_string().contains("towed-pod"), "{e}");
+        assert_eq!(RotorModelFile::from_json(&serde_json::to_string(&m).unwrap(), "x.json").unwrap(), m);
+        let mut short = m.clone();
+        short.model.params.pop();
+        assert!(short.validate().unwrap_err().to_string().contains("finite rotor parameters"));
+        let mut nan = m;
+        nan.model.params[0] = f64::NAN;
+        assert!(nan.validate().is_err());
+    }
+}
