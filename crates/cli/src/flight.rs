@@ -143,6 +143,30 @@ pub fn add_compensation(table: &mut FlightTable, interf_col: &str, flag_col: &st
     Ok(missing)
 }
 
+/// Write a compensated `table` to `out` and tell the user: a warning for
+/// the `missing` rows (`why` they could not be compensated; kept with
+/// `flag_col` = 1) and a summary naming the `model` file, with `detail` in
+/// parentheses when not empty. Used by `compensate`, `rotor apply` and
+/// `pod apply`.
+pub fn write_compensated(
+    table: &FlightTable,
+    out: &std::path::Path,
+    model: &std::path::Path,
+    detail: &str,
+    missing: usize,
+    flag_col: &str,
+    why: &str,
+) -> anyhow::Result<()> {
+    aeromag_io::write_csv(table, out)?;
+    let n = table.n_rows();
+    if missing > 0 {
+        eprintln!("warning: {missing} of {n} rows could not be compensated ({why}); they are kept with {flag_col} = 1");
+    }
+    let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
+    println!("compensated {} of {n} rows with {}{detail}; written to {}", n - missing, model.display(), out.display());
+    Ok(())
+}
+
 /// Read a model file and parse it with `parse` (a `from_json(text, origin)`
 /// of the library's model types); any failure is bad input naming the file.
 pub fn load_model_file<T>(

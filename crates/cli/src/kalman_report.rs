@@ -41,7 +41,7 @@ pub fn kalman_section(heading: &str, table: &FlightTable, ls: &TlModel, kalman: 
         f.rows,
         f.runs
     )));
-    if k.rows.len() == 5 {
+    if k.rows.len() == crate::commands::calibrate::KALMAN_SERIES.len() {
         let time = table.require("time")?;
         let t0 = time.iter().copied().find(|t| t.is_finite()).unwrap_or(0.0);
         let used: Vec<usize> = (0..time.len()).filter(|&i| k.rows[2][i].is_finite()).collect();

@@ -13,9 +13,10 @@ use aeromag_compensation::tolles_lawson::lag_select::{
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
 use aeromag_compensation::kalman::{
     NoiseModel,
-    fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment,
+    fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries,
 };
 use aeromag_io::FlightTable;
+use std::ops::Range;
 use std::path::PathBuf;
 
 /// Fit the aircraft's magnetic interference model (Tolles-Lawson / Leliak)
@@ -342,6 +343,17 @@ fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
     })
 }
 
+/// One series of a Kalman fit (`pick` from each segment's [`KalmanSeries`])
+/// placed on the `n` rows of the table the segments `segs` come from; NaN on
+/// the other rows.
+fn on_rows(n: usize, segs: &[Range<usize>], series: &[KalmanSeries], pick: impl Fn(&KalmanSeries) -> &[f64]) -> Vec<f64> {
+    let mut out = vec![f64::NAN; n];
+    for (r, s) in segs.iter().zip(series) {
+        out[r.clone()].copy_from_slice(pick(s));
+    }
+    out
+}
+
 /// Names of the per-row series of the Kalman method ([`fit_model_kalman`]).
 pub const KALMAN_SERIES: [&str; 5] =
     ["kalman_reading", "kalman_compensated", "kalman_field", "kalman_innovation", "kalman_innovation_std"];
@@ -365,23 +377,20 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
         .collect();
     let fail = |e: aeromag_compensation::CompError| bad_input!("{}: {e}", table.file_label());
     // `auto` chooses the lags with the band-pass LS machinery on the same
-    // legs, after a first Kalman pass without lags has removed its smoothed
-    // field: over geology the band-pass leaves part of the anomaly field in
-    // the band, where it hides lagged eddy currents (or buys a spurious slow
-    // lag); the field model takes it out first.
+    // legs, after a first Kalman pass (with the bracketing lags
+    // PASS1_LAGS_S) has removed its smoothed field: over geology the
+    // band-pass leaves part of the anomaly field in the band, where it hides
+    // lagged eddy currents (or buys a spurious slow lag); the field model
+    // takes it out first.
     let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
     let (terms, selection) = match opts.eddy_lag {
         EddyLag::Auto if cfg.terms.has_eddy() => {
-            let spinner = crate::progress::spinner("Kalman pass without lags");
-            let classical = KalmanConfig { terms: cfg.terms.with_eddy_lags(&PASS1_LAGS_S).map_err(fail)?, compute_series: true, ..cfg.clone() };
-            let first = fit_kalman(&segments, &classical).map_err(fail)?;
+            let spinner = crate::progress::spinner("Kalman pass 1: removing the field");
+            let pass1 = KalmanConfig { terms: cfg.terms.with_eddy_lags(&PASS1_LAGS_S).map_err(fail)?, compute_series: true, ..cfg.clone() };
+            let first = fit_kalman(&segments, &pass1).map_err(fail)?;
             spinner.finish_and_clear();
-            let mut y_field_removed = vec![f64::NAN; y.len()];
-            for (r, series) in segs.iter().zip(&first.series) {
-                for (k, i) in r.clone().enumerate() {
-                    y_field_removed[i] = y[i] - series.external_nt[k];
-                }
-            }
+            let field = on_rows(y.len(), &segs, &first.series, |s| &s.external_nt);
+            let y_field_removed: Vec<f64> = y.iter().zip(&field).map(|(a, b)| a - b).collect();
             let reduced = TlColumns { mag: &y_field_removed, ..cols };
             let (rsegs, _) = reduced.segments(opts.split_lines, 1);
             let data: Vec<Segment> = rsegs.iter().map(|r| whole(&reduced).slice(r.clone())).collect();
@@ -396,18 +405,19 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     let spinner = crate::progress::spinner("Kalman filter and smoother");
     let fit = fit_kalman(&segments, cfg).map_err(fail)?;
     spinner.finish_and_clear();
-    let mut rows: Vec<Vec<f64>> = Vec::new();
-    if !fit.series.is_empty() {
-        rows = vec![vec![f64::NAN; y.len()]; KALMAN_SERIES.len()];
-        for (r, s) in segs.iter().zip(&fit.series) {
-            for (k, i) in r.clone().enumerate() {
-                let v = [y[i], s.compensated_nt[k], s.external_nt[k], s.innovation_nt[k], s.innovation_std_nt[k]];
-                for (col, v) in rows.iter_mut().zip(v) {
-                    col[i] = v;
-                }
-            }
-        }
-    }
+    let rows: Vec<Vec<f64>> = if fit.series.is_empty() {
+        Vec::new()
+    } else {
+        let compensated = on_rows(y.len(), &segs, &fit.series, |s| &s.compensated_nt);
+        let reading = y.iter().zip(&compensated).map(|(v, c)| if c.is_nan() { f64::NAN } else { *v }).collect();
+        vec![
+            reading,
+            compensated,
+            on_rows(y.len(), &segs, &fit.series, |s| &s.external_nt),
+            on_rows(y.len(), &segs, &fit.series, |s| &s.innovation_nt),
+            on_rows(y.len(), &segs, &fit.series, |s| &s.innovation_std_nt),
+        ]
+    };
     for w in &fit.warnings {
         eprintln!("warning: {w}");
     }

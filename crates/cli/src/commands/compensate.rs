@@ -65,19 +65,7 @@ pub fn compensate_table(model: &TlModel, table: &mut FlightTable) -> anyhow::Res
 pub fn run(a: Args) -> anyhow::Result<()> {
     let model = load_model(&a.model)?;
     let mut table = a.input.load()?;
-    let n = table.n_rows();
     let missing = compensate_table(&model, &mut table)?;
-    aeromag_io::write_csv(&table, &a.out)?;
-    if missing > 0 {
-        eprintln!("warning: {missing} of {n} rows could not be compensated (missing values); they are kept with comp_flag = 1");
-    }
-    println!(
-        "compensated {} of {n} rows with {} ({} terms, method {}); written to {}",
-        n - missing,
-        a.model.display(),
-        model.terms,
-        model.method,
-        a.out.display()
-    );
-    Ok(())
+    let detail = format!("{} terms, method {}", model.terms, model.method);
+    crate::flight::write_compensated(&table, &a.out, &a.model, &detail, missing, "comp_flag", "missing values")
 }

@@ -493,23 +493,10 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     let model = load_model(&a.model)?;
     let mut t = a.input.load()?;
-    let n = t.n_rows();
     let (interf, r) = apply_table(&model, &t)?;
     let missing = add_compensation(&mut t, "pod_interf", "pod_flag", interf)?;
-    aeromag_io::write_csv(&t, &a.out)?;
-    if missing > 0 {
-        eprintln!(
-            "warning: {missing} of {n} rows could not be compensated (missing values or headings under \
-             {MIN_HEADING_S} s); they are kept with pod_flag = 1"
-        );
-    }
-    println!(
-        "compensated {} of {n} rows with {} ({}); written to {}",
-        n - missing,
-        a.model.display(),
-        model.method.name(),
-        a.out.display()
-    );
+    let why = format!("missing values or headings under {MIN_HEADING_S} s");
+    crate::flight::write_compensated(&t, &a.out, &a.model, model.method.name(), missing, "pod_flag", &why)?;
     print_rates("", &r);
     Ok(())
 }

@@ -338,14 +338,14 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     // Short dropouts (missing cells, no time gap) are bridged so that the
     // stretches on both sides are fitted as one record.
     let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
-    let filled: Vec<Vec<f64>> = raw
-        .all()
+    let raw_cols = raw.all();
+    let filled: Vec<Vec<f64>> = raw_cols
         .iter()
         .enumerate()
         .map(|(k, c)| bridge_dropouts(raw.time, c, max_fill, if k == 4 { Some(360.0) } else { None }))
         .collect();
     let bridged = (0..raw.time.len())
-        .filter(|&i| raw.all().iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite()))
+        .filter(|&i| raw_cols.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite()))
         .count();
     let cols = RotorColumns {
         time: raw.time,
@@ -368,7 +368,8 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     let used: usize = segs.iter().map(|s| s.len()).sum();
     if used < table.n_rows() {
         eprintln!(
-            "warning: {} of {} rows are in stretches without gaps or missing values of at least {MIN_SEGMENT_S} s              and are fitted; the others are left out",
+            "warning: {} of {} rows are in stretches without gaps or missing values of at least {MIN_SEGMENT_S} s \
+             and are fitted; the others are left out",
             used,
             table.n_rows()
         );
@@ -453,11 +454,11 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     // angles tracked as `rotor apply` would.
     if segs.len() > 1 {
         for _ in 0..REFINE_ITERATIONS {
-        let tracked: Vec<TrackedSegment> = segs.iter().map(|s| track_segment(&model, &cols, s, fs)).collect::<anyhow::Result<_>>()?;
-        let regs: Vec<Vec<Vec<f64>>> =
-            tracked.iter().map(|t| regressors(&model.geometry, model.model.terms, &t.input())).collect::<Result<_, _>>()?;
-        let records: Vec<(&[Vec<f64>], &[f64])> = regs.iter().zip(&segs).map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()])).collect();
-        model.model = fit_records(&records, model.model.terms, fs, &fit_opts)?;
+            let tracked: Vec<TrackedSegment> = segs.iter().map(|s| track_segment(&model, &cols, s, fs)).collect::<anyhow::Result<_>>()?;
+            let regs: Vec<Vec<Vec<f64>>> =
+                tracked.iter().map(|t| regressors(&model.geometry, model.model.terms, &t.input())).collect::<Result<_, _>>()?;
+            let records: Vec<(&[Vec<f64>], &[f64])> = regs.iter().zip(&segs).map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()])).collect();
+            model.model = fit_records(&records, model.model.terms, fs, &fit_opts)?;
         }
         model.rows = used;
         eprintln!("note: parameters refined on all {} stretches ({used} rows)", segs.len());
@@ -551,23 +552,10 @@ fn track_segment(model: &RotorModelFile, cols: &RotorColumns, r: &Range<usize>, 
 pub fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     let model = load_model(&a.model)?;
     let mut table = a.input.load()?;
-    let n = table.n_rows();
     let interf = rotor_interference(&model, &table)?;
     let missing = add_compensation(&mut table, "rotor_interf", "rotor_flag", interf)?;
-    aeromag_io::write_csv(&table, &a.out)?;
-    if missing > 0 {
-        eprintln!(
-            "warning: {missing} of {n} rows could not be compensated (missing values or stretches under \
-             {MIN_SEGMENT_S} s); they are kept with rotor_flag = 1"
-        );
-    }
-    println!(
-        "compensated {} of {n} rows with {}; written to {}",
-        n - missing,
-        a.model.display(),
-        a.out.display()
-    );
-    Ok(())
+    let why = format!("missing values or stretches under {MIN_SEGMENT_S} s");
+    crate::flight::write_compensated(&table, &a.out, &a.model, "", missing, "rotor_flag", &why)
 }
 
 #[cfg(test)]

@@ -198,40 +198,6 @@ fn for_each_filtered_block(
     Ok(())
 }
 
-/// The filtered normal equations of each segment (`None` for a segment
-/// that is skipped, with a warning), and the sampling rates of those used.
-pub(crate) struct SegmentEquations {
-    pub(crate) per_segment: Vec<Option<NormalEquations>>,
-    pub(crate) warnings: Vec<String>,
-    pub(crate) fs_used: Vec<f64>,
-}
-
-/// Design, filter and accumulate every segment on its own.
-pub(crate) fn segment_equations(segments: &[Segment], cfg: &LsConfig) -> Result<SegmentEquations> {
-    validate(cfg)?;
-    let ncol = cfg.terms.n_columns();
-    let mut per_segment = Vec::with_capacity(segments.len());
-    let mut warnings = Vec::new();
-    let mut fs_used = Vec::new();
-    for (k, seg) in segments.iter().enumerate() {
-        per_segment.push(None);
-        let (dt, sos) = match segment_filter(k, seg, cfg)? {
-            Ok(f) => f,
-            Err(w) => {
-                warnings.push(w);
-                continue;
-            }
-        };
-        let mut ne = NormalEquations::new(ncol);
-        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
-            ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
-        })?;
-        per_segment[k] = Some(ne);
-        fs_used.push(1.0 / dt);
-    }
-    Ok(SegmentEquations { per_segment, warnings, fs_used })
-}
-
 /// Segment `k`'s sampling interval (s) and band-pass filter, or the warning
 /// that says why it is skipped (no valid time step, too short to filter and
 /// trim); columns of unequal length are an error.
@@ -257,7 +223,7 @@ fn segment_filter(k: usize, seg: &Segment, cfg: &LsConfig) -> Result<std::result
 }
 
 /// The band-passed residual `y − A c` of every segment that
-/// [`segment_equations`] uses (trimmed like the fit), with its sampling
+/// [`fit_band_pass_ls`] uses (trimmed like the fit), with its sampling
 /// rate (Hz); segments that are skipped are left out.
 pub(crate) fn band_passed_residuals(segments: &[Segment], cfg: &LsConfig, coef: &[f64]) -> Result<Vec<(Vec<f64>, f64)>> {
     validate(cfg)?;
@@ -282,12 +248,24 @@ pub(crate) fn band_passed_residuals(segments: &[Segment], cfg: &LsConfig, coef: 
 
 /// Fit the Tolles-Lawson coefficients to calibration segments.
 pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
-    let SegmentEquations { per_segment, mut warnings, fs_used } = segment_equations(segments, cfg)?;
+    validate(cfg)?;
     let mut ne = NormalEquations::new(cfg.terms.n_columns());
+    let mut warnings = Vec::new();
     let mut used = 0;
-    for seg in per_segment.iter().flatten() {
-        ne.merge(seg).map_err(|e| CompError::BadData(e.to_string()))?;
+    let mut fs_used = Vec::new();
+    for (k, seg) in segments.iter().enumerate() {
+        let (dt, sos) = match segment_filter(k, seg, cfg)? {
+            Ok(f) => f,
+            Err(w) => {
+                warnings.push(w);
+                continue;
+            }
+        };
+        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
+            ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
+        })?;
         used += 1;
+        fs_used.push(1.0 / dt);
     }
     if used == 0 {
         return Err(CompError::BadData("no segment is long enough to fit (see the warnings)".into()));

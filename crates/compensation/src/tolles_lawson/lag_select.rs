@@ -347,12 +347,11 @@ mod tests {
 
     #[test]
     fn white_noise_is_flat_and_a_tone_is_not() {
-        let mut state = 99u64;
-        let mut white = Vec::new();
-        for _ in 0..4000 {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            white.push(((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5);
-        }
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Uniform};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
+        let u = Uniform::new(-0.5, 0.5).unwrap();
+        let white: Vec<f64> = (0..4000).map(|_| u.sample(&mut rng)).collect();
         let f = spectral_flatness(&[(white.clone(), 10.0)], (0.1, 0.9));
         assert!(f > 0.85 && f <= 1.0, "white {f}");
         let tone: Vec<f64> = (0..4000).map(|i| (std::f64::consts::TAU * 0.3 * i as f64 / 10.0).sin() + 0.01 * white[i]).collect();

@@ -146,21 +146,6 @@ impl NormalEquations {
         Ok(())
     }
 
-    /// Remove another accumulator's rows (e.g. one segment held out for
-    /// cross-validation): the accumulator of the remaining rows.
-    pub fn without(&self, other: &NormalEquations) -> Result<NormalEquations> {
-        if other.n() != self.n() || other.rows > self.rows {
-            return Err(EstError::Dimension("removing an accumulator that is not part of this one".into()));
-        }
-        Ok(Self { ata: &self.ata - &other.ata, aty: &self.aty - &other.aty, yty: self.yty - other.yty, rows: self.rows - other.rows })
-    }
-
-    /// The residual sum of squares `‖y − A c‖² = yᵀy − 2cᵀAᵀy + cᵀAᵀAc` of
-    /// these rows for given coefficients `c` (clamped at 0 against round-off).
-    pub fn rss_of(&self, coef: &DVector<f64>) -> f64 {
-        (self.yty - 2.0 * coef.dot(&self.aty) + coef.dot(&(self.ata() * coef))).max(0.0)
-    }
-
     /// The symmetric `AᵀA` (full matrix).
     pub fn ata(&self) -> DMatrix<f64> {
         let mut m = self.ata.clone();
@@ -213,7 +198,8 @@ impl NormalEquations {
         let u = &inv_reg * &rhs;
         let coef = DVector::from_fn(n, |i, _| u[i] / d[i]);
 
-        let rss = self.rss_of(&coef);
+        // RSS = yᵀy − 2cᵀAᵀy + cᵀAᵀAc, clamped at 0 against round-off.
+        let rss = (self.yty - 2.0 * coef.dot(&self.aty) + coef.dot(&(&ata * &coef))).max(0.0);
         let eff = effective_rows.min(self.rows as f64);
         let dof = (eff - n as f64).max(1.0);
         let sigma2 = rss * (eff / self.rows as f64) / dof;
