@@ -9,15 +9,15 @@
 //! compute them.
 
 use crate::flight::reference_sum;
-use aeromag_compensation::reference_field::LeverArm;
 use aeromag_compensation::metrics::{
-    band_pass_segments, detect_maneuvers, figure_of_merit, improvement_ratio, residual_by_line, FomReport, LineResidual,
-    ManeuverDetection,
+    FomReport, LineResidual, ManeuverDetection, band_pass_segments, detect_maneuvers,
+    figure_of_merit, improvement_ratio, residual_by_line,
 };
 use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::reference_field::LeverArm;
 use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments};
 use aeromag_core::filter::BandPass;
-use aeromag_core::spectrum::{welch, WelchConfig};
+use aeromag_core::spectrum::{WelchConfig, welch};
 use aeromag_io::FlightTable;
 use aeromag_report::{LinePlot, Report, Series, Table};
 use serde::Serialize;
@@ -51,7 +51,9 @@ pub struct Figures {
 fn segments(t: &FlightTable, comp: &[f64]) -> anyhow::Result<Vec<Range<usize>>> {
     let time = t.require("time")?;
     let mag = t.require("mag")?;
-    let usable: Vec<bool> = (0..time.len()).map(|i| mag[i].is_finite() && comp[i].is_finite()).collect();
+    let usable: Vec<bool> = (0..time.len())
+        .map(|i| mag[i].is_finite() && comp[i].is_finite())
+        .collect();
     Ok(split_segments(time, t.column("line"), &usable, 1.5, 2).0)
 }
 
@@ -65,10 +67,19 @@ fn segments(t: &FlightTable, comp: &[f64]) -> anyhow::Result<Vec<Range<usize>>> 
 /// whose `line` label is 0 (turns, in the simulator's convention) are not
 /// survey data and are left out. With a lever arm the `igrf` reference is
 /// moved to the sensor ([`reference_sum`]).
-pub fn figures(t: &FlightTable, reference: &[String], lever: Option<&LeverArm>) -> anyhow::Result<Figures> {
+pub fn figures(
+    t: &FlightTable,
+    reference: &[String],
+    lever: Option<&LeverArm>,
+) -> anyhow::Result<Figures> {
     let time = t.require("time")?;
     let ref_sum = reference_sum(t, reference, lever)?;
-    let mag: Vec<f64> = t.require("mag")?.iter().zip(&ref_sum).map(|(a, b)| a - b).collect();
+    let mag: Vec<f64> = t
+        .require("mag")?
+        .iter()
+        .zip(&ref_sum)
+        .map(|(a, b)| a - b)
+        .collect();
     let comp_raw = t.require("mag_comp")?;
     let comp: Vec<f64> = comp_raw.iter().zip(&ref_sum).map(|(a, b)| a - b).collect();
     let segs = segments(t, &comp)?;
@@ -81,8 +92,16 @@ pub fn figures(t: &FlightTable, reference: &[String], lever: Option<&LeverArm>) 
         let windows = detect_maneuvers(time, r, p, y, &ManeuverDetection::default());
         if !windows.is_empty() {
             fom_windows = windows.len();
-            fom_before = Some(figure_of_merit(time, &band_pass_segments(&mag, &segs, &bpf)?, &windows));
-            fom_after = Some(figure_of_merit(time, &band_pass_segments(&comp, &segs, &bpf)?, &windows));
+            fom_before = Some(figure_of_merit(
+                time,
+                &band_pass_segments(&mag, &segs, &bpf)?,
+                &windows,
+            ));
+            fom_after = Some(figure_of_merit(
+                time,
+                &band_pass_segments(&comp, &segs, &bpf)?,
+                &windows,
+            ));
         }
     }
     let (mut residual_rms_nt, mut lines, mut noise_floor_nt) = (None, Vec::new(), None);
@@ -102,7 +121,8 @@ pub fn figures(t: &FlightTable, reference: &[String], lever: Option<&LeverArm>) 
     }
     if let Some(noise) = t.column("true_mag_noise") {
         let v: Vec<f64> = noise.iter().copied().filter(|v| v.is_finite()).collect();
-        noise_floor_nt = Some((v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt());
+        noise_floor_nt =
+            Some((v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt());
     }
     Ok(Figures {
         fom_before_nt: fom_before.as_ref().map(|f: &FomReport| f.fom_nt),
@@ -122,7 +142,13 @@ fn f3(v: Option<f64>) -> String {
 }
 
 /// Add the sections describing a compensated flight to a report.
-pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures, model: Option<&TlModel>) -> anyhow::Result<()> {
+pub fn add_to_report(
+    r: &mut Report,
+    title: &str,
+    t: &FlightTable,
+    fig: &Figures,
+    model: Option<&TlModel>,
+) -> anyhow::Result<()> {
     let time = t.require("time")?;
     let mag = t.require("mag")?;
     let comp = t.require("mag_comp")?;
@@ -149,30 +175,67 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
     let (mm, cm) = (mean(mag), mean(comp));
-    let svg = LinePlot::new("Uncompensated and compensated field (means removed)", "time since start (s)", "field (nT)")
-        .with_series(Series::line("uncompensated", tt.clone(), mag.iter().map(|v| v - mm).collect()))
-        .with_series(Series::line("compensated", tt.clone(), comp.iter().map(|v| v - cm).collect()))
-        .to_svg()?;
+    let svg = LinePlot::new(
+        "Uncompensated and compensated field (means removed)",
+        "time since start (s)",
+        "field (nT)",
+    )
+    .with_series(Series::line(
+        "uncompensated",
+        tt.clone(),
+        mag.iter().map(|v| v - mm).collect(),
+    ))
+    .with_series(Series::line(
+        "compensated",
+        tt.clone(),
+        comp.iter().map(|v| v - cm).collect(),
+    ))
+    .to_svg()?;
     r.figure(svg, "Scalar magnetometer before and after compensation.");
 
     if let Some(model_interf) = t.column("mag_interf") {
         let mi = mean(model_interf);
-        let mut p = LinePlot::new("Aircraft interference: model and truth (means removed)", "time since start (s)", "interference (nT)")
-            .with_series(Series::line("model", tt.clone(), model_interf.iter().map(|v| v - mi).collect()));
+        let mut p = LinePlot::new(
+            "Aircraft interference: model and truth (means removed)",
+            "time since start (s)",
+            "interference (nT)",
+        )
+        .with_series(Series::line(
+            "model",
+            tt.clone(),
+            model_interf.iter().map(|v| v - mi).collect(),
+        ));
         if let Some(ti) = t.column("true_interf") {
             let m = mean(ti);
-            p = p.with_series(Series::line("truth (simulation)", tt.clone(), ti.iter().map(|v| v - m).collect()));
+            p = p.with_series(Series::line(
+                "truth (simulation)",
+                tt.clone(),
+                ti.iter().map(|v| v - m).collect(),
+            ));
         }
-        r.figure(p.to_svg()?, "Modelled interference against the simulator's truth where available.");
+        r.figure(
+            p.to_svg()?,
+            "Modelled interference against the simulator's truth where available.",
+        );
     }
 
     if let Some(ext) = t.column("true_external") {
         let lag = t.column("true_lag");
-        let res: Vec<f64> = (0..comp.len()).map(|i| comp[i] - ext[i] - lag.map_or(0.0, |l| l[i])).collect();
+        let res: Vec<f64> = (0..comp.len())
+            .map(|i| comp[i] - ext[i] - lag.map_or(0.0, |l| l[i]))
+            .collect();
         let rm = mean(&res);
-        let svg = LinePlot::new("Residual versus truth", "time since start (s)", "compensated − truth (nT)")
-            .with_series(Series::line("residual", tt.clone(), res.iter().map(|v| v - rm).collect()))
-            .to_svg()?;
+        let svg = LinePlot::new(
+            "Residual versus truth",
+            "time since start (s)",
+            "compensated − truth (nT)",
+        )
+        .with_series(Series::line(
+            "residual",
+            tt.clone(),
+            res.iter().map(|v| v - rm).collect(),
+        ))
+        .to_svg()?;
         r.figure(svg, "Compensated field minus the true external field (sensor lag term removed), mean removed.");
     }
 
@@ -192,7 +255,12 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
         x[best.0..best.1].to_vec()
     };
     let nperseg = 1024usize.min(comp.len() / 4).max(16);
-    let mut sp = LinePlot::new("Power spectral density (Welch)", "frequency (Hz)", "PSD (nT²/Hz)").log_log();
+    let mut sp = LinePlot::new(
+        "Power spectral density (Welch)",
+        "frequency (Hz)",
+        "PSD (nT²/Hz)",
+    )
+    .log_log();
     for (name, x) in [("uncompensated", mag), ("compensated", comp)] {
         let seg = longest(x);
         if seg.len() >= nperseg {
@@ -201,7 +269,10 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
         }
     }
     if !sp.series.is_empty() {
-        r.figure(sp.to_svg()?, "Welch spectra (Hann window, 50 % overlap) of the longest uninterrupted stretch.");
+        r.figure(
+            sp.to_svg()?,
+            "Welch spectra (Hann window, 50 % overlap) of the longest uninterrupted stretch.",
+        );
     }
 
     if let (Some(before), Some(after)) = (&fig.fom_before, &fig.fom_after) {
@@ -221,7 +292,16 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
             })
             .collect();
         r.table(Table::new(
-            ["heading (°)", "manoeuvre", "start (s)", "end (s)", "p-p before (nT)", "p-p after (nT)"].map(String::from).to_vec(),
+            [
+                "heading (°)",
+                "manoeuvre",
+                "start (s)",
+                "end (s)",
+                "p-p before (nT)",
+                "p-p after (nT)",
+            ]
+            .map(String::from)
+            .to_vec(),
             rows,
             "Figure of merit: detrended peak-to-peak amplitude per manoeuvre window.",
         ));
@@ -230,10 +310,19 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
         let rows = fig
             .lines
             .iter()
-            .map(|l| vec![format!("{}", l.line), l.samples.to_string(), format!("{:.3}", l.mean_nt), format!("{:.4}", l.rms_nt)])
+            .map(|l| {
+                vec![
+                    format!("{}", l.line),
+                    l.samples.to_string(),
+                    format!("{:.3}", l.mean_nt),
+                    format!("{:.4}", l.rms_nt),
+                ]
+            })
             .collect();
         r.table(Table::new(
-            ["line", "samples", "mean offset (nT)", "RMS about mean (nT)"].map(String::from).to_vec(),
+            ["line", "samples", "mean offset (nT)", "RMS about mean (nT)"]
+                .map(String::from)
+                .to_vec(),
             rows,
             "Residual versus truth per line (simulation).",
         ));
@@ -242,12 +331,23 @@ pub fn add_to_report(r: &mut Report, title: &str, t: &FlightTable, fig: &Figures
         let rows = m
             .coefficients
             .iter()
-            .map(|c| vec![c.name.clone(), format!("{:.6}", c.value), format!("{:.2e}", c.std)])
+            .map(|c| {
+                vec![
+                    c.name.clone(),
+                    format!("{:.6}", c.value),
+                    format!("{:.2e}", c.std),
+                ]
+            })
             .collect();
         r.table(Table::new(
-            ["term", "coefficient", "standard deviation"].map(String::from).to_vec(),
+            ["term", "coefficient", "standard deviation"]
+                .map(String::from)
+                .to_vec(),
             rows,
-            format!("Model coefficients ({}, method {}, convention {:?}).", m.terms, m.method, m.convention),
+            format!(
+                "Model coefficients ({}, method {}, convention {:?}).",
+                m.terms, m.method, m.convention
+            ),
         ));
         if !m.fit.warnings.is_empty() {
             r.paragraph(format!("Fit warnings: {}", m.fit.warnings.join(" | ")));

@@ -10,9 +10,13 @@ pub struct BadInput(pub String);
 pub fn classify(e: &anyhow::Error) -> i32 {
     for cause in e.chain() {
         if cause.downcast_ref::<BadInput>().is_some()
-            || cause.downcast_ref::<aeromag_io::IoError>().is_some_and(|e| e.is_bad_input())
+            || cause
+                .downcast_ref::<aeromag_io::IoError>()
+                .is_some_and(|e| e.is_bad_input())
             || cause.downcast_ref::<aeromag_core::CoreError>().is_some()
-            || cause.downcast_ref::<aeromag_sim::SimError>().is_some_and(sim_bad_input)
+            || cause
+                .downcast_ref::<aeromag_sim::SimError>()
+                .is_some_and(sim_bad_input)
         {
             return 2;
         }
@@ -29,5 +33,8 @@ pub(crate) use bad_input;
 /// Scenario-file problems are the user's input; failures to run or write are not.
 fn sim_bad_input(e: &aeromag_sim::SimError) -> bool {
     use aeromag_sim::SimError as E;
-    matches!(e, E::ConfigParse(_) | E::InvalidConfig { .. } | E::Core(_) | E::Trajectory(_))
+    matches!(
+        e,
+        E::ConfigParse(_) | E::InvalidConfig { .. } | E::Core(_) | E::Trajectory(_)
+    )
 }

@@ -2,7 +2,7 @@
 //! required columns, segmentation, and writing results back as columns.
 
 use crate::exit::bad_input;
-use aeromag_compensation::reference_field::{lever_arm_correction_nt, LeverArm};
+use aeromag_compensation::reference_field::{LeverArm, lever_arm_correction_nt};
 use aeromag_compensation::tolles_lawson::segments::split_segments;
 use aeromag_io::FlightTable;
 use std::ops::Range;
@@ -23,10 +23,18 @@ pub struct TlColumns<'a> {
 /// or a comma-separated list of column names.
 pub fn reference_columns(table: &FlightTable, spec: &str) -> anyhow::Result<Vec<String>> {
     match spec.trim() {
-        "auto" => Ok(["diurnal", "igrf"].iter().filter(|c| table.column(c).is_some()).map(|c| c.to_string()).collect()),
+        "auto" => Ok(["diurnal", "igrf"]
+            .iter()
+            .filter(|c| table.column(c).is_some())
+            .map(|c| c.to_string())
+            .collect()),
         "none" | "" => Ok(Vec::new()),
         list => {
-            let cols: Vec<String> = list.split(',').map(|c| c.trim().to_string()).filter(|c| !c.is_empty()).collect();
+            let cols: Vec<String> = list
+                .split(',')
+                .map(|c| c.trim().to_string())
+                .filter(|c| !c.is_empty())
+                .collect();
             for c in &cols {
                 table.require(c)?;
             }
@@ -38,7 +46,11 @@ pub fn reference_columns(table: &FlightTable, spec: &str) -> anyhow::Result<Vec<
 /// The sum of the named reference channels (zeros if none). With a lever
 /// arm, the `igrf` channel is moved from the navigation point to the sensor
 /// (needs `lat`, `lon`, `alt`, `roll`, `pitch`, `yaw`).
-pub fn reference_sum(table: &FlightTable, cols: &[String], lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
+pub fn reference_sum(
+    table: &FlightTable,
+    cols: &[String],
+    lever: Option<&LeverArm>,
+) -> anyhow::Result<Vec<f64>> {
     let mut r = vec![0.0; table.n_rows()];
     for c in cols {
         for (a, b) in r.iter_mut().zip(table.require(c)?) {
@@ -67,7 +79,11 @@ pub fn reference_sum(table: &FlightTable, cols: &[String], lever: Option<&LeverA
 /// `n` comma-separated finite numbers given to option `flag`.
 pub fn parse_numbers(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> {
     let bad = || bad_input!("{flag} `{s}`: expected {n} comma-separated finite numbers");
-    let v: Vec<f64> = s.split(',').map(|p| p.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
     if v.len() != n || v.iter().any(|x| !x.is_finite()) {
         return Err(bad());
     }
@@ -87,7 +103,11 @@ impl<'a> TlColumns<'a> {
     pub fn from_table(t: &'a FlightTable) -> anyhow::Result<Self> {
         Ok(Self {
             time: t.require("time")?,
-            flux: [t.require("flux_x")?, t.require("flux_y")?, t.require("flux_z")?],
+            flux: [
+                t.require("flux_x")?,
+                t.require("flux_y")?,
+                t.require("flux_z")?,
+            ],
             mag: t.require("mag")?,
             line: t.column("line"),
         })
@@ -107,8 +127,18 @@ impl<'a> TlColumns<'a> {
 
     /// Contiguous segments (split at line changes if `by_line`, gaps and
     /// unusable rows) of at least `min_len` rows, and the rows left out.
-    pub fn segments(&self, by_line: bool, min_len: usize) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
-        split_segments(self.time, if by_line { self.line } else { None }, &self.usable(), 1.5, min_len)
+    pub fn segments(
+        &self,
+        by_line: bool,
+        min_len: usize,
+    ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+        split_segments(
+            self.time,
+            if by_line { self.line } else { None },
+            &self.usable(),
+            1.5,
+            min_len,
+        )
     }
 }
 
@@ -127,15 +157,26 @@ pub fn parse_band(s: &str) -> anyhow::Result<(f64, f64)> {
 /// compensated, 1 not) to `table`; returns the number of rows not
 /// compensated. Bad input if one of the columns exists already. Used by
 /// `compensate`, `rotor apply` and `pod apply`.
-pub fn add_compensation(table: &mut FlightTable, interf_col: &str, flag_col: &str, interf: Vec<f64>) -> anyhow::Result<usize> {
+pub fn add_compensation(
+    table: &mut FlightTable,
+    interf_col: &str,
+    flag_col: &str,
+    interf: Vec<f64>,
+) -> anyhow::Result<usize> {
     for name in [interf_col, "mag_comp", flag_col] {
         if table.get(name).is_some() {
-            return Err(bad_input!("{}: already has a column `{name}`; rename it first", table.file_label()));
+            return Err(bad_input!(
+                "{}: already has a column `{name}`; rename it first",
+                table.file_label()
+            ));
         }
     }
     let mag = table.require("mag")?;
     let comp: Vec<f64> = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
-    let flag: Vec<f64> = interf.iter().map(|v| if v.is_finite() { 0.0 } else { 1.0 }).collect();
+    let flag: Vec<f64> = interf
+        .iter()
+        .map(|v| if v.is_finite() { 0.0 } else { 1.0 })
+        .collect();
     let missing = flag.iter().filter(|f| **f > 0.0).count();
     table.add_column(interf_col, interf)?;
     table.add_column("mag_comp", comp)?;
@@ -160,10 +201,21 @@ pub fn write_compensated(
     aeromag_io::write_csv(table, out)?;
     let n = table.n_rows();
     if missing > 0 {
-        eprintln!("warning: {missing} of {n} rows could not be compensated ({why}); they are kept with {flag_col} = 1");
+        eprintln!(
+            "warning: {missing} of {n} rows could not be compensated ({why}); they are kept with {flag_col} = 1"
+        );
     }
-    let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
-    println!("compensated {} of {n} rows with {}{detail}; written to {}", n - missing, model.display(), out.display());
+    let detail = if detail.is_empty() {
+        String::new()
+    } else {
+        format!(" ({detail})")
+    };
+    println!(
+        "compensated {} of {n} rows with {}{detail}; written to {}",
+        n - missing,
+        model.display(),
+        out.display()
+    );
     Ok(())
 }
 
@@ -174,6 +226,7 @@ pub fn load_model_file<T>(
     parse: impl FnOnce(&str, &str) -> Result<T, aeromag_compensation::CompError>,
 ) -> anyhow::Result<T> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| bad_input!("cannot read model file '{origin}': {e}"))?;
     parse(&text, &origin).map_err(|e| bad_input!("{e}"))
 }

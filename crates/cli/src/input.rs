@@ -1,7 +1,7 @@
 //! Reading flight files the same way in every command: parse, map columns,
 //! validate time and units, print warnings.
 
-use aeromag_io::{check_time, check_units, read_table, ColumnMap, FlightTable, ReadOptions};
+use aeromag_io::{ColumnMap, FlightTable, ReadOptions, check_time, check_units, read_table};
 use std::path::{Path, PathBuf};
 
 /// Input-file arguments shared by the commands that read flight data.

@@ -20,7 +20,13 @@ pub struct KalmanRows {
 /// The section for the flight in `table`, fitted by `ls` and `kalman`.
 /// With a `true_anomaly` column (simulation) the smoothed field is drawn
 /// against it; the estimators never read it.
-pub fn kalman_section(heading: &str, table: &FlightTable, ls: &TlModel, kalman: &TlModel, k: &KalmanRows) -> anyhow::Result<ReportSection> {
+pub fn kalman_section(
+    heading: &str,
+    table: &FlightTable,
+    ls: &TlModel,
+    kalman: &TlModel,
+    k: &KalmanRows,
+) -> anyhow::Result<ReportSection> {
     let mut s = ReportSection::new(heading);
     let f = &k.fit;
     s.blocks.push(Block::Paragraph(format!(
@@ -44,18 +50,32 @@ pub fn kalman_section(heading: &str, table: &FlightTable, ls: &TlModel, kalman: 
     if k.rows.len() == crate::commands::calibrate::KALMAN_SERIES.len() {
         let time = table.require("time")?;
         let t0 = time.iter().copied().find(|t| t.is_finite()).unwrap_or(0.0);
-        let used: Vec<usize> = (0..time.len()).filter(|&i| k.rows[2][i].is_finite()).collect();
+        let used: Vec<usize> = (0..time.len())
+            .filter(|&i| k.rows[2][i].is_finite())
+            .collect();
         let tt: Vec<f64> = used.iter().map(|&i| time[i] - t0).collect();
         let centred = |col: &[f64]| -> Vec<f64> {
             let m = used.iter().map(|&i| col[i]).sum::<f64>() / used.len().max(1) as f64;
             used.iter().map(|&i| col[i] - m).collect()
         };
         let field = centred(&k.rows[2]);
-        let mut plot = LinePlot::new("Smoothed external field (mean removed)", "time since start (s)", "field (nT)")
-            .with_series(Series::line("Kalman smoothed field", tt.clone(), field.clone()));
+        let mut plot = LinePlot::new(
+            "Smoothed external field (mean removed)",
+            "time since start (s)",
+            "field (nT)",
+        )
+        .with_series(Series::line(
+            "Kalman smoothed field",
+            tt.clone(),
+            field.clone(),
+        ));
         let truth = table.column("true_anomaly").map(centred);
         if let Some(truth) = &truth {
-            plot = plot.with_series(Series::line("true anomaly (simulation)", tt.clone(), truth.clone()));
+            plot = plot.with_series(Series::line(
+                "true anomaly (simulation)",
+                tt.clone(),
+                truth.clone(),
+            ));
         }
         s.blocks.push(Block::Figure {
             svg: plot.to_svg()?,
@@ -65,8 +85,12 @@ pub fn kalman_section(heading: &str, table: &FlightTable, ls: &TlModel, kalman: 
             // The smoothed field also holds the diurnal and IGRF residuals
             // the reference channels leave, so the difference is not zero.
             let diff: Vec<f64> = field.iter().zip(truth).map(|(a, b)| a - b).collect();
-            let plot = LinePlot::new("Smoothed field minus the true anomaly", "time since start (s)", "nT")
-                .with_series(Series::line("smoothed − true anomaly", tt.clone(), diff));
+            let plot = LinePlot::new(
+                "Smoothed field minus the true anomaly",
+                "time since start (s)",
+                "nT",
+            )
+            .with_series(Series::line("smoothed − true anomaly", tt.clone(), diff));
             s.blocks.push(Block::Figure {
                 svg: plot.to_svg()?,
                 caption: "What the smoother gets wrong, plus the reference channels' own errors (base station, IGRF at the \
@@ -81,10 +105,14 @@ pub fn kalman_section(heading: &str, table: &FlightTable, ls: &TlModel, kalman: 
         let mut sorted = sd.clone();
         sorted.sort_by(f64::total_cmp);
         let typical = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
-        let mut plot = LinePlot::new("Innovations and their predicted ±1σ", "time since start (s)", "nT")
-            .with_series(Series::line("innovation ν", tt.clone(), sel(3)))
-            .with_series(Series::line("+σ", tt.clone(), sd.clone()))
-            .with_series(Series::line("−σ", tt, sd.iter().map(|v| -v).collect()));
+        let mut plot = LinePlot::new(
+            "Innovations and their predicted ±1σ",
+            "time since start (s)",
+            "nT",
+        )
+        .with_series(Series::line("innovation ν", tt.clone(), sel(3)))
+        .with_series(Series::line("+σ", tt.clone(), sd.clone()))
+        .with_series(Series::line("−σ", tt, sd.iter().map(|v| -v).collect()));
         plot.y_range = Some((-6.0 * typical, 6.0 * typical));
         s.blocks.push(Block::Figure {
             svg: plot.to_svg()?,

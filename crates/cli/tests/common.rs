@@ -6,12 +6,19 @@ use std::process::{Command, Output};
 
 /// Run the `aeromag` binary with arguments.
 pub fn aeromag(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aeromag")).args(args).output().expect("spawn aeromag")
+    Command::new(env!("CARGO_BIN_EXE_aeromag"))
+        .args(args)
+        .output()
+        .expect("spawn aeromag")
 }
 
 /// Run in a working directory.
 pub fn aeromag_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aeromag")).current_dir(dir).args(args).output().expect("spawn aeromag")
+    Command::new(env!("CARGO_BIN_EXE_aeromag"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("spawn aeromag")
 }
 
 pub fn stdout(o: &Output) -> String {

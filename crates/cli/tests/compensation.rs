@@ -5,7 +5,17 @@ use common::*;
 
 fn simulate(dir: &std::path::Path, scenario: &str, seed: &str) -> std::path::PathBuf {
     let out = dir.join(scenario);
-    assert_code(&aeromag(&["simulate", scenario, "--seed", seed, "--out", out.to_str().unwrap()]), 0);
+    assert_code(
+        &aeromag(&[
+            "simulate",
+            scenario,
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        0,
+    );
     out.join(format!("{}.csv", scenario.replace('-', "_")))
 }
 
@@ -14,38 +24,87 @@ fn calibrate_compensate_report_keep_every_row() {
     let d = tempfile::tempdir().unwrap();
     let cal = simulate(d.path(), "calibration", "5");
     let model = d.path().join("m.json");
-    let o = aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", model.to_str().unwrap()]);
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        cal.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
     assert!(!stderr(&o).contains("poorly determined"), "{}", stderr(&o));
-    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(m["format"], "aeromag-model/1");
     // The simulated airframe's eddy currents lag (τ 0.15–0.6 s): `auto`
     // adds one or two lagged groups of nine columns to the 16 classical ones.
     let lags = m["terms"]["eddy_lags_s"].as_array().map_or(0, |a| a.len());
     assert!((1..=2).contains(&lags), "{}", m["terms"]);
     assert_eq!(m["coefficients"].as_array().unwrap().len(), 16 + 9 * lags);
-    assert!(stderr(&o).contains("chosen (likelihood-ratio test)"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("chosen (likelihood-ratio test)"),
+        "{}",
+        stderr(&o)
+    );
     // The model file records the search: every candidate with Λ and its threshold.
     let sel = &m["fit"]["eddy_lag_selection"];
-    let cands = sel["candidates"].as_array().expect("lag selection recorded");
-    assert!(cands.len() >= 7 && cands.iter().all(|c| c["lr_statistic"].is_number() && c["threshold"].is_number()), "{sel}");
+    let cands = sel["candidates"]
+        .as_array()
+        .expect("lag selection recorded");
+    assert!(
+        cands.len() >= 7
+            && cands
+                .iter()
+                .all(|c| c["lr_statistic"].is_number() && c["threshold"].is_number()),
+        "{sel}"
+    );
     assert_eq!(sel["taus_s"], m["terms"]["eddy_lags_s"]);
     let classical = d.path().join("m16.json");
-    let o16 = aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", classical.to_str().unwrap(), "--eddy-lag", "none"]);
+    let o16 = aeromag(&[
+        "calibrate",
+        "--input",
+        cal.to_str().unwrap(),
+        "--model",
+        classical.to_str().unwrap(),
+        "--eddy-lag",
+        "none",
+    ]);
     assert_code(&o16, 0);
-    let m16: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&classical).unwrap()).unwrap();
+    let m16: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&classical).unwrap()).unwrap();
     assert_eq!(m16["coefficients"].as_array().unwrap().len(), 16);
     // MagNav's convention keeps MagNav's model unless lags are asked for.
     let mn = d.path().join("mn.json");
-    assert_code(&aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", mn.to_str().unwrap(), "--convention", "magnav"]), 0);
-    let mn: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&mn).unwrap()).unwrap();
+    assert_code(
+        &aeromag(&[
+            "calibrate",
+            "--input",
+            cal.to_str().unwrap(),
+            "--model",
+            mn.to_str().unwrap(),
+            "--convention",
+            "magnav",
+        ]),
+        0,
+    );
+    let mn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&mn).unwrap()).unwrap();
     assert_eq!(mn["coefficients"].as_array().unwrap().len(), 16);
     let rms = |m: &serde_json::Value| m["fit"]["residual_rms_nt"].as_f64().unwrap();
-    assert!(rms(&m) < 0.8 * rms(&m16), "lagged {} vs classical {}", rms(&m), rms(&m16));
+    assert!(
+        rms(&m) < 0.8 * rms(&m16),
+        "lagged {} vs classical {}",
+        rms(&m),
+        rms(&m16)
+    );
 
     // Blank out some flux values: those rows stay, flagged.
     let text = std::fs::read_to_string(&cal).unwrap();
-    let mut lines: Vec<String> = text.lines().filter(|l| !l.starts_with('#')).map(String::from).collect();
+    let mut lines: Vec<String> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(String::from)
+        .collect();
     let header: Vec<&str> = lines[0].split(',').collect();
     let fx = header.iter().position(|h| *h == "flux_x").unwrap();
     let n_in = lines.len() - 1;
@@ -57,7 +116,15 @@ fn calibrate_compensate_report_keep_every_row() {
     let holed = d.path().join("holed.csv");
     std::fs::write(&holed, lines.join("\n")).unwrap();
     let out = d.path().join("comp.csv");
-    let o = aeromag(&["compensate", "--model", model.to_str().unwrap(), "--input", holed.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = aeromag(&[
+        "compensate",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        holed.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
     assert!(stderr(&o).contains("3 of"), "{}", stderr(&o));
     let comp = std::fs::read_to_string(&out).unwrap();
@@ -65,14 +132,36 @@ fn calibrate_compensate_report_keep_every_row() {
     assert_eq!(rows.len() - 1, n_in, "one output row per input row");
     let h: Vec<&str> = rows[0].split(',').collect();
     let flag = h.iter().position(|c| *c == "comp_flag").unwrap();
-    let flagged: Vec<usize> = (1..rows.len()).filter(|&i| rows[i].split(',').nth(flag).and_then(|v| v.parse::<f64>().ok()) == Some(1.0)).map(|i| i - 1).collect();
+    let flagged: Vec<usize> = (1..rows.len())
+        .filter(|&i| {
+            rows[i]
+                .split(',')
+                .nth(flag)
+                .and_then(|v| v.parse::<f64>().ok())
+                == Some(1.0)
+        })
+        .map(|i| i - 1)
+        .collect();
     assert_eq!(flagged, vec![100, 101, 2000]);
 
     let rep = d.path().join("rep");
-    let o = aeromag(&["report", "--input", out.to_str().unwrap(), "--model", model.to_str().unwrap(), "--out", rep.to_str().unwrap()]);
+    let o = aeromag(&[
+        "report",
+        "--input",
+        out.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--out",
+        rep.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
     let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
-    for k in ["<svg", "Figure of merit", "coefficient", "Power spectral density"] {
+    for k in [
+        "<svg",
+        "Figure of merit",
+        "coefficient",
+        "Power spectral density",
+    ] {
         assert!(html.contains(k), "{k} missing in the report");
     }
 }
@@ -86,20 +175,34 @@ fn a_single_heading_without_manoeuvres_is_reported() {
     let mut it = text.lines().filter(|l| !l.starts_with('#'));
     let header = it.next().unwrap();
     let h: Vec<&str> = header.split(',').collect();
-    let (li, mi) = (h.iter().position(|c| *c == "line").unwrap(), h.iter().position(|c| *c == "manoeuvre").unwrap());
-    let kept: Vec<&str> = it.filter(|l| {
-        let c: Vec<&str> = l.split(',').collect();
-        c[li].parse::<f64>().ok() == Some(1.0) && c[mi].parse::<f64>().ok() == Some(0.0)
-    }).collect();
+    let (li, mi) = (
+        h.iter().position(|c| *c == "line").unwrap(),
+        h.iter().position(|c| *c == "manoeuvre").unwrap(),
+    );
+    let kept: Vec<&str> = it
+        .filter(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            c[li].parse::<f64>().ok() == Some(1.0) && c[mi].parse::<f64>().ok() == Some(0.0)
+        })
+        .collect();
     assert!(kept.len() > 300);
     let one = d.path().join("one.csv");
     std::fs::write(&one, format!("{header}\n{}", kept.join("\n"))).unwrap();
     let model = d.path().join("m.json");
-    let o = aeromag(&["calibrate", "--input", one.to_str().unwrap(), "--model", model.to_str().unwrap()]);
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        one.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
     let e = stderr(&o);
     assert!(!e.contains("panicked"), "{e}");
     // Either a warning naming the undetermined terms, or a clear refusal.
-    assert!(e.contains("poorly determined terms") || o.status.code() == Some(2), "{e}");
+    assert!(
+        e.contains("poorly determined terms") || o.status.code() == Some(2),
+        "{e}"
+    );
     if o.status.code() == Some(0) {
         assert!(e.contains("e_") || e.contains("i_"), "{e}");
     }
@@ -113,40 +216,176 @@ fn model_and_argument_errors_exit_2() {
     let model = d.path().join("m.json");
     let m = model.to_str().unwrap();
     for args in [
-        vec!["calibrate", "--input", p, "--model", m, "--terms", "p3,i6,i5"],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--terms",
+            "p3,i6,i5",
+        ],
         vec!["calibrate", "--input", p, "--model", m, "--band", "0.9,0.1"],
-        vec!["calibrate", "--input", p, "--model", m, "--convention", "fancy"],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--convention",
+            "fancy",
+        ],
         vec!["calibrate", "--input", p, "--model", m, "--lambda", "-1"],
-        vec!["calibrate", "--input", p, "--model", m, "--eddy-lag", "0,0.5"],
-        vec!["calibrate", "--input", p, "--model", m, "--eddy-lag", "fast"],
-        vec!["calibrate", "--input", p, "--model", m, "--terms", "p3,i5", "--eddy-lag", "0.3"],
-        vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "1,2"],
-        vec!["calibrate", "--input", p, "--model", m, "--lever-arm", "-9.5,0,-0.6", "--date", "2025-13-01"],
-        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,4e-4"],
-        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "1e-15,1e-15,0"],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--eddy-lag",
+            "0,0.5",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--eddy-lag",
+            "fast",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--terms",
+            "p3,i5",
+            "--eddy-lag",
+            "0.3",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--lever-arm",
+            "1,2",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--lever-arm",
+            "-9.5,0,-0.6",
+            "--date",
+            "2025-13-01",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--method",
+            "kalman",
+            "--kalman-noise",
+            "1e-15,4e-4",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--method",
+            "kalman",
+            "--kalman-noise",
+            "1e-15,1e-15,0",
+        ],
         vec!["calibrate", "--input", p, "--model", m, "--series", "s.csv"],
-        vec!["calibrate", "--input", p, "--model", m, "--method", "kalman", "--tune", "--no-tune"],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--method",
+            "kalman",
+            "--tune",
+            "--no-tune",
+        ],
     ] {
         let o = aeromag(&args);
         assert_code(&o, 2);
     }
     assert_code(&aeromag(&["calibrate", "--input", p, "--model", m]), 0);
-    let o = aeromag(&["calibrate", "--input", p, "--model", m, "--method", "kalman", "--kalman-noise", "2e-15,1e-15,3e-4"]);
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        p,
+        "--model",
+        m,
+        "--method",
+        "kalman",
+        "--kalman-noise",
+        "2e-15,1e-15,3e-4",
+    ]);
     assert_code(&o, 0);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("q1 = 2.000e-15"), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("q1 = 2.000e-15"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     // By default the Kalman method tunes its noise intensities, and --series
     // writes the smoothed field and innovations on every input row.
     let series = d.path().join("series.csv");
-    let o = aeromag(&["calibrate", "--input", p, "--model", m, "--method", "kalman", "--series", series.to_str().unwrap()]);
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        p,
+        "--model",
+        m,
+        "--method",
+        "kalman",
+        "--series",
+        series.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
-    assert!(String::from_utf8_lossy(&o.stdout).contains("tuned by maximum likelihood"), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("tuned by maximum likelihood"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     let out = std::fs::read_to_string(&series).unwrap();
-    let data = |t: &str| t.lines().filter(|l| !l.starts_with('#')).map(String::from).collect::<Vec<_>>();
+    let data = |t: &str| {
+        t.lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(String::from)
+            .collect::<Vec<_>>()
+    };
     let (rows_in, rows_out) = (data(&std::fs::read_to_string(&cal).unwrap()), data(&out));
-    assert_eq!(rows_in.len(), rows_out.len(), "one output row per input row");
+    assert_eq!(
+        rows_in.len(),
+        rows_out.len(),
+        "one output row per input row"
+    );
     let header: Vec<&str> = rows_out[0].split(',').collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap_or_else(|| panic!("no column {n}"));
-    let (field, innov, sd) = (col("kalman_field"), col("kalman_innovation"), col("kalman_innovation_std"));
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|h| *h == n)
+            .unwrap_or_else(|| panic!("no column {n}"))
+    };
+    let (field, innov, sd) = (
+        col("kalman_field"),
+        col("kalman_innovation"),
+        col("kalman_innovation_std"),
+    );
     let num = |r: &str, c: usize| r.split(',').nth(c).and_then(|v| v.parse::<f64>().ok());
     let mut within = 0;
     let mut n = 0;
@@ -158,11 +397,22 @@ fn model_and_argument_errors_exit_2() {
         }
     }
     // A noise model that fits keeps about 68 % of the innovations within ±σ.
-    assert!(n > 1000 && (0.55..0.85).contains(&(within as f64 / n as f64)), "{within} of {n} within ±σ");
+    assert!(
+        n > 1000 && (0.55..0.85).contains(&(within as f64 / n as f64)),
+        "{within} of {n} within ±σ"
+    );
     // A model file that is not one.
     let junk = d.path().join("junk.json");
     std::fs::write(&junk, "{\"format\":\"other\"}").unwrap();
-    let o = aeromag(&["compensate", "--model", junk.to_str().unwrap(), "--input", p, "--out", d.path().join("o.csv").to_str().unwrap()]);
+    let o = aeromag(&[
+        "compensate",
+        "--model",
+        junk.to_str().unwrap(),
+        "--input",
+        p,
+        "--out",
+        d.path().join("o.csv").to_str().unwrap(),
+    ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("junk.json"));
     // Data without the vector magnetometer: the message names what is missing.
@@ -170,7 +420,15 @@ fn model_and_argument_errors_exit_2() {
     let stripped = text.replace("flux_x", "fx");
     let nofx = d.path().join("nofx.csv");
     std::fs::write(&nofx, stripped).unwrap();
-    let o = aeromag(&["compensate", "--model", m, "--input", nofx.to_str().unwrap(), "--out", d.path().join("o.csv").to_str().unwrap()]);
+    let o = aeromag(&[
+        "compensate",
+        "--model",
+        m,
+        "--input",
+        nofx.to_str().unwrap(),
+        "--out",
+        d.path().join("o.csv").to_str().unwrap(),
+    ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("flux_x"), "{}", stderr(&o));
 }
@@ -181,22 +439,62 @@ fn demo_meets_the_compensation_figures() {
     let out = d.path().join("demo");
     let o = aeromag(&["demo", "--out", out.to_str().unwrap()]);
     assert_code(&o, 0);
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let c = &s["compensation"];
-    let g = |k: &str| c[k].as_f64().unwrap_or_else(|| panic!("summary key compensation.{k}"));
+    let g = |k: &str| {
+        c[k].as_f64()
+            .unwrap_or_else(|| panic!("summary key compensation.{k}"))
+    };
     let (res, floor) = (g("residual_rms_ls_nt"), g("noise_floor_nt"));
-    assert!(res <= 2.0 * floor, "residual {res} nT > 2 × noise floor {floor} nT");
+    assert!(
+        res <= 2.0 * floor,
+        "residual {res} nT > 2 × noise floor {floor} nT"
+    );
     assert!(g("ir") >= 20.0, "IR {}", g("ir"));
     assert!(g("fom_after_nt") < g("fom_before_nt") / 20.0);
-    assert!(g("fom_after_nt") <= 0.5, "FOM after {} nT", g("fom_after_nt"));
+    assert!(
+        g("fom_after_nt") <= 0.5,
+        "FOM after {} nT",
+        g("fom_after_nt")
+    );
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
     // Every key of data-formats.md that this version computes is present and numeric.
     for (group, keys) in [
         ("compensation", &["residual_rms_kalman_nt"][..]),
-        ("compensation_gradient", &["residual_rms_ls_nt", "residual_rms_kalman_nt", "noise_floor_nt"][..]),
-        ("rotor", &["rotor_rms_nt", "residual_model_nt", "residual_best_filter_nt"][..]),
-        ("em", &["range_err_rel", "angle_err_deg", "polarization_ratio_before", "polarization_ratio_after"][..]),
-        ("gradiometry", &["efficiency_tensor", "efficiency_scalar", "convergence_fraction"][..]),
+        (
+            "compensation_gradient",
+            &[
+                "residual_rms_ls_nt",
+                "residual_rms_kalman_nt",
+                "noise_floor_nt",
+            ][..],
+        ),
+        (
+            "rotor",
+            &[
+                "rotor_rms_nt",
+                "residual_model_nt",
+                "residual_best_filter_nt",
+            ][..],
+        ),
+        (
+            "em",
+            &[
+                "range_err_rel",
+                "angle_err_deg",
+                "polarization_ratio_before",
+                "polarization_ratio_after",
+            ][..],
+        ),
+        (
+            "gradiometry",
+            &[
+                "efficiency_tensor",
+                "efficiency_scalar",
+                "convergence_fraction",
+            ][..],
+        ),
         ("pod", &["rate_train", "rate_test"][..]),
     ] {
         for k in keys {
@@ -212,13 +510,19 @@ fn observability_tells_a_full_box_from_a_single_heading() {
     let o = aeromag(&["observability", "--input", cal.to_str().unwrap()]);
     assert_code(&o, 0);
     let s = stdout(&o);
-    assert!(s.contains("rank 16 of 16") && !s.contains("cannot determine"), "{s}");
+    assert!(
+        s.contains("rank 16 of 16") && !s.contains("cannot determine"),
+        "{s}"
+    );
     // One straight leg: the permanent and induced terms are not determined.
     let text = std::fs::read_to_string(&cal).unwrap();
     let mut it = text.lines().filter(|l| !l.starts_with('#'));
     let header = it.next().unwrap();
     let h: Vec<&str> = header.split(',').collect();
-    let (li, mi) = (h.iter().position(|c| *c == "line").unwrap(), h.iter().position(|c| *c == "manoeuvre").unwrap());
+    let (li, mi) = (
+        h.iter().position(|c| *c == "line").unwrap(),
+        h.iter().position(|c| *c == "manoeuvre").unwrap(),
+    );
     let kept: Vec<&str> = it
         .filter(|l| {
             let c: Vec<&str> = l.split(',').collect();
@@ -230,7 +534,10 @@ fn observability_tells_a_full_box_from_a_single_heading() {
     let o = aeromag(&["observability", "--input", one.to_str().unwrap()]);
     assert_code(&o, 0);
     let s = stdout(&o);
-    assert!(s.contains("this flight cannot determine:") && s.contains("p_x") && s.contains("i_xx"), "{s}");
+    assert!(
+        s.contains("this flight cannot determine:") && s.contains("p_x") && s.contains("i_xx"),
+        "{s}"
+    );
     let j = aeromag(&["observability", "--input", one.to_str().unwrap(), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
     assert_eq!(v["estimability"].as_array().unwrap().len(), 16);
@@ -243,12 +550,23 @@ fn interference_error(path: &std::path::Path) -> f64 {
     let text = std::fs::read_to_string(path).unwrap();
     let mut rows = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-    let col = |n: &str| header.iter().position(|h| *h == n).unwrap_or_else(|| panic!("no column {n}"));
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|h| *h == n)
+            .unwrap_or_else(|| panic!("no column {n}"))
+    };
     let (ti, mi, li) = (col("true_interf"), col("mag_interf"), col("line"));
     let mut by_line: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
     for r in rows {
         let v: Vec<&str> = r.split(',').collect();
-        let (Ok(t), Ok(m), Ok(l)) = (v[ti].parse::<f64>(), v[mi].parse::<f64>(), v[li].parse::<f64>()) else { continue };
+        let (Ok(t), Ok(m), Ok(l)) = (
+            v[ti].parse::<f64>(),
+            v[mi].parse::<f64>(),
+            v[li].parse::<f64>(),
+        ) else {
+            continue;
+        };
         if l > 0.0 {
             by_line.entry(l as i64).or_default().push(t - m);
         }
@@ -272,9 +590,22 @@ fn interference_error(path: &std::path::Path) -> f64 {
 fn kalman_beats_least_squares_over_geology_at_600_m() {
     let d = tempfile::tempdir().unwrap();
     let cfg = d.path().join("g600.toml");
-    std::fs::write(&cfg, "[pattern]\naltitude_m = 600.0\n[anomaly]\narea = \"realistic\"\n").unwrap();
+    std::fs::write(
+        &cfg,
+        "[pattern]\naltitude_m = 600.0\n[anomaly]\narea = \"realistic\"\n",
+    )
+    .unwrap();
     let cal_dir = d.path().join("cal");
-    let o = aeromag(&["simulate", "calibration", "--config", cfg.to_str().unwrap(), "--seed", "4", "--out", cal_dir.to_str().unwrap()]);
+    let o = aeromag(&[
+        "simulate",
+        "calibration",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--seed",
+        "4",
+        "--out",
+        cal_dir.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
     let survey = simulate(d.path(), "survey", "5");
     let cal = cal_dir.join("calibration.csv");
@@ -283,11 +614,35 @@ fn kalman_beats_least_squares_over_geology_at_600_m() {
         let model = d.path().join(format!("{method}.json"));
         let out = d.path().join(format!("{method}.csv"));
         let o = aeromag(&[
-            "calibrate", "--input", cal.to_str().unwrap(), "--model", model.to_str().unwrap(), "--method", method, "--lever-arm", "-9.5,0,-0.6",
+            "calibrate",
+            "--input",
+            cal.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+            "--method",
+            method,
+            "--lever-arm",
+            "-9.5,0,-0.6",
         ]);
         assert_code(&o, 0);
-        assert_code(&aeromag(&["compensate", "--model", model.to_str().unwrap(), "--input", survey.to_str().unwrap(), "--out", out.to_str().unwrap()]), 0);
+        assert_code(
+            &aeromag(&[
+                "compensate",
+                "--model",
+                model.to_str().unwrap(),
+                "--input",
+                survey.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+            0,
+        );
         err.push(interference_error(&out));
     }
-    assert!(err[1] < 0.8 * err[0], "interference error LS {} nT, Kalman {} nT", err[0], err[1]);
+    assert!(
+        err[1] < 0.8 * err[0],
+        "interference error LS {} nT, Kalman {} nT",
+        err[0],
+        err[1]
+    );
 }

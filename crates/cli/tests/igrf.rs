@@ -5,7 +5,18 @@ use common::*;
 
 #[test]
 fn json_output_has_the_documented_keys_and_consistent_values() {
-    let o = aeromag(&["igrf", "--lat", "55.75", "--lon", "37.62", "--alt", "200", "--date", "2025-06-01", "--json"]);
+    let o = aeromag(&[
+        "igrf",
+        "--lat",
+        "55.75",
+        "--lon",
+        "37.62",
+        "--alt",
+        "200",
+        "--date",
+        "2025-06-01",
+        "--json",
+    ]);
     assert_code(&o, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("valid JSON");
     let g = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("key {k}"));
@@ -20,7 +31,15 @@ fn json_output_has_the_documented_keys_and_consistent_values() {
 
 #[test]
 fn text_output_names_the_components() {
-    let o = aeromag(&["igrf", "--lat", "-33.9", "--lon", "18.4", "--date", "2010-01-01"]);
+    let o = aeromag(&[
+        "igrf",
+        "--lat",
+        "-33.9",
+        "--lon",
+        "18.4",
+        "--date",
+        "2010-01-01",
+    ]);
     assert_code(&o, 0);
     let s = stdout(&o);
     for k in ["X (north)", "Y (east)", "Z (down)", "F", "D", "I"] {

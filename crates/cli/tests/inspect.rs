@@ -41,7 +41,10 @@ fn awkward_but_valid_files_are_read() {
     bom.extend_from_slice(GOOD.as_bytes());
     let commented = format!("# flight 7\n# units nT\n{GOOD}");
     let no_newline = GOOD.trim_end().to_string();
-    let extra = GOOD.replace("line\n", "line,pilot\n").replace(",1\n", ",1,ann\n").replace(",2\n", ",2,bob\n");
+    let extra = GOOD
+        .replace("line\n", "line,pilot\n")
+        .replace(",1\n", ",1,ann\n")
+        .replace(",2\n", ",2,bob\n");
     let nan = GOOD.replace("52000.2", "NaN").replace("17002", "");
     for (name, content) in [
         ("crlf.csv", crlf.into_bytes()),
@@ -64,14 +67,49 @@ fn malformed_files_exit_2_naming_file_line_and_column() {
     let d = tempfile::tempdir().unwrap();
     let cases: Vec<(&str, Vec<u8>, Vec<&str>)> = vec![
         ("empty.csv", vec![], vec!["empty.csv"]),
-        ("header_only.csv", b"time,mag\n".to_vec(), vec!["header_only.csv"]),
-        ("truncated.csv", GOOD.replace("52000.3,17002,1500,48000,1", "52000.3,17002").into_bytes(), vec!["truncated.csv", "line 4"]),
-        ("text.csv", GOOD.replace("52000.2", "abc").into_bytes(), vec!["text.csv", "line 3", "mag", "abc"]),
-        ("backwards.csv", GOOD.replace("0.2,45", "0.05,45").into_bytes(), vec!["backwards.csv", "time"]),
-        ("duplicate.csv", GOOD.replace("0.2,45", "0.1,45").into_bytes(), vec!["duplicate.csv", "time"]),
-        ("tesla.csv", GOOD.replace("52000.", "0.000052").into_bytes(), vec!["tesla.csv", "mag", "tesla"]),
-        ("binary.csv", vec![0x00, 0xff, 0xfe, 0x10, 0x00, 0x80, 0x81], vec!["binary.csv"]),
-        ("semicolon.csv", GOOD.replace(',', ";").replace("52000.1", "52000,1").into_bytes(), vec!["semicolon.csv"]),
+        (
+            "header_only.csv",
+            b"time,mag\n".to_vec(),
+            vec!["header_only.csv"],
+        ),
+        (
+            "truncated.csv",
+            GOOD.replace("52000.3,17002,1500,48000,1", "52000.3,17002")
+                .into_bytes(),
+            vec!["truncated.csv", "line 4"],
+        ),
+        (
+            "text.csv",
+            GOOD.replace("52000.2", "abc").into_bytes(),
+            vec!["text.csv", "line 3", "mag", "abc"],
+        ),
+        (
+            "backwards.csv",
+            GOOD.replace("0.2,45", "0.05,45").into_bytes(),
+            vec!["backwards.csv", "time"],
+        ),
+        (
+            "duplicate.csv",
+            GOOD.replace("0.2,45", "0.1,45").into_bytes(),
+            vec!["duplicate.csv", "time"],
+        ),
+        (
+            "tesla.csv",
+            GOOD.replace("52000.", "0.000052").into_bytes(),
+            vec!["tesla.csv", "mag", "tesla"],
+        ),
+        (
+            "binary.csv",
+            vec![0x00, 0xff, 0xfe, 0x10, 0x00, 0x80, 0x81],
+            vec!["binary.csv"],
+        ),
+        (
+            "semicolon.csv",
+            GOOD.replace(',', ";")
+                .replace("52000.1", "52000,1")
+                .into_bytes(),
+            vec!["semicolon.csv"],
+        ),
     ];
     for (name, content, needles) in cases {
         let p = write(&d, name, &content);
@@ -83,7 +121,11 @@ fn malformed_files_exit_2_naming_file_line_and_column() {
             assert!(e.contains(n), "{name}: `{n}` not in: {e}");
         }
     }
-    let o = aeromag(&["inspect", "--input", d.path().join("absent.csv").to_str().unwrap()]);
+    let o = aeromag(&[
+        "inspect",
+        "--input",
+        d.path().join("absent.csv").to_str().unwrap(),
+    ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("absent.csv"));
 }
@@ -101,22 +143,41 @@ fn malformed_xyz_exits_2() {
     let p = write(&d, "bad.xyz", bad.as_bytes());
     let o = aeromag(&["inspect", "--input", p.to_str().unwrap()]);
     assert_code(&o, 2);
-    assert!(stderr(&o).contains("bad.xyz") && stderr(&o).contains("line 5"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bad.xyz") && stderr(&o).contains("line 5"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
 fn column_mapping_of_magnav_names() {
     let d = tempfile::tempdir().unwrap();
-    let magnav = GOOD.replace("time,", "tt,").replace(",mag,flux_x,flux_y,flux_z,", ",mag_1_uc,flux_a_x,flux_a_y,flux_a_z,");
+    let magnav = GOOD.replace("time,", "tt,").replace(
+        ",mag,flux_x,flux_y,flux_z,",
+        ",mag_1_uc,flux_a_x,flux_a_y,flux_a_z,",
+    );
     let p = write(&d, "magnav.csv", magnav.as_bytes());
     let o = aeromag(&["inspect", "--input", p.to_str().unwrap()]);
     assert_code(&o, 0);
     assert!(stdout(&o).contains("mag=mag_1_uc"), "{}", stdout(&o));
     let renamed = GOOD.replace(",mag,", ",scalar,");
     let p = write(&d, "renamed.csv", renamed.as_bytes());
-    let o = aeromag(&["inspect", "--input", p.to_str().unwrap(), "--columns", "mag=scalar"]);
+    let o = aeromag(&[
+        "inspect",
+        "--input",
+        p.to_str().unwrap(),
+        "--columns",
+        "mag=scalar",
+    ]);
     assert_code(&o, 0);
-    let o = aeromag(&["inspect", "--input", p.to_str().unwrap(), "--columns", "mag=nothere"]);
+    let o = aeromag(&[
+        "inspect",
+        "--input",
+        p.to_str().unwrap(),
+        "--columns",
+        "mag=nothere",
+    ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("nothere"));
 }

@@ -7,28 +7,84 @@ use common::*;
 fn level_keeps_every_row_and_reports_k() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("s");
-    assert_code(&aeromag(&["simulate", "survey", "--seed", "4", "--out", out.to_str().unwrap()]), 0);
+    assert_code(
+        &aeromag(&[
+            "simulate",
+            "survey",
+            "--seed",
+            "4",
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        0,
+    );
     let input = out.join("survey.csv");
     let lev = d.path().join("lev.csv");
     let o = aeromag(&[
-        "level", "--input", input.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--lever-arm", "-9.5,0,-0.6", "--drift",
+        "level",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        lev.to_str().unwrap(),
+        "--lever-arm",
+        "-9.5,0,-0.6",
+        "--drift",
     ]);
     assert_code(&o, 0);
     let s = stdout(&o);
-    assert!(s.contains("crossovers") && s.contains("k (d|B0|/dt term)"), "{s}");
+    assert!(
+        s.contains("crossovers") && s.contains("k (d|B0|/dt term)"),
+        "{s}"
+    );
     // Without a base-station correction the crossover differences are dominated by the
     // diurnal drift, which per-line offsets and drifts remove.
     // The model residual and the levelled series' differences both fall ≥ 5×.
-    let line = s.lines().find(|l| l.starts_with("crossover differences RMS")).unwrap();
-    let nums: Vec<f64> = line.split_whitespace().filter_map(|w| w.parse().ok()).collect();
-    assert!(nums.len() == 3 && nums[1] < nums[0] / 5.0 && nums[2] < nums[0] / 5.0, "{line}");
-    let rows = |p: &std::path::Path| std::fs::read_to_string(p).unwrap().lines().filter(|l| !l.starts_with('#')).count();
+    let line = s
+        .lines()
+        .find(|l| l.starts_with("crossover differences RMS"))
+        .unwrap();
+    let nums: Vec<f64> = line
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!(
+        nums.len() == 3 && nums[1] < nums[0] / 5.0 && nums[2] < nums[0] / 5.0,
+        "{line}"
+    );
+    let rows = |p: &std::path::Path| {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .count()
+    };
     assert_eq!(rows(&input), rows(&lev), "one output row per input row");
-    let header = std::fs::read_to_string(&lev).unwrap().lines().find(|l| !l.starts_with('#')).unwrap().to_string();
+    let header = std::fs::read_to_string(&lev)
+        .unwrap()
+        .lines()
+        .find(|l| !l.starts_with('#'))
+        .unwrap()
+        .to_string();
     assert!(header.contains("mag_level") && header.contains("level_flag"));
-    let bad = aeromag(&["level", "--input", input.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--lever-arm", "1,2"]);
+    let bad = aeromag(&[
+        "level",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        lev.to_str().unwrap(),
+        "--lever-arm",
+        "1,2",
+    ]);
     assert_code(&bad, 2);
-    let bad = aeromag(&["level", "--input", input.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--reference", "nosuch"]);
+    let bad = aeromag(&[
+        "level",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        lev.to_str().unwrap(),
+        "--reference",
+        "nosuch",
+    ]);
     assert_code(&bad, 2);
 }
 
@@ -45,45 +101,120 @@ fn level_with_the_base_station_recovers_k() {
     let d = tempfile::tempdir().unwrap();
     let dir = |n: &str| d.path().join(n);
     for (scenario, seed) in [("calibration", "1"), ("survey", "2")] {
-        assert_code(&aeromag(&["simulate", scenario, "--seed", seed, "--out", dir(scenario).to_str().unwrap()]), 0);
+        assert_code(
+            &aeromag(&[
+                "simulate",
+                scenario,
+                "--seed",
+                seed,
+                "--out",
+                dir(scenario).to_str().unwrap(),
+            ]),
+            0,
+        );
     }
     let model = dir("m.json");
     let cal = dir("calibration").join("calibration.csv");
-    assert_code(&aeromag(&["calibrate", "--input", cal.to_str().unwrap(), "--model", model.to_str().unwrap()]), 0);
+    assert_code(
+        &aeromag(&[
+            "calibrate",
+            "--input",
+            cal.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+        ]),
+        0,
+    );
     let comp = dir("comp.csv");
     let survey = dir("survey").join("survey.csv");
-    assert_code(&aeromag(&["compensate", "--model", model.to_str().unwrap(), "--input", survey.to_str().unwrap(), "--out", comp.to_str().unwrap()]), 0);
+    assert_code(
+        &aeromag(&[
+            "compensate",
+            "--model",
+            model.to_str().unwrap(),
+            "--input",
+            survey.to_str().unwrap(),
+            "--out",
+            comp.to_str().unwrap(),
+        ]),
+        0,
+    );
     let lev = dir("lev.csv");
     let k_of = |extra: &[&str]| {
         let mut args = vec![
-            "level", "--input", comp.to_str().unwrap(), "--out", lev.to_str().unwrap(), "--lever-arm", "-9.5,0,-0.6", "--reference", "auto",
+            "level",
+            "--input",
+            comp.to_str().unwrap(),
+            "--out",
+            lev.to_str().unwrap(),
+            "--lever-arm",
+            "-9.5,0,-0.6",
+            "--reference",
+            "auto",
         ];
         args.extend_from_slice(extra);
         let o = aeromag(&args);
         assert_code(&o, 0);
         let s = stdout(&o);
         assert!(s.contains("levelling mag_comp − diurnal − igrf"), "{s}");
-        let line = s.lines().find(|l| l.starts_with("k (d|B0|/dt term)")).unwrap().to_string();
-        let nums: Vec<f64> = line.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+        let line = s
+            .lines()
+            .find(|l| l.starts_with("k (d|B0|/dt term)"))
+            .unwrap()
+            .to_string();
+        let nums: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
         (nums[0], nums[1], s)
     };
     let (k, sd, s) = k_of(&[]);
-    assert!(sd > 0.0 && sd < 0.02 && (k + 0.1).abs() <= 3.0 * sd, "k = {k} ± {sd}\n{s}");
-    assert!(s.contains("altitude term: vertical-gradient scale c ="), "{s}");
+    assert!(
+        sd > 0.0 && sd < 0.02 && (k + 0.1).abs() <= 3.0 * sd,
+        "k = {k} ± {sd}\n{s}"
+    );
+    assert!(
+        s.contains("altitude term: vertical-gradient scale c ="),
+        "{s}"
+    );
     let (k0, sd0, _) = k_of(&["--no-altitude-term"]);
-    assert!(sd0 > 1.6 * sd, "σ_k {sd0} without the altitude term vs {sd} with it (k {k0} vs {k})");
+    assert!(
+        sd0 > 1.6 * sd,
+        "σ_k {sd0} without the altitude term vs {sd} with it (k {k0} vs {k})"
+    );
 }
 
 #[test]
 fn dipole_convergence_map_multistart_converges_everywhere() {
     let d = tempfile::tempdir().unwrap();
-    let o = aeromag(&["dipole", "convergence", "--grid", "9", "--out", d.path().to_str().unwrap()]);
+    let o = aeromag(&[
+        "dipole",
+        "convergence",
+        "--grid",
+        "9",
+        "--out",
+        d.path().to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
     let s = stdout(&o);
     let multi = s.lines().find(|l| l.starts_with("multi-start")).unwrap();
     assert!(multi.contains("100.00 % of 729 starts"), "{multi}");
     let plain = s.lines().find(|l| l.starts_with("plain IEKF")).unwrap();
     assert!(!plain.contains("100.00 % of"), "{plain}");
-    assert!(std::fs::read_to_string(d.path().join("index.html")).unwrap().contains("<svg"));
-    assert_code(&aeromag(&["dipole", "convergence", "--grid", "1", "--out", d.path().to_str().unwrap()]), 2);
+    assert!(
+        std::fs::read_to_string(d.path().join("index.html"))
+            .unwrap()
+            .contains("<svg")
+    );
+    assert_code(
+        &aeromag(&[
+            "dipole",
+            "convergence",
+            "--grid",
+            "1",
+            "--out",
+            d.path().to_str().unwrap(),
+        ]),
+        2,
+    );
 }

@@ -35,8 +35,8 @@ fn rms(x: &[f64]) -> f64 {
 }
 
 /// Seed-style rate per heading (`line`): `1 − RMS(detrend(mag − true_external
-/// − pod_interf)) / RMS(detrend(mag))`.
-fn rates(out: &Path) -> Vec<f64> {
+/// − pod_interf)) / RMS(detrend(mag))`, and the same pooled over all rows.
+fn rates(out: &Path) -> (Vec<f64>, f64) {
     use aeromag_compensation::pod::detrend;
     let (h, rows) = read_csv(out);
     let (mag, ext, pred, line) = (
@@ -45,17 +45,21 @@ fn rates(out: &Path) -> Vec<f64> {
         column(&h, &rows, "pod_interf"),
         column(&h, &rows, "line"),
     );
-    let mut r = Vec::new();
+    let sum_sq = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>();
+    let (mut r, mut pooled_before, mut pooled_after) = (Vec::new(), 0.0, 0.0);
     let mut start = 0;
     for k in 1..=line.len() {
         if k == line.len() || line[k] != line[start] {
             let before = detrend(&mag[start..k]);
             let after: Vec<f64> = (start..k).map(|j| mag[j] - ext[j] - pred[j]).collect();
-            r.push(1.0 - rms(&detrend(&after)) / rms(&before));
+            let after = detrend(&after);
+            r.push(1.0 - rms(&after) / rms(&before));
+            pooled_before += sum_sq(&before);
+            pooled_after += sum_sq(&after);
             start = k;
         }
     }
-    r
+    (r, 1.0 - (pooled_after / pooled_before).sqrt())
 }
 
 const SETUP: [&str; 10] = [
@@ -71,16 +75,27 @@ const SETUP: [&str; 10] = [
     "-25.91",
 ];
 
+/// The seed's stated conditions (swing a 5° sinusoid): a learning flight on
+/// the seed's headings (sim seed 1) and the independent heading set (1001).
 fn simulate_pair(d: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
     let learn = d.join("learn");
+    let learn_cfg = d.join("learn.toml");
+    std::fs::write(&learn_cfg, "swing_sine = true\n").unwrap();
     assert_code(
-        &aeromag(&["simulate", "pod", "--out", learn.to_str().unwrap()]),
+        &aeromag(&[
+            "simulate",
+            "pod",
+            "--config",
+            learn_cfg.to_str().unwrap(),
+            "--out",
+            learn.to_str().unwrap(),
+        ]),
         0,
     );
     let cfg = d.join("test.toml");
     std::fs::write(
         &cfg,
-        "headings_deg = [30.0, 120.0, 210.0, 300.0, 70.0, 160.0, 250.0, 340.0]\n",
+        "swing_sine = true\nheadings_deg = [30.0, 120.0, 210.0, 300.0, 70.0, 160.0, 250.0, 340.0]\n",
     )
     .unwrap();
     let test = d.join("test");
@@ -121,7 +136,7 @@ fn fit_apply(d: &Path, learn: &Path, test: &Path, method: &str) -> std::path::Pa
 }
 
 #[test]
-fn dipole_array_and_joint_reach_97_percent_on_independent_headings_and_beat_the_seed_solve() {
+fn seed_solve_reaches_90_percent_on_the_set_dipole_array_and_joint_97_percent_on_every_heading() {
     let d = tempfile::tempdir().unwrap();
     let (learn, test) = simulate_pair(d.path());
     let text = std::fs::read_to_string(&learn).unwrap();
@@ -134,10 +149,13 @@ fn dipole_array_and_joint_reach_97_percent_on_independent_headings_and_beat_the_
     let da = fit_apply(d.path(), &learn, &test, "dipole-array");
     let two = fit_apply(d.path(), &learn, &test, "two-step");
     let joint = fit_apply(d.path(), &learn, &test, "joint");
-    let (rd, rt, rj) = (rates(&da), rates(&two), rates(&joint));
+    let ((rd, pd), (rt, pt), (rj, pj)) = (rates(&da), rates(&two), rates(&joint));
     eprintln!(
-        "dipole array per test heading {rd:?}\ntwo-step per test heading {rt:?}\njoint per test heading {rj:?}"
+        "dipole array per test heading {rd:?} pooled {pd}\ntwo-step per test heading {rt:?} \
+         pooled {pt}\njoint per test heading {rj:?} pooled {pj}"
     );
+    // The seed's solve: its "above 90 %" on the independent set as a whole.
+    assert!(pt >= 0.90, "two-step pooled {pt}");
     assert_eq!(rd.len(), 8);
     assert!(rd.iter().all(|r| *r >= 0.97), "dipole array {rd:?}");
     assert!(rj.iter().all(|r| *r >= 0.97), "joint {rj:?}");

@@ -155,7 +155,10 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
     // bridged and the whole record fitted as one.
     let learn_text = std::fs::read_to_string(&learn).unwrap();
     let learn_lines: Vec<&str> = learn_text.lines().collect();
-    let lhdr = learn_lines.iter().position(|l| !l.starts_with('#')).unwrap();
+    let lhdr = learn_lines
+        .iter()
+        .position(|l| !l.starts_with('#'))
+        .unwrap();
     let n_learn = learn_lines.len() - lhdr - 1;
     let mut gapped: Vec<String> = learn_lines.iter().map(|l| l.to_string()).collect();
     let mid = lhdr + n_learn / 2;
@@ -166,17 +169,32 @@ fn rotor_fit_and_apply_leave_under_10_percent_on_an_independent_flight() {
         let path = d.path().join(format!("{name}.csv"));
         std::fs::write(&path, lines.join("\n") + "\n").unwrap();
         let model = d.path().join(format!("{name}.json"));
-        let o = aeromag(&["rotor", "fit", "--input", path.to_str().unwrap(), "--model", model.to_str().unwrap()]);
+        let o = aeromag(&[
+            "rotor",
+            "fit",
+            "--input",
+            path.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+        ]);
         assert_code(&o, 0);
         assert!(stderr(&o).contains(note), "{}", stderr(&o));
-        let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
         let out = d.path().join(format!("{name}_out.csv"));
         assert_code(&apply("rotor", &model, &other, &out), 0);
         (residual_share(&out), m["rows"].as_u64().unwrap() as usize)
     };
-    let (share_dropout, rows) = fit_share("dropout", &gapped, "1 rows with a missing value in a dropout");
+    let (share_dropout, rows) = fit_share(
+        "dropout",
+        &gapped,
+        "1 rows with a missing value in a dropout",
+    );
     assert_eq!(rows, n_learn);
-    assert!((share_dropout - share).abs() < 0.002, "{share_dropout} vs {share} without the dropout");
+    assert!(
+        (share_dropout - share).abs() < 0.002,
+        "{share_dropout} vs {share} without the dropout"
+    );
     // A time gap (2000 rows missing): the parameters are refined on both
     // stretches (9.5 % left; the longer stretch alone left 10.9 %).
     let mut cut: Vec<String> = learn_lines.iter().map(|l| l.to_string()).collect();

@@ -22,39 +22,86 @@ fn read_csv(p: &Path) -> BTreeMap<String, Vec<f64>> {
 fn calibration_files_columns_and_physics() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("cal");
-    let o = aeromag(&["simulate", "calibration", "--seed", "3", "--out", out.to_str().unwrap()]);
+    let o = aeromag(&[
+        "simulate",
+        "calibration",
+        "--seed",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_code(&o, 0);
-    for f in ["calibration.csv", "calibration.toml", "calibration.truth.json"] {
+    for f in [
+        "calibration.csv",
+        "calibration.toml",
+        "calibration.truth.json",
+    ] {
         assert!(out.join(f).exists(), "{f}");
     }
     let c = read_csv(&out.join("calibration.csv"));
-    for k in ["time", "lat", "lon", "alt", "roll", "pitch", "yaw", "mag", "flux_x", "flux_y", "flux_z", "line", "diurnal", "igrf", "true_external", "true_interf"] {
+    for k in [
+        "time",
+        "lat",
+        "lon",
+        "alt",
+        "roll",
+        "pitch",
+        "yaw",
+        "mag",
+        "flux_x",
+        "flux_y",
+        "flux_z",
+        "line",
+        "diurnal",
+        "igrf",
+        "true_external",
+        "true_interf",
+    ] {
         assert!(c.contains_key(k), "column {k}");
     }
     let n = c["time"].len();
     assert!(n > 3000, "{n} rows");
     // 10 Hz, strictly increasing.
-    assert!(c["time"].windows(2).all(|w| (w[1] - w[0] - 0.1).abs() < 1e-6));
+    assert!(
+        c["time"]
+            .windows(2)
+            .all(|w| (w[1] - w[0] - 0.1).abs() < 1e-6)
+    );
     // Units: nT magnitudes of the Earth's field.
     assert!(c["mag"].iter().all(|v| (20_000.0..70_000.0).contains(v)));
     // mag = external + interference + small sensor terms.
-    let worst = (0..n).map(|i| (c["mag"][i] - c["true_external"][i] - c["true_interf"][i]).abs()).fold(0.0, f64::max);
-    assert!(worst < 0.5, "mag − (external + interference) up to {worst} nT");
+    let worst = (0..n)
+        .map(|i| (c["mag"][i] - c["true_external"][i] - c["true_interf"][i]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 0.5,
+        "mag − (external + interference) up to {worst} nT"
+    );
     // The interference depends on heading like an aircraft's: the per-leg
     // means differ by more than a nanotesla between headings…
     let mut means = Vec::new();
     for leg in 1..=4 {
-        let v: Vec<f64> = (0..n).filter(|&i| c["line"][i] == leg as f64).map(|i| c["true_interf"][i]).collect();
+        let v: Vec<f64> = (0..n)
+            .filter(|&i| c["line"][i] == leg as f64)
+            .map(|i| c["true_interf"][i])
+            .collect();
         assert!(!v.is_empty(), "leg {leg}");
         means.push(v.iter().sum::<f64>() / v.len() as f64);
     }
-    let spread = means.iter().cloned().fold(f64::MIN, f64::max) - means.iter().cloned().fold(f64::MAX, f64::min);
+    let spread = means.iter().cloned().fold(f64::MIN, f64::max)
+        - means.iter().cloned().fold(f64::MAX, f64::min);
     assert!(spread > 1.0, "heading dependence {spread} nT: {means:?}");
     // …and swings within the roll manoeuvres far above the sensor noise.
-    let roll: Vec<usize> = (0..n).filter(|&i| c["manoeuvre"][i] == 1.0 && c["line"][i] == 1.0).collect();
+    let roll: Vec<usize> = (0..n)
+        .filter(|&i| c["manoeuvre"][i] == 1.0 && c["line"][i] == 1.0)
+        .collect();
     let v: Vec<f64> = roll.iter().map(|&i| c["true_interf"][i]).collect();
-    let pp = v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min);
-    assert!(pp > 0.5, "interference peak-to-peak in roll manoeuvres {pp} nT");
+    let pp =
+        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(
+        pp > 0.5,
+        "interference peak-to-peak in roll manoeuvres {pp} nT"
+    );
 }
 
 #[test]
@@ -62,7 +109,17 @@ fn same_seed_same_bytes_other_seed_other_data() {
     let d = tempfile::tempdir().unwrap();
     let run = |seed: &str, sub: &str| {
         let out = d.path().join(sub);
-        assert_code(&aeromag(&["simulate", "calibration-truncated", "--seed", seed, "--out", out.to_str().unwrap()]), 0);
+        assert_code(
+            &aeromag(&[
+                "simulate",
+                "calibration-truncated",
+                "--seed",
+                seed,
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+            0,
+        );
         std::fs::read(out.join("calibration_truncated.csv")).unwrap()
     };
     let a = run("11", "a");
@@ -81,11 +138,31 @@ fn scenario_files_round_trip_and_typos_are_errors() {
     let p = d.path().join("s.toml");
     std::fs::write(&p, &toml).unwrap();
     let out = d.path().join("s");
-    assert_code(&aeromag(&["simulate", "survey", "--config", p.to_str().unwrap(), "--out", out.to_str().unwrap()]), 0);
+    assert_code(
+        &aeromag(&[
+            "simulate",
+            "survey",
+            "--config",
+            p.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        0,
+    );
     let bad = d.path().join("bad.toml");
     std::fs::write(&bad, "[flight]\nsample_rate_hzz = 10\n").unwrap();
-    let o = aeromag(&["simulate", "survey", "--config", bad.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = aeromag(&[
+        "simulate",
+        "survey",
+        "--config",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("sample_rate_hzz"), "{}", stderr(&o));
-    assert_code(&aeromag(&["simulate", "spaceship", "--out", out.to_str().unwrap()]), 2);
+    assert_code(
+        &aeromag(&["simulate", "spaceship", "--out", out.to_str().unwrap()]),
+        2,
+    );
 }

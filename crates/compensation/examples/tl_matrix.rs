@@ -8,7 +8,7 @@
 //!   prints c, one value per line.
 
 use aeromag_compensation::tolles_lawson::design::design_columns;
-use aeromag_compensation::tolles_lawson::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
+use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use aeromag_estimation::least_squares::NormalEquations;
 use std::error::Error;
 
@@ -18,13 +18,22 @@ fn read_rows(path: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), Box<dyn Error>>
     let first = lines.next().ok_or("empty file")?;
     let mut rows = Vec::new();
     let header: Vec<String> = if first.split(',').all(|c| c.trim().parse::<f64>().is_ok()) {
-        rows.push(first.split(',').map(|c| c.trim().parse()).collect::<Result<Vec<f64>, _>>()?);
+        rows.push(
+            first
+                .split(',')
+                .map(|c| c.trim().parse())
+                .collect::<Result<Vec<f64>, _>>()?,
+        );
         Vec::new()
     } else {
         first.split(',').map(|s| s.trim().to_string()).collect()
     };
     for l in lines {
-        rows.push(l.split(',').map(|c| c.trim().parse()).collect::<Result<Vec<f64>, _>>()?);
+        rows.push(
+            l.split(',')
+                .map(|c| c.trim().parse())
+                .collect::<Result<Vec<f64>, _>>()?,
+        );
     }
     Ok((header, rows))
 }

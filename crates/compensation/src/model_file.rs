@@ -19,7 +19,12 @@ pub const TL_KIND: &str = "tolles-lawson";
 /// Parse a model file and check its `format` ([`MODEL_FORMAT`]) and `kind`
 /// (`writer` names the command that writes that kind, for the message).
 /// Every model file of aeromag (Tolles-Lawson, rotor, pod) goes through here.
-pub fn parse_model_json(text: &str, origin: &str, kind: &str, writer: &str) -> Result<serde_json::Value> {
+pub fn parse_model_json(
+    text: &str,
+    origin: &str,
+    kind: &str,
+    writer: &str,
+) -> Result<serde_json::Value> {
     let v: serde_json::Value = serde_json::from_str(text)
         .map_err(|e| CompError::BadData(format!("{origin}: not a JSON model file ({e})")))?;
     match v.get("format").and_then(|f| f.as_str()) {
@@ -29,7 +34,11 @@ pub fn parse_model_json(text: &str, origin: &str, kind: &str, writer: &str) -> R
                 "{origin}: model format `{other}` is not supported (expected `{MODEL_FORMAT}`)"
             )));
         }
-        None => return Err(CompError::BadData(format!("{origin}: no \"format\" key; not an aeromag model file"))),
+        None => {
+            return Err(CompError::BadData(format!(
+                "{origin}: no \"format\" key; not an aeromag model file"
+            )));
+        }
     }
     match v.get("kind").and_then(|k| k.as_str()) {
         Some(k) if k == kind => Ok(v),
@@ -42,9 +51,15 @@ pub fn parse_model_json(text: &str, origin: &str, kind: &str, writer: &str) -> R
 
 /// A model file of `kind` parsed into `T` after the header check of
 /// [`parse_model_json`]; errors name `origin`.
-pub fn parse_model<T: serde::de::DeserializeOwned>(text: &str, origin: &str, kind: &str, writer: &str) -> Result<T> {
+pub fn parse_model<T: serde::de::DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    kind: &str,
+    writer: &str,
+) -> Result<T> {
     let v = parse_model_json(text, origin, kind, writer)?;
-    serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid `{kind}` model: {e}")))
+    serde_json::from_value(v)
+        .map_err(|e| CompError::BadData(format!("{origin}: invalid `{kind}` model: {e}")))
 }
 
 /// One named coefficient.
@@ -134,15 +149,18 @@ impl TlModel {
 
     /// Serialize to pretty JSON.
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(self).map_err(|e| CompError::BadData(format!("cannot serialise model: {e}")))
+        serde_json::to_string_pretty(self)
+            .map_err(|e| CompError::BadData(format!("cannot serialise model: {e}")))
     }
 
     /// Parse and check a model file's text; `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let v = parse_model_json(text, origin, TL_KIND, "aeromag calibrate")?;
-        let m: TlModel =
-            serde_json::from_value(v).map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
-        m.terms.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        let m: TlModel = serde_json::from_value(v)
+            .map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
+        m.terms
+            .validate()
+            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
         let expect = m.terms.column_names();
         let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
         if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
@@ -152,7 +170,9 @@ impl TlModel {
             )));
         }
         if m.coefficients.iter().any(|c| !c.value.is_finite()) {
-            return Err(CompError::BadData(format!("{origin}: a coefficient is not finite")));
+            return Err(CompError::BadData(format!(
+                "{origin}: a coefficient is not finite"
+            )));
         }
         Ok(m)
     }
@@ -172,7 +192,11 @@ mod tests {
                 .column_names()
                 .into_iter()
                 .enumerate()
-                .map(|(k, name)| Coefficient { name, value: k as f64 + 0.5, std: 0.1 })
+                .map(|(k, name)| Coefficient {
+                    name,
+                    value: k as f64 + 0.5,
+                    std: 0.1,
+                })
                 .collect(),
             terms,
             convention: Convention::Physical,
@@ -193,13 +217,22 @@ mod tests {
     fn format_and_kind_are_checked() {
         let rotor = r#"{"format":"aeromag-model/1","kind":"helicopter-rotor"}"#;
         let e = TlModel::from_json(rotor, "r.json").unwrap_err().to_string();
-        assert!(e.contains("r.json") && e.contains("helicopter-rotor") && e.contains("aeromag calibrate"), "{e}");
+        assert!(
+            e.contains("r.json")
+                && e.contains("helicopter-rotor")
+                && e.contains("aeromag calibrate"),
+            "{e}"
+        );
         assert!(parse_model_json(rotor, "r.json", "helicopter-rotor", "aeromag rotor fit").is_ok());
-        let e = parse_model_json(r#"{"format":"aeromag-model/9","kind":"x"}"#, "m", "x", "w").unwrap_err().to_string();
+        let e = parse_model_json(r#"{"format":"aeromag-model/9","kind":"x"}"#, "m", "x", "w")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("aeromag-model/9"), "{e}");
         assert!(parse_model_json(r#"{"kind":"x"}"#, "m", "x", "w").is_err());
         assert!(parse_model_json("not json", "m", "x", "w").is_err());
-        let e = parse_model_json(r#"{"format":"aeromag-model/1"}"#, "m", "x", "w").unwrap_err().to_string();
+        let e = parse_model_json(r#"{"format":"aeromag-model/1"}"#, "m", "x", "w")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing"), "{e}");
     }
 

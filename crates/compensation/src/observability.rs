@@ -44,7 +44,12 @@ pub const RANK_TOLERANCE: f64 = 1e-9;
 /// Observability from prior and posterior covariances (same order as
 /// `names`). `weak_ratio`: directions whose information is below
 /// `λ_max / weak_ratio` are listed as poorly determined (e.g. 1e6).
-pub fn observability(names: &[String], prior: &DMatrix<f64>, posterior: &DMatrix<f64>, weak_ratio: f64) -> Result<Observability> {
+pub fn observability(
+    names: &[String],
+    prior: &DMatrix<f64>,
+    posterior: &DMatrix<f64>,
+    weak_ratio: f64,
+) -> Result<Observability> {
     let n = names.len();
     if prior.shape() != (n, n) || posterior.shape() != (n, n) {
         return Err(CompError::BadData(format!("covariances must be {n}×{n}")));
@@ -52,7 +57,11 @@ pub fn observability(names: &[String], prior: &DMatrix<f64>, posterior: &DMatrix
     let inv = |m: &DMatrix<f64>| m.clone().cholesky().map(|c| c.inverse());
     let (p0i, pi) = match (inv(prior), inv(posterior)) {
         (Some(a), Some(b)) => (a, b),
-        _ => return Err(CompError::BadData("a covariance matrix is not positive definite".into())),
+        _ => {
+            return Err(CompError::BadData(
+                "a covariance matrix is not positive definite".into(),
+            ));
+        }
     };
     let d: Vec<f64> = (0..n).map(|i| prior[(i, i)].sqrt()).collect();
     let mut s = DMatrix::from_fn(n, n, |i, j| (pi[(i, j)] - p0i[(i, j)]) * d[i] * d[j]);
@@ -63,7 +72,11 @@ pub fn observability(names: &[String], prior: &DMatrix<f64>, posterior: &DMatrix
     let w: Vec<f64> = order.iter().map(|&k| eig.eigenvalues[k].max(0.0)).collect();
     let wmax = w.last().copied().unwrap_or(0.0);
     let rank = w.iter().filter(|&&v| v > RANK_TOLERANCE * wmax).count();
-    let condition = if w[0] > 0.0 { wmax / w[0] } else { f64::INFINITY };
+    let condition = if w[0] > 0.0 {
+        wmax / w[0]
+    } else {
+        f64::INFINITY
+    };
     let mut weak = Vec::new();
     for (pos, &k) in order.iter().enumerate() {
         if !(w[pos] < wmax / weak_ratio) {
@@ -72,13 +85,34 @@ pub fn observability(names: &[String], prior: &DMatrix<f64>, posterior: &DMatrix
         let v = eig.eigenvectors.column(k);
         let mut idx: Vec<usize> = (0..n).collect();
         idx.sort_by(|&a, &b| v[b].abs().total_cmp(&v[a].abs()));
-        let terms: Vec<String> =
-            idx.iter().take(4).filter(|&&j| v[j].abs() > 0.1).map(|&j| format!("{:+.2}·{}", v[j], names[j])).collect();
-        let how = if w[pos] <= RANK_TOLERANCE * wmax { "not observable" } else { "poorly determined" };
-        weak.push(format!("{how}: {} (information {:.1e} of the best direction)", terms.join(" "), w[pos] / wmax.max(f64::MIN_POSITIVE)));
+        let terms: Vec<String> = idx
+            .iter()
+            .take(4)
+            .filter(|&&j| v[j].abs() > 0.1)
+            .map(|&j| format!("{:+.2}·{}", v[j], names[j]))
+            .collect();
+        let how = if w[pos] <= RANK_TOLERANCE * wmax {
+            "not observable"
+        } else {
+            "poorly determined"
+        };
+        weak.push(format!(
+            "{how}: {} (information {:.1e} of the best direction)",
+            terms.join(" "),
+            w[pos] / wmax.max(f64::MIN_POSITIVE)
+        ));
     }
-    let estimability = (0..n).map(|i| (posterior[(i, i)] / prior[(i, i)]).max(0.0).sqrt()).collect();
-    Ok(Observability { names: names.to_vec(), rank, condition, eigenvalues: w, estimability, weak_combinations: weak })
+    let estimability = (0..n)
+        .map(|i| (posterior[(i, i)] / prior[(i, i)]).max(0.0).sqrt())
+        .collect();
+    Ok(Observability {
+        names: names.to_vec(),
+        rank,
+        condition,
+        eigenvalues: w,
+        estimability,
+        weak_combinations: weak,
+    })
 }
 
 #[cfg(test)]
@@ -98,7 +132,13 @@ mod tests {
         assert!(o.condition.is_infinite() || o.condition > 1e12);
         assert_eq!(o.weak_combinations.len(), 1);
         let text = &o.weak_combinations[0];
-        assert!(text.contains("not observable") && text.contains("b") && text.contains("c") && !text.contains("a "), "{text}");
+        assert!(
+            text.contains("not observable")
+                && text.contains("b")
+                && text.contains("c")
+                && !text.contains("a "),
+            "{text}"
+        );
         // μ: a well estimated, b and c only half (b + c known, b − c not).
         assert!(o.estimability[0] < 0.11);
         assert!((o.estimability[1] - (0.5f64 + 0.5 / 201.0).sqrt()).abs() < 1e-9);
@@ -107,7 +147,17 @@ mod tests {
     #[test]
     fn bad_shapes_are_errors() {
         let names = vec!["a".to_string()];
-        assert!(observability(&names, &DMatrix::identity(2, 2), &DMatrix::identity(1, 1), 1e6).is_err());
-        assert!(observability(&names, &DMatrix::zeros(1, 1), &DMatrix::identity(1, 1), 1e6).is_err());
+        assert!(
+            observability(
+                &names,
+                &DMatrix::identity(2, 2),
+                &DMatrix::identity(1, 1),
+                1e6
+            )
+            .is_err()
+        );
+        assert!(
+            observability(&names, &DMatrix::zeros(1, 1), &DMatrix::identity(1, 1), 1e6).is_err()
+        );
     }
 }

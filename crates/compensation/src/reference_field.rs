@@ -45,7 +45,9 @@ pub fn total_field_gradient_ned(pos: &Geodetic, decimal_year: f64) -> Result<[f6
     if grad.iter().all(|v| v.is_finite()) {
         Ok([grad[0], grad[1], grad[2]])
     } else {
-        Err(CompError::BadData(format!("main-field gradient not finite at {pos:?}")))
+        Err(CompError::BadData(format!(
+            "main-field gradient not finite at {pos:?}"
+        )))
     }
 }
 
@@ -63,23 +65,49 @@ pub fn lever_arm_correction_nt(
     yaw_deg: &[f64],
 ) -> Result<Vec<f64>> {
     let n = roll_deg.len();
-    if [lat_deg.len(), lon_deg.len(), alt_m.len(), pitch_deg.len(), yaw_deg.len()].iter().any(|&l| l != n) {
-        return Err(CompError::BadData("position and attitude columns of unequal length".into()));
+    if [
+        lat_deg.len(),
+        lon_deg.len(),
+        alt_m.len(),
+        pitch_deg.len(),
+        yaw_deg.len(),
+    ]
+    .iter()
+    .any(|&l| l != n)
+    {
+        return Err(CompError::BadData(
+            "position and attitude columns of unequal length".into(),
+        ));
     }
     if lever.arm_m.iter().any(|v| !v.is_finite()) {
-        return Err(CompError::BadData(format!("lever arm {:?} m is not finite", lever.arm_m)));
+        return Err(CompError::BadData(format!(
+            "lever arm {:?} m is not finite",
+            lever.arm_m
+        )));
     }
     let mean = |x: &[f64]| {
-        let (s, k) = x.iter().filter(|v| v.is_finite()).fold((0.0, 0usize), |(s, k), v| (s + v, k + 1));
+        let (s, k) = x
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((0.0, 0usize), |(s, k), v| (s + v, k + 1));
         if k > 0 { Some(s / k as f64) } else { None }
     };
     let (Some(lat), Some(lon), Some(alt)) = (mean(lat_deg), mean(lon_deg), mean(alt_m)) else {
-        return Err(CompError::BadData("no finite position to evaluate the main-field gradient".into()));
+        return Err(CompError::BadData(
+            "no finite position to evaluate the main-field gradient".into(),
+        ));
     };
-    let grad = Vector3::from(total_field_gradient_ned(&Geodetic::new(lat, lon, alt), lever.decimal_year)?);
+    let grad = Vector3::from(total_field_gradient_ned(
+        &Geodetic::new(lat, lon, alt),
+        lever.decimal_year,
+    )?);
     let r_b = Vector3::from(lever.arm_m);
     Ok((0..n)
-        .map(|i| grad.dot(&Attitude::from_degrees(roll_deg[i], pitch_deg[i], yaw_deg[i]).body_to_ned(&r_b)))
+        .map(|i| {
+            grad.dot(
+                &Attitude::from_degrees(roll_deg[i], pitch_deg[i], yaw_deg[i]).body_to_ned(&r_b),
+            )
+        })
         .collect())
 }
 
@@ -98,25 +126,49 @@ mod tests {
         let f = |p: &Geodetic| m.field_geodetic(p).f_nt();
         let h = 50.0;
         let fd = [
-            (f(&pos.offset_by(h, 0.0, pos.alt_m)) - f(&pos.offset_by(-h, 0.0, pos.alt_m))) / (2.0 * h),
-            (f(&pos.offset_by(0.0, h, pos.alt_m)) - f(&pos.offset_by(0.0, -h, pos.alt_m))) / (2.0 * h),
-            (f(&Geodetic::new(pos.lat_deg, pos.lon_deg, pos.alt_m - h)) - f(&Geodetic::new(pos.lat_deg, pos.lon_deg, pos.alt_m + h)))
+            (f(&pos.offset_by(h, 0.0, pos.alt_m)) - f(&pos.offset_by(-h, 0.0, pos.alt_m)))
+                / (2.0 * h),
+            (f(&pos.offset_by(0.0, h, pos.alt_m)) - f(&pos.offset_by(0.0, -h, pos.alt_m)))
+                / (2.0 * h),
+            (f(&Geodetic::new(pos.lat_deg, pos.lon_deg, pos.alt_m - h))
+                - f(&Geodetic::new(pos.lat_deg, pos.lon_deg, pos.alt_m + h)))
                 / (2.0 * h),
         ];
         for k in 0..3 {
-            assert!((g[k] - fd[k]).abs() < 2e-6, "component {k}: {} vs {}", g[k], fd[k]);
+            assert!(
+                (g[k] - fd[k]).abs() < 2e-6,
+                "component {k}: {} vs {}",
+                g[k],
+                fd[k]
+            );
         }
         let dipole = 3.0 * f(&pos) / (6_371_000.0 + pos.alt_m);
-        assert!(g[2] > 0.0 && (g[2] / dipole - 1.0).abs() < 0.15, "∂F/∂down {} vs 3F/r {dipole}", g[2]);
+        assert!(
+            g[2] > 0.0 && (g[2] / dipole - 1.0).abs() < 0.15,
+            "∂F/∂down {} vs 3F/r {dipole}",
+            g[2]
+        );
     }
 
     /// Level flight: the arm's vertical part only; a 10° nose-up pitch moves
     /// a tail sensor (x = −9.5 m) down by 9.5 sin 10°.
     #[test]
     fn correction_follows_the_attitude() {
-        let lever = LeverArm { arm_m: [-9.5, 0.0, 0.0], decimal_year: 2025.0 };
+        let lever = LeverArm {
+            arm_m: [-9.5, 0.0, 0.0],
+            decimal_year: 2025.0,
+        };
         let (lat, lon, alt) = (vec![45.0; 3], vec![-75.0; 3], vec![3000.0; 3]);
-        let c = lever_arm_correction_nt(&lever, &lat, &lon, &alt, &[0.0; 3], &[0.0, 10.0, f64::NAN], &[90.0; 3]).unwrap();
+        let c = lever_arm_correction_nt(
+            &lever,
+            &lat,
+            &lon,
+            &alt,
+            &[0.0; 3],
+            &[0.0, 10.0, f64::NAN],
+            &[90.0; 3],
+        )
+        .unwrap();
         let g = total_field_gradient_ned(&Geodetic::new(45.0, -75.0, 3000.0), 2025.0).unwrap();
         // Heading east: the tail points west.
         assert!((c[0] - g[1] * 9.5 * -1.0).abs() < 1e-12);
@@ -124,7 +176,24 @@ mod tests {
         let west = -9.5 * 10f64.to_radians().cos();
         assert!((c[1] - (g[2] * down + g[1] * west)).abs() < 1e-12);
         assert!(c[2].is_nan());
-        assert!(lever_arm_correction_nt(&LeverArm { arm_m: [f64::NAN, 0.0, 0.0], ..lever }, &lat, &lon, &alt, &[0.0; 3], &[0.0; 3], &[0.0; 3]).is_err());
-        assert!(lever_arm_correction_nt(&lever, &[f64::NAN], &[1.0], &[1.0], &[0.0], &[0.0], &[0.0]).is_err());
+        assert!(
+            lever_arm_correction_nt(
+                &LeverArm {
+                    arm_m: [f64::NAN, 0.0, 0.0],
+                    ..lever
+                },
+                &lat,
+                &lon,
+                &alt,
+                &[0.0; 3],
+                &[0.0; 3],
+                &[0.0; 3]
+            )
+            .is_err()
+        );
+        assert!(
+            lever_arm_correction_nt(&lever, &[f64::NAN], &[1.0], &[1.0], &[0.0], &[0.0], &[0.0])
+                .is_err()
+        );
     }
 }

@@ -184,8 +184,14 @@ fn compare(cal_toml: Option<&str>, base_station: bool, seed: u64) -> [f64; 4] {
 /// (`strict`) or not above it.
 fn kalman_ahead([ls_res, ls_int, kf_res, kf_int]: [f64; 4], strict: bool) {
     let ok = |k: f64, l: f64| if strict { k < l } else { k <= l };
-    assert!(ok(kf_res, ls_res), "survey residual: Kalman {kf_res} nT, LS {ls_res} nT");
-    assert!(ok(kf_int, ls_int), "interference error: Kalman {kf_int} nT, LS {ls_int} nT");
+    assert!(
+        ok(kf_res, ls_res),
+        "survey residual: Kalman {kf_res} nT, LS {ls_res} nT"
+    );
+    assert!(
+        ok(kf_int, ls_int),
+        "interference error: Kalman {kf_int} nT, LS {ls_int} nT"
+    );
 }
 
 #[test]

@@ -155,17 +155,13 @@ fn coefficient_ratios(cfg: &PodConfig) -> (f64, f64) {
 const SEED_TABLE1_EDDY_RATIO_S: f64 = 0.2489;
 const SEED_TABLE1_GRADIENT_RATIO_PER_M: f64 = 0.0765;
 
-/// The seed's scenario (default [`PodConfig`]): the equivalent-dipole-array
-/// solve and the joint solve with the eddy-current gradient keep ≥ 97 % on
-/// every independent heading and beat the seed's two-step solve on each.
-/// The two-step solve does **not** reach the seed's 90 % on every heading
-/// here (83.6 % worst, 89.4 % mean, see the module docs of `pod`): its
-/// first-order heading coefficients cannot carry the gradient of the
-/// eddy-current field (the product of the pod displacement and the field
-/// rate), which is large in this scenario, nor the second-order terms in
-/// `v` and in the displacement (without eddy currents its worst heading is
-/// 77 %, degradation table); the guard below (mean ≥ 85 %) only catches
-/// regressions.
+/// The seed's scenario (default [`PodConfig`], wind-driven swing): the
+/// equivalent-dipole-array solve keeps ≥ 97 % on every independent heading,
+/// and both improved solves beat the seed's two-step solve on each. The
+/// two-step solve's worst heading is far lower (78 %): with a random
+/// pendulum, the swing's second-order terms are not carried by its
+/// first-order heading coefficients (module docs of `pod`); the guards below
+/// on its mean and pooled rates only catch regressions.
 #[test]
 fn seed_scenario_two_step_and_dipole_array_joint_on_independent_headings() {
     let cfg = PodConfig::default();
@@ -177,68 +173,67 @@ fn seed_scenario_two_step_and_dipole_array_joint_on_independent_headings() {
     println!("joint θ (exact trajectory) per test heading: {:?}", r.joint);
     println!("dipole array per test heading: {:?}", r.dipole);
     assert!(min(&r.dipole) >= 0.97, "dipole array {:?}", r.dipole);
-    assert!(min(&r.joint) >= 0.97, "joint {:?}", r.joint);
+    assert!(mean(&r.joint) >= 0.97, "joint {:?}", r.joint);
     assert!(r.dipole.iter().zip(&r.two_step).all(|(d, t)| d > t));
     assert!(r.joint.iter().zip(&r.two_step).all(|(d, t)| d > t));
-    assert!(mean(&r.two_step) >= 0.85, "two-step {:?}", r.two_step);
+    assert!(mean(&r.two_step) >= 0.88, "two-step {:?}", r.two_step);
+    assert!(r.pooled[0] >= 0.90, "two-step pooled {}", r.pooled[0]);
 }
 
 /// The seed's stated simulation conditions ([`PodConfig::seed_002`]: the
-/// defaults with the swing a 5° sinusoid), with our dipole array and with
-/// its eddy currents scaled so that the step-1 coefficients have the
-/// eddy-to-attitude ratio of the seed's Table 1. The improved solves keep
-/// ≥ 97 % on every independent heading in both. The seed's two-step solve
-/// stays below 90 % on its worst independent heading in both, and the
-/// reason is its first-order heading model, not step 2: fitted on a single
-/// learning heading and applied to that same heading (`fit_two_step` on one
-/// heading reproduces its 7 coefficients exactly), it already leaves more
-/// than 10 % on the worst heading.
+/// defaults with the swing a 5° sinusoid). The simulated helicopter has the
+/// eddy-to-attitude ratio of the seed's Table 1 (step-1 coefficients
+/// `rms(W3, W4)/rms(W1, W2)`, within 15 %). The seed's two-step solve
+/// reaches ≥ 90 % on the independent set (pooled over its samples, the
+/// spec's rate `1 − std(after)/std(before)` on the test set, and in the
+/// mean over its headings); the improved solves keep ≥ 97 % on every
+/// independent heading. The two-step solve's worst heading stays below
+/// 90 %, and the reason is its first-order heading model, not step 2:
+/// fitted on a single learning heading and applied to that same heading
+/// (`fit_two_step` on one heading reproduces its 7 coefficients exactly),
+/// it already leaves more than 10 % on the worst heading.
 #[test]
-fn seed_002_conditions_two_step_is_limited_by_the_first_order_heading_model() {
+fn seed_002_conditions_two_step_reaches_90_percent_on_the_independent_set() {
     let seed = PodConfig::seed_002();
-    let (eddy0, grad0) = coefficient_ratios(&seed);
-    let f = SEED_TABLE1_EDDY_RATIO_S / eddy0;
-    let scaled = eddy_scaled(&seed, f);
-    let (eddy1, grad1) = coefficient_ratios(&scaled);
+    let (eddy, grad) = coefficient_ratios(&seed);
     println!(
-        "rms(W3,W4)/rms(W1,W2): seed Table 1 {SEED_TABLE1_EDDY_RATIO_S} s, ours {eddy0:.3} s, \
-         scaled ×{f:.4} {eddy1:.3} s; rms(W5..7)/rms(W1,W2): seed \
-         {SEED_TABLE1_GRADIENT_RATIO_PER_M} /m, ours {grad0:.4} /m, scaled {grad1:.4} /m"
+        "rms(W3,W4)/rms(W1,W2): seed Table 1 {SEED_TABLE1_EDDY_RATIO_S} s, ours {eddy:.3} s; \
+         rms(W5..7)/rms(W1,W2): seed {SEED_TABLE1_GRADIENT_RATIO_PER_M} /m, ours {grad:.4} /m"
     );
     assert!(
-        (eddy1 / SEED_TABLE1_EDDY_RATIO_S - 1.0).abs() < 0.1,
-        "{eddy1}"
+        (eddy / SEED_TABLE1_EDDY_RATIO_S - 1.0).abs() < 0.15,
+        "{eddy}"
     );
-    for (name, cfg) in [("seed_002", &seed), ("seed_002 eddy scaled", &scaled)] {
-        let r = run(cfg, &LEARNING_HEADINGS_DEG, Trajectory::Seed);
-        // In-sample first-order limit: each learning heading alone.
-        let segs = simulate_pod(cfg).unwrap();
-        let own: Vec<f64> = segs
-            .iter()
-            .map(|s| {
-                let h = to_heading(cfg, s, Trajectory::Seed);
-                let one = fit_two_step(std::slice::from_ref(&h)).unwrap();
-                compensation_rate(&h, &predict_small_signal(&one.theta, &h).unwrap()).unwrap()
-            })
-            .collect();
-        println!(
-            "{name}: two-step test {:?} pooled {:.4}; own-heading first-order fit {own:?}; \
-             joint min {:.4} pooled {:.4}; dipole array min {:.4} pooled {:.4}",
-            r.two_step,
-            r.pooled[0],
-            min(&r.joint),
-            r.pooled[1],
-            min(&r.dipole),
-            r.pooled[2]
-        );
-        assert!(min(&r.joint) >= 0.97 && min(&r.dipole) >= 0.97, "{name}");
-        // Why the seed's solve stays under 90 % on some headings: its
-        // first-order per-heading model, fitted on a heading and scored on
-        // that same heading, already does (the dropped displacement terms
-        // are not small at a 5° swing on a 40 m cable).
-        assert!(min(&own) < 0.90, "{name}: {own:?}");
-        assert!(mean(&r.two_step) >= 0.85, "{name}: {:?}", r.two_step);
-    }
+    let r = run(&seed, &LEARNING_HEADINGS_DEG, Trajectory::Seed);
+    // In-sample first-order limit: each learning heading alone.
+    let segs = simulate_pod(&seed).unwrap();
+    let own: Vec<f64> = segs
+        .iter()
+        .map(|s| {
+            let h = to_heading(&seed, s, Trajectory::Seed);
+            let one = fit_two_step(std::slice::from_ref(&h)).unwrap();
+            compensation_rate(&h, &predict_small_signal(&one.theta, &h).unwrap()).unwrap()
+        })
+        .collect();
+    println!(
+        "seed_002: two-step test {:?} pooled {:.4}; own-heading first-order fit {own:?}; \
+         joint min {:.4} pooled {:.4}; dipole array min {:.4} pooled {:.4}",
+        r.two_step,
+        r.pooled[0],
+        min(&r.joint),
+        r.pooled[1],
+        min(&r.dipole),
+        r.pooled[2]
+    );
+    assert!(r.pooled[0] >= 0.90, "two-step pooled {}", r.pooled[0]);
+    assert!(mean(&r.two_step) >= 0.90, "two-step {:?}", r.two_step);
+    assert!(min(&r.joint) >= 0.97 && min(&r.dipole) >= 0.97);
+    assert!(r.pooled[1] >= 0.97 && r.pooled[2] >= 0.97);
+    // Why the worst heading stays under 90 %: the first-order per-heading
+    // model, fitted on a heading and scored on that same heading, already
+    // does (the dropped displacement terms are not small at a 5° swing on a
+    // 40 m cable).
+    assert!(min(&own) < 0.90, "{own:?}");
 }
 
 /// The degradation table of the module docs (`--nocapture` prints it).
@@ -300,10 +295,12 @@ fn pod_degradation_table() {
         &seed,
         &LEARNING_HEADINGS_DEG,
     );
-    let f = SEED_TABLE1_EDDY_RATIO_S / coefficient_ratios(&seed).0;
+    // Robustness: eddy currents 37× stronger (the simulator's default
+    // before it took the seed's Table 1 ratio; eddy moments of ≈ 1800 A·m²
+    // in a 5° manoeuvre, unphysical for an airframe but a hard case).
     row(
-        format!("seed_002, eddy × {f:.3} (Table 1 ratio)"),
-        &eddy_scaled(&seed, f),
+        "`seed_002()`, eddy currents × 37".into(),
+        &eddy_scaled(&seed, 37.0),
         &LEARNING_HEADINGS_DEG,
     );
     for n in [4usize, 5, 6, 8] {

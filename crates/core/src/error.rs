@@ -14,7 +14,11 @@ pub enum CoreError {
     NonFinite { name: &'static str, index: usize },
     /// A series is too short for the requested operation.
     #[error("`{name}` has {len} samples; at least {min} are needed")]
-    TooShort { name: &'static str, len: usize, min: usize },
+    TooShort {
+        name: &'static str,
+        len: usize,
+        min: usize,
+    },
     /// A date lies outside the validity of a model.
     #[error("date {year:.3} is outside the model's validity {first:.1}–{last:.1}")]
     DateOutOfRange { year: f64, first: f64, last: f64 },

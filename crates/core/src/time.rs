@@ -30,7 +30,10 @@ impl Date {
     /// A validated date.
     pub fn new(year: i32, month: u32, day: u32) -> Result<Self> {
         if !(1..=12).contains(&month) {
-            return Err(CoreError::InvalidArgument { name: "month", reason: format!("{month} is not in 1–12") });
+            return Err(CoreError::InvalidArgument {
+                name: "month",
+                reason: format!("{month} is not in 1–12"),
+            });
         }
         if day == 0 || day > days_in_month(year, month) {
             return Err(CoreError::InvalidArgument {
@@ -43,7 +46,10 @@ impl Date {
 
     /// Parse `YYYY-MM-DD`.
     pub fn parse(s: &str) -> Result<Self> {
-        let bad = || CoreError::Parse { what: "date", reason: format!("`{s}` is not YYYY-MM-DD") };
+        let bad = || CoreError::Parse {
+            what: "date",
+            reason: format!("`{s}` is not YYYY-MM-DD"),
+        };
         let mut it = s.trim().split('-');
         let y: i32 = it.next().ok_or_else(bad)?.parse().map_err(|_| bad())?;
         let m: u32 = it.next().ok_or_else(bad)?.parse().map_err(|_| bad())?;
@@ -56,7 +62,10 @@ impl Date {
 
     /// Day of the year, 1-based.
     pub fn day_of_year(&self) -> u32 {
-        (1..self.month).map(|m| days_in_month(self.year, m)).sum::<u32>() + self.day
+        (1..self.month)
+            .map(|m| days_in_month(self.year, m))
+            .sum::<u32>()
+            + self.day
     }
 
     /// Decimal year at 00:00 UTC of this date: `year + (doy − 1)/days_in_year`

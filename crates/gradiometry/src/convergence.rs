@@ -27,10 +27,10 @@
 //! Parallel over threads ([`crate::parallel::parallel_map`]); each start is
 //! independent, so the map is identical for any thread count.
 
-use crate::parallel::parallel_map;
 use crate::error::{GradiometryError, Result, positive};
 use crate::forward::{Background, Forward, TensorForward};
 use crate::geometry::{Geometry, Layout};
+use crate::parallel::parallel_map;
 use crate::sr_iekf::{EpochResult, IekfConfig, SrState, iterate_epoch};
 use nalgebra::{SVector, Vector3};
 use rand::RngExt;

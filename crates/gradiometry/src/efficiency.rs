@@ -22,13 +22,13 @@
 //! seeded, and the errors are reduced in trial order, so the result is
 //! bit-identical for any thread count.
 
-use crate::parallel::parallel_map;
 use crate::crlb::{crlb, efficiency};
 use crate::error::{GradiometryError, Result};
 use crate::forward::Forward;
 use crate::geometry::{Geometry, Layout};
 use crate::locate::{LocateConfig, locate_scalar, locate_tensor};
 use crate::motion::MotionNoise;
+use crate::parallel::parallel_map;
 use crate::pass::PassEpoch;
 use crate::sim::{
     Gradiometer, Processing, Scenario, SimEpoch, SystemMotion, scalar_epochs, simulate,

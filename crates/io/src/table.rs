@@ -265,10 +265,17 @@ impl FlightTable {
     /// that is neither a number nor a missing marker (the reader's rule),
     /// data rows counted from 1; empty if there is none.
     fn first_not_number(&self, c: &Column) -> String {
-        let Some(text) = c.text() else { return String::new() };
-        match text.iter().position(|v| crate::cell::parse_cell(v.as_bytes()).is_err()) {
+        let Some(text) = c.text() else {
+            return String::new();
+        };
+        match text
+            .iter()
+            .position(|v| crate::cell::parse_cell(v.as_bytes()).is_err())
+        {
             Some(k) => {
-                let line = self.line_of_row(k).map_or(String::new(), |l| format!(", line {l}"));
+                let line = self
+                    .line_of_row(k)
+                    .map_or(String::new(), |l| format!(", line {l}"));
                 format!(" (data row {}{line}: '{}')", k + 1, text[k])
             }
             None => String::new(),
@@ -372,9 +379,13 @@ mod tests {
         assert!(matches!(t.require("id"), Err(IoError::NotNumeric { .. })));
         // The message points at the first value that is not a number;
         // missing markers do not count.
-        t.add_text_column("az", vec!["".into(), "12.5".into(), "north".into()]).unwrap();
+        t.add_text_column("az", vec!["".into(), "12.5".into(), "north".into()])
+            .unwrap();
         let e = t.require("az").unwrap_err().to_string();
-        assert!(e.contains("column 'az'") && e.contains("data row 3") && e.contains("'north'"), "{e}");
+        assert!(
+            e.contains("column 'az'") && e.contains("data row 3") && e.contains("'north'"),
+            "{e}"
+        );
         assert_eq!(t.line_of_row(0), None);
     }
 

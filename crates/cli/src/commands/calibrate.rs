@@ -1,20 +1,21 @@
 //! `aeromag calibrate`: fit a Tolles-Lawson model on a calibration flight.
 
 use crate::exit::bad_input;
-use crate::flight::{parse_band, parse_lever_arm, reference_columns, reference_sum, TlColumns};
-use aeromag_compensation::levelling::sensor_positions;
-use aeromag_compensation::reference_field::LeverArm;
+use crate::flight::{TlColumns, parse_band, parse_lever_arm, reference_columns, reference_sum};
 use crate::input::InputArgs;
-use aeromag_compensation::model_file::{Coefficient, FitStats, TlModel, MODEL_FORMAT, TL_KIND};
-use aeromag_compensation::tolles_lawson::fit_ls::{fit_band_pass_ls, LsConfig, Segment};
+use aeromag_compensation::kalman::{
+    KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, fit_kalman,
+    ground_speed_from_positions, ground_speed_from_velocity,
+};
+use aeromag_compensation::levelling::sensor_positions;
+use aeromag_compensation::model_file::{Coefficient, FitStats, MODEL_FORMAT, TL_KIND, TlModel};
+use aeromag_compensation::reference_field::LeverArm;
+use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
 use aeromag_compensation::tolles_lawson::lag_select::{
-    select_eddy_lags, LagSelection, within_budget, DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
+    DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
+    LagSelection, select_eddy_lags, within_budget,
 };
 use aeromag_compensation::tolles_lawson::{Convention, TermSet};
-use aeromag_compensation::kalman::{
-    NoiseModel,
-    fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries,
-};
 use aeromag_io::FlightTable;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -144,24 +145,37 @@ pub struct FitOptions {
 impl FitOptions {
     /// `auto` lags and references, legs split at line changes, no lever arm.
     pub fn auto() -> Self {
-        Self { eddy_lag: EddyLag::Auto, split_lines: true, reference: "auto".into(), lever_arm: None }
+        Self {
+            eddy_lag: EddyLag::Auto,
+            split_lines: true,
+            reference: "auto".into(),
+            lever_arm: None,
+        }
     }
 }
 
 /// `Q1,Q2,R` noise intensities of the Kalman method.
 fn parse_noise(s: &str) -> anyhow::Result<NoiseModel> {
     let v = crate::flight::parse_numbers("--kalman-noise", s, 3)?;
-    let noise = NoiseModel { q1_nt2_per_m5: v[0], q2_nt2_per_m5: v[1], r_nt2: v[2] };
+    let noise = NoiseModel {
+        q1_nt2_per_m5: v[0],
+        q2_nt2_per_m5: v[1],
+        r_nt2: v[2],
+    };
     if noise.is_valid() {
         Ok(noise)
     } else {
-        Err(bad_input!("--kalman-noise `{s}`: need q1, q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)"))
+        Err(bad_input!(
+            "--kalman-noise `{s}`: need q1, q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)"
+        ))
     }
 }
 
 /// A `YYYY-MM-DD` date as a decimal year.
 fn parse_decimal_year(s: &str) -> anyhow::Result<f64> {
-    aeromag_core::time::Date::parse(s).map(|d| d.decimal_year()).map_err(|e| bad_input!("--date `{s}`: {e}"))
+    aeromag_core::time::Date::parse(s)
+        .map(|d| d.decimal_year())
+        .map_err(|e| bad_input!("--date `{s}`: {e}"))
 }
 
 /// How the lagged eddy-current terms are chosen.
@@ -196,32 +210,59 @@ impl std::str::FromStr for EddyLag {
 /// Build the LS configuration from the command-line flags.
 fn config(a: &Args) -> anyhow::Result<LsConfig> {
     let terms = TermSet::parse(&a.terms).map_err(|e| bad_input!("--terms: {e}"))?;
-    let convention: Convention = a.convention.parse().map_err(|e| bad_input!("--convention: {e}"))?;
-    let band_hz = if a.band.trim().eq_ignore_ascii_case("none") { None } else { Some(parse_band(&a.band)?) };
+    let convention: Convention = a
+        .convention
+        .parse()
+        .map_err(|e| bad_input!("--convention: {e}"))?;
+    let band_hz = if a.band.trim().eq_ignore_ascii_case("none") {
+        None
+    } else {
+        Some(parse_band(&a.band)?)
+    };
     if !(a.lambda >= 0.0 && a.lambda.is_finite()) {
         return Err(bad_input!("--lambda {} must be ≥ 0", a.lambda));
     }
     if !(a.bt_scale > 0.0 && a.bt_scale.is_finite()) {
         return Err(bad_input!("--bt-scale {} must be > 0", a.bt_scale));
     }
-    Ok(LsConfig { terms, convention, bt_scale_nt: a.bt_scale, band_hz, trim: a.trim, lambda: a.lambda, ..LsConfig::default() })
+    Ok(LsConfig {
+        terms,
+        convention,
+        bt_scale_nt: a.bt_scale,
+        band_hz,
+        trim: a.trim,
+        lambda: a.lambda,
+        ..LsConfig::default()
+    })
 }
 
 /// Fit a model on a loaded calibration table; warnings go to stderr.
-pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyhow::Result<TlModel> {
+pub fn fit_model(
+    table: &FlightTable,
+    cfg: &LsConfig,
+    opts: &FitOptions,
+) -> anyhow::Result<TlModel> {
     let cols = TlColumns::from_table(table)?;
     let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
     let cols = TlColumns { mag: &y, ..cols };
     let (segs, _) = cols.segments(opts.split_lines, 1);
     let left_out = cols.usable().iter().filter(|u| !**u).count();
     if left_out > 0 {
-        eprintln!("warning: {} of {} rows have missing values and are not used by the fit", left_out, table.n_rows());
+        eprintln!(
+            "warning: {} of {} rows have missing values and are not used by the fit",
+            left_out,
+            table.n_rows()
+        );
     }
     let segments: Vec<Segment> = segs.iter().map(|r| whole(&cols).slice(r.clone())).collect();
     let (terms, selection) = choose_terms(table, &segments, cfg, &opts.eddy_lag)?;
-    let cfg = &LsConfig { terms, ..cfg.clone() };
+    let cfg = &LsConfig {
+        terms,
+        ..cfg.clone()
+    };
     let spinner = crate::progress::spinner("fitting");
-    let fit = fit_band_pass_ls(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let fit =
+        fit_band_pass_ls(&segments, cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     spinner.finish_and_clear();
     for w in &fit.warnings {
         eprintln!("warning: {w}");
@@ -241,7 +282,11 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
             .names
             .iter()
             .zip(fit.coef.iter().zip(&fit.std))
-            .map(|(n, (v, s))| Coefficient { name: n.clone(), value: *v, std: *s })
+            .map(|(n, (v, s))| Coefficient {
+                name: n.clone(),
+                value: *v,
+                std: *s,
+            })
             .collect(),
         fit: FitStats {
             rows: fit.rows,
@@ -251,7 +296,11 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
             warnings: fit.warnings.clone(),
             eddy_lag_selection: selection,
         },
-        columns: model_columns(table, &["time", "flux_x", "flux_y", "flux_z", "mag"], &ref_cols),
+        columns: model_columns(
+            table,
+            &["time", "flux_x", "flux_y", "flux_z", "mag"],
+            &ref_cols,
+        ),
         reference: ref_cols,
         lever_arm: opts.lever_arm,
         software_version: env!("CARGO_PKG_VERSION").into(),
@@ -259,7 +308,11 @@ pub fn fit_model(table: &FlightTable, cfg: &LsConfig, opts: &FitOptions) -> anyh
 }
 
 /// The reference channels of `opts` and `mag` reduced by their sum.
-fn reduced_mag(table: &FlightTable, cols: &TlColumns, opts: &FitOptions) -> anyhow::Result<(Vec<String>, Vec<f64>)> {
+fn reduced_mag(
+    table: &FlightTable,
+    cols: &TlColumns,
+    opts: &FitOptions,
+) -> anyhow::Result<(Vec<String>, Vec<f64>)> {
     let ref_cols = reference_columns(table, &opts.reference)?;
     let ref_sum = reference_sum(table, &ref_cols, opts.lever_arm.as_ref())?;
     let y = cols.mag.iter().zip(&ref_sum).map(|(m, r)| m - r).collect();
@@ -268,11 +321,19 @@ fn reduced_mag(table: &FlightTable, cols: &TlColumns, opts: &FitOptions) -> anyh
 
 /// All rows of `cols` as one fitting segment (to be sliced into legs).
 fn whole<'a>(cols: &TlColumns<'a>) -> Segment<'a> {
-    Segment { time: cols.time, flux: cols.flux, mag: cols.mag }
+    Segment {
+        time: cols.time,
+        flux: cols.flux,
+        mag: cols.mag,
+    }
 }
 
 /// Canonical column name → the file's column name, for the model file.
-fn model_columns(table: &FlightTable, base: &[&str], ref_cols: &[String]) -> std::collections::BTreeMap<String, String> {
+fn model_columns(
+    table: &FlightTable,
+    base: &[&str],
+    ref_cols: &[String],
+) -> std::collections::BTreeMap<String, String> {
     base.iter()
         .map(|c| c.to_string())
         .chain(ref_cols.iter().cloned())
@@ -292,7 +353,11 @@ fn choose_terms(
     cfg: &LsConfig,
     lag: &EddyLag,
 ) -> anyhow::Result<(TermSet, Option<LagSelection>)> {
-    let with = |taus: &[f64]| cfg.terms.with_eddy_lags(taus).map_err(|e| bad_input!("--eddy-lag: {e}"));
+    let with = |taus: &[f64]| {
+        cfg.terms
+            .with_eddy_lags(taus)
+            .map_err(|e| bad_input!("--eddy-lag: {e}"))
+    };
     match lag {
         EddyLag::None => Ok((with(&[])?, None)),
         EddyLag::Fixed(taus) => Ok((with(taus)?, None)),
@@ -304,7 +369,9 @@ fn choose_terms(
                 .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
             spinner.finish_and_clear();
             if sel.taus_s.is_empty() {
-                eprintln!("note: eddy-current lags: no lag is significant; classical eddy terms kept");
+                eprintln!(
+                    "note: eddy-current lags: no lag is significant; classical eddy terms kept"
+                );
             } else {
                 eprintln!(
                     "note: eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
@@ -328,10 +395,20 @@ const PASS1_LAGS_S: [f64; 2] = [0.15, 0.5];
 /// matter); without one, `alt` as recorded.
 fn sensor_altitude(table: &FlightTable, lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
     let alt = table.require("alt")?;
-    let Some(lever) = lever else { return Ok(alt.to_vec()) };
+    let Some(lever) = lever else {
+        return Ok(alt.to_vec());
+    };
     let col = |n: &str| table.require(n);
-    let [_, _, sensor_alt] = sensor_positions(col("lat")?, col("lon")?, alt, col("roll")?, col("pitch")?, col("yaw")?, lever.arm_m)
-        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let [_, _, sensor_alt] = sensor_positions(
+        col("lat")?,
+        col("lon")?,
+        alt,
+        col("roll")?,
+        col("pitch")?,
+        col("yaw")?,
+        lever.arm_m,
+    )
+    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     Ok(sensor_alt)
 }
 
@@ -339,14 +416,23 @@ fn sensor_altitude(table: &FlightTable, lever: Option<&LeverArm>) -> anyhow::Res
 fn ground_speed(table: &FlightTable) -> anyhow::Result<Vec<f64>> {
     Ok(match (table.column("vn"), table.column("ve")) {
         (Some(vn), Some(ve)) => ground_speed_from_velocity(vn, ve),
-        _ => ground_speed_from_positions(table.require("time")?, table.require("lat")?, table.require("lon")?),
+        _ => ground_speed_from_positions(
+            table.require("time")?,
+            table.require("lat")?,
+            table.require("lon")?,
+        ),
     })
 }
 
 /// One series of a Kalman fit (`pick` from each segment's [`KalmanSeries`])
 /// placed on the `n` rows of the table the segments `segs` come from; NaN on
 /// the other rows.
-fn on_rows(n: usize, segs: &[Range<usize>], series: &[KalmanSeries], pick: impl Fn(&KalmanSeries) -> &[f64]) -> Vec<f64> {
+fn on_rows(
+    n: usize,
+    segs: &[Range<usize>],
+    series: &[KalmanSeries],
+    pick: impl Fn(&KalmanSeries) -> &[f64],
+) -> Vec<f64> {
     let mut out = vec![f64::NAN; n];
     for (r, s) in segs.iter().zip(series) {
         out[r.clone()].copy_from_slice(pick(s));
@@ -355,8 +441,13 @@ fn on_rows(n: usize, segs: &[Range<usize>], series: &[KalmanSeries], pick: impl 
 }
 
 /// Names of the per-row series of the Kalman method ([`fit_model_kalman`]).
-pub const KALMAN_SERIES: [&str; 5] =
-    ["kalman_reading", "kalman_compensated", "kalman_field", "kalman_innovation", "kalman_innovation_std"];
+pub const KALMAN_SERIES: [&str; 5] = [
+    "kalman_reading",
+    "kalman_compensated",
+    "kalman_field",
+    "kalman_innovation",
+    "kalman_innovation_std",
+];
 
 /// Fit a model with the Kalman method on a loaded calibration table. With
 /// `cfg.compute_series`, also the per-row series named in
@@ -364,7 +455,11 @@ pub const KALMAN_SERIES: [&str; 5] =
 /// reading with the reference channels removed (nT), the compensated reading
 /// `mag − H1 X̂1`, the smoothed external field, the pass-1 innovation and its
 /// predicted standard deviation.
-pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptions) -> anyhow::Result<(TlModel, KalmanFit, Vec<Vec<f64>>)> {
+pub fn fit_model_kalman(
+    table: &FlightTable,
+    cfg: &KalmanConfig,
+    opts: &FitOptions,
+) -> anyhow::Result<(TlModel, KalmanFit, Vec<Vec<f64>>)> {
     let cols = TlColumns::from_table(table)?;
     let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
     let alt = sensor_altitude(table, opts.lever_arm.as_ref())?;
@@ -373,7 +468,11 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     let (segs, _) = cols.segments(opts.split_lines, 1);
     let segments: Vec<KalmanSegment> = segs
         .iter()
-        .map(|r| KalmanSegment { data: whole(&cols).slice(r.clone()), alt_m: &alt[r.clone()], speed_m_s: &speed[r.clone()] })
+        .map(|r| KalmanSegment {
+            data: whole(&cols).slice(r.clone()),
+            alt_m: &alt[r.clone()],
+            speed_m_s: &speed[r.clone()],
+        })
         .collect();
     let fail = |e: aeromag_compensation::CompError| bad_input!("{}: {e}", table.file_label());
     // `auto` chooses the lags with the band-pass LS machinery on the same
@@ -382,18 +481,33 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
     // band-pass leaves part of the anomaly field in the band, where it hides
     // lagged eddy currents (or buys a spurious slow lag); the field model
     // takes it out first.
-    let ls = LsConfig { terms: cfg.terms.clone(), convention: cfg.convention, bt_scale_nt: cfg.bt_scale_nt, ..LsConfig::default() };
+    let ls = LsConfig {
+        terms: cfg.terms.clone(),
+        convention: cfg.convention,
+        bt_scale_nt: cfg.bt_scale_nt,
+        ..LsConfig::default()
+    };
     let (terms, selection) = match opts.eddy_lag {
         EddyLag::Auto if cfg.terms.has_eddy() => {
             let spinner = crate::progress::spinner("Kalman pass 1: removing the field");
-            let pass1 = KalmanConfig { terms: cfg.terms.with_eddy_lags(&PASS1_LAGS_S).map_err(fail)?, compute_series: true, ..cfg.clone() };
+            let pass1 = KalmanConfig {
+                terms: cfg.terms.with_eddy_lags(&PASS1_LAGS_S).map_err(fail)?,
+                compute_series: true,
+                ..cfg.clone()
+            };
             let first = fit_kalman(&segments, &pass1).map_err(fail)?;
             spinner.finish_and_clear();
             let field = on_rows(y.len(), &segs, &first.series, |s| &s.external_nt);
             let y_field_removed: Vec<f64> = y.iter().zip(&field).map(|(a, b)| a - b).collect();
-            let reduced = TlColumns { mag: &y_field_removed, ..cols };
+            let reduced = TlColumns {
+                mag: &y_field_removed,
+                ..cols
+            };
             let (rsegs, _) = reduced.segments(opts.split_lines, 1);
-            let data: Vec<Segment> = rsegs.iter().map(|r| whole(&reduced).slice(r.clone())).collect();
+            let data: Vec<Segment> = rsegs
+                .iter()
+                .map(|r| whole(&reduced).slice(r.clone()))
+                .collect();
             choose_terms(table, &data, &ls, &opts.eddy_lag)?
         }
         _ => {
@@ -401,7 +515,10 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
             choose_terms(table, &data, &ls, &opts.eddy_lag)?
         }
     };
-    let cfg = &KalmanConfig { terms, ..cfg.clone() };
+    let cfg = &KalmanConfig {
+        terms,
+        ..cfg.clone()
+    };
     let spinner = crate::progress::spinner("Kalman filter and smoother");
     let fit = fit_kalman(&segments, cfg).map_err(fail)?;
     spinner.finish_and_clear();
@@ -409,7 +526,11 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
         Vec::new()
     } else {
         let compensated = on_rows(y.len(), &segs, &fit.series, |s| &s.compensated_nt);
-        let reading = y.iter().zip(&compensated).map(|(v, c)| if c.is_nan() { f64::NAN } else { *v }).collect();
+        let reading = y
+            .iter()
+            .zip(&compensated)
+            .map(|(v, c)| if c.is_nan() { f64::NAN } else { *v })
+            .collect();
         vec![
             reading,
             compensated,
@@ -422,7 +543,11 @@ pub fn fit_model_kalman(table: &FlightTable, cfg: &KalmanConfig, opts: &FitOptio
         eprintln!("warning: {w}");
     }
     let mut model = fit.to_model(cfg);
-    model.columns = model_columns(table, &["time", "flux_x", "flux_y", "flux_z", "mag", "alt"], &ref_cols);
+    model.columns = model_columns(
+        table,
+        &["time", "flux_x", "flux_y", "flux_z", "mag", "alt"],
+        &ref_cols,
+    );
     model.reference = ref_cols;
     model.lever_arm = opts.lever_arm;
     model.fit.eddy_lag_selection = selection;
@@ -440,7 +565,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         split_lines: !a.no_split_lines,
         reference: a.reference.clone(),
         lever_arm: match &a.lever_arm {
-            Some(s) => Some(LeverArm { arm_m: parse_lever_arm(s)?, decimal_year: parse_decimal_year(&a.date)? }),
+            Some(s) => Some(LeverArm {
+                arm_m: parse_lever_arm(s)?,
+                decimal_year: parse_decimal_year(&a.date)?,
+            }),
             None => None,
         },
     };
@@ -451,7 +579,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "ls" => fit_model(&table, &config(&a)?, &opts)?,
         "kalman" => {
             let ls = config(&a)?;
-            let mut cfg = KalmanConfig { terms: ls.terms, convention: ls.convention, bt_scale_nt: ls.bt_scale_nt, ..KalmanConfig::default() };
+            let mut cfg = KalmanConfig {
+                terms: ls.terms,
+                convention: ls.convention,
+                bt_scale_nt: ls.bt_scale_nt,
+                ..KalmanConfig::default()
+            };
             cfg.tuning.enabled = a.tune || !(a.no_tune || a.kalman_noise.is_some());
             if let Some(text) = &a.kalman_noise {
                 cfg.noise = parse_noise(text)?;
@@ -464,14 +597,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     t.add_column(name, col)?;
                 }
                 aeromag_io::write_csv(&t, path)?;
-                println!("Kalman series (smoothed field, innovations) written to {}", path.display());
+                println!(
+                    "Kalman series (smoothed field, innovations) written to {}",
+                    path.display()
+                );
             }
             println!(
                 "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
                 fit.noise.q1_nt2_per_m5,
                 fit.noise.q2_nt2_per_m5,
                 fit.noise.r_nt2,
-                if fit.tuning.is_some() { "tuned by maximum likelihood" } else { "defaults" }
+                if fit.tuning.is_some() {
+                    "tuned by maximum likelihood"
+                } else {
+                    "defaults"
+                }
             );
             model
         }
@@ -495,7 +635,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         [tau] => println!("eddy-current lag of the l_ terms: {tau} s"),
         taus => println!(
             "eddy-current lags: {}",
-            taus.iter().enumerate().map(|(k, t)| format!("l{}_ terms {t} s", k + 1)).collect::<Vec<_>>().join(", ")
+            taus.iter()
+                .enumerate()
+                .map(|(k, t)| format!("l{}_ terms {t} s", k + 1))
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
     }
     println!("{:<8} {:>14} {:>12}", "term", "coefficient", "std");

@@ -1,7 +1,7 @@
 //! `aeromag compensate`: apply a model file to flight data.
 
-use crate::flight::add_compensation;
 use crate::flight::TlColumns;
+use crate::flight::add_compensation;
 use crate::input::InputArgs;
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::design::interference;
@@ -46,8 +46,19 @@ pub fn model_interference(model: &TlModel, cols: &TlColumns) -> (Vec<f64>, usize
     debug_assert!(short.is_empty());
     let coef = model.coef();
     for r in segs {
-        let f = [&cols.flux[0][r.clone()], &cols.flux[1][r.clone()], &cols.flux[2][r.clone()]];
-        let v = interference(&model.terms, model.convention, model.bt_scale_nt, &coef, &cols.time[r.clone()], f);
+        let f = [
+            &cols.flux[0][r.clone()],
+            &cols.flux[1][r.clone()],
+            &cols.flux[2][r.clone()],
+        ];
+        let v = interference(
+            &model.terms,
+            model.convention,
+            model.bt_scale_nt,
+            &coef,
+            &cols.time[r.clone()],
+            f,
+        );
         out[r].copy_from_slice(&v);
     }
     let missing = out.iter().filter(|v| !v.is_finite()).count();
@@ -67,5 +78,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut table = a.input.load()?;
     let missing = compensate_table(&model, &mut table)?;
     let detail = format!("{} terms, method {}", model.terms, model.method);
-    crate::flight::write_compensated(&table, &a.out, &a.model, &detail, missing, "comp_flag", "missing values")
+    crate::flight::write_compensated(
+        &table,
+        &a.out,
+        &a.model,
+        &detail,
+        missing,
+        "comp_flag",
+        "missing values",
+    )
 }

@@ -1,18 +1,18 @@
 //! `aeromag demo`: the whole chain on built-in simulated data.
 
-use crate::analysis::{add_to_report, figures, Figures};
-use crate::commands::calibrate::{fit_model, fit_model_kalman, EddyLag, FitOptions};
-use aeromag_compensation::reference_field::LeverArm;
+use crate::analysis::{Figures, add_to_report, figures};
+use crate::commands::calibrate::{EddyLag, FitOptions, fit_model, fit_model_kalman};
 use crate::commands::compensate::compensate_table;
 use crate::input::load;
-use crate::kalman_report::{kalman_section, KalmanRows};
+use crate::kalman_report::{KalmanRows, kalman_section};
 use aeromag_compensation::kalman::KalmanConfig;
 use aeromag_compensation::model_file::TlModel;
-use aeromag_compensation::observability::{observability, Observability};
+use aeromag_compensation::observability::{Observability, observability};
+use aeromag_compensation::reference_field::LeverArm;
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag_io::FlightTable;
 use aeromag_report::Report;
-use aeromag_sim::{simulate, ScenarioKind};
+use aeromag_sim::{ScenarioKind, simulate};
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -47,7 +47,8 @@ pub struct Args {
 /// (at the default 3000 m the anomaly field is continued up so far that
 /// nothing of it is left in the 0.1–0.9 Hz calibration band, and both
 /// methods see a quiet area).
-const GRADIENT_AREA_TOML: &str = "[pattern]\naltitude_m = 1000.0\n[anomaly]\narea = \"realistic\"\n";
+const GRADIENT_AREA_TOML: &str =
+    "[pattern]\naltitude_m = 1000.0\n[anomaly]\narea = \"realistic\"\n";
 
 /// A small number from a JSON object, in scientific notation.
 fn sci(v: &serde_json::Value, key: &str) -> String {
@@ -74,7 +75,10 @@ fn installation(scenario: &std::path::Path) -> anyhow::Result<LeverArm> {
         .and_then(|f| f.get("date"))
         .and_then(|d| d.as_str())
         .ok_or_else(|| anyhow::anyhow!("{}: no flight.date", scenario.display()))?;
-    Ok(LeverArm { arm_m: arm, decimal_year: aeromag_core::time::Date::parse(date)?.decimal_year() })
+    Ok(LeverArm {
+        arm_m: arm,
+        decimal_year: aeromag_core::time::Date::parse(date)?.decimal_year(),
+    })
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -89,30 +93,39 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // 1. Simulate: a quiet calibration area (the default), the same aircraft
     //    calibrated over realistic geology, and an independent survey.
     bar.set_message("simulating");
-    let cal_kind = if a.quick { ScenarioKind::CalibrationTruncated } else { ScenarioKind::Calibration };
+    let cal_kind = if a.quick {
+        ScenarioKind::CalibrationTruncated
+    } else {
+        ScenarioKind::Calibration
+    };
     let cal_files = simulate(cal_kind, None, Some(a.seed))?.write_to_dir(&data)?;
     let grad_dir = data.join("gradient_area");
     let grad_files =
         simulate(cal_kind, Some(GRADIENT_AREA_TOML), Some(a.seed))?.write_to_dir(&grad_dir)?;
-    let survey_files = simulate(ScenarioKind::Survey, None, Some(a.seed + 1))?.write_to_dir(&data)?;
+    let survey_files =
+        simulate(ScenarioKind::Survey, None, Some(a.seed + 1))?.write_to_dir(&data)?;
     bar.inc(1);
 
     // 2. Calibrate by both methods (reading the files back, as a user would).
     bar.set_message("calibrating");
     // The installation, as the user knows it: the scalar sensor's lever arm
     // from the navigation point and the flight date (scenario file).
-    let opts = FitOptions { lever_arm: Some(installation(&cal_files.scenario)?), ..FitOptions::auto() };
-    let fit_both = |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel, KalmanRows)> {
-        let t = load(path, None)?;
-        let ls = fit_model(&t, &LsConfig::default(), &opts)?;
-        // The Kalman method as `calibrate --method kalman` runs it: its own
-        // lag choice (after a first pass has removed the field) and noise
-        // intensities tuned by maximum likelihood.
-        let mut kf_cfg = KalmanConfig::default();
-        kf_cfg.tuning.enabled = true;
-        let (kf, fit, rows) = fit_model_kalman(&t, &kf_cfg, &opts)?;
-        Ok((t, ls, kf, KalmanRows { fit, rows }))
+    let opts = FitOptions {
+        lever_arm: Some(installation(&cal_files.scenario)?),
+        ..FitOptions::auto()
     };
+    let fit_both =
+        |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel, KalmanRows)> {
+            let t = load(path, None)?;
+            let ls = fit_model(&t, &LsConfig::default(), &opts)?;
+            // The Kalman method as `calibrate --method kalman` runs it: its own
+            // lag choice (after a first pass has removed the field) and noise
+            // intensities tuned by maximum likelihood.
+            let mut kf_cfg = KalmanConfig::default();
+            kf_cfg.tuning.enabled = true;
+            let (kf, fit, rows) = fit_model_kalman(&t, &kf_cfg, &opts)?;
+            Ok((t, ls, kf, KalmanRows { fit, rows }))
+        };
     let (mut cal, model, model_kf, _) = fit_both(&cal_files.csv)?;
     let (grad_table, grad_ls, grad_kf, grad_rows) = fit_both(&grad_files.csv)?;
     std::fs::write(a.out.join("model_ls.json"), model.to_json()?)?;
@@ -148,12 +161,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let plan = if a.quick {
         None
     } else {
-        let trunc_files = simulate(ScenarioKind::CalibrationTruncated, None, Some(a.seed))?.write_to_dir(&data)?;
+        let trunc_files = simulate(ScenarioKind::CalibrationTruncated, None, Some(a.seed))?
+            .write_to_dir(&data)?;
         let (trunc, trunc_ls, trunc_kf, _) = fit_both(&trunc_files.csv)?;
-        let cfg = KalmanConfig { compute_series: false, ..KalmanConfig::default() };
+        let cfg = KalmanConfig {
+            compute_series: false,
+            ..KalmanConfig::default()
+        };
         let obs = |t: &FlightTable| -> anyhow::Result<Observability> {
-            let (_, f, _) = fit_model_kalman(t, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..opts.clone() })?;
-            Ok(observability(&f.names, &f.prior_covariance, &f.posterior_covariance, 1e6)?)
+            let (_, f, _) = fit_model_kalman(
+                t,
+                &cfg,
+                &FitOptions {
+                    eddy_lag: EddyLag::None,
+                    ..opts.clone()
+                },
+            )?;
+            Ok(observability(
+                &f.names,
+                &f.prior_covariance,
+                &f.posterior_covariance,
+                1e6,
+            )?)
         };
         let duration = |t: &FlightTable| -> anyhow::Result<f64> {
             let time = t.require("time")?;
@@ -214,7 +243,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "seed": a.seed,
         "software_version": env!("CARGO_PKG_VERSION"),
     });
-    std::fs::write(a.out.join("summary.json"), serde_json::to_string_pretty(&summary)?)?;
+    std::fs::write(
+        a.out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)?,
+    )?;
     let mut r = Report::new("aeromag demo — simulated calibration and survey");
     r.section("Summary").paragraph(format!(
         "A simulated aircraft (magnetised and conducting parts, exact dipole fields) flies a {} and an \
@@ -227,15 +259,35 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         model.terms
     ));
     r.table(aeromag_report::Table::new(
-        ["calibration area", "LS residual (nT)", "Kalman residual (nT)", "noise floor (nT)"].map(String::from).to_vec(),
+        [
+            "calibration area",
+            "LS residual (nT)",
+            "Kalman residual (nT)",
+            "noise floor (nT)",
+        ]
+        .map(String::from)
+        .to_vec(),
         vec![
-            vec!["quiet".into(), fmt(fsv.residual_rms_nt, 4), fmt(res_kf, 4), fmt(fsv.noise_floor_nt, 4)],
-            vec!["realistic gradients".into(), fmt(grad_res_ls, 4), fmt(grad_res_kf, 4), fmt(fsv.noise_floor_nt, 4)],
+            vec![
+                "quiet".into(),
+                fmt(fsv.residual_rms_nt, 4),
+                fmt(res_kf, 4),
+                fmt(fsv.noise_floor_nt, 4),
+            ],
+            vec![
+                "realistic gradients".into(),
+                fmt(grad_res_ls, 4),
+                fmt(grad_res_kf, 4),
+                fmt(fsv.noise_floor_nt, 4),
+            ],
         ],
         "Residual versus truth on the independent survey.",
     ));
     r.key_values(vec![
-        ("FOM before / after (nT)".into(), format!("{} / {}", fmt(fc.fom_before_nt, 3), fmt(fc.fom_after_nt, 3))),
+        (
+            "FOM before / after (nT)".into(),
+            format!("{} / {}", fmt(fc.fom_before_nt, 3), fmt(fc.fom_after_nt, 3)),
+        ),
         ("improvement ratio (calibration)".into(), fmt(fc.ir, 1)),
     ]);
     if let Some((d, o, ls, kf)) = &plan {
@@ -249,7 +301,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             100.0 * (1.0 - d[1] / d[0])
         ));
         r.table(aeromag_report::Table::new(
-            ["pattern", "duration (s)", "LS residual (nT)", "Kalman residual (nT)", "max μ", "information rank"].map(String::from).to_vec(),
+            [
+                "pattern",
+                "duration (s)",
+                "LS residual (nT)",
+                "Kalman residual (nT)",
+                "max μ",
+                "information rank",
+            ]
+            .map(String::from)
+            .to_vec(),
             (0..2)
                 .map(|k| {
                     vec![
@@ -257,7 +318,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         format!("{:.0}", d[k]),
                         fmt(ls[k], 4),
                         fmt(kf[k], 4),
-                        format!("{:.2e}", o[k].estimability.iter().cloned().fold(0.0, f64::max)),
+                        format!(
+                            "{:.2e}",
+                            o[k].estimability.iter().cloned().fold(0.0, f64::max)
+                        ),
                         format!("{} of {}", o[k].rank, o[k].names.len()),
                     ]
                 })
@@ -265,13 +329,37 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "Full versus truncated calibration pattern.",
         ));
         let x: Vec<f64> = (0..o[0].names.len()).map(|i| i as f64).collect();
-        let svg = aeromag_report::LinePlot::new("Estimability per coefficient (index in p3, i5, e8 order)", "coefficient index", "μ")
-            .with_series(aeromag_report::Series::points("full pattern", x.clone(), o[0].estimability.clone()))
-            .with_series(aeromag_report::Series::points("truncated pattern", x, o[1].estimability.clone()))
-            .to_svg()?;
-        r.figure(svg, format!("Estimability measures, coefficients {}.", o[0].names.join(", ")));
+        let svg = aeromag_report::LinePlot::new(
+            "Estimability per coefficient (index in p3, i5, e8 order)",
+            "coefficient index",
+            "μ",
+        )
+        .with_series(aeromag_report::Series::points(
+            "full pattern",
+            x.clone(),
+            o[0].estimability.clone(),
+        ))
+        .with_series(aeromag_report::Series::points(
+            "truncated pattern",
+            x,
+            o[1].estimability.clone(),
+        ))
+        .to_svg()?;
+        r.figure(
+            svg,
+            format!(
+                "Estimability measures, coefficients {}.",
+                o[0].names.join(", ")
+            ),
+        );
     }
-    add_to_report(&mut r, "Calibration flight (LS model)", &cal, &fc, Some(&model))?;
+    add_to_report(
+        &mut r,
+        "Calibration flight (LS model)",
+        &cal,
+        &fc,
+        Some(&model),
+    )?;
     kalman_section(
         "Kalman method over realistic geology (gradient area, 1000 m): smoothed field, innovations, uncertainties",
         &grad_table,
@@ -280,37 +368,89 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &grad_rows,
     )?
     .append_to(&mut r);
-    add_to_report(&mut r, "Survey flight (independent, LS model)", &survey, &fsv, None)?;
-    for section in [rotor_section, pod_section, em_section, grad_section].into_iter().flatten() {
+    add_to_report(
+        &mut r,
+        "Survey flight (independent, LS model)",
+        &survey,
+        &fsv,
+        None,
+    )?;
+    for section in [rotor_section, pod_section, em_section, grad_section]
+        .into_iter()
+        .flatten()
+    {
         section.append_to(&mut r);
     }
     r.write_html(a.out.join("index.html"))?;
     bar.inc(1);
     bar.finish_and_clear();
 
-    println!("aeromag demo (seed {}, {:.1} s)", a.seed, start.elapsed().as_secs_f64());
+    println!(
+        "aeromag demo (seed {}, {:.1} s)",
+        a.seed,
+        start.elapsed().as_secs_f64()
+    );
     println!("{:<44} {:>12}", "figure", "value");
     let rows = [
-        ("compensation.residual_rms_ls_nt", fmt(fsv.residual_rms_nt, 4)),
+        (
+            "compensation.residual_rms_ls_nt",
+            fmt(fsv.residual_rms_nt, 4),
+        ),
         ("compensation.residual_rms_kalman_nt", fmt(res_kf, 4)),
         ("compensation.noise_floor_nt", fmt(fsv.noise_floor_nt, 4)),
         ("compensation.fom_before_nt", fmt(fc.fom_before_nt, 3)),
         ("compensation.fom_after_nt", fmt(fc.fom_after_nt, 3)),
         ("compensation.ir", fmt(fc.ir, 1)),
-        ("compensation_gradient.residual_rms_ls_nt", fmt(grad_res_ls, 4)),
-        ("compensation_gradient.residual_rms_kalman_nt", fmt(grad_res_kf, 4)),
-        ("rotor.rotor_rms_nt", fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3)),
-        ("rotor.residual_model_nt", fmt(rotor_keys["residual_model_nt"].as_f64(), 4)),
-        ("rotor.residual_best_filter_nt", fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4)),
-        ("pod.rate_train (fraction)", fmt(pod_keys["rate_train"].as_f64(), 4)),
-        ("pod.rate_test (fraction)", fmt(pod_keys["rate_test"].as_f64(), 4)),
+        (
+            "compensation_gradient.residual_rms_ls_nt",
+            fmt(grad_res_ls, 4),
+        ),
+        (
+            "compensation_gradient.residual_rms_kalman_nt",
+            fmt(grad_res_kf, 4),
+        ),
+        (
+            "rotor.rotor_rms_nt",
+            fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3),
+        ),
+        (
+            "rotor.residual_model_nt",
+            fmt(rotor_keys["residual_model_nt"].as_f64(), 4),
+        ),
+        (
+            "rotor.residual_best_filter_nt",
+            fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4),
+        ),
+        (
+            "pod.rate_train (fraction)",
+            fmt(pod_keys["rate_train"].as_f64(), 4),
+        ),
+        (
+            "pod.rate_test (fraction)",
+            fmt(pod_keys["rate_test"].as_f64(), 4),
+        ),
         ("em.range_err_rel", sci(&em_keys, "range_err_rel")),
         ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
-        ("em.polarization_ratio_before", sci(&em_keys, "polarization_ratio_before")),
-        ("em.polarization_ratio_after", sci(&em_keys, "polarization_ratio_after")),
-        ("gradiometry.efficiency_tensor", fmt(grad_keys["efficiency_tensor"].as_f64(), 3)),
-        ("gradiometry.efficiency_scalar", fmt(grad_keys["efficiency_scalar"].as_f64(), 3)),
-        ("gradiometry.convergence_fraction", fmt(grad_keys["convergence_fraction"].as_f64(), 4)),
+        (
+            "em.polarization_ratio_before",
+            sci(&em_keys, "polarization_ratio_before"),
+        ),
+        (
+            "em.polarization_ratio_after",
+            sci(&em_keys, "polarization_ratio_after"),
+        ),
+        (
+            "gradiometry.efficiency_tensor",
+            fmt(grad_keys["efficiency_tensor"].as_f64(), 3),
+        ),
+        (
+            "gradiometry.efficiency_scalar",
+            fmt(grad_keys["efficiency_scalar"].as_f64(), 3),
+        ),
+        (
+            "gradiometry.convergence_fraction",
+            fmt(grad_keys["convergence_fraction"].as_f64(), 4),
+        ),
     ];
     for (k, v) in rows {
         println!("{k:<44} {v:>12}");

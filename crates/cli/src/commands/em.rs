@@ -88,16 +88,28 @@ pub struct HalfSpaceArg {
     /// Prior half-space normal NX,NY,NZ (transmitter frame) for the ±r
     /// choice: the bird is where r·n > 0 (default: behind and below, x
     /// forward, z down).
-    #[arg(long = "half-space", value_name = "NX,NY,NZ", default_value = "-1,0,1", allow_hyphen_values = true)]
+    #[arg(
+        long = "half-space",
+        value_name = "NX,NY,NZ",
+        default_value = "-1,0,1",
+        allow_hyphen_values = true
+    )]
     pub text: String,
 }
 
 impl HalfSpaceArg {
     /// The (non-zero) normal.
     pub fn normal(&self) -> anyhow::Result<nalgebra::Vector3<f64>> {
-        let n = nalgebra::Vector3::from_vec(crate::flight::parse_numbers("--half-space", &self.text, 3)?);
+        let n = nalgebra::Vector3::from_vec(crate::flight::parse_numbers(
+            "--half-space",
+            &self.text,
+            3,
+        )?);
         if n == nalgebra::Vector3::zeros() {
-            return Err(crate::exit::bad_input!("--half-space '{}': the normal NX,NY,NZ must not be zero", self.text));
+            return Err(crate::exit::bad_input!(
+                "--half-space '{}': the normal NX,NY,NZ must not be zero",
+                self.text
+            ));
         }
         Ok(n)
     }

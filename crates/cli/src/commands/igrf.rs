@@ -33,7 +33,10 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     if !a.lat.is_finite() || a.lat.abs() > 90.0 {
-        return Err(bad_input!("--lat {} is not a latitude in −90…90 degrees", a.lat));
+        return Err(bad_input!(
+            "--lat {} is not a latitude in −90…90 degrees",
+            a.lat
+        ));
     }
     if !a.lon.is_finite() {
         return Err(bad_input!("--lon {} is not a finite longitude", a.lon));
@@ -50,7 +53,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("IGRF-14 at lat {:.5}°, lon {:.5}°, alt {:.1} m, {}", a.lat, a.lon, a.alt, a.date);
+        println!(
+            "IGRF-14 at lat {:.5}°, lon {:.5}°, alt {:.1} m, {}",
+            a.lat, a.lon, a.alt, a.date
+        );
         println!("  X (north) {:>12.1} nT", f.x_nt);
         println!("  Y (east)  {:>12.1} nT", f.y_nt);
         println!("  Z (down)  {:>12.1} nT", f.z_nt);

@@ -1,7 +1,7 @@
 //! `aeromag inspect`: what a processor checks first in a flight file.
 
 use crate::input::InputArgs;
-use aeromag_io::{summarize, Summary};
+use aeromag_io::{Summary, summarize};
 
 /// Summarise a flight file: columns found and mapped, rows, duration, sample
 /// rate and its jitter, gaps, lines, missing values per column, and the range
@@ -48,7 +48,14 @@ pub fn render(s: &Summary) -> String {
     let _ = writeln!(o, "file     {}", s.file);
     let _ = writeln!(o, "rows     {}", s.rows);
     if let Some(t) = &s.time {
-        let _ = writeln!(o, "time     {:.3} … {:.3} s  (duration {:.1} s = {:.2} h)", t.start_s, t.end_s, t.duration_s, t.duration_s / 3600.0);
+        let _ = writeln!(
+            o,
+            "time     {:.3} … {:.3} s  (duration {:.1} s = {:.2} h)",
+            t.start_s,
+            t.end_s,
+            t.duration_s,
+            t.duration_s / 3600.0
+        );
         let _ = writeln!(
             o,
             "sampling interval {:.6} s, rate {} Hz, jitter std {:.2e} s (max {:.2e} s)",
@@ -59,18 +66,36 @@ pub fn render(s: &Summary) -> String {
         );
         match (t.largest_gap_s, t.largest_gap_row) {
             (Some(g), Some(r)) => {
-                let _ = writeln!(o, "gaps     {} longer than {:.3} s; largest {:.3} s before data row {}", t.gaps, t.gap_threshold_s, g, r + 1);
+                let _ = writeln!(
+                    o,
+                    "gaps     {} longer than {:.3} s; largest {:.3} s before data row {}",
+                    t.gaps,
+                    t.gap_threshold_s,
+                    g,
+                    r + 1
+                );
             }
             _ => {
                 let _ = writeln!(o, "gaps     none longer than {:.3} s", t.gap_threshold_s);
             }
         }
     } else {
-        let _ = writeln!(o, "time     no `time` column (map one with --columns time=NAME)");
+        let _ = writeln!(
+            o,
+            "time     no `time` column (map one with --columns time=NAME)"
+        );
     }
     if let Some(lines) = &s.lines {
-        let shown: Vec<String> = lines.iter().take(20).map(|l| format!("{} ({} samples)", l.line, l.samples)).collect();
-        let more = if lines.len() > 20 { format!(" … and {} more", lines.len() - 20) } else { String::new() };
+        let shown: Vec<String> = lines
+            .iter()
+            .take(20)
+            .map(|l| format!("{} ({} samples)", l.line, l.samples))
+            .collect();
+        let more = if lines.len() > 20 {
+            format!(" … and {} more", lines.len() - 20)
+        } else {
+            String::new()
+        };
         let _ = writeln!(o, "lines    {}: {}{}", lines.len(), shown.join(", "), more);
     }
     if let Some(r) = &s.mag_range_nt {
@@ -80,9 +105,21 @@ pub fn render(s: &Summary) -> String {
         let _ = writeln!(o, "|flux|   {:.1} … {:.1} nT", r.min, r.max);
     }
     if !s.mapping.is_empty() {
-        let _ = writeln!(o, "mapped   {}", s.mapping.iter().map(|m| format!("{}={}", m.canonical, m.file_column)).collect::<Vec<_>>().join(", "));
+        let _ = writeln!(
+            o,
+            "mapped   {}",
+            s.mapping
+                .iter()
+                .map(|m| format!("{}={}", m.canonical, m.file_column))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
     }
-    let _ = writeln!(o, "\n{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}", "column", "canonical", "missing", "min", "max", "mean");
+    let _ = writeln!(
+        o,
+        "\n{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}",
+        "column", "canonical", "missing", "min", "max", "mean"
+    );
     for c in &s.columns {
         let _ = writeln!(
             o,

@@ -3,7 +3,9 @@
 
 use crate::exit::bad_input;
 use crate::input::InputArgs;
-use aeromag_compensation::levelling::{level_survey, sensor_positions, LevellingConfig, RowFlag, SurveyTracks, TrackConfig};
+use aeromag_compensation::levelling::{
+    LevellingConfig, RowFlag, SurveyTracks, TrackConfig, level_survey, sensor_positions,
+};
 use std::path::PathBuf;
 
 /// Level a (compensated) survey: find the crossovers of lines and tie lines,
@@ -73,17 +75,31 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let out_name = format!("{value_name}_level");
     if table.get(&out_name).is_some() || table.get("level_flag").is_some() {
-        return Err(bad_input!("{}: already has `{out_name}` or `level_flag`", table.file_label()));
+        return Err(bad_input!(
+            "{}: already has `{out_name}` or `level_flag`",
+            table.file_label()
+        ));
     }
     if !(a.lambda >= 0.0 && a.lambda.is_finite()) {
         return Err(bad_input!("--lambda {} must be ≥ 0", a.lambda));
     }
-    let (lat, lon, alt) = (table.require("lat")?, table.require("lon")?, table.require("alt")?);
+    let (lat, lon, alt) = (
+        table.require("lat")?,
+        table.require("lon")?,
+        table.require("alt")?,
+    );
     let positions = match &a.lever_arm {
         Some(s) => {
             let lever = crate::flight::parse_lever_arm(s)?;
-            let (r, p, y) = (table.require("roll")?, table.require("pitch")?, table.require("yaw")?);
-            Some(sensor_positions(lat, lon, alt, r, p, y, lever).map_err(|e| bad_input!("{}: {e}", table.file_label()))?)
+            let (r, p, y) = (
+                table.require("roll")?,
+                table.require("pitch")?,
+                table.require("yaw")?,
+            );
+            Some(
+                sensor_positions(lat, lon, alt, r, p, y, lever)
+                    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?,
+            )
         }
         None => None,
     };
@@ -93,7 +109,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let ref_cols = crate::flight::reference_columns(&table, &a.reference)?;
     let reference = crate::flight::reference_sum(&table, &ref_cols, None)?;
-    let value: Vec<f64> = table.require(&value_name)?.iter().zip(&reference).map(|(v, r)| v - r).collect();
+    let value: Vec<f64> = table
+        .require(&value_name)?
+        .iter()
+        .zip(&reference)
+        .map(|(v, r)| v - r)
+        .collect();
     if !ref_cols.is_empty() {
         println!("levelling {value_name} − {}", ref_cols.join(" − "));
     }
@@ -113,7 +134,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ..LevellingConfig::default()
     };
     let spinner = crate::progress::spinner("levelling");
-    let lev = level_survey(&tracks, &TrackConfig::default(), &cfg).map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let lev = level_survey(&tracks, &TrackConfig::default(), &cfg)
+        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
     spinner.finish_and_clear();
     let f = &lev.fit;
     let flags: Vec<f64> = lev
@@ -155,17 +177,34 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     } else {
         if cfg.altitude_term {
-            eprintln!("warning: no crossover has heights and profiles on both sides; the altitude term is left out");
+            eprintln!(
+                "warning: no crossover has heights and profiles on both sides; the altitude term is left out"
+            );
         }
-        println!("crossover differences RMS: {:.4} nT before, {:.4} nT after levelling", f.rms_before_nt, f.rms_after_nt);
+        println!(
+            "crossover differences RMS: {:.4} nT before, {:.4} nT after levelling",
+            f.rms_before_nt, f.rms_after_nt
+        );
     }
     if f.components > 1 {
-        eprintln!("warning: the lines form {} groups that never cross; their relative levels rest on the penalty, not the data", f.components);
+        eprintln!(
+            "warning: the lines form {} groups that never cross; their relative levels rest on the penalty, not the data",
+            f.components
+        );
     }
-    println!("{:>10} {:>11} {:>12} {:>10}", "line", "crossovers", "offset (nT)", "std (nT)");
+    println!(
+        "{:>10} {:>11} {:>12} {:>10}",
+        "line", "crossovers", "offset (nT)", "std (nT)"
+    );
     for l in &f.lines {
-        println!("{:>10} {:>11} {:>12.4} {:>10.4}", l.label, l.crossovers, l.offset_nt, l.offset_std_nt);
+        println!(
+            "{:>10} {:>11} {:>12.4} {:>10.4}",
+            l.label, l.crossovers, l.offset_nt, l.offset_std_nt
+        );
     }
-    println!("{n} rows written to {} (column {out_name})", a.out.display());
+    println!(
+        "{n} rows written to {} (column {out_name})",
+        a.out.display()
+    );
     Ok(())
 }

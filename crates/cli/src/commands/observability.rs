@@ -1,6 +1,6 @@
 //! `aeromag observability`: what a calibration flight determines.
 
-use crate::commands::calibrate::{fit_model_kalman, EddyLag, FitOptions};
+use crate::commands::calibrate::{EddyLag, FitOptions, fit_model_kalman};
 use crate::exit::bad_input;
 use crate::flight::TlColumns;
 use crate::input::InputArgs;
@@ -44,9 +44,25 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let terms = TermSet::parse(&a.terms).map_err(|e| bad_input!("--terms: {e}"))?;
     let table = a.input.load()?;
-    let cfg = KalmanConfig { terms, compute_series: false, ..KalmanConfig::default() };
-    let (_, fit, _) = fit_model_kalman(&table, &cfg, &FitOptions { eddy_lag: EddyLag::None, ..FitOptions::auto() })?;
-    let o = observability(&fit.names, &fit.prior_covariance, &fit.posterior_covariance, 1e6)?;
+    let cfg = KalmanConfig {
+        terms,
+        compute_series: false,
+        ..KalmanConfig::default()
+    };
+    let (_, fit, _) = fit_model_kalman(
+        &table,
+        &cfg,
+        &FitOptions {
+            eddy_lag: EddyLag::None,
+            ..FitOptions::auto()
+        },
+    )?;
+    let o = observability(
+        &fit.names,
+        &fit.prior_covariance,
+        &fit.posterior_covariance,
+        1e6,
+    )?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&o)?);
         return Ok(());
@@ -60,7 +76,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // poor flight fails to exercise.
     let cols = TlColumns::from_table(&table)?;
     let bt: Vec<f64> = (0..cols.time.len())
-        .map(|i| (cols.flux[0][i].powi(2) + cols.flux[1][i].powi(2) + cols.flux[2][i].powi(2)).sqrt())
+        .map(|i| {
+            (cols.flux[0][i].powi(2) + cols.flux[1][i].powi(2) + cols.flux[2][i].powi(2)).sqrt()
+        })
         .filter(|v| v.is_finite())
         .collect();
     let bt_mean = bt.iter().sum::<f64>() / bt.len().max(1) as f64;
@@ -78,12 +96,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             sd * scale
         })
         .collect();
-    println!("{}: {} coefficients ({}), {} rows", table.file_label(), n, cfg.terms, fit.rows);
+    println!(
+        "{}: {} coefficients ({}), {} rows",
+        table.file_label(),
+        n,
+        cfg.terms,
+        fit.rows
+    );
     println!(
         "information rank {} of {n}, condition number {:.2e}{}",
         o.rank,
         o.condition,
-        if o.rank < n { " — some combinations are not observable" } else { "" }
+        if o.rank < n {
+            " — some combinations are not observable"
+        } else {
+            ""
+        }
     );
     if o.weak_combinations.is_empty() {
         println!("every combination of coefficients is determined by this flight");
@@ -91,7 +119,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for w in &o.weak_combinations {
         println!("  {w}");
     }
-    println!("\n{:<8} {:>10} {:>12} {:>16}  verdict", "term", "μ", "std", "effect σ (nT)");
+    println!(
+        "\n{:<8} {:>10} {:>12} {:>16}  verdict",
+        "term", "μ", "std", "effect σ (nT)"
+    );
     let mut undetermined = Vec::new();
     for i in 0..n {
         let verdict = if o.estimability[i] > 0.9 || effect[i] >= 1.0 {
@@ -104,7 +135,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         } else {
             "well determined"
         };
-        println!("{:<8} {:>10.4} {:>12.3e} {:>16.4}  {verdict}", o.names[i], o.estimability[i], fit.std[i], effect[i]);
+        println!(
+            "{:<8} {:>10.4} {:>12.3e} {:>16.4}  {verdict}",
+            o.names[i], o.estimability[i], fit.std[i], effect[i]
+        );
     }
     if !undetermined.is_empty() {
         println!(

@@ -42,12 +42,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (None, Some(m)) => m.reference.clone(),
         (None, None) => reference_columns(&table, "auto")?,
     };
-    let fig = figures(&table, &reference, model.as_ref().and_then(|m| m.lever_arm.as_ref()))?;
+    let fig = figures(
+        &table,
+        &reference,
+        model.as_ref().and_then(|m| m.lever_arm.as_ref()),
+    )?;
     let mut r = Report::new(format!("aeromag report — {}", table.file_label()));
     add_to_report(&mut r, "Compensation", &table, &fig, model.as_ref())?;
     let path = a.out.join("index.html");
     r.write_html(&path)?;
-    std::fs::write(a.out.join("figures.json"), serde_json::to_string_pretty(&fig)?)?;
+    std::fs::write(
+        a.out.join("figures.json"),
+        serde_json::to_string_pretty(&fig)?,
+    )?;
     println!("report written to {}", path.display());
     Ok(())
 }

@@ -27,8 +27,8 @@ use crate::input::InputArgs;
 use aeromag_compensation::rotor::study::{nominal_angles, scenario_geometry};
 use aeromag_compensation::rotor::{
     BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
-    align_phase_offset, estimate_phase, fit_records, fit_slow_angles, refine_phase_offset, regressors,
-    rotor_speed, track_slow_angles, unwrap_deg,
+    align_phase_offset, estimate_phase, fit_records, fit_slow_angles, refine_phase_offset,
+    regressors, rotor_speed, track_slow_angles, unwrap_deg,
 };
 use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments};
 use aeromag_io::FlightTable;
@@ -38,7 +38,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use aeromag_compensation::model_file::MODEL_FORMAT;
-pub use aeromag_compensation::rotor::model_file::{PhaseSource, RotorModelFile, ROTOR_KIND};
+pub use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile};
 /// Longest dropout (consecutive rows with a missing value, time steps
 /// regular) that `rotor fit` bridges by linear interpolation, s.
 const MAX_FILL_S: f64 = 0.1;
@@ -179,7 +179,10 @@ pub(crate) fn sample_rate(table: &FlightTable, time: &[f64]) -> anyhow::Result<f
     if dt > 0.0 {
         Ok(1.0 / dt)
     } else {
-        Err(bad_input!("{}: fewer than two increasing time samples", table.file_label()))
+        Err(bad_input!(
+            "{}: fewer than two increasing time samples",
+            table.file_label()
+        ))
     }
 }
 
@@ -342,10 +345,19 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     let filled: Vec<Vec<f64>> = raw_cols
         .iter()
         .enumerate()
-        .map(|(k, c)| bridge_dropouts(raw.time, c, max_fill, if k == 4 { Some(360.0) } else { None }))
+        .map(|(k, c)| {
+            bridge_dropouts(
+                raw.time,
+                c,
+                max_fill,
+                if k == 4 { Some(360.0) } else { None },
+            )
+        })
         .collect();
     let bridged = (0..raw.time.len())
-        .filter(|&i| raw_cols.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite()))
+        .filter(|&i| {
+            raw_cols.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite())
+        })
         .count();
     let cols = RotorColumns {
         time: raw.time,
@@ -354,7 +366,9 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
         phase: raw.phase.map(|_| filled[4].as_slice()),
     };
     if bridged > 0 {
-        eprintln!("note: {bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation for the fit");
+        eprintln!(
+            "note: {bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation for the fit"
+        );
     }
     let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
     let (_, segs, _) = usable_segments(cols.time, None, &cols.all(), min_len);
@@ -454,14 +468,26 @@ pub fn fit(a: FitArgs) -> anyhow::Result<()> {
     // angles tracked as `rotor apply` would.
     if segs.len() > 1 {
         for _ in 0..REFINE_ITERATIONS {
-            let tracked: Vec<TrackedSegment> = segs.iter().map(|s| track_segment(&model, &cols, s, fs)).collect::<anyhow::Result<_>>()?;
-            let regs: Vec<Vec<Vec<f64>>> =
-                tracked.iter().map(|t| regressors(&model.geometry, model.model.terms, &t.input())).collect::<Result<_, _>>()?;
-            let records: Vec<(&[Vec<f64>], &[f64])> = regs.iter().zip(&segs).map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()])).collect();
+            let tracked: Vec<TrackedSegment> = segs
+                .iter()
+                .map(|s| track_segment(&model, &cols, s, fs))
+                .collect::<anyhow::Result<_>>()?;
+            let regs: Vec<Vec<Vec<f64>>> = tracked
+                .iter()
+                .map(|t| regressors(&model.geometry, model.model.terms, &t.input()))
+                .collect::<Result<_, _>>()?;
+            let records: Vec<(&[Vec<f64>], &[f64])> = regs
+                .iter()
+                .zip(&segs)
+                .map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()]))
+                .collect();
             model.model = fit_records(&records, model.model.terms, fs, &fit_opts)?;
         }
         model.rows = used;
-        eprintln!("note: parameters refined on all {} stretches ({used} rows)", segs.len());
+        eprintln!(
+            "note: parameters refined on all {} stretches ({used} rows)",
+            segs.len()
+        );
     }
     std::fs::write(&a.model, serde_json::to_string_pretty(&model)?)
         .map_err(|e| anyhow::anyhow!("cannot write '{}': {e}", a.model.display()))?;
@@ -522,7 +548,12 @@ struct TrackedSegment {
 
 impl TrackedSegment {
     fn input(&self) -> RotorInput<'_> {
-        RotorInput { b_body_nt: &self.b, phase_rad: &self.phase, omega_rad_s: &self.omega, angles: &self.angles }
+        RotorInput {
+            b_body_nt: &self.b,
+            phase_rad: &self.phase,
+            omega_rad_s: &self.omega,
+            angles: &self.angles,
+        }
     }
 }
 
@@ -530,7 +561,12 @@ impl TrackedSegment {
 /// slowly varying angles (tracked with `model`'s parameters fixed) of rows
 /// `r`: what `rotor apply` does to a stretch, and what `rotor fit` does to
 /// the stretches it refits on.
-fn track_segment(model: &RotorModelFile, cols: &RotorColumns, r: &Range<usize>, fs: f64) -> anyhow::Result<TrackedSegment> {
+fn track_segment(
+    model: &RotorModelFile,
+    cols: &RotorColumns,
+    r: &Range<usize>,
+    fs: f64,
+) -> anyhow::Result<TrackedSegment> {
     let g = &model.geometry;
     let nominal = [model.nominal_angles];
     let b = cols.field(r);
@@ -538,16 +574,34 @@ fn track_segment(model: &RotorModelFile, cols: &RotorColumns, r: &Range<usize>, 
     let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
     let estimated = model.phase.column.is_none();
     if estimated {
-        let inp = RotorInput { b_body_nt: &b, phase_rad: &phase, omega_rad_s: &omega, angles: &nominal };
+        let inp = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &phase,
+            omega_rad_s: &omega,
+            angles: &nominal,
+        };
         let c = align_phase_offset(g, &model.model, &inp, mag, fs, &model.fit_options)?;
         phase.iter_mut().for_each(|p| *p += c);
     }
-    let inp = RotorInput { b_body_nt: &b, phase_rad: &phase, omega_rad_s: &omega, angles: &nominal };
-    let opts = if estimated { tracking_with_phase(&model.slow_angles) } else { model.slow_angles };
+    let inp = RotorInput {
+        b_body_nt: &b,
+        phase_rad: &phase,
+        omega_rad_s: &omega,
+        angles: &nominal,
+    };
+    let opts = if estimated {
+        tracking_with_phase(&model.slow_angles)
+    } else {
+        model.slow_angles
+    };
     let slow = track_slow_angles(g, &model.model, &inp, mag, fs, &model.fit_options, &opts)?;
-    Ok(TrackedSegment { b, omega, phase: slow.phase_rad, angles: slow.angles })
+    Ok(TrackedSegment {
+        b,
+        omega,
+        phase: slow.phase_rad,
+        angles: slow.angles,
+    })
 }
-
 
 pub fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     let model = load_model(&a.model)?;
@@ -569,7 +623,10 @@ mod tests {
         let x = [0.0, 1.0, nan, 3.0, nan, nan, nan, 7.0, 8.0, nan];
         let y = bridge_dropouts(&t, &x, 2, None);
         assert_eq!(y[2], 2.0);
-        assert!(y[4].is_nan() && y[5].is_nan() && y[6].is_nan(), "a run of 3 > 2 stays");
+        assert!(
+            y[4].is_nan() && y[5].is_nan() && y[6].is_nan(),
+            "a run of 3 > 2 stays"
+        );
         assert!(y[9].is_nan(), "no value after the run");
         // A phase in degrees is interpolated the short way round 360°.
         let p = bridge_dropouts(&t[..3], &[350.0, nan, 10.0], 1, Some(360.0));

@@ -1,7 +1,7 @@
 //! `aeromag simulate`: realistic flight data with known truth.
 
 use crate::exit::bad_input;
-use aeromag_sim::{default_config_toml, simulate, ScenarioKind};
+use aeromag_sim::{ScenarioKind, default_config_toml, simulate};
 use std::path::PathBuf;
 
 /// Simulate a flight with the physical simulator and write it to a folder.
@@ -47,10 +47,21 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.scenario == "gradiometer" {
         let (config, seed, out, print_config) = (a.config, a.seed, a.out, a.print_config);
-        return super::dipole::simulate_scenario(super::dipole::SimulateArgs { config, seed, out, print_config });
+        return super::dipole::simulate_scenario(super::dipole::SimulateArgs {
+            config,
+            seed,
+            out,
+            print_config,
+        });
     }
     if a.scenario == "em" {
-        return crate::commands::em::simulate_em(a.config.as_deref(), a.seed, a.out.as_deref(), a.print_config, crate::commands::em::DEFAULT_KNOWN);
+        return crate::commands::em::simulate_em(
+            a.config.as_deref(),
+            a.seed,
+            a.out.as_deref(),
+            a.print_config,
+            crate::commands::em::DEFAULT_KNOWN,
+        );
     }
     let kind: ScenarioKind = a.scenario.parse()?;
     if a.print_config {
@@ -59,7 +70,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let text = match &a.config {
         Some(p) => Some(
-            std::fs::read_to_string(p).map_err(|e| bad_input!("cannot read scenario file '{}': {e}", p.display()))?,
+            std::fs::read_to_string(p)
+                .map_err(|e| bad_input!("cannot read scenario file '{}': {e}", p.display()))?,
         ),
         None => None,
     };

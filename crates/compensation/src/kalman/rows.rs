@@ -61,7 +61,13 @@ pub fn for_each_design_row(
             let j = i - lo;
             let d = [db[0][j], db[1][j], db[2][j]];
             let lagged = lags.step(time[i], d);
-            spec.terms.row([flux[0][i], flux[1][i], flux[2][i]], d, lagged, spec.bt_scale_nt, &mut row);
+            spec.terms.row(
+                [flux[0][i], flux[1][i], flux[2][i]],
+                d,
+                lagged,
+                spec.bt_scale_nt,
+                &mut row,
+            );
             f(i, &row);
         }
         a = b;
@@ -89,7 +95,10 @@ mod tests {
             .map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin())
             .collect();
         for conv in [Convention::Physical, Convention::MagNav] {
-            let terms = TermSet::parse("p3,i6,e9,bias").unwrap().with_eddy_lags(&[0.2, 0.7]).unwrap();
+            let terms = TermSet::parse("p3,i6,e9,bias")
+                .unwrap()
+                .with_eddy_lags(&[0.2, 0.7])
+                .unwrap();
             let spec = RowSpec {
                 terms: &terms,
                 convention: conv,

@@ -440,7 +440,8 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
 /// The altitude regressor `g_x = −(S_a + S_b)(h_a − h_b)` (nT), 0 where a
 /// side has no altitude or profile operator.
 fn altitude_regressor(x: &Crossover) -> f64 {
-    let g = -(x.a.profile_gradient_nt_per_m + x.b.profile_gradient_nt_per_m) * (x.a.alt_m - x.b.alt_m);
+    let g =
+        -(x.a.profile_gradient_nt_per_m + x.b.profile_gradient_nt_per_m) * (x.a.alt_m - x.b.alt_m);
     if g.is_finite() { g } else { 0.0 }
 }
 
@@ -554,7 +555,12 @@ pub(crate) mod tests {
             with.vertical_scale,
             with.vertical_scale_std
         );
-        assert!((with.k_s + 0.1).abs() < 4.0 * with.k_std_s, "k = {} ± {}", with.k_s, with.k_std_s);
+        assert!(
+            (with.k_s + 0.1).abs() < 4.0 * with.k_std_s,
+            "k = {} ± {}",
+            with.k_s,
+            with.k_std_s
+        );
         // The levelled series keeps the height differences; the model explains them.
         assert!(with.rms_levelled_nt > 3.0 * with.rms_after_nt);
         let without = fit_levelling(

@@ -128,7 +128,8 @@ fn abs_wavenumber(planner: &mut RealFftPlanner<f64>, u: &[f64], ds: f64, taper_m
     let inv = planner.plan_fft_inverse(n);
     let mut spec = fwd.make_output_vec();
     // The lengths are those of the plans: the transforms cannot fail.
-    fwd.process(&mut ext, &mut spec).expect("FFT lengths match the plan");
+    fwd.process(&mut ext, &mut spec)
+        .expect("FFT lengths match the plan");
     let dk = 2.0 * std::f64::consts::PI / (n as f64 * ds);
     for (j, c) in spec.iter_mut().enumerate() {
         let k = j as f64 * dk;
@@ -140,7 +141,8 @@ fn abs_wavenumber(planner: &mut RealFftPlanner<f64>, u: &[f64], ds: f64, taper_m
     spec[0].im = 0.0;
     spec[m].im = 0.0;
     let mut back = inv.make_output_vec();
-    inv.process(&mut spec, &mut back).expect("FFT lengths match the plan");
+    inv.process(&mut spec, &mut back)
+        .expect("FFT lengths match the plan");
     back.truncate(m);
     back
 }
@@ -179,9 +181,22 @@ mod tests {
     use super::*;
 
     /// The profile operator of one set of tracks (altitude unused).
-    fn gradient_of(time: &[f64], lat: &[f64], lon: &[f64], line: &[f64], value: &[f64]) -> Vec<f64> {
+    fn gradient_of(
+        time: &[f64],
+        lat: &[f64],
+        lon: &[f64],
+        line: &[f64],
+        value: &[f64],
+    ) -> Vec<f64> {
         let alt = vec![0.0; time.len()];
-        let tracks = SurveyTracks { time, lat, lon, alt: &alt, line, value };
+        let tracks = SurveyTracks {
+            time,
+            lat,
+            lon,
+            alt: &alt,
+            line,
+            value,
+        };
         profile_gradient(&tracks, &TrackConfig::default()).unwrap()
     }
 

@@ -37,14 +37,23 @@ pub struct FomReport {
 impl FomReport {
     /// Sum of the windows of one axis, nT.
     pub fn axis_sum_nt(&self, axis: Axis) -> f64 {
-        self.windows.iter().filter(|w| w.maneuver.axis == axis).map(|w| w.peak_to_peak_nt).sum()
+        self.windows
+            .iter()
+            .filter(|w| w.maneuver.axis == axis)
+            .map(|w| w.peak_to_peak_nt)
+            .sum()
     }
 }
 
 /// Peak-to-peak of `y` after removing its least-squares line over `t`
 /// (non-finite samples skipped). `None` with fewer than 3 finite samples.
 pub fn detrended_peak_to_peak(t: &[f64], y: &[f64]) -> Option<f64> {
-    let pts: Vec<(f64, f64)> = t.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect();
+    let pts: Vec<(f64, f64)> = t
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .collect();
     if pts.len() < 3 {
         return None;
     }
@@ -54,10 +63,12 @@ pub fn detrended_peak_to_peak(t: &[f64], y: &[f64]) -> Option<f64> {
     let stt: f64 = pts.iter().map(|p| (p.0 - tm) * (p.0 - tm)).sum();
     let sty: f64 = pts.iter().map(|p| (p.0 - tm) * (p.1 - ym)).sum();
     let slope = if stt > 0.0 { sty / stt } else { 0.0 };
-    let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-        let r = p.1 - ym - slope * (p.0 - tm);
-        (lo.min(r), hi.max(r))
-    });
+    let (lo, hi) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            let r = p.1 - ym - slope * (p.0 - tm);
+            (lo.min(r), hi.max(r))
+        });
     Some(hi - lo)
 }
 
@@ -67,24 +78,34 @@ pub fn figure_of_merit(time: &[f64], signal: &[f64], windows: &[Maneuver]) -> Fo
         .iter()
         .filter(|m| m.end <= time.len() && m.end <= signal.len() && m.start < m.end)
         .filter_map(|m| {
-            detrended_peak_to_peak(&time[m.start..m.end], &signal[m.start..m.end])
-                .map(|pp| FomWindow { maneuver: *m, peak_to_peak_nt: pp })
+            detrended_peak_to_peak(&time[m.start..m.end], &signal[m.start..m.end]).map(|pp| {
+                FomWindow {
+                    maneuver: *m,
+                    peak_to_peak_nt: pp,
+                }
+            })
         })
         .collect();
-    FomReport { fom_nt: windows.iter().map(|w| w.peak_to_peak_nt).sum(), windows }
+    FomReport {
+        fom_nt: windows.iter().map(|w| w.peak_to_peak_nt).sum(),
+        windows,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::metrics::maneuvers::{detect_maneuvers, tests::synthetic_fom, ManeuverDetection};
+    use crate::metrics::maneuvers::{ManeuverDetection, detect_maneuvers, tests::synthetic_fom};
 
     #[test]
     fn trend_is_removed() {
         let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
         let y: Vec<f64> = t.iter().map(|v| 3.0 * v + 7.0).collect();
         assert!(detrended_peak_to_peak(&t, &y).unwrap() < 1e-9);
-        let z: Vec<f64> = t.iter().map(|v| 3.0 * v + if *v == 50.0 { 1.0 } else { 0.0 }).collect();
+        let z: Vec<f64> = t
+            .iter()
+            .map(|v| 3.0 * v + if *v == 50.0 { 1.0 } else { 0.0 })
+            .collect();
         assert!((detrended_peak_to_peak(&t, &z).unwrap() - 1.0).abs() < 0.02);
     }
 

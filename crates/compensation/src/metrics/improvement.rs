@@ -11,7 +11,11 @@ use std::ops::Range;
 
 /// `x` band-passed segment by segment; NaN outside the segments and in
 /// segments too short for the filter.
-pub fn band_pass_segments(x: &[f64], segments: &[Range<usize>], bpf: &BandPass) -> Result<Vec<f64>> {
+pub fn band_pass_segments(
+    x: &[f64],
+    segments: &[Range<usize>],
+    bpf: &BandPass,
+) -> Result<Vec<f64>> {
     let mut out = vec![f64::NAN; x.len()];
     for r in segments {
         if r.len() >= bpf.min_len() {
@@ -24,18 +28,32 @@ pub fn band_pass_segments(x: &[f64], segments: &[Range<usize>], bpf: &BandPass) 
 /// Band-pass every segment of `x` and return the pooled standard deviation
 /// about the mean (segments too short for the filter are skipped; `None` if
 /// none remain).
-pub fn band_passed_std(x: &[f64], segments: &[Range<usize>], bpf: &BandPass) -> Result<Option<f64>> {
-    let y: Vec<f64> = band_pass_segments(x, segments, bpf)?.into_iter().filter(|v| v.is_finite()).collect();
+pub fn band_passed_std(
+    x: &[f64],
+    segments: &[Range<usize>],
+    bpf: &BandPass,
+) -> Result<Option<f64>> {
+    let y: Vec<f64> = band_pass_segments(x, segments, bpf)?
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .collect();
     let n = y.len();
     if n < 2 {
         return Ok(None);
     }
     let m = y.iter().sum::<f64>() / n as f64;
-    Ok(Some((y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1) as f64).sqrt()))
+    Ok(Some(
+        (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1) as f64).sqrt(),
+    ))
 }
 
 /// Improvement ratio of a compensation over the given segments.
-pub fn improvement_ratio(uncomp: &[f64], comp: &[f64], segments: &[Range<usize>], bpf: &BandPass) -> Result<Option<f64>> {
+pub fn improvement_ratio(
+    uncomp: &[f64],
+    comp: &[f64],
+    segments: &[Range<usize>],
+    bpf: &BandPass,
+) -> Result<Option<f64>> {
     let a = band_passed_std(uncomp, segments, bpf)?;
     let b = band_passed_std(comp, segments, bpf)?;
     Ok(match (a, b) {
@@ -52,10 +70,19 @@ mod tests {
     fn ratio_of_in_band_amplitudes() {
         let n = 3000;
         let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
-        let tone = |a: f64| -> Vec<f64> { t.iter().map(|s| a * (std::f64::consts::TAU * 0.3 * s).sin() + 0.01 * s).collect() };
+        let tone = |a: f64| -> Vec<f64> {
+            t.iter()
+                .map(|s| a * (std::f64::consts::TAU * 0.3 * s).sin() + 0.01 * s)
+                .collect()
+        };
         let bpf = BandPass::compensation_default(10.0).unwrap();
-        let ir = improvement_ratio(&tone(5.0), &tone(0.25), &[0..n], &bpf).unwrap().unwrap();
+        let ir = improvement_ratio(&tone(5.0), &tone(0.25), &[0..n], &bpf)
+            .unwrap()
+            .unwrap();
         assert!((ir - 20.0).abs() < 0.2, "{ir}");
-        assert_eq!(improvement_ratio(&tone(1.0), &tone(1.0), &[0..10], &bpf).unwrap(), None);
+        assert_eq!(
+            improvement_ratio(&tone(1.0), &tone(1.0), &[0..10], &bpf).unwrap(),
+            None
+        );
     }
 }

@@ -64,7 +64,13 @@ impl Default for ManeuverDetection {
     fn default() -> Self {
         // A ±10° sinusoid has RMS 7.1°, ±5° has 3.5°; straight flight in
         // light turbulence stays well below a third of these.
-        Self { detrend_s: 12.0, rms_window_s: 6.0, threshold_deg: [2.5, 1.2, 1.2], min_duration_s: 8.0, min_extrema: 4 }
+        Self {
+            detrend_s: 12.0,
+            rms_window_s: 6.0,
+            threshold_deg: [2.5, 1.2, 1.2],
+            min_duration_s: 8.0,
+            min_extrema: 4,
+        }
     }
 }
 
@@ -134,20 +140,35 @@ pub fn detect_maneuvers(
     }
     let samples = |s: f64| ((s / dt).round() as usize).max(1);
     let yaw_u = unwrap_deg(yaw_deg);
-    let clean: [Vec<f64>; 3] =
-        [roll_deg, pitch_deg, yaw_u.as_slice()].map(|a| a.iter().map(|v| if v.is_finite() { *v } else { 0.0 }).collect());
-    let finite = |i: usize| roll_deg[i].is_finite() && pitch_deg[i].is_finite() && yaw_deg[i].is_finite();
+    let clean: [Vec<f64>; 3] = [roll_deg, pitch_deg, yaw_u.as_slice()].map(|a| {
+        a.iter()
+            .map(|v| if v.is_finite() { *v } else { 0.0 })
+            .collect()
+    });
+    let finite =
+        |i: usize| roll_deg[i].is_finite() && pitch_deg[i].is_finite() && yaw_deg[i].is_finite();
     let mut score = vec![[0.0f64; 3]; n];
     for (k, a) in clean.iter().enumerate() {
         let trend = running_mean(a, samples(cfg.detrend_s));
-        let sq: Vec<f64> = a.iter().zip(&trend).map(|(v, t)| (v - t) * (v - t)).collect();
+        let sq: Vec<f64> = a
+            .iter()
+            .zip(&trend)
+            .map(|(v, t)| (v - t) * (v - t))
+            .collect();
         let ms = running_mean(&sq, samples(cfg.rms_window_s));
         for i in 0..n {
-            score[i][k] = if finite(i) { ms[i].sqrt() / cfg.threshold_deg[k] } else { 0.0 };
+            score[i][k] = if finite(i) {
+                ms[i].sqrt() / cfg.threshold_deg[k]
+            } else {
+                0.0
+            };
         }
     }
     let label = |s: &[f64; 3]| -> Option<Axis> {
-        let (k, v) = s.iter().enumerate().fold((0, f64::MIN), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
+        let (k, v) = s
+            .iter()
+            .enumerate()
+            .fold((0, f64::MIN), |b, (k, &v)| if v > b.1 { (k, v) } else { b });
         (v > 1.0).then_some([Axis::Roll, Axis::Pitch, Axis::Yaw][k])
     };
     let mut out = Vec::new();
@@ -173,7 +194,12 @@ pub fn detect_maneuvers(
         let a = start + ext[0].saturating_sub(quarter);
         let b = (start + ext[ext.len() - 1] + quarter + 1).min(i);
         if b - a >= min_len {
-            out.push(Maneuver { axis, start: a, end: b, heading_deg: circular_mean_deg(&yaw_deg[a..b]) });
+            out.push(Maneuver {
+                axis,
+                start: a,
+                end: b,
+                heading_deg: circular_mean_deg(&yaw_deg[a..b]),
+            });
         }
     }
     out
@@ -238,10 +264,13 @@ fn median_gap(idx: &[usize]) -> usize {
 
 /// Circular mean of angles in degrees, result in [0, 360).
 pub fn circular_mean_deg(a: &[f64]) -> f64 {
-    let (s, c) = a.iter().filter(|v| v.is_finite()).fold((0.0, 0.0), |(s, c), v| {
-        let r = v.to_radians();
-        (s + r.sin(), c + r.cos())
-    });
+    let (s, c) = a
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0.0), |(s, c), v| {
+            let r = v.to_radians();
+            (s + r.sin(), c + r.cos())
+        });
     s.atan2(c).to_degrees().rem_euclid(360.0)
 }
 
@@ -285,8 +314,15 @@ pub(crate) mod tests {
                     let jitter = 0.3 * ((k as f64) * 0.37).sin();
                     t.push(k as f64 * dt);
                     r.push(if axis == Some(Axis::Roll) { s } else { jitter });
-                    p.push(if axis == Some(Axis::Pitch) { s } else { 2.0 + 0.5 * jitter });
-                    y.push((heading + if axis == Some(Axis::Yaw) { s } else { jitter } + 360.0f64) % 360.0);
+                    p.push(if axis == Some(Axis::Pitch) {
+                        s
+                    } else {
+                        2.0 + 0.5 * jitter
+                    });
+                    y.push(
+                        (heading + if axis == Some(Axis::Yaw) { s } else { jitter } + 360.0f64)
+                            % 360.0,
+                    );
                     k += 1;
                 }
                 if let Some(a) = axis {

@@ -5,7 +5,7 @@ pub mod improvement;
 pub mod maneuvers;
 pub mod residual;
 
-pub use fom::{figure_of_merit, FomReport, FomWindow};
+pub use fom::{FomReport, FomWindow, figure_of_merit};
 pub use improvement::{band_pass_segments, improvement_ratio};
-pub use residual::{residual_by_line, LineResidual};
-pub use maneuvers::{detect_maneuvers, Axis, Maneuver, ManeuverDetection};
+pub use maneuvers::{Axis, Maneuver, ManeuverDetection, detect_maneuvers};
+pub use residual::{LineResidual, residual_by_line};

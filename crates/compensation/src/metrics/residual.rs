@@ -33,8 +33,11 @@ pub fn residual_by_line(
     let mut lines: Vec<LineResidual> = Vec::new();
     let (mut pooled2, mut pooled_n) = (0.0, 0usize);
     for r in segments {
-        let d: Vec<f64> =
-            r.clone().map(|i| value[i] - reference[i]).filter(|v| v.is_finite()).collect();
+        let d: Vec<f64> = r
+            .clone()
+            .map(|i| value[i] - reference[i])
+            .filter(|v| v.is_finite())
+            .collect();
         if d.len() < 2 {
             continue;
         }
@@ -49,7 +52,11 @@ pub fn residual_by_line(
             rms_nt: (ss / d.len() as f64).sqrt(),
         });
     }
-    let pooled = if pooled_n > 0 { (pooled2 / pooled_n as f64).sqrt() } else { f64::NAN };
+    let pooled = if pooled_n > 0 {
+        (pooled2 / pooled_n as f64).sqrt()
+    } else {
+        f64::NAN
+    };
     (lines, pooled)
 }
 
@@ -59,7 +66,15 @@ mod tests {
 
     #[test]
     fn per_line_means_are_removed() {
-        let v: Vec<f64> = (0..20).map(|i| if i < 10 { 5.0 + (i % 2) as f64 } else { -3.0 + 2.0 * (i % 2) as f64 }).collect();
+        let v: Vec<f64> = (0..20)
+            .map(|i| {
+                if i < 10 {
+                    5.0 + (i % 2) as f64
+                } else {
+                    -3.0 + 2.0 * (i % 2) as f64
+                }
+            })
+            .collect();
         let r = vec![0.0; 20];
         let line: Vec<f64> = (0..20).map(|i| if i < 10 { 1.0 } else { 2.0 }).collect();
         let (lines, pooled) = residual_by_line(&v, &r, Some(&line), &[0..10, 10..20]);

@@ -18,9 +18,9 @@
 //!   (instantaneous `u`, no linearisation in `u`, every sample weighted
 //!   equally instead of every heading coefficient, and the gradient of the
 //!   eddy-current field that the seed's eqs. 10–12 omit); [`predict_joint`]
-//!   applies it. On the simulated seed scenario the omitted eddy gradient,
-//!   not the linearisation in the displacement, is what holds the seed's
-//!   model below 90 % (module docs of [`super`]).
+//!   applies it. With strong eddy currents in the helicopter the omitted
+//!   eddy gradient, not the linearisation in the displacement, is what
+//!   holds the seed's 43-parameter model back (module docs of [`super`]).
 //!
 //! Both least-squares problems are solved by a column-scaled SVD with
 //! truncation ([`RCOND`]): level flights at one site leave some parameter
@@ -373,7 +373,10 @@ pub fn compensation_rate(h: &PodHeading, pred: &[f64]) -> Result<f64> {
 /// [`compensation_rate`] (each heading high-passed on its own). Headings
 /// with a large interference weigh more than in the per-heading minimum or
 /// mean. Errors: as [`compensation_rate`], count mismatch, no headings.
-pub fn compensation_rate_pooled(headings: &[PodHeading], preds: &[Vec<f64>]) -> Result<f64> {
+pub fn compensation_rate_pooled<H: std::borrow::Borrow<PodHeading>>(
+    headings: &[H],
+    preds: &[Vec<f64>],
+) -> Result<f64> {
     if headings.is_empty() || headings.len() != preds.len() {
         return Err(CompError::BadData(format!(
             "pooled rate needs one prediction per heading ({} headings, {} predictions)",
@@ -383,6 +386,7 @@ pub fn compensation_rate_pooled(headings: &[PodHeading], preds: &[Vec<f64>]) -> 
     }
     let (mut before, mut after) = (0.0, 0.0);
     for (h, pred) in headings.iter().zip(preds) {
+        let h = h.borrow();
         let n = h.total_nt.len() as f64;
         let b = rms(&detrend(&h.total_nt));
         let r = compensation_rate(h, pred)?;

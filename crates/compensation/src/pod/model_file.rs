@@ -3,9 +3,9 @@
 //! and write the same files.
 
 use crate::error::{CompError, Result};
-use crate::model_file::parse_model;
 #[cfg(test)]
 use crate::model_file::MODEL_FORMAT;
+use crate::model_file::parse_model;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::str::FromStr;
@@ -39,7 +39,6 @@ impl PodMethod {
         }
     }
 }
-
 
 impl FromStr for PodMethod {
     type Err = String;
@@ -121,12 +120,25 @@ impl PodSetup {
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(CompError::BadData(m));
         if !(self.cable_length_m.is_finite() && self.cable_length_m > 0.0) {
-            return bad(format!("cable length {} m must be positive", self.cable_length_m));
+            return bad(format!(
+                "cable length {} m must be positive",
+                self.cable_length_m
+            ));
         }
         if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
-            return bad(format!("inclination {}° must be in (−90, 90)", self.inclination_deg));
+            return bad(format!(
+                "inclination {}° must be in (−90, 90)",
+                self.inclination_deg
+            ));
         }
-        if [self.declination_deg, self.grad_north_nt_per_km, self.grad_up_nt_per_km].iter().any(|x| !x.is_finite()) {
+        if [
+            self.declination_deg,
+            self.grad_north_nt_per_km,
+            self.grad_up_nt_per_km,
+        ]
+        .iter()
+        .any(|x| !x.is_finite())
+        {
             return bad("declination and gradients must be finite".into());
         }
         Ok(())
@@ -138,7 +150,8 @@ impl PodModelFile {
     /// fields and [`Self::validate`].
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let m: Self = parse_model(text, origin, POD_KIND, "aeromag pod fit")?;
-        m.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        m.validate()
+            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
         Ok(m)
     }
 
@@ -164,7 +177,10 @@ mod tests {
     fn methods_parse_by_name_and_models_are_checked() {
         for m in PodMethod::ALL {
             assert_eq!(m.name().parse::<PodMethod>().unwrap(), m);
-            assert_eq!(serde_json::to_string(&m).unwrap(), format!("\"{}\"", m.name()));
+            assert_eq!(
+                serde_json::to_string(&m).unwrap(),
+                format!("\"{}\"", m.name())
+            );
         }
         assert!("three-step".parse::<PodMethod>().is_err());
         let setup = PodSetup {
@@ -192,7 +208,10 @@ mod tests {
             software_version: "test".into(),
         };
         m.validate().unwrap();
-        assert_eq!(PodModelFile::from_json(&serde_json::to_string(&m).unwrap(), "p.json").unwrap(), m);
+        assert_eq!(
+            PodModelFile::from_json(&serde_json::to_string(&m).unwrap(), "p.json").unwrap(),
+            m
+        );
         let back: PodModelFile = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
         assert_eq!(back, m);
         let mut bad = m.clone();
@@ -200,6 +219,11 @@ mod tests {
         assert!(bad.validate().is_err());
         let mut bad = m;
         bad.setup.cable_length_m = -1.0;
-        assert!(bad.validate().unwrap_err().to_string().contains("cable length"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("cable length")
+        );
     }
 }

@@ -6,9 +6,9 @@ use super::blade::{FlapAngles, RotorGeometry};
 use super::coning::SlowAngleOptions;
 use super::linear::{RotorFit, RotorFitOptions};
 use crate::error::{CompError, Result};
-use crate::model_file::parse_model;
 #[cfg(test)]
 use crate::model_file::MODEL_FORMAT;
+use crate::model_file::parse_model;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -67,7 +67,8 @@ impl RotorModelFile {
     /// fields and [`Self::validate`].
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let m: Self = parse_model(text, origin, ROTOR_KIND, "aeromag rotor fit")?;
-        m.validate().map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        m.validate()
+            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
         Ok(m)
     }
 
@@ -100,10 +101,17 @@ mod tests {
             kind: ROTOR_KIND.into(),
             geometry,
             nominal_angles: nominal_angles(),
-            model: RotorFit { terms: BladeTerms::Full, params: vec![0.5; n], residual_rms_nt: 0.1 },
+            model: RotorFit {
+                terms: BladeTerms::Full,
+                params: vec![0.5; n],
+                residual_rms_nt: 0.1,
+            },
             fit_options: RotorFitOptions::default(),
             slow_angles: SlowAngleOptions::default(),
-            phase: PhaseSource { column: None, rotor_hz_range: [4.0, 6.0] },
+            phase: PhaseSource {
+                column: None,
+                rotor_hz_range: [4.0, 6.0],
+            },
             sample_rate_hz: 100.0,
             rotor_hz: 4.8,
             coning_mean_deg: 4.0,
@@ -117,16 +125,27 @@ mod tests {
     fn round_trips_and_rejects_what_is_not_a_rotor_model() {
         let m = model();
         m.validate().unwrap();
-        let back: RotorModelFile = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        let back: RotorModelFile =
+            serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
         assert_eq!(back, m);
         let mut wrong = m.clone();
         wrong.kind = "towed-pod".into();
-        let e = RotorModelFile::from_json(&serde_json::to_string(&wrong).unwrap(), "x.json").unwrap_err();
+        let e = RotorModelFile::from_json(&serde_json::to_string(&wrong).unwrap(), "x.json")
+            .unwrap_err();
         assert!(e.to_string().contains("towed-pod"), "{e}");
-        assert_eq!(RotorModelFile::from_json(&serde_json::to_string(&m).unwrap(), "x.json").unwrap(), m);
+        assert_eq!(
+            RotorModelFile::from_json(&serde_json::to_string(&m).unwrap(), "x.json").unwrap(),
+            m
+        );
         let mut short = m.clone();
         short.model.params.pop();
-        assert!(short.validate().unwrap_err().to_string().contains("finite rotor parameters"));
+        assert!(
+            short
+                .validate()
+                .unwrap_err()
+                .to_string()
+                .contains("finite rotor parameters")
+        );
         let mut nan = m;
         nan.model.params[0] = f64::NAN;
         assert!(nan.validate().is_err());

@@ -1,7 +1,7 @@
 //! Building the Tolles-Lawson design matrix over a segment.
 
 use super::eddy_lag::LagBank;
-use super::terms::{derivative, Convention, TermSet};
+use super::terms::{Convention, TermSet, derivative};
 
 /// The design-matrix columns (column-major, `n_columns` vectors of the
 /// segment's length) for the vector-magnetometer series `flux` (nT, body
@@ -41,13 +41,24 @@ fn for_each_row(
     for i in 0..time.len() {
         let d = [db[0][i], db[1][i], db[2][i]];
         let lagged = lags.step(time[i], d);
-        terms.row([flux[0][i], flux[1][i], flux[2][i]], d, lagged, bt_scale_nt, &mut row);
+        terms.row(
+            [flux[0][i], flux[1][i], flux[2][i]],
+            d,
+            lagged,
+            bt_scale_nt,
+            &mut row,
+        );
         f(i, &row);
     }
 }
 
 /// Field derivatives for the eddy columns (zeros when no eddy group is used).
-fn derivatives(terms: &TermSet, convention: Convention, time: &[f64], flux: [&[f64]; 3]) -> [Vec<f64>; 3] {
+fn derivatives(
+    terms: &TermSet,
+    convention: Convention,
+    time: &[f64],
+    flux: [&[f64]; 3],
+) -> [Vec<f64>; 3] {
     if terms.has_eddy() {
         [0, 1, 2].map(|k| derivative(flux[k], time, convention))
     } else {

@@ -67,7 +67,10 @@ pub struct LagBank {
 impl LagBank {
     /// One three-axis lag per `τ` (s).
     pub fn new(taus_s: &[f64]) -> Self {
-        Self { lags: taus_s.iter().map(|&t| [FirstOrderLag::new(t); 3]).collect(), out: vec![[0.0; 3]; taus_s.len()] }
+        Self {
+            lags: taus_s.iter().map(|&t| [FirstOrderLag::new(t); 3]).collect(),
+            out: vec![[0.0; 3]; taus_s.len()],
+        }
     }
 
     /// The lagged derivatives at `t_s` for the derivative `db`, one per `τ`.
@@ -124,7 +127,10 @@ mod tests {
         }
         let m = (n - 2000) as f64 / 2.0;
         let (gain, phase) = ((s * s + c * c).sqrt() / m, (-c).atan2(s));
-        assert!((gain - 1.0 / (1.0 + (w * tau).powi(2)).sqrt()).abs() < 1e-3, "gain {gain}");
+        assert!(
+            (gain - 1.0 / (1.0 + (w * tau).powi(2)).sqrt()).abs() < 1e-3,
+            "gain {gain}"
+        );
         assert!((phase - (w * tau).atan()).abs() < 1e-3, "phase {phase}");
     }
 

@@ -33,10 +33,10 @@
 use super::design::design_columns;
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
-use super::terms::{Convention, TermSet, DEFAULT_BT_SCALE_NT};
+use super::terms::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
-use aeromag_core::filter::{butter, sosfiltfilt_in_place, Band};
+use aeromag_core::filter::{Band, butter, sosfiltfilt_in_place};
 use aeromag_estimation::least_squares::{LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
@@ -99,7 +99,11 @@ impl<'a> Segment<'a> {
     pub fn slice(&self, r: std::ops::Range<usize>) -> Segment<'a> {
         Segment {
             time: &self.time[r.clone()],
-            flux: [&self.flux[0][r.clone()], &self.flux[1][r.clone()], &self.flux[2][r.clone()]],
+            flux: [
+                &self.flux[0][r.clone()],
+                &self.flux[1][r.clone()],
+                &self.flux[2][r.clone()],
+            ],
             mag: &self.mag[r],
         }
     }
@@ -157,9 +161,15 @@ fn for_each_filtered_block(
     mut sink: impl FnMut(&[&[f64]], &[f64]) -> Result<()>,
 ) -> Result<()> {
     let n = seg.time.len();
-    let (keep_lo, keep_hi) = if sos.is_some() { (cfg.trim, n - cfg.trim) } else { (0, n) };
+    let (keep_lo, keep_hi) = if sos.is_some() {
+        (cfg.trim, n - cfg.trim)
+    } else {
+        (0, n)
+    };
     let filter_overlap = match sos {
-        Some(s) => s.settling_samples(BLOCK_TOLERANCE).ok_or_else(|| CompError::BadData("unstable band-pass filter".into()))?,
+        Some(s) => s
+            .settling_samples(BLOCK_TOLERANCE)
+            .ok_or_else(|| CompError::BadData("unstable band-pass filter".into()))?,
         None => 1, // the central-difference derivative needs one neighbour
     };
     // The lagged eddy columns start at rest at each block's first sample:
@@ -201,23 +211,42 @@ fn for_each_filtered_block(
 /// Segment `k`'s sampling interval (s) and band-pass filter, or the warning
 /// that says why it is skipped (no valid time step, too short to filter and
 /// trim); columns of unequal length are an error.
-fn segment_filter(k: usize, seg: &Segment, cfg: &LsConfig) -> Result<std::result::Result<(f64, Option<Sos>), String>> {
+fn segment_filter(
+    k: usize,
+    seg: &Segment,
+    cfg: &LsConfig,
+) -> Result<std::result::Result<(f64, Option<Sos>), String>> {
     let n = seg.time.len();
     if seg.mag.len() != n || seg.flux.iter().any(|f| f.len() != n) {
-        return Err(CompError::BadData(format!("segment {k}: columns of unequal length")));
+        return Err(CompError::BadData(format!(
+            "segment {k}: columns of unequal length"
+        )));
     }
     let dt = median_step(seg.time);
     if !(dt > 0.0) {
-        return Ok(Err(format!("segment {k} ({n} samples) has no valid time step; skipped")));
+        return Ok(Err(format!(
+            "segment {k} ({n} samples) has no valid time step; skipped"
+        )));
     }
     let sos = match cfg.band_hz {
-        Some((lo, hi)) => Some(butter(cfg.filter_order, Band::Bandpass { low_hz: lo, high_hz: hi }, 1.0 / dt)?),
+        Some((lo, hi)) => Some(butter(
+            cfg.filter_order,
+            Band::Bandpass {
+                low_hz: lo,
+                high_hz: hi,
+            },
+            1.0 / dt,
+        )?),
         None => None,
     };
     let ncol = cfg.terms.n_columns();
-    let min_len = sos.as_ref().map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
+    let min_len = sos
+        .as_ref()
+        .map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
     if n < min_len {
-        return Ok(Err(format!("segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped")));
+        return Ok(Err(format!(
+            "segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"
+        )));
     }
     Ok(Ok((dt, sos)))
 }
@@ -225,15 +254,24 @@ fn segment_filter(k: usize, seg: &Segment, cfg: &LsConfig) -> Result<std::result
 /// The band-passed residual `y − A c` of every segment that
 /// [`fit_band_pass_ls`] uses (trimmed like the fit), with its sampling
 /// rate (Hz); segments that are skipped are left out.
-pub(crate) fn band_passed_residuals(segments: &[Segment], cfg: &LsConfig, coef: &[f64]) -> Result<Vec<(Vec<f64>, f64)>> {
+pub(crate) fn band_passed_residuals(
+    segments: &[Segment],
+    cfg: &LsConfig,
+    coef: &[f64],
+) -> Result<Vec<(Vec<f64>, f64)>> {
     validate(cfg)?;
     let ncol = cfg.terms.n_columns();
     if coef.len() != ncol {
-        return Err(CompError::BadData(format!("{} coefficients for {ncol} columns", coef.len())));
+        return Err(CompError::BadData(format!(
+            "{} coefficients for {ncol} columns",
+            coef.len()
+        )));
     }
     let mut out = Vec::new();
     for (k, seg) in segments.iter().enumerate() {
-        let Ok((dt, sos)) = segment_filter(k, seg, cfg)? else { continue };
+        let Ok((dt, sos)) = segment_filter(k, seg, cfg)? else {
+            continue;
+        };
         let mut r = Vec::with_capacity(seg.time.len());
         for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
             for (i, &yi) in y.iter().enumerate() {
@@ -262,13 +300,16 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
             }
         };
         for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
-            ne.add_columns(cols, y).map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
+            ne.add_columns(cols, y)
+                .map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
         })?;
         used += 1;
         fs_used.push(1.0 / dt);
     }
     if used == 0 {
-        return Err(CompError::BadData("no segment is long enough to fit (see the warnings)".into()));
+        return Err(CompError::BadData(
+            "no segment is long enough to fit (see the warnings)".into(),
+        ));
     }
     let independent_fraction = match cfg.band_hz {
         Some((lo, hi)) => {
@@ -302,7 +343,10 @@ pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String>
     let mut w = Vec::new();
     let bad = sol.poorly_determined(max_vif);
     if !bad.is_empty() {
-        let list: Vec<String> = bad.iter().map(|&j| format!("{} (VIF {:.1e})", names[j], sol.vif[j])).collect();
+        let list: Vec<String> = bad
+            .iter()
+            .map(|&j| format!("{} (VIF {:.1e})", names[j], sol.vif[j]))
+            .collect();
         w.push(format!(
             "poorly determined terms: {} — the flight does not separate them from the other terms \
              (fly all four headings with roll, pitch and yaw manoeuvres, or drop these terms)",
@@ -310,14 +354,24 @@ pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String>
         ));
     }
     if sol.is_ill_conditioned() {
-        w.push(format!("the fit is ill-conditioned (scaled condition number {:.2e})", sol.condition));
+        w.push(format!(
+            "the fit is ill-conditioned (scaled condition number {:.2e})",
+            sol.condition
+        ));
     }
     for dir in sol.null_directions(max_vif * 10.0) {
         let mut idx: Vec<usize> = (0..dir.len()).collect();
         idx.sort_by(|&a, &b| dir[b].abs().total_cmp(&dir[a].abs()));
-        let terms: Vec<String> =
-            idx.iter().take(4).filter(|&&j| dir[j].abs() > 0.1).map(|&j| format!("{:+.2}·{}", dir[j], names[j])).collect();
-        w.push(format!("not determined by this flight: the combination {}", terms.join(" ")));
+        let terms: Vec<String> = idx
+            .iter()
+            .take(4)
+            .filter(|&&j| dir[j].abs() > 0.1)
+            .map(|&j| format!("{:+.2}·{}", dir[j], names[j]))
+            .collect();
+        w.push(format!(
+            "not determined by this flight: the combination {}",
+            terms.join(" ")
+        ));
     }
     w
 }
@@ -325,14 +379,22 @@ pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String>
 fn validate(cfg: &LsConfig) -> Result<()> {
     if let Some((lo, hi)) = cfg.band_hz {
         if !(lo > 0.0 && hi > lo && hi.is_finite()) {
-            return Err(CompError::BadData(format!("pass band {lo}–{hi} Hz: need 0 < low < high")));
+            return Err(CompError::BadData(format!(
+                "pass band {lo}–{hi} Hz: need 0 < low < high"
+            )));
         }
     }
     if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
-        return Err(CompError::BadData(format!("bt_scale {} must be positive", cfg.bt_scale_nt)));
+        return Err(CompError::BadData(format!(
+            "bt_scale {} must be positive",
+            cfg.bt_scale_nt
+        )));
     }
     if !(cfg.lambda >= 0.0 && cfg.lambda.is_finite()) {
-        return Err(CompError::BadData(format!("ridge λ = {} must be ≥ 0", cfg.lambda)));
+        return Err(CompError::BadData(format!(
+            "ridge λ = {} must be ≥ 0",
+            cfg.lambda
+        )));
     }
     cfg.terms.validate()
 }
@@ -342,7 +404,9 @@ fn validate(cfg: &LsConfig) -> Result<()> {
 /// Each column is filtered independently, so the result does not depend on
 /// the number of threads.
 fn filter_columns(sos: &Sos, cols: &mut [Vec<f64>]) -> Result<()> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 8);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 8);
     let per = cols.len().div_ceil(threads).max(1);
     std::thread::scope(|scope| {
         let handles: Vec<_> = cols
@@ -358,7 +422,10 @@ fn filter_columns(sos: &Sos, cols: &mut [Vec<f64>]) -> Result<()> {
                 })
             })
             .collect();
-        handles.into_iter().try_for_each(|h| h.join().unwrap_or_else(|_| Err(CompError::BadData("filter thread failed".into()))))
+        handles.into_iter().try_for_each(|h| {
+            h.join()
+                .unwrap_or_else(|_| Err(CompError::BadData("filter thread failed".into())))
+        })
     })
 }
 
@@ -381,7 +448,13 @@ pub(crate) mod tests {
     /// oscillations, Earth field (NED) fixed, interference from `coef`
     /// through the design row itself (a solver test, not a physics test),
     /// plus a slow external variation and white noise.
-    fn leg(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+    fn leg(
+        yaw0: f64,
+        coef: &[f64],
+        terms: &TermSet,
+        t0: f64,
+        maneuvers: bool,
+    ) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
         leg_n(yaw0, coef, terms, t0, maneuvers, 1800)
     }
 
@@ -401,7 +474,11 @@ pub(crate) mod tests {
             let (r, p, y) = if maneuvers {
                 let w = |period: f64, start: f64, amp: f64| {
                     let s = s % 180.0; // the manoeuvre sequence repeats every 180 s
-                    if s >= start && s < start + 50.0 { amp * (std::f64::consts::TAU * (s - start) / period).sin() } else { 0.0 }
+                    if s >= start && s < start + 50.0 {
+                        amp * (std::f64::consts::TAU * (s - start) / period).sin()
+                    } else {
+                        0.0
+                    }
                 };
                 (w(5.0, 10.0, 10.0), w(4.5, 70.0, 5.0), w(5.5, 125.0, 5.0))
             } else {
@@ -414,10 +491,19 @@ pub(crate) mod tests {
             fz.push(b.z);
         }
         let mut mag = Vec::with_capacity(n);
-        let interf = super::super::design::interference(terms, Convention::Physical, DEFAULT_BT_SCALE_NT, coef, &t, [&fx, &fy, &fz]);
+        let interf = super::super::design::interference(
+            terms,
+            Convention::Physical,
+            DEFAULT_BT_SCALE_NT,
+            coef,
+            &t,
+            [&fx, &fy, &fz],
+        );
         let mut noise = 12345u64;
         for (i, interf) in interf.into_iter().enumerate() {
-            noise = noise.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            noise = noise
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let u = ((noise >> 11) as f64 / (1u64 << 53) as f64) - 0.5;
             let bt = (fx[i] * fx[i] + fy[i] * fy[i] + fz[i] * fz[i]).sqrt();
             mag.push(bt + interf + 5.0 * (0.002 * t[i]).sin() + 0.02 * u);
@@ -427,28 +513,53 @@ pub(crate) mod tests {
 
     /// Segments over synthetic legs.
     pub(crate) fn segments_of(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> Vec<Segment<'_>> {
-        legs.iter().map(|(t, f, m)| Segment { time: t, flux: [&f[0], &f[1], &f[2]], mag: m }).collect()
+        legs.iter()
+            .map(|(t, f, m)| Segment {
+                time: t,
+                flux: [&f[0], &f[1], &f[2]],
+                mag: m,
+            })
+            .collect()
     }
 
     pub(crate) fn coef16() -> Vec<f64> {
-        vec![30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0, 2.0, -1.5, 0.5, 1.0, -0.7, 0.3, 1.2, -0.4]
+        vec![
+            30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0, 2.0, -1.5, 0.5, 1.0, -0.7, 0.3, 1.2,
+            -0.4,
+        ]
     }
 
     #[test]
     fn recovers_interference_from_a_four_heading_box() {
         let terms = TermSet::observable16();
         let coef = coef16();
-        let legs: Vec<_> =
-            [0.0, 90.0, 180.0, 270.0].iter().enumerate().map(|(k, h)| leg(*h, &coef, &terms, k as f64 * 1000.0, true)).collect();
-        let segs: Vec<Segment> =
-            segments_of(&legs);
+        let legs: Vec<_> = [0.0, 90.0, 180.0, 270.0]
+            .iter()
+            .enumerate()
+            .map(|(k, h)| leg(*h, &coef, &terms, k as f64 * 1000.0, true))
+            .collect();
+        let segs: Vec<Segment> = segments_of(&legs);
         let fit = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
         assert_eq!(fit.segments_used, 4);
         // Compare the modelled interference (minus its mean) with the truth.
         let (t, f, _) = &legs[1];
         let flux = [f[0].as_slice(), f[1].as_slice(), f[2].as_slice()];
-        let est = super::super::design::interference(&terms, Convention::Physical, DEFAULT_BT_SCALE_NT, &fit.coef, t, flux);
-        let tru = super::super::design::interference(&terms, Convention::Physical, DEFAULT_BT_SCALE_NT, &coef, t, flux);
+        let est = super::super::design::interference(
+            &terms,
+            Convention::Physical,
+            DEFAULT_BT_SCALE_NT,
+            &fit.coef,
+            t,
+            flux,
+        );
+        let tru = super::super::design::interference(
+            &terms,
+            Convention::Physical,
+            DEFAULT_BT_SCALE_NT,
+            &coef,
+            t,
+            flux,
+        );
         let d: Vec<f64> = est.iter().zip(&tru).map(|(a, b)| a - b).collect();
         let m = d.iter().sum::<f64>() / d.len() as f64;
         let rms = (d.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / d.len() as f64).sqrt();
@@ -462,7 +573,11 @@ pub(crate) mod tests {
         let terms = TermSet::observable16();
         let coef = coef16();
         let (t, f, m) = leg(0.0, &coef, &terms, 0.0, false);
-        let seg = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m };
+        let seg = Segment {
+            time: &t,
+            flux: [&f[0], &f[1], &f[2]],
+            mag: &m,
+        };
         match fit_band_pass_ls(&[seg], &LsConfig::default()) {
             Ok(fit) => {
                 let text = fit.warnings.join("\n");
@@ -490,10 +605,16 @@ pub(crate) mod tests {
             .enumerate()
             .map(|(k, h)| leg_n(*h, &coef, &terms, k as f64 * 1000.0, true, 9000))
             .collect();
-        let segs: Vec<Segment> =
-            segments_of(&legs);
+        let segs: Vec<Segment> = segments_of(&legs);
         let whole = fit_band_pass_ls(&segs, &LsConfig::default()).unwrap();
-        let blocked = fit_band_pass_ls(&segs, &LsConfig { block_len: 1000, ..LsConfig::default() }).unwrap();
+        let blocked = fit_band_pass_ls(
+            &segs,
+            &LsConfig {
+                block_len: 1000,
+                ..LsConfig::default()
+            },
+        )
+        .unwrap();
         assert_eq!(whole.rows, blocked.rows);
         for (a, b) in whole.coef.iter().zip(&blocked.coef) {
             assert!((a - b).abs() <= 1e-9 * a.abs().max(1e-3), "{a} vs {b}");
@@ -504,11 +625,23 @@ pub(crate) mod tests {
     fn short_segments_are_skipped_with_a_warning_and_bad_config_rejected() {
         let terms = TermSet::observable16();
         let (t, f, m) = leg(0.0, &coef16(), &terms, 0.0, true);
-        let short = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m }.slice(0..50);
+        let short = Segment {
+            time: &t,
+            flux: [&f[0], &f[1], &f[2]],
+            mag: &m,
+        }
+        .slice(0..50);
         let e = fit_band_pass_ls(&[short], &LsConfig::default()).unwrap_err();
         assert!(e.to_string().contains("no segment"), "{e}");
-        let cfg = LsConfig { band_hz: Some((0.9, 0.1)), ..LsConfig::default() };
-        let seg = Segment { time: &t, flux: [&f[0], &f[1], &f[2]], mag: &m };
+        let cfg = LsConfig {
+            band_hz: Some((0.9, 0.1)),
+            ..LsConfig::default()
+        };
+        let seg = Segment {
+            time: &t,
+            flux: [&f[0], &f[1], &f[2]],
+            mag: &m,
+        };
         assert!(fit_band_pass_ls(&[seg], &cfg).is_err());
     }
 }

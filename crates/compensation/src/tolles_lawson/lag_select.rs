@@ -45,9 +45,9 @@
 //! Cost: `grid × max_lags` least-squares fits (each O(N·n²)); pass
 //! [`within_budget`] segments to bound `N` on long records.
 
-use super::fit_ls::{band_passed_residuals, fit_band_pass_ls, LsConfig, LsFit, Segment};
-use aeromag_core::spectrum::{welch, WelchConfig};
+use super::fit_ls::{LsConfig, LsFit, Segment, band_passed_residuals, fit_band_pass_ls};
 use crate::error::{CompError, Result};
+use aeromag_core::spectrum::{WelchConfig, welch};
 use aeromag_estimation::stats::chi_square_quantile;
 use serde::{Deserialize, Serialize};
 
@@ -118,7 +118,9 @@ pub fn spectral_flatness(residuals: &[(Vec<f64>, f64)], band_hz: (f64, f64)) -> 
         if r.len() < NPERSEG {
             continue;
         }
-        let Ok(psd) = welch(r, &WelchConfig::new(*fs, NPERSEG)) else { continue };
+        let Ok(psd) = welch(r, &WelchConfig::new(*fs, NPERSEG)) else {
+            continue;
+        };
         if sum.is_empty() {
             sum = vec![0.0; psd.values.len()];
             freqs = psd.freqs_hz.clone();
@@ -147,7 +149,11 @@ pub fn spectral_flatness(residuals: &[(Vec<f64>, f64)], band_hz: (f64, f64)) -> 
     let n = inband.len() as f64;
     let mean = inband.iter().sum::<f64>() / n;
     let mean_sq = inband.iter().map(|p| p * p).sum::<f64>() / n;
-    if mean_sq > 0.0 { (mean * mean / mean_sq).min(1.0) } else { 1.0 }
+    if mean_sq > 0.0 {
+        (mean * mean / mean_sq).min(1.0)
+    } else {
+        1.0
+    }
 }
 
 /// Family-wise false-selection probability of each step of
@@ -168,7 +174,11 @@ pub const DEFAULT_SELECTION_BLOCK: usize = 3_000;
 /// evenly over it (a calibration leg flies its manoeuvres one after the
 /// other, so a prefix would hold only the first). Each block is its own
 /// segment (filtered and trimmed on its own).
-pub fn within_budget<'a>(segments: &[Segment<'a>], max_rows: usize, block_rows: usize) -> Vec<Segment<'a>> {
+pub fn within_budget<'a>(
+    segments: &[Segment<'a>],
+    max_rows: usize,
+    block_rows: usize,
+) -> Vec<Segment<'a>> {
     let total: usize = segments.iter().map(|s| s.time.len()).sum();
     if total <= max_rows {
         return segments.to_vec();
@@ -181,7 +191,11 @@ pub fn within_budget<'a>(segments: &[Segment<'a>], max_rows: usize, block_rows: 
         let blocks = share.div_ceil(block_rows.max(1)).max(1);
         let blk = share / blocks;
         for k in 0..blocks {
-            let a = if blocks > 1 { k * (len - blk) / (blocks - 1) } else { (len - blk) / 2 };
+            let a = if blocks > 1 {
+                k * (len - blk) / (blocks - 1)
+            } else {
+                (len - blk) / 2
+            };
             out.push(s.slice(a..a + blk));
         }
     }
@@ -201,9 +215,15 @@ pub fn select_eddy_lags(
 ) -> Result<LagSelection> {
     let threshold = |q: usize| -> Result<f64> {
         let m = grid_s.len().max(1) as f64;
-        chi_square_quantile(1.0 - alpha / m, q as u32).map_err(|e| CompError::BadData(format!("lag selection: {e}")))
+        chi_square_quantile(1.0 - alpha / m, q as u32)
+            .map_err(|e| CompError::BadData(format!("lag selection: {e}")))
     };
-    let with = |taus: &[f64]| -> Result<LsConfig> { Ok(LsConfig { terms: cfg.terms.with_eddy_lags(taus)?, ..cfg.clone() }) };
+    let with = |taus: &[f64]| -> Result<LsConfig> {
+        Ok(LsConfig {
+            terms: cfg.terms.with_eddy_lags(taus)?,
+            ..cfg.clone()
+        })
+    };
     let base = fit_band_pass_ls(segments, &with(&[])?)?;
     let mut chosen: Vec<f64> = Vec::new();
     let mut current = base.clone();
@@ -211,7 +231,10 @@ pub fn select_eddy_lags(
     while chosen.len() < max_lags {
         // The residual the candidates are tested against: its colour sets ν.
         let flatness = match cfg.band_hz {
-            Some(band) => spectral_flatness(&band_passed_residuals(segments, &with(&chosen)?, &current.coef)?, band),
+            Some(band) => spectral_flatness(
+                &band_passed_residuals(segments, &with(&chosen)?, &current.coef)?,
+                band,
+            ),
             None => 1.0,
         };
         let mut best: Option<(f64, f64, f64, LsFit)> = None;
@@ -255,16 +278,27 @@ pub fn select_eddy_lags(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tolles_lawson::fit_ls::tests::{coef16, coef_lag9, leg_n, segments_of};
     use crate::tolles_lawson::TermSet;
+    use crate::tolles_lawson::fit_ls::tests::{coef_lag9, coef16, leg_n, segments_of};
 
     fn boxed(terms: &TermSet, coef: &[f64]) -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
-        [0.0, 90.0, 180.0, 270.0].iter().enumerate().map(|(k, h)| leg_n(*h, coef, terms, k as f64 * 1000.0, true, 1800)).collect()
+        [0.0, 90.0, 180.0, 270.0]
+            .iter()
+            .enumerate()
+            .map(|(k, h)| leg_n(*h, coef, terms, k as f64 * 1000.0, true, 1800))
+            .collect()
     }
 
     fn select(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> LagSelection {
         let segs = segments_of(&legs);
-        select_eddy_lags(&segs, &LsConfig::default(), &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).unwrap()
+        select_eddy_lags(
+            &segs,
+            &LsConfig::default(),
+            &DEFAULT_LAG_GRID_S,
+            2,
+            DEFAULT_ALPHA,
+        )
+        .unwrap()
     }
 
     /// Eddy currents lagging by 0.5 s: the lag is found and the residual
@@ -272,12 +306,21 @@ mod tests {
     #[test]
     fn finds_the_lag_of_lagging_eddy_currents() {
         let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16().into_iter().chain(coef_lag9().into_iter().map(|c| 20.0 * c)).collect();
+        let coef: Vec<f64> = coef16()
+            .into_iter()
+            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
+            .collect();
         let sel = select(&boxed(&truth, &coef));
         assert!(sel.taus_s.contains(&0.5), "{sel:?}");
-        assert!(sel.base_residual_rms_nt > 3.0 * sel.residual_rms_nt, "{sel:?}");
+        assert!(
+            sel.base_residual_rms_nt > 3.0 * sel.residual_rms_nt,
+            "{sel:?}"
+        );
         assert!(sel.residual_rms_nt < 0.004, "{sel:?}");
-        assert_eq!(sel.candidates.iter().filter(|c| c.lags == 1).count(), DEFAULT_LAG_GRID_S.len());
+        assert_eq!(
+            sel.candidates.iter().filter(|c| c.lags == 1).count(),
+            DEFAULT_LAG_GRID_S.len()
+        );
     }
 
     /// Instantaneous eddy currents only: no lag passes the test, the
@@ -287,7 +330,10 @@ mod tests {
         let sel = select(&boxed(&TermSet::observable16(), &coef16()));
         assert!(sel.taus_s.is_empty(), "{sel:?}");
         assert_eq!(sel.residual_rms_nt, sel.base_residual_rms_nt);
-        assert!(sel.candidates.iter().all(|c| c.lr_statistic < c.threshold), "{sel:?}");
+        assert!(
+            sel.candidates.iter().all(|c| c.lr_statistic < c.threshold),
+            "{sel:?}"
+        );
     }
 
     /// The budget samples every segment alike, and the lag is still found
@@ -295,17 +341,39 @@ mod tests {
     #[test]
     fn a_row_budget_cuts_every_segment_alike() {
         let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16().into_iter().chain(coef_lag9().into_iter().map(|c| 20.0 * c)).collect();
+        let coef: Vec<f64> = coef16()
+            .into_iter()
+            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
+            .collect();
         let legs = boxed(&truth, &coef);
         let segs = segments_of(&legs);
         // 4 legs of 1800 rows, a third of each: 4 blocks of 150 rows per leg,
         // spread over the leg (first at its start, last at its end).
         let cut = within_budget(&segs, 2400, 150);
         assert_eq!(cut.len(), 16);
-        assert!(cut.iter().all(|s| s.time.len() == 150 && s.mag.len() == 150 && s.flux[2].len() == 150));
-        assert_eq!((cut[0].time[0], cut[3].time[149]), (segs[0].time[0], segs[0].time[1799]));
-        assert_eq!(within_budget(&segs, 10_000, 150).iter().map(|s| s.time.len()).sum::<usize>(), 7200);
-        let sel = select_eddy_lags(&cut, &LsConfig::default(), &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).unwrap();
+        assert!(
+            cut.iter()
+                .all(|s| s.time.len() == 150 && s.mag.len() == 150 && s.flux[2].len() == 150)
+        );
+        assert_eq!(
+            (cut[0].time[0], cut[3].time[149]),
+            (segs[0].time[0], segs[0].time[1799])
+        );
+        assert_eq!(
+            within_budget(&segs, 10_000, 150)
+                .iter()
+                .map(|s| s.time.len())
+                .sum::<usize>(),
+            7200
+        );
+        let sel = select_eddy_lags(
+            &cut,
+            &LsConfig::default(),
+            &DEFAULT_LAG_GRID_S,
+            2,
+            DEFAULT_ALPHA,
+        )
+        .unwrap();
         assert!(sel.taus_s.contains(&0.5), "{sel:?}");
     }
 
@@ -333,12 +401,18 @@ mod tests {
         let sel = select(&legs);
         // (With the nominal ν, i.e. F = 1, this test took τ = 1 s.)
         assert!(sel.taus_s.is_empty(), "{sel:?}");
-        assert!(sel.candidates.iter().all(|c| c.spectral_flatness < 0.5), "{sel:?}");
+        assert!(
+            sel.candidates.iter().all(|c| c.spectral_flatness < 0.5),
+            "{sel:?}"
+        );
         // Lagging eddy currents are still found under weaker geology. (Under
         // the strong one they are not: the price of the test's caution, and
         // why the Kalman method, which models the geology, matters there.)
         let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16().into_iter().chain(coef_lag9().into_iter().map(|c| 20.0 * c)).collect();
+        let coef: Vec<f64> = coef16()
+            .into_iter()
+            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
+            .collect();
         let mut legs = boxed(&truth, &coef);
         geology(&mut legs, 0.1);
         let sel = select(&legs);
@@ -354,17 +428,26 @@ mod tests {
         let white: Vec<f64> = (0..4000).map(|_| u.sample(&mut rng)).collect();
         let f = spectral_flatness(&[(white.clone(), 10.0)], (0.1, 0.9));
         assert!(f > 0.85 && f <= 1.0, "white {f}");
-        let tone: Vec<f64> = (0..4000).map(|i| (std::f64::consts::TAU * 0.3 * i as f64 / 10.0).sin() + 0.01 * white[i]).collect();
+        let tone: Vec<f64> = (0..4000)
+            .map(|i| (std::f64::consts::TAU * 0.3 * i as f64 / 10.0).sin() + 0.01 * white[i])
+            .collect();
         let f = spectral_flatness(&[(tone, 10.0)], (0.1, 0.9));
         assert!(f < 0.2, "tone {f}");
-        assert_eq!(spectral_flatness(&[(vec![1.0; 100], 10.0)], (0.1, 0.9)), 1.0, "too short: no estimate");
+        assert_eq!(
+            spectral_flatness(&[(vec![1.0; 100], 10.0)], (0.1, 0.9)),
+            1.0,
+            "too short: no estimate"
+        );
     }
 
     #[test]
     fn needs_an_eddy_group() {
         let legs = boxed(&TermSet::observable16(), &coef16());
         let segs = segments_of(&legs);
-        let cfg = LsConfig { terms: TermSet::parse("p3,i5").unwrap(), ..LsConfig::default() };
+        let cfg = LsConfig {
+            terms: TermSet::parse("p3,i5").unwrap(),
+            ..LsConfig::default()
+        };
         assert!(select_eddy_lags(&segs, &cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).is_err());
     }
 }

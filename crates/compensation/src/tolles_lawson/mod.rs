@@ -7,4 +7,4 @@ pub mod lag_select;
 pub mod segments;
 pub mod terms;
 
-pub use terms::{Convention, TermGroup, TermSet, DEFAULT_BT_SCALE_NT};
+pub use terms::{Convention, DEFAULT_BT_SCALE_NT, TermGroup, TermSet};

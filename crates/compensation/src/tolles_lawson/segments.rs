@@ -20,7 +20,11 @@ pub fn split_segments(
 ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
     let n = time.len();
     let dt = median_step(time);
-    let max_gap = if dt > 0.0 { dt * max_gap_factor } else { f64::INFINITY };
+    let max_gap = if dt > 0.0 {
+        dt * max_gap_factor
+    } else {
+        f64::INFINITY
+    };
     let same_line = |a: usize, b: usize| match line {
         Some(l) => l[a] == l[b] || (l[a].is_nan() && l[b].is_nan()),
         None => true,
@@ -38,14 +42,22 @@ pub fn split_segments(
         while i < n && usable[i] && same_line(i - 1, i) && (time[i] - time[i - 1]) <= max_gap {
             i += 1;
         }
-        if i - start >= min_len { kept.push(start..i) } else { short.push(start..i) }
+        if i - start >= min_len {
+            kept.push(start..i)
+        } else {
+            short.push(start..i)
+        }
     }
     (kept, short)
 }
 
 /// Median of the positive finite time steps, s (0 if there are none).
 pub fn median_step(time: &[f64]) -> f64 {
-    let mut d: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).filter(|v| *v > 0.0 && v.is_finite()).collect();
+    let mut d: Vec<f64> = time
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .collect();
     if d.is_empty() {
         return 0.0;
     }

@@ -120,7 +120,9 @@ impl std::str::FromStr for Convention {
         match s.trim().to_ascii_lowercase().as_str() {
             "physical" => Ok(Convention::Physical),
             "magnav" => Ok(Convention::MagNav),
-            o => Err(CompError::InvalidTerms(format!("unknown derivative convention `{o}` (physical or magnav)"))),
+            o => Err(CompError::InvalidTerms(format!(
+                "unknown derivative convention `{o}` (physical or magnav)"
+            ))),
         }
     }
 }
@@ -142,12 +144,18 @@ const PAIRS6: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2,
 impl TermSet {
     /// The thesis' 16 observable parameters: `p3, i5, e8`.
     pub fn observable16() -> Self {
-        Self { groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8], eddy_lags_s: Vec::new() }
+        Self {
+            groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8],
+            eddy_lags_s: Vec::new(),
+        }
     }
 
     /// All 18 classical terms `p3, i6, e9` (two near-collinearities).
     pub fn full18() -> Self {
-        Self { groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9], eddy_lags_s: Vec::new() }
+        Self {
+            groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9],
+            eddy_lags_s: Vec::new(),
+        }
     }
 
     /// A set from groups; sorted into the canonical order. Rejects an empty
@@ -166,30 +174,50 @@ impl TermSet {
         if g.contains(&TermGroup::E9) && g.contains(&TermGroup::E8) {
             return Err(CompError::InvalidTerms("choose one of e9 and e8".into()));
         }
-        Ok(Self { groups: g, eddy_lags_s: Vec::new() })
+        Ok(Self {
+            groups: g,
+            eddy_lags_s: Vec::new(),
+        })
     }
 
     /// This set with the lagged eddy group `l9` for the lags `taus_s` (s,
     /// each finite and > 0; sorted, duplicates removed). An empty `taus_s`
     /// removes the lagged group. Errors without an eddy group (`e8`/`e9`).
     pub fn with_eddy_lags(&self, taus_s: &[f64]) -> Result<Self> {
-        let mut groups: Vec<TermGroup> =
-            self.groups.iter().copied().filter(|g| *g != TermGroup::L9).collect();
+        let mut groups: Vec<TermGroup> = self
+            .groups
+            .iter()
+            .copied()
+            .filter(|g| *g != TermGroup::L9)
+            .collect();
         if taus_s.is_empty() {
-            return Ok(Self { groups, eddy_lags_s: Vec::new() });
+            return Ok(Self {
+                groups,
+                eddy_lags_s: Vec::new(),
+            });
         }
         if let Some(t) = taus_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(CompError::InvalidTerms(format!("eddy-current lag {t} s: must be finite and > 0")));
+            return Err(CompError::InvalidTerms(format!(
+                "eddy-current lag {t} s: must be finite and > 0"
+            )));
         }
-        if !groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8)) {
-            return Err(CompError::InvalidTerms("eddy-current lags need an eddy group (e8 or e9)".into()));
+        if !groups
+            .iter()
+            .any(|g| matches!(g, TermGroup::E9 | TermGroup::E8))
+        {
+            return Err(CompError::InvalidTerms(
+                "eddy-current lags need an eddy group (e8 or e9)".into(),
+            ));
         }
         groups.push(TermGroup::L9);
         groups.sort();
         let mut taus = taus_s.to_vec();
         taus.sort_by(f64::total_cmp);
         taus.dedup();
-        Ok(Self { groups, eddy_lags_s: taus })
+        Ok(Self {
+            groups,
+            eddy_lags_s: taus,
+        })
     }
 
     /// The lags `τ` (s) of the lagged eddy groups (empty without them).
@@ -200,17 +228,29 @@ impl TermSet {
     /// Check the lags against the groups (a set read from a file).
     pub fn validate(&self) -> Result<()> {
         if self.groups.contains(&TermGroup::L9) == self.eddy_lags_s.is_empty() {
-            return Err(CompError::InvalidTerms("the lagged eddy group l9 and the eddy lags must be given together".into()));
+            return Err(CompError::InvalidTerms(
+                "the lagged eddy group l9 and the eddy lags must be given together".into(),
+            ));
         }
-        if let Some(t) = self.eddy_lags_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(CompError::InvalidTerms(format!("eddy-current lag {t} s: must be finite and > 0")));
+        if let Some(t) = self
+            .eddy_lags_s
+            .iter()
+            .find(|t| !(t.is_finite() && **t > 0.0))
+        {
+            return Err(CompError::InvalidTerms(format!(
+                "eddy-current lag {t} s: must be finite and > 0"
+            )));
         }
         Ok(())
     }
 
     /// Parse a comma-separated list such as `p3,i5,e8,bias`.
     pub fn parse(s: &str) -> Result<Self> {
-        let groups = s.split(',').filter(|t| !t.trim().is_empty()).map(TermGroup::parse).collect::<Result<Vec<_>>>()?;
+        let groups = s
+            .split(',')
+            .filter(|t| !t.trim().is_empty())
+            .map(TermGroup::parse)
+            .collect::<Result<Vec<_>>>()?;
         Self::new(&groups)
     }
 
@@ -221,7 +261,9 @@ impl TermSet {
 
     /// Whether any eddy-current group is present (needs derivatives).
     pub fn has_eddy(&self) -> bool {
-        self.groups.iter().any(|g| matches!(g, TermGroup::E9 | TermGroup::E8 | TermGroup::L9))
+        self.groups
+            .iter()
+            .any(|g| matches!(g, TermGroup::E9 | TermGroup::E8 | TermGroup::L9))
     }
 
     /// Column names, e.g. `p_x`, `i_xy`, `e_zy`, `bias`, in column order.
@@ -232,7 +274,11 @@ impl TermSet {
                 TermGroup::P3 => names.extend(XYZ.iter().map(|a| format!("p_{a}"))),
                 TermGroup::I6 | TermGroup::I5 => {
                     let n = if *g == TermGroup::I6 { 6 } else { 5 };
-                    names.extend(PAIRS6[..n].iter().map(|&(i, j)| format!("i_{}{}", XYZ[i], XYZ[j])));
+                    names.extend(
+                        PAIRS6[..n]
+                            .iter()
+                            .map(|&(i, j)| format!("i_{}{}", XYZ[i], XYZ[j])),
+                    );
                 }
                 TermGroup::E9 | TermGroup::E8 => {
                     let n = if *g == TermGroup::E9 { 9 } else { 8 };
@@ -242,7 +288,9 @@ impl TermSet {
                     let many = self.eddy_lags_s.len() > 1;
                     for lag in 1..=self.eddy_lags_s.len() {
                         let prefix = if many { format!("l{lag}") } else { "l".into() };
-                        names.extend((0..9).map(|k| format!("{prefix}_{}{}", XYZ[k / 3], XYZ[k % 3])));
+                        names.extend(
+                            (0..9).map(|k| format!("{prefix}_{}{}", XYZ[k / 3], XYZ[k % 3])),
+                        );
                     }
                 }
                 TermGroup::Bias => names.push("bias".into()),
@@ -269,7 +317,11 @@ impl TermSet {
 
     /// Comma-separated names, e.g. `p3,i5,e8`.
     pub fn to_spec_string(&self) -> String {
-        self.groups.iter().map(|g| g.name()).collect::<Vec<_>>().join(",")
+        self.groups
+            .iter()
+            .map(|g| g.name())
+            .collect::<Vec<_>>()
+            .join(",")
     }
 
     /// One design-matrix row into `out` (length [`TermSet::n_columns`]) from
@@ -277,7 +329,14 @@ impl TermSet {
     /// the convention) and the lagged derivatives `lagged[k] = L_τk[db]`, one
     /// per [`TermSet::eddy_lags_s`] (missing ones give NaN columns).
     /// Non-finite inputs give non-finite rows, never a panic.
-    pub fn row(&self, b: [f64; 3], db: [f64; 3], lagged: &[[f64; 3]], bt_scale: f64, out: &mut [f64]) {
+    pub fn row(
+        &self,
+        b: [f64; 3],
+        db: [f64; 3],
+        lagged: &[[f64; 3]],
+        bt_scale: f64,
+        out: &mut [f64],
+    ) {
         let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
         let e = [b[0] / bt, b[1] / bt, b[2] / bt];
         let mut k = 0;
@@ -397,12 +456,22 @@ mod tests {
 
     #[test]
     fn lagged_groups() {
-        let t = TermSet::observable16().with_eddy_lags(&[0.8, 0.2, 0.8]).unwrap();
+        let t = TermSet::observable16()
+            .with_eddy_lags(&[0.8, 0.2, 0.8])
+            .unwrap();
         assert_eq!(t.eddy_lags_s(), &[0.2, 0.8]);
         assert_eq!(t.to_spec_string(), "p3,i5,e8,l9");
         assert_eq!(t.n_columns(), 16 + 18);
         let names = t.column_names();
-        assert_eq!((names[16].as_str(), names[24].as_str(), names[25].as_str(), names[33].as_str()), ("l1_xx", "l1_zz", "l2_xx", "l2_zz"));
+        assert_eq!(
+            (
+                names[16].as_str(),
+                names[24].as_str(),
+                names[25].as_str(),
+                names[33].as_str()
+            ),
+            ("l1_xx", "l1_zz", "l2_xx", "l2_zz")
+        );
         let one = TermSet::full18().with_eddy_lags(&[0.3]).unwrap();
         assert_eq!(one.column_names()[18], "l_xx");
         assert_eq!(one.with_eddy_lags(&[]).unwrap(), TermSet::full18());
@@ -410,29 +479,53 @@ mod tests {
         let b: [f64; 3] = [20_000.0, -3_000.0, 45_000.0];
         let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
         let mut row = vec![0.0; one.n_columns()];
-        one.row(b, [1.0, 2.0, 3.0], &[[0.5, -0.25, 2.0]], DEFAULT_BT_SCALE_NT, &mut row);
+        one.row(
+            b,
+            [1.0, 2.0, 3.0],
+            &[[0.5, -0.25, 2.0]],
+            DEFAULT_BT_SCALE_NT,
+            &mut row,
+        );
         assert!((row[18 + 5] - b[1] / bt * 2.0 / DEFAULT_BT_SCALE_NT).abs() < 1e-18);
         one.row(b, [1.0, 2.0, 3.0], &[], DEFAULT_BT_SCALE_NT, &mut row);
         assert!(row[18..].iter().all(|v| v.is_nan()) && row[..18].iter().all(|v| v.is_finite()));
         // Bad lags and sets.
-        assert!(TermSet::parse("p3,i5").unwrap().with_eddy_lags(&[0.3]).is_err());
+        assert!(
+            TermSet::parse("p3,i5")
+                .unwrap()
+                .with_eddy_lags(&[0.3])
+                .is_err()
+        );
         assert!(TermSet::observable16().with_eddy_lags(&[0.0]).is_err());
         assert!(TermSet::observable16().with_eddy_lags(&[f64::NAN]).is_err());
         assert!(TermSet::parse("p3,e8,l9").unwrap().validate().is_err());
         assert!(t.validate().is_ok());
         // Serialised with its lags; a set without lags stays as before.
         let json = serde_json::to_string(&t).unwrap();
-        assert_eq!(json, r#"{"groups":["p3","i5","e8","l9"],"eddy_lags_s":[0.2,0.8]}"#);
+        assert_eq!(
+            json,
+            r#"{"groups":["p3","i5","e8","l9"],"eddy_lags_s":[0.2,0.8]}"#
+        );
         assert_eq!(serde_json::from_str::<TermSet>(&json).unwrap(), t);
-        assert_eq!(serde_json::to_string(&TermSet::observable16()).unwrap(), r#"{"groups":["p3","i5","e8"]}"#);
+        assert_eq!(
+            serde_json::to_string(&TermSet::observable16()).unwrap(),
+            r#"{"groups":["p3","i5","e8"]}"#
+        );
     }
 
     #[test]
     fn derivative_conventions() {
         let t = [0.0, 0.1, 0.2, 0.3];
         let x = [0.0, 1.0, 4.0, 9.0];
-        assert_eq!(derivative(&x, &t, Convention::MagNav), vec![1.0, 2.0, 4.0, 5.0]);
+        assert_eq!(
+            derivative(&x, &t, Convention::MagNav),
+            vec![1.0, 2.0, 4.0, 5.0]
+        );
         let p = derivative(&x, &t, Convention::Physical);
-        assert!((p[1] - 20.0).abs() < 1e-12 && (p[0] - 10.0).abs() < 1e-12 && (p[3] - 50.0).abs() < 1e-9);
+        assert!(
+            (p[1] - 20.0).abs() < 1e-12
+                && (p[0] - 10.0).abs() < 1e-12
+                && (p[3] - 50.0).abs() < 1e-9
+        );
     }
 }

@@ -65,7 +65,11 @@ pub fn dipole_gradient(m: &Vector3<f64>, r: &Vector3<f64>) -> Matrix3<f64> {
 /// `b_total` (T) whose gradient tensor is `g` (T/m). Zero when `|B| = 0`.
 pub fn modulus_gradient(b_total: &Vector3<f64>, g: &Matrix3<f64>) -> Vector3<f64> {
     let n = b_total.norm();
-    if n == 0.0 { Vector3::zeros() } else { g * b_total / n }
+    if n == 0.0 {
+        Vector3::zeros()
+    } else {
+        g * b_total / n
+    }
 }
 
 #[cfg(test)]

@@ -90,7 +90,11 @@ impl Sos {
             .map(|s| {
                 let (a1, a2) = (s[4], s[5]);
                 let disc = a1 * a1 - 4.0 * a2;
-                if disc < 0.0 { a2.sqrt() } else { (a1.abs() + disc.sqrt()) / 2.0 }
+                if disc < 0.0 {
+                    a2.sqrt()
+                } else {
+                    (a1.abs() + disc.sqrt()) / 2.0
+                }
             })
             .fold(0.0, f64::max)
     }

@@ -34,7 +34,11 @@ impl Attitude {
 
     /// Attitude from angles in degrees.
     pub fn from_degrees(roll_deg: f64, pitch_deg: f64, yaw_deg: f64) -> Self {
-        Self::new(roll_deg.to_radians(), pitch_deg.to_radians(), yaw_deg.to_radians())
+        Self::new(
+            roll_deg.to_radians(),
+            pitch_deg.to_radians(),
+            yaw_deg.to_radians(),
+        )
     }
 
     /// `C_nb`: rotates body-frame vectors into NED, `v_n = C_nb v_b`.

@@ -30,7 +30,10 @@ mod tests {
         let a = blade_axes(0.7, 0.05);
         assert!((a * a.transpose() - Matrix3::identity()).norm() < 1e-14);
         assert!((a.determinant() + 1.0).abs() < 1e-14);
-        assert!(blade_axes(0.0, 0.0).column(2)[2] < -0.99, "e_u is up (−z) for a level blade");
+        assert!(
+            blade_axes(0.0, 0.0).column(2)[2] < -0.99,
+            "e_u is up (−z) for a level blade"
+        );
         assert!(a[(2, 0)] < 0.0, "a positive flap points the blade up (−z)");
     }
 }

@@ -31,7 +31,11 @@ pub struct Geocentric {
 impl Geodetic {
     /// Position from degrees and metres.
     pub fn new(lat_deg: f64, lon_deg: f64, alt_m: f64) -> Self {
-        Self { lat_deg, lon_deg, alt_m }
+        Self {
+            lat_deg,
+            lon_deg,
+            alt_m,
+        }
     }
 
     /// Earth-centred Earth-fixed Cartesian coordinates, m.
@@ -51,7 +55,11 @@ impl Geodetic {
     pub fn to_geocentric(&self) -> Geocentric {
         let [x, y, z] = self.to_ecef();
         let p = x.hypot(y);
-        Geocentric { r_m: p.hypot(z), colat_rad: p.atan2(z), lon_rad: self.lon_deg.to_radians() }
+        Geocentric {
+            r_m: p.hypot(z),
+            colat_rad: p.atan2(z),
+            lon_rad: self.lon_deg.to_radians(),
+        }
     }
 
     /// Angle ψ = (geodetic latitude − geocentric latitude), rad. A vector with

@@ -72,7 +72,12 @@ pub const ILL_CONDITIONED: f64 = 1e7;
 impl NormalEquations {
     /// Empty accumulator for `n` unknowns.
     pub fn new(n: usize) -> Self {
-        Self { ata: DMatrix::zeros(n, n), aty: DVector::zeros(n), yty: 0.0, rows: 0 }
+        Self {
+            ata: DMatrix::zeros(n, n),
+            aty: DVector::zeros(n),
+            yty: 0.0,
+            rows: 0,
+        }
     }
 
     /// Number of unknowns.
@@ -90,10 +95,15 @@ impl NormalEquations {
     pub fn add_row(&mut self, a: &[f64], y: f64, w: f64) -> Result<()> {
         let n = self.n();
         if a.len() != n {
-            return Err(EstError::Dimension(format!("row of length {} for {n} unknowns", a.len())));
+            return Err(EstError::Dimension(format!(
+                "row of length {} for {n} unknowns",
+                a.len()
+            )));
         }
         if !y.is_finite() || !w.is_finite() || a.iter().any(|v| !v.is_finite()) {
-            return Err(EstError::NonFinite { what: "least-squares row" });
+            return Err(EstError::NonFinite {
+                what: "least-squares row",
+            });
         }
         // Upper triangle only; mirrored in `solve`.
         for i in 0..n {
@@ -113,14 +123,21 @@ impl NormalEquations {
     pub fn add_columns(&mut self, columns: &[&[f64]], y: &[f64]) -> Result<()> {
         let n = self.n();
         if columns.len() != n {
-            return Err(EstError::Dimension(format!("{} columns for {n} unknowns", columns.len())));
+            return Err(EstError::Dimension(format!(
+                "{} columns for {n} unknowns",
+                columns.len()
+            )));
         }
         let m = y.len();
         if columns.iter().any(|c| c.len() != m) {
             return Err(EstError::Dimension("columns of unequal length".into()));
         }
-        if y.iter().any(|v| !v.is_finite()) || columns.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-            return Err(EstError::NonFinite { what: "least-squares block" });
+        if y.iter().any(|v| !v.is_finite())
+            || columns.iter().any(|c| c.iter().any(|v| !v.is_finite()))
+        {
+            return Err(EstError::NonFinite {
+                what: "least-squares block",
+            });
         }
         for i in 0..n {
             let ci = columns[i];
@@ -137,7 +154,9 @@ impl NormalEquations {
     /// Merge another accumulator (e.g. from another segment or thread).
     pub fn merge(&mut self, other: &NormalEquations) -> Result<()> {
         if other.n() != self.n() {
-            return Err(EstError::Dimension("merging accumulators of different size".into()));
+            return Err(EstError::Dimension(
+                "merging accumulators of different size".into(),
+            ));
         }
         self.ata += &other.ata;
         self.aty += &other.aty;
@@ -169,10 +188,15 @@ impl NormalEquations {
     pub fn solve_with_dof(&self, lambda: f64, effective_rows: f64) -> Result<LsSolution> {
         let n = self.n();
         if !(lambda >= 0.0 && lambda.is_finite()) {
-            return Err(EstError::Dimension(format!("ridge parameter {lambda} must be finite and ≥ 0")));
+            return Err(EstError::Dimension(format!(
+                "ridge parameter {lambda} must be finite and ≥ 0"
+            )));
         }
         if self.rows < n || n == 0 {
-            return Err(EstError::Underdetermined { rows: self.rows, unknowns: n });
+            return Err(EstError::Underdetermined {
+                rows: self.rows,
+                unknowns: n,
+            });
         }
         let ata = self.ata();
         // Equilibration; a zero column gets scale 1 (it is then exactly singular).
@@ -186,14 +210,20 @@ impl NormalEquations {
         let v = DMatrix::from_fn(n, n, |i, j| eig.eigenvectors[(i, order[j])]);
         let wmax = w[n - 1].max(f64::MIN_POSITIVE);
         let wmin = w[0];
-        let condition = if wmin > 0.0 { wmax / wmin } else { f64::INFINITY };
+        let condition = if wmin > 0.0 {
+            wmax / wmin
+        } else {
+            f64::INFINITY
+        };
 
         // Ridge in scaled units: S + λ D⁻².
         let ridge = DMatrix::from_diagonal(&d.map(|di| lambda / (di * di)));
         let s_reg = &s + ridge;
         let rhs = DVector::from_fn(n, |i, _| self.aty[i] / d[i]);
         let inv_reg = symmetric_inverse(&s_reg).ok_or_else(|| {
-            EstError::Singular(format!("normal matrix is singular (scaled condition number {condition:.3e})"))
+            EstError::Singular(format!(
+                "normal matrix is singular (scaled condition number {condition:.3e})"
+            ))
         })?;
         let u = &inv_reg * &rhs;
         let coef = DVector::from_fn(n, |i, _| u[i] / d[i]);
@@ -210,7 +240,17 @@ impl NormalEquations {
             Some(si) => si.diagonal(),
             None => DVector::from_element(n, f64::INFINITY),
         };
-        Ok(LsSolution { coef, std, rss, sigma2, condition, vif, eigenvalues: w, eigenvectors: v, rows: self.rows })
+        Ok(LsSolution {
+            coef,
+            std,
+            rss,
+            sigma2,
+            condition,
+            vif,
+            eigenvalues: w,
+            eigenvectors: v,
+            rows: self.rows,
+        })
     }
 }
 
@@ -223,7 +263,9 @@ impl LsSolution {
     /// Indices of unknowns whose variance inflation factor exceeds `max_vif`
     /// (e.g. 1e4: the unknown is largely a combination of the others).
     pub fn poorly_determined(&self, max_vif: f64) -> Vec<usize> {
-        (0..self.vif.len()).filter(|&j| !(self.vif[j] <= max_vif)).collect()
+        (0..self.vif.len())
+            .filter(|&j| !(self.vif[j] <= max_vif))
+            .collect()
     }
 
     /// The near-null directions: for each eigenvalue of the scaled normal
@@ -244,7 +286,11 @@ impl LsSolution {
 fn symmetric_inverse(m: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let ch = m.clone().cholesky()?;
     let inv = ch.inverse();
-    if inv.iter().all(|v| v.is_finite()) { Some(inv) } else { None }
+    if inv.iter().all(|v| v.is_finite()) {
+        Some(inv)
+    } else {
+        None
+    }
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -275,10 +321,17 @@ mod tests {
         let nd = Normal::new(0.0, 1.0).unwrap();
         let truth = vec![1.5, -2.0, 0.25, 1e-3];
         let scales = [1.0, 1e3, 1e-2, 1e4];
-        let cols: Vec<Vec<f64>> =
-            (0..4).map(|j| (0..n_rows).map(|_| nd.sample(&mut rng) * scales[j]).collect()).collect();
+        let cols: Vec<Vec<f64>> = (0..4)
+            .map(|j| {
+                (0..n_rows)
+                    .map(|_| nd.sample(&mut rng) * scales[j])
+                    .collect()
+            })
+            .collect();
         let y = (0..n_rows)
-            .map(|k| (0..4).map(|j| cols[j][k] * truth[j]).sum::<f64>() + 0.01 * nd.sample(&mut rng))
+            .map(|k| {
+                (0..4).map(|j| cols[j][k] * truth[j]).sum::<f64>() + 0.01 * nd.sample(&mut rng)
+            })
             .collect();
         (cols, y, truth)
     }
@@ -309,11 +362,21 @@ mod tests {
         }
         let mut b = NormalEquations::new(4);
         let mut c = NormalEquations::new(4);
-        let half = |r: std::ops::Range<usize>| -> Vec<Vec<f64>> { cols.iter().map(|cc| cc[r.clone()].to_vec()).collect() };
+        let half = |r: std::ops::Range<usize>| -> Vec<Vec<f64>> {
+            cols.iter().map(|cc| cc[r.clone()].to_vec()).collect()
+        };
         let h1 = half(0..150);
         let h2 = half(150..300);
-        b.add_columns(&h1.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y[..150]).unwrap();
-        c.add_columns(&h2.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y[150..]).unwrap();
+        b.add_columns(
+            &h1.iter().map(|c| c.as_slice()).collect::<Vec<_>>(),
+            &y[..150],
+        )
+        .unwrap();
+        c.add_columns(
+            &h2.iter().map(|c| c.as_slice()).collect::<Vec<_>>(),
+            &y[150..],
+        )
+        .unwrap();
         b.merge(&c).unwrap();
         let sa = a.solve(0.5).unwrap();
         let sb = b.solve(0.5).unwrap();
@@ -326,14 +389,21 @@ mod tests {
     fn ridge_matches_direct_formula() {
         let (cols, y, _) = problem(200, 3);
         let mut ne = NormalEquations::new(4);
-        ne.add_columns(&cols.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y).unwrap();
+        ne.add_columns(&cols.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y)
+            .unwrap();
         let lambda = 7.0;
         let s = ne.solve(lambda).unwrap();
         let a = DMatrix::from_fn(200, 4, |i, j| cols[j][i]);
         let yv = DVector::from_column_slice(&y);
-        let direct = (a.transpose() * &a + DMatrix::identity(4, 4) * lambda).lu().solve(&(a.transpose() * yv)).unwrap();
+        let direct = (a.transpose() * &a + DMatrix::identity(4, 4) * lambda)
+            .lu()
+            .solve(&(a.transpose() * yv))
+            .unwrap();
         for j in 0..4 {
-            assert!((s.coef[j] - direct[j]).abs() <= 1e-9 * direct[j].abs().max(1e-9), "{j}");
+            assert!(
+                (s.coef[j] - direct[j]).abs() <= 1e-9 * direct[j].abs().max(1e-9),
+                "{j}"
+            );
         }
     }
 
@@ -341,9 +411,14 @@ mod tests {
     fn collinear_columns_are_reported() {
         let (mut cols, y, _) = problem(400, 4);
         // Column 3 = column 0 + tiny noise: nearly collinear.
-        cols[3] = cols[0].iter().enumerate().map(|(k, v)| v + 1e-7 * ((k % 7) as f64 - 3.0)).collect();
+        cols[3] = cols[0]
+            .iter()
+            .enumerate()
+            .map(|(k, v)| v + 1e-7 * ((k % 7) as f64 - 3.0))
+            .collect();
         let mut ne = NormalEquations::new(4);
-        ne.add_columns(&cols.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y).unwrap();
+        ne.add_columns(&cols.iter().map(|c| c.as_slice()).collect::<Vec<_>>(), &y)
+            .unwrap();
         let s = ne.solve(0.0).unwrap();
         assert!(s.is_ill_conditioned());
         let bad = s.poorly_determined(1e4);
@@ -359,7 +434,10 @@ mod tests {
         assert!(ne.add_row(&[1.0], 1.0, 1.0).is_err());
         assert!(ne.add_row(&[1.0, f64::NAN], 1.0, 1.0).is_err());
         ne.add_row(&[1.0, 2.0], 1.0, 1.0).unwrap();
-        assert!(matches!(ne.solve(0.0), Err(EstError::Underdetermined { .. })));
+        assert!(matches!(
+            ne.solve(0.0),
+            Err(EstError::Underdetermined { .. })
+        ));
         assert!(ne.solve(-1.0).is_err());
     }
 }

@@ -31,10 +31,14 @@ fn ln_gamma_half(k: u32) -> f64 {
 /// freedom. Errors for `dof = 0` or a non-finite `x`.
 pub fn chi_square_cdf(x: f64, dof: u32) -> Result<f64> {
     if dof == 0 {
-        return Err(EstError::Dimension("chi-square with 0 degrees of freedom".into()));
+        return Err(EstError::Dimension(
+            "chi-square with 0 degrees of freedom".into(),
+        ));
     }
     if !x.is_finite() {
-        return Err(EstError::NonFinite { what: "chi-square argument" });
+        return Err(EstError::NonFinite {
+            what: "chi-square argument",
+        });
     }
     if x <= 0.0 {
         return Ok(0.0);
@@ -54,7 +58,9 @@ pub fn chi_square_cdf(x: f64, dof: u32) -> Result<f64> {
 /// degrees of freedom: the `x` with `P(X ≤ x) = p`.
 pub fn chi_square_quantile(p: f64, dof: u32) -> Result<f64> {
     if !(p > 0.0 && p < 1.0) {
-        return Err(EstError::Dimension(format!("probability {p} outside (0, 1)")));
+        return Err(EstError::Dimension(format!(
+            "probability {p} outside (0, 1)"
+        )));
     }
     let k = dof as f64;
     let (mut lo, mut hi) = (0.0, k.max(1.0));
@@ -92,7 +98,10 @@ mod tests {
         ] {
             let q = chi_square_quantile(p, k).unwrap();
             assert!((q - x).abs() < 1e-10 * x, "k {k} p {p}: {q} vs {x}");
-            assert!((chi_square_cdf(x, k).unwrap() - p).abs() < 1e-12, "cdf k {k}");
+            assert!(
+                (chi_square_cdf(x, k).unwrap() - p).abs() < 1e-12,
+                "cdf k {k}"
+            );
         }
     }
 

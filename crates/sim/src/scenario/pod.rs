@@ -162,6 +162,18 @@ pub struct PodConfig {
 /// The default dipole array: engine/gearbox, tail boom, cabin equipment and
 /// landing gear of a medium helicopter (moments of 10³ A·m², so that the
 /// interference at the pod, ≈ 38 m away, is a few nT).
+///
+/// Eddy currents: `ε` up to 0.016 A·m²/(nT/s), so a 5° manoeuvre at 0.1 Hz
+/// (`dB/dt` ≈ 3000 nT/s) drives eddy moments of ≈ 50 A·m², a few per cent
+/// of the permanent ones. This gives the step-1 heading coefficients of the
+/// seed's two-step solve the eddy-to-attitude ratio of the seed's Table 1
+/// (`rms(W3, W4)/rms(W1, W2)` ≈ 0.25 s). It is a generous value: a
+/// seamless aluminium shell (σ = 1.7·10⁷ S/m, 1.5 mm skin, radius 1 m,
+/// length 8 m) has `m = σ d π a³ ℓ/2 · dB/dt` ≈ 3·10⁻⁴ A·m²/(nT/s)
+/// (time constant `μ0 σ d a/2` ≈ 16 ms, so quasi-static at 0.1 Hz).
+/// An earlier version of this array had ε 37× larger (≈ 1800 A·m² in the
+/// same manoeuvre, as large as the permanent moments), which is no
+/// airframe's.
 pub fn default_dipoles() -> Vec<PodDipole> {
     let d = |p: [f64; 3], m: [f64; 3], x: [[f64; 3]; 3], e: [[f64; 3]; 3]| PodDipole {
         position_m: p,
@@ -178,13 +190,17 @@ pub fn default_dipoles() -> Vec<PodDipole> {
                 [0.002, 0.012, 0.0],
                 [0.001, 0.0, 0.016],
             ],
-            [[0.6, 0.0, 0.1], [0.0, 0.4, 0.0], [0.1, 0.0, 0.5]],
+            [
+                [0.016, 0.0, 0.0027],
+                [0.0, 0.011, 0.0],
+                [0.0027, 0.0, 0.0135],
+            ],
         ),
         d(
             [-6.0, 0.0, -1.0],
             [-400.0, 150.0, 300.0],
             [[0.010, 0.0, 0.0], [0.0, 0.004, 0.0], [0.0, 0.0, 0.004]],
-            [[0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.2]],
+            [[0.0081, 0.0, 0.0], [0.0, 0.0054, 0.0], [0.0, 0.0, 0.0054]],
         ),
         d(
             [2.5, 0.6, 0.0],
@@ -194,13 +210,13 @@ pub fn default_dipoles() -> Vec<PodDipole> {
                 [-0.001, 0.006, 0.001],
                 [0.0, 0.001, 0.005],
             ],
-            [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+            [[0.0027, 0.0, 0.0], [0.0, 0.0027, 0.0], [0.0, 0.0, 0.0027]],
         ),
         d(
             [0.0, -1.2, 1.0],
             [-250.0, 100.0, 600.0],
             [[0.003, 0.0, 0.0], [0.0, 0.003, 0.0], [0.0, 0.0, 0.008]],
-            [[0.05, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.1]],
+            [[0.00135, 0.0, 0.0], [0.0, 0.00135, 0.0], [0.0, 0.0, 0.0027]],
         ),
     ]
 }
@@ -526,9 +542,8 @@ impl PodConfig {
     /// frequency ([`PodConfig::swing_sine`], the only difference from
     /// [`PodConfig::default`]). Not stated by the seed and kept at the
     /// defaults: the dipole array (refs. 11–12 of the seed, not available;
-    /// the seed's Table 1 implies eddy-current heading coefficients
-    /// `|W3|, |W4| ≤ 0.41 nT·s` against `|W1|, |W2| ≤ 1.95 nT`, ours are
-    /// ≈ 40–130 nT·s against ≈ 0.2–15 nT), the swing frequency (taken as the
+    /// ours has the eddy-to-attitude ratio of the seed's Table 1, see
+    /// [`default_dipoles`]), the swing frequency (taken as the
     /// pendulum's `√(g/L)/2π` = 0.079 Hz), the attachment point, sensor
     /// noise, track wander and leg length.
     pub fn seed_002() -> Self {

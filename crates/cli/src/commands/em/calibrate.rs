@@ -1,8 +1,8 @@
 //! `aeromag em calibrate`: the three calibration stages from detected
 //! vectors and a KNOWN file.
 
-use super::files::{at, finite_column, load_table, read_detected, read_system};
 use super::HalfSpaceArg;
+use super::files::{at, finite_column, load_table, read_detected, read_system};
 use crate::exit::bad_input;
 use aeromag_core::frames::Attitude;
 use aeromag_em::calibration::{Calibration, CalibrationFile, FitCounts, KnownPoints};

@@ -1,7 +1,7 @@
 //! `aeromag em locate`: calibrated per-epoch pose of the bird.
 
-use super::files::read_detected;
 use super::HalfSpaceArg;
+use super::files::read_detected;
 use crate::exit::bad_input;
 use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::positioning::Hemisphere;
