@@ -31,7 +31,7 @@
 //!
 //! Scenarios ([`ScenarioKind`]): `calibration` (four-heading box at 3000 m
 //! with roll/pitch/yaw manoeuvres), `calibration_truncated` (the thesis'
-//! truncated pattern, ≈ 73 % of the time), `survey` (12 lines + 3 ties at
+//! truncated pattern, ≈ 73 % of the time), `survey` (20 lines + 5 ties at
 //! 100 m above ground with turbulence), `helicopter` (the box at 40 m/s and
 //! 100 Hz with a fuselage and a main rotor of magnetised, conducting blades
 //! with coning and tip-path-plane tilt, [`scenario::helicopter`],

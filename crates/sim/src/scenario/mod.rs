@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | `calibration` | full four-heading box with roll/pitch/yaw manoeuvres at 3000 m ([`calibration`]) | quiet |
 //! | `calibration_truncated` | the truncated box (≈ 73 % of the time) | quiet |
-//! | `survey` | 12 lines + 3 tie lines at 100 m above ground, turbulence ([`survey`]) | realistic gradients, two dipoles |
+//! | `survey` | 20 lines + 5 tie lines at 100 m above ground, turbulence ([`survey`]) | realistic gradients, two dipoles |
 //! | `helicopter` | the box at 40 m/s, 150 m above ground, 100 Hz, fuselage + main rotor ([`helicopter`]) | realistic |
 //! | `pod` | straight headings with pitch/roll/yaw manoeuvres, pod on a 40 m cable under a dipole-array helicopter, 20 Hz ([`pod`]; its own flat configuration [`pod::PodConfig`]) | gradients 5.91 / −25.91 nT/km |
 //!

@@ -39,22 +39,24 @@ pub struct SurveyPattern {
     pub line_heading_deg: f64,
     /// Length of the survey lines, m. Default 10 000.
     pub line_length_m: f64,
-    /// Number of survey lines. Default 12.
+    /// Number of survey lines. Default 20.
     pub line_count: u32,
     /// Distance between survey lines, m. Default 500 (with the default turn
     /// diameter of 2.1 km every line is reached by a clean 180° turn).
     pub line_spacing_m: f64,
-    /// Number of tie lines. Default 3.
+    /// Number of tie lines. Default 5 (100 crossovers with the default
+    /// lines: the levelling's `k` needs about that many, see
+    /// `aeromag_compensation::levelling`).
     pub tie_count: u32,
-    /// Distance between tie lines, m. Default 4000.
+    /// Distance between tie lines, m. Default 2000 (4× the line spacing).
     pub tie_spacing_m: f64,
     /// Extension of the tie lines beyond the outer survey lines, m. Default 500.
     pub tie_overshoot_m: f64,
     /// Straight flight before the first line, m. Default 1500.
     pub run_in_m: f64,
     /// Straight flight after the end of each line before turning, m.
-    /// Default 1500 (room for the L1 loop to settle on the next line after
-    /// the turn).
+    /// Default 2500 (room for the L1 loop to settle on the next line after
+    /// the turn; with 1500 m some of 20 lines were captured 500–800 m late).
     pub run_out_m: f64,
     /// Label of the first survey line. Default 1001.
     pub first_line_label: u32,
@@ -68,13 +70,13 @@ impl Default for SurveyPattern {
             clearance_m: 100.0,
             line_heading_deg: 0.0,
             line_length_m: 10_000.0,
-            line_count: 12,
+            line_count: 20,
             line_spacing_m: 500.0,
-            tie_count: 3,
-            tie_spacing_m: 4000.0,
+            tie_count: 5,
+            tie_spacing_m: 2000.0,
             tie_overshoot_m: 500.0,
             run_in_m: 1500.0,
-            run_out_m: 1500.0,
+            run_out_m: 2500.0,
             first_line_label: 1001,
             first_tie_label: 2001,
         }
