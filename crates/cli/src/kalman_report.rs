@@ -30,11 +30,15 @@ pub fn kalman_section(
     let mut s = ReportSection::new(heading);
     let f = &k.fit;
     s.blocks.push(Block::Paragraph(format!(
-        "Noise intensities {}: q1 = {:.2e} nT²/m⁵, q2 = {:.2e} nT²/m⁵, r = {:.2e} nT². Eddy-current lags: {}. \
+        "Field model of order {} (B^h the {}-th integral of white noise). Noise intensities {}: q1 = {:.2e} {}, \
+         q2 = {:.2e} nT²/m⁵, r = {:.2e} nT². Eddy-current lags: {}. \
          Normalised innovation variance {:.2} (1 when the noise model fits), innovation RMS {:.4} nT over {} samples \
          in {} runs.",
+        f.field_order,
+        f.field_order,
         if f.tuning.is_some() { "tuned by maximum likelihood" } else { "(defaults)" },
-        f.noise.q1_nt2_per_m5,
+        f.noise.q1,
+        aeromag_compensation::kalman::q1_unit(f.field_order),
         f.noise.q2_nt2_per_m5,
         f.noise.r_nt2,
         if kalman.terms.eddy_lags_s().is_empty() {

@@ -314,6 +314,26 @@ fn model_and_argument_errors_exit_2() {
             p,
             "--model",
             m,
+            "--field-order",
+            "3",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
+            "--method",
+            "kalman",
+            "--field-order",
+            "7",
+        ],
+        vec![
+            "calibrate",
+            "--input",
+            p,
+            "--model",
+            m,
             "--method",
             "kalman",
             "--tune",
@@ -581,13 +601,15 @@ fn interference_error(path: &std::path::Path) -> f64 {
 }
 
 /// Over realistic geology at 600 m the Kalman method (as `calibrate`
-/// runs it: two-pass lag choice, tuned noise) leaves a smaller
-/// interference-model error on an independent survey than band-pass LS.
-/// Measured, seeds 1–5 (×10⁻³ nT, LS / Kalman): 14.1/10.6, 19.4/10.5,
-/// 10.8/8.6, 14.4/6.3, 16.9/8.0. The spec's "at most half" holds on two
-/// of the five (the module docs of `kalman::tuning` have the whole table).
+/// runs it: two-pass lag choice, tuned noise, field model of order 4)
+/// leaves at most half the interference-model error of band-pass LS on an
+/// independent survey, and less than with the thesis' order-3 field model
+/// (`--field-order 3`). Measured, seeds 1–5 (×10⁻³ nT, LS / Kalman order 4
+/// / order 3): 14.1/6.1/10.6, 19.4/6.7/10.5, 10.8/4.1/8.6, 14.4/3.3/6.3,
+/// 16.9/8.0/8.0 (the module docs of `kalman::anomaly_model` and
+/// `kalman::tuning` have the other altitudes).
 #[test]
-fn kalman_beats_least_squares_over_geology_at_600_m() {
+fn kalman_halves_the_least_squares_error_over_geology_at_600_m() {
     let d = tempfile::tempdir().unwrap();
     let cfg = d.path().join("g600.toml");
     std::fs::write(
@@ -610,10 +632,14 @@ fn kalman_beats_least_squares_over_geology_at_600_m() {
     let survey = simulate(d.path(), "survey", "5");
     let cal = cal_dir.join("calibration.csv");
     let mut err = Vec::new();
-    for method in ["ls", "kalman"] {
-        let model = d.path().join(format!("{method}.json"));
-        let out = d.path().join(format!("{method}.csv"));
-        let o = aeromag(&[
+    for (tag, method, order) in [
+        ("ls", "ls", ""),
+        ("k4", "kalman", "4"),
+        ("k3", "kalman", "3"),
+    ] {
+        let model = d.path().join(format!("{tag}.json"));
+        let out = d.path().join(format!("{tag}.csv"));
+        let mut args = vec![
             "calibrate",
             "--input",
             cal.to_str().unwrap(),
@@ -623,7 +649,11 @@ fn kalman_beats_least_squares_over_geology_at_600_m() {
             method,
             "--lever-arm",
             "-9.5,0,-0.6",
-        ]);
+        ];
+        if method == "kalman" {
+            args.extend(["--field-order", order]);
+        }
+        let o = aeromag(&args);
         assert_code(&o, 0);
         assert_code(
             &aeromag(&[
@@ -639,10 +669,10 @@ fn kalman_beats_least_squares_over_geology_at_600_m() {
         );
         err.push(interference_error(&out));
     }
-    assert!(
-        err[1] < 0.8 * err[0],
-        "interference error LS {} nT, Kalman {} nT",
-        err[0],
-        err[1]
+    eprintln!(
+        "interference error LS {:.4} nT, Kalman order 4 {:.4} nT, order 3 {:.4} nT",
+        err[0], err[1], err[2]
     );
+    assert!(err[1] <= 0.5 * err[0], "{err:?}");
+    assert!(err[1] < err[2], "{err:?}");
 }

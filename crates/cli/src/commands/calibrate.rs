@@ -4,8 +4,8 @@ use crate::exit::bad_input;
 use crate::flight::{TlColumns, parse_band, parse_lever_arm, reference_columns, reference_sum};
 use crate::input::InputArgs;
 use aeromag_compensation::kalman::{
-    KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, fit_kalman,
-    ground_speed_from_positions, ground_speed_from_velocity,
+    DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, ORDERS,
+    X2Prior, fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
 };
 use aeromag_compensation::levelling::sensor_positions;
 use aeromag_compensation::model_file::{Coefficient, FitStats, MODEL_FORMAT, TL_KIND, TlModel};
@@ -71,13 +71,22 @@ pub struct Args {
     /// documented defaults, or --kalman-noise), without tuning.
     #[arg(long)]
     no_tune: bool,
-    /// With --method kalman: noise intensities Q1,Q2,R (q1, q2 in nT²/m⁵: the
-    /// spectral densities of d³B^h/ds³ and d²B_z/ds² along the path; r in nT²:
-    /// the measurement noise variance), e.g. from an earlier calibration.
-    /// Default 1e-15,1e-15,4e-4. Given values are used as they are, unless
+    /// With --method kalman: noise intensities Q1,Q2,R (q1 in nT²/m^(2n−1),
+    /// i.e. nT²/m⁷ for the default order n = 4 and nT²/m⁵ for n = 3: the
+    /// spectral density of the n-th along-track derivative of B^h; q2 in
+    /// nT²/m⁵: that of d²B_z/ds²; r in nT²: the measurement noise variance),
+    /// e.g. from an earlier calibration. Default 3.9e-20,1e-15,4e-4 (n = 4),
+    /// 1e-15,1e-15,4e-4 (n = 3). Given values are used as they are, unless
     /// --tune is also given (then they are the starting point).
     #[arg(long, value_name = "Q1,Q2,R")]
     kalman_noise: Option<String>,
+    /// With --method kalman: order n of the along-track field model, B^h the
+    /// n-th integral of white noise (2–6). 3 is the thesis' model; the
+    /// default 4 separates the field from the manoeuvres better over
+    /// geology (library docs of aeromag_compensation::kalman::anomaly_model).
+    /// Default 4.
+    #[arg(long, value_name = "N")]
+    field_order: Option<usize>,
     /// With --method kalman: write every input row plus the series
     /// kalman_reading (reference removed), kalman_compensated, kalman_field
     /// (the smoothed external field), kalman_innovation and
@@ -155,10 +164,10 @@ impl FitOptions {
 }
 
 /// `Q1,Q2,R` noise intensities of the Kalman method.
-fn parse_noise(s: &str) -> anyhow::Result<NoiseModel> {
+fn parse_noise(s: &str, order: usize) -> anyhow::Result<NoiseModel> {
     let v = crate::flight::parse_numbers("--kalman-noise", s, 3)?;
     let noise = NoiseModel {
-        q1_nt2_per_m5: v[0],
+        q1: v[0],
         q2_nt2_per_m5: v[1],
         r_nt2: v[2],
     };
@@ -166,7 +175,8 @@ fn parse_noise(s: &str) -> anyhow::Result<NoiseModel> {
         Ok(noise)
     } else {
         Err(bad_input!(
-            "--kalman-noise `{s}`: need q1, q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)"
+            "--kalman-noise `{s}`: need q1 ≥ 0 ({}), q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)",
+            q1_unit(order)
         ))
     }
 }
@@ -575,19 +585,35 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.series.is_some() && a.method != "kalman" {
         return Err(bad_input!("--series needs --method kalman"));
     }
+    if a.field_order.is_some() && a.method != "kalman" {
+        return Err(bad_input!("--field-order needs --method kalman"));
+    }
+    let field_order = a.field_order.unwrap_or(DEFAULT_ORDER);
     let model = match a.method.as_str() {
         "ls" => fit_model(&table, &config(&a)?, &opts)?,
         "kalman" => {
             let ls = config(&a)?;
+            if !ORDERS.contains(&field_order) {
+                return Err(bad_input!(
+                    "--field-order {field_order}: must be in {}–{}",
+                    ORDERS.start(),
+                    ORDERS.end()
+                ));
+            }
             let mut cfg = KalmanConfig {
                 terms: ls.terms,
                 convention: ls.convention,
                 bt_scale_nt: ls.bt_scale_nt,
+                noise: NoiseModel::calibration_default_for(field_order),
+                field_prior: X2Prior {
+                    order: field_order,
+                    ..X2Prior::default()
+                },
                 ..KalmanConfig::default()
             };
             cfg.tuning.enabled = a.tune || !(a.no_tune || a.kalman_noise.is_some());
             if let Some(text) = &a.kalman_noise {
-                cfg.noise = parse_noise(text)?;
+                cfg.noise = parse_noise(text, field_order)?;
             }
             cfg.compute_series = a.series.is_some();
             let (model, fit, rows) = fit_model_kalman(&table, &cfg, &opts)?;
@@ -603,8 +629,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 );
             }
             println!(
-                "noise intensities: q1 = {:.3e} nT²/m⁵, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
-                fit.noise.q1_nt2_per_m5,
+                "field model of order {}; noise intensities: q1 = {:.3e} {}, q2 = {:.3e} nT²/m⁵, r = {:.3e} nT² ({})",
+                cfg.field_prior.order,
+                fit.noise.q1,
+                q1_unit(cfg.field_prior.order),
                 fit.noise.q2_nt2_per_m5,
                 fit.noise.r_nt2,
                 if fit.tuning.is_some() {

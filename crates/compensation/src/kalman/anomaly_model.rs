@@ -9,37 +9,57 @@
 //! The field at the sensor is expanded about a reference altitude `z0`:
 //! `B0(s, z) = B^h(s) + B_z(s) Δz`, `Δz = alt − z0` (m, **up**), so `B_z` is the
 //! derivative of the field modulus with respect to *altitude* (nT/m; it is
-//! `−∂B/∂z` in the NED frame). Along the path length `s` (m):
+//! `−∂B/∂z` in the NED frame). Along the path length `s` (m), with `n` the
+//! order of the chain ([`X2Prior::order`]):
 //!
 //! ```text
-//! dB^h/ds = B^h_x,   dB^h_x/ds = B^h_xx,   dB^h_xx/ds = w₁(s),   E[w₁(s) w₁(s')] = q₁ δ(s − s')
-//! dB_z/ds = B_zx,    dB_zx/ds = w₂(s),                          E[w₂(s) w₂(s')] = q₂ δ(s − s')
+//! dB^h/ds = B^h_x,  dB^h_x/ds = B^h_xx,  …,  d(∂ⁿ⁻¹B^h)/ds = w₁(s),   E[w₁(s) w₁(s')] = q₁ δ(s − s')
+//! dB_z/ds = B_zx,   dB_zx/ds = w₂(s),                                 E[w₂(s) w₂(s')] = q₂ δ(s − s')
 //! ```
 //!
-//! i.e. `B^h` is the third integral and `B_z` the second integral of white
-//! noise along the path (the thesis writes the same with `d/dt = v d/ds`, `v`
-//! the ground speed). The state is `X2 = (B^h, B^h_x, B^h_xx, B_z, B_zx)` in
-//! nT, nT/m, nT/m², nT/m, nT/m². `B^h` also absorbs the main field, the
-//! diurnal variation (a function of time, but `s ≈ v t`) and any constant.
+//! The thesis (seed `000_…` §7) takes `n = 3`: `B^h` is the third integral
+//! and `B_z` the second integral of white noise along the path (the thesis
+//! writes the same with `d/dt = v d/ds`, `v` the ground speed). The state is
+//! `X2 = (B^h, B^h_x, …, ∂ⁿ⁻¹B^h, B_z, B_zx)` in nT, nT/m, …, nT/m, nT/m²
+//! (dimension `n + 2`). `B^h` also absorbs the main field, the diurnal
+//! variation (a function of time, but `s ≈ v t`) and any constant.
 //!
-//! **Units of the intensities.** `w₁` is in nT/m³ and `δ(s)` in 1/m, so `q₁`
-//! (and likewise `q₂`) is in **nT²/m⁵** — the one-sided spectral density of
-//! the third (second) along-track derivative. Over a step `d` the
-//! third derivative changes by `√(q₁ d)` nT/m² (1 σ).
+//! **Why the default order is 4.** The chain's spectrum is `q₁/k^{2n}`. A
+//! potential field observed at a height `H` above its sources has the
+//! spectrum of its sources times `e^{−2kH}`: it falls faster than any power
+//! beyond `k ≈ 1/H`. Maximum likelihood fits `q₁` where most of the field's
+//! variance is, at long wavelengths; with `n = 3` the model then puts far
+//! more field power in the manoeuvre band (0.05–0.5 Hz, wavelengths of
+//! 0.2–2 km) than a field at calibration height has there, and the filter
+//! explains part of the manoeuvre signal as field. `n = 4` decays as `k⁻⁸`
+//! and separates better. Measured on the simulator's calibration over
+//! geology, seeds 1–5 (interference-model error on an independent survey,
+//! 10⁻³ nT, `n = 3` → `n = 4`, the table in [`super::tuning`]): 1000 m
+//! 2.9–6.1 → 2.6–5.3, 600 m 6.3–10.6 → 3.3–8.0, 300 m 10.7–17.8 →
+//! 7.0–13.5; over the quiet box unchanged (2.0–5.1 → 2.0–5.0). The CLI
+//! test `kalman_halves_the_least_squares_error_over_geology_at_600_m`
+//! checks the gain. `n = 5` gains little more at 300 m and loses in the
+//! quiet box. `n = 3` stays available (`aeromag calibrate --field-order 3`).
+//!
+//! **Units of the intensities.** `w₁` is in nT/mⁿ and `δ(s)` in 1/m, so `q₁`
+//! is in **nT²/m^{2n−1}** (nT²/m⁵ for the thesis' `n = 3`, nT²/m⁷ for
+//! `n = 4`) — the one-sided spectral density of the `n`-th along-track
+//! derivative; `q₂` is in nT²/m⁵. Over a step `d` the `(n−1)`-th derivative
+//! changes by `√(q₁ d)` (1 σ).
 //!
 //! ## Exact discretisation over a step of length `d = ∫ v dt` (m)
 //!
 //! ```text
-//! Φ₁ = [[1, d, d²/2], [0, 1, d], [0, 0, 1]],   Q₁ = q₁ [[d⁵/20, d⁴/8, d³/6], [d⁴/8, d³/3, d²/2], [d³/6, d²/2, d]]
-//! Φ₂ = [[1, d], [0, 1]],                       Q₂ = q₂ [[d³/3, d²/2], [d²/2, d]]
+//! Φ₁[i][j] = d^{j−i}/(j−i)!  (j ≥ i),   Q₁ = q₁ T M T,   T = diag(d^{n−1/2}, …, d^{3/2}, d^{1/2}),
+//! M[i][j] = 1 / ((n−1−i)! (n−1−j)! (2n−1−i−j))
+//! Φ₂ = [[1, d], [0, 1]],               Q₂ = q₂ [[d³/3, d²/2], [d²/2, d]]
 //! ```
 //!
-//! (`Q = ∫₀^d e^{Aσ} b bᵀ e^{Aᵀσ} dσ`, Van Loan 1978). The filter needs a
-//! factor `G`, `Q = G Gᵀ`: with `T = diag(d^{5/2}, d^{3/2}, d^{1/2})` and the
-//! constant `M₁ = [[1/20, 1/8, 1/6], [1/8, 1/3, 1/2], [1/6, 1/2, 1]]`,
-//! `Q₁ = q₁ T M₁ T`, so `G₁ = √q₁ T chol(M₁)` in closed form (and likewise
-//! `G₂ = √q₂ diag(d^{3/2}, d^{1/2}) chol(M₂)`); no factorisation per step,
-//! exact also for `d → 0`.
+//! (`Q = ∫₀^d e^{Aσ} b bᵀ e^{Aᵀσ} dσ`, Van Loan 1978; for `n = 3`,
+//! `Q₁ = q₁ [[d⁵/20, d⁴/8, d³/6], [d⁴/8, d³/3, d²/2], [d³/6, d²/2, d]]`). The
+//! filter needs a factor `G`, `Q = G Gᵀ`: `G₁ = √q₁ T chol(M)`, with the
+//! constant `chol(M)` computed once, so no factorisation per step, exact
+//! also for `d → 0` (and likewise `G₂`).
 //!
 //! ## Default intensities (calibration altitude)
 //!
@@ -48,41 +68,76 @@
 //! over a path length of order `H`. If `σ_xx` is the RMS of the second
 //! along-track derivative, a random walk that changes by about `σ_xx` over
 //! `H` has `q₁ ≈ σ_xx²/H`, and `σ_xx ≈ σ_x/H` with `σ_x` the RMS along-track
-//! gradient: `q₁ ≈ σ_x²/H³`. A realistic area (3 nT/100 m at 100 m above
-//! ground) gives `σ_x ≈ 3·10⁻³ nT/m` at `H ≈ 3 km` above the sources,
+//! gradient: `q₁ ≈ σ_x²/H³` for `n = 3` (and `σ_x²/H⁵` for `n = 4`). A
+//! realistic area (3 nT/100 m at 100 m above ground) gives
+//! `σ_x ≈ 3·10⁻³ nT/m` at `H ≈ 3 km` above the sources,
 //! `q₁ ≈ 3·10⁻¹⁶ nT²/m⁵`. The *path* adds curvature: in a turn of radius
 //! `R` the along-track second derivative of a field with horizontal
 //! gradient `g` jumps by `g/R` (main field: `g ≈ 3·10⁻³ nT/m`, `R ≈ 1.7 km`
 //! at 90 m/s and 3°/s, so `≈ 2·10⁻⁶ nT/m²` per turn entry or exit); eight
 //! such jumps over a 56 km box give `q₁ ≈ 8 (2·10⁻⁶)² / 56 km ≈ 6·10⁻¹⁶`.
-//! The default is `q₁ = 10⁻¹⁵ nT²/m⁵`, which is also the maximum-likelihood
-//! value of the true main field plus anomaly along the simulator's
-//! calibration box (both areas). The vertical gradient has the same spectrum
-//! up to a factor: `q₂ = 10⁻¹⁵`. `r = 4·10⁻⁴ nT²` (0.02 nT RMS: scalar
-//! sensor noise, heading error and what the Tolles-Lawson model leaves).
-//! [`super::tuning`] adjusts them by maximum likelihood on request.
+//! The default for `n = 3` is `q₁ = 10⁻¹⁵ nT²/m⁵`, which is also the
+//! maximum-likelihood value of the true main field plus anomaly along the
+//! simulator's calibration box (both areas). Another order `n` gets the
+//! same spectral level `q₁/k^{2n}` at the wavelength of 1 km, in the
+//! manoeuvre band: `q₁ = 10⁻¹⁵ k₀^{2(n−3)}`, `k₀ = 2π/1 km`
+//! (3.9·10⁻²⁰ nT²/m⁷ for `n = 4`), so an untuned filter follows the same
+//! field there, and more of it at longer wavelengths (the diurnal variation
+//! when no base station is subtracted). Maximum likelihood moves it to
+//! 2–8·10⁻²³ nT²/m⁷ over the simulator's quiet box (base station
+//! subtracted, lagged eddy terms; `q₁ ≈ σ_x²/H⁵` ≈ 4·10⁻²³ by the argument
+//! above) and ≈ 5·10⁻¹⁹ over the 1000 m geology box. The
+//! vertical gradient has the same spectrum up to a factor: `q₂ = 10⁻¹⁵`.
+//! `r = 4·10⁻⁴ nT²` (0.02 nT RMS: scalar sensor noise, heading error and
+//! what the Tolles-Lawson model leaves). [`super::tuning`] adjusts them by
+//! maximum likelihood (the default of `aeromag calibrate --method kalman`).
 
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// Number of states of the field model `X2`.
-pub const X2_DIM: usize = 5;
+/// The thesis' order of the `B^h` chain (third integral of white noise).
+pub const THESIS_ORDER: usize = 3;
+/// The default order of the `B^h` chain (module docs: why 4).
+pub const DEFAULT_ORDER: usize = 4;
+/// The orders accepted.
+pub const ORDERS: std::ops::RangeInclusive<usize> = 2..=6;
 /// Index of `B^h` (nT) in `X2`.
 pub const B_H: usize = 0;
-/// Index of `B^h_x` (nT/m).
-pub const B_H_X: usize = 1;
-/// Index of `B^h_xx` (nT/m²).
-pub const B_H_XX: usize = 2;
-/// Index of `B_z` (nT/m, derivative with respect to altitude).
-pub const B_Z: usize = 3;
-/// Index of `B_zx` (nT/m²).
-pub const B_Z_X: usize = 4;
+/// Default `q₁` for the thesis' order 3, nT²/m⁵ (module docs).
+pub const DEFAULT_Q1_ORDER3: f64 = 1e-15;
+/// Wavelength at which the default `q₁` of every order gives the same
+/// spectral level as the thesis' default, m (module docs).
+pub const DEFAULT_MATCH_WAVELENGTH_M: f64 = 1000.0;
+
+/// Number of states of `X2` for a chain of order `n`: `n + 2`.
+pub fn x2_dim(order: usize) -> usize {
+    order + 2
+}
+
+/// Index of `B_z` (nT/m, derivative with respect to altitude) in `X2` for a
+/// chain of order `n` (`B_zx` follows it).
+pub fn b_z_index(order: usize) -> usize {
+    order
+}
+
+/// The unit of `q₁` for a chain of order `n`: nT²/m^{2n−1}.
+pub fn q1_unit(order: usize) -> String {
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let e: String = (2 * order)
+        .saturating_sub(1)
+        .to_string()
+        .chars()
+        .map(|c| SUP[c.to_digit(10).unwrap_or(0) as usize])
+        .collect();
+    format!("nT²/m{e}")
+}
 
 /// Noise intensities of the model (module docs for the units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NoiseModel {
-    /// `q₁`: spectral density of `d³B^h/ds³` along the path, nT²/m⁵.
-    pub q1_nt2_per_m5: f64,
+    /// `q₁`: spectral density of the `n`-th along-track derivative of
+    /// `B^h`, nT²/m^{2n−1} (nT²/m⁵ for `n = 3`, nT²/m⁷ for `n = 4`).
+    pub q1: f64,
     /// `q₂`: spectral density of `d²B_z/ds²` along the path, nT²/m⁵.
     pub q2_nt2_per_m5: f64,
     /// `r`: variance of the scalar measurement noise per sample, nT².
@@ -90,11 +145,21 @@ pub struct NoiseModel {
 }
 
 impl NoiseModel {
-    /// Defaults for a calibration flight at ~3 km (module docs):
-    /// `q₁ = q₂ = 10⁻¹⁵ nT²/m⁵`, `r = 4·10⁻⁴ nT²` (0.02 nT RMS).
+    /// Defaults for a calibration flight at ~3 km with the default order
+    /// ([`Self::calibration_default_for`]).
     pub fn calibration_default() -> Self {
+        Self::calibration_default_for(DEFAULT_ORDER)
+    }
+
+    /// Defaults for a calibration flight at ~3 km and a `B^h` chain of
+    /// order `n` (module docs): `q₁ = 10⁻¹⁵ k₀^{2(n−3)}` nT²/m^{2n−1} with
+    /// `k₀ = 2π/`[`DEFAULT_MATCH_WAVELENGTH_M`] (10⁻¹⁵ nT²/m⁵ for `n = 3`,
+    /// 3.9·10⁻²⁰ nT²/m⁷ for `n = 4`), `q₂ = 10⁻¹⁵ nT²/m⁵`, `r = 4·10⁻⁴ nT²`
+    /// (0.02 nT RMS).
+    pub fn calibration_default_for(order: usize) -> Self {
+        let k0 = 2.0 * std::f64::consts::PI / DEFAULT_MATCH_WAVELENGTH_M;
         Self {
-            q1_nt2_per_m5: 1e-15,
+            q1: DEFAULT_Q1_ORDER3 * k0.powi(2 * (order as i32 - THESIS_ORDER as i32)),
             q2_nt2_per_m5: 1e-15,
             r_nt2: 4e-4,
         }
@@ -102,10 +167,10 @@ impl NoiseModel {
 
     /// Whether every intensity is finite, `q ≥ 0` and `r > 0`.
     pub fn is_valid(&self) -> bool {
-        self.q1_nt2_per_m5 >= 0.0
+        self.q1 >= 0.0
             && self.q2_nt2_per_m5 >= 0.0
             && self.r_nt2 > 0.0
-            && self.q1_nt2_per_m5.is_finite()
+            && self.q1.is_finite()
             && self.q2_nt2_per_m5.is_finite()
             && self.r_nt2.is_finite()
     }
@@ -117,18 +182,27 @@ impl Default for NoiseModel {
     }
 }
 
-/// The (diffuse) prior of `X2` at the start of every contiguous run of data:
-/// zero mean (the measurement is centred first), independent components
-/// with these standard deviations.
+/// The layout and the (diffuse) prior of `X2` at the start of every
+/// contiguous run of data: the order `n` of the `B^h` chain, zero mean (the
+/// measurement is centred first), independent components with these
+/// standard deviations.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct X2Prior {
+    /// Order `n` of the `B^h` chain ([`ORDERS`]; 3 is the thesis' third
+    /// integral, the default [`DEFAULT_ORDER`] = 4, module docs).
+    pub order: usize,
     /// Standard deviation of `B^h`, nT (default 1000: diffuse for a centred
     /// reading).
     pub b_nt: f64,
     /// Standard deviation of `B^h_x`, nT/m (default 0.1, i.e. 10 nT/100 m).
     pub b_x_nt_per_m: f64,
-    /// Standard deviation of `B^h_xx`, nT/m² (default 1e-4).
+    /// Standard deviation of `B^h_xx`, nT/m² (default 1e-4); each further
+    /// derivative (order ≥ 4) gets the previous one's divided by
+    /// [`Self::decorrelation_m`].
     pub b_xx_nt_per_m2: f64,
+    /// Path length over which the field's derivatives decorrelate, m
+    /// (default 1000), for the priors of the third and higher derivatives.
+    pub decorrelation_m: f64,
     /// Standard deviation of `B_z`, nT/m (default 0.1; the main field's
     /// vertical gradient is ≈ 0.02–0.03 nT/m).
     pub b_z_nt_per_m: f64,
@@ -139,9 +213,11 @@ pub struct X2Prior {
 impl Default for X2Prior {
     fn default() -> Self {
         Self {
+            order: DEFAULT_ORDER,
             b_nt: 1000.0,
             b_x_nt_per_m: 0.1,
             b_xx_nt_per_m2: 1e-4,
+            decorrelation_m: 1000.0,
             b_z_nt_per_m: 0.1,
             b_zx_nt_per_m2: 1e-4,
         }
@@ -149,92 +225,143 @@ impl Default for X2Prior {
 }
 
 impl X2Prior {
+    /// The thesis' model (order 3) with the default priors.
+    pub fn thesis() -> Self {
+        Self {
+            order: THESIS_ORDER,
+            ..Self::default()
+        }
+    }
+
+    /// Number of states of `X2`, `order + 2`.
+    pub fn dim(&self) -> usize {
+        x2_dim(self.order)
+    }
+
+    /// Index of `B_z` in `X2`.
+    pub fn b_z(&self) -> usize {
+        b_z_index(self.order)
+    }
+
     /// The standard deviations in state order.
-    pub fn stds(&self) -> [f64; X2_DIM] {
-        [
-            self.b_nt,
-            self.b_x_nt_per_m,
-            self.b_xx_nt_per_m2,
-            self.b_z_nt_per_m,
-            self.b_zx_nt_per_m2,
-        ]
+    pub fn stds(&self) -> Vec<f64> {
+        let mut v = vec![self.b_nt, self.b_x_nt_per_m, self.b_xx_nt_per_m2];
+        v.truncate(self.order);
+        while v.len() < self.order {
+            let last = *v.last().unwrap_or(&self.b_nt);
+            v.push(last / self.decorrelation_m);
+        }
+        v.push(self.b_z_nt_per_m);
+        v.push(self.b_zx_nt_per_m2);
+        v
     }
 
-    /// The prior factor (diagonal), `X2_DIM × X2_DIM`.
+    /// The prior factor (diagonal), `dim × dim`.
     pub fn factor(&self) -> DMatrix<f64> {
-        DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&self.stds()))
+        DMatrix::from_diagonal(&nalgebra::DVector::from_vec(self.stds()))
     }
 
-    /// Whether every standard deviation is finite and positive.
+    /// Whether the order is in [`ORDERS`] and every standard deviation is
+    /// finite and positive.
     pub fn is_valid(&self) -> bool {
-        self.stds().iter().all(|s| *s > 0.0 && s.is_finite())
+        ORDERS.contains(&self.order)
+            && self.decorrelation_m > 0.0
+            && self.decorrelation_m.is_finite()
+            && self.stds().iter().all(|s| *s > 0.0 && s.is_finite())
     }
 }
 
+/// `n!` as a float.
+fn factorial(n: usize) -> f64 {
+    (1..=n).map(|k| k as f64).product()
+}
+
 /// Exact transition over an along-track step (module docs) for given noise
-/// intensities, with the Cholesky factors of `M₁`, `M₂` and `√q₁`, `√q₂`
-/// computed once.
+/// intensities and order, with the Cholesky factors of `M` (order `n`) and
+/// `M₂`, and `√q₁`, `√q₂` computed once.
 #[derive(Debug, Clone)]
 pub struct AnomalyTransition {
-    l1: [[f64; 3]; 3],
+    order: usize,
+    l1: DMatrix<f64>,
     l2: [[f64; 2]; 2],
     s1: f64,
     s2: f64,
 }
 
 impl AnomalyTransition {
-    /// Precompute the constant factors for `noise`.
-    pub fn new(noise: &NoiseModel) -> Self {
-        // Lower Cholesky factor of M₁ = [[1/20, 1/8, 1/6], [1/8, 1/3, 1/2], [1/6, 1/2, 1]].
-        let l00 = (1.0f64 / 20.0).sqrt();
-        let l10 = (1.0 / 8.0) / l00;
-        let l20 = (1.0 / 6.0) / l00;
-        let l11 = (1.0 / 3.0 - l10 * l10).sqrt();
-        let l21 = (0.5 - l20 * l10) / l11;
-        let l22 = (1.0 - l20 * l20 - l21 * l21).sqrt();
+    /// Precompute the constant factors for `noise` and a `B^h` chain of
+    /// order `order` (in [`ORDERS`]; panics otherwise, a programming error:
+    /// [`X2Prior::is_valid`] checks it for callers).
+    pub fn new(noise: &NoiseModel, order: usize) -> Self {
+        assert!(
+            ORDERS.contains(&order),
+            "field order {order} not in {ORDERS:?}"
+        );
+        let n = order;
+        // M[i][j] = 1/((n−1−i)! (n−1−j)! (2n−1−i−j)): positive definite (a
+        // Gram matrix of the monomials σ^{n−1−i}/(n−1−i)! on [0, 1]).
+        let m = DMatrix::from_fn(n, n, |i, j| {
+            let (a, b) = (n - 1 - i, n - 1 - j);
+            1.0 / (factorial(a) * factorial(b) * (a + b + 1) as f64)
+        });
+        let l1 = m
+            .cholesky()
+            .expect("the Gram matrix of the monomials is positive definite")
+            .l();
         // M₂ = [[1/3, 1/2], [1/2, 1]].
         let m00 = (1.0f64 / 3.0).sqrt();
         let m10 = 0.5 / m00;
         let m11 = (1.0 - m10 * m10).sqrt();
         Self {
-            l1: [[l00, 0.0, 0.0], [l10, l11, 0.0], [l20, l21, l22]],
+            order,
+            l1,
             l2: [[m00, 0.0], [m10, m11]],
-            s1: noise.q1_nt2_per_m5.max(0.0).sqrt(),
+            s1: noise.q1.max(0.0).sqrt(),
             s2: noise.q2_nt2_per_m5.max(0.0).sqrt(),
         }
     }
 
-    /// Fill `phi` (5×5) and `g` (5×5, `Q = G Gᵀ`) for a step of `d ≥ 0` m.
-    /// Panics if the matrices are not 5×5 (a programming error).
+    /// Number of states of `X2`.
+    pub fn dim(&self) -> usize {
+        x2_dim(self.order)
+    }
+
+    /// Fill `phi` (`dim × dim`) and `g` (`dim × dim`, `Q = G Gᵀ`) for a step
+    /// of `d ≥ 0` m. Panics if the matrices have another shape (a
+    /// programming error).
     pub fn fill(&self, d: f64, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
+        let dim = self.dim();
         assert!(
-            phi.shape() == (X2_DIM, X2_DIM) && g.shape() == (X2_DIM, X2_DIM),
-            "field transition matrices must be 5×5"
+            phi.shape() == (dim, dim) && g.shape() == (dim, dim),
+            "field transition matrices must be {dim}×{dim}"
         );
         let d = d.max(0.0);
-        // Column-major: entry (i, j) at i + 5 j.
-        let p = phi.as_mut_slice();
-        p.fill(0.0);
-        for i in 0..X2_DIM {
-            p[i + X2_DIM * i] = 1.0;
+        let n = self.order;
+        phi.fill(0.0);
+        for i in 0..dim {
+            phi[(i, i)] = 1.0;
         }
-        p[B_H + X2_DIM * B_H_X] = d;
-        p[B_H + X2_DIM * B_H_XX] = 0.5 * d * d;
-        p[B_H_X + X2_DIM * B_H_XX] = d;
-        p[B_Z + X2_DIM * B_Z_X] = d;
-        let gs = g.as_mut_slice();
-        gs.fill(0.0);
+        for i in 0..n {
+            let mut p = 1.0;
+            for j in i + 1..n {
+                p *= d / (j - i) as f64;
+                phi[(i, j)] = p;
+            }
+        }
+        let bz = b_z_index(n);
+        phi[(bz, bz + 1)] = d;
+        g.fill(0.0);
         let sd = d.sqrt();
-        let t1 = [d * d * sd, d * sd, sd];
-        for i in 0..3 {
+        for i in 0..n {
+            let ti = self.s1 * sd * d.powi((n - 1 - i) as i32);
             for j in 0..=i {
-                gs[i + X2_DIM * j] = self.s1 * t1[i] * self.l1[i][j];
+                g[(i, j)] = ti * self.l1[(i, j)];
             }
         }
         let t2 = [d * sd, sd];
         for i in 0..2 {
             for j in 0..=i {
-                gs[(B_Z + i) + X2_DIM * (B_Z + j)] = self.s2 * t2[i] * self.l2[i][j];
+                g[(bz + i, bz + j)] = self.s2 * t2[i] * self.l2[i][j];
             }
         }
     }
@@ -244,68 +371,130 @@ impl AnomalyTransition {
 mod tests {
     use super::*;
 
-    /// Q by numerical integration of e^{Aσ} b bᵀ e^{Aᵀσ} (Simpson), for the
-    /// triple integrator, against G Gᵀ.
+    /// Q by numerical integration of e^{Aσ} b bᵀ e^{Aᵀσ} (Simpson) against
+    /// G Gᵀ, for the thesis' triple integrator and the default order 4:
+    /// e^{Aσ} b = (σ^{n−1}/(n−1)!, …, σ, 1) for the chain, (σ, 1) for `B_z`.
     #[test]
     fn noise_factor_reproduces_the_integrated_covariance() {
         let noise = NoiseModel {
-            q1_nt2_per_m5: 2.5e-15,
+            q1: 2.5e-15,
             q2_nt2_per_m5: 7e-16,
             r_nt2: 1.0,
         };
-        let tr = AnomalyTransition::new(&noise);
-        let d = 9.0;
-        let mut phi = DMatrix::zeros(5, 5);
-        let mut g = DMatrix::zeros(5, 5);
+        for order in [THESIS_ORDER, DEFAULT_ORDER, 6] {
+            let tr = AnomalyTransition::new(&noise, order);
+            let dim = x2_dim(order);
+            let d = 9.0;
+            let mut phi = DMatrix::zeros(dim, dim);
+            let mut g = DMatrix::zeros(dim, dim);
+            tr.fill(d, &mut phi, &mut g);
+            let q = &g * g.transpose();
+            let n = 2000;
+            let h = d / n as f64;
+            let mut qn = DMatrix::<f64>::zeros(dim, dim);
+            for k in 0..=n {
+                let s = k as f64 * h;
+                let w = if k == 0 || k == n {
+                    1.0
+                } else if k % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                let u: Vec<f64> = (0..order)
+                    .map(|i| s.powi((order - 1 - i) as i32) / factorial(order - 1 - i))
+                    .collect();
+                let v = [s, 1.0];
+                for i in 0..order {
+                    for j in 0..order {
+                        qn[(i, j)] += w * h / 3.0 * noise.q1 * u[i] * u[j];
+                    }
+                }
+                for i in 0..2 {
+                    for j in 0..2 {
+                        qn[(order + i, order + j)] +=
+                            w * h / 3.0 * noise.q2_nt2_per_m5 * v[i] * v[j];
+                    }
+                }
+            }
+            for i in 0..dim {
+                for j in 0..dim {
+                    assert!(
+                        (q[(i, j)] - qn[(i, j)]).abs() <= 1e-10 * qn[(i, j)].abs().max(1e-30),
+                        "order {order}: Q[{i},{j}] {} vs {}",
+                        q[(i, j)],
+                        qn[(i, j)]
+                    );
+                }
+            }
+            // Φ: d^{j−i}/(j−i)! on the chain, d for B_z.
+            assert_eq!(phi[(0, 1)], 9.0);
+            assert_eq!(phi[(0, 2)], 40.5);
+            if order >= 4 {
+                assert!((phi[(0, 3)] - 729.0 / 6.0).abs() < 1e-12);
+            }
+            assert_eq!(phi[(order, order + 1)], 9.0);
+            assert_eq!(phi[(order - 1, order)], 0.0);
+        }
+    }
+
+    /// The thesis' closed form for n = 3: Q₁ = q₁ [[d⁵/20, d⁴/8, d³/6], …].
+    #[test]
+    fn order_three_is_the_thesis_model() {
+        let noise = NoiseModel {
+            q1: 1.0,
+            q2_nt2_per_m5: 1.0,
+            r_nt2: 1.0,
+        };
+        let tr = AnomalyTransition::new(&noise, THESIS_ORDER);
+        let (mut phi, mut g) = (DMatrix::zeros(5, 5), DMatrix::zeros(5, 5));
+        let d: f64 = 2.0;
         tr.fill(d, &mut phi, &mut g);
         let q = &g * g.transpose();
-        // e^{Aσ} b for the triple integrator with b = e₃: (σ²/2, σ, 1); double: (σ, 1).
-        let n = 2000;
-        let h = d / n as f64;
-        let mut qn = DMatrix::<f64>::zeros(5, 5);
-        for k in 0..=n {
-            let s = k as f64 * h;
-            let w = if k == 0 || k == n {
-                1.0
-            } else if k % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            let u = [s * s / 2.0, s, 1.0];
-            let v = [s, 1.0];
-            for i in 0..3 {
-                for j in 0..3 {
-                    qn[(i, j)] += w * h / 3.0 * noise.q1_nt2_per_m5 * u[i] * u[j];
-                }
-            }
-            for i in 0..2 {
-                for j in 0..2 {
-                    qn[(3 + i, 3 + j)] += w * h / 3.0 * noise.q2_nt2_per_m5 * v[i] * v[j];
-                }
+        let expect = [
+            [d.powi(5) / 20.0, d.powi(4) / 8.0, d.powi(3) / 6.0],
+            [d.powi(4) / 8.0, d.powi(3) / 3.0, d * d / 2.0],
+            [d.powi(3) / 6.0, d * d / 2.0, d],
+        ];
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((q[(i, j)] - expect[i][j]).abs() < 1e-12, "Q[{i},{j}]");
             }
         }
-        for i in 0..5 {
-            for j in 0..5 {
-                assert!(
-                    (q[(i, j)] - qn[(i, j)]).abs() <= 1e-10 * qn[(i, j)].abs().max(1e-30),
-                    "Q[{i},{j}] {} vs {}",
-                    q[(i, j)],
-                    qn[(i, j)]
-                );
-            }
-        }
-        assert_eq!(phi[(0, 2)], 40.5);
-        assert_eq!(phi[(3, 4)], 9.0);
+        assert_eq!(X2Prior::thesis().dim(), 5);
+        assert_eq!(X2Prior::thesis().b_z(), 3);
     }
 
     #[test]
     fn zero_step_is_the_identity_without_noise() {
-        let tr = AnomalyTransition::new(&NoiseModel::default());
-        let mut phi = DMatrix::zeros(5, 5);
-        let mut g = DMatrix::from_element(5, 5, 3.0);
-        tr.fill(0.0, &mut phi, &mut g);
-        assert_eq!(phi, DMatrix::identity(5, 5));
-        assert!(g.iter().all(|v| *v == 0.0));
+        for order in ORDERS {
+            let tr = AnomalyTransition::new(&NoiseModel::default(), order);
+            let dim = x2_dim(order);
+            let mut phi = DMatrix::zeros(dim, dim);
+            let mut g = DMatrix::from_element(dim, dim, 3.0);
+            tr.fill(0.0, &mut phi, &mut g);
+            assert_eq!(phi, DMatrix::identity(dim, dim));
+            assert!(g.iter().all(|v| *v == 0.0));
+        }
+    }
+
+    #[test]
+    fn priors_follow_the_order() {
+        let p = X2Prior::default();
+        assert_eq!(p.order, DEFAULT_ORDER);
+        let s = p.stds();
+        assert_eq!(s.len(), 6);
+        assert_eq!(s[3], 1e-4 / 1000.0);
+        assert_eq!(s[4], p.b_z_nt_per_m);
+        let two = X2Prior { order: 2, ..p };
+        assert_eq!(two.stds(), vec![1000.0, 0.1, 0.1, 1e-4]);
+        assert!(!X2Prior { order: 7, ..p }.is_valid());
+        assert!(!X2Prior { order: 1, ..p }.is_valid());
+        // Defaults: the thesis' q₁ for n = 3, the documented one for n = 4.
+        assert_eq!(NoiseModel::calibration_default_for(3).q1, DEFAULT_Q1_ORDER3);
+        let q4 = NoiseModel::calibration_default().q1;
+        assert!((q4 / 3.948e-20 - 1.0).abs() < 1e-3, "{q4}");
+        assert_eq!(q1_unit(3), "nT²/m⁵");
+        assert_eq!(q1_unit(6), "nT²/m¹¹");
     }
 }

@@ -22,7 +22,7 @@
 //! compensated reading; the output is the external field at the sensor,
 //! `y_ref + B^h_k + Δz_k B_z,k` (nT).
 
-use super::anomaly_model::{AnomalyTransition, B_H, B_Z, NoiseModel, X2_DIM, X2Prior};
+use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
 use super::joint_filter::est;
 use super::track::step_length;
 use crate::error::Result;
@@ -51,13 +51,13 @@ pub struct FieldModel<'a> {
     pub noise: NoiseModel,
     /// Field prior.
     pub prior: X2Prior,
-    /// Transition helper (built for `noise`).
+    /// Transition helper (built for `noise` and `prior.order`).
     pub transition: AnomalyTransition,
 }
 
 impl StateSpaceModel for FieldModel<'_> {
     fn dim(&self) -> usize {
-        X2_DIM
+        self.prior.dim()
     }
     fn steps(&self) -> usize {
         self.len
@@ -67,7 +67,7 @@ impl StateSpaceModel for FieldModel<'_> {
         s0.copy_from(&self.prior.factor());
     }
     fn noise_dim(&self) -> usize {
-        X2_DIM
+        self.prior.dim()
     }
     fn transition(&self, k: usize, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
         let d = step_length(self.time, self.speed_m_s, self.offset + k);
@@ -77,7 +77,7 @@ impl StateSpaceModel for FieldModel<'_> {
         let i = self.offset + k;
         h.fill(0.0);
         h[B_H] = 1.0;
-        h[B_Z] = self.alt_m[i] - self.z0_m;
+        h[self.prior.b_z()] = self.alt_m[i] - self.z0_m;
         Some((self.compensated_nt[i] - self.y_ref_nt, self.noise.r_nt2))
     }
 }
@@ -92,7 +92,8 @@ pub fn smooth_field(
 ) -> Result<()> {
     smooth_from_checkpoints(model, checkpoints, false, |k, x, _| {
         let i = model.offset + k;
-        external[i] = model.y_ref_nt + x[B_H] + (model.alt_m[i] - model.z0_m) * x[B_Z];
+        external[i] =
+            model.y_ref_nt + x[B_H] + (model.alt_m[i] - model.z0_m) * x[model.prior.b_z()];
     })
     .map_err(est)
 }

@@ -1,7 +1,7 @@
 //! Method 2 end to end: runs, tuning, pass 1 (coefficients), pass 2 (the
 //! smoothed external field), outputs and diagnostics.
 
-use super::anomaly_model::{AnomalyTransition, NoiseModel, X2_DIM, X2Prior};
+use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::JointFilter;
 use super::rows::{RowSpec, for_each_design_row};
@@ -44,7 +44,9 @@ pub struct KalmanConfig {
     pub noise: NoiseModel,
     /// Maximum-likelihood tuning of the intensities.
     pub tuning: TuningConfig,
-    /// Prior of the field states at every run start.
+    /// Order of the along-track field model and the prior of its states at
+    /// every run start (set [`Self::noise`] to match the order:
+    /// [`NoiseModel::calibration_default_for`]).
     pub field_prior: X2Prior,
     /// Prior standard deviation of every coefficient (mean 0), in its own
     /// units (nT for `p`, `i`, `bias`; nT·s for physical-convention eddy
@@ -115,7 +117,9 @@ pub struct KalmanFit {
     pub vif: Vec<f64>,
     /// Scaled condition number of `P1⁻¹ − P0⁻¹` (∞ when singular).
     pub condition: f64,
-    /// Noise intensities used.
+    /// Order of the along-track field model used ([`X2Prior::order`]).
+    pub field_order: usize,
+    /// Noise intensities used (`q₁` in nT²/m^{2n−1}, `n` the field order).
     pub noise: NoiseModel,
     /// The tuning, when it ran.
     pub tuning: Option<TuningReport>,
@@ -219,7 +223,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         ));
     }
     let rows: usize = runs.iter().map(|r| r.range.len()).sum();
-    if rows < m + X2_DIM {
+    if rows < m + cfg.field_prior.dim() {
         return Err(CompError::BadData(format!(
             "{rows} usable samples are too few for {m} coefficients"
         )));
@@ -318,7 +322,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
                 match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
                     Ok(inn) => {
                         log_lik += inn.log_likelihood();
-                        if i - run.range.start >= X2_DIM {
+                        if i - run.range.start >= cfg.field_prior.dim() {
                             chi2 += inn.value * inn.value / inn.variance;
                             ss += inn.value * inn.value;
                             n_stat += 1;
@@ -366,7 +370,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     // ---- compensated series and pass 2: the smoothed field.
     let mut residual_rms_nt = f64::NAN;
     if cfg.compute_series {
-        let transition = AnomalyTransition::new(&noise);
+        let transition = AnomalyTransition::new(&noise, cfg.field_prior.order);
         let mut res2 = 0.0;
         for (run, cps) in runs.iter().zip(&conditionals) {
             let s = &segments[run.seg];
@@ -431,6 +435,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         posterior_covariance,
         vif,
         condition,
+        field_order: cfg.field_prior.order,
         noise,
         tuning,
         z0_m: z0,

@@ -10,9 +10,9 @@
 //!
 //! with `y = mag − y_ref` (a constant removed for numerical range; `B^h`
 //! absorbs it), `H1_k` the design row and `Δz = alt − z0`. Ordering the
-//! constant states last makes the time update touch only the 5 field rows
+//! constant states last makes the time update touch only the `n + 2` field rows
 //! of the factor ([`SqrtKalmanFilter::predict_leading`]): a step costs
-//! `O(n²)` for the Carlson update plus `O(5 n)` for the prediction, and the
+//! `O(n²)` for the Carlson update plus `O(n_f n)` for the prediction (`n_f = order + 2` field states), and the
 //! memory is `O(n²)` whatever the flight length.
 //!
 //! At the start of every contiguous run of data the field states are
@@ -22,7 +22,7 @@
 //! `P1 = U_c U_cᵀ` are the estimate from the whole flight (a constant's
 //! filtered estimate at the end is also its smoothed estimate).
 
-use super::anomaly_model::{AnomalyTransition, B_H, B_Z, NoiseModel, X2_DIM, X2Prior};
+use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
 use crate::error::{CompError, Result};
 use aeromag_estimation::kalman::{Innovation, LeadingConditional, SqrtKalmanFilter};
 use nalgebra::{DMatrix, DVector};
@@ -33,6 +33,9 @@ pub struct JointFilter {
     filter: SqrtKalmanFilter,
     m: usize,
     noise: NoiseModel,
+    /// Number of field states and the index of `B_z` among them.
+    x2_dim: usize,
+    b_z: usize,
     x2_factor: DMatrix<f64>,
     x1_prior_cov: DMatrix<f64>,
     transition: AnomalyTransition,
@@ -72,28 +75,31 @@ impl JointFilter {
                 "invalid field prior {x2_prior:?} (positive, finite)"
             )));
         }
-        let n = X2_DIM + m;
+        let x2_dim = x2_prior.dim();
+        let n = x2_dim + m;
         let mut x0 = vec![0.0; n];
-        x0[X2_DIM..].copy_from_slice(coef_prior_mean);
+        x0[x2_dim..].copy_from_slice(coef_prior_mean);
         let mut s0 = DMatrix::zeros(n, n);
         let x2_factor = x2_prior.factor();
-        s0.view_mut((0, 0), (X2_DIM, X2_DIM)).copy_from(&x2_factor);
+        s0.view_mut((0, 0), (x2_dim, x2_dim)).copy_from(&x2_factor);
         for (j, s) in coef_prior_std.iter().enumerate() {
-            s0[(X2_DIM + j, X2_DIM + j)] = *s;
+            s0[(x2_dim + j, x2_dim + j)] = *s;
         }
         let filter = SqrtKalmanFilter::new(&x0, &s0).map_err(est)?;
         Ok(Self {
             filter,
             m,
             noise,
+            x2_dim,
+            b_z: x2_prior.b_z(),
             x2_factor,
             x1_prior_cov: DMatrix::from_diagonal(&DVector::from_iterator(
                 m,
                 coef_prior_std.iter().map(|s| s * s),
             )),
-            transition: AnomalyTransition::new(&noise),
-            phi: DMatrix::zeros(X2_DIM, X2_DIM),
-            g: DMatrix::zeros(X2_DIM, X2_DIM),
+            transition: AnomalyTransition::new(&noise, x2_prior.order),
+            phi: DMatrix::zeros(x2_dim, x2_dim),
+            g: DMatrix::zeros(x2_dim, x2_dim),
             h: vec![0.0; n],
             fresh: true,
             last_d: f64::NAN,
@@ -109,7 +115,7 @@ impl JointFilter {
     /// independent of the coefficients; the next step is not predicted.
     pub fn start_run(&mut self) -> Result<()> {
         self.filter
-            .reset_leading(&[0.0; X2_DIM], &self.x2_factor)
+            .reset_leading(&vec![0.0; self.x2_dim], &self.x2_factor)
             .map_err(est)?;
         self.fresh = true;
         Ok(())
@@ -142,10 +148,10 @@ impl JointFilter {
                 .map_err(est)?;
         }
         self.fresh = false;
-        self.h[..X2_DIM].fill(0.0);
+        self.h[..self.x2_dim].fill(0.0);
         self.h[B_H] = 1.0;
-        self.h[B_Z] = dz_m;
-        self.h[X2_DIM..].copy_from_slice(h1);
+        self.h[self.b_z] = dz_m;
+        self.h[self.x2_dim..].copy_from_slice(h1);
         self.filter
             .update(&self.h, y_nt, self.noise.r_nt2)
             .map_err(est)
@@ -153,24 +159,24 @@ impl JointFilter {
 
     /// The current coefficient estimate `X1`.
     pub fn coefficients(&self) -> &[f64] {
-        &self.filter.state().as_slice()[X2_DIM..]
+        &self.filter.state().as_slice()[self.x2_dim..]
     }
 
     /// The current field-state estimate `X2`.
     pub fn field_state(&self) -> &[f64] {
-        &self.filter.state().as_slice()[..X2_DIM]
+        &self.filter.state().as_slice()[..self.x2_dim]
     }
 
     /// The covariance of the coefficients, `U_c U_cᵀ` (`m × m`).
     pub fn coefficient_covariance(&self) -> DMatrix<f64> {
-        self.filter.trailing_covariance(X2_DIM)
+        self.filter.trailing_covariance(self.x2_dim)
     }
 
     /// The upper-triangular factor `U_c` of the coefficient covariance.
     pub fn coefficient_factor(&self) -> DMatrix<f64> {
         self.filter
             .factor()
-            .view((X2_DIM, X2_DIM), (self.m, self.m))
+            .view((self.x2_dim, self.x2_dim), (self.m, self.m))
             .into_owned()
     }
 
@@ -179,7 +185,7 @@ impl JointFilter {
     /// of the whole flight it is the filtered estimate of pass 2 at this
     /// sample, a restart point for the smoother.
     pub fn field_conditional(&self) -> Result<LeadingConditional> {
-        self.filter.leading_conditional(X2_DIM).map_err(est)
+        self.filter.leading_conditional(self.x2_dim).map_err(est)
     }
 
     /// The prior covariance of the coefficients (diagonal).

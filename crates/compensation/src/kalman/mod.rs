@@ -94,7 +94,7 @@ pub mod rows;
 pub mod track;
 pub mod tuning;
 
-pub use anomaly_model::{NoiseModel, X2Prior};
+pub use anomaly_model::{DEFAULT_ORDER, NoiseModel, ORDERS, THESIS_ORDER, X2Prior, q1_unit};
 pub use fit::{KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman};
 pub use joint_filter::JointFilter;
 pub use track::{ground_speed_from_positions, ground_speed_from_velocity};

@@ -81,7 +81,7 @@ pub struct HeadingRate {
 /// The pod model file (versioned JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PodModelFile {
-    /// Always [`MODEL_FORMAT`].
+    /// Always [`crate::model_file::MODEL_FORMAT`].
     pub format: String,
     /// Always [`POD_KIND`].
     pub kind: String,

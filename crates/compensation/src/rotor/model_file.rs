@@ -28,7 +28,7 @@ pub struct PhaseSource {
 /// The rotor model file (versioned JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RotorModelFile {
-    /// Always [`MODEL_FORMAT`].
+    /// Always [`crate::model_file::MODEL_FORMAT`].
     pub format: String,
     /// Always [`ROTOR_KIND`].
     pub kind: String,
