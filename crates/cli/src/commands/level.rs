@@ -52,6 +52,12 @@ pub struct Args {
     /// levelled series is not reduced to a common height either way.
     #[arg(long)]
     no_altitude_term: bool,
+    /// Plain least squares: do not down-weight outlying crossovers. By
+    /// default the fit is iteratively reweighted with Huber weights (2σ̂,
+    /// σ̂ from the median absolute residual), so one bad crossover (a GNSS
+    /// height error at a steep gradient, a spike) cannot pull k.
+    #[arg(long)]
+    no_robust: bool,
     /// Ridge penalty on the offsets (and drifts).
     #[arg(long, default_value_t = 1e-3)]
     lambda: f64,
@@ -64,6 +70,11 @@ pub struct Args {
     /// column is then the reduced value, levelled.
     #[arg(long, default_value = "none", value_name = "none|auto|COLS")]
     reference: String,
+    /// Also write the crossover table to this CSV: one row per crossover
+    /// with both lines, position, times, altitudes, values, d|B0|/dt,
+    /// the difference, what the fitted model leaves of it and its weight.
+    #[arg(long, value_name = "FILE.csv")]
+    crossovers: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -131,6 +142,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         drift: a.drift,
         lambda: a.lambda,
         altitude_term: !(a.tie_only || a.no_altitude_term),
+        robust: !a.no_robust,
         ..LevellingConfig::default()
     };
     let spinner = crate::progress::spinner("levelling");
@@ -186,6 +198,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             f.rms_before_nt, f.rms_after_nt
         );
     }
+    if cfg.robust {
+        println!(
+            "robust weighting: {} of {} crossovers down-weighted (Huber, {} σ̂ = {:.4} nT){}",
+            f.downweighted,
+            f.weights.len(),
+            aeromag_compensation::levelling::HUBER_K,
+            f.sigma_nt,
+            if f.downweighted > 0 {
+                "; --crossovers writes the weights"
+            } else {
+                ""
+            }
+        );
+    }
     if f.components > 1 {
         eprintln!(
             "warning: the lines form {} groups that never cross; their relative levels rest on the penalty, not the data",
@@ -206,5 +232,44 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "{n} rows written to {} (column {out_name})",
         a.out.display()
     );
+    if let Some(path) = &a.crossovers {
+        write_crossovers(&lev.crossovers.crossovers, f, path)?;
+        println!("crossover table written to {}", path.display());
+    }
+    Ok(())
+}
+
+/// The crossover table of `--crossovers` (units in the column names).
+fn write_crossovers(
+    xs: &[aeromag_compensation::levelling::Crossover],
+    fit: &aeromag_compensation::levelling::LevellingFit,
+    path: &std::path::Path,
+) -> anyhow::Result<()> {
+    let mut t = aeromag_io::FlightTable::new();
+    let col = |f: &dyn Fn(&aeromag_compensation::levelling::Crossover) -> f64| -> Vec<f64> {
+        xs.iter().map(f).collect()
+    };
+    let columns: Vec<(&str, Vec<f64>)> = vec![
+        ("line_a", col(&|x| x.a.label as f64)),
+        ("line_b", col(&|x| x.b.label as f64)),
+        ("north_m", col(&|x| x.north_m)),
+        ("east_m", col(&|x| x.east_m)),
+        ("angle_deg", col(&|x| x.angle_deg)),
+        ("time_a_s", col(&|x| x.a.time_s)),
+        ("time_b_s", col(&|x| x.b.time_s)),
+        ("alt_a_m", col(&|x| x.a.alt_m)),
+        ("alt_b_m", col(&|x| x.b.alt_m)),
+        ("value_a_nt", col(&|x| x.a.value_nt)),
+        ("value_b_nt", col(&|x| x.b.value_nt)),
+        ("rate_a_nt_per_s", col(&|x| x.a.derivative_nt_per_s)),
+        ("rate_b_nt_per_s", col(&|x| x.b.derivative_nt_per_s)),
+        ("difference_nt", col(&|x| x.difference_nt())),
+        ("residual_nt", fit.residuals_nt.clone()),
+        ("weight", fit.weights.clone()),
+    ];
+    for (name, v) in columns {
+        t.add_column(name, v)?;
+    }
+    aeromag_io::write_csv(&t, path)?;
     Ok(())
 }
