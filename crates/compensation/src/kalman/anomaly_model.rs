@@ -109,9 +109,12 @@ pub const DEFAULT_Q1_ORDER3: f64 = 1e-15;
 /// spectral level as the thesis' default, m (module docs).
 pub const DEFAULT_MATCH_WAVELENGTH_M: f64 = 1000.0;
 
+/// Order of the `B_z` chain (the thesis' second integral).
+const Z_ORDER: usize = 2;
+
 /// Number of states of `X2` for a chain of order `n`: `n + 2`.
 pub fn x2_dim(order: usize) -> usize {
-    order + 2
+    order + Z_ORDER
 }
 
 /// Index of `B_z` (nT/m, derivative with respect to altitude) in `X2` for a
@@ -276,16 +279,64 @@ fn factorial(n: usize) -> f64 {
     (1..=n).map(|k| k as f64).product()
 }
 
+/// One chain of `n` integrators driven by white noise of intensity `q`:
+/// the constant Cholesky factor of its `M` (module docs) and `√q`.
+#[derive(Debug, Clone)]
+struct Chain {
+    n: usize,
+    l: DMatrix<f64>,
+    sqrt_q: f64,
+}
+
+impl Chain {
+    fn new(n: usize, q: f64) -> Self {
+        // M[i][j] = 1/((n−1−i)! (n−1−j)! (2n−1−i−j)): positive definite (a
+        // Gram matrix of the monomials σ^{n−1−i}/(n−1−i)! on [0, 1]).
+        let m = DMatrix::from_fn(n, n, |i, j| {
+            let (a, b) = (n - 1 - i, n - 1 - j);
+            1.0 / (factorial(a) * factorial(b) * (a + b + 1) as f64)
+        });
+        let l = m
+            .cholesky()
+            .expect("the Gram matrix of the monomials is positive definite")
+            .l();
+        Self {
+            n,
+            l,
+            sqrt_q: q.max(0.0).sqrt(),
+        }
+    }
+
+    /// Write `Φ` (`d^{j−i}/(j−i)!`) and `G = √q T chol(M)` of a step `d`
+    /// into the diagonal block starting at `at` (the rest is untouched).
+    fn fill(&self, d: f64, at: usize, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
+        let n = self.n;
+        for i in 0..n {
+            phi[(at + i, at + i)] = 1.0;
+            let mut p = 1.0;
+            for j in i + 1..n {
+                p *= d / (j - i) as f64;
+                phi[(at + i, at + j)] = p;
+            }
+        }
+        let sd = d.sqrt();
+        for i in 0..n {
+            let ti = self.sqrt_q * sd * d.powi((n - 1 - i) as i32);
+            for j in 0..=i {
+                g[(at + i, at + j)] = ti * self.l[(i, j)];
+            }
+        }
+    }
+}
+
 /// Exact transition over an along-track step (module docs) for given noise
-/// intensities and order, with the Cholesky factors of `M` (order `n`) and
-/// `M₂`, and `√q₁`, `√q₂` computed once.
+/// intensities and order: the `B^h` chain of order `n` and the `B_z`
+/// chain of order 2, their constant factors computed once.
 #[derive(Debug, Clone)]
 pub struct AnomalyTransition {
     order: usize,
-    l1: DMatrix<f64>,
-    l2: [[f64; 2]; 2],
-    s1: f64,
-    s2: f64,
+    horizontal: Chain,
+    vertical: Chain,
 }
 
 impl AnomalyTransition {
@@ -297,27 +348,10 @@ impl AnomalyTransition {
             ORDERS.contains(&order),
             "field order {order} not in {ORDERS:?}"
         );
-        let n = order;
-        // M[i][j] = 1/((n−1−i)! (n−1−j)! (2n−1−i−j)): positive definite (a
-        // Gram matrix of the monomials σ^{n−1−i}/(n−1−i)! on [0, 1]).
-        let m = DMatrix::from_fn(n, n, |i, j| {
-            let (a, b) = (n - 1 - i, n - 1 - j);
-            1.0 / (factorial(a) * factorial(b) * (a + b + 1) as f64)
-        });
-        let l1 = m
-            .cholesky()
-            .expect("the Gram matrix of the monomials is positive definite")
-            .l();
-        // M₂ = [[1/3, 1/2], [1/2, 1]].
-        let m00 = (1.0f64 / 3.0).sqrt();
-        let m10 = 0.5 / m00;
-        let m11 = (1.0 - m10 * m10).sqrt();
         Self {
             order,
-            l1,
-            l2: [[m00, 0.0], [m10, m11]],
-            s1: noise.q1.max(0.0).sqrt(),
-            s2: noise.q2_nt2_per_m5.max(0.0).sqrt(),
+            horizontal: Chain::new(order, noise.q1),
+            vertical: Chain::new(Z_ORDER, noise.q2_nt2_per_m5),
         }
     }
 
@@ -336,34 +370,10 @@ impl AnomalyTransition {
             "field transition matrices must be {dim}×{dim}"
         );
         let d = d.max(0.0);
-        let n = self.order;
         phi.fill(0.0);
-        for i in 0..dim {
-            phi[(i, i)] = 1.0;
-        }
-        for i in 0..n {
-            let mut p = 1.0;
-            for j in i + 1..n {
-                p *= d / (j - i) as f64;
-                phi[(i, j)] = p;
-            }
-        }
-        let bz = b_z_index(n);
-        phi[(bz, bz + 1)] = d;
         g.fill(0.0);
-        let sd = d.sqrt();
-        for i in 0..n {
-            let ti = self.s1 * sd * d.powi((n - 1 - i) as i32);
-            for j in 0..=i {
-                g[(i, j)] = ti * self.l1[(i, j)];
-            }
-        }
-        let t2 = [d * sd, sd];
-        for i in 0..2 {
-            for j in 0..=i {
-                g[(bz + i, bz + j)] = self.s2 * t2[i] * self.l2[i][j];
-            }
-        }
+        self.horizontal.fill(d, 0, phi, g);
+        self.vertical.fill(d, b_z_index(self.order), phi, g);
     }
 }
 
