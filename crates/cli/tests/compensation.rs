@@ -521,6 +521,25 @@ fn demo_meets_the_compensation_figures() {
             assert!(s[group][k].as_f64().is_some(), "summary key {group}.{k}");
         }
     }
+    // Levelling of the compensated survey (seed 1's survey: k = −0.0972 ±
+    // 0.0042 s measured, truth −0.1): k within 10 % and 3σ, and the classic
+    // case (no base station) reduced more than 5×.
+    let l = |k: &str| {
+        s["levelling"][k]
+            .as_f64()
+            .unwrap_or_else(|| panic!("summary key levelling.{k}"))
+    };
+    assert_eq!(l("crossovers"), 100.0);
+    let (k, sk, kt) = (l("k_s"), l("k_std_s"), l("k_true_s"));
+    assert!(
+        (k - kt).abs() <= 0.1 * kt.abs() && (k - kt).abs() <= 3.0 * sk,
+        "k = {k} ± {sk}, truth {kt}"
+    );
+    assert!(
+        l("rms_before_no_base_station_nt") >= 5.0 * l("rms_after_no_base_station_nt"),
+        "{}",
+        s["levelling"]
+    );
 }
 
 #[test]

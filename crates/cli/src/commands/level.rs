@@ -4,8 +4,10 @@
 use crate::exit::bad_input;
 use crate::input::InputArgs;
 use aeromag_compensation::levelling::{
-    LevellingConfig, RowFlag, SurveyTracks, TrackConfig, level_survey, sensor_positions,
+    LevellingConfig, RowFlag, SurveyLevelling, SurveyTracks, TrackConfig, level_survey,
+    sensor_positions,
 };
+use aeromag_io::FlightTable;
 use std::path::PathBuf;
 
 /// Level a (compensated) survey: find the crossovers of lines and tie lines,
@@ -94,49 +96,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if !(a.lambda >= 0.0 && a.lambda.is_finite()) {
         return Err(bad_input!("--lambda {} must be ≥ 0", a.lambda));
     }
-    let (lat, lon, alt) = (
-        table.require("lat")?,
-        table.require("lon")?,
-        table.require("alt")?,
-    );
-    let positions = match &a.lever_arm {
-        Some(s) => {
-            let lever = crate::flight::parse_lever_arm(s)?;
-            let (r, p, y) = (
-                table.require("roll")?,
-                table.require("pitch")?,
-                table.require("yaw")?,
-            );
-            Some(
-                sensor_positions(lat, lon, alt, r, p, y, lever)
-                    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?,
-            )
-        }
-        None => None,
-    };
-    let (lat, lon, alt) = match &positions {
-        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
-        None => (lat, lon, alt),
-    };
-    let ref_cols = crate::flight::reference_columns(&table, &a.reference)?;
-    let reference = crate::flight::reference_sum(&table, &ref_cols, None)?;
-    let value: Vec<f64> = table
-        .require(&value_name)?
-        .iter()
-        .zip(&reference)
-        .map(|(v, r)| v - r)
-        .collect();
-    if !ref_cols.is_empty() {
-        println!("levelling {value_name} − {}", ref_cols.join(" − "));
-    }
-    let tracks = SurveyTracks {
-        time: table.require("time")?,
-        lat,
-        lon,
-        alt,
-        line: table.require("line")?,
-        value: &value,
-    };
     let cfg = LevellingConfig {
         estimate_k: !a.tie_only,
         drift: a.drift,
@@ -145,10 +104,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         robust: !a.no_robust,
         ..LevellingConfig::default()
     };
+    let lever = a
+        .lever_arm
+        .as_deref()
+        .map(crate::flight::parse_lever_arm)
+        .transpose()?;
     let spinner = crate::progress::spinner("levelling");
-    let lev = level_survey(&tracks, &TrackConfig::default(), &cfg)
-        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let (lev, ref_cols) = level_table(&table, &value_name, lever, &a.reference, &cfg)?;
     spinner.finish_and_clear();
+    if !ref_cols.is_empty() {
+        println!("levelling {value_name} − {}", ref_cols.join(" − "));
+    }
     let f = &lev.fit;
     let flags: Vec<f64> = lev
         .levelled
@@ -272,4 +238,59 @@ fn write_crossovers(
     }
     aeromag_io::write_csv(&t, path)?;
     Ok(())
+}
+
+/// Level `value_name` of `table` (the command's docs): sensor positions
+/// from the lever arm (body frame, m) when given, the reference channels
+/// (`none`, `auto` or a list) subtracted, crossovers found and fitted with
+/// `cfg`. Returns the levelling and the reference columns used.
+pub fn level_table(
+    table: &FlightTable,
+    value_name: &str,
+    lever_arm_m: Option<[f64; 3]>,
+    reference: &str,
+    cfg: &LevellingConfig,
+) -> anyhow::Result<(SurveyLevelling, Vec<String>)> {
+    let (lat, lon, alt) = (
+        table.require("lat")?,
+        table.require("lon")?,
+        table.require("alt")?,
+    );
+    let positions = match lever_arm_m {
+        Some(lever) => {
+            let (r, p, y) = (
+                table.require("roll")?,
+                table.require("pitch")?,
+                table.require("yaw")?,
+            );
+            Some(
+                sensor_positions(lat, lon, alt, r, p, y, lever)
+                    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?,
+            )
+        }
+        None => None,
+    };
+    let (lat, lon, alt) = match &positions {
+        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
+        None => (lat, lon, alt),
+    };
+    let ref_cols = crate::flight::reference_columns(table, reference)?;
+    let reference = crate::flight::reference_sum(table, &ref_cols, None)?;
+    let value: Vec<f64> = table
+        .require(value_name)?
+        .iter()
+        .zip(&reference)
+        .map(|(v, r)| v - r)
+        .collect();
+    let tracks = SurveyTracks {
+        time: table.require("time")?,
+        lat,
+        lon,
+        alt,
+        line: table.require("line")?,
+        value: &value,
+    };
+    let lev = level_survey(&tracks, &TrackConfig::default(), cfg)
+        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    Ok((lev, ref_cols))
 }
