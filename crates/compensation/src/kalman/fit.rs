@@ -558,6 +558,28 @@ fn validate(cfg: &KalmanConfig) -> Result<()> {
 }
 
 impl KalmanFit {
+    /// The profile log-likelihood of the coefficients, for comparing models
+    /// with different terms: [`KalmanFit::log_likelihood`] is the marginal
+    /// likelihood under the coefficients' prior `N(0, P0)`, which penalises
+    /// every added coefficient by its prior width (with the diffuse default,
+    /// a model with more terms always loses). For a linear-Gaussian model
+    /// `ℓ_marginal = ℓ_profile − ½ ln det(P0 P1⁻¹) + ½ X̂1ᵀ P0⁻¹ X̂1`; with a
+    /// diffuse prior the last term vanishes, so
+    /// `ℓ_profile ≈ ℓ_marginal + ½ (ln det P0 − ln det P1)`. Twice the
+    /// difference of two nested models is the likelihood-ratio statistic
+    /// (χ² with the number of added coefficients). NaN if a covariance is
+    /// not positive definite.
+    pub fn profile_log_likelihood(&self) -> f64 {
+        let log_det = |m: &DMatrix<f64>| {
+            m.clone()
+                .cholesky()
+                .map(|c| 2.0 * c.l().diagonal().iter().map(|v| v.ln()).sum::<f64>())
+                .unwrap_or(f64::NAN)
+        };
+        self.log_likelihood
+            + 0.5 * (log_det(&self.prior_covariance) - log_det(&self.posterior_covariance))
+    }
+
     /// The fit in the shape of the band-pass least-squares result, so
     /// callers can report and store both the same way (VIF and condition are
     /// those of the posterior information; the residual is

@@ -569,3 +569,30 @@ fn a_flight_without_manoeuvres_on_one_heading_is_reported() {
         .fold(0.0, f64::max);
     assert!(worst > 0.5, "{worst}");
 }
+
+/// The profile likelihood compares nested term sets: a group the data hold
+/// gives a huge likelihood-ratio statistic, a group they do not hold one of
+/// the size of χ² for its columns (the marginal likelihood would instead
+/// penalise every added coefficient by its diffuse prior).
+#[test]
+fn profile_likelihood_ratio_tells_a_real_group_from_an_empty_one() {
+    let p3i5 = TermSet::parse("p3,i5").unwrap();
+    let coef = [30.0, -12.0, 45.0, 20.0, -5.0, 8.0, 15.0, -3.0];
+    let b = flight(NOISE, &p3i5, &coef, 5);
+    let fit = |terms: &str| {
+        let cfg = no_tuning(TermSet::parse(terms).unwrap(), NOISE);
+        fit_kalman(&[b.segment()], &cfg).unwrap()
+    };
+    let (p3, truth, more) = (fit("p3"), fit("p3,i5"), fit("p3,i5,e8"));
+    let lr_missing = 2.0 * (truth.profile_log_likelihood() - p3.profile_log_likelihood());
+    let lr_empty = 2.0 * (more.profile_log_likelihood() - truth.profile_log_likelihood());
+    eprintln!("LR induced group {lr_missing:.1}, empty eddy group {lr_empty:.2}");
+    assert!(lr_missing > 1000.0, "LR for the induced group {lr_missing}");
+    // χ²₈: mean 8, 99.9 % quantile 26.1.
+    assert!(
+        (-1.0..26.1).contains(&lr_empty),
+        "LR for an empty eddy group {lr_empty}"
+    );
+    // The marginal likelihood prefers the smaller, true model.
+    assert!(more.log_likelihood < truth.log_likelihood);
+}

@@ -202,6 +202,16 @@ pub fn within_budget<'a>(
     out
 }
 
+/// The threshold a likelihood-ratio statistic must exceed for the best of
+/// `candidates` lags, each adding `columns` columns, to be kept at the
+/// false-selection probability `alpha`: the `χ²_columns` quantile at
+/// `1 − α/candidates` (Bonferroni over the candidates tried).
+pub fn lag_threshold(alpha: f64, candidates: usize, columns: usize) -> Result<f64> {
+    let m = candidates.max(1) as f64;
+    chi_square_quantile(1.0 - alpha / m, columns as u32)
+        .map_err(|e| CompError::BadData(format!("lag selection: {e}")))
+}
+
 /// Choose up to `max_lags` lags from `grid_s` (s) for `cfg`'s term set (which
 /// must hold an eddy group; lagged groups already in it are replaced), each
 /// kept at the false-selection probability `alpha` (0 < α < 1). Pass
@@ -213,11 +223,7 @@ pub fn select_eddy_lags(
     max_lags: usize,
     alpha: f64,
 ) -> Result<LagSelection> {
-    let threshold = |q: usize| -> Result<f64> {
-        let m = grid_s.len().max(1) as f64;
-        chi_square_quantile(1.0 - alpha / m, q as u32)
-            .map_err(|e| CompError::BadData(format!("lag selection: {e}")))
-    };
+    let threshold = |q: usize| lag_threshold(alpha, grid_s.len(), q);
     let with = |taus: &[f64]| -> Result<LsConfig> {
         Ok(LsConfig {
             terms: cfg.terms.with_eddy_lags(taus)?,
