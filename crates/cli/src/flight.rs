@@ -90,6 +90,23 @@ pub fn parse_numbers(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> 
     Ok(v)
 }
 
+/// The sensor's track `[lat (deg), lon (deg), alt (m)]` from the
+/// navigation point's (`lat`, `lon`, `alt`) moved by the lever arm
+/// `arm_m` (body frame, m) with the attitude (`roll`, `pitch`, `yaw`).
+pub fn sensor_track(table: &FlightTable, arm_m: [f64; 3]) -> anyhow::Result<[Vec<f64>; 3]> {
+    let col = |n: &str| table.require(n);
+    aeromag_compensation::levelling::sensor_positions(
+        col("lat")?,
+        col("lon")?,
+        col("alt")?,
+        col("roll")?,
+        col("pitch")?,
+        col("yaw")?,
+        arm_m,
+    )
+    .map_err(|e| bad_input!("{}: {e}", table.file_label()))
+}
+
 /// A parsed `X,Y,Z` lever arm in metres (body frame: x forward, y right,
 /// z down).
 pub fn parse_lever_arm(s: &str) -> anyhow::Result<[f64; 3]> {

@@ -7,7 +7,6 @@ use aeromag_compensation::kalman::{
     DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, ORDERS,
     X2Prior, fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
 };
-use aeromag_compensation::levelling::sensor_positions;
 use aeromag_compensation::model_file::{Coefficient, FitStats, MODEL_FORMAT, TL_KIND, TlModel};
 use aeromag_compensation::reference_field::LeverArm;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
@@ -417,23 +416,24 @@ fn add_lags_by_kalman_likelihood(
     first: &KalmanFit,
     fail: impl Fn(aeromag_compensation::CompError) -> anyhow::Error,
 ) -> anyhow::Result<TermSet> {
-    let fixed = |terms: &TermSet| KalmanConfig {
-        terms: terms.clone(),
-        noise: first.noise,
-        tuning: aeromag_compensation::kalman::TuningConfig {
-            enabled: false,
-            ..cfg.tuning.clone()
-        },
-        compute_series: false,
-        ..cfg.clone()
-    };
-    let profile = |terms: &TermSet| -> anyhow::Result<(f64, usize)> {
-        let f = fit_kalman(segments, &fixed(terms)).map_err(&fail)?;
-        Ok((f.profile_log_likelihood(), f.coef.len()))
-    };
     if terms.eddy_lags_s().len() >= 2 {
         return Ok(terms);
     }
+    // Untuned passes with the first pass's noise intensities.
+    let mut fixed = KalmanConfig {
+        noise: first.noise,
+        compute_series: false,
+        ..cfg.clone()
+    };
+    fixed.tuning.enabled = false;
+    let profile = |terms: &TermSet| -> anyhow::Result<(f64, usize)> {
+        let c = KalmanConfig {
+            terms: terms.clone(),
+            ..fixed.clone()
+        };
+        let f = fit_kalman(segments, &c).map_err(&fail)?;
+        Ok((f.profile_log_likelihood(), f.coef.len()))
+    };
     let spinner = crate::progress::spinner("Kalman likelihood-ratio test of further lags");
     let (mut base, mut m) = profile(&terms)?;
     while terms.eddy_lags_s().len() < 2 {
@@ -476,21 +476,10 @@ fn add_lags_by_kalman_likelihood(
 /// manoeuvre, where the vertical gradient of a low calibration makes it
 /// matter); without one, `alt` as recorded.
 fn sensor_altitude(table: &FlightTable, lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
-    let alt = table.require("alt")?;
     let Some(lever) = lever else {
-        return Ok(alt.to_vec());
+        return Ok(table.require("alt")?.to_vec());
     };
-    let col = |n: &str| table.require(n);
-    let [_, _, sensor_alt] = sensor_positions(
-        col("lat")?,
-        col("lon")?,
-        alt,
-        col("roll")?,
-        col("pitch")?,
-        col("yaw")?,
-        lever.arm_m,
-    )
-    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+    let [_, _, sensor_alt] = crate::flight::sensor_track(table, lever.arm_m)?;
     Ok(sensor_alt)
 }
 

@@ -61,10 +61,15 @@ fn fmt(v: Option<f64>, digits: usize) -> String {
     v.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
+/// A written scenario file, parsed.
+fn scenario_toml(scenario: &std::path::Path) -> anyhow::Result<toml::Value> {
+    Ok(toml::from_str(&std::fs::read_to_string(scenario)?)?)
+}
+
 /// The scalar sensor's lever arm (`scalar.position_m`, body frame, m) and
 /// the flight date (`flight.date`) from a scenario file.
 fn installation(scenario: &std::path::Path) -> anyhow::Result<LeverArm> {
-    let v: toml::Value = toml::from_str(&std::fs::read_to_string(scenario)?)?;
+    let v = scenario_toml(scenario)?;
     let arm = v
         .get("scalar")
         .and_then(|s| s.get("position_m"))
@@ -86,8 +91,8 @@ fn installation(scenario: &std::path::Path) -> anyhow::Result<LeverArm> {
 /// The scalar sensor's lag (s) of a written survey scenario: the truth of
 /// the levelling's k (`k = −lag`). Read for scoring only.
 fn survey_lag_s(scenario: &std::path::Path) -> anyhow::Result<f64> {
-    let v: toml::Value = toml::from_str(&std::fs::read_to_string(scenario)?)?;
-    v.get("scalar")
+    scenario_toml(scenario)?
+        .get("scalar")
         .and_then(|s| s.get("lag_s"))
         .and_then(|x| x.as_float())
         .ok_or_else(|| anyhow::anyhow!("{}: no scalar.lag_s", scenario.display()))
@@ -215,6 +220,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let level_cfg = LevellingConfig::default();
     let (lev, _) = level_table(&survey, "mag_comp", lever, "auto", &level_cfg)?;
     let (lev_none, _) = level_table(&survey, "mag_comp", lever, "none", &level_cfg)?;
+    let survey_lag = survey_lag_s(&survey_files.scenario)?;
     bar.inc(1);
 
     // Helicopter rotor and EM bird positioning.
@@ -258,7 +264,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "crossovers": lev.crossovers.crossovers.len(),
             "k_s": lev.fit.k_s,
             "k_std_s": lev.fit.k_std_s,
-            "k_true_s": -survey_lag_s(&survey_files.scenario)?,
+            "k_true_s": -survey_lag,
             "rms_before_nt": lev.fit.rms_before_nt,
             "rms_after_nt": lev.fit.rms_after_nt,
             "downweighted": lev.fit.downweighted,
@@ -412,7 +418,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
          with Huber weights ({} crossovers down-weighted). With the base station and IGRF removed \
          (`--reference auto`) k = {:.4} ± {:.4} s.",
         lev.crossovers.crossovers.len(),
-        survey_lag_s(&survey_files.scenario)?,
+        survey_lag,
         lev.fit.downweighted,
         lev.fit.k_s,
         lev.fit.k_std_s

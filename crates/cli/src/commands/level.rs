@@ -5,7 +5,6 @@ use crate::exit::bad_input;
 use crate::input::InputArgs;
 use aeromag_compensation::levelling::{
     LevellingConfig, RowFlag, SurveyLevelling, SurveyTracks, TrackConfig, level_survey,
-    sensor_positions,
 };
 use aeromag_io::FlightTable;
 use std::path::PathBuf;
@@ -251,28 +250,16 @@ pub fn level_table(
     reference: &str,
     cfg: &LevellingConfig,
 ) -> anyhow::Result<(SurveyLevelling, Vec<String>)> {
-    let (lat, lon, alt) = (
-        table.require("lat")?,
-        table.require("lon")?,
-        table.require("alt")?,
-    );
-    let positions = match lever_arm_m {
-        Some(lever) => {
-            let (r, p, y) = (
-                table.require("roll")?,
-                table.require("pitch")?,
-                table.require("yaw")?,
-            );
-            Some(
-                sensor_positions(lat, lon, alt, r, p, y, lever)
-                    .map_err(|e| bad_input!("{}: {e}", table.file_label()))?,
-            )
-        }
-        None => None,
-    };
+    let positions = lever_arm_m
+        .map(|arm| crate::flight::sensor_track(table, arm))
+        .transpose()?;
     let (lat, lon, alt) = match &positions {
         Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
-        None => (lat, lon, alt),
+        None => (
+            table.require("lat")?,
+            table.require("lon")?,
+            table.require("alt")?,
+        ),
     };
     let ref_cols = crate::flight::reference_columns(table, reference)?;
     let reference = crate::flight::reference_sum(table, &ref_cols, None)?;
