@@ -12,13 +12,14 @@
 //! the lag term (levellable through `k`), the heading error (a level per line
 //! direction), and — not levellable — the anomaly difference between the
 //! altitudes of the two passes (turbulence: ±7 m RMS), the IGRF evaluated at
-//! the recorded rather than the true position, the lag of the interference
-//! itself, and noise. The altitude term (on by default) models the anomaly
+//! the recorded rather than the true position, and noise. (The lag of the
+//! interference itself is levellable too: the regressor is the derivative
+//! of the uncompensated `mag`, [`SurveyTracks::sensed`].) The altitude term (on by default) models the anomaly
 //! difference from the vertical gradient of the two profiles, so the model
 //! residual goes below that floor. On the default survey (20 lines × 5
 //! ties, 100 crossovers) the tests check that levelling reduces the
 //! crossover RMS ≥ 3× below the floor and recovers `k` within 10 % and
-//! within 3σ (σ ≈ 6 %), that a larger block (576 crossovers) does so too,
+//! within 3σ (σ ≈ 4 %), that a larger block (576 crossovers) does so too,
 //! and that the classic levelling error — a diurnal variation left
 //! uncorrected — is reduced far more than 5×.
 
@@ -76,6 +77,7 @@ fn run(
         alt: &alt,
         line: col(&sim, "line"),
         value: &value,
+        sensed: Some(mag),
     };
     let r = level_survey(&tracks, &TrackConfig::default(), cfg).expect("levelling");
     let f = &r.fit;
@@ -235,6 +237,7 @@ fn level_survey_offsets_only(sim: &Simulation, value: &[f64]) -> f64 {
         alt: &alt,
         line: col(sim, "line"),
         value,
+        sensed: None,
     };
     let cfg = LevellingConfig {
         estimate_k: false,

@@ -218,8 +218,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // --lever-arm … --reference auto`, and without the base station).
     let lever = opts.lever_arm.as_ref().map(|l| l.arm_m);
     let level_cfg = LevellingConfig::default();
-    let (lev, _) = level_table(&survey, "mag_comp", lever, "auto", &level_cfg)?;
-    let (lev_none, _) = level_table(&survey, "mag_comp", lever, "none", &level_cfg)?;
+    let lev = level_table(&survey, "mag_comp", None, lever, "auto", &level_cfg)?.levelling;
+    let lev_none = level_table(&survey, "mag_comp", None, lever, "none", &level_cfg)?.levelling;
     let survey_lag = survey_lag_s(&survey_files.scenario)?;
     bar.inc(1);
 

@@ -40,6 +40,14 @@ pub struct Args {
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m.
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     lever_arm: Option<String>,
+    /// Column whose along-track derivative is the regressor of the
+    /// d|B0|/dt term (default `mag`, the uncompensated reading, when the
+    /// file has it; else the levelled value). A lag of the scalar channel
+    /// acts on everything the sensor sees, the aircraft's own interference
+    /// included, and the compensated value has lost the interference's rate
+    /// but not its lag.
+    #[arg(long, value_name = "COLUMN")]
+    rate_of: Option<String>,
     /// Plain tie-line levelling: offsets only, no d|B0|/dt term.
     #[arg(long)]
     tie_only: bool,
@@ -109,10 +117,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(crate::flight::parse_lever_arm)
         .transpose()?;
     let spinner = crate::progress::spinner("levelling");
-    let (lev, ref_cols) = level_table(&table, &value_name, lever, &a.reference, &cfg)?;
+    let LevelTable {
+        levelling: lev,
+        reference_columns: ref_cols,
+        rate_column,
+    } = level_table(
+        &table,
+        &value_name,
+        a.rate_of.as_deref(),
+        lever,
+        &a.reference,
+        &cfg,
+    )?;
     spinner.finish_and_clear();
     if !ref_cols.is_empty() {
         println!("levelling {value_name} − {}", ref_cols.join(" − "));
+    }
+    if cfg.estimate_k {
+        println!("d|B0|/dt regressor: along-track derivative of `{rate_column}`");
     }
     let f = &lev.fit;
     let flags: Vec<f64> = lev
@@ -228,6 +250,14 @@ fn write_crossovers(
         ("value_b_nt", col(&|x| x.b.value_nt)),
         ("rate_a_nt_per_s", col(&|x| x.a.derivative_nt_per_s)),
         ("rate_b_nt_per_s", col(&|x| x.b.derivative_nt_per_s)),
+        (
+            "profile_gradient_a_nt_per_m",
+            col(&|x| x.a.profile_gradient_nt_per_m),
+        ),
+        (
+            "profile_gradient_b_nt_per_m",
+            col(&|x| x.b.profile_gradient_nt_per_m),
+        ),
         ("difference_nt", col(&|x| x.difference_nt())),
         ("residual_nt", fit.residuals_nt.clone()),
         ("weight", fit.weights.clone()),
@@ -239,17 +269,29 @@ fn write_crossovers(
     Ok(())
 }
 
+/// What [`level_table`] did.
+pub struct LevelTable {
+    /// The levelling.
+    pub levelling: SurveyLevelling,
+    /// The reference channels subtracted from the value.
+    pub reference_columns: Vec<String>,
+    /// The column whose derivative is the `d|B0|/dt` regressor.
+    pub rate_column: String,
+}
+
 /// Level `value_name` of `table` (the command's docs): sensor positions
 /// from the lever arm (body frame, m) when given, the reference channels
-/// (`none`, `auto` or a list) subtracted, crossovers found and fitted with
-/// `cfg`. Returns the levelling and the reference columns used.
+/// (`none`, `auto` or a list) subtracted, the `d|B0|/dt` regressor the
+/// derivative of `rate_of` (default `mag` when present, else the value),
+/// crossovers found and fitted with `cfg`.
 pub fn level_table(
     table: &FlightTable,
     value_name: &str,
+    rate_of: Option<&str>,
     lever_arm_m: Option<[f64; 3]>,
     reference: &str,
     cfg: &LevellingConfig,
-) -> anyhow::Result<(SurveyLevelling, Vec<String>)> {
+) -> anyhow::Result<LevelTable> {
     let positions = lever_arm_m
         .map(|arm| crate::flight::sensor_track(table, arm))
         .transpose()?;
@@ -269,6 +311,14 @@ pub fn level_table(
         .zip(&reference)
         .map(|(v, r)| v - r)
         .collect();
+    let rate_column = match rate_of {
+        Some(c) => c.to_string(),
+        None if table.column("mag").is_some() => "mag".into(),
+        None => value_name.to_string(),
+    };
+    let sensed = (rate_column != value_name)
+        .then(|| table.require(&rate_column))
+        .transpose()?;
     let tracks = SurveyTracks {
         time: table.require("time")?,
         lat,
@@ -276,8 +326,13 @@ pub fn level_table(
         alt,
         line: table.require("line")?,
         value: &value,
+        sensed,
     };
-    let lev = level_survey(&tracks, &TrackConfig::default(), cfg)
+    let levelling = level_survey(&tracks, &TrackConfig::default(), cfg)
         .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
-    Ok((lev, ref_cols))
+    Ok(LevelTable {
+        levelling,
+        reference_columns: ref_cols,
+        rate_column,
+    })
 }

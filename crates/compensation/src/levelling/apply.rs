@@ -146,6 +146,7 @@ mod tests {
         let zeros = vec![0.0; truth.len()];
         let tr = SurveyTracks {
             value: &truth,
+            sensed: None,
             alt: &zeros,
             ..b.tracks()
         };
@@ -224,6 +225,64 @@ mod tests {
             let expect = b.v[i] - r.fit.k_s * r.derivative_nt_per_s[i];
             assert!((r.levelled.value_nt[i] - expect).abs() < 1e-12);
         }
+    }
+
+    /// The lag acts on the total the sensor saw: with an interference-like
+    /// series `q` in the reading, compensated away but not its lag, the
+    /// regressor must be the derivative of the uncompensated `v + q`.
+    #[test]
+    fn the_regressor_is_the_derivative_of_the_sensed_series() {
+        let (b0, truth) = levelled_block(0.0);
+        let q: Vec<f64> =
+            b0.t.iter()
+                .map(|t| 3.0 * (std::f64::consts::TAU * t / 9.3).sin())
+                .collect();
+        let total: Vec<f64> = b0.v.iter().zip(&q).map(|(v, q)| v + q).collect();
+        let zeros = vec![0.0; truth.len()];
+        let bdot = track_derivative(
+            &SurveyTracks {
+                value: &total,
+                alt: &zeros,
+                ..b0.tracks()
+            },
+            &TrackConfig::default(),
+        )
+        .unwrap();
+        // Compensated value: offsets, field and the lag of the total.
+        let value: Vec<f64> = (0..truth.len())
+            .map(|i| b0.v[i] - 0.1 * if bdot[i].is_finite() { bdot[i] } else { 0.0 })
+            .collect();
+        let cfg = LevellingConfig {
+            robust: false,
+            lambda: 0.0,
+            ..LevellingConfig::default()
+        };
+        let with = |sensed: Option<&[f64]>| {
+            let tr = SurveyTracks {
+                value: &value,
+                sensed,
+                ..b0.tracks()
+            };
+            level_survey(&tr, &TrackConfig::default(), &cfg)
+                .unwrap()
+                .fit
+        };
+        let right = with(Some(&total));
+        let wrong = with(None);
+        // Up to the linear interpolation of the curved field along two edges
+        // (≈ 0.002 nT here) the model is exact.
+        assert!(
+            (right.k_s + 0.1).abs() < 0.002 && right.rms_after_nt < 0.005,
+            "k = {}, residual {} nT",
+            right.k_s,
+            right.rms_after_nt
+        );
+        assert!(
+            wrong.rms_after_nt > 10.0 * right.rms_after_nt,
+            "derivative of the compensated value: k = {}, residual {} nT",
+            wrong.k_s,
+            wrong.rms_after_nt
+        );
     }
 
     proptest! {

@@ -475,6 +475,7 @@ pub(crate) mod tests {
                 alt: &self.alt,
                 line: &self.line,
                 value: &self.v,
+                sensed: None,
             }
         }
     }
@@ -585,6 +586,7 @@ pub(crate) mod tests {
             alt: &alt,
             line: &line,
             value: &v,
+            sensed: None,
         };
         // Time steps of line 2 equal those of line 1: no gap.
         let d = vec![0.0; rows.len()];

@@ -82,7 +82,20 @@
 //! `p_eff` the unknowns minus one per group of connected lines left free by
 //! the datum. This assumes independent crossover errors (it ignores the
 //! tilt null directions of the drift model, so with drifts σ is slightly
-//! optimistic).
+//! optimistic), and errors of equal size. They are not of equal size: the
+//! altitude term's errors (GNSS height errors, the profile estimate of the
+//! gradient) grow with the gradient, and so does `|ΔḂ|`, so that
+//! covariance is too small for `k`. The reported standard deviations are
+//! therefore the larger of it and the heteroscedasticity-consistent
+//! sandwich (MacKinnon & White's HC3)
+//!
+//! ```text
+//! Cov_HC3(c) = C (Σ_x a_x a_xᵀ (w_x r_x)²/(1 − h_x)²) C,    h_x = w_x a_xᵀ C a_x
+//! ```
+//!
+//! (`a_x` the design row, `h_x` its leverage; a crossover with `h_x = 1`,
+//! the only one of its line, adds nothing). Over 25 simulated surveys the
+//! spread of `k` was 1.4× the classical `σ` and 1.0× the sandwich's.
 
 use super::crossovers::Crossover;
 use super::tracks::bad;
@@ -465,7 +478,26 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
         .ok_or_else(|| bad("the levelling normal matrix is not positive definite".into()))?
         .inverse();
     let cov: DMatrix<f64> = &cinv * data.ata() * &cinv * sigma2;
-    let std = DVector::from_fn(p, |j, _| cov[(j, j)].max(0.0).sqrt());
+    // The heteroscedasticity-consistent (HC3) sandwich C M C, M = Σ a aᵀ
+    // (w r)²/(1 − h)², h = w aᵀ C a the leverage; each standard deviation
+    // is the larger of the two.
+    let mut meat = DMatrix::<f64>::zeros(p, p);
+    for ((((x, li), &g), &r), &w) in crossovers
+        .iter()
+        .zip(&line_index)
+        .zip(&altitude)
+        .zip(&residuals_nt)
+        .zip(&weights)
+    {
+        row_of(x, li, g, &mut row);
+        let a = DVector::from_column_slice(&row);
+        let h = (w * (a.transpose() * &cinv * &a)[(0, 0)]).min(1.0);
+        if h < 1.0 - 1e-9 {
+            meat.ger(((w * r) / (1.0 - h)).powi(2), &a, &a, 1.0);
+        }
+    }
+    let hc3: DMatrix<f64> = &cinv * meat * &cinv;
+    let std = DVector::from_fn(p, |j, _| cov[(j, j)].max(hc3[(j, j)]).max(0.0).sqrt());
 
     for (line, &(oi, si)) in lines.iter_mut().zip(&index) {
         if let Some(oi) = oi {

@@ -23,8 +23,10 @@
 //! ```
 //!
 //! * `B(x)` the true field at the position `x` (the same for every pass);
-//! * `Ḃ = dm/dt` the along-track time derivative of the measured series,
-//!   nT/s, estimated from the data themselves ([`track_derivative`]);
+//! * `Ḃ` the along-track time derivative of the field the sensor saw (the
+//!   uncompensated reading when given, [`SurveyTracks::sensed`]; else the
+//!   levelled series), nT/s, estimated from the data themselves
+//!   ([`track_derivative`]);
 //! * `k` (s) the coefficient of the derivative term;
 //! * `o_L` (nT) the level offset of line `L`, and optionally a linear drift
 //!   `s_L` (nT at the ends of the line's crossover time span, `t_L` its

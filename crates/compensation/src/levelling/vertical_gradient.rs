@@ -196,6 +196,7 @@ mod tests {
             alt: &alt,
             line,
             value,
+            sensed: None,
         };
         profile_gradient(&tracks, &TrackConfig::default()).unwrap()
     }
