@@ -6,9 +6,9 @@
 //! `AEROMAG_BENCH_ONCE=1` runs the full fit once and prints its time
 //! (use with `/usr/bin/time -v` to see the peak memory, e.g. for 10⁷).
 //!
-//! * `filter+smoother`: pass 1 (joint 22-state filter: the default field
-//!   model of order 4 has 6 states, plus 16 coefficients), compensated
-//!   series, pass 2 (6-state filter + checkpointed RTS smoother), no tuning;
+//! * `filter+smoother`: pass 1 (joint 24-state filter: the default field
+//!   model of order 6 has 8 states, plus 16 coefficients), compensated
+//!   series, pass 2 (8-state filter + checkpointed RTS smoother), no tuning;
 //! * `filter only`: pass 1 alone (coefficients and covariances).
 
 use aeromag_compensation::kalman::{KalmanConfig, KalmanSegment, TuningConfig, fit_kalman};

@@ -71,19 +71,19 @@ pub struct Args {
     #[arg(long)]
     no_tune: bool,
     /// With --method kalman: noise intensities Q1,Q2,R (q1 in nT²/m^(2n−1),
-    /// i.e. nT²/m⁷ for the default order n = 4 and nT²/m⁵ for n = 3: the
+    /// i.e. nT²/m¹¹ for the default order n = 6 and nT²/m⁵ for n = 3: the
     /// spectral density of the n-th along-track derivative of B^h; q2 in
     /// nT²/m⁵: that of d²B_z/ds²; r in nT²: the measurement noise variance),
-    /// e.g. from an earlier calibration. Default 3.9e-20,1e-15,4e-4 (n = 4),
-    /// 1e-15,1e-15,4e-4 (n = 3). Given values are used as they are, unless
+    /// e.g. from an earlier calibration. Default 6.2e-29,1e-15,4e-4 (n = 6),
+    /// 3.9e-20,1e-15,4e-4 (n = 4), 1e-15,1e-15,4e-4 (n = 3). Given values are used as they are, unless
     /// --tune is also given (then they are the starting point).
     #[arg(long, value_name = "Q1,Q2,R")]
     kalman_noise: Option<String>,
     /// With --method kalman: order n of the along-track field model, B^h the
     /// n-th integral of white noise (2–6). 3 is the thesis' model; the
-    /// default 4 separates the field from the manoeuvres better over
+    /// default 6 separates the field from the manoeuvres better over
     /// geology (library docs of aeromag_compensation::kalman::anomaly_model).
-    /// Default 4.
+    /// Default 6.
     #[arg(long, value_name = "N")]
     field_order: Option<usize>,
     /// With --method kalman: write every input row plus the series
