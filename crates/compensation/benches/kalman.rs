@@ -3,7 +3,8 @@
 //!
 //! Run: `cargo bench -p aeromag-compensation --bench kalman`. Environment:
 //! `AEROMAG_BENCH_N` sets the length (default 10⁶ samples at 10 Hz);
-//! `AEROMAG_BENCH_ONCE=1` runs the full fit once and prints its time
+//! `AEROMAG_BENCH_ORDER` the order of the field model (default
+//! [`DEFAULT_ORDER`]); `AEROMAG_BENCH_ONCE=1` runs the full fit once and prints its time
 //! (use with `/usr/bin/time -v` to see the peak memory, e.g. for 10⁷).
 //!
 //! * `filter+smoother`: pass 1 (joint 24-state filter: the default field
@@ -11,7 +12,9 @@
 //!   series, pass 2 (8-state filter + checkpointed RTS smoother), no tuning;
 //! * `filter only`: pass 1 alone (coefficients and covariances).
 
-use aeromag_compensation::kalman::{KalmanConfig, KalmanSegment, TuningConfig, fit_kalman};
+use aeromag_compensation::kalman::{
+    DEFAULT_ORDER, KalmanConfig, KalmanSegment, NoiseModel, TuningConfig, X2Prior, fit_kalman,
+};
 use aeromag_compensation::tolles_lawson::fit_ls::Segment;
 use aeromag_compensation::tolles_lawson::terms::derivative;
 use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
@@ -84,7 +87,16 @@ fn flight(n: usize) -> Flight {
 }
 
 fn config(series: bool) -> KalmanConfig {
+    let order = std::env::var("AEROMAG_BENCH_ORDER")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(DEFAULT_ORDER);
     KalmanConfig {
+        field_prior: X2Prior {
+            order,
+            ..X2Prior::default()
+        },
+        noise: NoiseModel::calibration_default_for(order),
         tuning: TuningConfig {
             enabled: false,
             ..TuningConfig::default()

@@ -77,19 +77,26 @@ pub fn carlson_update(
             what: "scalar measurement or its row",
         });
     }
-    // The same code, specialised by the compiler for the 5-state field model.
-    if n == 5 {
-        Ok(carlson_impl(
-            &mut s[..25],
-            &mut x[..5],
-            &h[..5],
-            y,
-            r,
-            &mut gain[..5],
-            &mut work[..15],
-        ))
-    } else {
-        Ok(carlson_impl(s, x, h, y, r, gain, &mut work[..3 * n]))
+    // The same code, specialised by the compiler for the field models of
+    // orders 3, 4 and 6 (5, 6 and 8 states).
+    macro_rules! fixed {
+        ($k:literal) => {
+            Ok(carlson_impl(
+                &mut s[..$k * $k],
+                &mut x[..$k],
+                &h[..$k],
+                y,
+                r,
+                &mut gain[..$k],
+                &mut work[..3 * $k],
+            ))
+        };
+    }
+    match n {
+        5 => fixed!(5),
+        6 => fixed!(6),
+        8 => fixed!(8),
+        _ => Ok(carlson_impl(s, x, h, y, r, gain, &mut work[..3 * n])),
     }
 }
 

@@ -266,11 +266,13 @@ impl SqrtKalmanFilter {
         if self.v.len() < c {
             self.v.resize(c, 0.0);
         }
-        // The same code, specialised by the compiler for the 5-state field model.
-        if k == 5 && g.ncols() == 5 {
-            self.propagate_impl(5, 5, g.as_slice());
-        } else {
-            self.propagate_impl(k, g.ncols(), g.as_slice());
+        // The same code, specialised by the compiler for the field models of
+        // orders 3, 4 and 6 (5, 6 and 8 states).
+        match (k, g.ncols()) {
+            (5, 5) => self.propagate_impl(5, 5, g.as_slice()),
+            (6, 6) => self.propagate_impl(6, 6, g.as_slice()),
+            (8, 8) => self.propagate_impl(8, 8, g.as_slice()),
+            _ => self.propagate_impl(k, g.ncols(), g.as_slice()),
         }
     }
 

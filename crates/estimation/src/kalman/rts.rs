@@ -78,29 +78,14 @@ impl SqrtRts {
                 )));
             }
         }
-        // The same code, specialised by the compiler for the 5-state field model.
-        if n == 5 {
-            gain_impl(
-                5,
-                sf,
-                ph,
-                sp,
-                &mut self.a,
-                &mut self.b,
-                &mut self.d,
-                c.as_mut_slice(),
-            );
-        } else {
-            gain_impl(
-                n,
-                sf,
-                ph,
-                sp,
-                &mut self.a,
-                &mut self.b,
-                &mut self.d,
-                c.as_mut_slice(),
-            );
+        // The same code, specialised by the compiler for the field models of
+        // orders 3, 4 and 6 (5, 6 and 8 states).
+        let (a, b, d, c) = (&mut self.a, &mut self.b, &mut self.d, c.as_mut_slice());
+        match n {
+            5 => gain_impl(5, sf, ph, sp, a, b, d, c),
+            6 => gain_impl(6, sf, ph, sp, a, b, d, c),
+            8 => gain_impl(8, sf, ph, sp, a, b, d, c),
+            _ => gain_impl(n, sf, ph, sp, a, b, d, c),
         }
         Ok(())
     }

@@ -47,10 +47,15 @@ pub fn triangularize_upper(a: &mut [f64], n: usize, c: usize, v: &mut [f64]) {
         "triangularize_upper: bad sizes"
     );
     // The same code, specialised by the compiler for the sizes of the
-    // 5-state field model (time update 5×10, smoother 5×15).
+    // field models of orders 3, 4 and 6 (k = 5, 6, 8 states: time update
+    // k × 2k, smoother k × 3k).
     match (n, c) {
         (5, 10) => triangularize_impl(&mut a[..50], 5, 10, &mut v[..10]),
         (5, 15) => triangularize_impl(&mut a[..75], 5, 15, &mut v[..15]),
+        (6, 12) => triangularize_impl(&mut a[..72], 6, 12, &mut v[..12]),
+        (6, 18) => triangularize_impl(&mut a[..108], 6, 18, &mut v[..18]),
+        (8, 16) => triangularize_impl(&mut a[..128], 8, 16, &mut v[..16]),
+        (8, 24) => triangularize_impl(&mut a[..192], 8, 24, &mut v[..24]),
         _ => triangularize_impl(a, n, c, v),
     }
 }
