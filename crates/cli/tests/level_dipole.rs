@@ -194,6 +194,32 @@ fn level_with_the_base_station_recovers_k() {
         sd0 > 1.6 * sd,
         "σ_k {sd0} without the altitude term vs {sd} with it (k {k0} vs {k})"
     );
+    // The regressor is the derivative of the uncompensated `mag` by default;
+    // that of the compensated value misses the lag of the aircraft's own
+    // field, which stays in the crossover residual.
+    assert!(s.contains("along-track derivative of `mag`"), "{s}");
+    let (_, _, sc) = k_of(&["--rate-of", "mag_comp"]);
+    assert!(sc.contains("along-track derivative of `mag_comp`"), "{sc}");
+    let residual = |s: &str| -> f64 {
+        let l = s
+            .lines()
+            .find(|l| l.starts_with("crossover differences RMS:"))
+            .unwrap();
+        l.split(", ")
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert!(
+        residual(&s) < 0.9 * residual(&sc),
+        "model residual {} nT (Ḃ of mag) vs {} nT (Ḃ of mag_comp)",
+        residual(&s),
+        residual(&sc)
+    );
 }
 
 #[test]
