@@ -41,8 +41,8 @@ pub struct Args {
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     lever_arm: Option<String>,
     /// Column whose along-track derivative is the regressor of the
-    /// d|B0|/dt term (default `mag`, the uncompensated reading, when the
-    /// file has it; else the levelled value). A lag of the scalar channel
+    /// d|B0|/dt term, as recorded (default `mag`, the uncompensated
+    /// reading, when the file has it; else the column levelled). A lag of the scalar channel
     /// acts on everything the sensor sees, the aircraft's own interference
     /// included, and the compensated value has lost the interference's rate
     /// but not its lag.
@@ -316,7 +316,10 @@ pub fn level_table(
         None if table.column("mag").is_some() => "mag".into(),
         None => value_name.to_string(),
     };
-    let sensed = (rate_column != value_name)
+    // The column as recorded (the sensor lags the reference fields too);
+    // not needed, and its gaps not imposed, without the k term.
+    let sensed = cfg
+        .estimate_k
         .then(|| table.require(&rate_column))
         .transpose()?;
     let tracks = SurveyTracks {

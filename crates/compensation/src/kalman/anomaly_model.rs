@@ -106,7 +106,7 @@ use serde::{Deserialize, Serialize};
 
 /// The thesis' order of the `B^h` chain (third integral of white noise).
 pub const THESIS_ORDER: usize = 3;
-/// The default order of the `B^h` chain (module docs: why 4).
+/// The default order of the `B^h` chain (module docs: why 6).
 pub const DEFAULT_ORDER: usize = 6;
 /// The orders accepted.
 pub const ORDERS: std::ops::RangeInclusive<usize> = 2..=6;
@@ -201,7 +201,7 @@ impl Default for NoiseModel {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct X2Prior {
     /// Order `n` of the `B^h` chain ([`ORDERS`]; 3 is the thesis' third
-    /// integral, the default [`DEFAULT_ORDER`] = 4, module docs).
+    /// integral, the default [`DEFAULT_ORDER`] = 6, module docs).
     pub order: usize,
     /// Standard deviation of `B^h`, nT (default 1000: diffuse for a centred
     /// reading).

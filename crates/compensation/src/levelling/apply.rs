@@ -44,7 +44,8 @@ pub struct Levelled {
 /// Everything [`level_survey`] computed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SurveyLevelling {
-    /// Along-track derivative `Ḃ` of the input value, nT/s (one per row).
+    /// Along-track derivative `Ḃ` of the sensed reading (else the input
+    /// value), nT/s (one per row).
     pub derivative_nt_per_s: Vec<f64>,
     /// The crossovers and the skipped crossings.
     pub crossovers: CrossoverSet,
@@ -267,6 +268,26 @@ mod tests {
                 .unwrap()
                 .fit
         };
+        // A missing sensed reading on a line costs that row only.
+        let mut gappy = total.clone();
+        let gap = (0..gappy.len())
+            .find(|&i| b0.line[i] == 3.0 && b0.line[i - 3] == 3.0 && b0.line[i + 3] == 3.0)
+            .unwrap();
+        gappy[gap] = f64::NAN;
+        let tr = SurveyTracks {
+            value: &value,
+            sensed: Some(&gappy),
+            ..b0.tracks()
+        };
+        let r = level_survey(&tr, &TrackConfig::default(), &cfg).unwrap();
+        for i in gap - 3..=gap + 3 {
+            let want = if i == gap {
+                RowFlag::Missing
+            } else {
+                RowFlag::Levelled
+            };
+            assert_eq!(r.levelled.flag[i], want, "row {i} (gap at {gap})");
+        }
         let right = with(Some(&total));
         let wrong = with(None);
         // Up to the linear interpolation of the curved field along two edges

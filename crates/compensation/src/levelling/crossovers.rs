@@ -124,7 +124,7 @@ struct Edge {
 }
 
 /// Find the crossovers of `tracks` (module docs). `derivative` is the
-/// along-track derivative of `tracks.value` (nT/s, one per row, normally
+/// along-track derivative of `tracks.sensed` or `tracks.value` (nT/s, one per row, normally
 /// from [`super::track_derivative`]); `profile_gradient`, if given, the
 /// profile operator of [`super::profile_gradient`] (nT/m, one per row),
 /// interpolated like the other channels (NaN sides where it is missing).

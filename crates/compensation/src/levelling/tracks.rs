@@ -166,11 +166,16 @@ impl SurveyTracks<'_> {
         (l.is_finite() && l >= 1.0).then_some(l as i64)
     }
 
-    /// Track segments (see module docs): row ranges on one line each.
+    /// Track segments (see module docs): row ranges on one line each. A row
+    /// whose value or sensed reading is missing ends a segment, so it never
+    /// enters a neighbour's derivative window.
     pub fn segments(&self, cfg: &TrackConfig) -> Vec<Range<usize>> {
         let usable: Vec<bool> = (0..self.len())
             .map(|i| {
-                self.time[i].is_finite() && self.value[i].is_finite() && self.label(i).is_some()
+                self.time[i].is_finite()
+                    && self.value[i].is_finite()
+                    && self.sensed.is_none_or(|s| s[i].is_finite())
+                    && self.label(i).is_some()
             })
             .collect();
         split_segments(self.time, Some(self.line), &usable, cfg.max_gap_factor, 1).0
@@ -229,9 +234,9 @@ pub fn sensor_positions(
     Ok(out)
 }
 
-/// The along-track time derivative `Ḃ` of `tracks.value`, nT/s, one value
-/// per row: NaN off lines, at non-finite values and on single-sample
-/// segments (module docs give the estimator).
+/// The along-track time derivative `Ḃ` of `tracks.sensed` (else
+/// `tracks.value`), nT/s, one value per row: NaN off lines, at non-finite
+/// values and on single-sample segments (module docs give the estimator).
 pub fn track_derivative(tracks: &SurveyTracks, cfg: &TrackConfig) -> Result<Vec<f64>> {
     tracks.validate()?;
     cfg.validate()?;
