@@ -58,17 +58,9 @@ pub fn reference_sum(
         }
     }
     if let (Some(lever), true) = (lever, cols.iter().any(|c| c == "igrf")) {
-        let col = |n: &str| table.require(n);
-        let corr = lever_arm_correction_nt(
-            lever,
-            col("lat")?,
-            col("lon")?,
-            col("alt")?,
-            col("roll")?,
-            col("pitch")?,
-            col("yaw")?,
-        )
-        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
+        let [lat, lon, alt, roll, pitch, yaw] = nav_and_attitude(table)?;
+        let corr = lever_arm_correction_nt(lever, lat, lon, alt, roll, pitch, yaw)
+            .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
         for (a, c) in r.iter_mut().zip(corr) {
             *a += c;
         }
@@ -94,17 +86,22 @@ pub fn parse_numbers(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> 
 /// navigation point's (`lat`, `lon`, `alt`) moved by the lever arm
 /// `arm_m` (body frame, m) with the attitude (`roll`, `pitch`, `yaw`).
 pub fn sensor_track(table: &FlightTable, arm_m: [f64; 3]) -> anyhow::Result<[Vec<f64>; 3]> {
-    let col = |n: &str| table.require(n);
-    aeromag_compensation::levelling::sensor_positions(
-        col("lat")?,
-        col("lon")?,
-        col("alt")?,
-        col("roll")?,
-        col("pitch")?,
-        col("yaw")?,
-        arm_m,
-    )
-    .map_err(|e| bad_input!("{}: {e}", table.file_label()))
+    let [lat, lon, alt, roll, pitch, yaw] = nav_and_attitude(table)?;
+    aeromag_compensation::levelling::sensor_positions(lat, lon, alt, roll, pitch, yaw, arm_m)
+        .map_err(|e| bad_input!("{}: {e}", table.file_label()))
+}
+
+/// The navigation point's `lat`, `lon` (deg), `alt` (m) and the attitude
+/// `roll`, `pitch`, `yaw` (deg) of `table`: what moving a lever arm needs.
+fn nav_and_attitude(table: &FlightTable) -> anyhow::Result<[&[f64]; 6]> {
+    Ok([
+        table.require("lat")?,
+        table.require("lon")?,
+        table.require("alt")?,
+        table.require("roll")?,
+        table.require("pitch")?,
+        table.require("yaw")?,
+    ])
 }
 
 /// A parsed `X,Y,Z` lever arm in metres (body frame: x forward, y right,

@@ -43,14 +43,25 @@ pub fn assert_code(o: &Output, code: i32) {
 /// `aeromag <family> apply --model MODEL --input INPUT --out OUT` (rotor,
 /// pod).
 pub fn apply(family: &str, model: &Path, input: &Path, out: &Path) -> Output {
-    aeromag(&[
-        family,
-        "apply",
+    with_model(&[family, "apply"], model, input, out)
+}
+
+/// `aeromag compensate --model MODEL --input INPUT --out OUT`.
+#[allow(dead_code)] // not every test binary compensates
+pub fn compensate(model: &Path, input: &Path, out: &Path) -> Output {
+    with_model(&["compensate"], model, input, out)
+}
+
+/// `aeromag <command…> --model MODEL --input INPUT --out OUT`.
+fn with_model(command: &[&str], model: &Path, input: &Path, out: &Path) -> Output {
+    let mut args = command.to_vec();
+    args.extend([
         "--model",
         model.to_str().unwrap(),
         "--input",
         input.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-    ])
+    ]);
+    aeromag(&args)
 }

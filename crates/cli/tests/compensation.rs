@@ -116,15 +116,7 @@ fn calibrate_compensate_report_keep_every_row() {
     let holed = d.path().join("holed.csv");
     std::fs::write(&holed, lines.join("\n")).unwrap();
     let out = d.path().join("comp.csv");
-    let o = aeromag(&[
-        "compensate",
-        "--model",
-        model.to_str().unwrap(),
-        "--input",
-        holed.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = compensate(&model, &holed, &out);
     assert_code(&o, 0);
     assert!(stderr(&o).contains("3 of"), "{}", stderr(&o));
     let comp = std::fs::read_to_string(&out).unwrap();
@@ -424,15 +416,7 @@ fn model_and_argument_errors_exit_2() {
     // A model file that is not one.
     let junk = d.path().join("junk.json");
     std::fs::write(&junk, "{\"format\":\"other\"}").unwrap();
-    let o = aeromag(&[
-        "compensate",
-        "--model",
-        junk.to_str().unwrap(),
-        "--input",
-        p,
-        "--out",
-        d.path().join("o.csv").to_str().unwrap(),
-    ]);
+    let o = compensate(&junk, std::path::Path::new(p), &d.path().join("o.csv"));
     assert_code(&o, 2);
     assert!(stderr(&o).contains("junk.json"));
     // Data without the vector magnetometer: the message names what is missing.
@@ -440,15 +424,7 @@ fn model_and_argument_errors_exit_2() {
     let stripped = text.replace("flux_x", "fx");
     let nofx = d.path().join("nofx.csv");
     std::fs::write(&nofx, stripped).unwrap();
-    let o = aeromag(&[
-        "compensate",
-        "--model",
-        m,
-        "--input",
-        nofx.to_str().unwrap(),
-        "--out",
-        d.path().join("o.csv").to_str().unwrap(),
-    ]);
+    let o = compensate(std::path::Path::new(m), &nofx, &d.path().join("o.csv"));
     assert_code(&o, 2);
     assert!(stderr(&o).contains("flux_x"), "{}", stderr(&o));
 }
@@ -790,18 +766,7 @@ fn calibrate_and_compare(
             args.extend(["--field-order", order]);
         }
         assert_code(&aeromag(&args), 0);
-        assert_code(
-            &aeromag(&[
-                "compensate",
-                "--model",
-                model.to_str().unwrap(),
-                "--input",
-                survey.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ]),
-            0,
-        );
+        assert_code(&compensate(&model, &survey, &out), 0);
         err.push(interference_error(&out));
     }
     err

@@ -128,18 +128,7 @@ fn level_with_the_base_station_recovers_k() {
     );
     let comp = dir("comp.csv");
     let survey = dir("survey").join("survey.csv");
-    assert_code(
-        &aeromag(&[
-            "compensate",
-            "--model",
-            model.to_str().unwrap(),
-            "--input",
-            survey.to_str().unwrap(),
-            "--out",
-            comp.to_str().unwrap(),
-        ]),
-        0,
-    );
+    assert_code(&compensate(&model, &survey, &comp), 0);
     let lev = dir("lev.csv");
     let k_of = |extra: &[&str]| {
         let mut args = vec![
