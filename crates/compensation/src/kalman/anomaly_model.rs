@@ -66,9 +66,11 @@
 //!
 //! (`Q = ∫₀^d e^{Aσ} b bᵀ e^{Aᵀσ} dσ`, Van Loan 1978; for `n = 3`,
 //! `Q₁ = q₁ [[d⁵/20, d⁴/8, d³/6], [d⁴/8, d³/3, d²/2], [d³/6, d²/2, d]]`). The
-//! filter needs a factor `G`, `Q = G Gᵀ`: `G₁ = √q₁ T chol(M)`, with the
-//! constant `chol(M)` computed once, so no factorisation per step, exact
-//! also for `d → 0` (and likewise `G₂`).
+//! filter needs a factor `G`, `Q = G Gᵀ`: `G₁ = √q₁ T U_M`, with `U_M` the
+//! constant *upper*-triangular factor of `M` (`M = U_M U_Mᵀ`) computed once,
+//! so no factorisation per step, exact also for `d → 0` (and likewise `G₂`).
+//! `G` and `Φ` are both upper triangular, which the filter's time update
+//! exploits ([`aeromag_estimation::kalman::triangularize`]).
 //!
 //! ## Default intensities (calibration altitude)
 //!
@@ -101,6 +103,7 @@
 //! what the Tolles-Lawson model leaves). [`super::tuning`] adjusts them by
 //! maximum likelihood (the default of `aeromag calibrate --method kalman`).
 
+use aeromag_estimation::kalman::upper_cholesky;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -283,17 +286,21 @@ impl X2Prior {
     }
 }
 
+/// The longest chain of integrators ([`ORDERS`] and the `B_z` chain).
+const MAX_CHAIN: usize = 8;
+const _: () = assert!(*ORDERS.end() <= MAX_CHAIN && Z_ORDER <= MAX_CHAIN);
+
 /// `n!` as a float.
 fn factorial(n: usize) -> f64 {
     (1..=n).map(|k| k as f64).product()
 }
 
 /// One chain of `n` integrators driven by white noise of intensity `q`:
-/// the constant Cholesky factor of its `M` (module docs) and `√q`.
+/// the constant upper-triangular factor `U_M` of its `M` (module docs) and `√q`.
 #[derive(Debug, Clone)]
 struct Chain {
     n: usize,
-    l: DMatrix<f64>,
+    u: DMatrix<f64>,
     sqrt_q: f64,
 }
 
@@ -305,34 +312,36 @@ impl Chain {
             let (a, b) = (n - 1 - i, n - 1 - j);
             1.0 / (factorial(a) * factorial(b) * (a + b + 1) as f64)
         });
-        let l = m
-            .cholesky()
-            .expect("the Gram matrix of the monomials is positive definite")
-            .l();
+        let u = upper_cholesky(&m).expect("the Gram matrix of the monomials is positive definite");
         Self {
             n,
-            l,
+            u,
             sqrt_q: q.max(0.0).sqrt(),
         }
     }
 
-    /// Write `Φ` (`d^{j−i}/(j−i)!`) and `G = √q T chol(M)` of a step `d`
+    /// Write `Φ` (`d^{j−i}/(j−i)!`) and `G = √q T U_M` of a step `d`
     /// into the diagonal block starting at `at` (the rest is untouched).
     fn fill(&self, d: f64, at: usize, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
         let n = self.n;
-        for i in 0..n {
-            phi[(at + i, at + i)] = 1.0;
-            let mut p = 1.0;
-            for j in i + 1..n {
-                p *= d / (j - i) as f64;
-                phi[(at + i, at + j)] = p;
-            }
+        let rows = phi.nrows();
+        // d^m/m! and d^m for m < n (MAX_CHAIN bounds n: ORDERS).
+        let mut taylor = [0.0; MAX_CHAIN];
+        let mut power = [0.0; MAX_CHAIN];
+        let (mut t, mut p) = (1.0, 1.0);
+        for m in 0..n {
+            taylor[m] = t;
+            power[m] = p;
+            t *= d / (m + 1) as f64;
+            p *= d;
         }
-        let sd = d.sqrt();
-        for i in 0..n {
-            let ti = self.sqrt_q * sd * d.powi((n - 1 - i) as i32);
-            for j in 0..=i {
-                g[(at + i, at + j)] = ti * self.l[(i, j)];
+        let (phi, g) = (phi.as_mut_slice(), g.as_mut_slice());
+        let scale = self.sqrt_q * d.sqrt();
+        for j in 0..n {
+            let col = (at + j) * rows + at;
+            for i in 0..=j {
+                phi[col + i] = taylor[j - i];
+                g[col + i] = scale * power[n - 1 - i] * self.u[(i, j)];
             }
         }
     }
@@ -379,8 +388,8 @@ impl AnomalyTransition {
             "field transition matrices must be {dim}×{dim}"
         );
         let d = d.max(0.0);
-        phi.fill(0.0);
-        g.fill(0.0);
+        phi.as_mut_slice().fill(0.0);
+        g.as_mut_slice().fill(0.0);
         self.horizontal.fill(d, 0, phi, g);
         self.vertical.fill(d, b_z_index(self.order), phi, g);
     }

@@ -1,5 +1,5 @@
 //! Pass 2: the smoothed external field of one run, given the coefficient
-//! estimate — a 5-state square-root filter and RTS smoother
+//! estimate — a 5-state square-root filter and fixed-interval smoother
 //! ([`aeromag_estimation::kalman::smooth_from_checkpoints`], so memory is
 //! `O(√N)` beyond the output).
 //!

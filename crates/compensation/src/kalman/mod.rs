@@ -49,7 +49,8 @@
 //!
 //! which is that 5-state smoother run on `y_k − H1_k X̂1`. **Pass 2**
 //! ([`field_smoother`]) does exactly this, run by run, with the checkpointed
-//! square-root RTS smoother of `aeromag-estimation` (memory `O(√N · 5²)`
+//! square-root smoother of `aeromag-estimation` (means only: the
+//! modified Bryson–Frazier recursion; memory `O(√N · 5²)`
 //! beyond the outputs). Its restart points come from pass 1 for free: the
 //! joint filter's conditional of `X2` given `X1`, evaluated at `X̂1`, is the
 //! 5-state filter's estimate at that sample. Its covariances would be conditional on `X1`; the

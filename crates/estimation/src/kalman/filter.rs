@@ -21,7 +21,11 @@
 //! * [`SqrtKalmanFilter::update`]: Carlson's triangular update
 //!   ([`super::carlson`]), `O(n²)`.
 //! * [`SqrtKalmanFilter::predict`]: `x ← Φx`, `S ← tri([G, ΦS])`
-//!   ([`super::triangularize`]), `O(n³)`.
+//!   ([`super::triangularize`]), `O(n³)`. When `Φ` and `G` (`n × n`) are
+//!   both upper triangular, as for chains of integrators with the upper
+//!   factor of `Q`, `[G, ΦS]` is a pair of triangles and the cheaper
+//!   [`super::triangularize::triangularize_upper_pair`] is used (detected
+//!   from the matrices; same result up to round-off).
 //! * [`SqrtKalmanFilter::predict_leading`]: when only the first `k` states
 //!   evolve and the others are constant parameters (`Φ = diag(Φ_a, I)`,
 //!   `G = [G_a; 0]`), the time update is exact and cheap *because the constant
@@ -45,7 +49,7 @@
 
 use super::carlson::carlson_update;
 use super::innovation::Innovation;
-use super::triangularize::triangularize_upper;
+use super::triangularize::{triangularize_upper, triangularize_upper_pair};
 use crate::error::{EstError, Result};
 use nalgebra::{DMatrix, DVector};
 
@@ -60,6 +64,7 @@ pub struct SqrtKalmanFilter {
     v: Vec<f64>,
     tmp: Vec<f64>,
     nz: Vec<(usize, usize, f64)>,
+    phi_upper: Vec<f64>,
 }
 
 impl SqrtKalmanFilter {
@@ -89,6 +94,7 @@ impl SqrtKalmanFilter {
             v: vec![0.0; 2 * n.max(1)],
             tmp: vec![0.0; n],
             nz: Vec::with_capacity(n * n),
+            phi_upper: Vec::with_capacity(n * n),
         })
     }
 
@@ -203,32 +209,24 @@ impl SqrtKalmanFilter {
             )));
         }
         self.collect_nonzeros(phi_a);
-        // U_b ← Φ_a U_b over the non-zeros of Φ_a only (transition matrices
-        // of integrators are mostly zeros). When Φ_a is upper triangular the
-        // rows are updated in place in increasing order, each from rows not
-        // yet updated: row_i ← Φ_ii row_i + Σ_{l>i} Φ_il row_l.
+        // U_b ← Φ_a U_b, column by column (each column of U_b is contiguous
+        // in the column-major factor).
         let s = self.s.as_mut_slice();
         if self.nz.iter().all(|&(i, l, _)| i <= l) {
-            // self.nz is in column-major order; apply by rows i ascending.
-            for i in 0..k {
-                let mut diag = 1.0;
-                for &(r, l, p) in &self.nz {
-                    if r == i && l == i {
-                        diag = p;
-                    }
-                }
-                if diag != 1.0 {
-                    for j in k..n {
-                        s[i + j * n] *= diag;
-                    }
-                }
-                for &(r, l, p) in &self.nz {
-                    if r == i && l > i {
-                        for j in k..n {
-                            s[i + j * n] += p * s[l + j * n];
-                        }
-                    }
-                }
+            // Φ_a upper triangular: dense row-major copy of its upper part,
+            // then in place, rows ascending, each from rows not yet updated:
+            // col_i ← Σ_{l ≥ i} Φ_il col_l.
+            let dense = &mut self.phi_upper;
+            dense.clear();
+            dense.resize(k * k, 0.0);
+            for &(i, l, p) in &self.nz {
+                dense[i * k + l] = p;
+            }
+            match k {
+                5 => upper_times_columns(5, dense, s, n),
+                6 => upper_times_columns(6, dense, s, n),
+                8 => upper_times_columns(8, dense, s, n),
+                _ => upper_times_columns(k, dense, s, n),
             }
         } else {
             let tmp = &mut self.tmp[..k];
@@ -249,9 +247,11 @@ impl SqrtKalmanFilter {
     fn collect_nonzeros(&mut self, phi: &DMatrix<f64>) {
         self.nz.clear();
         let k = phi.nrows();
-        for (idx, &p) in phi.as_slice().iter().enumerate() {
-            if p != 0.0 {
-                self.nz.push((idx % k, idx / k, p));
+        for (l, col) in phi.as_slice().chunks_exact(k).enumerate() {
+            for (i, &p) in col.iter().enumerate() {
+                if p != 0.0 {
+                    self.nz.push((i, l, p));
+                }
             }
         }
     }
@@ -303,7 +303,16 @@ impl SqrtKalmanFilter {
                 w[i * c + q + j] += p * s[l + j * n];
             }
         }
-        triangularize_upper(w, k, c, &mut self.v[..c]);
+        // Φ and G both upper triangular (and U_a always is): the cheaper
+        // kernel for two triangular halves.
+        let pair = q == k
+            && self.nz.iter().all(|&(i, l, _)| i <= l)
+            && (0..k).all(|j| g[j * k + j + 1..(j + 1) * k].iter().all(|x| *x == 0.0));
+        if pair {
+            triangularize_upper_pair(w, k, &mut self.v[..c]);
+        } else {
+            triangularize_upper(w, k, c, &mut self.v[..c]);
+        }
         for j in 0..k {
             for i in 0..=j {
                 s[i + j * n] = w[i * c + q + j];
@@ -340,6 +349,23 @@ impl SqrtKalmanFilter {
             }
         }
         Ok(())
+    }
+}
+
+/// `U_b ← Φ U_b` for an upper-triangular `Φ` (`k × k`, row-major in
+/// `phi`) on the columns `k..n` of the column-major `n × n` factor `s`.
+#[inline(always)]
+fn upper_times_columns(k: usize, phi: &[f64], s: &mut [f64], n: usize) {
+    let phi = &phi[..k * k];
+    for j in k..n {
+        let col = &mut s[j * n..j * n + k];
+        for i in 0..k {
+            let mut t = 0.0;
+            for l in i..k {
+                t += phi[i * k + l] * col[l];
+            }
+            col[i] = t;
+        }
     }
 }
 

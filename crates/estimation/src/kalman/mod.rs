@@ -36,6 +36,7 @@
 //! | [`triangularize`] | Householder RQ re-triangularisation of a wide factor (time updates, smoother) |
 //! | [`filter`] | [`SqrtKalmanFilter`]: the filter; cheap time update when constant parameters are ordered last |
 //! | [`rts`] | one square-root RTS backward step ([`SqrtRts`]) |
+//! | [`mbf`] | the modified Bryson–Frazier smoother: smoothed means by an adjoint recursion, no gain |
 //! | [`fixed_interval`] | forward filter + backward smoother over a record, with checkpointing (`O(√N n²)` memory) |
 //! | [`innovation`] | innovations and their Gaussian log-likelihood |
 //! | [`conventional`] | the Joseph-form filter and textbook RTS smoother: the test reference |
@@ -50,6 +51,7 @@ pub mod conventional;
 pub mod filter;
 pub mod fixed_interval;
 pub mod innovation;
+pub mod mbf;
 pub mod rts;
 pub mod triangularize;
 
@@ -60,6 +62,7 @@ pub use fixed_interval::{
     fixed_interval_smooth, smooth_from_checkpoints,
 };
 pub use innovation::Innovation;
+pub use mbf::{MbfAdjoint, MbfUpdate};
 pub use rts::SqrtRts;
 
 #[cfg(test)]

@@ -109,6 +109,83 @@ fn triangularize_impl(a: &mut [f64], n: usize, c: usize, v: &mut [f64]) {
     }
 }
 
+/// Triangularise `a = [B, A]` (`n × 2n`, **row-major**) in place when
+/// **both** `n × n` halves are upper triangular, as in the time update
+/// `[G, Φ S]` of a model whose transition `Φ` and noise factor `G` are upper
+/// triangular (chains of integrators with the "upper" factor of `Q`): the
+/// result is that of [`triangularize_upper`] (`U` in the last `n` columns,
+/// the first `n` zero) at about a third of the cost.
+///
+/// Why it is cheaper: row `i` of `[B, A]` is non-zero only in the columns
+/// `i..n` of `B` and `i..n` of `A`, and the reflections of the rows below
+/// `i` (which act on the columns `≥ i + 1` of `B` and on one column of `A`
+/// each) keep it so. The reflection of row `i` therefore acts on the
+/// `n − i` columns `B[:, i..n]` and the pivot `A[:, i]` only, instead of the
+/// whole prefix of `n + i + 1` columns: about `4 Σ i (n − i + 1)` flops
+/// (448 for `n = 8`, against 1 568 for the general routine).
+///
+/// The caller guarantees the structure (entries below either diagonal must
+/// be zero; they are not read). `v` (length ≥ `n + 1`) is workspace.
+pub fn triangularize_upper_pair(a: &mut [f64], n: usize, v: &mut [f64]) {
+    assert!(
+        a.len() >= 2 * n * n && v.len() > n,
+        "triangularize_upper_pair: bad sizes"
+    );
+    match n {
+        5 => pair_impl(&mut a[..50], 5, &mut v[..6]),
+        6 => pair_impl(&mut a[..72], 6, &mut v[..7]),
+        8 => pair_impl(&mut a[..128], 8, &mut v[..9]),
+        _ => pair_impl(a, n, v),
+    }
+}
+
+#[inline(always)]
+fn pair_impl(a: &mut [f64], n: usize, v: &mut [f64]) {
+    let c = 2 * n;
+    for i in (0..n).rev() {
+        let (above, rest) = a.split_at_mut(i * c);
+        let row_i = &mut rest[..c];
+        let pivot = row_i[n + i];
+        let mut off2 = 0.0;
+        for x in &row_i[i..n] {
+            off2 += x * x;
+        }
+        if off2 > 0.0 {
+            let norm = (off2 + pivot * pivot).sqrt();
+            let alpha = if pivot >= 0.0 { -norm } else { norm };
+            // v = (B[i, i..n], A[i, i] − α): the reflection I − β v vᵀ.
+            let vb = &mut v[..n - i];
+            vb.copy_from_slice(&row_i[i..n]);
+            let vp = pivot - alpha;
+            let beta = 2.0 / (off2 + vp * vp);
+            for r in 0..i {
+                let row = &mut above[r * c..(r + 1) * c];
+                let mut t = row[n + i] * vp;
+                for (x, y) in row[i..n].iter().zip(vb.iter()) {
+                    t += x * y;
+                }
+                let bt = beta * t;
+                for (x, y) in row[i..n].iter_mut().zip(vb.iter()) {
+                    *x -= bt * y;
+                }
+                row[n + i] -= bt * vp;
+            }
+            row_i[i..n].fill(0.0);
+            row_i[n + i] = alpha;
+        }
+        if row_i[n + i] < 0.0 {
+            row_i[n + i] = -row_i[n + i];
+            for r in 0..i {
+                above[r * c + n + i] = -above[r * c + n + i];
+            }
+        }
+    }
+    // Exact zeros: all of B, and A below its diagonal.
+    for i in 0..n {
+        a[i * c..i * c + n + i].fill(0.0);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -161,5 +238,46 @@ mod tests {
         assert!((&u * u.transpose() - &m * m.transpose()).abs().max() < 1e-14);
         assert_eq!(u[(2, 2)], 3.0);
         assert_eq!(u[(1, 1)], 0.0);
+    }
+
+    #[test]
+    fn the_pair_kernel_equals_the_general_one_on_triangular_halves() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        for &n in &[1usize, 2, 5, 6, 7, 8] {
+            let upper = |rng: &mut ChaCha8Rng| {
+                DMatrix::from_fn(n, n, |i, j| {
+                    if i <= j {
+                        StandardNormal.sample(rng)
+                    } else {
+                        0.0
+                    }
+                })
+            };
+            let (b, a) = (upper(&mut rng), upper(&mut rng));
+            let mut m = DMatrix::zeros(n, 2 * n);
+            m.columns_mut(0, n).copy_from(&b);
+            m.columns_mut(n, n).copy_from(&a);
+            let general = run(&m);
+            let mut w: Vec<f64> = (0..n)
+                .flat_map(|i| (0..2 * n).map(move |j| (i, j)))
+                .map(|(i, j)| m[(i, j)])
+                .collect();
+            let mut v = vec![0.0; n + 1];
+            triangularize_upper_pair(&mut w, n, &mut v);
+            let pair = DMatrix::from_row_slice(n, 2 * n, &w);
+            assert!(pair.columns(0, n).iter().all(|x| *x == 0.0));
+            let u = pair.columns(n, n).into_owned();
+            for i in 0..n {
+                assert!(u[(i, i)] >= 0.0);
+                for j in 0..i {
+                    assert_eq!(u[(i, j)], 0.0);
+                }
+            }
+            let gram = &m * m.transpose();
+            assert!((&u * u.transpose() - &gram).abs().max() < 1e-12 * gram.abs().max());
+            // The upper factor with a non-negative diagonal is unique.
+            let diff = (&u - general.columns(n, n)).abs().max();
+            assert!(diff < 1e-12 * u.abs().max(), "n={n}: {diff}");
+        }
     }
 }
