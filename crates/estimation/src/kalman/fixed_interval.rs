@@ -188,12 +188,7 @@ pub fn smooth_from_checkpoints<M: StateSpaceModel>(
     let mut s_s = DMatrix::zeros(n, n);
     for blk in (0..starts.len()).rev() {
         let (k0, k1) = (starts[blk], ends[blk]);
-        if blk == 0 {
-            filter.set(&b.x0, &b.s0)?;
-        } else {
-            let c = &checkpoints[blk - 1];
-            filter.set(&c.mean, &c.factor)?;
-        }
+        restart(&mut filter, &b, checkpoints, blk)?;
         for k in k0..k1 {
             if k > 0 {
                 model.transition(k, &mut b.phi, &mut b.g);
@@ -253,6 +248,20 @@ pub fn smooth_from_checkpoints<M: StateSpaceModel>(
         }
     }
     Ok(())
+}
+
+/// Put the filter at the start of block `blk`: the prior for the first
+/// block, else the checkpoint before it.
+fn restart(
+    filter: &mut SqrtKalmanFilter,
+    b: &Buffers,
+    checkpoints: &[Checkpoint],
+    blk: usize,
+) -> Result<()> {
+    match blk.checked_sub(1) {
+        None => filter.set(&b.x0, &b.s0),
+        Some(c) => filter.set(&checkpoints[c].mean, &checkpoints[c].factor),
+    }
 }
 
 /// The blocks between checkpoints: block `b` covers `[starts[b], ends[b])`
@@ -320,12 +329,7 @@ fn smooth_means<M: StateSpaceModel>(
     let mut x_s = vec![0.0; n];
     for blk in (0..starts.len()).rev() {
         let (k0, k1) = (starts[blk], ends[blk]);
-        if blk == 0 {
-            filter.set(&b.x0, &b.s0)?;
-        } else {
-            let c = &checkpoints[blk - 1];
-            filter.set(&c.mean, &c.factor)?;
-        }
+        restart(&mut filter, &b, checkpoints, blk)?;
         for k in k0..k1 {
             if k > 0 {
                 model.transition(k, &mut b.phi, &mut b.g);
