@@ -26,6 +26,7 @@ pub mod error;
 pub mod field;
 pub mod filter;
 pub mod frames;
+pub mod quadrature;
 pub mod spectrum;
 pub mod time;
 

@@ -422,26 +422,19 @@ mod tests {
             let mut qn = DMatrix::<f64>::zeros(dim, dim);
             for k in 0..=n {
                 let s = k as f64 * h;
-                let w = if k == 0 || k == n {
-                    1.0
-                } else if k % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
+                let w = h * aeromag_core::quadrature::simpson_weight(k, n);
                 let u: Vec<f64> = (0..order)
                     .map(|i| s.powi((order - 1 - i) as i32) / factorial(order - 1 - i))
                     .collect();
                 let v = [s, 1.0];
                 for i in 0..order {
                     for j in 0..order {
-                        qn[(i, j)] += w * h / 3.0 * noise.q1 * u[i] * u[j];
+                        qn[(i, j)] += w * noise.q1 * u[i] * u[j];
                     }
                 }
                 for i in 0..2 {
                     for j in 0..2 {
-                        qn[(order + i, order + j)] +=
-                            w * h / 3.0 * noise.q2_nt2_per_m5 * v[i] * v[j];
+                        qn[(order + i, order + j)] += w * noise.q2_nt2_per_m5 * v[i] * v[j];
                     }
                 }
             }

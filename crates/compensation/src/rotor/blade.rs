@@ -140,14 +140,8 @@ mod tests {
         let h = (r1 - r0) / m as f64;
         (0..=m)
             .map(|i| {
-                let c = if i == 0 || i == m {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                dipole_matrix(&(a - (r0 + i as f64 * h) * u)) * (c * h / 3.0)
+                dipole_matrix(&(a - (r0 + i as f64 * h) * u))
+                    * (h * aeromag_core::quadrature::simpson_weight(i, m))
             })
             .sum()
     }

@@ -426,14 +426,8 @@ mod tests {
         let h = 6.0 / m as f64;
         let mut simpson = Matrix3::zeros();
         for i in 0..=m {
-            let c = if i == 0 || i == m {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            simpson += dipole_matrix(&(a - (1.0 + i as f64 * h) * u)) * (c * h / 3.0);
+            simpson += dipole_matrix(&(a - (1.0 + i as f64 * h) * u))
+                * (h * aeromag_core::quadrature::simpson_weight(i, m));
         }
         let rel = (gq - simpson).norm() / simpson.norm();
         assert!(rel < 1e-6, "relative error {rel}");
