@@ -37,6 +37,10 @@ pub struct Figures {
     /// Pooled per-line RMS of compensated − (true external + true lag), nT
     /// (simulation only).
     pub residual_rms_nt: Option<f64>,
+    /// Pooled per-line RMS of `true_interf − mag_interf`, nT: the error of the
+    /// interference model alone, the spec's "coefficient error versus truth,
+    /// in nT of effect" (simulation only; needs `mag_interf`).
+    pub interference_rms_nt: Option<f64>,
     /// Scalar sensor noise floor, RMS of `true_mag_noise`, nT (simulation only).
     pub noise_floor_nt: Option<f64>,
     /// Per-line residuals (simulation only).
@@ -105,15 +109,22 @@ pub fn figures(
         }
     }
     let (mut residual_rms_nt, mut lines, mut noise_floor_nt) = (None, Vec::new(), None);
+    let on_line: Vec<Range<usize>> = match t.column("line") {
+        Some(l) => segs.iter().filter(|r| l[r.start] != 0.0).cloned().collect(),
+        None => segs.clone(),
+    };
+    let interference_rms_nt = match (t.column("true_interf"), t.column("mag_interf")) {
+        (Some(truth), Some(model)) => {
+            let (_, pooled) = residual_by_line(model, truth, t.column("line"), &on_line);
+            pooled.is_finite().then_some(pooled)
+        }
+        _ => None,
+    };
     if let Some(ext) = t.column("true_external") {
         // The sensor lag is not aircraft interference: levelling handles it.
         let truth: Vec<f64> = match t.column("true_lag") {
             Some(lag) => ext.iter().zip(lag).map(|(e, l)| e + l).collect(),
             None => ext.to_vec(),
-        };
-        let on_line: Vec<Range<usize>> = match t.column("line") {
-            Some(l) => segs.iter().filter(|r| l[r.start] != 0.0).cloned().collect(),
-            None => segs.clone(),
         };
         let (l, pooled) = residual_by_line(comp_raw, &truth, t.column("line"), &on_line);
         residual_rms_nt = pooled.is_finite().then_some(pooled);
@@ -130,6 +141,7 @@ pub fn figures(
         fom_windows,
         ir,
         residual_rms_nt,
+        interference_rms_nt,
         noise_floor_nt,
         lines,
         fom_before,

@@ -86,7 +86,17 @@ pub fn parse_numbers(flag: &str, s: &str, n: usize) -> anyhow::Result<Vec<f64>> 
 /// navigation point's (`lat`, `lon`, `alt`) moved by the lever arm
 /// `arm_m` (body frame, m) with the attitude (`roll`, `pitch`, `yaw`).
 pub fn sensor_track(table: &FlightTable, arm_m: [f64; 3]) -> anyhow::Result<[Vec<f64>; 3]> {
-    let [lat, lon, alt, roll, pitch, yaw] = nav_and_attitude(table)?;
+    sensor_track_at(table, table.require("alt")?, arm_m)
+}
+
+/// [`sensor_track`] with the navigation altitude `alt` (m) given instead of
+/// the table's `alt` column (e.g. a cleaned copy of it).
+pub fn sensor_track_at(
+    table: &FlightTable,
+    alt: &[f64],
+    arm_m: [f64; 3],
+) -> anyhow::Result<[Vec<f64>; 3]> {
+    let [lat, lon, _, roll, pitch, yaw] = nav_and_attitude(table)?;
     aeromag_compensation::levelling::sensor_positions(lat, lon, alt, roll, pitch, yaw, arm_m)
         .map_err(|e| bad_input!("{}: {e}", table.file_label()))
 }

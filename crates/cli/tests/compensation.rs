@@ -455,6 +455,22 @@ fn demo_meets_the_compensation_figures() {
         g("fom_after_nt")
     );
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
+    // The interference model alone: the Kalman method is not worse than LS
+    // in the quiet box and better over the gradient area (seed 1 measured:
+    // quiet 1.6 / 1.3, gradient area 4.2 / 1.9, ×10⁻³ nT).
+    let int = |grp: &str, k: &str| s[grp][k].as_f64().unwrap_or(f64::NAN);
+    assert!(
+        int("compensation", "interference_rms_kalman_nt")
+            <= int("compensation", "interference_rms_ls_nt"),
+        "{}",
+        s["compensation"]
+    );
+    assert!(
+        int("compensation_gradient", "interference_rms_kalman_nt")
+            < int("compensation_gradient", "interference_rms_ls_nt"),
+        "{}",
+        s["compensation_gradient"]
+    );
     // Every key of data-formats.md that this version computes is present and numeric.
     for (group, keys) in [
         ("compensation", &["residual_rms_kalman_nt"][..]),
@@ -463,6 +479,8 @@ fn demo_meets_the_compensation_figures() {
             &[
                 "residual_rms_ls_nt",
                 "residual_rms_kalman_nt",
+                "interference_rms_ls_nt",
+                "interference_rms_kalman_nt",
                 "noise_floor_nt",
             ][..],
         ),
@@ -558,10 +576,13 @@ fn observability_tells_a_full_box_from_a_single_heading() {
     assert_eq!(v["estimability"].as_array().unwrap().len(), 16);
 }
 
-/// RMS over the survey/tie lines (each line's mean removed, pooled) of
-/// `true_interf − mag_interf` in a compensated simulated survey: the error
-/// of the interference model alone (scoring only).
-fn interference_error(path: &std::path::Path) -> f64 {
+/// Errors of a compensated simulated survey, nT, each the RMS over the
+/// survey/tie lines with each line's mean removed (pooled), for scoring
+/// only: `[0]` the interference model alone, `true_interf − mag_interf`;
+/// `[1]` the survey residual of the spec (`compensation.md`, Metrics),
+/// `mag_comp − true_external − true_lag`, which holds the scalar sensor's
+/// noise (0.011 nT).
+fn survey_errors(path: &std::path::Path) -> [f64; 2] {
     let text = std::fs::read_to_string(path).unwrap();
     let mut rows = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = rows.next().unwrap().split(',').collect();
@@ -571,28 +592,42 @@ fn interference_error(path: &std::path::Path) -> f64 {
             .position(|h| *h == n)
             .unwrap_or_else(|| panic!("no column {n}"))
     };
-    let (ti, mi, li) = (col("true_interf"), col("mag_interf"), col("line"));
-    let mut by_line: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
+    let idx = [
+        col("true_interf"),
+        col("mag_interf"),
+        col("mag_comp"),
+        col("true_external"),
+        col("true_lag"),
+        col("line"),
+    ];
+    let mut by_line: std::collections::BTreeMap<i64, [Vec<f64>; 2]> = Default::default();
     for r in rows {
         let v: Vec<&str> = r.split(',').collect();
-        let (Ok(t), Ok(m), Ok(l)) = (
-            v[ti].parse::<f64>(),
-            v[mi].parse::<f64>(),
-            v[li].parse::<f64>(),
-        ) else {
+        let Ok(x) = idx
+            .iter()
+            .map(|&i| v[i].parse::<f64>())
+            .collect::<Result<Vec<f64>, _>>()
+        else {
             continue;
         };
-        if l > 0.0 {
-            by_line.entry(l as i64).or_default().push(t - m);
+        if x[5] > 0.0 {
+            let e = by_line.entry(x[5] as i64).or_default();
+            e[0].push(x[0] - x[1]);
+            e[1].push(x[2] - x[3] - x[4]);
         }
     }
-    let (mut ss, mut n) = (0.0, 0usize);
-    for e in by_line.values() {
-        let mean = e.iter().sum::<f64>() / e.len() as f64;
-        ss += e.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
-        n += e.len();
+    let mut out = [0.0; 2];
+    for (j, o) in out.iter_mut().enumerate() {
+        let (mut ss, mut n) = (0.0, 0usize);
+        for e in by_line.values() {
+            let e = &e[j];
+            let mean = e.iter().sum::<f64>() / e.len() as f64;
+            ss += e.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
+            n += e.len();
+        }
+        *o = (ss / n as f64).sqrt();
     }
-    (ss / n as f64).sqrt()
+    out
 }
 
 /// Over realistic geology at 600 m the Kalman method (as `calibrate`
@@ -600,9 +635,9 @@ fn interference_error(path: &std::path::Path) -> f64 {
 /// order 6) leaves at most half the interference-model error of band-pass
 /// LS on an independent survey, and less than with the thesis' order-3
 /// field model (`--field-order 3`). Measured on the demo surveys, seeds
-/// 1–5 (×10⁻³ nT, LS / Kalman order 6): 13.4/4.2, 17.8/3.1, 8.7/2.1,
-/// 13.7/2.7, 14.9/6.5 (the module docs of `kalman::tuning` have the other
-/// altitudes).
+/// 1–5 (×10⁻³ nT, LS / Kalman order 6): 13.4/3.1, 17.8/2.6, 8.7/2.1,
+/// 13.7/2.4, 14.9/6.2 (the module docs of `kalman::tuning` have the other
+/// altitudes and stronger geology).
 #[test]
 fn kalman_halves_the_least_squares_error_over_geology_at_600_m() {
     let err = calibrate_and_compare(
@@ -613,21 +648,52 @@ fn kalman_halves_the_least_squares_error_over_geology_at_600_m() {
         "-9.5,0,-0.6",
         &[None, Some("3")],
     );
+    let e: Vec<f64> = err.iter().map(|e| e[0]).collect();
     eprintln!(
         "interference error LS {:.4} nT, Kalman (order 6) {:.4} nT, order 3 {:.4} nT",
-        err[0], err[1], err[2]
+        e[0], e[1], e[2]
     );
-    assert!(err[1] <= 0.5 * err[0], "{err:?}");
-    assert!(err[1] < err[2], "{err:?}");
+    assert!(e[1] <= 0.5 * e[0], "{err:?}");
+    assert!(e[1] < e[2], "{err:?}");
+}
+
+/// Over strong geology (10 nT/100 m at 100 m above ground, the top of the
+/// survey range; ≈ 8 nT/100 m at the calibration height of 300 m) the
+/// band-pass LS model leaves several times the sensor noise on the survey,
+/// and the Kalman method halves the survey residual of the spec itself
+/// (compensated − true external field, noise included), not only the
+/// interference-model error. This needs the cleaned altitude of the
+/// vertical-gradient term and the multi-start noise tuning: with the raw
+/// GNSS altitude (0.2 m white noise) and Nelder–Mead from the defaults,
+/// the Kalman error at 600 m over this geology was 2× the LS error (module
+/// docs of `aeromag_compensation::kalman::altitude`).
+#[test]
+fn kalman_halves_the_survey_residual_over_strong_geology() {
+    let err = calibrate_and_compare(
+        "[pattern]\naltitude_m = 300.0\n[anomaly]\narea = \"realistic\"\ngradient_rms_nt_per_100m = 10.0\n",
+        "6",
+        "",
+        "7",
+        "-9.5,0,-0.6",
+        &[None],
+    );
+    eprintln!(
+        "strong geology, LS interference {:.4} residual {:.4} nT; Kalman {:.4} / {:.4} nT",
+        err[0][0], err[0][1], err[1][0], err[1][1]
+    );
+    assert!(err[1][1] <= 0.5 * err[0][1], "{err:?}");
+    assert!(err[1][0] <= 0.5 * err[0][0], "{err:?}");
 }
 
 /// A different aircraft, not the one the defaults were tuned on: one engine
 /// in the nose, a 7 m stinger, other eddy-current circuits (a wing with
 /// τ = 0.4 s, between the lags the lag test offers), calibrated at 300 m
 /// over realistic geology. Measured (calibration seeds 1–3, surveys 41–43,
-/// ×10⁻³ nT, LS / Kalman): 300 m 23.7/6.6, 26.3/9.3, 22.1/12.0; 600 m
-/// 10.7/6.9, 16.6/6.2, 8.6/4.4. In the quiet box at 3 km both methods give
-/// 5.1–5.5: what the Tolles-Lawson model itself leaves for this aircraft.
+/// ×10⁻³ nT, LS / Kalman): 300 m 23.7/6.0, 26.3/8.9, 22.1/5.6; 600 m
+/// 10.7/5.9, 16.6/5.8, 8.6/4.5 (before the cleaned altitude and the grid
+/// search of the noise tuning: 6.6, 9.3, 12.0; 6.9, 6.2, 4.4). In the
+/// quiet box at 3 km both methods gave 5.1–5.5 (not re-measured): what the
+/// Tolles-Lawson model itself leaves for this aircraft.
 #[test]
 fn kalman_halves_the_least_squares_error_for_another_aircraft_at_300_m() {
     let err = calibrate_and_compare(
@@ -642,9 +708,9 @@ fn kalman_halves_the_least_squares_error_for_another_aircraft_at_300_m() {
     );
     eprintln!(
         "other aircraft, interference error LS {:.4} nT, Kalman {:.4} nT",
-        err[0], err[1]
+        err[0][0], err[1][0]
     );
-    assert!(err[1] <= 0.5 * err[0], "{err:?}");
+    assert!(err[1][0] <= 0.5 * err[0][0], "{err:?}");
 }
 
 /// A single-engine aircraft with a short stinger (scenario TOML sections).
@@ -715,7 +781,8 @@ misalignment_deg = [-0.2, 0.4, 0.1]
 /// (`survey_toml`, empty for the defaults; seed `survey_seed`), calibrate
 /// with band-pass LS and then with the Kalman method for each field order
 /// of `kalman_orders` (`None`: the default), compensate the survey with
-/// each model, and return the interference-model errors (LS first), nT.
+/// each model, and return the survey errors of each ([`survey_errors`]: the
+/// interference model's, the survey residual), LS first, nT.
 fn calibrate_and_compare(
     cal_toml: &str,
     cal_seed: &str,
@@ -723,7 +790,7 @@ fn calibrate_and_compare(
     survey_seed: &str,
     lever_arm: &str,
     kalman_orders: &[Option<&str>],
-) -> Vec<f64> {
+) -> Vec<[f64; 2]> {
     let d = tempfile::tempdir().unwrap();
     let run_simulation = |scenario: &str, toml: &str, seed: &str| {
         let cfg = d.path().join(format!("{scenario}.toml"));
@@ -767,7 +834,7 @@ fn calibrate_and_compare(
         }
         assert_code(&aeromag(&args), 0);
         assert_code(&compensate(&model, &survey, &out), 0);
-        err.push(interference_error(&out));
+        err.push(survey_errors(&out));
     }
     err
 }

@@ -57,7 +57,10 @@ pub struct Args {
     model: PathBuf,
     /// Fitting method: `ls` (band-pass least squares) or `kalman` (Kalman
     /// filter and smoother with a stochastic model of the external field;
-    /// needs `alt` and ground speed from `vn`,`ve` or positions).
+    /// needs `alt` and ground speed from `vn`,`ve` or positions; the
+    /// altitude of the vertical-gradient term is cleaned of GNSS noise,
+    /// blended with the integrated down velocity `vd` when that is recorded
+    /// and agrees with `alt`, else low-passed at 1 Hz).
     #[arg(long, default_value = "ls")]
     method: String,
     /// With --method kalman: tune the noise intensities q1, q2, r by maximum
@@ -470,16 +473,78 @@ fn add_lags_by_kalman_likelihood(
     Ok(terms)
 }
 
-/// The scalar sensor's altitude (m): with a lever arm, the navigation
-/// altitude moved to the sensor with the attitude (a pitch of 5° moves a
-/// sensor 9.5 m behind the reference point by 0.8 m, in step with the
-/// manoeuvre, where the vertical gradient of a low calibration makes it
-/// matter); without one, `alt` as recorded.
-fn sensor_altitude(table: &FlightTable, lever: Option<&LeverArm>) -> anyhow::Result<Vec<f64>> {
-    let Some(lever) = lever else {
-        return Ok(table.require("alt")?.to_vec());
+/// The scalar sensor's altitude (m) for the field model's `Δz B_z` term.
+///
+/// 1. The navigation altitude `alt` is cleaned on each leg `segs` (module
+///    docs of [`aeromag_compensation::kalman::altitude`]): blended with the
+///    integrated down velocity `vd` when that column is recorded and agrees
+///    with `alt` (a warning says so when it does not), else low-passed at
+///    1 Hz. A noisy altitude times the vertical gradient of a low
+///    calibration otherwise spoils the coefficients.
+/// 2. With a lever arm it is moved to the sensor with the attitude (a pitch
+///    of 5° moves a sensor 9.5 m behind the reference point by 0.8 m, in
+///    step with the manoeuvre).
+fn sensor_altitude(
+    table: &FlightTable,
+    segs: &[Range<usize>],
+    lever: Option<&LeverArm>,
+) -> anyhow::Result<Vec<f64>> {
+    use aeromag_compensation::kalman::altitude::{
+        AltitudeSmoothing, AltitudeSource, NavRun, check_down_velocity, smooth_altitude,
     };
-    let [_, _, sensor_alt] = crate::flight::sensor_track(table, lever.arm_m)?;
+    let time = table.require("time")?;
+    let alt = table.require("alt")?;
+    let vd = table.column("vd");
+    let runs: Vec<NavRun> = segs
+        .iter()
+        .map(|r| NavRun {
+            time: &time[r.clone()],
+            alt_m: &alt[r.clone()],
+            down_velocity_m_s: vd.map(|v| &v[r.clone()]),
+        })
+        .collect();
+    let cfg = AltitudeSmoothing::default();
+    let check = check_down_velocity(&runs, &cfg);
+    let use_vd = check.is_some_and(|c| c.accepted);
+    if let Some(c) = check.filter(|c| !c.accepted) {
+        eprintln!(
+            "warning: {}: `vd` does not follow the change of `alt` (slope {:.2}, correlation {:.2} \
+             over 0.02–0.5 Hz; a down velocity in m/s gives ≈ 1, 1): the altitude is low-passed \
+             instead of blended with it",
+            table.file_label(),
+            c.slope,
+            c.correlation
+        );
+    }
+    let mut clean = alt.to_vec();
+    let mut how = AltitudeSource::AsRecorded;
+    for (r, run) in segs.iter().zip(&runs) {
+        let (s, h) = smooth_altitude(run, use_vd, &cfg);
+        clean[r.clone()].copy_from_slice(&s);
+        if how == AltitudeSource::AsRecorded {
+            how = h;
+        }
+    }
+    match (how, check) {
+        (AltitudeSource::Blended(fc), Some(c)) => eprintln!(
+            "note: altitude of the vertical-gradient term: `alt` blended with the integrated `vd` \
+             (crossover {fc} Hz; they agree with slope {:.3}, correlation {:.3})",
+            c.slope, c.correlation
+        ),
+        (AltitudeSource::LowPass(fc), _) => eprintln!(
+            "note: altitude of the vertical-gradient term: `alt` low-passed at {fc} Hz{}",
+            if vd.is_none() {
+                " (no `vd` column to blend with)"
+            } else {
+                ""
+            }
+        ),
+        _ => {}
+    }
+    let Some(lever) = lever else {
+        return Ok(clean);
+    };
+    let [_, _, sensor_alt] = crate::flight::sensor_track_at(table, &clean, lever.arm_m)?;
     Ok(sensor_alt)
 }
 
@@ -533,10 +598,10 @@ pub fn fit_model_kalman(
 ) -> anyhow::Result<(TlModel, KalmanFit, Vec<Vec<f64>>)> {
     let cols = TlColumns::from_table(table)?;
     let (ref_cols, y) = reduced_mag(table, &cols, opts)?;
-    let alt = sensor_altitude(table, opts.lever_arm.as_ref())?;
-    let speed = ground_speed(table)?;
     let cols = TlColumns { mag: &y, ..cols };
     let (segs, _) = cols.segments(opts.split_lines, 1);
+    let alt = sensor_altitude(table, &segs, opts.lever_arm.as_ref())?;
+    let speed = ground_speed(table)?;
     let segments: Vec<KalmanSegment> = segs
         .iter()
         .map(|r| KalmanSegment {
@@ -558,7 +623,7 @@ pub fn fit_model_kalman(
         bt_scale_nt: cfg.bt_scale_nt,
         ..LsConfig::default()
     };
-    let (terms, selection) = match opts.eddy_lag {
+    let (terms, selection, tuned) = match opts.eddy_lag {
         EddyLag::Auto if cfg.terms.has_eddy() => {
             let spinner = crate::progress::spinner("Kalman pass 1: removing the field");
             let pass1 = KalmanConfig {
@@ -581,17 +646,30 @@ pub fn fit_model_kalman(
                 .collect();
             let (terms, selection) = choose_terms(table, &data, &ls, &opts.eddy_lag)?;
             let terms = add_lags_by_kalman_likelihood(&segments, cfg, terms, &first, fail)?;
-            (terms, selection)
+            (
+                terms,
+                selection,
+                first.tuning.is_some().then_some(first.noise),
+            )
         }
         _ => {
             let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
-            choose_terms(table, &data, &ls, &opts.eddy_lag)?
+            let (terms, selection) = choose_terms(table, &data, &ls, &opts.eddy_lag)?;
+            (terms, selection, None)
         }
     };
-    let cfg = &KalmanConfig {
+    let mut cfg = KalmanConfig {
         terms,
         ..cfg.clone()
     };
+    // Pass 1 searched the likelihood globally (kalman::tuning, several
+    // starts) on the same flight with nearly the same terms: the final fit
+    // refines its maximum locally.
+    if let Some(noise) = tuned {
+        cfg.noise = noise;
+        cfg.tuning.grid_starts = 0;
+    }
+    let cfg = &cfg;
     let spinner = crate::progress::spinner("Kalman filter and smoother");
     let fit = fit_kalman(&segments, cfg).map_err(fail)?;
     spinner.finish_and_clear();
@@ -698,10 +776,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 q1_unit(cfg.field_prior.order),
                 fit.noise.q2_nt2_per_m5,
                 fit.noise.r_nt2,
-                if fit.tuning.is_some() {
-                    "tuned by maximum likelihood"
-                } else {
-                    "defaults"
+                match &fit.tuning {
+                    Some(t) => format!(
+                        "tuned by maximum likelihood, {} filter runs on {} samples",
+                        t.evaluations, t.rows
+                    ),
+                    None => "defaults".into(),
                 }
             );
             println!(

@@ -167,10 +167,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.set_message("scoring");
     let fc: Figures = figures(&cal, &model.reference, model.lever_arm.as_ref())?;
     let fsv: Figures = figures(&survey, &model.reference, model.lever_arm.as_ref())?;
-    let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> {
-        Ok(figures(&compensated(m)?, &m.reference, m.lever_arm.as_ref())?.residual_rms_nt)
+    // The survey residual and the interference-model error of a model.
+    let scores = |m: &TlModel| -> anyhow::Result<[Option<f64>; 2]> {
+        let f = figures(&compensated(m)?, &m.reference, m.lever_arm.as_ref())?;
+        Ok([f.residual_rms_nt, f.interference_rms_nt])
     };
-    let res_kf = residual(&model_kf)?;
+    let residual = |m: &TlModel| -> anyhow::Result<Option<f64>> { Ok(scores(m)?[0]) };
+    let [res_kf, int_kf] = scores(&model_kf)?;
 
     // Calibration planning (thesis fig. 2): the truncated pattern against the
     // full one — flight time, estimability of every coefficient, and the
@@ -213,7 +216,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             [res_kf, residual(&trunc_kf)?],
         ))
     };
-    let (grad_res_ls, grad_res_kf) = (residual(&grad_ls)?, residual(&grad_kf)?);
+    let ([grad_res_ls, grad_int_ls], [grad_res_kf, grad_int_kf]) =
+        (scores(&grad_ls)?, scores(&grad_kf)?);
     // Levelling of the compensated survey at its crossovers (`aeromag level
     // --lever-arm … --reference auto`, and without the base station).
     let lever = opts.lever_arm.as_ref().map(|l| l.arm_m);
@@ -237,6 +241,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "compensation": {
             "residual_rms_ls_nt": fsv.residual_rms_nt,
             "residual_rms_kalman_nt": res_kf,
+            "interference_rms_ls_nt": fsv.interference_rms_nt,
+            "interference_rms_kalman_nt": int_kf,
             "noise_floor_nt": fsv.noise_floor_nt,
             "fom_before_nt": fc.fom_before_nt,
             "fom_after_nt": fc.fom_after_nt,
@@ -258,6 +264,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "compensation_gradient": {
             "residual_rms_ls_nt": grad_res_ls,
             "residual_rms_kalman_nt": grad_res_kf,
+            "interference_rms_ls_nt": grad_int_ls,
+            "interference_rms_kalman_nt": grad_int_kf,
             "noise_floor_nt": fsv.noise_floor_nt,
         },
         "levelling": {
@@ -299,6 +307,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "LS residual (nT)",
             "Kalman residual (nT)",
             "noise floor (nT)",
+            "LS model error (nT)",
+            "Kalman model error (nT)",
         ]
         .map(String::from)
         .to_vec(),
@@ -308,15 +318,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 fmt(fsv.residual_rms_nt, 4),
                 fmt(res_kf, 4),
                 fmt(fsv.noise_floor_nt, 4),
+                fmt(fsv.interference_rms_nt, 4),
+                fmt(int_kf, 4),
             ],
             vec![
                 "realistic gradients".into(),
                 fmt(grad_res_ls, 4),
                 fmt(grad_res_kf, 4),
                 fmt(fsv.noise_floor_nt, 4),
+                fmt(grad_int_ls, 4),
+                fmt(grad_int_kf, 4),
             ],
         ],
-        "Residual versus truth on the independent survey.",
+        "Residual versus truth on the independent survey (compensated − true external field, which holds \
+         the sensor noise), and the error of the interference model alone (true − modelled interference), \
+         per survey line with the mean removed.",
     ));
     r.key_values(vec![
         (
@@ -481,6 +497,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (
             "compensation_gradient.residual_rms_kalman_nt",
             fmt(grad_res_kf, 4),
+        ),
+        (
+            "compensation_gradient.interference_rms ls / kalman",
+            format!("{} / {}", fmt(grad_int_ls, 4), fmt(grad_int_kf, 4)),
         ),
         ("levelling.k_s", format!("{:.4}", lev.fit.k_s)),
         (

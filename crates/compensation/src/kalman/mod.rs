@@ -87,6 +87,7 @@
 //!
 //! [`TermSet`]: crate::tolles_lawson::TermSet
 
+pub mod altitude;
 pub mod anomaly_model;
 pub mod field_smoother;
 pub mod fit;
