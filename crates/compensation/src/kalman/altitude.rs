@@ -36,7 +36,7 @@
 
 use aeromag_core::filter::{Band, BandPass, butter, sosfiltfilt};
 
-use crate::tolles_lawson::segments::median_step;
+use crate::tolles_lawson::segments::{median_step, split_segments};
 
 /// How the altitude is cleaned (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,21 +116,11 @@ fn climb(time: &[f64], vd: &[f64]) -> Vec<f64> {
     z
 }
 
-/// Maximal stretches where every given channel is finite.
-fn finite_runs(n: usize, finite: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for k in 0..=n {
-        match (k < n && finite(k), start) {
-            (true, None) => start = Some(k),
-            (false, Some(s)) => {
-                out.push(s..k);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    out
+/// Maximal stretches of `time` where `ok` holds (no split at time gaps: the
+/// caller's runs are already split there).
+fn usable_runs(time: &[f64], n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
+    let usable: Vec<bool> = (0..n).map(ok).collect();
+    split_segments(&time[..n], None, &usable, f64::INFINITY, 1).0
 }
 
 /// Compare the altitude with the integrated down velocity over all `runs`
@@ -145,7 +135,7 @@ pub fn check_down_velocity(runs: &[NavRun<'_>], cfg: &AltitudeSmoothing) -> Opti
         let n = run.time.len().min(run.alt_m.len()).min(vd.len());
         let ok =
             |k: usize| run.time[k].is_finite() && run.alt_m[k].is_finite() && vd[k].is_finite();
-        for r in finite_runs(n, ok) {
+        for r in usable_runs(run.time, n, ok) {
             let t = &run.time[r.clone()];
             let dt = median_step(t);
             if dt <= 0.0 || cfg.check_band_hz.1 >= 0.45 / dt {
@@ -202,7 +192,7 @@ pub fn smooth_altitude(
             && vd.is_none_or(|v| v.get(k).is_some_and(|x| x.is_finite()))
     };
     let mut longest = (0, AltitudeSource::AsRecorded);
-    for r in finite_runs(n, ok) {
+    for r in usable_runs(run.time, n, ok) {
         let t = &run.time[r.clone()];
         let dt = median_step(t);
         if dt <= 0.0 {
