@@ -429,6 +429,17 @@ fn model_and_argument_errors_exit_2() {
     assert!(stderr(&o).contains("flux_x"), "{}", stderr(&o));
 }
 
+/// The keys of each calibration area over geology in the demo's summary.
+const GEOLOGY_KEYS: [&str; 7] = [
+    "residual_rms_ls_nt",
+    "residual_rms_kalman_nt",
+    "interference_rms_ls_nt",
+    "interference_rms_kalman_nt",
+    "noise_floor_nt",
+    "calibration_altitude_m",
+    "expected_gradient_nt_per_100m",
+];
+
 #[test]
 fn demo_meets_the_compensation_figures() {
     let d = tempfile::tempdir().unwrap();
@@ -455,35 +466,44 @@ fn demo_meets_the_compensation_figures() {
         g("fom_after_nt")
     );
     assert!(out.join("index.html").exists() && out.join("model_ls.json").exists());
-    // The interference model alone: the Kalman method is not worse than LS
-    // in the quiet box and better over the gradient area (seed 1 measured:
-    // quiet 1.6 / 1.3, gradient area 4.2 / 1.9, ×10⁻³ nT).
-    let int = |grp: &str, k: &str| s[grp][k].as_f64().unwrap_or(f64::NAN);
+    // The spec's figure (compensation.md, "Acceptance"): over the gradient
+    // area (the box at 300 m, 8.8 nT/100 m expected there) the Kalman
+    // method's survey residual is at most half of LS's; in the quiet box it
+    // is not worse. Seed 1 measured: gradient area 0.0446 / 0.0138 nT,
+    // quiet 0.0113 / 0.0113 nT. The interference model alone: quiet 1.6 /
+    // 1.3, gradient area 42.8 / 8.4, mild area (1000 m, 1.0 nT/100 m) 4.3 /
+    // 1.9, ×10⁻³ nT.
+    let num = |grp: &str, k: &str| s[grp][k].as_f64().unwrap_or(f64::NAN);
     assert!(
-        int("compensation", "interference_rms_kalman_nt")
-            <= int("compensation", "interference_rms_ls_nt"),
+        num("compensation_gradient", "residual_rms_kalman_nt")
+            <= 0.5 * num("compensation_gradient", "residual_rms_ls_nt"),
+        "{}",
+        s["compensation_gradient"]
+    );
+    assert!(
+        num("compensation", "residual_rms_kalman_nt")
+            <= num("compensation", "residual_rms_ls_nt"),
         "{}",
         s["compensation"]
     );
+    for grp in ["compensation_gradient", "compensation_gradient_mild"] {
+        assert!(
+            num(grp, "interference_rms_kalman_nt") < num(grp, "interference_rms_ls_nt"),
+            "{grp}: {}",
+            s[grp]
+        );
+    }
     assert!(
-        int("compensation_gradient", "interference_rms_kalman_nt")
-            < int("compensation_gradient", "interference_rms_ls_nt"),
+        num("compensation", "interference_rms_kalman_nt")
+            <= num("compensation", "interference_rms_ls_nt"),
         "{}",
-        s["compensation_gradient"]
+        s["compensation"]
     );
     // Every key of data-formats.md that this version computes is present and numeric.
     for (group, keys) in [
         ("compensation", &["residual_rms_kalman_nt"][..]),
-        (
-            "compensation_gradient",
-            &[
-                "residual_rms_ls_nt",
-                "residual_rms_kalman_nt",
-                "interference_rms_ls_nt",
-                "interference_rms_kalman_nt",
-                "noise_floor_nt",
-            ][..],
-        ),
+        ("compensation_gradient", &GEOLOGY_KEYS[..]),
+        ("compensation_gradient_mild", &GEOLOGY_KEYS[..]),
         (
             "rotor",
             &[

@@ -45,12 +45,81 @@ pub struct Args {
     quick: bool,
 }
 
-/// The calibration over realistic geology: the same box flown at 1000 m
-/// (at the default 3000 m the anomaly field is continued up so far that
-/// nothing of it is left in the 0.1–0.9 Hz calibration band, and both
-/// methods see a quiet area).
-const GRADIENT_AREA_TOML: &str =
-    "[pattern]\naltitude_m = 1000.0\n[anomaly]\narea = \"realistic\"\n";
+/// A calibration box flown over geology instead of the quiet default area,
+/// scored on the same independent survey.
+struct GeologyArea {
+    /// Group of `summary.json` (`data-formats.md`).
+    key: &'static str,
+    /// Folder of its data under `DIR/data`.
+    dir: &'static str,
+    /// Row label in the report.
+    label: &'static str,
+    /// Scenario overrides of the `calibration` scenario.
+    toml: &'static str,
+}
+
+/// The calibrations over geology. At the default 3000 m the anomaly field is
+/// continued up so far that nothing of it is left in the 0.1–0.9 Hz
+/// calibration band and both methods see a quiet area, so the box is flown
+/// lower:
+///
+/// - `compensation_gradient`, the spec's "calibration area with realistic
+///   anomaly gradients": 300 m over geology of 10 nT/100 m at 100 m above
+///   ground, 8.8 nT/100 m expected at the box's height (the spec calls
+///   1–10 nT/100 m realistic). Here the geology costs LS about 0.04 nT,
+///   well above the 0.011 nT sensor noise, and the Kalman method's survey
+///   residual is at most half of LS's (seeds 1–10: ratio 0.22–0.44).
+/// - `compensation_gradient_mild`: 1000 m over the simulator's preset
+///   realistic area (3 nT/100 m at 100 m, 1.0 nT/100 m at the box). LS
+///   loses only a few 10⁻³ nT to the geology; the Kalman method's
+///   interference model is still better, but both survey residuals sit on
+///   the sensor noise (ratio 0.65–0.99 on seeds 1–5).
+const GEOLOGY_AREAS: [GeologyArea; 2] = [
+    GeologyArea {
+        key: "compensation_gradient",
+        dir: "gradient_area",
+        label: "realistic gradients",
+        toml: "[pattern]\naltitude_m = 300.0\n[anomaly]\narea = \"realistic\"\ngradient_rms_nt_per_100m = 10.0\n",
+    },
+    GeologyArea {
+        key: "compensation_gradient_mild",
+        dir: "gradient_area_mild",
+        label: "mild gradients",
+        toml: "[pattern]\naltitude_m = 1000.0\n[anomaly]\narea = \"realistic\"\n",
+    },
+];
+
+/// One calibration over geology, fitted by both methods and scored.
+struct GeologyResult {
+    /// The calibration flight as read back.
+    table: FlightTable,
+    ls: TlModel,
+    kalman: TlModel,
+    rows: KalmanRows,
+    /// Survey residual (LS, Kalman), nT.
+    residual: [Option<f64>; 2],
+    /// Interference-model error on the survey (LS, Kalman), nT.
+    interference: [Option<f64>; 2],
+    /// Altitude of the box, m above ground, and the expected RMS horizontal
+    /// anomaly gradient there, nT/100 m (from the truth file; a description
+    /// of the scenario, never read by the estimators).
+    altitude_m: Option<f64>,
+    gradient_nt_per_100m: Option<f64>,
+}
+
+/// `pattern.altitude_m` of a written scenario and the truth file's
+/// `anomaly.expected_gradient_nt_per_100m_at_flight_height`.
+fn box_geology(files: &aeromag_sim::WrittenFiles) -> anyhow::Result<(Option<f64>, Option<f64>)> {
+    let alt = scenario_toml(&files.scenario)?
+        .get("pattern")
+        .and_then(|p| p.get("altitude_m"))
+        .and_then(|x| x.as_float());
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&files.truth)?)?;
+    Ok((
+        alt,
+        truth["anomaly"]["expected_gradient_nt_per_100m_at_flight_height"].as_f64(),
+    ))
+}
 
 /// A small number from a JSON object, in scientific notation.
 fn sci(v: &serde_json::Value, key: &str) -> String {
@@ -116,9 +185,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ScenarioKind::Calibration
     };
     let cal_files = simulate(cal_kind, None, Some(a.seed))?.write_to_dir(&data)?;
-    let grad_dir = data.join("gradient_area");
-    let grad_files =
-        simulate(cal_kind, Some(GRADIENT_AREA_TOML), Some(a.seed))?.write_to_dir(&grad_dir)?;
+    let geology_files = GEOLOGY_AREAS
+        .iter()
+        .map(|g| {
+            Ok(simulate(cal_kind, Some(g.toml), Some(a.seed))?.write_to_dir(&data.join(g.dir))?)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let survey_files =
         simulate(ScenarioKind::Survey, None, Some(a.seed + 1))?.write_to_dir(&data)?;
     bar.inc(1);
@@ -144,7 +216,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             Ok((t, ls, kf, KalmanRows { fit, rows }))
         };
     let (mut cal, model, model_kf, _) = fit_both(&cal_files.csv)?;
-    let (grad_table, grad_ls, grad_kf, grad_rows) = fit_both(&grad_files.csv)?;
+    let geology_fits = geology_files
+        .iter()
+        .map(|f| fit_both(&f.csv))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     std::fs::write(a.out.join("model_ls.json"), model.to_json()?)?;
     std::fs::write(a.out.join("model_kalman.json"), model_kf.to_json()?)?;
     bar.inc(1);
@@ -216,8 +291,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             [res_kf, residual(&trunc_kf)?],
         ))
     };
-    let ([grad_res_ls, grad_int_ls], [grad_res_kf, grad_int_kf]) =
-        (scores(&grad_ls)?, scores(&grad_kf)?);
+    let quiet_box = box_geology(&cal_files)?;
+    let geology = geology_fits
+        .into_iter()
+        .zip(&geology_files)
+        .map(|((table, ls, kalman, rows), files)| {
+            let ([res_ls, int_ls], [res_kf, int_kf]) = (scores(&ls)?, scores(&kalman)?);
+            let (altitude_m, gradient_nt_per_100m) = box_geology(files)?;
+            Ok(GeologyResult {
+                table,
+                ls,
+                kalman,
+                rows,
+                residual: [res_ls, res_kf],
+                interference: [int_ls, int_kf],
+                altitude_m,
+                gradient_nt_per_100m,
+            })
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     // Levelling of the compensated survey at its crossovers (`aeromag level
     // --lever-arm … --reference auto`, and without the base station).
     let lever = opts.lever_arm.as_ref().map(|l| l.arm_m);
@@ -237,7 +329,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
     // 5. Report.
     bar.set_message("writing report");
-    let summary = json!({
+    let mut summary = json!({
         "compensation": {
             "residual_rms_ls_nt": fsv.residual_rms_nt,
             "residual_rms_kalman_nt": res_kf,
@@ -261,13 +353,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "estimability_full": o[0].estimability,
             "estimability_truncated": o[1].estimability,
         })),
-        "compensation_gradient": {
-            "residual_rms_ls_nt": grad_res_ls,
-            "residual_rms_kalman_nt": grad_res_kf,
-            "interference_rms_ls_nt": grad_int_ls,
-            "interference_rms_kalman_nt": grad_int_kf,
-            "noise_floor_nt": fsv.noise_floor_nt,
-        },
         "levelling": {
             "crossovers": lev.crossovers.crossovers.len(),
             "k_s": lev.fit.k_s,
@@ -286,6 +371,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "seed": a.seed,
         "software_version": env!("CARGO_PKG_VERSION"),
     });
+    for (area, g) in GEOLOGY_AREAS.iter().zip(&geology) {
+        summary[area.key] = json!({
+            "residual_rms_ls_nt": g.residual[0],
+            "residual_rms_kalman_nt": g.residual[1],
+            "interference_rms_ls_nt": g.interference[0],
+            "interference_rms_kalman_nt": g.interference[1],
+            "noise_floor_nt": fsv.noise_floor_nt,
+            "calibration_altitude_m": g.altitude_m,
+            "expected_gradient_nt_per_100m": g.gradient_nt_per_100m,
+        });
+    }
     std::fs::write(
         a.out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
@@ -296,43 +392,64 @@ pub fn run(a: Args) -> anyhow::Result<()> {
          independent survey (seed {}). The Tolles-Lawson model ({} terms) is fitted on the calibration flight \
          by band-pass least squares (LS) and by the Kalman filter and smoother with a stochastic field model, \
          and applied to the survey. Residuals are scored against the simulator's truth (per survey line, mean \
-         removed). The same aircraft is also calibrated over realistic geology at 1000 m (gradient area).",
+         removed). The same aircraft is also calibrated lower, over geology: at 300 m over an area of \
+         realistic anomaly gradients (the gradient area), and at 1000 m over a milder one. The Kalman method \
+         pays off where the geology costs LS well more than the sensor noise.",
         if a.quick { "truncated calibration box" } else { "four-heading calibration box" },
         a.seed,
         model.terms
     ));
+    let area_row = |label: &str,
+                    (alt, grad): (Option<f64>, Option<f64>),
+                    res: [Option<f64>; 2],
+                    int: [Option<f64>; 2]| {
+        vec![
+            label.to_string(),
+            fmt(alt, 0),
+            fmt(grad, 2),
+            fmt(res[0], 4),
+            fmt(res[1], 4),
+            fmt(res[0].zip(res[1]).map(|(l, k)| k / l), 2),
+            fmt(fsv.noise_floor_nt, 4),
+            fmt(int[0], 4),
+            fmt(int[1], 4),
+        ]
+    };
+    let mut area_rows = vec![area_row(
+        "quiet",
+        quiet_box,
+        [fsv.residual_rms_nt, res_kf],
+        [fsv.interference_rms_nt, int_kf],
+    )];
+    area_rows.extend(GEOLOGY_AREAS.iter().zip(&geology).map(|(area, g)| {
+        area_row(
+            area.label,
+            (g.altitude_m, g.gradient_nt_per_100m),
+            g.residual,
+            g.interference,
+        )
+    }));
     r.table(aeromag_report::Table::new(
         [
             "calibration area",
+            "box altitude (m)",
+            "anomaly gradient at the box (nT/100 m)",
             "LS residual (nT)",
             "Kalman residual (nT)",
+            "Kalman / LS",
             "noise floor (nT)",
             "LS model error (nT)",
             "Kalman model error (nT)",
         ]
         .map(String::from)
         .to_vec(),
-        vec![
-            vec![
-                "quiet".into(),
-                fmt(fsv.residual_rms_nt, 4),
-                fmt(res_kf, 4),
-                fmt(fsv.noise_floor_nt, 4),
-                fmt(fsv.interference_rms_nt, 4),
-                fmt(int_kf, 4),
-            ],
-            vec![
-                "realistic gradients".into(),
-                fmt(grad_res_ls, 4),
-                fmt(grad_res_kf, 4),
-                fmt(fsv.noise_floor_nt, 4),
-                fmt(grad_int_ls, 4),
-                fmt(grad_int_kf, 4),
-            ],
-        ],
+        area_rows,
         "Residual versus truth on the independent survey (compensated − true external field, which holds \
          the sensor noise), and the error of the interference model alone (true − modelled interference), \
-         per survey line with the mean removed.",
+         per survey line with the mean removed. The gradient is the expected RMS horizontal gradient of the \
+         anomaly at the calibration box's height (simulator truth). No estimator's residual goes below the \
+         noise floor, so the Kalman / LS ratio of the residuals can only be small where LS's model error is \
+         well above it.",
     ));
     r.key_values(vec![
         (
@@ -411,12 +528,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &fc,
         Some(&model),
     )?;
+    let g = &geology[0];
     kalman_section(
-        "Kalman method over realistic geology (gradient area, 1000 m): smoothed field, innovations, uncertainties",
-        &grad_table,
-        &grad_ls,
-        &grad_kf,
-        &grad_rows,
+        &format!(
+            "Kalman method over realistic geology (gradient area, {} m): smoothed field, innovations, uncertainties",
+            fmt(g.altitude_m, 0)
+        ),
+        &g.table,
+        &g.ls,
+        &g.kalman,
+        &g.rows,
     )?
     .append_to(&mut r);
     add_to_report(
@@ -479,8 +600,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.seed,
         start.elapsed().as_secs_f64()
     );
-    println!("{:<44} {:>12}", "figure", "value");
-    let rows = [
+    println!("{:<56} {:>12}", "figure", "value");
+    let mut rows: Vec<(String, String)> = [
         (
             "compensation.residual_rms_ls_nt",
             fmt(fsv.residual_rms_nt, 4),
@@ -490,68 +611,83 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("compensation.fom_before_nt", fmt(fc.fom_before_nt, 3)),
         ("compensation.fom_after_nt", fmt(fc.fom_after_nt, 3)),
         ("compensation.ir", fmt(fc.ir, 1)),
-        (
-            "compensation_gradient.residual_rms_ls_nt",
-            fmt(grad_res_ls, 4),
-        ),
-        (
-            "compensation_gradient.residual_rms_kalman_nt",
-            fmt(grad_res_kf, 4),
-        ),
-        (
-            "compensation_gradient.interference_rms ls / kalman",
-            format!("{} / {}", fmt(grad_int_ls, 4), fmt(grad_int_kf, 4)),
-        ),
-        ("levelling.k_s", format!("{:.4}", lev.fit.k_s)),
-        (
-            "levelling.rms_before_nt / after",
-            format!("{:.3} / {:.3}", lev.fit.rms_before_nt, lev.fit.rms_after_nt),
-        ),
-        (
-            "rotor.rotor_rms_nt",
-            fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3),
-        ),
-        (
-            "rotor.residual_model_nt",
-            fmt(rotor_keys["residual_model_nt"].as_f64(), 4),
-        ),
-        (
-            "rotor.residual_best_filter_nt",
-            fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4),
-        ),
-        (
-            "pod.rate_train (fraction)",
-            fmt(pod_keys["rate_train"].as_f64(), 4),
-        ),
-        (
-            "pod.rate_test (fraction)",
-            fmt(pod_keys["rate_test"].as_f64(), 4),
-        ),
-        ("em.range_err_rel", sci(&em_keys, "range_err_rel")),
-        ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
-        (
-            "em.polarization_ratio_before",
-            sci(&em_keys, "polarization_ratio_before"),
-        ),
-        (
-            "em.polarization_ratio_after",
-            sci(&em_keys, "polarization_ratio_after"),
-        ),
-        (
-            "gradiometry.efficiency_tensor",
-            fmt(grad_keys["efficiency_tensor"].as_f64(), 3),
-        ),
-        (
-            "gradiometry.efficiency_scalar",
-            fmt(grad_keys["efficiency_scalar"].as_f64(), 3),
-        ),
-        (
-            "gradiometry.convergence_fraction",
-            fmt(grad_keys["convergence_fraction"].as_f64(), 4),
-        ),
-    ];
+    ]
+    .map(|(k, v)| (k.to_string(), v))
+    .to_vec();
+    for (area, g) in GEOLOGY_AREAS.iter().zip(&geology) {
+        rows.extend([
+            (
+                format!("{}.residual_rms_ls_nt", area.key),
+                fmt(g.residual[0], 4),
+            ),
+            (
+                format!("{}.residual_rms_kalman_nt", area.key),
+                fmt(g.residual[1], 4),
+            ),
+            (
+                format!("{}.interference_rms ls / kalman", area.key),
+                format!(
+                    "{} / {}",
+                    fmt(g.interference[0], 4),
+                    fmt(g.interference[1], 4)
+                ),
+            ),
+        ]);
+    }
+    rows.extend(
+        [
+            ("levelling.k_s", format!("{:.4}", lev.fit.k_s)),
+            (
+                "levelling.rms_before_nt / after",
+                format!("{:.3} / {:.3}", lev.fit.rms_before_nt, lev.fit.rms_after_nt),
+            ),
+            (
+                "rotor.rotor_rms_nt",
+                fmt(rotor_keys["rotor_rms_nt"].as_f64(), 3),
+            ),
+            (
+                "rotor.residual_model_nt",
+                fmt(rotor_keys["residual_model_nt"].as_f64(), 4),
+            ),
+            (
+                "rotor.residual_best_filter_nt",
+                fmt(rotor_keys["residual_best_filter_nt"].as_f64(), 4),
+            ),
+            (
+                "pod.rate_train (fraction)",
+                fmt(pod_keys["rate_train"].as_f64(), 4),
+            ),
+            (
+                "pod.rate_test (fraction)",
+                fmt(pod_keys["rate_test"].as_f64(), 4),
+            ),
+            ("em.range_err_rel", sci(&em_keys, "range_err_rel")),
+            ("em.angle_err_deg", sci(&em_keys, "angle_err_deg")),
+            (
+                "em.polarization_ratio_before",
+                sci(&em_keys, "polarization_ratio_before"),
+            ),
+            (
+                "em.polarization_ratio_after",
+                sci(&em_keys, "polarization_ratio_after"),
+            ),
+            (
+                "gradiometry.efficiency_tensor",
+                fmt(grad_keys["efficiency_tensor"].as_f64(), 3),
+            ),
+            (
+                "gradiometry.efficiency_scalar",
+                fmt(grad_keys["efficiency_scalar"].as_f64(), 3),
+            ),
+            (
+                "gradiometry.convergence_fraction",
+                fmt(grad_keys["convergence_fraction"].as_f64(), 4),
+            ),
+        ]
+        .map(|(k, v)| (k.to_string(), v)),
+    );
     for (k, v) in rows {
-        println!("{k:<44} {v:>12}");
+        println!("{k:<56} {v:>12}");
     }
     println!("results in {}/ (summary.json, index.html)", a.out.display());
     Ok(())
