@@ -481,8 +481,7 @@ fn demo_meets_the_compensation_figures() {
         s["compensation_gradient"]
     );
     assert!(
-        num("compensation", "residual_rms_kalman_nt")
-            <= num("compensation", "residual_rms_ls_nt"),
+        num("compensation", "residual_rms_kalman_nt") <= num("compensation", "residual_rms_ls_nt"),
         "{}",
         s["compensation"]
     );
@@ -713,7 +712,10 @@ fn kalman_halves_the_survey_residual_over_strong_geology() {
 /// 10.7/5.9, 16.6/5.8, 8.6/4.5 (before the cleaned altitude and the grid
 /// search of the noise tuning: 6.6, 9.3, 12.0; 6.9, 6.2, 4.4). In the
 /// quiet box at 3 km both methods gave 5.1–5.5 (not re-measured): what the
-/// Tolles-Lawson model itself leaves for this aircraft.
+/// Tolles-Lawson model itself leaves for this aircraft. On the full survey
+/// residual (sensor noise included) the ratio Kalman / LS is 0.49–0.51 at
+/// 300 m (the preset geology, 2.6 nT/100 m at the box) and 0.62–0.85 at
+/// 600 m.
 #[test]
 fn kalman_halves_the_least_squares_error_for_another_aircraft_at_300_m() {
     let err = calibrate_and_compare(
