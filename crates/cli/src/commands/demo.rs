@@ -205,6 +205,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let fit_both =
         |path: &std::path::Path| -> anyhow::Result<(FlightTable, TlModel, TlModel, KalmanRows)> {
+            // The fits' notes (lag choice, altitude cleaning) follow this line.
+            eprintln!("fitting {}", path.display());
             let t = load(path, None)?;
             let ls = fit_model(&t, &LsConfig::default(), &opts)?;
             // The Kalman method as `calibrate --method kalman` runs it: its own
@@ -263,7 +265,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             compute_series: false,
             ..KalmanConfig::default()
         };
-        let obs = |t: &FlightTable| -> anyhow::Result<Observability> {
+        let obs = |t: &FlightTable, pattern: &str| -> anyhow::Result<Observability> {
+            eprintln!("estimability of the {pattern} pattern");
             let (_, f, _) = fit_model_kalman(
                 t,
                 &cfg,
@@ -286,7 +289,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let full_table = load(&cal_files.csv, None)?;
         Some((
             [duration(&full_table)?, duration(&trunc)?],
-            [obs(&full_table)?, obs(&trunc)?],
+            [obs(&full_table, "full")?, obs(&trunc, "truncated")?],
             [fsv.residual_rms_nt, residual(&trunc_ls)?],
             [res_kf, residual(&trunc_kf)?],
         ))
