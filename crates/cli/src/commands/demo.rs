@@ -68,7 +68,7 @@ struct GeologyArea {
 ///   ground, 8.8 nT/100 m expected at the box's height (the spec calls
 ///   1–10 nT/100 m realistic). Here the geology costs LS about 0.04 nT,
 ///   well above the 0.011 nT sensor noise, and the Kalman method's survey
-///   residual is at most half of LS's (seeds 1–10: ratio 0.22–0.44).
+///   residual is at most half of LS's (seeds 1–10: ratio 0.20–0.44).
 /// - `compensation_gradient_mild`: 1000 m over the simulator's preset
 ///   realistic area (3 nT/100 m at 100 m, 1.0 nT/100 m at the box). LS
 ///   loses only a few 10⁻³ nT to the geology; the Kalman method's

@@ -368,39 +368,32 @@ fn grid_starts(
         };
     }
     let step = GRID_STEP_DECADES * std::f64::consts::LN_10;
-    let half = (GRID_SPAN_DECADES / GRID_STEP_DECADES).round() as i32;
-    let offsets: Vec<f64> = (-half..=half).map(|i| f64::from(i) * step).collect();
+    let half = (GRID_SPAN_DECADES / GRID_STEP_DECADES).round() as usize;
+    let per_axis = 2 * half + 1;
     let mut nodes: Vec<(f64, Vec<f64>)> = vec![(objective(theta0), theta0.to_vec())];
-    let mut index = vec![0usize; q_axes.len()];
-    loop {
-        if index.iter().any(|&i| i != half as usize) {
-            let mut t = theta0.to_vec();
-            for (a, &j) in q_axes.iter().enumerate() {
-                t[j] += offsets[index[a]];
-            }
+    // Node `flat` has the digits of `flat` in base `per_axis` as its grid
+    // indices along the free field axes, the first axis fastest; the centre
+    // (every index `half`) is the start, already in.
+    for flat in 0..per_axis.pow(q_axes.len() as u32) {
+        let mut t = theta0.to_vec();
+        let (mut rest, mut centre) = (flat, true);
+        for &j in &q_axes {
+            let i = rest % per_axis;
+            rest /= per_axis;
+            centre &= i == half;
+            t[j] += (i as f64 - half as f64) * step;
+        }
+        if !centre {
             nodes.push((objective(&t), t));
         }
-        // Next node (odometer order).
-        let mut a = 0;
-        loop {
-            if a == q_axes.len() {
-                let evaluations = nodes.len();
-                // The start is the first node; the stable sort keeps it
-                // ahead of equally good ones.
-                nodes.sort_by(|x, y| x.0.total_cmp(&y.0));
-                let points = nodes.into_iter().take(n).map(|(_, t)| t).collect();
-                return Starts {
-                    points,
-                    evaluations,
-                };
-            }
-            index[a] += 1;
-            if index[a] < offsets.len() {
-                break;
-            }
-            index[a] = 0;
-            a += 1;
-        }
+    }
+    let evaluations = nodes.len();
+    // The start is the first node; the stable sort keeps it ahead of
+    // equally good ones.
+    nodes.sort_by(|x, y| x.0.total_cmp(&y.0));
+    Starts {
+        points: nodes.into_iter().take(n).map(|(_, t)| t).collect(),
+        evaluations,
     }
 }
 

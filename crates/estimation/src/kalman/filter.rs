@@ -64,6 +64,8 @@ pub struct SqrtKalmanFilter {
     v: Vec<f64>,
     tmp: Vec<f64>,
     nz: Vec<(usize, usize, f64)>,
+    /// Whether every entry of `nz` is on or above the diagonal.
+    nz_upper: bool,
     phi_upper: Vec<f64>,
 }
 
@@ -94,6 +96,7 @@ impl SqrtKalmanFilter {
             v: vec![0.0; 2 * n.max(1)],
             tmp: vec![0.0; n],
             nz: Vec::with_capacity(n * n),
+            nz_upper: true,
             phi_upper: Vec::with_capacity(n * n),
         })
     }
@@ -212,7 +215,7 @@ impl SqrtKalmanFilter {
         // U_b ← Φ_a U_b, column by column (each column of U_b is contiguous
         // in the column-major factor).
         let s = self.s.as_mut_slice();
-        if self.nz.iter().all(|&(i, l, _)| i <= l) {
+        if self.nz_upper {
             // Φ_a upper triangular: dense row-major copy of its upper part,
             // then in place, rows ascending, each from rows not yet updated:
             // col_i ← Σ_{l ≥ i} Φ_il col_l.
@@ -243,13 +246,16 @@ impl SqrtKalmanFilter {
         Ok(())
     }
 
-    /// The non-zero entries `(i, l, Φ_il)` of `phi` into `self.nz`.
+    /// The non-zero entries `(i, l, Φ_il)` of `phi` into `self.nz`, and
+    /// whether `phi` is upper triangular into `self.nz_upper`.
     fn collect_nonzeros(&mut self, phi: &DMatrix<f64>) {
         self.nz.clear();
+        self.nz_upper = true;
         let k = phi.nrows();
         for (l, col) in phi.as_slice().chunks_exact(k).enumerate() {
             for (i, &p) in col.iter().enumerate() {
                 if p != 0.0 {
+                    self.nz_upper &= i <= l;
                     self.nz.push((i, l, p));
                 }
             }
@@ -306,7 +312,7 @@ impl SqrtKalmanFilter {
         // Φ and G both upper triangular (and U_a always is): the cheaper
         // kernel for two triangular halves.
         let pair = q == k
-            && self.nz.iter().all(|&(i, l, _)| i <= l)
+            && self.nz_upper
             && (0..k).all(|j| g[j * k + j + 1..(j + 1) * k].iter().all(|x| *x == 0.0));
         if pair {
             triangularize_upper_pair(w, k, &mut self.v[..c]);
