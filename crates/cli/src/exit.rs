@@ -1,27 +1,41 @@
-//! Exit codes: 2 for bad input, 1 for other failures.
+//! Exit codes: 2 for bad input, 1 for other failures; and the message.
 
-/// Marks an error as caused by the user's input (exit code 2).
+/// Marks an error found by the command itself (an option combination) as
+/// caused by the user's input (exit code 2).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-/// Exit code of an error chain: 2 if any cause is a bad-input error of ours or
-/// of a library crate, 1 otherwise.
+/// Exit code of an error chain: 2 if the first error that knows its cause
+/// says bad input, 1 otherwise (clap's own usage errors exit 2 before).
 pub fn classify(e: &anyhow::Error) -> i32 {
     for cause in e.chain() {
-        if cause.downcast_ref::<BadInput>().is_some()
-            || cause
-                .downcast_ref::<aeromag_io::IoError>()
-                .is_some_and(|e| e.is_bad_input())
-            || cause.downcast_ref::<aeromag_core::CoreError>().is_some()
-            || cause
-                .downcast_ref::<aeromag_sim::SimError>()
-                .is_some_and(sim_bad_input)
-        {
+        if cause.downcast_ref::<BadInput>().is_some() {
             return 2;
+        }
+        if let Some(bad) = aeromag::error::classify(cause) {
+            return if bad { 2 } else { 1 };
         }
     }
     1
+}
+
+/// The message of an error chain: each cause whose text the message does
+/// not already hold, joined by ": " (library errors that quote their
+/// source are not repeated).
+pub fn message(e: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if msg.contains(&text) {
+            continue;
+        }
+        if !msg.is_empty() {
+            msg.push_str(": ");
+        }
+        msg.push_str(&text);
+    }
+    msg
 }
 
 /// Shorthand: a bad-input error with a message.
@@ -30,11 +44,18 @@ macro_rules! bad_input {
 }
 pub(crate) use bad_input;
 
-/// Scenario-file problems are the user's input; failures to run or write are not.
-fn sim_bad_input(e: &aeromag_sim::SimError) -> bool {
-    use aeromag_sim::SimError as E;
-    matches!(
-        e,
-        E::ConfigParse(_) | E::InvalidConfig { .. } | E::Core(_) | E::Trajectory(_)
-    )
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn causes_are_classified_and_not_repeated() {
+        let io = std::io::Error::other("disk full");
+        let e = anyhow::Error::new(aeromag::Error::write("/x/o.csv", io)).context("writing");
+        assert_eq!(classify(&e), 1);
+        assert_eq!(message(&e), "writing: cannot write '/x/o.csv': disk full");
+        assert_eq!(classify(&bad_input!("--x")), 2);
+        let bad = anyhow::Error::new(aeromag::Error::bad_input("no"));
+        assert_eq!(classify(&bad), 2);
+    }
 }

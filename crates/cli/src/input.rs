@@ -1,7 +1,7 @@
-//! Reading flight files the same way in every command: parse, map columns,
-//! validate time and units, print warnings.
+//! Reading flight files the same way in every command: read, map columns,
+//! check (the library's `Flight`), print the warnings.
 
-use aeromag_io::{ColumnMap, FlightTable, ReadOptions, check_time, check_units, read_table};
+use aeromag::{ColumnMap, Flight};
 use std::path::{Path, PathBuf};
 
 /// Input-file arguments shared by the commands that read flight data.
@@ -17,25 +17,22 @@ pub struct InputArgs {
     pub columns: Option<String>,
 }
 
-/// Read, map and validate a flight file; warnings go to stderr.
-pub fn load(path: &Path, columns: Option<&str>) -> anyhow::Result<FlightTable> {
-    let mut opts = ReadOptions::default();
-    if let Some(map) = columns {
-        opts.columns = ColumnMap::parse(map)?;
+/// Read and check a flight file; its warnings go to stderr.
+pub fn load(path: &Path, columns: Option<&str>) -> anyhow::Result<Flight> {
+    let map = match columns {
+        Some(m) => ColumnMap::parse(m)?,
+        None => ColumnMap::new(),
+    };
+    let flight = Flight::read_mapped(path, &map)?;
+    for w in flight.warnings() {
+        eprintln!("{w}");
     }
-    let table = read_table(path, &opts)?;
-    if table.column("time").is_some() {
-        check_time(&table)?;
-    }
-    for w in check_units(&table)? {
-        eprintln!("warning: {w}");
-    }
-    Ok(table)
+    Ok(flight)
 }
 
 impl InputArgs {
     /// [`load`] with these arguments.
-    pub fn load(&self) -> anyhow::Result<FlightTable> {
+    pub fn load(&self) -> anyhow::Result<Flight> {
         load(&self.input, self.columns.as_deref())
     }
 }

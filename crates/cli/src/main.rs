@@ -1,17 +1,17 @@
 //! `aeromag`: the command-line program.
 //!
-//! Every command returns `anyhow::Result`; [`exit::classify`] maps errors to
-//! exit codes: 2 for bad input (files, columns, arguments, scenario files),
-//! 1 for everything else. Nothing panics on user input.
+//! Each command parses its arguments, calls one function of the `aeromag`
+//! library, writes the files and prints. Every command returns
+//! `anyhow::Result`; [`exit::classify`] maps errors to exit codes: 2 for bad
+//! input (files, columns, arguments, scenario files), 1 for everything else.
+//! Nothing panics on user input.
 
-mod analysis;
+mod args;
 mod commands;
 mod exit;
-mod flight;
 mod input;
-mod kalman_report;
+mod output;
 mod progress;
-mod report_section;
 
 use clap::{Parser, Subcommand};
 
@@ -76,7 +76,7 @@ fn main() {
         Command::Observability(a) => commands::observability::run(a),
     };
     if let Err(e) = result {
-        eprintln!("error: {e:#}");
+        eprintln!("error: {}", exit::message(&e));
         std::process::exit(exit::classify(&e));
     }
 }

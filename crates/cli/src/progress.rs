@@ -1,31 +1,66 @@
-//! Progress bars on stderr, shown only when both stdout and stderr are a
-//! terminal (none when output is piped or redirected).
+//! The command's observer: stages as spinners on stderr (only when both
+//! stdout and stderr are a terminal), notes and warnings printed as they
+//! come.
 
-use indicatif::{ProgressBar, ProgressStyle};
+use aeromag::{Note, Observer};
+use indicatif::ProgressBar;
 use std::io::IsTerminal;
 
-/// A progress bar over `len` steps with a message; hidden when not on a terminal.
-pub fn bar(len: u64, msg: &str) -> ProgressBar {
-    if !(std::io::stdout().is_terminal() && std::io::stderr().is_terminal()) {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(len);
-    pb.set_style(
-        ProgressStyle::with_template("{spinner} {msg:24} [{bar:30}] {pos}/{len} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_message(msg.to_string());
-    pb
+fn on_terminal() -> bool {
+    std::io::stdout().is_terminal() && std::io::stderr().is_terminal()
 }
 
 /// A spinner for a step of unknown length; hidden when not on a terminal.
 pub fn spinner(msg: &str) -> ProgressBar {
-    if !(std::io::stdout().is_terminal() && std::io::stderr().is_terminal()) {
+    if !on_terminal() {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new_spinner();
     pb.set_message(msg.to_string());
     pb.enable_steady_tick(std::time::Duration::from_millis(120));
     pb
+}
+
+/// Renders a library workflow's stages as spinners and prints its notes.
+#[derive(Default)]
+pub struct Bars {
+    current: Option<ProgressBar>,
+}
+
+impl Bars {
+    /// An observer with nothing shown yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+impl Observer for Bars {
+    fn stage(&mut self, name: &str) {
+        if let Some(pb) = self.current.take() {
+            pb.finish_and_clear();
+        }
+        self.current = Some(spinner(name));
+    }
+
+    fn progress(&mut self, done: u64, total: u64) {
+        if let Some(pb) = &self.current {
+            pb.set_length(total);
+            pb.set_position(done);
+        }
+    }
+
+    fn note(&mut self, note: &Note) {
+        match &self.current {
+            Some(pb) => pb.suspend(|| eprintln!("{note}")),
+            None => eprintln!("{note}"),
+        }
+    }
+}
+
+impl Drop for Bars {
+    fn drop(&mut self) {
+        if let Some(pb) = self.current.take() {
+            pb.finish_and_clear();
+        }
+    }
 }

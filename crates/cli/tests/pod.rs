@@ -1,7 +1,6 @@
-//! `aeromag simulate pod`, `aeromag pod fit` and `aeromag pod apply` end to
-//! end (spec `helicopter.md` part B, issue 5): learn on the seed's headings,
-//! compensate the independent heading set of another flight, score against
-//! the simulator's truth columns (the commands never read them).
+//! `aeromag simulate pod`, `aeromag pod fit` and `aeromag pod apply` as
+//! commands: files, rows kept and flagged, messages and exit codes (the
+//! compensation rates are tested in the library, crates/aeromag/tests/pod.rs).
 
 mod common;
 use common::*;
@@ -28,38 +27,6 @@ fn column(h: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
     rows.iter()
         .map(|r| r[i].parse().unwrap_or(f64::NAN))
         .collect()
-}
-
-fn rms(x: &[f64]) -> f64 {
-    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-}
-
-/// Seed-style rate per heading (`line`): `1 − RMS(detrend(mag − true_external
-/// − pod_interf)) / RMS(detrend(mag))`, and the same pooled over all rows.
-fn rates(out: &Path) -> (Vec<f64>, f64) {
-    use aeromag_compensation::pod::detrend;
-    let (h, rows) = read_csv(out);
-    let (mag, ext, pred, line) = (
-        column(&h, &rows, "mag"),
-        column(&h, &rows, "true_external"),
-        column(&h, &rows, "pod_interf"),
-        column(&h, &rows, "line"),
-    );
-    let sum_sq = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>();
-    let (mut r, mut pooled_before, mut pooled_after) = (Vec::new(), 0.0, 0.0);
-    let mut start = 0;
-    for k in 1..=line.len() {
-        if k == line.len() || line[k] != line[start] {
-            let before = detrend(&mag[start..k]);
-            let after: Vec<f64> = (start..k).map(|j| mag[j] - ext[j] - pred[j]).collect();
-            let after = detrend(&after);
-            r.push(1.0 - rms(&after) / rms(&before));
-            pooled_before += sum_sq(&before);
-            pooled_after += sum_sq(&after);
-            start = k;
-        }
-    }
-    (r, 1.0 - (pooled_after / pooled_before).sqrt())
 }
 
 const SETUP: [&str; 10] = [
@@ -125,70 +92,6 @@ fn simulate_pair_with(
     (learn.join("pod.csv"), test.join("pod.csv"))
 }
 
-fn fit_apply(d: &Path, learn: &Path, test: &Path, method: &str) -> std::path::PathBuf {
-    fit_apply_with(d, learn, test, method, &SETUP)
-}
-
-fn fit_apply_with(
-    d: &Path,
-    learn: &Path,
-    test: &Path,
-    method: &str,
-    setup: &[&str],
-) -> std::path::PathBuf {
-    let model = d.join(format!("{method}.json"));
-    let mut args = vec![
-        "pod",
-        "fit",
-        "--input",
-        learn.to_str().unwrap(),
-        "--model",
-        model.to_str().unwrap(),
-        "--method",
-        method,
-    ];
-    args.extend(setup);
-    assert_code(&aeromag(&args), 0);
-    let out = d.join(format!("{method}.csv"));
-    let o = apply("pod", &model, &test, &out);
-    assert_code(&o, 0);
-    out
-}
-
-#[test]
-fn seed_solve_reaches_90_percent_on_the_set_dipole_array_and_joint_97_percent_on_every_heading() {
-    let d = tempfile::tempdir().unwrap();
-    let (learn, test) = simulate_pair(d.path());
-    let text = std::fs::read_to_string(&learn).unwrap();
-    let header = text.lines().find(|l| !l.starts_with('#')).unwrap();
-    assert!(
-        header.contains("cable_inclination")
-            && header.contains("cable_azimuth")
-            && header.contains("true_interf")
-    );
-    let da = fit_apply(d.path(), &learn, &test, "dipole-array");
-    let two = fit_apply(d.path(), &learn, &test, "two-step");
-    let joint = fit_apply(d.path(), &learn, &test, "joint");
-    let ((rd, pd), (rt, pt), (rj, pj)) = (rates(&da), rates(&two), rates(&joint));
-    eprintln!(
-        "dipole array per test heading {rd:?} pooled {pd}\ntwo-step per test heading {rt:?} \
-         pooled {pt}\njoint per test heading {rj:?} pooled {pj}"
-    );
-    // The seed's solve: its "above 90 %" on the independent set as a whole.
-    assert!(pt >= 0.90, "two-step pooled {pt}");
-    assert_eq!(rd.len(), 8);
-    assert!(rd.iter().all(|r| *r >= 0.97), "dipole array {rd:?}");
-    assert!(rj.iter().all(|r| *r >= 0.97), "joint {rj:?}");
-    assert!(rd.iter().zip(&rt).all(|(a, b)| a > b), "{rd:?} vs {rt:?}");
-    // One output row per input row, the new columns present.
-    let (h, rows) = read_csv(&da);
-    let (_, input_rows) = read_csv(&test);
-    assert_eq!(rows.len(), input_rows.len());
-    for c in ["pod_interf", "mag_comp", "pod_flag"] {
-        assert!(h.iter().any(|x| x == c), "{c}");
-    }
-}
-
 #[test]
 fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     let d = tempfile::tempdir().unwrap();
@@ -203,8 +106,10 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
         model.to_str().unwrap(),
     ];
     args.extend(SETUP);
-    assert_code(&aeromag(&args), 0);
-    // Blank two `mag` cells of the test file: rows kept, flagged.
+    let o = aeromag(&args);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("learning heading"), "{}", stdout(&o));
+    // Blank a `mag` cell of the test file: rows kept, flagged.
     let text = std::fs::read_to_string(&test).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     let hdr = lines.iter().position(|l| !l.starts_with('#')).unwrap();
@@ -222,7 +127,12 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     let out = d.path().join("out.csv");
     let o = apply("pod", &model, &gap, &out);
     assert_code(&o, 0);
+    assert!(stdout(&o).contains("all headings pooled"), "{}", stdout(&o));
+    assert!(stderr(&o).contains("pod_flag = 1"), "{}", stderr(&o));
     let (h, rows) = read_csv(&out);
+    for c in ["pod_interf", "mag_comp", "pod_flag"] {
+        assert!(h.iter().any(|x| x == c), "{c}");
+    }
     assert_eq!(rows.len(), lines.len() - hdr - 1);
     let flag = column(&h, &rows, "pod_flag");
     assert_eq!(flag[499], 1.0);
@@ -250,47 +160,9 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     // A model file of another kind.
     std::fs::write(
         &bad,
-        "{\"format\": \"aeromag-model/1\", \"kind\": \"tolles-lawson\"}",
+        "{\"format\": \"aeromag-model/2\", \"kind\": \"tolles-lawson\"}",
     )
     .unwrap();
     let o = apply("pod", &bad, &test, &out);
     assert_code(&o, 2);
-}
-
-/// Another installation and other headings than the seed's: a 30 m cable at
-/// 65°, the attachment 1 m forward and 0.3 m right, inclination 60°, the
-/// wind-driven (random) swing, tested on headings 15, 105, …, 330°.
-#[test]
-fn other_geometry_and_headings() {
-    let d = tempfile::tempdir().unwrap();
-    let toml = "cable_m = 30.0\ncable_inclination_deg = 65.0\nattach_m = [1.0, 0.3, 1.5]\n\
-                inclination_deg = 60.0\n";
-    let (learn, test) = simulate_pair_with(
-        d.path(),
-        toml,
-        "[15.0, 105.0, 195.0, 285.0, 60.0, 150.0, 240.0, 330.0]",
-    );
-    let setup = [
-        "--cable-length-m",
-        "30",
-        "--attach-m",
-        "1.0,0.3,1.5",
-        "--inclination-deg",
-        "60",
-        "--grad-north-nt-per-km",
-        "5.91",
-        "--grad-up-nt-per-km",
-        "-25.91",
-    ];
-    let mut all = Vec::new();
-    for method in ["dipole-array", "joint", "two-step"] {
-        let out = fit_apply_with(d.path(), &learn, &test, method, &setup);
-        let (r, pooled) = rates(&out);
-        eprintln!("{method}: per heading {r:?} pooled {pooled:.4}");
-        all.push((r, pooled));
-    }
-    let (da, joint, two) = (&all[0], &all[1], &all[2]);
-    assert!(da.0.iter().all(|r| *r >= 0.97), "dipole array {:?}", da.0);
-    assert!(joint.1 >= 0.97, "joint pooled {}", joint.1);
-    assert!(two.1 >= 0.90, "two-step pooled {}", two.1);
 }

@@ -68,11 +68,11 @@ fn bench(c: &mut Criterion) {
             );
             let sel =
                 select_eddy_lags(&sample, &cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).unwrap();
-            let terms = cfg.terms.with_eddy_lags(&sel.taus_s).unwrap();
+            let terms = cfg.design.terms.with_eddy_lags(&sel.taus_s).unwrap();
             fit_band_pass_ls(
                 std::slice::from_ref(&seg),
                 &LsConfig {
-                    terms,
+                    design: cfg.design.with_terms(terms),
                     ..cfg.clone()
                 },
             )

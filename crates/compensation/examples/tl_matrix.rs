@@ -7,8 +7,7 @@
 //!   solves (AᵀA + λI) c = Aᵀy with the crate's scaled normal equations and
 //!   prints c, one value per line.
 
-use aeromag_compensation::tolles_lawson::design::design_columns;
-use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
+use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, Design, TermSet};
 use aeromag_estimation::least_squares::NormalEquations;
 use std::error::Error;
 
@@ -51,7 +50,12 @@ fn main() -> Result<(), Box<dyn Error>> {
             let conv: Convention = args.get(4).map_or("magnav", String::as_str).parse()?;
             let (x, y, z) = (col("flux_x")?, col("flux_y")?, col("flux_z")?);
             let t = col("time").unwrap_or_else(|_| (0..x.len()).map(|i| i as f64).collect());
-            let cols = design_columns(&terms, conv, DEFAULT_BT_SCALE_NT, &t, [&x, &y, &z]);
+            let design = Design {
+                terms: terms.clone(),
+                convention: conv,
+                bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            };
+            let cols = design.columns(&t, [&x, &y, &z]);
             let mut out = String::new();
             for i in 0..x.len() {
                 let row: Vec<String> = cols.iter().map(|c| format!("{:e}", c[i])).collect();

@@ -1,22 +1,42 @@
 //! The compensation model file (`spec/data-formats.md`, "Model files").
 //!
-//! JSON, versioned by `"format": "aeromag-model/1"`. It records everything
-//! needed to rebuild the design matrix on new data (terms, derivative
-//! convention, `bt_scale`), how the model was fitted (method, band, trim, λ),
-//! the coefficients with names and standard deviations, fit statistics, the
-//! input columns used, and the software version.
+//! JSON, versioned by `"format": "aeromag-model/2"`. It records everything
+//! needed to rebuild the design matrix on new data (the [`Design`]: terms,
+//! derivative convention, `bt_scale`), how the model was fitted
+//! ([`MethodSettings`]: `"method": "ls"` with the band, filter order, trim
+//! and ridge λ, or `"method": "kalman"` with the field-model order and the
+//! noise intensities), the coefficients with names and standard deviations,
+//! fit statistics, the input columns used, and the software version.
+//!
+//! Version history: `aeromag-model/1` recorded `band_hz`, `filter_order`,
+//! `trim` and `lambda` for both methods (zeros for the Kalman method) and
+//! not the Kalman settings; such files are still read (their Kalman
+//! settings are unknown: `None`). Rotor and pod model files share the
+//! header and are the same in both versions.
 
 use crate::error::{CompError, Result};
-use crate::tolles_lawson::{Convention, TermSet};
+use crate::kalman::NoiseModel;
+use crate::tolles_lawson::Design;
 use serde::{Deserialize, Serialize};
 
-/// The format tag of this version of the model file.
-pub const MODEL_FORMAT: &str = "aeromag-model/1";
+/// The format tag this version writes.
+pub const MODEL_FORMAT: &str = "aeromag-model/2";
+
+/// The format tags this version reads: the current one and its predecessor.
+pub const READ_FORMATS: [&str; 2] = [MODEL_FORMAT, "aeromag-model/1"];
 
 /// `kind` of a Tolles-Lawson model (both fitting methods).
 pub const TL_KIND: &str = "tolles-lawson";
 
-/// Parse a model file and check its `format` ([`MODEL_FORMAT`]) and `kind`
+/// [`CompError::ModelFile`] of `origin`.
+fn model_error(origin: &str, reason: impl Into<String>) -> CompError {
+    CompError::ModelFile {
+        origin: origin.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// Parse a model file and check its `format` (one of [`READ_FORMATS`]) and `kind`
 /// (`writer` names the command that writes that kind, for the message).
 /// Every model file of aeromag (Tolles-Lawson, rotor, pod) goes through here.
 pub fn parse_model_json(
@@ -26,26 +46,34 @@ pub fn parse_model_json(
     writer: &str,
 ) -> Result<serde_json::Value> {
     let v: serde_json::Value = serde_json::from_str(text)
-        .map_err(|e| CompError::BadData(format!("{origin}: not a JSON model file ({e})")))?;
+        .map_err(|e| model_error(origin, format!("not a JSON model file ({e})")))?;
     match v.get("format").and_then(|f| f.as_str()) {
-        Some(MODEL_FORMAT) => {}
+        Some(f) if READ_FORMATS.contains(&f) => {}
         Some(other) => {
-            return Err(CompError::BadData(format!(
-                "{origin}: model format `{other}` is not supported (expected `{MODEL_FORMAT}`)"
-            )));
+            return Err(model_error(
+                origin,
+                format!(
+                    "model format `{other}` is not supported (expected one of {})",
+                    READ_FORMATS.map(|f| format!("`{f}`")).join(", ")
+                ),
+            ));
         }
         None => {
-            return Err(CompError::BadData(format!(
-                "{origin}: no \"format\" key; not an aeromag model file"
-            )));
+            return Err(model_error(
+                origin,
+                "no \"format\" key; not an aeromag model file",
+            ));
         }
     }
     match v.get("kind").and_then(|k| k.as_str()) {
         Some(k) if k == kind => Ok(v),
-        found => Err(CompError::BadData(format!(
-            "{origin}: model kind `{}` is not a `{kind}` model (written by `{writer}`)",
-            found.unwrap_or("missing")
-        ))),
+        found => Err(model_error(
+            origin,
+            format!(
+                "model kind `{}` is not a `{kind}` model (written by `{writer}`)",
+                found.unwrap_or("missing")
+            ),
+        )),
     }
 }
 
@@ -57,9 +85,12 @@ pub fn parse_model<T: serde::de::DeserializeOwned>(
     kind: &str,
     writer: &str,
 ) -> Result<T> {
-    let v = parse_model_json(text, origin, kind, writer)?;
+    let mut v = parse_model_json(text, origin, kind, writer)?;
+    // Read as the current version (the kinds with a layout of their own
+    // convert before they come here).
+    v["format"] = MODEL_FORMAT.into();
     serde_json::from_value(v)
-        .map_err(|e| CompError::BadData(format!("{origin}: invalid `{kind}` model: {e}")))
+        .map_err(|e| model_error(origin, format!("invalid `{kind}` model: {e}")))
 }
 
 /// One named coefficient.
@@ -99,29 +130,70 @@ fn null_as_infinity<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Resu
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
+/// The band-pass least-squares settings a model was fitted with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LsSettings {
+    /// Pass band, Hz (`null` when unfiltered).
+    pub band_hz: Option<(f64, f64)>,
+    /// Butterworth order.
+    pub filter_order: usize,
+    /// Samples trimmed at each end of each segment.
+    pub trim: usize,
+    /// Ridge parameter λ.
+    pub lambda: f64,
+}
+
+/// The Kalman-method settings a model was fitted with (`None` in files
+/// converted from `aeromag-model/1`, which did not record them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct KalmanSettings {
+    /// Order of the along-track field model.
+    pub field_order: Option<usize>,
+    /// Noise intensities of the final fit (`q₁` in nT²/m^(2n−1), `q₂` in
+    /// nT²/m⁵, `r` in nT²).
+    pub noise: Option<NoiseModel>,
+}
+
+/// How a model was fitted: the method and its own settings. In the file:
+/// `"method": "ls"` or `"method": "kalman"` beside the settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "lowercase")]
+pub enum MethodSettings {
+    /// Band-pass least squares.
+    Ls(LsSettings),
+    /// The Kalman filter and smoother.
+    Kalman(KalmanSettings),
+}
+
+impl MethodSettings {
+    /// `ls` or `kalman`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            MethodSettings::Ls(_) => "ls",
+            MethodSettings::Kalman(_) => "kalman",
+        }
+    }
+}
+
+impl std::fmt::Display for MethodSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A Tolles-Lawson compensation model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TlModel {
-    /// Always [`MODEL_FORMAT`].
+    /// Always [`MODEL_FORMAT`] in memory.
     pub format: String,
-    /// Model kind, `"tolles-lawson"`.
+    /// Model kind, [`TL_KIND`].
     pub kind: String,
-    /// Fitting method: `"ls"` or `"kalman"`.
-    pub method: String,
-    /// Term groups.
-    pub terms: TermSet,
-    /// Derivative convention.
-    pub convention: Convention,
-    /// Scale of the induced and eddy columns, nT.
-    pub bt_scale_nt: f64,
-    /// Pass band used by the fit, Hz (`null` when unfiltered).
-    pub band_hz: Option<(f64, f64)>,
-    /// Filter order.
-    pub filter_order: usize,
-    /// Samples trimmed per segment end.
-    pub trim: usize,
-    /// Ridge parameter.
-    pub lambda: f64,
+    /// Terms, derivative convention and `bt_scale`: how the rows are built.
+    #[serde(flatten)]
+    pub design: Design,
+    /// The method and its settings.
+    #[serde(flatten)]
+    pub method: MethodSettings,
     /// Coefficients in column order.
     pub coefficients: Vec<Coefficient>,
     /// Fit statistics.
@@ -149,30 +221,35 @@ impl TlModel {
 
     /// Serialize to pretty JSON.
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(self)
-            .map_err(|e| CompError::BadData(format!("cannot serialise model: {e}")))
+        serde_json::to_string_pretty(self).map_err(|e| CompError::Serialize {
+            what: "model",
+            reason: e.to_string(),
+        })
     }
 
-    /// Parse and check a model file's text; `origin` names the file in errors.
+    /// Parse and check a model file's text (either version,
+    /// [`READ_FORMATS`]); `origin` names the file in errors.
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let v = parse_model_json(text, origin, TL_KIND, "aeromag calibrate")?;
-        let m: TlModel = serde_json::from_value(v)
-            .map_err(|e| CompError::BadData(format!("{origin}: invalid model file: {e}")))?;
-        m.terms
+        let mut m: TlModel = serde_json::from_value(v)
+            .map_err(|e| model_error(origin, format!("invalid model file: {e}")))?;
+        m.format = MODEL_FORMAT.into();
+        m.design
             .validate()
-            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
-        let expect = m.terms.column_names();
+            .map_err(|e| model_error(origin, e.to_string()))?;
+        let expect = m.design.column_names();
         let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
         if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
-            return Err(CompError::BadData(format!(
-                "{origin}: coefficient names {got:?} do not match terms `{}` ({expect:?})",
-                m.terms
-            )));
+            return Err(model_error(
+                origin,
+                format!(
+                    "coefficient names {got:?} do not match terms `{}` ({expect:?})",
+                    m.design.terms
+                ),
+            ));
         }
         if m.coefficients.iter().any(|c| !c.value.is_finite()) {
-            return Err(CompError::BadData(format!(
-                "{origin}: a coefficient is not finite"
-            )));
+            return Err(model_error(origin, "a coefficient is not finite"));
         }
         Ok(m)
     }
@@ -181,13 +258,19 @@ impl TlModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tolles_lawson::{Convention, TermSet};
 
     fn sample() -> TlModel {
         let terms = TermSet::parse("p3,bias").unwrap();
         TlModel {
             format: MODEL_FORMAT.into(),
             kind: "tolles-lawson".into(),
-            method: "ls".into(),
+            method: MethodSettings::Ls(LsSettings {
+                band_hz: Some((0.1, 0.9)),
+                filter_order: 4,
+                trim: 20,
+                lambda: 0.0,
+            }),
             coefficients: terms
                 .column_names()
                 .into_iter()
@@ -198,13 +281,11 @@ mod tests {
                     std: 0.1,
                 })
                 .collect(),
-            terms,
-            convention: Convention::Physical,
-            bt_scale_nt: 50_000.0,
-            band_hz: Some((0.1, 0.9)),
-            filter_order: 4,
-            trim: 20,
-            lambda: 0.0,
+            design: Design {
+                terms,
+                convention: Convention::Physical,
+                bt_scale_nt: 50_000.0,
+            },
             fit: FitStats::default(),
             columns: Default::default(),
             reference: vec![],
@@ -234,6 +315,64 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("missing"), "{e}");
+    }
+
+    /// The model of a Kalman fit, as `aeromag-model/1` wrote it.
+    const KALMAN_V1: &str = r#"{
+      "format": "aeromag-model/1", "kind": "tolles-lawson", "method": "kalman",
+      "terms": {"groups": ["p3", "bias"]}, "convention": "physical", "bt_scale_nt": 50000.0,
+      "band_hz": null, "filter_order": 0, "trim": 0, "lambda": 0.0,
+      "coefficients": [
+        {"name": "p_x", "value": 1.5, "std": 0.1}, {"name": "p_y", "value": -2.0, "std": 0.1},
+        {"name": "p_z", "value": 0.25, "std": 0.1}, {"name": "bias", "value": 3.0, "std": 0.2}],
+      "fit": {"rows": 10, "segments": 1, "condition": 5.0, "residual_rms_nt": 0.01, "warnings": []},
+      "columns": {}, "software_version": "0.1.0"
+    }"#;
+
+    #[test]
+    fn version_1_files_are_read_as_the_current_version() {
+        let m = TlModel::from_json(KALMAN_V1, "k.json").unwrap();
+        assert_eq!(m.format, MODEL_FORMAT);
+        assert_eq!(
+            m.method,
+            MethodSettings::Kalman(KalmanSettings {
+                field_order: None,
+                noise: None
+            })
+        );
+        assert_eq!(m.coef(), [1.5, -2.0, 0.25, 3.0]);
+        let ls_v1 = sample()
+            .to_json()
+            .unwrap()
+            .replace(MODEL_FORMAT, "aeromag-model/1");
+        let ls = TlModel::from_json(&ls_v1, "l.json").unwrap();
+        assert_eq!(
+            ls,
+            sample(),
+            "an LS model reads the same from either version"
+        );
+    }
+
+    #[test]
+    fn the_method_and_its_settings_are_one_tagged_object() {
+        let mut m = sample();
+        let v: serde_json::Value = serde_json::from_str(&m.to_json().unwrap()).unwrap();
+        assert_eq!(v["method"], "ls");
+        assert_eq!(v["trim"], 20);
+        assert_eq!(v["terms"], serde_json::json!({"groups": ["p3", "bias"]}));
+        m.method = MethodSettings::Kalman(KalmanSettings {
+            field_order: Some(6),
+            noise: Some(NoiseModel::calibration_default()),
+        });
+        let text = m.to_json().unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["method"], "kalman");
+        assert_eq!(v["field_order"], 6);
+        assert!(
+            v["noise"]["r_nt2"].is_number() && v.get("trim").is_none(),
+            "{v}"
+        );
+        assert_eq!(TlModel::from_json(&text, "m.json").unwrap(), m);
     }
 
     #[test]

@@ -52,15 +52,15 @@ pub fn observability(
 ) -> Result<Observability> {
     let n = names.len();
     if prior.shape() != (n, n) || posterior.shape() != (n, n) {
-        return Err(CompError::BadData(format!("covariances must be {n}×{n}")));
+        return Err(CompError::setting(format!("covariances must be {n}×{n}")));
     }
     let inv = |m: &DMatrix<f64>| m.clone().cholesky().map(|c| c.inverse());
     let (p0i, pi) = match (inv(prior), inv(posterior)) {
         (Some(a), Some(b)) => (a, b),
         _ => {
-            return Err(CompError::BadData(
-                "a covariance matrix is not positive definite".into(),
-            ));
+            return Err(CompError::Singular {
+                reason: "a covariance matrix is not positive definite".into(),
+            });
         }
     };
     let d: Vec<f64> = (0..n).map(|i| prior[(i, i)].sqrt()).collect();

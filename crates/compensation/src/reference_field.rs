@@ -45,7 +45,7 @@ pub fn total_field_gradient_ned(pos: &Geodetic, decimal_year: f64) -> Result<[f6
     if grad.iter().all(|v| v.is_finite()) {
         Ok([grad[0], grad[1], grad[2]])
     } else {
-        Err(CompError::BadData(format!(
+        Err(CompError::data(format!(
             "main-field gradient not finite at {pos:?}"
         )))
     }
@@ -75,12 +75,12 @@ pub fn lever_arm_correction_nt(
     .iter()
     .any(|&l| l != n)
     {
-        return Err(CompError::BadData(
-            "position and attitude columns of unequal length".into(),
+        return Err(CompError::data(
+            "position and attitude columns of unequal length",
         ));
     }
     if lever.arm_m.iter().any(|v| !v.is_finite()) {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "lever arm {:?} m is not finite",
             lever.arm_m
         )));
@@ -93,8 +93,8 @@ pub fn lever_arm_correction_nt(
         if k > 0 { Some(s / k as f64) } else { None }
     };
     let (Some(lat), Some(lon), Some(alt)) = (mean(lat_deg), mean(lon_deg), mean(alt_m)) else {
-        return Err(CompError::BadData(
-            "no finite position to evaluate the main-field gradient".into(),
+        return Err(CompError::data(
+            "no finite position to evaluate the main-field gradient",
         ));
     };
     let grad = Vector3::from(total_field_gradient_ned(

@@ -46,10 +46,10 @@ use aeromag_compensation::kalman::{
     KalmanConfig, KalmanFit, KalmanSegment, fit_kalman, ground_speed_from_velocity,
 };
 use aeromag_compensation::metrics::residual_by_line;
-use aeromag_compensation::tolles_lawson::design::interference;
+use aeromag_compensation::tolles_lawson::Design;
+use aeromag_compensation::tolles_lawson::TermSet;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, LsFit, Segment, fit_band_pass_ls};
 use aeromag_compensation::tolles_lawson::segments::split_segments;
-use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use aeromag_sim::{ScenarioKind, Simulation, simulate};
 use std::ops::Range;
 
@@ -149,14 +149,7 @@ fn survey_error(survey: &Flight, coef: &[f64]) -> (f64, f64) {
         .collect();
     for r in &legs {
         let seg = survey.segment(r.clone());
-        let a = interference(
-            &terms,
-            Convention::Physical,
-            DEFAULT_BT_SCALE_NT,
-            coef,
-            seg.time,
-            seg.flux,
-        );
+        let a = Design::new(terms.clone()).interference(coef, seg.time, seg.flux);
         model[r.clone()].copy_from_slice(&a);
     }
     let mag = col(s, "mag");

@@ -5,6 +5,7 @@
 /// Functions return an error instead of panicking on bad input (NaN,
 /// empty series, impossible filter specifications, out-of-range dates).
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum CoreError {
     /// An argument is outside its valid domain.
     #[error("invalid argument `{name}`: {reason}")]
@@ -27,5 +28,46 @@ pub enum CoreError {
     Parse { what: &'static str, reason: String },
 }
 
+impl CoreError {
+    /// Whether the caller's input caused the error. Every variant here
+    /// says what was wrong with an argument, a series, a date or a file to
+    /// parse, so all are bad input; a caller that passes computed values
+    /// (not the user's) and gets one has a bug to report.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            CoreError::InvalidArgument { .. }
+            | CoreError::NonFinite { .. }
+            | CoreError::TooShort { .. }
+            | CoreError::DateOutOfRange { .. }
+            | CoreError::Parse { .. } => true,
+        }
+    }
+}
+
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, CoreError>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_core_error_is_bad_input() {
+        assert!(
+            CoreError::TooShort {
+                name: "x",
+                len: 1,
+                min: 3
+            }
+            .is_bad_input()
+        );
+        assert!(
+            CoreError::DateOutOfRange {
+                year: 1800.0,
+                first: 1900.0,
+                last: 2030.0
+            }
+            .is_bad_input()
+        );
+    }
+}

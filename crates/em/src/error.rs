@@ -4,17 +4,54 @@ use thiserror::Error;
 
 /// Everything that can go wrong in detection, calibration and positioning.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum EmError {
-    /// A caller-supplied argument is out of its domain.
-    #[error("invalid argument: {0}")]
-    InvalidArgument(String),
-    /// A matrix that must be invertible is (numerically) singular.
-    #[error("singular matrix: {0}")]
-    Singular(String),
-    /// Input data are inconsistent with the model (e.g. non-finite values).
-    #[error("invalid data: {0}")]
-    InvalidData(String),
+    /// A caller-supplied argument or setting is out of its domain (bad
+    /// input).
+    #[error("invalid argument: {reason}")]
+    InvalidArgument {
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
+    /// A matrix that must be invertible is (numerically) singular: the data
+    /// do not determine the result (a failure, not bad input).
+    #[error("singular matrix: {what}")]
+    Singular {
+        /// Which matrix, and why when known.
+        what: String,
+    },
+    /// Input data are inconsistent with the model or malformed (e.g.
+    /// non-finite values, a truncated record) (bad input).
+    #[error("invalid data: {reason}")]
+    InvalidData {
+        /// What is wrong.
+        reason: String,
+    },
     /// An error from the core crate (filters, windows).
     #[error(transparent)]
     Core(#[from] aeromag_core::CoreError),
+}
+
+impl EmError {
+    /// Whether the caller's input caused the error: invalid arguments and
+    /// data; not a singular matrix.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            EmError::InvalidArgument { .. } | EmError::InvalidData { .. } => true,
+            EmError::Singular { .. } => false,
+            EmError::Core(e) => e.is_bad_input(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn classification() {
+        assert!(EmError::InvalidArgument { reason: "x".into() }.is_bad_input());
+        assert!(EmError::InvalidData { reason: "x".into() }.is_bad_input());
+        assert!(!EmError::Singular { what: "M".into() }.is_bad_input());
+    }
 }

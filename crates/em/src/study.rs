@@ -96,7 +96,9 @@ pub fn epochs_at(
         out.extend(ep);
         scenario = Some(sc);
     }
-    let sc = scenario.ok_or_else(|| EmError::InvalidArgument("no epoch times".into()))?;
+    let sc = scenario.ok_or_else(|| EmError::InvalidArgument {
+        reason: "no epoch times".into(),
+    })?;
     Ok((sc, out))
 }
 
@@ -197,9 +199,9 @@ pub fn run_flight_study(base: &EmSimConfig, study: &FlightStudyConfig) -> Result
         || study.evaluation_epochs == 0
         || !crate::positive_finite(study.flight_s)
     {
-        return Err(EmError::InvalidArgument(format!(
-            "flight study sizes {study:?}"
-        )));
+        return Err(EmError::InvalidArgument {
+            reason: format!("flight study sizes {study:?}"),
+        });
     }
     let spread = |n: usize, offset: f64| -> Vec<f64> {
         (0..n)

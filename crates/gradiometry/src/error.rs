@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Errors of the gradiometry library (bad configuration or input; never a panic).
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum GradiometryError {
     /// A length, noise level or count that must be positive and finite is not.
     #[error("{name} must be positive and finite, got {value}")]
@@ -41,6 +42,15 @@ pub enum GradiometryError {
     },
 }
 
+impl GradiometryError {
+    /// Whether the caller's input caused the error: every variant but a
+    /// singular matrix (the data do not determine the estimate) is a value,
+    /// geometry, scenario file or length the caller gave.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, GradiometryError::Singular(_))
+    }
+}
+
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, GradiometryError>;
 
@@ -50,5 +60,17 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
         Ok(value)
     } else {
         Err(GradiometryError::NotPositive { name, value })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_a_singular_matrix_is_not_bad_input() {
+        assert!(GradiometryError::NotFinite { name: "x" }.is_bad_input());
+        assert!(GradiometryError::Config("bad".into()).is_bad_input());
+        assert!(!GradiometryError::Singular("information").is_bad_input());
     }
 }

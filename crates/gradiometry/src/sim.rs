@@ -46,6 +46,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
+use std::borrow::Borrow;
 
 /// Which body moves (`"stationary"`, `"mobile"` in scenario files).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -180,19 +181,17 @@ impl Scenario {
     }
 }
 
-/// One simulated epoch (system body frame unless stated).
+/// One measured epoch of a pass (system body frame unless stated): the
+/// readings and what navigation and the object's known track give — what
+/// a pass file holds. The estimators read nothing else.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SimEpoch {
+pub struct Epoch {
     /// Time, s.
     pub t_s: f64,
     /// Vector sensor readings, body frame, nT.
     pub vector_nt: [Vector3<f64>; 4],
     /// Scalar sensor readings, nT.
     pub scalar_nt: [f64; 4],
-    /// True object position relative to the measuring centre, body, m.
-    pub true_position_m: Vector3<f64>,
-    /// True moment, body frame, A·m².
-    pub true_moment_am2: Vector3<f64>,
     /// Known Earth field and gradient at the centre (IGRF), body frame.
     pub background: Background,
     /// Known motion over the step into this epoch (body frame).
@@ -207,6 +206,32 @@ pub struct SimEpoch {
     pub object_position_ned_m: Vector3<f64>,
     /// Object heading, rad (its known track).
     pub object_yaw_rad: f64,
+}
+
+/// One simulated epoch: the measured [`Epoch`] and the truth. It
+/// dereferences to the measured epoch, so `e.t_s`, `e.vector_nt`, … read
+/// the same on both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimEpoch {
+    /// What the instruments and the navigation record.
+    pub measured: Epoch,
+    /// True object position relative to the measuring centre, body, m.
+    pub true_position_m: Vector3<f64>,
+    /// True moment, body frame, A·m².
+    pub true_moment_am2: Vector3<f64>,
+}
+
+impl std::ops::Deref for SimEpoch {
+    type Target = Epoch;
+    fn deref(&self) -> &Epoch {
+        &self.measured
+    }
+}
+
+impl std::borrow::Borrow<Epoch> for SimEpoch {
+    fn borrow(&self) -> &Epoch {
+        &self.measured
+    }
 }
 
 fn local_to_geodetic(origin: &Geodetic, p_ned: &Vector3<f64>) -> Geodetic {
@@ -294,12 +319,10 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
             vector_nt[i] = c_bn * b + bias_v[i] + nv * s.vector_sensor.noise_nt;
             scalar_nt[i] = b.norm() + bias_s[i] + normal(&mut noise_rng) * s.scalar_sensor.noise_nt;
         }
-        out.push(SimEpoch {
+        let measured = Epoch {
             t_s: t,
             vector_nt,
             scalar_nt,
-            true_position_m: c_bn * (p_o - p_s),
-            true_moment_am2: c_bn * m_ned,
             background,
             motion: Motion {
                 v_object: c_bn * v_o,
@@ -313,6 +336,11 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
             system_attitude: s.system_attitude,
             object_position_ned_m: p_o,
             object_yaw_rad: yaw,
+        };
+        out.push(SimEpoch {
+            measured,
+            true_position_m: c_bn * (p_o - p_s),
+            true_moment_am2: c_bn * m_ned,
         });
     }
     Ok(out)
@@ -343,15 +371,19 @@ fn quiet_mean<const K: usize>(
 }
 
 /// Tensor-system filter input (state `(r, M)`, body frame).
-pub fn tensor_epochs(
-    sim: &[SimEpoch],
+pub fn tensor_epochs<E: Borrow<Epoch>>(
+    sim: &[E],
     geometry: &Geometry,
     p: &Processing,
 ) -> Vec<PassEpoch<6, 9, TensorForward>> {
     let q = p.quiet_epochs.min(sim.len());
-    let z0 = quiet_mean(sim.iter().map(|e| contrasts_vector(&e.vector_nt)), q);
+    let z0 = quiet_mean(
+        sim.iter().map(|e| contrasts_vector(&e.borrow().vector_nt)),
+        q,
+    );
     sim.iter()
         .map(|e| {
+            let e: &Epoch = e.borrow();
             let (f, u, s_q) = motion_mt(
                 &e.motion,
                 &p.noise,
@@ -378,8 +410,8 @@ pub fn tensor_epochs(
 
 /// Scalar-system filter input (state `M`, body frame), position known
 /// (`positions_m[j]`, e.g. the true or a navigated relative position).
-pub fn scalar_epochs(
-    sim: &[SimEpoch],
+pub fn scalar_epochs<E: Borrow<Epoch>>(
+    sim: &[E],
     geometry: &Geometry,
     positions_m: &[Vector3<f64>],
     p: &Processing,
@@ -392,11 +424,15 @@ pub fn scalar_epochs(
         });
     }
     let q = p.quiet_epochs.min(sim.len());
-    let z0 = quiet_mean(sim.iter().map(|e| contrasts_scalar(&e.scalar_nt)), q);
+    let z0 = quiet_mean(
+        sim.iter().map(|e| contrasts_scalar(&e.borrow().scalar_nt)),
+        q,
+    );
     Ok(sim
         .iter()
         .zip(positions_m)
         .map(|(e, r)| {
+            let e: &Epoch = e.borrow();
             let (f, u, s_q) = motion_mv(
                 &e.motion,
                 &p.noise,

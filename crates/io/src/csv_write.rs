@@ -27,17 +27,40 @@ use std::path::Path;
 use crate::error::{IoError, Result};
 use crate::table::{ColumnData, FlightTable};
 
-/// Writes `table` as CSV to the file `path` (created or truncated).
+/// Writes `table` as CSV to the file `path` (created or replaced).
+///
+/// The table is written to a temporary file in the same folder
+/// (`.NAME.PID.tmp`) and renamed to `path` when complete, so an interrupted
+/// or failed write never leaves a complete-looking partial file; on failure
+/// the temporary file is removed.
 pub fn write_csv(table: &FlightTable, path: &Path) -> Result<()> {
     let file = path.display().to_string();
     let write_err = |source| IoError::Write {
         file: file.clone(),
         source,
     };
-    let f = File::create(path).map_err(write_err)?;
-    let mut out = BufWriter::with_capacity(1 << 20, f);
-    write_csv_to(table, &mut out).map_err(write_err)?;
-    out.flush().map_err(write_err)
+    let tmp = temporary_path(path);
+    let written = File::create(&tmp).and_then(|f| {
+        let mut out = BufWriter::with_capacity(1 << 20, f);
+        write_csv_to(table, &mut out)?;
+        out.flush()?;
+        drop(out);
+        std::fs::rename(&tmp, path)
+    });
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(write_err(e));
+    }
+    Ok(())
+}
+
+/// The temporary file [`write_csv`] writes before renaming it to `path`.
+fn temporary_path(path: &Path) -> std::path::PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 /// Writes `table` as CSV to any writer (wrap unbuffered writers in a `BufWriter`).
@@ -118,6 +141,28 @@ mod tests {
         assert_eq!(
             s,
             "time,mag,note,id\n0.1,,\"a,b\",\"#1\"\n1e-7,-0.0,\"say \"\"hi\"\"\",plain\n"
+        );
+    }
+
+    #[test]
+    fn a_file_is_replaced_whole_and_no_temporary_is_left() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("out.csv");
+        let mut t = FlightTable::new();
+        t.add_column("time", vec![0.0, 1.0]).unwrap();
+        write_csv(&t, &p).unwrap();
+        t.add_column("mag", vec![1.0, 2.0]).unwrap();
+        write_csv(&t, &p).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p).unwrap(),
+            "time,mag\n0.0,1.0\n1.0,2.0\n"
+        );
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1);
+        // A folder that does not exist: an error naming the file, nothing left.
+        let e = write_csv(&t, &d.path().join("no/out.csv")).unwrap_err();
+        assert!(
+            !e.is_bad_input() && e.to_string().contains("out.csv"),
+            "{e}"
         );
     }
 }

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 
 /// Errors of plotting and report writing.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ReportError {
     /// Writing an output file (or creating its folder) failed.
     #[error("cannot write {path}: {source}")]
@@ -92,6 +93,24 @@ pub enum ReportError {
 pub type Result<T> = std::result::Result<T, ReportError>;
 
 impl ReportError {
+    /// Whether the caller's data or arguments caused the error (lengths,
+    /// no finite data, ranges, sizes, grids); writing, fonts, drawing and
+    /// encoding failures are not.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            ReportError::LengthMismatch { .. }
+            | ReportError::NoData { .. }
+            | ReportError::InvalidRange { .. }
+            | ReportError::InvalidSize { .. }
+            | ReportError::ShapeMismatch { .. }
+            | ReportError::InvalidGrid { .. } => true,
+            ReportError::Io { .. }
+            | ReportError::Font(_)
+            | ReportError::Draw(_)
+            | ReportError::Png(_) => false,
+        }
+    }
+
     /// Wraps an I/O error with the path it concerns.
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         ReportError::Io {
@@ -103,5 +122,17 @@ impl ReportError {
     /// Converts any plotters drawing error into [`ReportError::Draw`].
     pub(crate) fn draw(err: impl std::fmt::Display) -> Self {
         ReportError::Draw(err.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn data_problems_are_bad_input_and_drawing_failures_are_not() {
+        assert!(ReportError::NoData { title: "t".into() }.is_bad_input());
+        assert!(!ReportError::Draw("backend".into()).is_bad_input());
+        assert!(!ReportError::io("/x", std::io::Error::other("full")).is_bad_input());
     }
 }

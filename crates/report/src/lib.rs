@@ -55,6 +55,7 @@ pub mod style;
 
 pub use error::{ReportError, Result};
 pub use html::report::{Report, Table};
+pub use html::section::{Block, ReportSection};
 pub use plot::colormap::Colormap;
 pub use plot::heatmap::Heatmap;
 pub use plot::line::{LinePlot, Series, SeriesStyle};

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 /// Everything that can go wrong while configuring, running or writing a
 /// simulation.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SimError {
     /// The scenario TOML could not be parsed (syntax, unknown field, wrong
     /// type). The message of the TOML parser names the line and column.
@@ -53,6 +54,22 @@ pub enum SimError {
     },
 }
 
+impl SimError {
+    /// Whether the user's input caused the error: a scenario file that does
+    /// not parse or holds an invalid value, a date outside IGRF-14, a
+    /// pattern that cannot be flown. Running and writing failures are not.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            SimError::ConfigParse(_) | SimError::InvalidConfig { .. } | SimError::Trajectory(_) => {
+                true
+            }
+            SimError::Core(e) => e.is_bad_input(),
+            SimError::Io(e) => e.is_bad_input(),
+            SimError::Numerics(_) | SimError::Write { .. } | SimError::Serialize { .. } => false,
+        }
+    }
+}
+
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, SimError>;
 
@@ -94,5 +111,22 @@ pub(crate) fn require_finite(field: &str, value: f64) -> Result<()> {
         Ok(())
     } else {
         Err(invalid(field, format!("{value} must be finite")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scenario_problems_are_bad_input_and_failures_are_not() {
+        assert!(SimError::ConfigParse("line 3".into()).is_bad_input());
+        assert!(invalid("scalar.lag_s", "< 0").is_bad_input());
+        assert!(!SimError::Numerics("fft".into()).is_bad_input());
+        let w = SimError::Write {
+            path: "/x".into(),
+            source: std::io::Error::other("full"),
+        };
+        assert!(!w.is_bad_input());
     }
 }

@@ -1,31 +1,14 @@
 //! `aeromag level`: levelling at line/tie-line crossovers with the
-//! survey-altitude `k·d|B0|/dt` term.
+//! survey-altitude `k·d|B0|/dt` term (library: [`aeromag::level`]).
 
-use crate::exit::bad_input;
+use crate::args;
 use crate::input::InputArgs;
-use aeromag_compensation::levelling::{
-    LevellingConfig, RowFlag, SurveyLevelling, SurveyTracks, TrackConfig, level_survey,
-};
-use aeromag_io::FlightTable;
+use crate::progress::Bars;
+use aeromag::ReferenceChannels;
+use aeromag::compensation::levelling::{HUBER_K, LevellingConfig};
+use aeromag::level::{LevelOptions, level};
 use std::path::PathBuf;
 
-/// Level a (compensated) survey: find the crossovers of lines and tie lines,
-/// fit the coefficient k (s) of the d|B0|/dt term jointly with a level offset
-/// per line (regularised least squares; the offsets have zero mean), apply
-/// them, and report the crossover differences before and after.
-///
-/// Lines are told apart by the `line` column (label 0 = not on a line, e.g.
-/// turns). Crossovers are computed at the scalar sensor's position: give the
-/// sensor's lever arm from the navigation reference point with --lever-arm
-/// (body frame x forward, y right, z down; m), otherwise a stinger's offset
-/// along the track is mistaken for a time lag.
-///
-/// Writes every input column plus `<value>_level` and `level_flag`
-/// (0 levelled, 1 line without crossovers, 2 not on a line, 3 missing value).
-///
-/// Examples:
-///   aeromag level --input survey_comp.csv --out survey_level.csv
-///   aeromag level --input s.csv --out o.csv --value mag --lever-arm -9.5,0,-0.6 --tie-only
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
@@ -38,8 +21,8 @@ pub struct Args {
     #[arg(long)]
     value: Option<String>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m.
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    lever_arm: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
+    lever_arm: Option<[f64; 3]>,
     /// Column whose along-track derivative is the regressor of the
     /// d|B0|/dt term, as recorded (default `mag`, the uncompensated
     /// reading, when the file has it; else the column levelled). A lag of the scalar channel
@@ -68,7 +51,7 @@ pub struct Args {
     #[arg(long)]
     no_robust: bool,
     /// Ridge penalty on the offsets (and drifts).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, value_parser = args::non_negative, default_value_t = LevellingConfig::default().lambda)]
     lambda: f64,
     /// Known external-field channels subtracted from the value before the
     /// crossovers are formed: `none` (default), `auto` (`diurnal` and `igrf`
@@ -77,8 +60,9 @@ pub struct Args {
     /// 10–300 s, which per-line offsets cannot follow) leave the crossovers,
     /// and the d|B0|/dt coefficient k is determined far better. The levelled
     /// column is then the reduced value, levelled.
-    #[arg(long, default_value = "none", value_name = "none|auto|COLS")]
-    reference: String,
+    #[arg(long, default_value_t = ReferenceChannels::None, value_name = "none|auto|COLS",
+          value_parser = args::parsed::<ReferenceChannels>)]
+    reference: ReferenceChannels,
     /// Also write the crossover table to this CSV: one row per crossover
     /// with both lines, position, times, altitudes, values, d|B0|/dt,
     /// the difference, what the fitted model leaves of it and its weight.
@@ -87,79 +71,50 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let mut table = a.input.load()?;
-    let value_name = match &a.value {
-        Some(v) => v.clone(),
-        None if table.column("mag_comp").is_some() => "mag_comp".into(),
-        None => "mag".into(),
+    let flight = a.input.load()?;
+    let opts = LevelOptions {
+        value: a.value.clone(),
+        rate_of: a.rate_of.clone(),
+        lever_arm_m: a.lever_arm,
+        reference: a.reference.clone(),
+        fit: LevellingConfig {
+            estimate_k: !a.tie_only,
+            drift: a.drift,
+            lambda: a.lambda,
+            altitude_term: !(a.tie_only || a.no_altitude_term),
+            robust: !a.no_robust,
+            ..LevellingConfig::default()
+        },
+        ..LevelOptions::default()
     };
-    let out_name = format!("{value_name}_level");
-    if table.get(&out_name).is_some() || table.get("level_flag").is_some() {
-        return Err(bad_input!(
-            "{}: already has `{out_name}` or `level_flag`",
-            table.file_label()
-        ));
+    let lev = level(&flight, &opts, &mut Bars::new())?;
+    let value_name = &lev.value_column;
+    let out_name = lev.output_column();
+    if !lev.reference_columns.is_empty() {
+        println!(
+            "levelling {value_name} − {}",
+            lev.reference_columns.join(" − ")
+        );
     }
-    if !(a.lambda >= 0.0 && a.lambda.is_finite()) {
-        return Err(bad_input!("--lambda {} must be ≥ 0", a.lambda));
+    if opts.fit.estimate_k {
+        println!(
+            "d|B0|/dt regressor: along-track derivative of `{}`",
+            lev.rate_column
+        );
     }
-    let cfg = LevellingConfig {
-        estimate_k: !a.tie_only,
-        drift: a.drift,
-        lambda: a.lambda,
-        altitude_term: !(a.tie_only || a.no_altitude_term),
-        robust: !a.no_robust,
-        ..LevellingConfig::default()
-    };
-    let lever = a
-        .lever_arm
-        .as_deref()
-        .map(crate::flight::parse_lever_arm)
-        .transpose()?;
-    let spinner = crate::progress::spinner("levelling");
-    let LevelTable {
-        levelling: lev,
-        reference_columns: ref_cols,
-        rate_column,
-    } = level_table(
-        &table,
-        &value_name,
-        a.rate_of.as_deref(),
-        lever,
-        &a.reference,
-        &cfg,
-    )?;
-    spinner.finish_and_clear();
-    if !ref_cols.is_empty() {
-        println!("levelling {value_name} − {}", ref_cols.join(" − "));
-    }
-    if cfg.estimate_k {
-        println!("d|B0|/dt regressor: along-track derivative of `{rate_column}`");
-    }
-    let f = &lev.fit;
-    let flags: Vec<f64> = lev
-        .levelled
-        .flag
-        .iter()
-        .map(|fl| match fl {
-            RowFlag::Levelled => 0.0,
-            RowFlag::NoCrossovers => 1.0,
-            RowFlag::NotOnLine => 2.0,
-            RowFlag::Missing => 3.0,
-        })
-        .collect();
-    let n = table.n_rows();
-    table.add_column(&out_name, lev.levelled.value_nt.clone())?;
-    table.add_column("level_flag", flags)?;
-    aeromag_io::write_csv(&table, &a.out)?;
+    let n = flight.n_rows();
+    let mut table = flight.into_table();
+    lev.add_to(&mut table)?;
+    aeromag::io::write_csv(&table, &a.out)?;
+    let (xs, f) = (&lev.levelling.crossovers, &lev.levelling.fit);
     println!(
         "{} crossovers ({} skipped in gaps, {} with missing values, {} too shallow)",
-        lev.crossovers.crossovers.len(),
-        lev.crossovers.skipped_gap,
-        lev.crossovers.skipped_missing,
-        lev.crossovers.skipped_shallow
+        xs.crossovers.len(),
+        xs.skipped_gap,
+        xs.skipped_missing,
+        xs.skipped_shallow
     );
-    if cfg.estimate_k {
+    if opts.fit.estimate_k {
         println!("k (d|B0|/dt term) = {:.4} ± {:.4} s", f.k_s, f.k_std_s);
     }
     if f.altitude_term_used {
@@ -168,41 +123,30 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             f.vertical_scale,
             f.vertical_scale_std,
             f.altitude_corrected,
-            lev.crossovers.crossovers.len()
+            xs.crossovers.len()
         );
         println!(
             "crossover differences RMS: {:.4} nT before, {:.4} nT model residual, {:.4} nT levelled series (keeps the height differences)",
             f.rms_before_nt, f.rms_after_nt, f.rms_levelled_nt
         );
     } else {
-        if cfg.altitude_term {
-            eprintln!(
-                "warning: no crossover has heights and profiles on both sides; the altitude term is left out"
-            );
-        }
         println!(
             "crossover differences RMS: {:.4} nT before, {:.4} nT after levelling",
             f.rms_before_nt, f.rms_after_nt
         );
     }
-    if cfg.robust {
+    if opts.fit.robust {
         println!(
             "robust weighting: {} of {} crossovers down-weighted (Huber, {} σ̂ = {:.4} nT){}",
             f.downweighted,
             f.weights.len(),
-            aeromag_compensation::levelling::HUBER_K,
+            HUBER_K,
             f.sigma_nt,
             if f.downweighted > 0 {
                 "; --crossovers writes the weights"
             } else {
                 ""
             }
-        );
-    }
-    if f.components > 1 {
-        eprintln!(
-            "warning: the lines form {} groups that never cross; their relative levels rest on the penalty, not the data",
-            f.components
         );
     }
     println!(
@@ -220,122 +164,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.out.display()
     );
     if let Some(path) = &a.crossovers {
-        write_crossovers(&lev.crossovers.crossovers, f, path)?;
+        aeromag::io::write_csv(&lev.crossover_table()?, path)?;
         println!("crossover table written to {}", path.display());
     }
     Ok(())
-}
-
-/// The crossover table of `--crossovers` (units in the column names).
-fn write_crossovers(
-    xs: &[aeromag_compensation::levelling::Crossover],
-    fit: &aeromag_compensation::levelling::LevellingFit,
-    path: &std::path::Path,
-) -> anyhow::Result<()> {
-    let mut t = aeromag_io::FlightTable::new();
-    let col = |f: &dyn Fn(&aeromag_compensation::levelling::Crossover) -> f64| -> Vec<f64> {
-        xs.iter().map(f).collect()
-    };
-    let columns: Vec<(&str, Vec<f64>)> = vec![
-        ("line_a", col(&|x| x.a.label as f64)),
-        ("line_b", col(&|x| x.b.label as f64)),
-        ("north_m", col(&|x| x.north_m)),
-        ("east_m", col(&|x| x.east_m)),
-        ("angle_deg", col(&|x| x.angle_deg)),
-        ("time_a_s", col(&|x| x.a.time_s)),
-        ("time_b_s", col(&|x| x.b.time_s)),
-        ("alt_a_m", col(&|x| x.a.alt_m)),
-        ("alt_b_m", col(&|x| x.b.alt_m)),
-        ("value_a_nt", col(&|x| x.a.value_nt)),
-        ("value_b_nt", col(&|x| x.b.value_nt)),
-        ("rate_a_nt_per_s", col(&|x| x.a.derivative_nt_per_s)),
-        ("rate_b_nt_per_s", col(&|x| x.b.derivative_nt_per_s)),
-        (
-            "profile_gradient_a_nt_per_m",
-            col(&|x| x.a.profile_gradient_nt_per_m),
-        ),
-        (
-            "profile_gradient_b_nt_per_m",
-            col(&|x| x.b.profile_gradient_nt_per_m),
-        ),
-        ("difference_nt", col(&|x| x.difference_nt())),
-        ("residual_nt", fit.residuals_nt.clone()),
-        ("weight", fit.weights.clone()),
-    ];
-    for (name, v) in columns {
-        t.add_column(name, v)?;
-    }
-    aeromag_io::write_csv(&t, path)?;
-    Ok(())
-}
-
-/// What [`level_table`] did.
-pub struct LevelTable {
-    /// The levelling.
-    pub levelling: SurveyLevelling,
-    /// The reference channels subtracted from the value.
-    pub reference_columns: Vec<String>,
-    /// The column whose derivative is the `d|B0|/dt` regressor.
-    pub rate_column: String,
-}
-
-/// Level `value_name` of `table` (the command's docs): sensor positions
-/// from the lever arm (body frame, m) when given, the reference channels
-/// (`none`, `auto` or a list) subtracted, the `d|B0|/dt` regressor the
-/// derivative of `rate_of` (default `mag` when present, else the value),
-/// crossovers found and fitted with `cfg`.
-pub fn level_table(
-    table: &FlightTable,
-    value_name: &str,
-    rate_of: Option<&str>,
-    lever_arm_m: Option<[f64; 3]>,
-    reference: &str,
-    cfg: &LevellingConfig,
-) -> anyhow::Result<LevelTable> {
-    let positions = lever_arm_m
-        .map(|arm| crate::flight::sensor_track(table, arm))
-        .transpose()?;
-    let (lat, lon, alt) = match &positions {
-        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
-        None => (
-            table.require("lat")?,
-            table.require("lon")?,
-            table.require("alt")?,
-        ),
-    };
-    let ref_cols = crate::flight::reference_columns(table, reference)?;
-    let reference = crate::flight::reference_sum(table, &ref_cols, None)?;
-    let value: Vec<f64> = table
-        .require(value_name)?
-        .iter()
-        .zip(&reference)
-        .map(|(v, r)| v - r)
-        .collect();
-    let rate_column = match rate_of {
-        Some(c) => c.to_string(),
-        None if table.column("mag").is_some() => "mag".into(),
-        None => value_name.to_string(),
-    };
-    // The column as recorded (the sensor lags the reference fields too);
-    // not needed, and its gaps not imposed, without the k term.
-    let sensed = cfg
-        .estimate_k
-        .then(|| table.require(&rate_column))
-        .transpose()?;
-    let tracks = SurveyTracks {
-        time: table.require("time")?,
-        lat,
-        lon,
-        alt,
-        line: table.require("line")?,
-        value: &value,
-        sensed,
-    };
-    let levelling = level_survey(&tracks, &TrackConfig::default(), cfg)
-        .map_err(|e| bad_input!("{}: {e}", table.file_label()))?;
-    Ok(LevelTable {
-        levelling,
-        reference_columns: ref_cols,
-        rate_column,
-    })
 }

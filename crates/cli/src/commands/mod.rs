@@ -12,5 +12,4 @@ pub mod observability;
 pub mod pod;
 pub mod report;
 pub mod rotor;
-pub mod rotor_fit;
 pub mod simulate;

@@ -1,12 +1,9 @@
-//! `aeromag observability`: what a calibration flight determines.
+//! `aeromag observability`: what a calibration flight determines (library:
+//! [`aeromag::observability`]).
 
-use crate::commands::calibrate::{EddyLag, FitOptions, fit_model_kalman};
-use crate::exit::bad_input;
-use crate::flight::TlColumns;
 use crate::input::InputArgs;
-use aeromag_compensation::kalman::KalmanConfig;
-use aeromag_compensation::observability::observability;
-use aeromag_compensation::tolles_lawson::TermSet;
+use crate::progress::Bars;
+use aeromag::compensation::tolles_lawson::{Design, TermSet};
 
 /// Observability and estimability of the interference coefficients on a
 /// calibration flight (thesis sections 10 and 12).
@@ -34,74 +31,29 @@ pub struct Args {
     #[command(flatten)]
     input: InputArgs,
     /// Term groups: p3, i6 or i5, e9 or e8, bias.
-    #[arg(long, default_value = "p3,i5,e8")]
-    terms: String,
+    #[arg(long, value_parser = |s: &str| TermSet::parse(s).map_err(|e| e.to_string()),
+          default_value_t = Design::default().terms)]
+    terms: TermSet,
     /// Print JSON.
     #[arg(long)]
     json: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let terms = TermSet::parse(&a.terms).map_err(|e| bad_input!("--terms: {e}"))?;
-    let table = a.input.load()?;
-    let cfg = KalmanConfig {
-        terms,
-        compute_series: false,
-        ..KalmanConfig::default()
-    };
-    let (_, fit, _) = fit_model_kalman(
-        &table,
-        &cfg,
-        &FitOptions {
-            eddy_lag: EddyLag::None,
-            ..FitOptions::auto()
-        },
-    )?;
-    let o = observability(
-        &fit.names,
-        &fit.prior_covariance,
-        &fit.posterior_covariance,
-        1e6,
-    )?;
+    let flight = a.input.load()?;
+    let obs = aeromag::observability(&flight, &a.terms, None, &mut Bars::new())?;
+    let o = &obs.observability;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&o)?);
+        println!("{}", serde_json::to_string_pretty(o)?);
         return Ok(());
     }
     let n = o.names.len();
-    // Effect uncertainty of each term, nT: its standard deviation times the
-    // size its column takes over a full set of headings and manoeuvres —
-    // 1 for the permanent terms (e_i spans ±1), |B|/bt_scale for the induced
-    // terms, and |B|·0.1 rad/s / bt_scale for the eddy terms (the body-frame
-    // field rate of a 6°/s manoeuvre). The column's spread on *this* flight would hide exactly what a
-    // poor flight fails to exercise.
-    let cols = TlColumns::from_table(&table)?;
-    let bt: Vec<f64> = (0..cols.time.len())
-        .map(|i| {
-            (cols.flux[0][i].powi(2) + cols.flux[1][i].powi(2) + cols.flux[2][i].powi(2)).sqrt()
-        })
-        .filter(|v| v.is_finite())
-        .collect();
-    let bt_mean = bt.iter().sum::<f64>() / bt.len().max(1) as f64;
-    let effect: Vec<f64> = o
-        .names
-        .iter()
-        .zip(&fit.std)
-        .map(|(name, sd)| {
-            let scale = match name.as_bytes().first() {
-                Some(b'p') => 1.0,
-                Some(b'i') => bt_mean / cfg.bt_scale_nt,
-                Some(b'e') => 0.1 * bt_mean / cfg.bt_scale_nt,
-                _ => 1.0,
-            };
-            sd * scale
-        })
-        .collect();
     println!(
         "{}: {} coefficients ({}), {} rows",
-        table.file_label(),
+        flight.file_label(),
         n,
-        cfg.terms,
-        fit.rows
+        a.terms,
+        obs.rows
     );
     println!(
         "information rank {} of {n}, condition number {:.2e}{}",
@@ -123,23 +75,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "\n{:<8} {:>10} {:>12} {:>16}  verdict",
         "term", "μ", "std", "effect σ (nT)"
     );
-    let mut undetermined = Vec::new();
-    for i in 0..n {
-        let verdict = if o.estimability[i] > 0.9 || effect[i] >= 1.0 {
-            undetermined.push(o.names[i].clone());
-            "NOT determined by this flight"
-        } else if effect[i] >= 0.1 {
-            "weakly determined"
-        } else if effect[i] >= 0.01 {
-            "determined"
-        } else {
-            "well determined"
-        };
+    for c in &obs.coefficients {
         println!(
-            "{:<8} {:>10.4} {:>12.3e} {:>16.4}  {verdict}",
-            o.names[i], o.estimability[i], fit.std[i], effect[i]
+            "{:<8} {:>10.4} {:>12.3e} {:>16.4}  {}",
+            c.name,
+            c.mu,
+            c.std,
+            c.effect_std_nt,
+            c.verdict.words()
         );
     }
+    let undetermined = obs.undetermined();
     if !undetermined.is_empty() {
         println!(
             "\nthis flight cannot determine: {} — fly all four headings with roll, pitch and yaw manoeuvres, or drop these terms",

@@ -1,10 +1,10 @@
-//! `aeromag report`: an HTML report of a compensated flight.
+//! `aeromag report`: an HTML report of a compensated flight (library:
+//! [`aeromag::score`]).
 
-use crate::analysis::{add_to_report, figures};
-use crate::commands::compensate::load_model;
-use crate::flight::reference_columns;
+use crate::args;
 use crate::input::InputArgs;
-use aeromag_report::Report;
+use aeromag::report::Report;
+use aeromag::{ModelFile, ReferenceChannels, TlModel};
 use std::path::PathBuf;
 
 /// Write a single-file HTML report (plots inline) of a compensated flight:
@@ -27,34 +27,33 @@ pub struct Args {
     /// Known external-field channels removed before computing FOM and IR
     /// (`auto`: `diurnal` and `igrf` when present; `none`; or a list).
     /// Default: those the model was fitted with, else `auto`.
-    #[arg(long)]
-    reference: Option<String>,
+    #[arg(long, value_parser = args::parsed::<ReferenceChannels>)]
+    reference: Option<ReferenceChannels>,
     /// Output folder; the report is DIR/index.html.
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let table = a.input.load()?;
-    let model = a.model.as_deref().map(load_model).transpose()?;
+    let flight = a.input.load()?;
+    let model = a.model.as_deref().map(TlModel::read).transpose()?;
     let reference = match (&a.reference, &model) {
-        (Some(r), _) => reference_columns(&table, r)?,
+        (Some(r), _) => r.resolve(&flight)?,
         (None, Some(m)) => m.reference.clone(),
-        (None, None) => reference_columns(&table, "auto")?,
+        (None, None) => ReferenceChannels::Auto.resolve(&flight)?,
     };
-    let fig = figures(
-        &table,
-        &reference,
-        model.as_ref().and_then(|m| m.lever_arm.as_ref()),
-    )?;
-    let mut r = Report::new(format!("aeromag report — {}", table.file_label()));
-    add_to_report(&mut r, "Compensation", &table, &fig, model.as_ref())?;
+    let lever = model.as_ref().and_then(|m| m.lever_arm.as_ref());
+    let fig = aeromag::score::score(&flight, &reference, lever)?;
+    let mut r = Report::new(format!("aeromag report — {}", flight.file_label()));
+    fig.section("Compensation", &flight, model.as_ref())?
+        .append_to(&mut r);
     let path = a.out.join("index.html");
     r.write_html(&path)?;
     std::fs::write(
         a.out.join("figures.json"),
         serde_json::to_string_pretty(&fig)?,
-    )?;
+    )
+    .map_err(|e| aeromag::Error::write(a.out.join("figures.json"), e))?;
     println!("report written to {}", path.display());
     Ok(())
 }

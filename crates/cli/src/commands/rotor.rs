@@ -1,12 +1,14 @@
 //! `aeromag rotor`: helicopter main-rotor interference (spec `helicopter.md`
-//! part A, seed 000 ch. 3; library `aeromag_compensation::rotor`).
+//! part A, seed 000 ch. 3; library [`aeromag::rotor`] and
+//! [`aeromag::studies::RotorStudyRun`]).
 
-use crate::report_section::{Block, ReportSection};
-use aeromag_compensation::rotor::study::{RotorStudy, StudyInput, evaluate, scenario_geometry};
-use aeromag_report::{LinePlot, Report, Series, Table};
-use aeromag_sim::{ScenarioKind, simulate};
-use nalgebra::Vector3;
-use serde_json::json;
+use crate::args;
+use crate::input::InputArgs;
+use crate::progress::Bars;
+use aeromag::report::Report;
+use aeromag::rotor::{PhaseChoice, RotorGeometry, RotorOptions, RotorPreset, fit_rotor};
+use aeromag::studies::{RotorStudyRun, Study, StudyOutcome, StudySize, pct};
+use aeromag::{Compensator, ModelFile};
 use std::path::PathBuf;
 
 /// Helicopter main-rotor interference: physical blade model against filters.
@@ -39,242 +41,188 @@ struct StudyArgs {
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Seed of the simulated flight.
-    #[arg(long, default_value_t = 11)]
+    #[arg(long, default_value_t = RotorStudyRun::default().seed)]
     seed: u64,
+}
+
+/// Fit the physical main-rotor model on a helicopter flight file.
+///
+/// Needs `time` (s, uniform sampling ≥ 2.5 × the blade-passing frequency),
+/// `mag` (nT) and `flux_x/y/z` (nT, body axes: the field direction), and a
+/// rotor phase channel (deg, azimuth of a reference blade from the nose
+/// towards the right) if there is one: `--phase-column COL`, by default
+/// `rotor_phase` when the file has it. Without a phase channel (or with
+/// --estimate-phase) the rotor frequency and phase are estimated from the
+/// scalar data (search band --rotor-hz). Dropouts of up to 0.1 s (missing
+/// values, regular time steps) are bridged by linear interpolation; across
+/// longer gaps the model is fitted on the longest stretch and its
+/// parameters refined on every stretch of at least 10 s. Columns named
+/// `true_…` are never read.
+///
+/// The rotor geometry is required: either a named installation
+/// (--preset aeromag-sim-helicopter: the helicopter of `aeromag simulate
+/// helicopter`, hub 0,0,−2.6 m, sensor 5,0,0.6 m, blades 0.8 to 7.5 m,
+/// 4 blades, nominal coning 4°, tilt −1.5°), whose values the flags below
+/// override, or all of --hub-m, --sensor-m, --blade-span-m and --blades.
+///
+/// Example:
+///   aeromag rotor fit --input heli.csv --model rotor.json --preset aeromag-sim-helicopter
+///   aeromag rotor fit --input heli.csv --model rotor.json --hub-m 0,0,-2.6 --sensor-m 5,0,0.6 \
+///       --blade-span-m 0.8,7.5 --blades 4 --estimate-phase --rotor-hz 4.5,5.2
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+struct FitArgs {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Model file to write (JSON).
+    #[arg(long, value_name = "ROTOR.json")]
+    model: PathBuf,
+    /// A named rotor installation (its geometry and nominal angles).
+    #[arg(long, value_enum)]
+    preset: Option<RotorPreset>,
+    /// Rotor phase channel, deg (default `rotor_phase` if present).
+    #[arg(long, value_name = "COL")]
+    phase_column: Option<String>,
+    /// Estimate the rotor phase from the data even if a phase channel exists.
+    #[arg(long, conflicts_with = "phase_column")]
+    estimate_phase: bool,
+    /// Search band of the rotor frequency when the phase is estimated, Hz
+    /// (default 4,6).
+    #[arg(long, value_name = "LO,HI", value_parser = args::pair)]
+    rotor_hz: Option<[f64; 2]>,
+    /// Rotor hub position, body axes (x forward, y right, z down), m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
+          required_unless_present = "preset")]
+    hub_m: Option<[f64; 3]>,
+    /// Scalar sensor position, body axes, m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
+          required_unless_present = "preset")]
+    sensor_m: Option<[f64; 3]>,
+    /// Magnetised span of a blade from the hub, m.
+    #[arg(long, value_name = "ROOT,TIP", value_parser = args::pair,
+          required_unless_present = "preset")]
+    blade_span_m: Option<[f64; 2]>,
+    /// Number of blades.
+    #[arg(long, required_unless_present = "preset")]
+    blades: Option<usize>,
+    /// Nominal coning angle, deg (the start of the slowly varying estimate;
+    /// default 4 or the preset's).
+    #[arg(long, allow_hyphen_values = true)]
+    coning_deg: Option<f64>,
+    /// Nominal longitudinal tilt of the tip-path plane, deg (default −1.5
+    /// or the preset's).
+    #[arg(long, allow_hyphen_values = true)]
+    tilt_lon_deg: Option<f64>,
+    /// Window over which the cone angles are taken as constant, s (default 1).
+    #[arg(long)]
+    window_s: Option<f64>,
+}
+
+/// Apply a rotor model (from `aeromag rotor fit`) to a flight file.
+///
+/// Writes every input column plus `rotor_interf` (modelled rotor
+/// interference, nT), `mag_comp` (mag − rotor_interf, nT) and `rotor_flag`
+/// (0 compensated, 1 not: a missing value in the row, or a stretch shorter
+/// than 10 s between gaps). Every input row is written, in order.
+///
+/// Example:
+///   aeromag rotor apply --model rotor.json --input heli2.csv --out heli2_comp.csv
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+struct ApplyArgs {
+    /// Model file written by `aeromag rotor fit`.
+    #[arg(long, value_name = "ROTOR.json")]
+    model: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output CSV file.
+    #[arg(long, value_name = "OUT.csv")]
+    out: PathBuf,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     match a.command {
         Sub::Study(s) => study(s),
-        Sub::Fit(f) => super::rotor_fit::fit(f),
-        Sub::Apply(x) => super::rotor_fit::apply(x),
+        Sub::Fit(f) => fit(f),
+        Sub::Apply(x) => apply(x),
     }
 }
 
-pub use super::rotor_fit::{ApplyArgs, FitArgs};
-
-/// Samples excluded at each end (3 s at 100 Hz: filter transients).
-const EDGE: usize = 300;
-
-/// The study, time (s), true rotor interference (nT), scalar reading (nT).
-type StudyRun = (RotorStudy, Vec<f64>, Vec<f64>, Vec<f64>);
-
-/// Simulate the scenario with `seed` and run the comparison; also returns
-/// time (s), the true rotor interference (nT) and the scalar reading (nT)
-/// for the plots.
-fn run_study(seed: u64) -> anyhow::Result<StudyRun> {
-    let sim = simulate(ScenarioKind::Helicopter, None, Some(seed))?;
-    let col = |n: &str| {
-        sim.column(n)
-            .ok_or_else(|| anyhow::anyhow!("helicopter scenario has no column {n}"))
+/// The library's options from the flags: the preset's values (if any)
+/// overridden by the flags given.
+fn options(a: &FitArgs) -> RotorOptions {
+    let mut o = match a.preset {
+        Some(p) => RotorOptions::preset(p),
+        // Every geometry flag is required without a preset (clap).
+        None => RotorOptions::new(RotorGeometry {
+            hub_m: a.hub_m.unwrap_or_default(),
+            sensor_m: a.sensor_m.unwrap_or_default(),
+            root_m: a.blade_span_m.map_or(0.0, |s| s[0]),
+            tip_m: a.blade_span_m.map_or(0.0, |s| s[1]),
+            blades: a.blades.unwrap_or_default(),
+        }),
     };
-    let (x, y, z) = (col("flux_x")?, col("flux_y")?, col("flux_z")?);
-    let b: Vec<Vector3<f64>> = (0..x.len())
-        .map(|k| Vector3::new(x[k], y[k], z[k]))
-        .collect();
-    let t = col("time")?;
-    let fs = if t.len() > 1 {
-        (t.len() - 1) as f64 / (t[t.len() - 1] - t[0])
-    } else {
-        0.0
-    };
-    let st = evaluate(
-        &scenario_geometry(),
-        &StudyInput {
-            mag_nt: col("mag")?,
-            b_body_nt: &b,
-            rotor_phase_deg: col("rotor_phase")?,
-            true_rotor_nt: col("true_rotor")?,
-            true_anomaly_nt: col("true_anomaly")?,
-            fs_hz: fs,
-            edge: EDGE,
-        },
-    )?;
-    Ok((
-        st,
-        t.to_vec(),
-        col("true_rotor")?.to_vec(),
-        col("mag")?.to_vec(),
-    ))
-}
-
-/// The `rotor.*` keys of `aeromag demo`'s summary (data-formats.md).
-fn summary_json(s: &RotorStudy) -> serde_json::Value {
-    json!({
-        "rotor_rms_nt": s.rotor_rms_nt,
-        "residual_model_nt": s.residual_model_nt,
-        "residual_best_filter_nt": s.residual_best_filter_nt,
-        "anomaly_rms_nt": s.anomaly_rms_nt,
-        "rotor_hz": s.rotor_hz,
-    })
-}
-
-fn pct(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.2}", 100.0 * x)
-    } else {
-        "–".into()
+    let g = &mut o.geometry;
+    g.hub_m = a.hub_m.unwrap_or(g.hub_m);
+    g.sensor_m = a.sensor_m.unwrap_or(g.sensor_m);
+    if let Some([root, tip]) = a.blade_span_m {
+        (g.root_m, g.tip_m) = (root, tip);
     }
+    g.blades = a.blades.unwrap_or(g.blades);
+    if let Some(c) = a.coning_deg {
+        o.nominal_angles.coning_rad = c.to_radians();
+    }
+    if let Some(t) = a.tilt_lon_deg {
+        o.nominal_angles.tilt_lon_rad = t.to_radians();
+    }
+    o.phase = match (&a.phase_column, a.estimate_phase) {
+        (_, true) => PhaseChoice::Estimate,
+        (Some(c), false) => PhaseChoice::Column(c.clone()),
+        (None, false) => PhaseChoice::Auto,
+    };
+    o.rotor_hz_range = a.rotor_hz.unwrap_or(o.rotor_hz_range);
+    o.window_s = a.window_s.unwrap_or(o.window_s);
+    o
 }
 
-/// Waveforms of the scalar reading (high-passed at 2 Hz) before and after
-/// the model over a 5 s excerpt, and their Welch spectra (10 s segments).
-fn before_after(s: &RotorStudy, t: &[f64], mag: &[f64]) -> anyhow::Result<Vec<Block>> {
-    use aeromag_compensation::rotor::linear::highpass;
-    use aeromag_core::spectrum::welch::{WelchConfig, welch};
-    let fs = (t.len() - 1) as f64 / (t[t.len() - 1] - t[0]);
-    let after: Vec<f64> = mag
-        .iter()
-        .zip(&s.prediction_nt)
-        .map(|(m, p)| m - p)
-        .collect();
-    let (hb, ha) = (highpass(mag, fs, 2.0)?, highpass(&after, fs, 2.0)?);
-    let mid = t.len() / 2;
-    let r = mid..(mid + (5.0 * fs) as usize).min(t.len());
-    let wave = LinePlot::new(
-        "Scalar reading above 2 Hz before and after the rotor model (5 s excerpt)",
-        "time (s)",
-        "nT",
-    )
-    .with_series(Series::line(
-        "before",
-        t[r.clone()].to_vec(),
-        hb[r.clone()].to_vec(),
-    ))
-    .with_series(Series::line(
-        "after the model",
-        t[r.clone()].to_vec(),
-        ha[r].to_vec(),
-    ));
-    let cfg = WelchConfig::new(fs, ((10.0 * fs) as usize).min(mag.len()));
-    let (pb, pa) = (
-        welch(&hb[EDGE..hb.len() - EDGE], &cfg)?,
-        welch(&ha[EDGE..ha.len() - EDGE], &cfg)?,
+fn fit(a: FitArgs) -> anyhow::Result<()> {
+    let opts = options(&a);
+    let flight = a.input.load()?;
+    let fit = fit_rotor(&flight, &opts, &mut Bars::new())?;
+    let model = &fit.model;
+    model.write(&a.model)?;
+    println!(
+        "fitted the rotor model on {} rows of {} ({:.3} Hz, f_r {:.4} Hz, phase {}): {} parameters, \
+         high-passed residual {:.4} nT, mean coning {:.2}°; written to {}",
+        model.rows,
+        flight.file_label(),
+        model.sample_rate_hz,
+        model.rotor_hz,
+        model
+            .phase
+            .column
+            .as_deref()
+            .map_or("estimated from the data".to_string(), |c| format!(
+                "from `{c}`"
+            )),
+        model.model.params.len(),
+        model.model.residual_rms_nt,
+        model.coning_mean_deg,
+        a.model.display()
     );
-    let keep = |f: &[f64], v: &[f64]| -> (Vec<f64>, Vec<f64>) {
-        f.iter()
-            .zip(v)
-            .filter(|(f, _)| **f > 0.0)
-            .map(|(f, v)| (*f, *v))
-            .unzip()
-    };
-    let (fb, vb) = keep(&pb.freqs_hz, &pb.values);
-    let (fa, va) = keep(&pa.freqs_hz, &pa.values);
-    let spec = LinePlot::new(
-        "Power spectral density before and after the rotor model",
-        "frequency (Hz)",
-        "nT²/Hz",
-    )
-    .with_series(Series::line("before", fb, vb))
-    .with_series(Series::line("after the model", fa, va))
-    .log_log();
-    Ok(vec![
-        Block::Figure {
-            svg: wave.to_svg()?,
-            caption: "Measured scalar field above 2 Hz (rotor interference, anomaly edges, noise) before and after \
-                      subtracting the modelled rotor interference."
-                .into(),
-        },
-        Block::Figure {
-            svg: spec.to_svg()?,
-            caption: format!(
-                "Welch spectra (10 s Hann segments) of the high-passed reading: the peaks at f_r = {:.2} Hz, the \
-                 blade-passing frequency and their harmonics disappear after the model.",
-                s.rotor_hz
-            ),
-        },
-    ])
+    Ok(())
 }
 
-fn section(s: &RotorStudy, t: &[f64], rotor: &[f64], mag: &[f64]) -> anyhow::Result<ReportSection> {
-    let mut sec = ReportSection::new("Helicopter rotor interference (seed 000, ch. 3)");
-    sec.blocks.push(Block::Paragraph(format!(
-        "Rotor interference {:.3} nT RMS at the sensor (f_r = {:.3} Hz), anomaly {:.3} nT RMS. The physical model \
-         leaves {:.4} nT ({:.1} % of the rotor RMS); the best filter leaves {:.4} nT ({:.1}× the model's residual).",
-        s.rotor_rms_nt,
-        s.rotor_hz,
-        s.anomaly_rms_nt,
-        s.residual_model_nt,
-        100.0 * s.residual_model_nt / s.rotor_rms_nt,
-        s.residual_best_filter_nt,
-        s.residual_best_filter_nt / s.residual_model_nt
-    )));
-    let rows = s
-        .methods
-        .iter()
-        .map(|m| {
-            vec![
-                m.name.clone(),
-                format!("{:.4}", m.residual_nt),
-                pct(m.residual_nt / s.rotor_rms_nt),
-                pct(m.removed_anomaly),
-                pct(m.removed_bumps_05),
-                pct(m.removed_bumps_01),
-            ]
-        })
-        .collect();
-    sec.blocks.push(Block::Table(Table::new(
-        [
-            "method",
-            "residual rotor (nT RMS)",
-            "of rotor RMS (%)",
-            "anomaly removed (%)",
-            "0.5 s bumps removed (%)",
-            "0.1 s bumps removed (%)",
-        ]
-        .map(String::from)
-        .to_vec(),
-        rows,
-        "Residual rotor interference and signal removed by each method (3 s excluded at each end).",
-    )));
-    // 20 s excerpt from the middle of the record.
-    let mid = t.len() / 2;
-    let n = ((20.0 / (t[1] - t[0]).max(1e-9)) as usize).min(mid);
-    let r = mid - n / 2..mid + n / 2;
-    let resid: Vec<f64> = rotor[r.clone()]
-        .iter()
-        .zip(&s.prediction_nt[r.clone()])
-        .map(|(a, b)| a - b)
-        .collect();
-    let p = LinePlot::new(
-        "Rotor interference and model residual (20 s excerpt)",
-        "time (s)",
-        "nT",
-    )
-    .with_series(Series::line(
-        "true rotor interference",
-        t[r.clone()].to_vec(),
-        rotor[r.clone()].to_vec(),
-    ))
-    .with_series(Series::line(
-        "residual after the model",
-        t[r].to_vec(),
-        resid,
-    ));
-    sec.blocks.push(Block::Figure {
-        svg: p.to_svg()?,
-        caption: "True rotor interference and what the model leaves.".into(),
-    });
-    sec.blocks.extend(before_after(s, t, mag)?);
-    Ok(sec)
-}
-
-/// The study for `aeromag demo` (seed 11): the `rotor.*` summary object
-/// (`rotor_rms_nt`, `residual_model_nt`, `residual_best_filter_nt`,
-/// `anomaly_rms_nt`, `rotor_hz`) and the report section. `quick` is
-/// accepted for symmetry with [`super::em::demo_em`]; the study has one size.
-pub fn demo_rotor(quick: bool) -> anyhow::Result<(serde_json::Value, Option<ReportSection>)> {
-    let _ = quick;
-    let (s, t, rotor, mag) = run_study(11)?;
-    Ok((summary_json(&s), Some(section(&s, &t, &rotor, &mag)?)))
+fn apply(a: ApplyArgs) -> anyhow::Result<()> {
+    let model = aeromag::rotor::RotorModelFile::read(&a.model)?;
+    let flight = a.input.load()?;
+    let out = model.compensate_observed(&flight, &mut Bars::new())?;
+    crate::output::write_compensated(flight, out, &a.out, &a.model, "")
 }
 
 fn study(a: StudyArgs) -> anyhow::Result<()> {
-    let bar = crate::progress::bar(1, "rotor study");
-    bar.set_message("simulating and fitting");
-    let (s, t, rotor, mag) = run_study(a.seed)?;
-    bar.inc(1);
-    bar.finish_and_clear();
+    let out = RotorStudyRun { seed: a.seed }.run(StudySize::Full, &mut Bars::new())?;
+    let s = &out.study;
     println!(
         "rotor interference RMS {:.3} nT, anomaly RMS {:.3} nT, f_r {:.3} Hz",
         s.rotor_rms_nt, s.anomaly_rms_nt, s.rotor_hz
@@ -290,13 +238,15 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
             pct(m.removed_bumps_01)
         );
     }
-    std::fs::create_dir_all(&a.out)?;
+    std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
+    let summary = serde_json::json!({ "rotor": out.summary() });
     std::fs::write(
         a.out.join("summary.json"),
-        serde_json::to_string_pretty(&json!({ "rotor": summary_json(&s) }))?,
-    )?;
+        serde_json::to_string_pretty(&summary)?,
+    )
+    .map_err(|e| aeromag::Error::write(a.out.join("summary.json"), e))?;
     let mut r = Report::new("aeromag — helicopter rotor interference study");
-    section(&s, &t, &rotor, &mag)?.append_to(&mut r);
+    out.section()?.append_to(&mut r);
     let path = a.out.join("index.html");
     r.write_html(&path)?;
     println!("report written to {}", path.display());

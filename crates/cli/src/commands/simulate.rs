@@ -46,21 +46,20 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.scenario == "gradiometer" {
-        let (config, seed, out, print_config) = (a.config, a.seed, a.out, a.print_config);
-        return super::dipole::simulate_scenario(super::dipole::SimulateArgs {
-            config,
-            seed,
-            out,
-            print_config,
-        });
-    }
-    if a.scenario == "em" {
-        return crate::commands::em::simulate_em(
+        return crate::output::simulate_gradiometer(
             a.config.as_deref(),
             a.seed,
             a.out.as_deref(),
             a.print_config,
-            crate::commands::em::DEFAULT_KNOWN,
+        );
+    }
+    if a.scenario == "em" {
+        return crate::output::simulate_em(
+            a.config.as_deref(),
+            a.seed,
+            a.out.as_deref(),
+            a.print_config,
+            aeromag::em::DEFAULT_KNOWN,
         );
     }
     let kind: ScenarioKind = a.scenario.parse()?;

@@ -4,14 +4,16 @@
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::JointFilter;
-use super::rows::{RowSpec, for_each_design_row};
+use super::rows::for_each_design_row;
 use super::track::step_length;
 use super::tuning::{Subset, TuningConfig, TuningReport, tune};
 use crate::error::{CompError, Result};
-use crate::model_file::{Coefficient, FitStats, MODEL_FORMAT, TlModel};
+use crate::model_file::{
+    Coefficient, FitStats, KalmanSettings, MODEL_FORMAT, MethodSettings, TlModel,
+};
+use crate::tolles_lawson::Design;
 use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
-use crate::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use aeromag_estimation::kalman::{Checkpoint, LeadingConditional, default_block_len};
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::DMatrix;
@@ -34,12 +36,10 @@ pub struct KalmanSegment<'a> {
 /// Settings of the Kalman fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct KalmanConfig {
-    /// Term groups `X1` (default `p3,i5,e8`).
-    pub terms: TermSet,
-    /// Derivative convention of the eddy columns.
-    pub convention: Convention,
-    /// Scale of the induced and eddy columns, nT (default 50 000).
-    pub bt_scale_nt: f64,
+    /// The design of `X1`: terms (default `p3,i5,e8`), derivative
+    /// convention, scale of the induced and eddy columns (default 50 000 nT).
+    #[serde(flatten)]
+    pub design: Design,
     /// Noise intensities (the start point when tuning).
     pub noise: NoiseModel,
     /// Maximum-likelihood tuning of the intensities.
@@ -69,9 +69,7 @@ pub struct KalmanConfig {
 impl Default for KalmanConfig {
     fn default() -> Self {
         Self {
-            terms: TermSet::observable16(),
-            convention: Convention::Physical,
-            bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            design: Design::default(),
             noise: NoiseModel::calibration_default(),
             tuning: TuningConfig::default(),
             field_prior: X2Prior::default(),
@@ -162,13 +160,9 @@ const MIN_RUN: usize = 3;
 /// model (spec `compensation.md`, Method 2; module docs of [`super`]).
 pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<KalmanFit> {
     validate(cfg)?;
-    let m = cfg.terms.n_columns();
-    let names = cfg.terms.column_names();
-    let spec = RowSpec {
-        terms: &cfg.terms,
-        convention: cfg.convention,
-        bt_scale_nt: cfg.bt_scale_nt,
-    };
+    let m = cfg.design.n_columns();
+    let names = cfg.design.column_names();
+    let spec = &cfg.design;
     let mut warnings = Vec::new();
 
     // ---- runs: maximal stretches of usable samples.
@@ -183,7 +177,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
             || s.alt_m.len() != n
             || s.speed_m_s.len() != n
         {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::data(format!(
                 "segment {si}: columns of unequal length"
             )));
         }
@@ -203,7 +197,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         let (kept, _) = split_segments(d.time, None, &usable, f64::INFINITY, 1);
         for r in kept {
             if let Some(k) = (r.start + 1..r.end).find(|&k| !(d.time[k] > d.time[k - 1])) {
-                return Err(CompError::BadData(format!(
+                return Err(CompError::data(format!(
                     "segment {si}: time does not increase at row {k}"
                 )));
             }
@@ -224,7 +218,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     }
     let rows: usize = runs.iter().map(|r| r.range.len()).sum();
     if rows < m + cfg.field_prior.dim() {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "{rows} usable samples are too few for {m} coefficients"
         )));
     }
@@ -340,12 +334,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
                             }
                         }
                     }
-                    Err(e) => {
-                        err = Some(CompError::BadData(format!(
-                            "segment {}, row {i}: {e}",
-                            run.seg
-                        )))
-                    }
+                    Err(e) => err = Some(e.at(format!("segment {}, row {i}", run.seg))),
                 }
             },
         );
@@ -460,12 +449,12 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
 fn decimated_subset(
     segments: &[KalmanSegment],
     runs: &[Run],
-    spec: RowSpec,
+    spec: &Design,
     dec: usize,
     z0: f64,
     y_ref: f64,
 ) -> Subset {
-    let m = spec.terms.n_columns();
+    let m = spec.n_columns();
     let mut sub = Subset {
         m,
         ..Subset::default()
@@ -510,10 +499,9 @@ fn information_diagnostics(
     max_vif: f64,
 ) -> Result<(Vec<f64>, f64, Vec<String>)> {
     let m = u.nrows();
-    let a = u
-        .clone()
-        .try_inverse()
-        .ok_or_else(|| CompError::BadData("the coefficient covariance is singular".into()))?;
+    let a = u.clone().try_inverse().ok_or_else(|| CompError::Singular {
+        reason: "the coefficient covariance is singular".into(),
+    })?;
     let mut j = a.transpose() * &a;
     for i in 0..m {
         j[(i, i)] -= 1.0 / prior_var;
@@ -524,25 +512,20 @@ fn information_diagnostics(
         let lam = eig.eigenvalues[k].max(0.0).sqrt();
         let row: Vec<f64> = eig.eigenvectors.column(k).iter().map(|v| v * lam).collect();
         ne.add_row(&row, 0.0, 1.0)
-            .map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+            .map_err(CompError::estimation("information matrix"))?;
     }
     // The prior as ridge keeps the solve defined; VIF and condition are of the data part.
     let sol = ne
         .solve(1.0 / prior_var)
-        .map_err(|e| CompError::BadData(format!("information matrix: {e}")))?;
+        .map_err(CompError::estimation("information matrix"))?;
     let warnings = diagnose(&sol, names, max_vif);
     Ok((sol.vif.iter().copied().collect(), sol.condition, warnings))
 }
 
 fn validate(cfg: &KalmanConfig) -> Result<()> {
-    if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
-        return Err(CompError::BadData(format!(
-            "bt_scale {} must be positive",
-            cfg.bt_scale_nt
-        )));
-    }
+    cfg.design.validate()?;
     if !(cfg.coef_prior_std > 0.0 && cfg.coef_prior_std.is_finite()) {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::setting(format!(
             "coefficient prior std {} must be positive",
             cfg.coef_prior_std
         )));
@@ -550,9 +533,7 @@ fn validate(cfg: &KalmanConfig) -> Result<()> {
     if let Some(z) = cfg.z0_m
         && !z.is_finite()
     {
-        return Err(CompError::BadData(
-            "reference altitude z0 must be finite".into(),
-        ));
+        return Err(CompError::setting("reference altitude z0 must be finite"));
     }
     Ok(())
 }
@@ -607,21 +588,18 @@ impl KalmanFit {
         }
     }
 
-    /// A model file (`method: "kalman"`; no band, order, trim or ridge). The
-    /// caller fills [`TlModel::columns`] (and `reference` if it subtracted
-    /// known channels).
+    /// A model file (`"method": "kalman"` with the field-model order and the
+    /// noise intensities). The caller fills [`TlModel::columns`] (and
+    /// `reference` if it subtracted known channels).
     pub fn to_model(&self, cfg: &KalmanConfig) -> TlModel {
         TlModel {
             format: MODEL_FORMAT.into(),
             kind: crate::model_file::TL_KIND.into(),
-            method: "kalman".into(),
-            terms: cfg.terms.clone(),
-            convention: cfg.convention,
-            bt_scale_nt: cfg.bt_scale_nt,
-            band_hz: None,
-            filter_order: 0,
-            trim: 0,
-            lambda: 0.0,
+            design: cfg.design.clone(),
+            method: MethodSettings::Kalman(KalmanSettings {
+                field_order: Some(self.field_order),
+                noise: Some(self.noise),
+            }),
             coefficients: self
                 .names
                 .iter()

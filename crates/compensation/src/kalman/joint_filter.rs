@@ -61,17 +61,17 @@ impl JointFilter {
         let m = coef_prior_mean.len();
         if coef_prior_std.len() != m || coef_prior_std.iter().any(|s| !(*s > 0.0 && s.is_finite()))
         {
-            return Err(CompError::BadData(
-                "coefficient prior: one finite positive standard deviation per coefficient".into(),
+            return Err(CompError::setting(
+                "coefficient prior: one finite positive standard deviation per coefficient",
             ));
         }
         if !noise.is_valid() {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::setting(format!(
                 "invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)"
             )));
         }
         if !x2_prior.is_valid() {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::setting(format!(
                 "invalid field prior {x2_prior:?} (positive, finite)"
             )));
         }
@@ -127,7 +127,7 @@ impl JointFilter {
     /// reading `y_nt` (nT). Returns the innovation.
     pub fn step(&mut self, d_m: f64, h1: &[f64], dz_m: f64, y_nt: f64) -> Result<Innovation> {
         if h1.len() != self.m {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::data(format!(
                 "design row of length {} for {} coefficients",
                 h1.len(),
                 self.m
@@ -135,7 +135,7 @@ impl JointFilter {
         }
         if !self.fresh {
             if !(d_m >= 0.0 && d_m.is_finite()) {
-                return Err(CompError::BadData(format!(
+                return Err(CompError::setting(format!(
                     "along-track step {d_m} m must be finite and ≥ 0"
                 )));
             }
@@ -196,5 +196,5 @@ impl JointFilter {
 
 /// Map an estimation error into this crate's error.
 pub(crate) fn est(e: aeromag_estimation::EstError) -> CompError {
-    CompError::BadData(format!("Kalman filter: {e}"))
+    CompError::estimation("Kalman filter")(e)
 }

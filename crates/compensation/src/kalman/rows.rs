@@ -10,29 +10,18 @@
 //! one. The lagged derivatives of the `l9` group run through the whole
 //! run sample by sample, as over one segment.
 
+use crate::tolles_lawson::Design;
 use crate::tolles_lawson::eddy_lag::LagBank;
 use crate::tolles_lawson::terms::derivative;
-use crate::tolles_lawson::{Convention, TermSet};
 use std::ops::Range;
 
 /// Samples per chunk.
 const CHUNK: usize = 4096;
 
-/// The settings that define a design row.
-#[derive(Debug, Clone, Copy)]
-pub struct RowSpec<'a> {
-    /// Term groups.
-    pub terms: &'a TermSet,
-    /// Derivative convention.
-    pub convention: Convention,
-    /// Scale of the induced and eddy columns, nT.
-    pub bt_scale_nt: f64,
-}
-
 /// Call `f(i, row)` for every sample `i` of `run` (indices into `time` and
 /// `flux`, in increasing order); derivatives are taken over `run` alone.
 pub fn for_each_design_row(
-    spec: RowSpec,
+    spec: &Design,
     time: &[f64],
     flux: [&[f64]; 3],
     run: Range<usize>,
@@ -77,7 +66,7 @@ pub fn for_each_design_row(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tolles_lawson::design::design_columns;
+    use crate::tolles_lawson::{Convention, TermSet};
 
     #[test]
     fn streamed_rows_equal_the_design_columns() {
@@ -99,21 +88,18 @@ mod tests {
                 .unwrap()
                 .with_eddy_lags(&[0.2, 0.7])
                 .unwrap();
-            let spec = RowSpec {
-                terms: &terms,
+            let spec = Design {
+                terms,
                 convention: conv,
                 bt_scale_nt: 50_000.0,
             };
             for run in [0..n, 5..CHUNK + 7, 10..13, 100..101] {
-                let cols = design_columns(
-                    &terms,
-                    conv,
-                    50_000.0,
+                let cols = spec.columns(
                     &time[run.clone()],
                     [&fx[run.clone()], &fy[run.clone()], &fz[run.clone()]],
                 );
                 let mut count = 0;
-                for_each_design_row(spec, &time, [&fx, &fy, &fz], run.clone(), |i, row| {
+                for_each_design_row(&spec, &time, [&fx, &fy, &fz], run.clone(), |i, row| {
                     for (c, v) in row.iter().enumerate() {
                         assert_eq!(*v, cols[c][i - run.start], "run {run:?} row {i} col {c}");
                     }

@@ -5,9 +5,9 @@
 use super::anomaly_model::{AnomalyTransition, B_H, DEFAULT_ORDER, THESIS_ORDER};
 use super::*;
 use crate::model_file::TlModel;
-use crate::tolles_lawson::design::interference;
+use crate::tolles_lawson::Design;
+use crate::tolles_lawson::TermSet;
 use crate::tolles_lawson::fit_ls::Segment;
-use crate::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use aeromag_core::frames::Attitude;
 use aeromag_estimation::kalman::{SmootherOptions, StateSpaceModel, fixed_interval_smooth};
 use nalgebra::{DMatrix, Vector3};
@@ -93,10 +93,7 @@ fn flight(noise: NoiseModel, terms: &TermSet, coef: &[f64], seed: u64) -> Box {
         }
         b.field.push(53_000.0 + x[B_H] + (b.alt[i] - z0) * x[3]);
     }
-    let a = interference(
-        terms,
-        Convention::Physical,
-        DEFAULT_BT_SCALE_NT,
+    let a = Design::new(terms.clone()).interference(
         coef,
         &b.time,
         [&b.flux[0], &b.flux[1], &b.flux[2]],
@@ -128,7 +125,7 @@ impl Box {
 /// The fit with the data's own model (the thesis' order 3), fixed noise.
 fn no_tuning(terms: TermSet, noise: NoiseModel) -> KalmanConfig {
     KalmanConfig {
-        terms,
+        design: Design::new(terms),
         noise,
         field_prior: X2Prior::thesis(),
         tuning: TuningConfig {
@@ -225,13 +222,7 @@ fn two_passes_equal_the_full_state_smoother_for(order: usize) {
     };
     let fit = fit_kalman(&[b.segment()], &cfg).unwrap();
     assert_eq!(fit.runs, 1);
-    let cols = crate::tolles_lawson::design::design_columns(
-        &terms,
-        Convention::Physical,
-        DEFAULT_BT_SCALE_NT,
-        &b.time,
-        [&b.flux[0], &b.flux[1], &b.flux[2]],
-    );
+    let cols = Design::new(terms.clone()).columns(&b.time, [&b.flux[0], &b.flux[1], &b.flux[2]]);
     let rows: Vec<Vec<f64>> = (0..b.time.len())
         .map(|k| cols.iter().map(|c| c[k]).collect())
         .collect();
@@ -309,32 +300,12 @@ fn recovers_the_coefficients_with_honest_standard_deviations() {
         b.flux[1].as_slice(),
         b.flux[2].as_slice(),
     ];
-    let est = interference(
-        &terms,
-        Convention::Physical,
-        DEFAULT_BT_SCALE_NT,
-        &fit.coef,
-        &b.time,
-        flux,
-    );
-    let tru = interference(
-        &terms,
-        Convention::Physical,
-        DEFAULT_BT_SCALE_NT,
-        &coef,
-        &b.time,
-        flux,
-    );
+    let est = Design::new(terms.clone()).interference(&fit.coef, &b.time, flux);
+    let tru = Design::new(terms.clone()).interference(&coef, &b.time, flux);
     let d: Vec<f64> = est.iter().zip(&tru).map(|(a, t)| a - t).collect();
     let m = d.iter().sum::<f64>() / d.len() as f64;
     let rms = (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt();
-    let cols = crate::tolles_lawson::design::design_columns(
-        &terms,
-        Convention::Physical,
-        DEFAULT_BT_SCALE_NT,
-        &b.time,
-        flux,
-    );
+    let cols = Design::new(terms.clone()).columns(&b.time, flux);
     let n = b.time.len();
     let mean: Vec<f64> = cols
         .iter()
@@ -389,7 +360,7 @@ fn maximum_likelihood_recovers_the_noise_intensities() {
         r_nt2: 1e-4,
     };
     let cfg = KalmanConfig {
-        terms,
+        design: Design::new(terms),
         noise: start,
         tuning: TuningConfig {
             enabled: true,
@@ -503,7 +474,10 @@ fn bad_input_is_an_error() {
             ..cfg.clone()
         },
         KalmanConfig {
-            bt_scale_nt: -1.0,
+            design: Design {
+                bt_scale_nt: -1.0,
+                ..cfg.design.clone()
+            },
             ..cfg.clone()
         },
         KalmanConfig {
@@ -529,13 +503,17 @@ fn the_model_file_records_the_kalman_fit() {
     let fit = fit_kalman(&[b.segment()], &cfg).unwrap();
     assert!(fit.series.is_empty() && fit.residual_rms_nt.is_nan());
     let model = fit.to_model(&cfg);
-    assert_eq!(model.method, "kalman");
-    assert_eq!(model.band_hz, None);
+    assert_eq!(
+        model.method,
+        crate::model_file::MethodSettings::Kalman(crate::model_file::KalmanSettings {
+            field_order: Some(3),
+            noise: Some(NOISE),
+        })
+    );
     let back = TlModel::from_json(&model.to_json().unwrap(), "m.json").unwrap();
-    // (serde_json's default float parser may differ in the last bit.)
-    for (a, b) in back.coef().iter().zip(&fit.coef) {
-        assert!((a - b).abs() <= 1e-14 * b.abs());
-    }
+    // The coefficients survive the file bit for bit (serde_json's
+    // float_roundtrip).
+    assert_eq!(back.coef(), fit.coef);
     assert!(
         (back.fit.residual_rms_nt - fit.innovation_rms_nt).abs() <= 1e-14 * fit.innovation_rms_nt
     );

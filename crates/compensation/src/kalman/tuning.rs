@@ -258,7 +258,7 @@ pub fn tune(
     decimation: usize,
 ) -> Result<TuningReport> {
     if subset.len() < 10 {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "{} samples are too few to tune the noise intensities",
             subset.len()
         )));
@@ -326,8 +326,8 @@ pub fn tune(
     let mut evaluations = starts.evaluations;
     let mut best: Option<NelderMeadResult> = None;
     for x0 in &starts.points {
-        let r = nelder_mead(&objective, x0, &opts)
-            .map_err(|e| CompError::BadData(format!("noise tuning: {e}")))?;
+        let r =
+            nelder_mead(&objective, x0, &opts).map_err(CompError::estimation("noise tuning"))?;
         evaluations += r.evaluations;
         if best.as_ref().is_none_or(|b| r.f < b.f) {
             best = Some(r);

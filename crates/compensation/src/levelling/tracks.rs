@@ -281,7 +281,7 @@ fn slope(x: &[f64], y: &[f64]) -> f64 {
 }
 
 pub(crate) fn bad(msg: String) -> CompError {
-    CompError::BadData(format!("levelling: {msg}"))
+    CompError::data(format!("levelling: {msg}"))
 }
 
 #[cfg(test)]

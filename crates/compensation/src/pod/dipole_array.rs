@@ -84,12 +84,12 @@ fn columns(sources: &[[f64; 3]], h: &PodHeading, hp: bool) -> Result<(Vec<Vec<f6
 /// all `headings`. Errors: no sources or headings, bad data.
 pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result<DipoleArrayModel> {
     if sources.is_empty() || headings.is_empty() {
-        return Err(CompError::BadData(
-            "dipole-array pod fit needs sources and headings".into(),
+        return Err(CompError::data(
+            "dipole-array pod fit needs sources and headings",
         ));
     }
     if sources.iter().flatten().any(|x| !x.is_finite()) {
-        return Err(CompError::BadData("non-finite source point".into()));
+        return Err(CompError::data("non-finite source point"));
     }
     let m = sources.len() * PER_SOURCE;
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); m];
@@ -123,8 +123,8 @@ pub fn predict_dipole_array_raw(model: &DipoleArrayModel, h: &PodHeading) -> Res
 
 fn predict(model: &DipoleArrayModel, h: &PodHeading, hp: bool) -> Result<Vec<f64>> {
     if model.coefficients.len() != model.sources_m.len() * PER_SOURCE {
-        return Err(CompError::BadData(
-            "dipole-array model: wrong coefficient count".into(),
+        return Err(CompError::data(
+            "dipole-array model: wrong coefficient count",
         ));
     }
     let (cols, s0) = columns(&model.sources_m, h, hp)?;

@@ -105,7 +105,7 @@ pub(super) fn prepare(h: &PodHeading) -> Result<Prepared> {
 fn prepare_about(h: &PodHeading, reference: Option<[f64; 3]>) -> Result<Prepared> {
     let n = h.total_nt.len();
     if n < 16 || h.track_nt.len() != n || h.u.len() != n || h.pod_body_m.len() != n {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "pod heading needs ≥ 16 samples and equal lengths (total {n}, track {}, u {}, pod {})",
             h.track_nt.len(),
             h.u.len(),
@@ -113,16 +113,14 @@ fn prepare_about(h: &PodHeading, reference: Option<[f64; 3]>) -> Result<Prepared
         )));
     }
     if !(h.dt_s.is_finite() && h.dt_s > 0.0) {
-        return Err(CompError::BadData(
-            "pod heading: dt_s must be positive".into(),
-        ));
+        return Err(CompError::setting("pod heading: dt_s must be positive"));
     }
     let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
     if h.total_nt.iter().chain(&h.track_nt).any(|x| !x.is_finite())
         || !h.u.iter().all(finite)
         || !h.pod_body_m.iter().all(finite)
     {
-        return Err(CompError::BadData("pod heading: non-finite input".into()));
+        return Err(CompError::data("pod heading: non-finite input"));
     }
     let mean3 = |v: &[[f64; 3]]| {
         let mut m = [0.0; 3];
@@ -176,7 +174,9 @@ pub(super) fn lstsq(a: DMatrix<f64>, y: &DVector<f64>) -> Result<DVector<f64>> {
     let smax = svd.singular_values.max();
     let x = svd
         .solve(y, RCOND * smax)
-        .map_err(|e| CompError::BadData(format!("pod least squares: {e}")))?;
+        .map_err(|e| CompError::Singular {
+            reason: format!("pod least squares: {e}"),
+        })?;
     Ok(DVector::from_iterator(
         x.len(),
         x.iter().zip(&scale).map(|(v, s)| v * s),
@@ -218,7 +218,7 @@ pub fn fit_heading_coefficients(h: &PodHeading) -> Result<[f64; N_HEADING]> {
 /// too small on a heading.
 pub fn fit_two_step(headings: &[PodHeading]) -> Result<TwoStepFit> {
     if headings.is_empty() {
-        return Err(CompError::BadData("two-step pod fit needs headings".into()));
+        return Err(CompError::data("two-step pod fit needs headings"));
     }
     let mut ws = Vec::with_capacity(headings.len());
     let mut rows: Vec<[f64; N_PARAMS]> = Vec::new();
@@ -273,7 +273,7 @@ pub struct JointFit {
 pub fn fit_joint(headings: &[PodHeading]) -> Result<JointFit> {
     let count: usize = headings.iter().map(|h| h.pod_body_m.len()).sum();
     if count == 0 {
-        return Err(CompError::BadData("joint pod fit needs headings".into()));
+        return Err(CompError::data("joint pod fit needs headings"));
     }
     let mut reference = [0.0; 3];
     for p in headings.iter().flat_map(|h| &h.pod_body_m) {
@@ -331,15 +331,13 @@ pub fn predict_joint_raw(fit: &JointFit, h: &PodHeading) -> Result<Vec<f64>> {
 fn joint(fit: &JointFit, h: &PodHeading, hp: bool) -> Result<Vec<f64>> {
     let theta = &fit.theta;
     if theta.len() != N_PARAMS && theta.len() != N_JOINT {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "pod model needs {N_PARAMS} or {N_JOINT} parameters, got {}",
             theta.len()
         )));
     }
     if fit.reference_m.iter().any(|x| !x.is_finite()) {
-        return Err(CompError::BadData(
-            "pod model: non-finite reference position".into(),
-        ));
+        return Err(CompError::data("pod model: non-finite reference position"));
     }
     let p = prepare_about(h, Some(fit.reference_m))?;
     let cols = joint_columns(h, &p, hp);
@@ -355,13 +353,13 @@ fn joint(fit: &JointFit, h: &PodHeading, hp: bool) -> Result<Vec<f64>> {
 pub fn compensation_rate(h: &PodHeading, pred: &[f64]) -> Result<f64> {
     let p = prepare(h)?;
     if pred.len() != p.s0.len() {
-        return Err(CompError::BadData(
-            "prediction length differs from the heading".into(),
+        return Err(CompError::data(
+            "prediction length differs from the heading",
         ));
     }
     let before = rms(&detrend(&h.total_nt));
     if before <= 0.0 {
-        return Err(CompError::BadData("heading without interference".into()));
+        return Err(CompError::data("heading without interference"));
     }
     let after: Vec<f64> = p.s0.iter().zip(pred).map(|(s, m)| s - m).collect();
     Ok(1.0 - rms(&after) / before)
@@ -378,7 +376,7 @@ pub fn compensation_rate_pooled<H: std::borrow::Borrow<PodHeading>>(
     preds: &[Vec<f64>],
 ) -> Result<f64> {
     if headings.is_empty() || headings.len() != preds.len() {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "pooled rate needs one prediction per heading ({} headings, {} predictions)",
             headings.len(),
             preds.len()

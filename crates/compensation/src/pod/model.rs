@@ -76,13 +76,13 @@ fn gradient_block(g: &[f64], u: &[f64; 3]) -> f64 {
 /// `|U3| <` [`MIN_U3`].
 pub fn heading_coefficients(theta: &[f64], u0: &[f64; 3]) -> Result<[f64; N_HEADING]> {
     if theta.len() != N_PARAMS {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "pod model needs {N_PARAMS} parameters, got {}",
             theta.len()
         )));
     }
     if u0[2].abs() < MIN_U3 {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "|U3| = {:.3} too small for the small-signal elimination of v3",
             u0[2].abs()
         )));

@@ -14,16 +14,25 @@ use std::str::FromStr;
 pub const POD_KIND: &str = "towed-pod";
 
 /// The solve of `aeromag pod fit`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum PodMethod {
     /// The seed's two-step solve (heading coefficients, then parameters).
     TwoStep,
     /// One least-squares fit of the large-signal model (43 + 24 eddy
     /// gradient parameters) over all samples.
     Joint,
-    /// Equivalent dipole array, exact field at the pod.
+    /// Equivalent dipole array, exact field at the pod (the default: the
+    /// solve that reaches ≥ 97 % on every heading).
+    #[default]
     DipoleArray,
+}
+
+impl std::fmt::Display for PodMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 impl PodMethod {
@@ -118,7 +127,7 @@ impl PodSetup {
     /// Check the values: a positive cable length (m), an inclination in
     /// (−90°, 90°), a finite declination and finite gradients.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(CompError::BadData(m));
+        let bad = |m: String| Err(CompError::setting(m));
         if !(self.cable_length_m.is_finite() && self.cable_length_m > 0.0) {
             return bad(format!(
                 "cable length {} m must be positive",
@@ -150,8 +159,10 @@ impl PodModelFile {
     /// fields and [`Self::validate`].
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let m: Self = parse_model(text, origin, POD_KIND, "aeromag pod fit")?;
-        m.validate()
-            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        m.validate().map_err(|e| CompError::ModelFile {
+            origin: origin.to_string(),
+            reason: e.to_string(),
+        })?;
         Ok(m)
     }
 
@@ -161,8 +172,8 @@ impl PodModelFile {
         if self.coefficients.len() != self.coefficient_names.len()
             || self.coefficients.iter().any(|c| !c.is_finite())
         {
-            return Err(CompError::BadData(
-                "coefficients and names differ in number or are not finite".into(),
+            return Err(CompError::data(
+                "coefficients and names differ in number or are not finite",
             ));
         }
         self.setup.validate()

@@ -74,8 +74,8 @@ impl RotorGeometry {
         if ok {
             Ok(())
         } else {
-            Err(CompError::BadData(
-                "rotor geometry: finite positions, 0 ≤ root < tip and ≥ 2 blades required".into(),
+            Err(CompError::setting(
+                "rotor geometry: finite positions, 0 ≤ root < tip and ≥ 2 blades required",
             ))
         }
     }
@@ -107,8 +107,8 @@ pub fn dipole_integral(
     let p = a.dot(u);
     let h2 = a.norm_squared() - p * p;
     if !(h2 > 1e-12) {
-        return Err(CompError::BadData(
-            "dipole integral: the sensor lies on the blade's line".into(),
+        return Err(CompError::data(
+            "dipole integral: the sensor lies on the blade's line",
         ));
     }
     let prim = |t: f64| {

@@ -166,8 +166,8 @@ fn slow_angles(
     let n = mag_nt.len();
     let win = (opts.window_s * fs_hz).round() as usize;
     if win < 10 || n < 2 * win {
-        return Err(CompError::BadData(
-            "slow-angle fit: window too short or data shorter than two windows".into(),
+        return Err(CompError::setting(
+            "slow-angle fit: window too short or data shorter than two windows",
         ));
     }
     let mut angles: Vec<FlapAngles> = (0..n)
@@ -300,8 +300,8 @@ fn slow_angles(
             }
             let sol = ata
                 .cholesky()
-                .ok_or_else(|| {
-                    CompError::BadData("slow-angle fit: singular normal equations".into())
+                .ok_or_else(|| CompError::Singular {
+                    reason: "slow-angle fit: singular normal equations".into(),
                 })?
                 .solve(&atb);
             for w in 0..nw {

@@ -75,9 +75,7 @@ impl RotorInput<'_> {
             || self.omega_rad_s.len() != n
             || !(self.angles.len() == n || self.angles.len() == 1)
         {
-            return Err(CompError::BadData(
-                "rotor input: series of different lengths".into(),
-            ));
+            return Err(CompError::data("rotor input: series of different lengths"));
         }
         Ok(n)
     }
@@ -105,7 +103,7 @@ pub fn regressors(
         let b = input.b_body_nt[k] * 1e-9;
         let bn = b.norm();
         if !(bn.is_finite() && bn > 0.0) {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::data(format!(
                 "rotor input: field at sample {k} is zero or not finite"
             )));
         }
@@ -214,20 +212,20 @@ pub fn fit_records(
 ) -> Result<RotorFit> {
     let p = records.first().map_or(0, |r| r.0.len());
     if p == 0 {
-        return Err(CompError::BadData("rotor fit: no regressors".into()));
+        return Err(CompError::data("rotor fit: no regressors"));
     }
     let edge = (opts.edge_s * fs_hz).round() as usize;
     let mut ne = NormalEquations::new(p);
     for (cols, mag_nt) in records {
         let n = mag_nt.len();
         if cols.len() != p || cols.iter().any(|c| c.len() != n) {
-            return Err(CompError::BadData(
-                "rotor fit: regressors and data differ in length".into(),
+            return Err(CompError::data(
+                "rotor fit: regressors and data differ in length",
             ));
         }
         if n <= 2 * edge + 10 * p {
             if records.len() == 1 {
-                return Err(CompError::BadData("rotor fit: too few samples".into()));
+                return Err(CompError::data("rotor fit: too few samples"));
             }
             continue;
         }
@@ -238,14 +236,14 @@ pub fn fit_records(
         let y = highpass(mag_nt, fs_hz, opts.highpass_hz)?;
         let slices: Vec<&[f64]> = hp.iter().map(|c| &c[edge..n - edge]).collect();
         ne.add_columns(&slices, &y[edge..n - edge])
-            .map_err(|e| CompError::BadData(format!("rotor fit: {e}")))?;
+            .map_err(CompError::estimation("rotor fit"))?;
     }
     if ne.rows() == 0 {
-        return Err(CompError::BadData("rotor fit: too few samples".into()));
+        return Err(CompError::data("rotor fit: too few samples"));
     }
     let sol = ne
         .solve(opts.ridge)
-        .map_err(|e| CompError::BadData(format!("rotor fit failed: {e}")))?;
+        .map_err(CompError::estimation("rotor fit failed"))?;
     Ok(RotorFit {
         terms,
         params: sol.coef.iter().copied().collect(),
@@ -263,9 +261,7 @@ impl RotorFit {
     /// Prediction from precomputed columns.
     pub fn predict_columns(&self, cols: &[Vec<f64>]) -> Result<Vec<f64>> {
         if cols.len() != self.params.len() {
-            return Err(CompError::BadData(
-                "rotor model: wrong number of regressors".into(),
-            ));
+            return Err(CompError::data("rotor model: wrong number of regressors"));
         }
         let n = cols.first().map_or(0, |c| c.len());
         Ok((0..n)

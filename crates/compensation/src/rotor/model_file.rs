@@ -67,8 +67,10 @@ impl RotorModelFile {
     /// fields and [`Self::validate`].
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let m: Self = parse_model(text, origin, ROTOR_KIND, "aeromag rotor fit")?;
-        m.validate()
-            .map_err(|e| CompError::BadData(format!("{origin}: {e}")))?;
+        m.validate().map_err(|e| CompError::ModelFile {
+            origin: origin.to_string(),
+            reason: e.to_string(),
+        })?;
         Ok(m)
     }
 
@@ -78,7 +80,7 @@ impl RotorModelFile {
         self.geometry.validate()?;
         let expect = self.geometry.blades * self.model.terms.per_blade();
         if self.model.params.len() != expect || self.model.params.iter().any(|p| !p.is_finite()) {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::data(format!(
                 "expected {expect} finite rotor parameters, got {}",
                 self.model.params.len()
             )));

@@ -48,9 +48,7 @@ pub fn unwrap_rad(phase: &[f64]) -> Vec<f64> {
 pub fn rotor_speed(phase_rad: &[f64], fs_hz: f64, cutoff_hz: f64) -> Result<Vec<f64>> {
     let n = phase_rad.len();
     if n < 3 {
-        return Err(CompError::BadData(
-            "rotor phase: fewer than 3 samples".into(),
-        ));
+        return Err(CompError::data("rotor phase: fewer than 3 samples"));
     }
     let d: Vec<f64> = (0..n)
         .map(|k| {
@@ -83,7 +81,9 @@ pub fn estimate_phase(
 ) -> Result<PhaseEstimate> {
     let nb = blades as f64;
     if blades < 2 || !(f_min_hz > 0.0 && f_max_hz > f_min_hz) || nb * f_max_hz >= 0.5 * fs_hz {
-        return Err(CompError::BadData("rotor phase: need ≥ 2 blades and 0 < f_min < f_max with the blade-passing frequency below Nyquist".into()));
+        return Err(CompError::setting(
+            "rotor phase: need ≥ 2 blades and 0 < f_min < f_max with the blade-passing frequency below Nyquist",
+        ));
     }
     let x = highpass(mag_nt, fs_hz, 0.5 * f_min_hz)?;
     let nper = ((20.0 * fs_hz) as usize).min(x.len());
@@ -96,9 +96,7 @@ pub fn estimate_phase(
         .filter(|(_, f)| **f >= lo && **f <= hi)
         .max_by(|a, b| psd.values[a.0].total_cmp(&psd.values[b.0]))
         .map(|(i, _)| i)
-        .ok_or_else(|| {
-            CompError::BadData("rotor phase: no spectral bin in the search band".into())
-        })?;
+        .ok_or_else(|| CompError::data("rotor phase: no spectral bin in the search band"))?;
     let df = psd.freqs_hz[1] - psd.freqs_hz[0];
     let mut f_bp = psd.freqs_hz[best];
     if best > 0 && best + 1 < psd.values.len() {

@@ -164,8 +164,8 @@ pub fn evaluate(geom: &RotorGeometry, input: &StudyInput) -> Result<RotorStudy> 
     .any(|&l| l != n)
         || n <= 2 * input.edge
     {
-        return Err(CompError::BadData(
-            "rotor study: columns of different lengths or record too short".into(),
+        return Err(CompError::data(
+            "rotor study: columns of different lengths or record too short",
         ));
     }
     let (fs, edge) = (input.fs_hz, input.edge);

@@ -21,8 +21,8 @@ pub fn synchronous_template(
 ) -> Result<Vec<f64>> {
     let n = x.len();
     if phase_rad.len() != n || bins < 2 || !(block_s > 0.0) {
-        return Err(CompError::BadData(
-            "synchronous averaging: lengths differ, < 2 bins or block ≤ 0".into(),
+        return Err(CompError::data(
+            "synchronous averaging: lengths differ, < 2 bins or block ≤ 0",
         ));
     }
     let y = highpass(x, fs_hz, highpass_hz)?;

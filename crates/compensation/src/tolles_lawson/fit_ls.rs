@@ -30,10 +30,9 @@
 //! flight does not separate them from the other terms: typically one heading
 //! or missing manoeuvres), and near-null combinations are spelled out.
 
-use super::design::design_columns;
+use super::design::Design;
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
-use super::terms::{Convention, DEFAULT_BT_SCALE_NT, TermSet};
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
 use aeromag_core::filter::{Band, butter, sosfiltfilt_in_place};
@@ -43,12 +42,11 @@ use serde::{Deserialize, Serialize};
 /// Settings of the band-pass least-squares fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LsConfig {
-    /// Term groups (default `p3,i5,e8`: the 16 observable parameters).
-    pub terms: TermSet,
-    /// Derivative convention of the eddy columns.
-    pub convention: Convention,
-    /// Scale of induced and eddy columns, nT (default 50 000).
-    pub bt_scale_nt: f64,
+    /// Terms (default `p3,i5,e8`: the 16 observable parameters), derivative
+    /// convention and scale of the induced and eddy columns (default
+    /// 50 000 nT).
+    #[serde(flatten)]
+    pub design: Design,
     /// Pass band in Hz (default 0.1–0.9 Hz); `None` fits unfiltered data.
     pub band_hz: Option<(f64, f64)>,
     /// Butterworth order (default 4).
@@ -69,9 +67,7 @@ pub struct LsConfig {
 impl Default for LsConfig {
     fn default() -> Self {
         Self {
-            terms: TermSet::observable16(),
-            convention: Convention::Physical,
-            bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            design: Design::default(),
             band_hz: Some((0.1, 0.9)),
             filter_order: 4,
             trim: 20,
@@ -169,12 +165,15 @@ fn for_each_filtered_block(
     let filter_overlap = match sos {
         Some(s) => s
             .settling_samples(BLOCK_TOLERANCE)
-            .ok_or_else(|| CompError::BadData("unstable band-pass filter".into()))?,
+            .ok_or_else(|| CompError::Failed {
+                reason: "unstable band-pass filter".into(),
+            })?,
         None => 1, // the central-difference derivative needs one neighbour
     };
     // The lagged eddy columns start at rest at each block's first sample:
     // their start-up transient must also have decayed inside the core.
     let lag_overlap = cfg
+        .design
         .terms
         .eddy_lags_s()
         .iter()
@@ -193,7 +192,7 @@ fn for_each_filtered_block(
         };
         let time = &seg.time[a..b];
         let flux = [&seg.flux[0][a..b], &seg.flux[1][a..b], &seg.flux[2][a..b]];
-        let mut cols = design_columns(&cfg.terms, cfg.convention, cfg.bt_scale_nt, time, flux);
+        let mut cols = cfg.design.columns(time, flux);
         let mut y = seg.mag[a..b].to_vec();
         if let Some(sos) = sos {
             cols.push(std::mem::take(&mut y));
@@ -218,7 +217,7 @@ fn segment_filter(
 ) -> Result<std::result::Result<(f64, Option<Sos>), String>> {
     let n = seg.time.len();
     if seg.mag.len() != n || seg.flux.iter().any(|f| f.len() != n) {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "segment {k}: columns of unequal length"
         )));
     }
@@ -239,7 +238,7 @@ fn segment_filter(
         )?),
         None => None,
     };
-    let ncol = cfg.terms.n_columns();
+    let ncol = cfg.design.n_columns();
     let min_len = sos
         .as_ref()
         .map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
@@ -260,9 +259,9 @@ pub(crate) fn band_passed_residuals(
     coef: &[f64],
 ) -> Result<Vec<(Vec<f64>, f64)>> {
     validate(cfg)?;
-    let ncol = cfg.terms.n_columns();
+    let ncol = cfg.design.n_columns();
     if coef.len() != ncol {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::data(format!(
             "{} coefficients for {ncol} columns",
             coef.len()
         )));
@@ -287,7 +286,7 @@ pub(crate) fn band_passed_residuals(
 /// Fit the Tolles-Lawson coefficients to calibration segments.
 pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
     validate(cfg)?;
-    let mut ne = NormalEquations::new(cfg.terms.n_columns());
+    let mut ne = NormalEquations::new(cfg.design.n_columns());
     let mut warnings = Vec::new();
     let mut used = 0;
     let mut fs_used = Vec::new();
@@ -301,14 +300,14 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
         };
         for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
             ne.add_columns(cols, y)
-                .map_err(|e| CompError::BadData(format!("segment {k}: {e}")))
+                .map_err(CompError::estimation(format!("segment {k}")))
         })?;
         used += 1;
         fs_used.push(1.0 / dt);
     }
     if used == 0 {
-        return Err(CompError::BadData(
-            "no segment is long enough to fit (see the warnings)".into(),
+        return Err(CompError::data(
+            "no segment is long enough to fit (see the warnings)",
         ));
     }
     let independent_fraction = match cfg.band_hz {
@@ -321,8 +320,8 @@ pub fn fit_band_pass_ls(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
     let effective_dof = ne.rows() as f64 * independent_fraction;
     let sol = ne
         .solve_with_dof(cfg.lambda, effective_dof)
-        .map_err(|e| CompError::BadData(format!("least-squares fit failed: {e}")))?;
-    let names = cfg.terms.column_names();
+        .map_err(CompError::estimation("least-squares fit failed"))?;
+    let names = cfg.design.column_names();
     warnings.extend(diagnose(&sol, &names, cfg.max_vif));
     Ok(LsFit {
         coef: sol.coef.iter().copied().collect(),
@@ -379,24 +378,18 @@ pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String>
 fn validate(cfg: &LsConfig) -> Result<()> {
     if let Some((lo, hi)) = cfg.band_hz {
         if !(lo > 0.0 && hi > lo && hi.is_finite()) {
-            return Err(CompError::BadData(format!(
+            return Err(CompError::setting(format!(
                 "pass band {lo}–{hi} Hz: need 0 < low < high"
             )));
         }
     }
-    if !(cfg.bt_scale_nt > 0.0 && cfg.bt_scale_nt.is_finite()) {
-        return Err(CompError::BadData(format!(
-            "bt_scale {} must be positive",
-            cfg.bt_scale_nt
-        )));
-    }
     if !(cfg.lambda >= 0.0 && cfg.lambda.is_finite()) {
-        return Err(CompError::BadData(format!(
+        return Err(CompError::setting(format!(
             "ridge λ = {} must be ≥ 0",
             cfg.lambda
         )));
     }
-    cfg.terms.validate()
+    cfg.design.validate()
 }
 
 /// Zero-phase filter every non-constant column in place (MagNav's rule:
@@ -423,8 +416,11 @@ fn filter_columns(sos: &Sos, cols: &mut [Vec<f64>]) -> Result<()> {
             })
             .collect();
         handles.into_iter().try_for_each(|h| {
-            h.join()
-                .unwrap_or_else(|_| Err(CompError::BadData("filter thread failed".into())))
+            h.join().unwrap_or_else(|_| {
+                Err(CompError::Failed {
+                    reason: "filter thread failed".into(),
+                })
+            })
         })
     })
 }
@@ -441,6 +437,7 @@ fn std_dev(x: &[f64]) -> f64 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::tolles_lawson::TermSet;
     use aeromag_core::frames::Attitude;
     use nalgebra::Vector3;
 
@@ -491,14 +488,7 @@ pub(crate) mod tests {
             fz.push(b.z);
         }
         let mut mag = Vec::with_capacity(n);
-        let interf = super::super::design::interference(
-            terms,
-            Convention::Physical,
-            DEFAULT_BT_SCALE_NT,
-            coef,
-            &t,
-            [&fx, &fy, &fz],
-        );
+        let interf = Design::new(terms.clone()).interference(coef, &t, [&fx, &fy, &fz]);
         let mut noise = 12345u64;
         for (i, interf) in interf.into_iter().enumerate() {
             noise = noise
@@ -544,22 +534,8 @@ pub(crate) mod tests {
         // Compare the modelled interference (minus its mean) with the truth.
         let (t, f, _) = &legs[1];
         let flux = [f[0].as_slice(), f[1].as_slice(), f[2].as_slice()];
-        let est = super::super::design::interference(
-            &terms,
-            Convention::Physical,
-            DEFAULT_BT_SCALE_NT,
-            &fit.coef,
-            t,
-            flux,
-        );
-        let tru = super::super::design::interference(
-            &terms,
-            Convention::Physical,
-            DEFAULT_BT_SCALE_NT,
-            &coef,
-            t,
-            flux,
-        );
+        let est = Design::new(terms.clone()).interference(&fit.coef, t, flux);
+        let tru = Design::new(terms.clone()).interference(&coef, t, flux);
         let d: Vec<f64> = est.iter().zip(&tru).map(|(a, b)| a - b).collect();
         let m = d.iter().sum::<f64>() / d.len() as f64;
         let rms = (d.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / d.len() as f64).sqrt();

@@ -209,7 +209,7 @@ pub fn within_budget<'a>(
 pub fn lag_threshold(alpha: f64, candidates: usize, columns: usize) -> Result<f64> {
     let m = candidates.max(1) as f64;
     chi_square_quantile(1.0 - alpha / m, columns as u32)
-        .map_err(|e| CompError::BadData(format!("lag selection: {e}")))
+        .map_err(CompError::estimation("lag selection"))
 }
 
 /// Choose up to `max_lags` lags from `grid_s` (s) for `cfg`'s term set (which
@@ -226,7 +226,9 @@ pub fn select_eddy_lags(
     let threshold = |q: usize| lag_threshold(alpha, grid_s.len(), q);
     let with = |taus: &[f64]| -> Result<LsConfig> {
         Ok(LsConfig {
-            terms: cfg.terms.with_eddy_lags(taus)?,
+            design: cfg
+                .design
+                .with_terms(cfg.design.terms.with_eddy_lags(taus)?),
             ..cfg.clone()
         })
     };
@@ -284,6 +286,7 @@ pub fn select_eddy_lags(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tolles_lawson::Design;
     use crate::tolles_lawson::TermSet;
     use crate::tolles_lawson::fit_ls::tests::{coef_lag9, coef16, leg_n, segments_of};
 
@@ -451,7 +454,7 @@ mod tests {
         let legs = boxed(&TermSet::observable16(), &coef16());
         let segs = segments_of(&legs);
         let cfg = LsConfig {
-            terms: TermSet::parse("p3,i5").unwrap(),
+            design: Design::new(TermSet::parse("p3,i5").unwrap()),
             ..LsConfig::default()
         };
         assert!(select_eddy_lags(&segs, &cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA).is_err());

@@ -7,4 +7,5 @@ pub mod lag_select;
 pub mod segments;
 pub mod terms;
 
+pub use design::Design;
 pub use terms::{Convention, DEFAULT_BT_SCALE_NT, TermGroup, TermSet};

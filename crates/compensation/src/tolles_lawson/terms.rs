@@ -95,9 +95,11 @@ impl TermGroup {
             "l9" => TermGroup::L9,
             "bias" | "b" => TermGroup::Bias,
             other => {
-                return Err(CompError::InvalidTerms(format!(
-                    "unknown term group `{other}` (use p3, i6, i5, e9, e8, l9, bias)"
-                )));
+                return Err(CompError::InvalidTerms {
+                    reason: format!(
+                        "unknown term group `{other}` (use p3, i6, i5, e9, e8, l9, bias)"
+                    ),
+                });
             }
         })
     }
@@ -106,12 +108,24 @@ impl TermGroup {
 /// How the field derivative `dB_j` of the eddy-current columns is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Convention {
     /// Time derivative in nT/s over the actual time stamps.
     #[default]
     Physical,
     /// MagNav.jl `create_TL_A`: per-sample central difference, not divided by dt.
+    #[cfg_attr(feature = "clap", value(name = "magnav"))]
     MagNav,
+}
+
+impl std::fmt::Display for Convention {
+    /// `physical` or `magnav`, as in files and on the command line.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Convention::Physical => "physical",
+            Convention::MagNav => "magnav",
+        })
+    }
 }
 
 impl std::str::FromStr for Convention {
@@ -120,9 +134,9 @@ impl std::str::FromStr for Convention {
         match s.trim().to_ascii_lowercase().as_str() {
             "physical" => Ok(Convention::Physical),
             "magnav" => Ok(Convention::MagNav),
-            o => Err(CompError::InvalidTerms(format!(
-                "unknown derivative convention `{o}` (physical or magnav)"
-            ))),
+            o => Err(CompError::InvalidTerms {
+                reason: format!("unknown derivative convention `{o}` (physical or magnav)"),
+            }),
         }
     }
 }
@@ -166,13 +180,19 @@ impl TermSet {
         g.sort();
         g.dedup();
         if g.is_empty() {
-            return Err(CompError::InvalidTerms("no term groups given".into()));
+            return Err(CompError::InvalidTerms {
+                reason: "no term groups given".into(),
+            });
         }
         if g.contains(&TermGroup::I6) && g.contains(&TermGroup::I5) {
-            return Err(CompError::InvalidTerms("choose one of i6 and i5".into()));
+            return Err(CompError::InvalidTerms {
+                reason: "choose one of i6 and i5".into(),
+            });
         }
         if g.contains(&TermGroup::E9) && g.contains(&TermGroup::E8) {
-            return Err(CompError::InvalidTerms("choose one of e9 and e8".into()));
+            return Err(CompError::InvalidTerms {
+                reason: "choose one of e9 and e8".into(),
+            });
         }
         Ok(Self {
             groups: g,
@@ -197,17 +217,17 @@ impl TermSet {
             });
         }
         if let Some(t) = taus_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(CompError::InvalidTerms(format!(
-                "eddy-current lag {t} s: must be finite and > 0"
-            )));
+            return Err(CompError::InvalidTerms {
+                reason: format!("eddy-current lag {t} s: must be finite and > 0"),
+            });
         }
         if !groups
             .iter()
             .any(|g| matches!(g, TermGroup::E9 | TermGroup::E8))
         {
-            return Err(CompError::InvalidTerms(
-                "eddy-current lags need an eddy group (e8 or e9)".into(),
-            ));
+            return Err(CompError::InvalidTerms {
+                reason: "eddy-current lags need an eddy group (e8 or e9)".into(),
+            });
         }
         groups.push(TermGroup::L9);
         groups.sort();
@@ -228,18 +248,18 @@ impl TermSet {
     /// Check the lags against the groups (a set read from a file).
     pub fn validate(&self) -> Result<()> {
         if self.groups.contains(&TermGroup::L9) == self.eddy_lags_s.is_empty() {
-            return Err(CompError::InvalidTerms(
-                "the lagged eddy group l9 and the eddy lags must be given together".into(),
-            ));
+            return Err(CompError::InvalidTerms {
+                reason: "the lagged eddy group l9 and the eddy lags must be given together".into(),
+            });
         }
         if let Some(t) = self
             .eddy_lags_s
             .iter()
             .find(|t| !(t.is_finite() && **t > 0.0))
         {
-            return Err(CompError::InvalidTerms(format!(
-                "eddy-current lag {t} s: must be finite and > 0"
-            )));
+            return Err(CompError::InvalidTerms {
+                reason: format!("eddy-current lag {t} s: must be finite and > 0"),
+            });
         }
         Ok(())
     }

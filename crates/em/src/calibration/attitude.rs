@@ -19,11 +19,13 @@ pub fn fit_attitude_correction(
     computed: &[Matrix3<f64>],
 ) -> Result<Matrix3<f64>> {
     if truth.len() != computed.len() || truth.is_empty() {
-        return Err(EmError::InvalidArgument(format!(
-            "{} known and {} computed attitudes",
-            truth.len(),
-            computed.len()
-        )));
+        return Err(EmError::InvalidArgument {
+            reason: format!(
+                "{} known and {} computed attitudes",
+                truth.len(),
+                computed.len()
+            ),
+        });
     }
     let sum: Matrix3<f64> = truth
         .iter()

@@ -62,7 +62,9 @@ impl CalibrationFile {
 
     /// Pretty JSON text.
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData(e.to_string()))
+        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData {
+            reason: e.to_string(),
+        })
     }
 
     /// Parse and check format, version and finiteness.
@@ -70,18 +72,24 @@ impl CalibrationFile {
     /// Errors ([`EmError::InvalidData`]) with serde's line and column for
     /// malformed JSON, or naming the offending field.
     pub fn from_json(s: &str) -> Result<Self> {
-        let f: Self = serde_json::from_str(s).map_err(|e| EmError::InvalidData(e.to_string()))?;
+        let f: Self = serde_json::from_str(s).map_err(|e| EmError::InvalidData {
+            reason: e.to_string(),
+        })?;
         if f.format != CALIBRATION_FORMAT {
-            return Err(EmError::InvalidData(format!(
-                "field 'format' is \"{}\", expected \"{CALIBRATION_FORMAT}\"",
-                f.format
-            )));
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'format' is \"{}\", expected \"{CALIBRATION_FORMAT}\"",
+                    f.format
+                ),
+            });
         }
         if f.version != CALIBRATION_VERSION {
-            return Err(EmError::InvalidData(format!(
-                "field 'version' is {}, this program reads version {CALIBRATION_VERSION}",
-                f.version
-            )));
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'version' is {}, this program reads version {CALIBRATION_VERSION}",
+                    f.version
+                ),
+            });
         }
         let c = &f.calibration;
         let finite = |m: &Matrix3<f64>| m.iter().all(|v| v.is_finite());
@@ -92,14 +100,14 @@ impl CalibrationFile {
             && c.polarisation.p.iter().all(finite)
             && c.polarisation.phase_rad.iter().all(|v| v.is_finite()))
         {
-            return Err(EmError::InvalidData(
-                "non-finite number in the calibration".into(),
-            ));
+            return Err(EmError::InvalidData {
+                reason: "non-finite number in the calibration".into(),
+            });
         }
         if f.moments_am2.determinant().abs() == 0.0 {
-            return Err(EmError::InvalidData(
-                "field 'moments_am2' is singular".into(),
-            ));
+            return Err(EmError::InvalidData {
+                reason: "field 'moments_am2' is singular".into(),
+            });
         }
         Ok(f)
     }

@@ -93,10 +93,9 @@ impl PolarisationCalibration {
     /// system (too little variety of positions and attitudes).
     pub fn fit(epochs: &[[[Complex64; 3]; 3]]) -> Result<Self> {
         if epochs.len() < 8 {
-            return Err(EmError::InvalidArgument(format!(
-                "{} epochs, need ≥ 8",
-                epochs.len()
-            )));
+            return Err(EmError::InvalidArgument {
+                reason: format!("{} epochs, need ≥ 8", epochs.len()),
+            });
         }
         if epochs
             .iter()
@@ -104,7 +103,9 @@ impl PolarisationCalibration {
             .flatten()
             .any(|c| !c.re.is_finite() || !c.im.is_finite())
         {
-            return Err(EmError::InvalidData("non-finite detected values".into()));
+            return Err(EmError::InvalidData {
+                reason: "non-finite detected values".into(),
+            });
         }
         // Starting phase: average of e^{2iφ*} (the major axis has a ±π ambiguity).
         let mut phase_rad = [0.0; 3];
@@ -139,8 +140,8 @@ impl PolarisationCalibration {
                 }
                 let sol = ata
                     .cholesky()
-                    .ok_or_else(|| {
-                        EmError::Singular(format!("stage-1 normal equations, frequency {i}"))
+                    .ok_or_else(|| EmError::Singular {
+                        what: format!("stage-1 normal equations, frequency {i}"),
                     })?
                     .solve(&aty);
                 let mut p = Matrix3::zeros();

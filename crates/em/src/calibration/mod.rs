@@ -66,12 +66,16 @@ pub struct Located {
 impl Calibration {
     /// Serialise to JSON.
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData(e.to_string()))
+        serde_json::to_string_pretty(self).map_err(|e| EmError::InvalidData {
+            reason: e.to_string(),
+        })
     }
 
     /// Read from JSON.
     pub fn from_json(s: &str) -> Result<Self> {
-        serde_json::from_str(s).map_err(|e| EmError::InvalidData(e.to_string()))
+        serde_json::from_str(s).map_err(|e| EmError::InvalidData {
+            reason: e.to_string(),
+        })
     }
 
     /// Effective moments `M' = (I + S) M` (A·m²).

@@ -44,17 +44,14 @@ impl Calibration {
         hemisphere: &Hemisphere,
     ) -> Result<Self> {
         let get = |k: usize| {
-            epochs.get(k).ok_or_else(|| {
-                EmError::InvalidArgument(format!(
-                    "known point refers to epoch {k} of {}",
-                    epochs.len()
-                ))
+            epochs.get(k).ok_or_else(|| EmError::InvalidArgument {
+                reason: format!("known point refers to epoch {k} of {}", epochs.len()),
             })
         };
         if known.attitudes.is_empty() {
-            return Err(EmError::InvalidArgument(
-                "stage 3 needs at least one point of known attitude".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "stage 3 needs at least one point of known attitude".into(),
+            });
         }
         let polarisation = PolarisationCalibration::fit(epochs)?;
         let mut fields = Vec::with_capacity(known.positions.len());

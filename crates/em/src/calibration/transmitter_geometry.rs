@@ -44,11 +44,13 @@ pub fn fit_transmitter_geometry(
     moments: &Matrix3<f64>,
 ) -> Result<Matrix3<f64>> {
     if fields.len() != positions_m.len() || fields.len() < 2 {
-        return Err(EmError::InvalidArgument(format!(
-            "{} fields for {} positions (need ≥ 2 of each, equal counts)",
-            fields.len(),
-            positions_m.len()
-        )));
+        return Err(EmError::InvalidArgument {
+            reason: format!(
+                "{} fields for {} positions (need ≥ 2 of each, equal counts)",
+                fields.len(),
+                positions_m.len()
+            ),
+        });
     }
     let ws: Vec<Matrix3<f64>> = fields
         .iter()
@@ -80,7 +82,9 @@ pub fn fit_transmitter_geometry(
         }
         let d = ata
             .cholesky()
-            .ok_or_else(|| EmError::Singular("stage-2 normal equations".into()))?
+            .ok_or_else(|| EmError::Singular {
+                what: "stage-2 normal equations".into(),
+            })?
             .solve(&atb);
         for k in 0..6 {
             s += sym_basis(k) * d[k];

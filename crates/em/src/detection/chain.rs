@@ -58,23 +58,23 @@ impl FieldChain {
     ) -> Result<Self> {
         let f = detector.config().frequencies_hz.clone();
         if f.len() != 9 {
-            return Err(EmError::InvalidArgument(
-                "detector must have 9 frequencies (3 × working, −δ, +δ)".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "detector must have 9 frequencies (3 × working, −δ, +δ)".into(),
+            });
         }
         if !crate::positive_finite(coil_gain_v_per_t_s.abs()) {
-            return Err(EmError::InvalidArgument(
-                "coil gain must be non-zero".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "coil gain must be non-zero".into(),
+            });
         }
         let mut chi_inv = [CMatrix3::identity(); 3];
         let mut pilots = [PilotCorrection::from_amplitudes([1.0; 3]); 3];
         let mut transfer = [Complex64::new(0.0, 0.0); 3];
         let p = pilot_field_t.map(|v| Complex64::new(v, 0.0));
         for i in 0..3 {
-            chi_inv[i] = chi[i]
-                .try_inverse()
-                .ok_or_else(|| EmError::Singular(format!("χ at frequency {i}")))?;
+            chi_inv[i] = chi[i].try_inverse().ok_or_else(|| EmError::Singular {
+                what: format!("χ at frequency {i}"),
+            })?;
             let ideal = |freq: f64| -> [Complex64; 3] {
                 let v = chi[i] * p * Complex64::new(0.0, -TAU * freq * coil_gain_v_per_t_s);
                 [v[0], v[1], v[2]]

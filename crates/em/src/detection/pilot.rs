@@ -51,15 +51,15 @@ impl PilotCorrection {
         for c in 0..3 {
             let (el, er) = (self.expected_left[c], self.expected_right[c]);
             if !(crate::positive_finite(el.norm()) && crate::positive_finite(er.norm())) {
-                return Err(EmError::InvalidData(format!(
-                    "expected pilot of channel {c} is zero"
-                )));
+                return Err(EmError::InvalidData {
+                    reason: format!("expected pilot of channel {c} is zero"),
+                });
             }
             xi[c] = (u_right[c] / er + u_left[c] / el) * 0.5;
             if !crate::positive_finite(xi[c].norm() - 1e-12) {
-                return Err(EmError::InvalidData(format!(
-                    "pilot not detected on channel {c}"
-                )));
+                return Err(EmError::InvalidData {
+                    reason: format!("pilot not detected on channel {c}"),
+                });
             }
         }
         Ok(xi)

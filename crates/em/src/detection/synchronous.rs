@@ -237,31 +237,37 @@ impl SyncDetector {
     pub fn new(config: DetectorConfig) -> Result<Self> {
         let fs = config.sample_rate_hz;
         if !crate::positive_finite(fs) {
-            return Err(EmError::InvalidArgument(format!("sample rate {fs} Hz")));
+            return Err(EmError::InvalidArgument {
+                reason: format!("sample rate {fs} Hz"),
+            });
         }
         if config.window_len < 8 {
-            return Err(EmError::InvalidArgument(
-                "window shorter than 8 samples".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "window shorter than 8 samples".into(),
+            });
         }
         if config.frequencies_hz.is_empty() {
-            return Err(EmError::InvalidArgument("no detection frequencies".into()));
+            return Err(EmError::InvalidArgument {
+                reason: "no detection frequencies".into(),
+            });
         }
         if let Some(f) = config
             .frequencies_hz
             .iter()
             .find(|&&f| !(f > 0.0 && f < fs / 2.0))
         {
-            return Err(EmError::InvalidArgument(format!(
-                "frequency {f} Hz outside (0, fs/2)"
-            )));
+            return Err(EmError::InvalidArgument {
+                reason: format!("frequency {f} Hz outside (0, fs/2)"),
+            });
         }
         let weights = config
             .window
             .samples(config.window_len, Symmetry::Periodic)?;
         let sum: f64 = weights.iter().sum();
         if !crate::positive_finite(sum) {
-            return Err(EmError::InvalidArgument("window sums to zero".into()));
+            return Err(EmError::InvalidArgument {
+                reason: "window sums to zero".into(),
+            });
         }
         let mut kernels_re = Vec::with_capacity(config.frequencies_hz.len());
         let mut kernels_im = Vec::with_capacity(config.frequencies_hz.len());
@@ -319,7 +325,9 @@ impl SyncDetector {
             .config
             .frequencies_hz
             .get(k)
-            .ok_or_else(|| EmError::InvalidArgument(format!("detector index {k}")))?;
+            .ok_or_else(|| EmError::InvalidArgument {
+                reason: format!("detector index {k}"),
+            })?;
         Ok(self.window_transform(fk - f_hz).norm() + self.window_transform(fk + f_hz).norm())
     }
 
@@ -350,9 +358,9 @@ impl SyncDetector {
         points: usize,
     ) -> Result<Vec<(f64, f64)>> {
         if points < 2 || f_hi_hz.partial_cmp(&f_lo_hz) != Some(std::cmp::Ordering::Greater) {
-            return Err(EmError::InvalidArgument(
-                "need ≥ 2 points over a non-empty interval".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "need ≥ 2 points over a non-empty interval".into(),
+            });
         }
         (0..points)
             .map(|j| {
@@ -368,11 +376,13 @@ impl SyncDetector {
     /// Errors if the block length differs from the window length.
     pub fn detect_block(&self, samples: &[f32], start_index: u64) -> Result<Vec<Complex64>> {
         if samples.len() != self.config.window_len {
-            return Err(EmError::InvalidArgument(format!(
-                "block of {} samples, window is {}",
-                samples.len(),
-                self.config.window_len
-            )));
+            return Err(EmError::InvalidArgument {
+                reason: format!(
+                    "block of {} samples, window is {}",
+                    samples.len(),
+                    self.config.window_len
+                ),
+            });
         }
         let fs = self.config.sample_rate_hz;
         Ok(self
@@ -399,7 +409,9 @@ impl SyncDetector {
         start_index: u64,
     ) -> Result<Vec<Epoch>> {
         if channels == 0 {
-            return Err(EmError::InvalidArgument("zero channels".into()));
+            return Err(EmError::InvalidArgument {
+                reason: "zero channels".into(),
+            });
         }
         let n = self.config.window_len;
         let nf = self.config.frequencies_hz.len();

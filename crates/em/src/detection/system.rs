@@ -40,7 +40,7 @@ impl EmSystem {
     ///
     /// Errors ([`EmError::InvalidData`]) naming the offending field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: &str| Err(EmError::InvalidData(m.into()));
+        let bad = |m: &str| Err(EmError::InvalidData { reason: m.into() });
         let finite = self.frequencies_hz.iter().all(|v| v.is_finite())
             && self.pilot_offset_hz.is_finite()
             && self.coil_gain_v_per_t_s.is_finite()

@@ -46,7 +46,9 @@ pub fn closed_form(
     hemisphere: &mut Hemisphere,
 ) -> Result<ClosedForm> {
     if h.iter().any(|v| !v.is_finite()) {
-        return Err(EmError::InvalidData("non-finite field matrix".into()));
+        return Err(EmError::InvalidData {
+            reason: "non-finite field matrix".into(),
+        });
     }
     let w = whitened_gram(h, moments)?;
     let eig = w.symmetric_eigen();
@@ -59,7 +61,9 @@ pub fn closed_form(
     ];
     let k2 = (4.0 * lam[0] + lam[1] + lam[2]) / 18.0;
     if !crate::positive_finite(k2) {
-        return Err(EmError::InvalidData("zero field: range undefined".into()));
+        return Err(EmError::InvalidData {
+            reason: "zero field: range undefined".into(),
+        });
     }
     let k = k2.sqrt();
     let range = (MU0_OVER_4PI / k).cbrt();
@@ -68,7 +72,9 @@ pub fn closed_form(
     let omega = (e * e.transpose() * 3.0 - Matrix3::identity()) * k;
     let om_inv = (omega * moments)
         .try_inverse()
-        .ok_or_else(|| EmError::Singular("Ω M".into()))?;
+        .ok_or_else(|| EmError::Singular {
+            what: "Ω M".into()
+        })?;
     let a = h * om_inv;
     let rotation = project_to_so3(&a)?;
     let lower = lam[1] + lam[2];

@@ -83,15 +83,19 @@ pub fn error_study(
         || ranges_m.iter().any(|&r| !crate::positive_finite(r))
         || noises_t.iter().any(|&s| !(s.is_finite() && s >= 0.0))
     {
-        return Err(EmError::InvalidArgument(
-            "need trials > 0, ranges > 0 and noise ≥ 0".into(),
-        ));
+        return Err(EmError::InvalidArgument {
+            reason: "need trials > 0, ranges > 0 and noise ≥ 0".into(),
+        });
     }
     if half_space.norm() == 0.0 {
-        return Err(EmError::InvalidArgument("zero half-space normal".into()));
+        return Err(EmError::InvalidArgument {
+            reason: "zero half-space normal".into(),
+        });
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let normal = Normal::new(0.0, 1.0).map_err(|e| EmError::InvalidArgument(e.to_string()))?;
+    let normal = Normal::new(0.0, 1.0).map_err(|e| EmError::InvalidArgument {
+        reason: e.to_string(),
+    })?;
     let mut out = Vec::with_capacity(ranges_m.len() * noises_t.len());
     for &range_m in ranges_m {
         for &noise_t in noises_t {

@@ -17,9 +17,9 @@ pub fn gram_matrix(h: &Matrix3<f64>) -> Matrix3<f64> {
 ///
 /// Errors with [`EmError::Singular`] if the moment matrix is not invertible.
 pub fn whitened_gram(h: &Matrix3<f64>, moments: &Matrix3<f64>) -> Result<Matrix3<f64>> {
-    let m_inv = moments
-        .try_inverse()
-        .ok_or_else(|| EmError::Singular("transmitter moment matrix M".into()))?;
+    let m_inv = moments.try_inverse().ok_or_else(|| EmError::Singular {
+        what: "transmitter moment matrix M".into(),
+    })?;
     let w = m_inv.transpose() * gram_matrix(h) * m_inv;
     Ok((w + w.transpose()) * 0.5)
 }
@@ -62,6 +62,9 @@ mod tests {
     fn singular_moments_error() {
         let h = Matrix3::identity();
         let m = Matrix3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 0.0, 1.0);
-        assert!(matches!(whitened_gram(&h, &m), Err(EmError::Singular(_))));
+        assert!(matches!(
+            whitened_gram(&h, &m),
+            Err(EmError::Singular { what: _ })
+        ));
     }
 }

@@ -69,9 +69,9 @@ pub fn polish(
 ) -> Result<Polished> {
     let scale = h.norm();
     if !crate::positive_finite(scale) {
-        return Err(EmError::InvalidData(
-            "zero or non-finite field matrix".into(),
-        ));
+        return Err(EmError::InvalidData {
+            reason: "zero or non-finite field matrix".into(),
+        });
     }
     let mut base = *start;
     let mut p = Vec6::new(

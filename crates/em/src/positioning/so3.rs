@@ -13,14 +13,18 @@ use nalgebra::Matrix3;
 /// Errors with [`EmError::InvalidData`] for non-finite input or a failed SVD.
 pub fn project_to_so3(a: &Matrix3<f64>) -> Result<Matrix3<f64>> {
     if a.iter().any(|v| !v.is_finite()) {
-        return Err(EmError::InvalidData(
-            "non-finite matrix to project onto SO(3)".into(),
-        ));
+        return Err(EmError::InvalidData {
+            reason: "non-finite matrix to project onto SO(3)".into(),
+        });
     }
     let svd = a.svd(true, true);
     let (u, vt) = match (svd.u, svd.v_t) {
         (Some(u), Some(vt)) => (u, vt),
-        _ => return Err(EmError::InvalidData("SVD failed".into())),
+        _ => {
+            return Err(EmError::InvalidData {
+                reason: "SVD failed".into(),
+            });
+        }
     };
     let d = (u * vt).determinant().signum();
     let s = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, d));

@@ -69,10 +69,9 @@ pub fn detected_csv(epochs: &[FieldEpoch]) -> String {
 /// finiteness (it knows the file positions).
 pub fn field_epoch_from_values(time_s: f64, values: &[f64]) -> Result<FieldEpoch> {
     if values.len() != 36 {
-        return Err(EmError::InvalidData(format!(
-            "{} detected values, expected 36",
-            values.len()
-        )));
+        return Err(EmError::InvalidData {
+            reason: format!("{} detected values, expected 36", values.len()),
+        });
     }
     let c = |k: usize| Complex64::new(values[2 * k], values[2 * k + 1]);
     let block = |o: usize| [0, 1, 2].map(|i| [0, 1, 2].map(|a| c(o + 3 * i + a)));

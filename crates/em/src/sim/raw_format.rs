@@ -60,15 +60,19 @@ impl RawHeader {
 pub fn write_raw<W: Write>(mut w: W, header: &RawHeader, samples: &[f32]) -> Result<()> {
     let expected = header.frames as usize * header.channels;
     if samples.len() != expected {
-        return Err(EmError::InvalidArgument(format!(
-            "{} samples, header says {expected}",
-            samples.len()
-        )));
+        return Err(EmError::InvalidArgument {
+            reason: format!("{} samples, header says {expected}", samples.len()),
+        });
     }
-    let json = serde_json::to_vec(header).map_err(|e| EmError::InvalidData(e.to_string()))?;
-    let len =
-        u32::try_from(json.len()).map_err(|_| EmError::InvalidData("header too long".into()))?;
-    let io = |e: std::io::Error| EmError::InvalidData(e.to_string());
+    let json = serde_json::to_vec(header).map_err(|e| EmError::InvalidData {
+        reason: e.to_string(),
+    })?;
+    let len = u32::try_from(json.len()).map_err(|_| EmError::InvalidData {
+        reason: "header too long".into(),
+    })?;
+    let io = |e: std::io::Error| EmError::InvalidData {
+        reason: e.to_string(),
+    };
     w.write_all(MAGIC).map_err(io)?;
     w.write_all(&len.to_le_bytes()).map_err(io)?;
     w.write_all(&json).map_err(io)?;
@@ -91,7 +95,7 @@ pub struct RawReader<R: Read> {
 }
 
 fn bad(m: String) -> EmError {
-    EmError::InvalidData(m)
+    EmError::InvalidData { reason: m }
 }
 
 /// Read exactly `buf.len()` bytes or report how many were there.

@@ -144,18 +144,20 @@ impl EmScenario {
             && c.range_min_m > 0.0
             && c.range_max_m >= c.range_min_m)
         {
-            return Err(EmError::InvalidArgument(
-                "rate, duration and ranges must be positive".into(),
-            ));
+            return Err(EmError::InvalidArgument {
+                reason: "rate, duration and ranges must be positive".into(),
+            });
         }
         if c.mean_direction.norm() == 0.0 {
-            return Err(EmError::InvalidArgument("zero mean direction".into()));
+            return Err(EmError::InvalidArgument {
+                reason: "zero mean direction".into(),
+            });
         }
         for f in c.frequencies_hz {
             if !(f - c.pilot_offset_hz > 0.0 && f + c.pilot_offset_hz < c.sample_rate_hz / 2.0) {
-                return Err(EmError::InvalidArgument(format!(
-                    "frequency {f} Hz with pilots outside (0, fs/2)"
-                )));
+                return Err(EmError::InvalidArgument {
+                    reason: format!("frequency {f} Hz with pilots outside (0, fs/2)"),
+                });
             }
         }
         let mut rng = ChaCha8Rng::seed_from_u64(c.seed);

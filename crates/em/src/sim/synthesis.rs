@@ -83,7 +83,9 @@ pub fn synthesize(scenario: &EmScenario) -> Result<EmRecording> {
     let tones = tones(scenario);
     let m_eff = scenario.effective_moments();
     let mut samples = vec![0.0f32; frames * 3];
-    let bad = |e: &dyn std::fmt::Display| crate::EmError::InvalidArgument(e.to_string());
+    let bad = |e: &dyn std::fmt::Display| crate::EmError::InvalidArgument {
+        reason: e.to_string(),
+    };
 
     // Deterministic signal: interpolated amplitudes × exact carriers.
     let amp_at = |n: u64| {

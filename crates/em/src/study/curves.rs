@@ -185,9 +185,11 @@ pub fn error_curves(
         || !crate::positive_finite(cfg.flight_s)
         || !crate::positive_finite(base.coil_noise_v)
     {
-        return Err(EmError::InvalidArgument(format!(
-            "error curves need positive ranges, scales, flight and coil noise: {cfg:?}"
-        )));
+        return Err(EmError::InvalidArgument {
+            reason: format!(
+                "error curves need positive ranges, scales, flight and coil noise: {cfg:?}"
+            ),
+        });
     }
     let hemi = Hemisphere {
         previous: None,

@@ -1,3 +1,4 @@
 //! The single-file HTML report.
 
 pub mod report;
+pub mod section;

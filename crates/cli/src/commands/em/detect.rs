@@ -1,11 +1,11 @@
-//! `aeromag em detect`: raw ADC record → detected complex field vectors.
+//! `aeromag em detect`: raw ADC record → detected complex field vectors
+//! (library: [`aeromag::em::detect`]).
 
-use super::files::{next_chunk, open_raw, read_system};
-use crate::exit::bad_input;
-use aeromag_core::filter::Window;
-use aeromag_em::detection::major_axis;
-use aeromag_em::sim::detected_csv;
-use aeromag_em::study::{STUDY_WINDOW_LEN, rms};
+use crate::progress::Bars;
+use aeromag::core::filter::Window;
+use aeromag::em::files::read_system;
+use aeromag::em::sim::detected_csv;
+use aeromag::em::{DetectOptions, detect};
 use std::path::PathBuf;
 
 /// Detect the complex field vectors of a raw EM record (pilot-corrected).
@@ -42,91 +42,48 @@ pub struct DetectArgs {
     #[arg(long)]
     no_pilot: bool,
     /// Detector block length N, samples (output rate f_s/N).
-    #[arg(long, value_name = "N", default_value_t = STUDY_WINDOW_LEN)]
+    #[arg(long, value_name = "N", default_value_t = DetectOptions::default().window_len)]
     window_len: usize,
     /// Weighting window: blackman-harris or nuttall (4-term: zeros at ≥ 4 bins).
-    #[arg(long, value_name = "NAME", default_value = "blackman-harris")]
-    window: String,
+    #[arg(long, value_name = "NAME", default_value = "blackman-harris", value_parser = window)]
+    window: Window,
     /// Instrument constants (JSON, as em.system.json) instead of the raw
     /// header's.
     #[arg(long, value_name = "FILE.json")]
     system: Option<PathBuf>,
 }
 
-fn window(name: &str) -> anyhow::Result<Window> {
+fn window(name: &str) -> Result<Window, String> {
     match name {
         "blackman-harris" => Ok(Window::BlackmanHarris),
         "nuttall" => Ok(Window::Nuttall),
-        _ => Err(bad_input!(
-            "--window '{name}': expected blackman-harris or nuttall"
-        )),
+        _ => Err("expected blackman-harris or nuttall".into()),
     }
 }
 
 pub fn run(a: DetectArgs) -> anyhow::Result<()> {
-    let win = window(&a.window)?;
-    let mut reader = open_raw(&a.input)?;
-    let header = reader.header().clone();
-    let system = match &a.system {
-        Some(p) => read_system(p)?,
-        None => header.system.clone(),
+    let opts = DetectOptions {
+        window_len: a.window_len,
+        window: a.window,
+        pilot: !a.no_pilot,
+        system: a.system.as_deref().map(read_system).transpose()?,
     };
-    let fs = header.sample_rate_hz;
-    let n = a.window_len;
-    if n < 8 || header.frames < n as u64 {
-        return Err(bad_input!(
-            "--window-len {n}: need 8 ≤ N ≤ the record's {} frames ('{}')",
-            header.frames,
-            a.input.display()
-        ));
-    }
-    let bin = fs / n as f64;
-    let off_grid = |f: f64| ((f / bin) - (f / bin).round()).abs() > 1e-6;
-    let pilot_bins = system.pilot_offset_hz / bin;
-    if system.frequencies_hz.iter().any(|&f| off_grid(f)) || off_grid(system.pilot_offset_hz) {
-        eprintln!(
-            "warning: frequencies {:?} Hz / pilot offset {} Hz are not multiples of the bin f_s/N = {bin} Hz: cross-talk is not exactly zero",
-            system.frequencies_hz, system.pilot_offset_hz
-        );
-    }
-    if pilot_bins < 4.0 - 1e-9 {
-        eprintln!(
-            "warning: pilot offset {} Hz is {pilot_bins:.2} bins (< 4): the pilots leak into the working detector",
-            system.pilot_offset_hz
-        );
-    }
-    let chain = system
-        .chain(fs, n, win, !a.no_pilot)
-        .map_err(|e| bad_input!("'{}': {e}", a.input.display()))?;
-    // Whole detector blocks of about 2¹⁸ frames (3 MB) per chunk: the
-    // default 10.24 s record is read in four.
-    let chunk = n * (1usize << 18).div_ceil(n);
-    let mut samples = Vec::new();
-    let mut epochs = Vec::new();
-    loop {
-        let (first, got) = next_chunk(&mut reader, &a.input, chunk, &mut samples)?;
-        if got == 0 {
-            break;
-        }
-        epochs.extend(chain.process(&samples, first)?);
-    }
-    std::fs::write(&a.out, detected_csv(&epochs))?;
-    let ratios: Vec<f64> = epochs
-        .iter()
-        .flat_map(|e| e.h.iter().map(|h| major_axis(h).ratio))
-        .collect();
+    let d = detect(&a.input, &opts, &mut Bars::new())?;
+    std::fs::write(&a.out, detected_csv(&d.epochs))
+        .map_err(|e| aeromag::Error::write(&a.out, e))?;
+    let n = d.window_len;
     println!(
         "detected {} epochs of {n} samples ({:.3} s, {:.2} Hz output) from '{}'{}; polarisation ratio RMS {:.3e} (before calibration)",
-        epochs.len(),
-        n as f64 / fs,
-        bin,
+        d.epochs.len(),
+        n as f64 / d.sample_rate_hz,
+        d.sample_rate_hz / n as f64,
         a.input.display(),
         if a.no_pilot {
             ", no pilot correction"
         } else {
             ""
         },
-        rms(&ratios)
+        d.polarization_ratio_rms
     );
     println!("  detected  {}", a.out.display());
     Ok(())

@@ -1,11 +1,12 @@
-//! `aeromag em locate`: calibrated per-epoch pose of the bird.
+//! `aeromag em locate`: calibrated per-epoch pose of the bird (library:
+//! [`aeromag::em::locate`]).
 
 use super::HalfSpaceArg;
-use super::files::read_detected;
 use crate::exit::bad_input;
-use aeromag_em::calibration::CalibrationFile;
-use aeromag_em::positioning::Hemisphere;
-use std::fmt::Write;
+use crate::progress::Bars;
+use aeromag::em::calibration::CalibrationFile;
+use aeromag::em::files::read_detected;
+use aeromag::em::locate;
 use std::path::PathBuf;
 
 /// Locate the bird per epoch: position, range, Euler angles, quality figures.
@@ -48,62 +49,19 @@ pub struct LocateArgs {
 }
 
 pub fn run(a: LocateArgs) -> anyhow::Result<()> {
-    let normal = a.half_space.normal()?;
     let text = std::fs::read_to_string(&a.calibration)
-        .map_err(|e| bad_input!("cannot read '{}': {e}", a.calibration.display()))?;
+        .map_err(|e| aeromag::Error::read(&a.calibration, e))?;
     let file = CalibrationFile::from_json(&text)
         .map_err(|e| bad_input!("'{}': {e}", a.calibration.display()))?;
     let epochs = read_detected(&a.input)?;
-    let mut hemi = Hemisphere::new(normal);
-    let mut s = String::from(
-        "time_s,x_m,y_m,z_m,range_m,roll_deg,pitch_deg,yaw_deg,pol_ratio_1,pol_ratio_2,pol_ratio_3,residual_rel,hemisphere_by_continuity,status\n",
-    );
-    let mut failed = 0usize;
-    let mut by_continuity = 0usize;
-    for e in &epochs {
-        match file.calibration.locate(&e.h, &file.moments_am2, &mut hemi) {
-            Ok(l) => {
-                let p = &l.pose.position_m;
-                let att = l.pose.attitude();
-                let q = l.polarisation_ratio;
-                by_continuity += usize::from(hemi.by_continuity);
-                let _ = writeln!(
-                    s,
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},0",
-                    e.time_s,
-                    p[0],
-                    p[1],
-                    p[2],
-                    l.pose.range_m(),
-                    att.roll.to_degrees(),
-                    att.pitch.to_degrees(),
-                    att.yaw.to_degrees(),
-                    q[0],
-                    q[1],
-                    q[2],
-                    l.rms_residual,
-                    u8::from(hemi.by_continuity)
-                );
-            }
-            Err(err) => {
-                failed += 1;
-                if failed == 1 {
-                    eprintln!("warning: epoch at {} s not located: {err}", e.time_s);
-                }
-                let _ = writeln!(s, "{},,,,,,,,,,,,,1", e.time_s);
-            }
-        }
-    }
-    std::fs::write(&a.out, s)?;
+    let poses = locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new())?;
+    std::fs::write(&a.out, poses.to_csv()).map_err(|e| aeromag::Error::write(&a.out, e))?;
     println!(
         "located {} of {} epochs ({} by continuity near the half-space plane)",
-        epochs.len() - failed,
+        epochs.len() - poses.failed(),
         epochs.len(),
-        by_continuity
+        poses.by_continuity()
     );
-    if failed > 0 {
-        eprintln!("warning: {failed} epochs could not be located (status = 1)");
-    }
     println!("  poses {}", a.out.display());
     Ok(())
 }

@@ -1,0 +1,145 @@
+//! Models that remove interference from a flight's scalar reading, and the
+//! columns they add to it.
+//!
+//! Every model of this library — the Tolles-Lawson model of a fixed-wing
+//! aircraft ([`TlModel`](crate::TlModel)), the helicopter rotor model and
+//! the towed-pod model — applies itself to a flight through the
+//! [`Compensator`] trait: `model.interference(&flight)` is the modelled
+//! interference of every row (nT; NaN where it cannot be computed), and
+//! `model.compensate(&flight)` the flight with `mag − interference`.
+
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use crate::observer::{Note, Notes, Observer, Silent};
+use aeromag_io::FlightTable;
+
+/// The columns a compensation adds to a flight, and why a row may be left
+/// uncompensated (for the message).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputColumns {
+    /// Modelled interference, nT (e.g. `mag_interf`).
+    pub interference: &'static str,
+    /// 0 compensated, 1 not (e.g. `comp_flag`).
+    pub flag: &'static str,
+    /// Why a row can be left uncompensated, in words.
+    pub why_missing: &'static str,
+}
+
+/// The compensated reading, always this column.
+pub const COMPENSATED: &str = "mag_comp";
+
+/// A model that removes interference from a flight's scalar reading `mag`.
+///
+/// Implementors provide [`Compensator::output`] and
+/// [`Compensator::interference_observed`]; the rest follows.
+pub trait Compensator {
+    /// The columns this model's compensation adds.
+    fn output(&self) -> OutputColumns;
+
+    /// The modelled interference of every row of `flight`, nT (NaN where
+    /// an input is missing or the row cannot be compensated); notes and
+    /// warnings (a flight that does not look like the one the model was
+    /// fitted on) go to `observer`.
+    fn interference_observed(
+        &self,
+        flight: &Flight,
+        observer: &mut dyn Observer,
+    ) -> Result<Vec<f64>>;
+
+    /// The modelled interference of every row of `flight`, nT (NaN where
+    /// it cannot be computed).
+    fn interference(&self, flight: &Flight) -> Result<Vec<f64>> {
+        self.interference_observed(flight, &mut Silent)
+    }
+
+    /// The interference, the compensated reading and the flags of every
+    /// row, with the notes raised.
+    fn compensate_observed(
+        &self,
+        flight: &Flight,
+        observer: &mut dyn Observer,
+    ) -> Result<Compensated> {
+        let mut notes = Notes::new(observer);
+        let interference_nt = self.interference_observed(flight, &mut notes)?;
+        let mut out = Compensated::new(flight, self.output(), interference_nt)?;
+        out.notes = notes.into_notes();
+        Ok(out)
+    }
+
+    /// The interference, the compensated reading and the flags of every row.
+    fn compensate(&self, flight: &Flight) -> Result<Compensated> {
+        self.compensate_observed(flight, &mut Silent)
+    }
+}
+
+/// A flight's reading with a model's interference removed, row by row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Compensated {
+    /// Column names.
+    pub output: OutputColumns,
+    /// Modelled interference, nT (NaN = not compensated).
+    pub interference_nt: Vec<f64>,
+    /// `mag − interference`, nT (NaN = not compensated).
+    pub compensated_nt: Vec<f64>,
+    /// Rows that could not be compensated.
+    pub missing: usize,
+    /// Notes and warnings of the model's application.
+    pub notes: Vec<Note>,
+}
+
+impl Compensated {
+    /// `mag − interference` of `flight`.
+    pub fn new(flight: &Flight, output: OutputColumns, interference_nt: Vec<f64>) -> Result<Self> {
+        let mag = flight.require("mag")?;
+        let compensated_nt = mag
+            .iter()
+            .zip(&interference_nt)
+            .map(|(m, i)| m - i)
+            .collect();
+        let missing = interference_nt.iter().filter(|v| !v.is_finite()).count();
+        Ok(Self {
+            output,
+            interference_nt,
+            compensated_nt,
+            missing,
+            notes: Vec::new(),
+        })
+    }
+
+    /// 0 for a compensated row, 1 for one that is not.
+    pub fn flags(&self) -> Vec<f64> {
+        self.interference_nt
+            .iter()
+            .map(|v| if v.is_finite() { 0.0 } else { 1.0 })
+            .collect()
+    }
+
+    /// Add the interference, [`COMPENSATED`] and flag columns to `table`
+    /// (bad input if one of them exists already).
+    pub fn add_to(self, table: &mut FlightTable) -> Result<()> {
+        for name in [self.output.interference, COMPENSATED, self.output.flag] {
+            if table.get(name).is_some() {
+                return Err(Error::bad_file(
+                    table.file_label(),
+                    format!("already has a column `{name}`; rename it first"),
+                ));
+            }
+        }
+        let flags = self.flags();
+        table.add_column(self.output.interference, self.interference_nt)?;
+        table.add_column(COMPENSATED, self.compensated_nt)?;
+        table.add_column(self.output.flag, flags)?;
+        Ok(())
+    }
+
+    /// The flight with the three columns added.
+    pub fn into_flight(self, mut flight: Flight) -> Result<Flight> {
+        self.add_to(flight.table_mut())?;
+        Ok(flight)
+    }
+
+    /// The flight's table with the three columns added.
+    pub fn into_table(self, flight: Flight) -> Result<FlightTable> {
+        Ok(self.into_flight(flight)?.into_table())
+    }
+}

@@ -1,0 +1,205 @@
+//! The three calibration stages of seed 001 from detected vectors and a
+//! KNOWN file.
+//!
+//! KNOWN.csv (CSV, `#` comments allowed), one row per known point:
+//!
+//! | column | meaning |
+//! |---|---|
+//! | `time_s` | time of the point, s; within half an epoch spacing of a detected epoch's `time_s` |
+//! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty) |
+//! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg (all three, or all three empty; the columns may be omitted) |
+//!
+//! A row gives a position, an attitude or both.
+
+use super::HalfSpace;
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use aeromag_core::frames::Attitude;
+use aeromag_em::calibration::{Calibration, CalibrationFile, FitCounts, KnownPoints};
+use aeromag_em::detection::{EmSystem, FieldEpoch};
+use aeromag_em::positioning::Hemisphere;
+use aeromag_em::study::rms;
+use nalgebra::Vector3;
+
+/// The known points of a KNOWN.csv table (module docs) against the
+/// detected epochs' times: each row's time must fall within half an epoch
+/// spacing of a detected epoch.
+pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
+    let time = t.finite("time_s")?;
+    let group = |names: [&str; 3], required: bool| -> Result<Option<[&[f64]; 3]>> {
+        let present = names.iter().filter(|n| t.get(n).is_some()).count();
+        if present == 0 && !required {
+            return Ok(None);
+        }
+        Ok(Some([
+            t.require(names[0])?,
+            t.require(names[1])?,
+            t.require(names[2])?,
+        ]))
+    };
+    let pos = group(["x_m", "y_m", "z_m"], true)?;
+    let att = group(["roll_deg", "pitch_deg", "yaw_deg"], false)?;
+    let names = |g: [&'static str; 3]| g;
+    let spacing = if epochs.len() > 1 {
+        let mut d: Vec<f64> = epochs
+            .windows(2)
+            .map(|w| w[1].time_s - w[0].time_s)
+            .collect();
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    } else {
+        f64::INFINITY
+    };
+    let mut known = KnownPoints::default();
+    for row in 0..t.n_rows() {
+        let tk = time[row];
+        let k = epochs.partition_point(|e| e.time_s < tk);
+        let nearest = [k.checked_sub(1), Some(k)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| j < epochs.len())
+            .min_by(|&a, &b| {
+                (epochs[a].time_s - tk)
+                    .abs()
+                    .total_cmp(&(epochs[b].time_s - tk).abs())
+            });
+        let epoch = nearest
+            .filter(|&j| (epochs[j].time_s - tk).abs() <= 0.5 * spacing)
+            .ok_or_else(|| {
+                t.bad_value(
+                    row,
+                    "time_s",
+                    format!(
+                        "{tk} s is not within half an epoch ({:.4} s) of any detected epoch ({} … {} s)",
+                        0.5 * spacing,
+                        epochs.first().map_or(f64::NAN, |e| e.time_s),
+                        epochs.last().map_or(f64::NAN, |e| e.time_s)
+                    ),
+                )
+            })?;
+        let mut any = false;
+        for (cols, g) in [
+            (pos, names(["x_m", "y_m", "z_m"])),
+            (att, names(["roll_deg", "pitch_deg", "yaw_deg"])),
+        ] {
+            let Some(c) = cols else { continue };
+            let v = [c[0][row], c[1][row], c[2][row]];
+            let given = v.map(|x| !x.is_nan());
+            if given.iter().all(|&g| !g) {
+                continue;
+            }
+            if let Some(j) = (0..3).find(|&j| !given[j] || !v[j].is_finite()) {
+                return Err(t.bad_value(
+                    row,
+                    g[j],
+                    format!(
+                        "value missing or not finite while {} are given (give all three or none)",
+                        g.iter()
+                            .filter(|&&n| n != g[j])
+                            .copied()
+                            .collect::<Vec<_>>()
+                            .join(" and ")
+                    ),
+                ));
+            }
+            any = true;
+            if g[0] == "x_m" {
+                known
+                    .positions
+                    .push((epoch, Vector3::new(v[0], v[1], v[2])));
+            } else {
+                let c_nb =
+                    Attitude::new(v[0].to_radians(), v[1].to_radians(), v[2].to_radians()).c_nb();
+                known.attitudes.push((epoch, c_nb.transpose()));
+            }
+        }
+        if !any {
+            return Err(t.bad_value(
+                row,
+                "x_m",
+                "the row gives neither a position (x_m, y_m, z_m) nor an attitude (roll_deg, pitch_deg, yaw_deg)",
+            ));
+        }
+    }
+    let file = t.file_label();
+    if known.positions.len() < 2 {
+        return Err(Error::bad_file(
+            file,
+            format!(
+                "{} known position(s); calibration stage 2 needs at least 2",
+                known.positions.len()
+            ),
+        ));
+    }
+    if known.attitudes.is_empty() {
+        return Err(Error::bad_file(
+            file,
+            "no known attitude (roll_deg, pitch_deg, yaw_deg); calibration stage 3 needs one",
+        ));
+    }
+    Ok(known)
+}
+/// A fitted calibration and the figures that show what it did.
+#[derive(Debug, Clone)]
+pub struct EmCalibration {
+    /// The calibration file (nominal moments, the three stages, counts).
+    pub file: CalibrationFile,
+    /// RMS polarisation ratio before calibration.
+    pub polarization_ratio_before: f64,
+    /// … after stage 1.
+    pub polarization_ratio_after: f64,
+    /// Size of the transmitter distortion |S|.
+    pub transmitter_distortion: f64,
+    /// Angle of the attitude correction, deg.
+    pub attitude_correction_deg: f64,
+}
+
+/// Fit the three stages: (1) polarisation, from all epochs (no external
+/// data; ≥ 8 epochs at varied attitudes); (2) transmitter geometry, from the
+/// epochs whose position `known` gives (≥ 2); (3) attitude, from the
+/// epoch(s) whose attitude it gives. `system` gives the nominal moments;
+/// the sign of r is taken from the half-space.
+pub fn calibrate(
+    epochs: &[FieldEpoch],
+    known: &KnownPoints,
+    system: &EmSystem,
+    half_space: &HalfSpace,
+) -> Result<EmCalibration> {
+    if epochs.len() < 8 {
+        return Err(Error::bad_input(format!(
+            "{} epochs; calibration stage 1 needs at least 8 at varied attitudes",
+            epochs.len()
+        )));
+    }
+    let data: Vec<_> = epochs.iter().map(|e| e.h).collect();
+    let m = system.moments_am2;
+    let cal = Calibration::fit(&data, known, &m, &Hemisphere::new(half_space.normal()))?;
+    let before: Vec<f64> = data
+        .iter()
+        .flat_map(|e| aeromag_em::calibration::uncalibrated(e, &cal.polarisation.phase_rad).1)
+        .collect();
+    let after: Vec<f64> = data
+        .iter()
+        .flat_map(|e| cal.polarisation.apply(e).1)
+        .collect();
+    let file = CalibrationFile::new(
+        cal,
+        m,
+        FitCounts {
+            epochs: data.len(),
+            known_positions: known.positions.len(),
+            known_attitudes: known.attitudes.len(),
+        },
+    );
+    Ok(EmCalibration {
+        polarization_ratio_before: rms(&before),
+        polarization_ratio_after: rms(&after),
+        transmitter_distortion: cal.transmitter_s.norm(),
+        attitude_correction_deg: aeromag_em::positioning::rotation_angle_between(
+            &cal.attitude_q,
+            &nalgebra::Matrix3::identity(),
+        )
+        .to_degrees(),
+        file,
+    })
+}

@@ -1,0 +1,122 @@
+//! An EM positioning flight simulated to a folder: the raw ADC record, the
+//! instrument constants, the calibration information a crew would have, and
+//! the truth.
+
+use crate::error::{Error, Result};
+use crate::model_file::{write_atomically, write_streamed};
+use aeromag_em::detection::block_centre_time_s;
+use aeromag_em::sim::{EmScenario, EmSimConfig, known_csv, synthesize, truth_csv, write_raw};
+use aeromag_em::study::STUDY_WINDOW_LEN;
+use std::path::{Path, PathBuf};
+
+/// Known positions written by default (calibration stage 2 needs ≥ 2).
+pub const DEFAULT_KNOWN: usize = 8;
+
+/// The scenario of `aeromag em simulate` without a file: the library's,
+/// 10.24 s long (64 epochs of 0.16 s).
+pub fn command_default() -> EmSimConfig {
+    EmSimConfig {
+        duration_s: 10.24,
+        ..EmSimConfig::default()
+    }
+}
+
+/// The scenario from [`command_default`] overlaid with a scenario file's
+/// TOML text (unknown keys are errors; `origin` names the file).
+pub fn parse_config(text: Option<&str>, origin: &str) -> Result<EmSimConfig> {
+    let bad = |e: &dyn std::fmt::Display| Error::bad_file(origin, e.to_string());
+    let toml::Value::Table(mut table) =
+        toml::Value::try_from(command_default()).map_err(|e| Error::Serialize {
+            what: "EM scenario",
+            reason: e.to_string(),
+        })?
+    else {
+        return Err(Error::Serialize {
+            what: "EM scenario",
+            reason: "not a TOML table".into(),
+        });
+    };
+    if let Some(text) = text {
+        let user: toml::Table = toml::from_str(text).map_err(|e| bad(&e))?;
+        table.extend(user);
+    }
+    toml::Value::Table(table).try_into().map_err(|e| bad(&e))
+}
+
+/// The files [`simulate_to_dir`] writes.
+#[derive(Debug, Clone)]
+pub struct SimulatedEm {
+    /// `em.raw`: the ADC record (header with the instrument constants,
+    /// interleaved little-endian f32 volts).
+    pub raw: PathBuf,
+    /// `em.system.json`: the instrument constants alone.
+    pub system: PathBuf,
+    /// `em.known.csv`: positions at the first epochs, attitude at the first.
+    pub known: PathBuf,
+    /// `em.truth.csv`: the true pose at every detector epoch (never read by
+    /// the other steps).
+    pub truth: PathBuf,
+    /// `em.toml`: the scenario with every default filled in.
+    pub scenario: PathBuf,
+    /// Frames written.
+    pub frames: u64,
+    /// Detector epochs of [`STUDY_WINDOW_LEN`] samples in the record.
+    pub epochs: usize,
+}
+
+/// Simulate `cfg` and write its files to `out` (created if needed), with
+/// `known_positions` known positions (2 ..= the record's epochs).
+pub fn simulate_to_dir(
+    cfg: &EmSimConfig,
+    known_positions: usize,
+    out: &Path,
+) -> Result<SimulatedEm> {
+    let sc = EmScenario::new(cfg.clone())?;
+    let fs = cfg.sample_rate_hz;
+    let frames = (cfg.duration_s * fs).round();
+    if frames > 2e9 {
+        return Err(Error::bad_input(format!(
+            "{frames} frames is more than a record holds here (2e9)"
+        )));
+    }
+    let rec = synthesize(&sc)?;
+    let start = rec.header.start_index;
+    let blocks = rec.header.frames as usize / STUDY_WINDOW_LEN;
+    let times: Vec<f64> = (0..blocks)
+        .map(|b| block_centre_time_s(start + (b * STUDY_WINDOW_LEN) as u64, STUDY_WINDOW_LEN, fs))
+        .collect();
+    if known_positions < 2 || known_positions > times.len() {
+        return Err(Error::bad_input(format!(
+            "{known_positions} known positions: need 2 ..= {} (the record has {} epochs of {STUDY_WINDOW_LEN} samples)",
+            times.len().max(2),
+            times.len()
+        )));
+    }
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    let path = |n: &str| out.join(n);
+    let files = SimulatedEm {
+        raw: path("em.raw"),
+        system: path("em.system.json"),
+        known: path("em.known.csv"),
+        truth: path("em.truth.csv"),
+        scenario: path("em.toml"),
+        frames: rec.header.frames,
+        epochs: times.len(),
+    };
+    write_streamed(&files.raw, |w| Ok(write_raw(w, &rec.header, &rec.samples)?))?;
+    write_atomically(
+        &files.system,
+        serde_json::to_string_pretty(&rec.header.system)?.as_bytes(),
+    )?;
+    write_atomically(
+        &files.known,
+        known_csv(&sc, &times[..known_positions], &times[..1]).as_bytes(),
+    )?;
+    write_atomically(&files.truth, truth_csv(&sc, &times).as_bytes())?;
+    let scenario = toml::to_string(cfg).map_err(|e| Error::Serialize {
+        what: "EM scenario",
+        reason: e.to_string(),
+    })?;
+    write_atomically(&files.scenario, scenario.as_bytes())?;
+    Ok(files)
+}

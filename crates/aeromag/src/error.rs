@@ -1,0 +1,308 @@
+//! The error type of the `aeromag` library.
+//!
+//! Every workflow returns [`Error`]. Its `Display` text is the message a
+//! user sees: it names the file (and the row and column where they are
+//! known). [`Error::is_bad_input`] tells the two kinds of failure apart:
+//!
+//! - **bad input** — the user's file, columns, values, options or scenario
+//!   file: fixing the input fixes the run (the `aeromag` command exits
+//!   with code 2);
+//! - **failure** — the input is valid but the method could not produce a
+//!   result (a singular or diverging fit, a numerical failure), or an output
+//!   could not be written (exit code 1).
+//!
+//! Errors of the sub-crates are kept as they are (with their own
+//! classification) and, where they do not know it, given the file they
+//! concern ([`Error::InFile`]).
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in a workflow of this crate.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading, mapping, checking or writing a flight table (aeromag-io;
+    /// its messages name file, line, row and column).
+    #[error(transparent)]
+    Io(Box<aeromag_io::IoError>),
+    /// A value, column or setting this workflow cannot use.
+    #[error("{}", bad_input_message(file.as_deref(), *line, *row, column.as_deref(), reason))]
+    BadInput {
+        /// The file (or table) concerned, when there is one.
+        file: Option<String>,
+        /// 1-based line in the file, when known.
+        line: Option<u64>,
+        /// 0-based data row (printed 1-based as "data row N").
+        row: Option<usize>,
+        /// Column name as the file spells it.
+        column: Option<String>,
+        /// What is wrong and what is expected.
+        reason: String,
+    },
+    /// An error of a sub-crate raised on the data of `file`.
+    #[error("{file}: {error}")]
+    InFile {
+        /// The file (label of the table) whose data raised it.
+        file: String,
+        /// The error.
+        error: Box<Error>,
+    },
+    /// Tolles-Lawson fits, levelling, rotor and pod models.
+    #[error(transparent)]
+    Compensation(#[from] aeromag_compensation::CompError),
+    /// The physical simulator (scenario files, running, writing).
+    #[error(transparent)]
+    Simulation(Box<aeromag_sim::SimError>),
+    /// EM detection, calibration and positioning.
+    #[error(transparent)]
+    Em(#[from] aeromag_em::EmError),
+    /// Gradiometer dipole estimation.
+    #[error(transparent)]
+    Gradiometry(#[from] aeromag_gradiometry::GradiometryError),
+    /// Plots and reports.
+    #[error(transparent)]
+    Report(#[from] aeromag_report::ReportError),
+    /// Frames, fields, filters, dates.
+    #[error(transparent)]
+    Core(#[from] aeromag_core::CoreError),
+    /// Estimation machinery (least squares, Kalman filters).
+    #[error(transparent)]
+    Estimation(#[from] aeromag_estimation::EstError),
+    /// Reading an input file other than a flight table (model file,
+    /// scenario file, raw record) failed at the operating-system level.
+    #[error("cannot read '{}': {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// Writing an output file (or creating its folder) failed.
+    #[error("cannot write '{}': {source}", path.display())]
+    Write {
+        /// The file or folder.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// Serialising a result (JSON, TOML) failed: a bug, reported instead of
+    /// a panic.
+    #[error("cannot serialise {what}: {reason}")]
+    Serialize {
+        /// What was being serialised.
+        what: &'static str,
+        /// The serialiser's message.
+        reason: String,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+fn bad_input_message(
+    file: Option<&str>,
+    line: Option<u64>,
+    row: Option<usize>,
+    column: Option<&str>,
+    reason: &str,
+) -> String {
+    let mut at = Vec::new();
+    match (file, line, row) {
+        (Some(f), Some(l), Some(r)) => at.push(format!("'{f}' line {l} (data row {})", r + 1)),
+        (f, _, r) => {
+            if let Some(f) = f {
+                at.push(format!("'{f}'"));
+            }
+            if let Some(r) = r {
+                at.push(format!("data row {}", r + 1));
+            }
+        }
+    }
+    if let Some(c) = column {
+        at.push(format!("column '{c}'"));
+    }
+    if at.is_empty() {
+        reason.to_string()
+    } else {
+        format!("{}: {reason}", at.join(", "))
+    }
+}
+
+impl Error {
+    /// Whether the user's input caused this error (see the module docs):
+    /// `true` for files, columns, values, options and scenario files that
+    /// cannot be used; `false` for valid input on which a method failed,
+    /// and for failures to write.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            Error::Io(e) => e.is_bad_input(),
+            Error::BadInput { .. } => true,
+            Error::InFile { error, .. } => error.is_bad_input(),
+            Error::Compensation(e) => e.is_bad_input(),
+            Error::Simulation(e) => e.is_bad_input(),
+            Error::Em(e) => e.is_bad_input(),
+            Error::Gradiometry(e) => e.is_bad_input(),
+            Error::Report(e) => e.is_bad_input(),
+            Error::Core(e) => e.is_bad_input(),
+            Error::Estimation(e) => e.is_bad_input(),
+            Error::Read { .. } => true,
+            Error::Write { .. } | Error::Serialize { .. } => false,
+        }
+    }
+
+    /// A bad-input error with only a reason (an option or setting).
+    pub fn bad_input(reason: impl Into<String>) -> Self {
+        Error::BadInput {
+            file: None,
+            line: None,
+            row: None,
+            column: None,
+            reason: reason.into(),
+        }
+    }
+
+    /// A bad-input error about the data of `file`.
+    pub fn bad_file(file: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::BadInput {
+            file: Some(file.into()),
+            line: None,
+            row: None,
+            column: None,
+            reason: reason.into(),
+        }
+    }
+
+    /// A bad-input error at a row and column of `file`.
+    pub fn bad_value(
+        file: impl Into<String>,
+        row: usize,
+        column: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> Self {
+        Error::BadInput {
+            file: Some(file.into()),
+            line: None,
+            row: Some(row),
+            column: Some(column.into()),
+            reason: reason.into(),
+        }
+    }
+
+    /// [`Error::Write`] for `path`.
+    pub fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Write {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// [`Error::Read`] for `path`.
+    pub fn read(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Read {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// The classification of any error of this library or its sub-crates
+/// (`None` for an error type none of them defines): for callers that hold
+/// errors type-erased, such as `anyhow` in the `aeromag` command.
+pub fn classify(e: &(dyn std::error::Error + 'static)) -> Option<bool> {
+    macro_rules! first_known {
+        ($($t:ty),*) => {
+            $(if let Some(e) = e.downcast_ref::<$t>() {
+                return Some(e.is_bad_input());
+            })*
+        };
+    }
+    first_known!(
+        Error,
+        aeromag_io::IoError,
+        aeromag_compensation::CompError,
+        aeromag_sim::SimError,
+        aeromag_em::EmError,
+        aeromag_gradiometry::GradiometryError,
+        aeromag_report::ReportError,
+        aeromag_core::CoreError,
+        aeromag_estimation::EstError
+    );
+    None
+}
+
+/// Attach the file a sub-crate error concerns ([`Error::InFile`]).
+pub trait InFile<T> {
+    /// The error, if any, as raised on the data of `file`.
+    fn in_file(self, file: &str) -> Result<T>;
+}
+
+impl<T, E: Into<Error>> InFile<T> for std::result::Result<T, E> {
+    fn in_file(self, file: &str) -> Result<T> {
+        self.map_err(|e| Error::InFile {
+            file: file.to_string(),
+            error: Box::new(e.into()),
+        })
+    }
+}
+
+impl From<aeromag_io::IoError> for Error {
+    fn from(e: aeromag_io::IoError) -> Self {
+        Error::Io(Box::new(e))
+    }
+}
+
+impl From<aeromag_sim::SimError> for Error {
+    fn from(e: aeromag_sim::SimError) -> Self {
+        Error::Simulation(Box::new(e))
+    }
+}
+
+impl From<serde_json::Error> for Error {
+    fn from(e: serde_json::Error) -> Self {
+        Error::Serialize {
+            what: "JSON",
+            reason: e.to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_input_names_file_row_and_column() {
+        let e = Error::bad_value("cal.csv", 14, "mag", "is not a total field");
+        assert_eq!(
+            e.to_string(),
+            "'cal.csv', data row 15, column 'mag': is not a total field"
+        );
+        assert!(e.is_bad_input());
+        assert_eq!(Error::bad_input("--band 1,0").to_string(), "--band 1,0");
+    }
+
+    #[test]
+    fn the_error_stays_small() {
+        // Returned by every workflow: boxed sub-errors keep it cheap to move.
+        assert!(
+            std::mem::size_of::<Error>() <= 112,
+            "{}",
+            std::mem::size_of::<Error>()
+        );
+    }
+
+    #[test]
+    fn context_keeps_the_classification() {
+        let failed: std::result::Result<(), Error> = Err(Error::Serialize {
+            what: "x",
+            reason: "y".into(),
+        });
+        let e = failed.in_file("f.csv").unwrap_err();
+        assert!(!e.is_bad_input());
+        assert!(e.to_string().starts_with("f.csv: "), "{e}");
+        let bad: std::result::Result<(), Error> = Err(Error::bad_input("no"));
+        assert!(bad.in_file("f.csv").unwrap_err().is_bad_input());
+        let w = Error::write("/x", std::io::Error::other("disk full"));
+        assert!(!w.is_bad_input());
+    }
+}

@@ -1,0 +1,220 @@
+//! A flight: a table of time series read from a file (or built in
+//! memory), checked once, and the views the workflows take of it.
+//!
+//! - [`Flight`] — the table with the warnings its checks raised;
+//! - [`TlInputs`] — the columns of a Tolles-Lawson fit or compensation,
+//!   the usable-row rule and the segments ([`SegmentRule`]);
+//! - [`ReferenceChannels`] — the known external-field channels removed from
+//!   the scalar reading before a fit or a score;
+//! - [`LeverArm`] and [`sensor_track`] — where the sensor is relative to
+//!   the navigation point.
+//!
+//! Files hold nT, m, s and degrees; frames are NED and body (x forward,
+//! y right, z down). Columns have the canonical names of
+//! `spec/data-formats.md` (`time`, `lat`, `lon`, `alt`, `roll`, `pitch`,
+//! `yaw`, `mag`, `flux_x`, …) after the column map.
+
+mod reference;
+mod segments;
+mod tl_inputs;
+
+pub use aeromag_compensation::reference_field::LeverArm;
+pub(crate) use reference::reduced;
+pub use reference::{ReferenceChannels, reference_sum};
+pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};
+pub use tl_inputs::TlInputs;
+
+use crate::error::{Error, InFile, Result};
+use crate::observer::Note;
+use aeromag_io::{ColumnMap, FlightTable, ReadOptions};
+use std::path::Path;
+
+/// A flight table, read and checked: time strictly increasing where there
+/// is a `time` column (bad input otherwise), and the plausibility of units
+/// (a `mag` in tesla, a fluxgate magnitude far from `mag`) as warnings.
+///
+/// `Flight` dereferences to [`FlightTable`]: `flight.require("mag")?` is the
+/// column in nT (NaN = missing), `flight.file_label()` the file's name.
+///
+/// ```
+/// use aeromag::{Flight, FlightTable};
+/// let mut t = FlightTable::new();
+/// t.add_column("time", vec![0.0, 0.1, 0.2])?;
+/// t.add_column("mag", vec![50_000.0, 50_001.0, 50_000.5])?;
+/// let flight = Flight::from_table(t)?;
+/// assert_eq!(flight.n_rows(), 3);
+/// assert!(flight.warnings().is_empty());
+/// # Ok::<(), aeromag::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Flight {
+    table: FlightTable,
+    warnings: Vec<Note>,
+}
+
+impl Flight {
+    /// Read a CSV or Geosoft XYZ flight file with the default options (MagNav
+    /// names recognised) and check it.
+    pub fn read(path: impl AsRef<Path>) -> Result<Flight> {
+        Self::read_with(path, &ReadOptions::default())
+    }
+
+    /// Read a flight file with its canonical names mapped by `columns` (e.g.
+    /// `mag=mag_1_uc,flux_x=flux_a_x`) and check it.
+    pub fn read_mapped(path: impl AsRef<Path>, columns: &ColumnMap) -> Result<Flight> {
+        Self::read_with(
+            path,
+            &ReadOptions {
+                columns: columns.clone(),
+                ..ReadOptions::default()
+            },
+        )
+    }
+
+    /// Read a flight file with explicit reading options and check it.
+    pub fn read_with(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Flight> {
+        Self::from_table(aeromag_io::read_table(path.as_ref(), opts)?)
+    }
+
+    /// Check a table built in memory (or read otherwise) and wrap it.
+    pub fn from_table(table: FlightTable) -> Result<Flight> {
+        if table.column("time").is_some() {
+            aeromag_io::check_time(&table)?;
+        }
+        let warnings = aeromag_io::check_units(&table)?
+            .into_iter()
+            .map(|w| Note::warning(w.to_string()))
+            .collect();
+        Ok(Flight { table, warnings })
+    }
+
+    /// Wrap a table that is not a flight record (a crossover table, a
+    /// detected-vector file): no time or unit checks.
+    pub(crate) fn unchecked(table: FlightTable) -> Flight {
+        Flight {
+            table,
+            warnings: Vec::new(),
+        }
+    }
+
+    /// The table.
+    pub fn table(&self) -> &FlightTable {
+        &self.table
+    }
+
+    /// The table, to add columns to or write.
+    pub fn into_table(self) -> FlightTable {
+        self.table
+    }
+
+    /// The table, to add result columns (never to change the checked ones).
+    pub(crate) fn table_mut(&mut self) -> &mut FlightTable {
+        &mut self.table
+    }
+
+    /// Add a column of results (bad input if the name exists).
+    pub fn add_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        Ok(self.table.add_column(name, values)?)
+    }
+
+    /// The warnings of the unit checks (empty when nothing looks wrong).
+    pub fn warnings(&self) -> &[Note] {
+        &self.warnings
+    }
+
+    /// The file's name as messages give it.
+    pub fn label(&self) -> String {
+        self.table.file_label()
+    }
+
+    /// The navigation point's `lat`, `lon` (deg), `alt` (m) and the attitude
+    /// `roll`, `pitch`, `yaw` (deg): what moving a lever arm needs.
+    pub fn nav_and_attitude(&self) -> Result<[&[f64]; 6]> {
+        Ok([
+            self.require("lat")?,
+            self.require("lon")?,
+            self.require("alt")?,
+            self.require("roll")?,
+            self.require("pitch")?,
+            self.require("yaw")?,
+        ])
+    }
+
+    /// A bad-input error at `row` (0-based) and `column` of this flight,
+    /// with the file's line when it is known.
+    pub fn bad_value(&self, row: usize, column: &str, reason: impl Into<String>) -> Error {
+        Error::BadInput {
+            file: Some(self.label()),
+            line: self.line_of_row(row),
+            row: Some(row),
+            column: Some(column.to_string()),
+            reason: reason.into(),
+        }
+    }
+
+    /// A numeric column whose every value must be finite: bad input naming
+    /// the first cell that is not a number (the reader keeps such a column
+    /// as text) or that is missing, NaN or infinite.
+    pub fn finite(&self, name: &str) -> Result<&[f64]> {
+        if let Some(text) = self.text_column(name)
+            && let Some(row) = text.iter().position(|c| c.trim().parse::<f64>().is_err())
+        {
+            return Err(self.bad_value(row, name, format!("'{}' is not a number", text[row])));
+        }
+        let v = self.require(name)?;
+        if let Some(row) = v.iter().position(|x| !x.is_finite()) {
+            return Err(self.bad_value(row, name, "value is missing, NaN or infinite"));
+        }
+        Ok(v)
+    }
+
+    /// Sample rate from the median time step, Hz (bad input without two
+    /// increasing time stamps).
+    pub fn sample_rate_hz(&self) -> Result<f64> {
+        let dt = aeromag_compensation::tolles_lawson::segments::median_step(self.require("time")?);
+        if dt > 0.0 {
+            Ok(1.0 / dt)
+        } else {
+            Err(Error::bad_file(
+                self.label(),
+                "fewer than two increasing time samples",
+            ))
+        }
+    }
+
+    /// Canonical column name → the file's column name, for a model file.
+    pub fn column_map_of(&self, names: &[&str]) -> std::collections::BTreeMap<String, String> {
+        names
+            .iter()
+            .map(|c| (c.to_string(), self.resolve(c).unwrap_or(c).to_string()))
+            .collect()
+    }
+}
+
+impl std::ops::Deref for Flight {
+    type Target = FlightTable;
+    fn deref(&self) -> &FlightTable {
+        &self.table
+    }
+}
+
+impl From<Flight> for FlightTable {
+    fn from(f: Flight) -> FlightTable {
+        f.table
+    }
+}
+
+/// The sensor's track `[lat (deg), lon (deg), alt (m)]`: the navigation
+/// point's (`lat`, `lon`, `alt`) moved by the lever arm `arm_m` (body frame,
+/// m) with the attitude (`roll`, `pitch`, `yaw`).
+pub fn sensor_track(flight: &Flight, arm_m: [f64; 3]) -> Result<[Vec<f64>; 3]> {
+    sensor_track_at(flight, flight.require("alt")?, arm_m)
+}
+
+/// [`sensor_track`] with the navigation altitude `alt` (m) given instead of
+/// the table's `alt` column (e.g. a cleaned copy of it).
+pub fn sensor_track_at(flight: &Flight, alt: &[f64], arm_m: [f64; 3]) -> Result<[Vec<f64>; 3]> {
+    let [lat, lon, _, roll, pitch, yaw] = flight.nav_and_attitude()?;
+    aeromag_compensation::levelling::sensor_positions(lat, lon, alt, roll, pitch, yaw, arm_m)
+        .in_file(&flight.label())
+}

@@ -1,0 +1,523 @@
+//! Dipole parameters from gradiometer passes on files (spec
+//! `gradiometry.md`, seed 004; algorithms in [`aeromag_gradiometry`]):
+//! the pass file format ([`pass_table`], [`read_pass`]), locating the
+//! object over a pass ([`locate_pass`] → [`Track`]), the Cramér–Rao bound
+//! of a configured pass ([`crlb`]), the convergence maps of the seed's
+//! fig. 2 ([`both_maps`]) and simulating a pass to a folder
+//! ([`simulate_to_dir`]). The algorithms' modules are re-exported here
+//! (`aeromag::gradiometry::sim`, `::locate`, `::crlb`, …).
+
+pub use aeromag_gradiometry::{
+    GradiometryError, config, convergence, crlb, decorrelate, efficiency, estimability, forward,
+    geometry, locate, motion, pass, sim, sr_iekf,
+};
+
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use aeromag_core::field::igrf::IgrfModel;
+use aeromag_core::frames::Attitude;
+use aeromag_core::frames::geodetic::Geodetic;
+use aeromag_gradiometry::config::GradiometerConfig;
+use aeromag_gradiometry::convergence::{
+    ConvergenceCase, ConvergenceMap, Initialisation, convergence_map,
+};
+use aeromag_gradiometry::efficiency::{scalar_pass_crlb, tensor_pass_crlb};
+use aeromag_gradiometry::forward::Background;
+use aeromag_gradiometry::locate::{Located, locate_scalar, locate_tensor};
+use aeromag_gradiometry::motion::{Motion, NavFix};
+use aeromag_gradiometry::sim::{
+    Epoch, Gradiometer, SimEpoch, scalar_epochs, simulate, tensor_epochs,
+};
+use aeromag_io::FlightTable;
+use aeromag_report::{Block, Heatmap};
+use nalgebra::{SVector, Vector3};
+use serde::Serialize;
+use std::borrow::Borrow;
+use std::path::{Path, PathBuf};
+
+/// A gradiometer scenario file (absent: the defaults), read and checked
+/// (bad input naming the file otherwise).
+pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
+    match path {
+        None => Ok(GradiometerConfig::default()),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| Error::read(p, e))?;
+            GradiometerConfig::from_toml(&text)
+                .map_err(|e| Error::bad_file(p.display().to_string(), e.to_string()))
+        }
+    }
+}
+
+/// The files [`simulate_to_dir`] writes.
+#[derive(Debug, Clone)]
+pub struct SimulatedPass {
+    /// The pass table, `DIR/gradiometer.csv`.
+    pub csv: PathBuf,
+    /// The scenario with every default filled in, `DIR/gradiometer.toml`.
+    pub scenario: PathBuf,
+    /// Rows (epochs) and columns of the table.
+    pub rows: usize,
+    /// Columns of the table.
+    pub columns: usize,
+}
+
+/// Simulate the configured pass and write `DIR/gradiometer.csv`
+/// ([`pass_table`]) and `DIR/gradiometer.toml`.
+pub fn simulate_to_dir(cfg: &GradiometerConfig, out: &Path) -> Result<SimulatedPass> {
+    cfg.validate()
+        .map_err(|e| Error::bad_input(format!("scenario: {e}")))?;
+    let sim = simulate(&cfg.scenario()?)?;
+    let table = pass_table(cfg, &sim)?;
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    let csv = out.join("gradiometer.csv");
+    let scenario = out.join("gradiometer.toml");
+    aeromag_io::write_csv(&table, &csv)?;
+    let text = cfg.to_toml()?;
+    crate::model_file::write_atomically(&scenario, text.as_bytes())?;
+    Ok(SimulatedPass {
+        csv,
+        scenario,
+        rows: table.n_rows(),
+        columns: table.columns().len(),
+    })
+}
+
+/// Names of the six state components, in state order.
+pub const STATE_NAMES: [&str; 6] = ["x_m", "y_m", "z_m", "mx_am2", "my_am2", "mz_am2"];
+
+/// The Cramér–Rao bound at one epoch of a pass.
+#[derive(Debug, Clone, Serialize)]
+pub struct CrlbAt {
+    /// Epoch index.
+    pub epoch: usize,
+    /// Its time, s.
+    pub time_s: f64,
+    /// Range to the object, m.
+    pub range_m: f64,
+    /// Standard deviations in [`STATE_NAMES`] order (NaN for the scalar
+    /// system's known position).
+    #[serde(skip)]
+    pub std: [f64; 6],
+}
+
+/// The Cramér–Rao bound of a configured pass at the closest approach and at
+/// its end, from every epoch up to each.
+#[derive(Debug, Clone)]
+pub struct CrlbReport {
+    /// The configuration (gradiometer, system, noise).
+    pub config: GradiometerConfig,
+    /// At the closest approach.
+    pub closest_approach: CrlbAt,
+    /// At the end of the pass.
+    pub end: CrlbAt,
+}
+
+/// The Cramér–Rao bound (standard deviation of each parameter) of the
+/// configured pass: geometry, sensor noise, trajectory and object of the
+/// scenario, the known motion, white contrasts.
+pub fn crlb(cfg: &GradiometerConfig) -> Result<CrlbReport> {
+    let sim = simulate(&cfg.scenario()?)?;
+    let closest = (0..sim.len())
+        .min_by(|&i, &j| {
+            sim[i]
+                .true_position_m
+                .norm()
+                .total_cmp(&sim[j].true_position_m.norm())
+        })
+        .unwrap_or(0);
+    let at = |j: usize| -> Result<CrlbAt> {
+        Ok(CrlbAt {
+            epoch: j,
+            time_s: sim[j].t_s,
+            range_m: sim[j].true_position_m.norm(),
+            std: crlb_at(cfg, &sim, j)?,
+        })
+    };
+    Ok(CrlbReport {
+        config: cfg.clone(),
+        closest_approach: at(closest)?,
+        end: at(sim.len() - 1)?,
+    })
+}
+
+/// The truth columns of a simulated pass (never read by the estimators).
+pub const TRUTH: [&str; 6] = [
+    "true_x_m",
+    "true_y_m",
+    "true_z_m",
+    "true_mx_am2",
+    "true_my_am2",
+    "true_mz_am2",
+];
+
+/// Reading columns of the four sensors: `b1_x … b4_z` (tensor, nT, body
+/// frame) or `f1 … f4` (scalar, nT).
+pub fn sensor_columns(g: Gradiometer) -> Vec<String> {
+    match g {
+        Gradiometer::Tensor => (1..=4)
+            .flat_map(|i| ["x", "y", "z"].map(|a| format!("b{i}_{a}")))
+            .collect(),
+        Gradiometer::Scalar => (1..=4).map(|i| format!("f{i}")).collect(),
+    }
+}
+
+/// The simulated pass as a table (one row per epoch): `time`; system
+/// `lat, lon, alt`, `north_m, east_m, down_m`, `roll, pitch, yaw` (deg); the
+/// object's known track `obj_north_m, obj_east_m, obj_down_m, obj_yaw`
+/// (deg); the readings ([`sensor_columns`]); the truth ([`TRUTH`]: object
+/// relative to the gradiometer centre, body frame, m, and its moment, A·m²).
+pub fn pass_table(cfg: &GradiometerConfig, sim: &[SimEpoch]) -> Result<FlightTable> {
+    let mut t = FlightTable::new();
+    let mut add = |name: &str, f: &dyn Fn(&SimEpoch) -> f64| -> Result<()> {
+        t.add_column(name, sim.iter().map(f).collect())?;
+        Ok(())
+    };
+    add("time", &|e| e.t_s)?;
+    add("lat", &|e| e.system_geodetic.lat_deg)?;
+    add("lon", &|e| e.system_geodetic.lon_deg)?;
+    add("alt", &|e| e.system_geodetic.alt_m)?;
+    for (k, n) in ["north_m", "east_m", "down_m"].iter().enumerate() {
+        add(n, &|e| e.system_position_ned_m[k])?;
+    }
+    add("roll", &|e| e.system_attitude.roll.to_degrees())?;
+    add("pitch", &|e| e.system_attitude.pitch.to_degrees())?;
+    add("yaw", &|e| e.system_attitude.yaw.to_degrees())?;
+    for (k, n) in ["obj_north_m", "obj_east_m", "obj_down_m"]
+        .iter()
+        .enumerate()
+    {
+        add(n, &|e| e.object_position_ned_m[k])?;
+    }
+    add("obj_yaw", &|e| e.object_yaw_rad.to_degrees())?;
+    let names = sensor_columns(cfg.system.gradiometer);
+    for (c, name) in names.iter().enumerate() {
+        match cfg.system.gradiometer {
+            Gradiometer::Tensor => add(name, &|e| e.vector_nt[c / 3][c % 3])?,
+            Gradiometer::Scalar => add(name, &|e| e.scalar_nt[c])?,
+        }
+    }
+    for (k, n) in TRUTH.iter().enumerate() {
+        if k < 3 {
+            add(n, &|e| e.true_position_m[k])?;
+        } else {
+            add(n, &|e| e.true_moment_am2[k - 3])?;
+        }
+    }
+    Ok(t)
+}
+
+/// A measured pass read from a flight table ([`pass_table`]'s columns; the
+/// truth columns are never read): the epochs and the object's position
+/// relative to the gradiometer centre from the known tracks (body frame, m:
+/// what the scalar gradiometer's filter is given).
+#[derive(Debug, Clone)]
+pub struct MeasuredPass {
+    /// Readings, IGRF background at the navigated position and attitude,
+    /// motion from consecutive fixes.
+    pub epochs: Vec<Epoch>,
+    /// The object's known position, body frame, m.
+    pub positions_m: Vec<Vector3<f64>>,
+}
+
+/// Read a measured pass for the configured gradiometer from `t`: every
+/// value must be a finite number (bad input naming file, line, row and
+/// column otherwise).
+pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
+    if t.n_rows() <= cfg.estimator.quiet_epochs {
+        return Err(Error::bad_file(
+            t.label(),
+            format!(
+                "{} rows, not more than estimator.quiet_epochs = {}",
+                t.n_rows(),
+                cfg.estimator.quiet_epochs
+            ),
+        ));
+    }
+    let col = |n: &str| t.finite(n);
+    let time = col("time")?;
+    let (lat, lon, alt) = (col("lat")?, col("lon")?, col("alt")?);
+    let sys = [col("north_m")?, col("east_m")?, col("down_m")?];
+    let att = [col("roll")?, col("pitch")?, col("yaw")?];
+    let obj = [col("obj_north_m")?, col("obj_east_m")?, col("obj_down_m")?];
+    let obj_yaw = col("obj_yaw")?;
+    let names = sensor_columns(cfg.system.gradiometer);
+    let readings = names.iter().map(|n| col(n)).collect::<Result<Vec<_>>>()?;
+    let igrf = IgrfModel::new(cfg.environment.decimal_year)?;
+    let fix = |j: usize| NavFix {
+        system_position_ned_m: Vector3::new(sys[0][j], sys[1][j], sys[2][j]),
+        system_attitude: Attitude::from_degrees(att[0][j], att[1][j], att[2][j]),
+        object_position_ned_m: Vector3::new(obj[0][j], obj[1][j], obj[2][j]),
+        object_yaw_rad: obj_yaw[j].to_radians(),
+    };
+    let mut epochs = Vec::with_capacity(t.n_rows());
+    let mut positions = Vec::with_capacity(t.n_rows());
+    for j in 0..t.n_rows() {
+        let f = fix(j);
+        let motion = if j == 0 {
+            Motion::between(&f, &f, 0.0)
+        } else {
+            Motion::between(&fix(j - 1), &f, time[j] - time[j - 1])
+        };
+        let geo = Geodetic {
+            lat_deg: lat[j],
+            lon_deg: lon[j],
+            alt_m: alt[j],
+        };
+        let mut vector_nt = [Vector3::zeros(); 4];
+        let mut scalar_nt = [0.0; 4];
+        for i in 0..4 {
+            match cfg.system.gradiometer {
+                Gradiometer::Tensor => {
+                    vector_nt[i] = Vector3::from_fn(|k, _| readings[3 * i + k][j]);
+                }
+                Gradiometer::Scalar => scalar_nt[i] = readings[i][j],
+            }
+        }
+        positions
+            .push(f.system_attitude.c_bn() * (f.object_position_ned_m - f.system_position_ned_m));
+        epochs.push(Epoch {
+            t_s: time[j],
+            vector_nt,
+            scalar_nt,
+            background: Background::from_igrf(&igrf, &geo, &f.system_attitude),
+            motion,
+            system_position_ned_m: f.system_position_ned_m,
+            system_geodetic: geo,
+            system_attitude: f.system_attitude,
+            object_position_ned_m: f.object_position_ned_m,
+            object_yaw_rad: f.object_yaw_rad,
+        });
+    }
+    Ok(MeasuredPass {
+        epochs,
+        positions_m: positions,
+    })
+}
+
+/// Per-epoch estimates over a pass: rows of 6 values in state order `x, y,
+/// z` (m, body frame, object relative to the gradiometer centre), `mx, my,
+/// mz` (A·m²); NaN where not estimated.
+#[derive(Debug, Clone)]
+pub struct Track {
+    /// Estimates.
+    pub x: Vec<[f64; 6]>,
+    /// Their standard deviations.
+    pub sd: Vec<[f64; 6]>,
+    /// Estimability of each component (`MeasureS`).
+    pub mu: Vec<[f64; 6]>,
+    /// Whether the object was detected at the epoch.
+    pub detected: Vec<bool>,
+    /// IEKF iterations.
+    pub iterations: Vec<f64>,
+    /// RMS measurement residual, nT.
+    pub residual_nt: Vec<f64>,
+    /// Whether the iteration converged.
+    pub converged: Vec<bool>,
+}
+
+impl Track {
+    /// The track of a tensor gradiometer's filter.
+    pub fn from_tensor(out: &[Option<Located<6>>]) -> Self {
+        let nan = [f64::NAN; 6];
+        let arr = |v: SVector<f64, 6>| std::array::from_fn(|k| v[k]);
+        Self {
+            x: out
+                .iter()
+                .map(|o| o.map_or(nan, |l| arr(l.step.posterior.x)))
+                .collect(),
+            sd: out
+                .iter()
+                .map(|o| o.map_or(nan, |l| arr(l.step.posterior.sigma())))
+                .collect(),
+            mu: out
+                .iter()
+                .map(|o| o.map_or(nan, |l| arr(l.step.estimability)))
+                .collect(),
+            detected: out.iter().map(Option::is_some).collect(),
+            iterations: out
+                .iter()
+                .map(|o| o.map_or(f64::NAN, |l| l.step.iterations as f64))
+                .collect(),
+            residual_nt: out
+                .iter()
+                .map(|o| o.map_or(f64::NAN, |l| l.residual_nt))
+                .collect(),
+            converged: out
+                .iter()
+                .map(|o| o.is_some_and(|l| l.step.converged))
+                .collect(),
+        }
+    }
+
+    /// Scalar system: the known position, σ and μ of the position NaN.
+    pub fn from_scalar(out: &[Located<3>], positions: &[Vector3<f64>]) -> Self {
+        let six = |p: [f64; 3], m: SVector<f64, 3>| [p[0], p[1], p[2], m[0], m[1], m[2]];
+        let nan3 = [f64::NAN; 3];
+        Self {
+            x: out
+                .iter()
+                .zip(positions)
+                .map(|(l, p)| six([p.x, p.y, p.z], l.step.posterior.x))
+                .collect(),
+            sd: out
+                .iter()
+                .map(|l| six(nan3, l.step.posterior.sigma()))
+                .collect(),
+            mu: out.iter().map(|l| six(nan3, l.step.estimability)).collect(),
+            detected: vec![true; out.len()],
+            iterations: out.iter().map(|l| l.step.iterations as f64).collect(),
+            residual_nt: out.iter().map(|l| l.residual_nt).collect(),
+            converged: out.iter().map(|l| l.step.converged).collect(),
+        }
+    }
+
+    /// The estimates as a table: `time, detected, x_m, y_m, z_m, mx_am2,
+    /// my_am2, mz_am2`, their standard deviations `sd_…`, the estimability
+    /// measures `mu_…`, `iterations, residual_nt, converged`.
+    pub fn to_table(&self, time: &[f64]) -> Result<FlightTable> {
+        let mut t = FlightTable::new();
+        t.add_column("time", time.to_vec())?;
+        let flag = |v: &[bool]| v.iter().map(|&b| f64::from(u8::from(b))).collect();
+        t.add_column("detected", flag(&self.detected))?;
+        const N: [&str; 6] = ["x_m", "y_m", "z_m", "mx_am2", "my_am2", "mz_am2"];
+        for (prefix, rows) in [("", &self.x), ("sd_", &self.sd), ("mu_", &self.mu)] {
+            for (k, n) in N.iter().enumerate() {
+                let name = if prefix == "mu_" {
+                    format!("mu_{}", n.split('_').next().unwrap_or(n))
+                } else {
+                    format!("{prefix}{n}")
+                };
+                t.add_column(&name, rows.iter().map(|r| r[k]).collect())?;
+            }
+        }
+        t.add_column("iterations", self.iterations.clone())?;
+        t.add_column("residual_nt", self.residual_nt.clone())?;
+        t.add_column("converged", flag(&self.converged))?;
+        Ok(t)
+    }
+}
+
+/// Locate the object over a pass with the configured estimator (the
+/// square-root IEKF: detection, multi-start or the seed's plain IEKF,
+/// filter or re-linearised passes). `positions` is the object's known
+/// position (body frame, m), used by the scalar gradiometer.
+pub fn locate_pass<E: Borrow<Epoch>>(
+    cfg: &GradiometerConfig,
+    epochs: &[E],
+    positions: &[Vector3<f64>],
+) -> Result<Track> {
+    cfg.validate()
+        .map_err(|e| Error::bad_input(format!("settings: {e}")))?;
+    let geometry = cfg.geometry()?;
+    let lc = cfg
+        .locate_config(None)
+        .map_err(|e| Error::bad_input(e.to_string()))?;
+    Ok(match cfg.system.gradiometer {
+        Gradiometer::Tensor => {
+            let input = tensor_epochs(epochs, &geometry, &cfg.processing());
+            Track::from_tensor(&locate_tensor(&input, &lc)?)
+        }
+        Gradiometer::Scalar => {
+            let input = scalar_epochs(epochs, &geometry, positions, &cfg.processing())?;
+            Track::from_scalar(&locate_scalar(&input, &lc)?, positions)
+        }
+    })
+}
+
+/// CRLB standard deviations at epoch `j` from every epoch up to it, state
+/// order (NaN for the scalar system's known position).
+pub fn crlb_at(cfg: &GradiometerConfig, sim: &[SimEpoch], j: usize) -> Result<[f64; 6]> {
+    let g = cfg.geometry()?;
+    let sigma = cfg.sensor_sigma_nt();
+    Ok(match cfg.system.gradiometer {
+        Gradiometer::Tensor => {
+            let b = tensor_pass_crlb(&sim[..=j], &g, sigma)?;
+            std::array::from_fn(|k| b[(k, k)].sqrt())
+        }
+        Gradiometer::Scalar => {
+            let b = scalar_pass_crlb(&sim[..=j], &g, sigma)?;
+            std::array::from_fn(|k| {
+                if k < 3 {
+                    f64::NAN
+                } else {
+                    b[(k - 3, k - 3)].sqrt()
+                }
+            })
+        }
+    })
+}
+
+/// A slice through the source of the iteration counts (NaN = no convergence).
+pub fn slice_heatmap(
+    case: &ConvergenceCase,
+    map: &ConvergenceMap,
+    axis: usize,
+    value: f64,
+    tag: &str,
+) -> Heatmap {
+    let coords: Vec<f64> = (0..case.grid_n).map(|i| case.start(i, 0, 0).x).collect();
+    let k = (0..case.grid_n)
+        .min_by(|&a, &b| {
+            (coords[a] - value)
+                .abs()
+                .total_cmp(&(coords[b] - value).abs())
+        })
+        .unwrap_or(0);
+    let values = map
+        .slice(axis, k)
+        .into_iter()
+        .map(|v| v.map_or(f64::NAN, f64::from))
+        .collect();
+    let (name, xl, yl) = if axis == 1 {
+        ("y", "x start (m)", "z start (m)")
+    } else {
+        ("z", "x start (m)", "y start (m)")
+    };
+    let mut h = Heatmap::new(
+        format!("IEKF iterations ({tag}), slice {name} = {:.2} m", coords[k]),
+        xl,
+        yl,
+        coords.clone(),
+        coords,
+        values,
+        "iterations",
+    );
+    h.equal_aspect = true;
+    h
+}
+
+/// The plain and multi-start maps of the seed's fig. 2 case on a `grid³`
+/// grid, with their run times (s; for the record, not a result).
+pub fn both_maps(
+    case: &ConvergenceCase,
+    threads: usize,
+) -> Result<Vec<(&'static str, ConvergenceMap, f64)>> {
+    [
+        (Initialisation::None, "plain IEKF"),
+        (Initialisation::MultiStart, "multi-start"),
+    ]
+    .into_iter()
+    .map(|(init, tag)| {
+        let t = std::time::Instant::now();
+        let map = convergence_map(case, init, threads.max(1))?;
+        Ok((tag, map, t.elapsed().as_secs_f64()))
+    })
+    .collect()
+}
+
+/// Slices z and y through the source of each map as report figures.
+pub fn map_figures(
+    case: &ConvergenceCase,
+    maps: &[(&'static str, ConvergenceMap, f64)],
+) -> Result<Vec<Block>> {
+    let mut out = Vec::new();
+    for (tag, map, _) in maps {
+        for (axis, v) in [(2, case.position_m.z), (1, case.position_m.y)] {
+            out.push(Block::Figure {
+                svg: slice_heatmap(case, map, axis, v, tag).to_svg()?,
+                caption: format!("{tag}: iterations per start (grey: no convergence)."),
+            });
+        }
+    }
+    Ok(out)
+}

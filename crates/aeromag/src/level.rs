@@ -1,0 +1,231 @@
+//! Levelling a survey at its line/tie-line crossovers with the
+//! `k·d|B0|/dt` term and the crossovers' height differences
+//! (algorithms: [`aeromag_compensation::levelling`]).
+
+use crate::error::{Error, InFile, Result};
+use crate::flight::{Flight, ReferenceChannels, reduced, reference_sum, sensor_track};
+use crate::observer::{Note, Notes, Observer};
+use aeromag_compensation::levelling::{
+    Crossover, LevellingConfig, RowFlag, SurveyLevelling, SurveyTracks, TrackConfig, level_survey,
+};
+use aeromag_io::FlightTable;
+
+/// What to level and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevelOptions {
+    /// Column to level; `None`: `mag_comp` when the flight has it, else `mag`.
+    pub value: Option<String>,
+    /// Column whose along-track derivative is the regressor of the
+    /// `d|B0|/dt` term, as recorded; `None`: `mag` (the uncompensated
+    /// reading) when the flight has it, else the levelled column. A lag of
+    /// the scalar channel acts on everything the sensor sees, the aircraft's
+    /// own interference included.
+    pub rate_of: Option<String>,
+    /// Sensor lever arm from the navigation point (body frame: x forward,
+    /// y right, z down; m): crossovers are found at the sensor's position.
+    pub lever_arm_m: Option<[f64; 3]>,
+    /// Known external-field channels subtracted from the value first
+    /// (default none: classic levelling).
+    pub reference: ReferenceChannels,
+    /// Crossover finding (gap rule, derivative window, minimum angle).
+    pub tracks: TrackConfig,
+    /// The fit (k, drift, ridge λ, altitude term, robust weights).
+    pub fit: LevellingConfig,
+}
+
+impl Default for LevelOptions {
+    fn default() -> Self {
+        Self {
+            value: None,
+            rate_of: None,
+            lever_arm_m: None,
+            reference: ReferenceChannels::None,
+            tracks: TrackConfig::default(),
+            fit: LevellingConfig::default(),
+        }
+    }
+}
+
+/// A levelled survey ([`level`]).
+#[derive(Debug, Clone)]
+pub struct Levelled {
+    /// Crossovers, the fit (k, line levels, residuals) and the corrected
+    /// series.
+    pub levelling: SurveyLevelling,
+    /// The column levelled.
+    pub value_column: String,
+    /// The reference channels subtracted from it.
+    pub reference_columns: Vec<String>,
+    /// The column whose derivative is the `d|B0|/dt` regressor.
+    pub rate_column: String,
+    /// Notes and warnings.
+    pub notes: Vec<Note>,
+}
+
+/// The flag column `level` adds.
+pub const LEVEL_FLAG: &str = "level_flag";
+
+impl Levelled {
+    /// Name of the levelled column: `<value>_level`.
+    pub fn output_column(&self) -> String {
+        format!("{}_level", self.value_column)
+    }
+
+    /// The flag of every row as written: 0 levelled, 1 on a line without
+    /// crossovers, 2 not on a line, 3 missing value.
+    pub fn flags(&self) -> Vec<f64> {
+        self.levelling
+            .levelled
+            .flag
+            .iter()
+            .map(|fl| match fl {
+                RowFlag::Levelled => 0.0,
+                RowFlag::NoCrossovers => 1.0,
+                RowFlag::NotOnLine => 2.0,
+                RowFlag::Missing => 3.0,
+            })
+            .collect()
+    }
+
+    /// Add `<value>_level` and [`LEVEL_FLAG`] to `table`.
+    pub fn add_to(&self, table: &mut FlightTable) -> Result<()> {
+        table.add_column(
+            &self.output_column(),
+            self.levelling.levelled.value_nt.clone(),
+        )?;
+        table.add_column(LEVEL_FLAG, self.flags())?;
+        Ok(())
+    }
+
+    /// The crossover table: one row per crossover with both lines,
+    /// position, times, altitudes, values, `d|B0|/dt`, profile gradients,
+    /// the difference, what the fitted model leaves of it and its weight
+    /// (units in the column names).
+    pub fn crossover_table(&self) -> Result<FlightTable> {
+        let xs = &self.levelling.crossovers.crossovers;
+        let fit = &self.levelling.fit;
+        let col = |f: &dyn Fn(&Crossover) -> f64| -> Vec<f64> { xs.iter().map(f).collect() };
+        let columns: Vec<(&str, Vec<f64>)> = vec![
+            ("line_a", col(&|x| x.a.label as f64)),
+            ("line_b", col(&|x| x.b.label as f64)),
+            ("north_m", col(&|x| x.north_m)),
+            ("east_m", col(&|x| x.east_m)),
+            ("angle_deg", col(&|x| x.angle_deg)),
+            ("time_a_s", col(&|x| x.a.time_s)),
+            ("time_b_s", col(&|x| x.b.time_s)),
+            ("alt_a_m", col(&|x| x.a.alt_m)),
+            ("alt_b_m", col(&|x| x.b.alt_m)),
+            ("value_a_nt", col(&|x| x.a.value_nt)),
+            ("value_b_nt", col(&|x| x.b.value_nt)),
+            ("rate_a_nt_per_s", col(&|x| x.a.derivative_nt_per_s)),
+            ("rate_b_nt_per_s", col(&|x| x.b.derivative_nt_per_s)),
+            (
+                "profile_gradient_a_nt_per_m",
+                col(&|x| x.a.profile_gradient_nt_per_m),
+            ),
+            (
+                "profile_gradient_b_nt_per_m",
+                col(&|x| x.b.profile_gradient_nt_per_m),
+            ),
+            ("difference_nt", col(&|x| x.difference_nt())),
+            ("residual_nt", fit.residuals_nt.clone()),
+            ("weight", fit.weights.clone()),
+        ];
+        let mut t = FlightTable::new();
+        for (name, v) in columns {
+            t.add_column(name, v)?;
+        }
+        Ok(t)
+    }
+}
+
+/// Level a (compensated) survey: find the crossovers of lines and tie lines
+/// (label 0 = not on a line) at the sensor's position, fit `k` of the
+/// `k·d|B0|/dt` term jointly with a level per line (and the altitude term,
+/// robust weights: [`LevellingConfig`]), and correct every row.
+///
+/// Reads `time`, `lat`, `lon`, `alt`, `line`, the value and rate columns,
+/// the reference channels, and the attitude with a lever arm. Bad input if
+/// the flight already has the output columns.
+pub fn level(
+    flight: &Flight,
+    opts: &LevelOptions,
+    observer: &mut dyn Observer,
+) -> Result<Levelled> {
+    let mut notes = Notes::new(observer);
+    let value_column = match &opts.value {
+        Some(v) => v.clone(),
+        None if flight.column("mag_comp").is_some() => "mag_comp".into(),
+        None => "mag".into(),
+    };
+    let out_name = format!("{value_column}_level");
+    if flight.get(&out_name).is_some() || flight.get(LEVEL_FLAG).is_some() {
+        return Err(Error::bad_file(
+            flight.label(),
+            format!("already has `{out_name}` or `{LEVEL_FLAG}`"),
+        ));
+    }
+    if !(opts.fit.lambda >= 0.0 && opts.fit.lambda.is_finite()) {
+        return Err(Error::bad_input(format!(
+            "levelling λ {} must be ≥ 0",
+            opts.fit.lambda
+        )));
+    }
+    notes.stage("levelling");
+    let positions = opts
+        .lever_arm_m
+        .map(|arm| sensor_track(flight, arm))
+        .transpose()?;
+    let (lat, lon, alt) = match &positions {
+        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
+        None => (
+            flight.require("lat")?,
+            flight.require("lon")?,
+            flight.require("alt")?,
+        ),
+    };
+    let reference_columns = opts.reference.resolve(flight)?;
+    let sum = reference_sum(flight, &reference_columns, None)?;
+    let value = reduced(flight.require(&value_column)?, &sum);
+    let rate_column = match &opts.rate_of {
+        Some(c) => c.clone(),
+        None if flight.column("mag").is_some() => "mag".into(),
+        None => value_column.clone(),
+    };
+    // The column as recorded (the sensor lags the reference fields too);
+    // not needed, and its gaps not imposed, without the k term.
+    let sensed = opts
+        .fit
+        .estimate_k
+        .then(|| flight.require(&rate_column))
+        .transpose()?;
+    let tracks = SurveyTracks {
+        time: flight.require("time")?,
+        lat,
+        lon,
+        alt,
+        line: flight.require("line")?,
+        value: &value,
+        sensed,
+    };
+    let levelling = level_survey(&tracks, &opts.tracks, &opts.fit).in_file(&flight.label())?;
+    let f = &levelling.fit;
+    if opts.fit.altitude_term && !f.altitude_term_used {
+        notes.warn(
+            "no crossover has heights and profiles on both sides; the altitude term is left out",
+        );
+    }
+    if f.components > 1 {
+        notes.warn(format!(
+            "the lines form {} groups that never cross; their relative levels rest on the penalty, not the data",
+            f.components
+        ));
+    }
+    Ok(Levelled {
+        levelling,
+        value_column,
+        reference_columns,
+        rate_column,
+        notes: notes.into_notes(),
+    })
+}

@@ -1,0 +1,140 @@
+//! Reading and writing model files of every kind (Tolles-Lawson, rotor,
+//! pod): JSON, versioned (`spec/data-formats.md`, "Model files").
+
+use crate::error::{Error, Result};
+use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::pod::model_file::PodModelFile;
+use aeromag_compensation::rotor::model_file::RotorModelFile;
+use std::io::Write;
+use std::path::Path;
+
+/// A model that is stored as a JSON model file.
+///
+/// ```no_run
+/// use aeromag::{ModelFile, TlModel};
+/// let model = TlModel::read("model.json")?;
+/// model.write("copy.json")?;
+/// # Ok::<(), aeromag::Error>(())
+/// ```
+pub trait ModelFile: Sized {
+    /// Parse and check a model file's text; `origin` names it in errors.
+    fn parse(text: &str, origin: &str) -> Result<Self>;
+
+    /// The model file's text (pretty JSON).
+    fn json(&self) -> Result<String>;
+
+    /// Read and check a model file (bad input when it cannot be read or is
+    /// not a model of this kind).
+    fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Write the model file: to a temporary file in the same folder,
+    /// renamed when complete, so an interrupted write never leaves a
+    /// complete-looking partial file.
+    fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        write_atomically(path.as_ref(), self.json()?.as_bytes())
+    }
+}
+
+impl ModelFile for TlModel {
+    fn parse(text: &str, origin: &str) -> Result<Self> {
+        Ok(TlModel::from_json(text, origin)?)
+    }
+    fn json(&self) -> Result<String> {
+        Ok(self.to_json()?)
+    }
+}
+
+impl ModelFile for RotorModelFile {
+    fn parse(text: &str, origin: &str) -> Result<Self> {
+        Ok(RotorModelFile::from_json(text, origin)?)
+    }
+    fn json(&self) -> Result<String> {
+        Ok(serde_json::to_string_pretty(self)?)
+    }
+}
+
+impl ModelFile for PodModelFile {
+    fn parse(text: &str, origin: &str) -> Result<Self> {
+        Ok(PodModelFile::from_json(text, origin)?)
+    }
+    fn json(&self) -> Result<String> {
+        Ok(serde_json::to_string_pretty(self)?)
+    }
+}
+
+/// Write `bytes` to `path` through a temporary file in the same folder,
+/// renamed when complete.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_streamed(path, |w| {
+        w.write_all(bytes).map_err(|e| Error::write(path, e))
+    })
+}
+
+/// Write `path` by streaming into a buffered temporary file in the same
+/// folder (`.NAME.PID.tmp`), renamed when `write` has succeeded and the
+/// buffer is flushed; on any failure the temporary file is removed, so an
+/// interrupted write never leaves a complete-looking partial file.
+pub fn write_streamed(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<()>,
+) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = std::fs::File::create(&tmp)
+        .map_err(|e| Error::write(path, e))
+        .and_then(|f| {
+            let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+            write(&mut w)?;
+            w.flush().map_err(|e| Error::write(path, e))
+        })
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::write(path, e)));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_replaces_and_reports_a_missing_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("m.json");
+        write_atomically(&p, b"one").unwrap();
+        write_atomically(&p, b"two").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "two");
+        assert_eq!(
+            std::fs::read_dir(d.path()).unwrap().count(),
+            1,
+            "no temporary left"
+        );
+        let e = write_atomically(&d.path().join("no/such/m.json"), b"x").unwrap_err();
+        assert!(!e.is_bad_input());
+        assert!(e.to_string().contains("no/such/m.json"), "{e}");
+    }
+
+    #[test]
+    fn a_file_that_is_not_a_model_is_bad_input() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("junk.json");
+        std::fs::write(&p, "{\"format\":\"other\"}").unwrap();
+        let e = TlModel::read(&p).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        assert!(e.to_string().contains("junk.json"), "{e}");
+        let e = TlModel::read(d.path().join("none.json")).unwrap_err();
+        assert!(e.is_bad_input());
+    }
+}

@@ -1,0 +1,195 @@
+//! A rotor model applied to a flight: per stretch between gaps, the phase
+//! from its channel (or estimated and aligned with the model over a whole
+//! revolution) and the slowly varying angles tracked with the parameters
+//! fixed.
+
+use super::MIN_SEGMENT_S;
+use crate::compensate::{Compensator, OutputColumns};
+use crate::error::{InFile, Result};
+use crate::flight::{Flight, SegmentRule, finite_segments};
+use crate::observer::{Note, Observer};
+use aeromag_compensation::rotor::model_file::RotorModelFile;
+use aeromag_compensation::rotor::{
+    FlapAngles, RotorInput, SlowAngleOptions, align_phase_offset, estimate_phase, rotor_speed,
+    track_slow_angles, unwrap_deg,
+};
+use nalgebra::Vector3;
+use std::ops::Range;
+
+/// The columns `rotor apply` adds: `rotor_interf`, `mag_comp`, `rotor_flag`.
+pub const ROTOR_OUTPUT: OutputColumns = OutputColumns {
+    interference: "rotor_interf",
+    flag: "rotor_flag",
+    why_missing: "missing values or stretches under 10 s",
+};
+
+/// The columns a rotor fit or application reads: `time` (s), `mag` (nT),
+/// `flux_x/y/z` (nT, body axes) and the phase channel (deg) when used.
+pub(super) struct RotorColumns<'a> {
+    pub time: &'a [f64],
+    pub mag: &'a [f64],
+    pub flux: [&'a [f64]; 3],
+    pub phase: Option<&'a [f64]>,
+}
+
+impl<'a> RotorColumns<'a> {
+    pub fn of(flight: &'a Flight, phase: Option<&str>) -> Result<Self> {
+        Ok(Self {
+            time: flight.require("time")?,
+            mag: flight.require("mag")?,
+            flux: [
+                flight.require("flux_x")?,
+                flight.require("flux_y")?,
+                flight.require("flux_z")?,
+            ],
+            phase: phase.map(|p| flight.require(p)).transpose()?,
+        })
+    }
+
+    /// `mag`, the flux components and the phase (when used), in that order.
+    pub fn all(&self) -> Vec<&'a [f64]> {
+        let mut v = vec![self.mag, self.flux[0], self.flux[1], self.flux[2]];
+        v.extend(self.phase);
+        v
+    }
+
+    /// The field vectors of rows `r`.
+    pub fn field(&self, r: &Range<usize>) -> Vec<Vector3<f64>> {
+        r.clone()
+            .map(|k| Vector3::new(self.flux[0][k], self.flux[1][k], self.flux[2][k]))
+            .collect()
+    }
+
+    /// The stretches without gaps or missing values of at least
+    /// [`MIN_SEGMENT_S`] at sampling rate `fs` (Hz).
+    pub fn stretches(&self, fs: f64) -> Vec<Range<usize>> {
+        let min_len = (MIN_SEGMENT_S * fs).ceil() as usize;
+        let rule = SegmentRule::ignoring_lines().min_len(min_len);
+        finite_segments(self.time, None, &self.all(), &rule).1.kept
+    }
+}
+
+/// Phase (rad, unwrapped) and rotor speed (rad/s) of one segment: from the
+/// channel, or estimated from `mag` (steps 1–2 of the library's `phase`).
+pub(super) fn segment_phase(
+    cols: &RotorColumns,
+    r: &Range<usize>,
+    fs: f64,
+    blades: usize,
+    band: [f64; 2],
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let phase = match cols.phase {
+        Some(p) => unwrap_deg(&p[r.clone()]),
+        None => estimate_phase(&cols.mag[r.clone()], fs, blades, band[0], band[1])?.phase_rad,
+    };
+    let omega = rotor_speed(&phase, fs, 1.0)?;
+    Ok((phase, omega))
+}
+
+/// Options of the tracking on new data with a phase estimated from it: the
+/// final options plus a slowly varying phase correction.
+fn tracking_with_phase(o: &SlowAngleOptions) -> SlowAngleOptions {
+    SlowAngleOptions {
+        estimate_phase: true,
+        iterations: o.iterations.max(6),
+        ..*o
+    }
+}
+
+/// One stretch of a record with the rotor phase, speed and slowly varying
+/// angles found for it with a fitted model.
+pub(super) struct TrackedSegment {
+    b: Vec<Vector3<f64>>,
+    omega: Vec<f64>,
+    phase: Vec<f64>,
+    angles: Vec<FlapAngles>,
+}
+
+impl TrackedSegment {
+    pub fn input(&self) -> RotorInput<'_> {
+        RotorInput {
+            b_body_nt: &self.b,
+            phase_rad: &self.phase,
+            omega_rad_s: &self.omega,
+            angles: &self.angles,
+        }
+    }
+}
+
+/// Phase (from the channel, or estimated and aligned to `model`) and the
+/// slowly varying angles (tracked with `model`'s parameters fixed) of rows
+/// `r`: what `rotor apply` does to a stretch, and what `rotor fit` does to
+/// the stretches it refits on.
+pub(super) fn track_segment(
+    model: &RotorModelFile,
+    cols: &RotorColumns,
+    r: &Range<usize>,
+    fs: f64,
+) -> Result<TrackedSegment> {
+    let g = &model.geometry;
+    let nominal = [model.nominal_angles];
+    let b = cols.field(r);
+    let mag = &cols.mag[r.clone()];
+    let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
+    let estimated = model.phase.column.is_none();
+    if estimated {
+        let inp = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &phase,
+            omega_rad_s: &omega,
+            angles: &nominal,
+        };
+        let c = align_phase_offset(g, &model.model, &inp, mag, fs, &model.fit_options)?;
+        phase.iter_mut().for_each(|p| *p += c);
+    }
+    let inp = RotorInput {
+        b_body_nt: &b,
+        phase_rad: &phase,
+        omega_rad_s: &omega,
+        angles: &nominal,
+    };
+    let opts = if estimated {
+        tracking_with_phase(&model.slow_angles)
+    } else {
+        model.slow_angles
+    };
+    let slow = track_slow_angles(g, &model.model, &inp, mag, fs, &model.fit_options, &opts)?;
+    Ok(TrackedSegment {
+        b,
+        omega,
+        phase: slow.phase_rad,
+        angles: slow.angles,
+    })
+}
+
+impl Compensator for RotorModelFile {
+    fn output(&self) -> OutputColumns {
+        ROTOR_OUTPUT
+    }
+
+    /// The modelled rotor interference (nT, slow part included) of every
+    /// stretch of at least 10 s without gaps or missing values; NaN
+    /// elsewhere. A sample rate other than the model's is a warning.
+    fn interference_observed(
+        &self,
+        flight: &Flight,
+        observer: &mut dyn Observer,
+    ) -> Result<Vec<f64>> {
+        let cols = RotorColumns::of(flight, self.phase.column.as_deref())?;
+        let fs = flight.sample_rate_hz()?;
+        if (fs / self.sample_rate_hz - 1.0).abs() > 0.01 {
+            observer.note(&Note::warning(format!(
+                "{}: sample rate {fs:.3} Hz differs from the model's {:.3} Hz",
+                flight.label(),
+                self.sample_rate_hz
+            )));
+        }
+        let mut out = vec![f64::NAN; flight.n_rows()];
+        for r in cols.stretches(fs) {
+            let t = track_segment(self, &cols, &r, fs).in_file(&flight.label())?;
+            let p = self.model.predict(&self.geometry, &t.input())?;
+            out[r].copy_from_slice(&p);
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,234 @@
+//! The report section of a scored flight.
+
+use super::Figures;
+use crate::error::Result;
+use crate::flight::Flight;
+use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::tolles_lawson::segments::median_step;
+use aeromag_core::spectrum::{WelchConfig, welch};
+use aeromag_report::{LinePlot, ReportSection, Series, Table};
+
+fn f3(v: Option<f64>) -> String {
+    v.map_or("—".into(), |x| format!("{x:.3}"))
+}
+
+impl Figures {
+    /// The report section of a compensated flight `t` scored with these
+    /// figures: the figures, the signal before and after, the modelled
+    /// interference (against the truth where simulated), the residual versus
+    /// truth, Welch spectra, the FOM per manoeuvre window, the residual per
+    /// line, and the model's coefficients when given.
+    pub fn section(
+        &self,
+        title: &str,
+        t: &Flight,
+        model: Option<&TlModel>,
+    ) -> Result<ReportSection> {
+        let fig = self;
+        let time = t.require("time")?;
+        let mag = t.require("mag")?;
+        let comp = t.require("mag_comp")?;
+        let t0 = time.first().copied().unwrap_or(0.0);
+        let tt: Vec<f64> = time.iter().map(|v| v - t0).collect();
+        let mut r = ReportSection::new(title);
+        let mut kv = vec![
+            ("rows".to_string(), t.n_rows().to_string()),
+            ("FOM before (nT)".into(), f3(fig.fom_before_nt)),
+            ("FOM after (nT)".into(), f3(fig.fom_after_nt)),
+            ("manoeuvre windows".into(), fig.fom_windows.to_string()),
+            ("improvement ratio".into(), f3(fig.ir)),
+        ];
+        if let Some(v) = fig.residual_rms_nt {
+            kv.push(("residual vs truth, RMS (nT)".into(), format!("{v:.4}")));
+        }
+        if let Some(v) = fig.noise_floor_nt {
+            kv.push(("scalar sensor noise floor (nT)".into(), format!("{v:.4}")));
+        }
+        r.key_values(kv);
+
+        let mean = |x: &[f64]| {
+            let v: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+            v.iter().sum::<f64>() / v.len().max(1) as f64
+        };
+        let (mm, cm) = (mean(mag), mean(comp));
+        let svg = LinePlot::new(
+            "Uncompensated and compensated field (means removed)",
+            "time since start (s)",
+            "field (nT)",
+        )
+        .with_series(Series::line(
+            "uncompensated",
+            tt.clone(),
+            mag.iter().map(|v| v - mm).collect(),
+        ))
+        .with_series(Series::line(
+            "compensated",
+            tt.clone(),
+            comp.iter().map(|v| v - cm).collect(),
+        ))
+        .to_svg()?;
+        r.figure(svg, "Scalar magnetometer before and after compensation.");
+
+        if let Some(model_interf) = t.column("mag_interf") {
+            let mi = mean(model_interf);
+            let mut p = LinePlot::new(
+                "Aircraft interference: model and truth (means removed)",
+                "time since start (s)",
+                "interference (nT)",
+            )
+            .with_series(Series::line(
+                "model",
+                tt.clone(),
+                model_interf.iter().map(|v| v - mi).collect(),
+            ));
+            if let Some(ti) = t.column("true_interf") {
+                let m = mean(ti);
+                p = p.with_series(Series::line(
+                    "truth (simulation)",
+                    tt.clone(),
+                    ti.iter().map(|v| v - m).collect(),
+                ));
+            }
+            r.figure(
+                p.to_svg()?,
+                "Modelled interference against the simulator's truth where available.",
+            );
+        }
+
+        if let Some(ext) = t.column("true_external") {
+            let lag = t.column("true_lag");
+            let res: Vec<f64> = (0..comp.len())
+                .map(|i| comp[i] - ext[i] - lag.map_or(0.0, |l| l[i]))
+                .collect();
+            let rm = mean(&res);
+            let svg = LinePlot::new(
+                "Residual versus truth",
+                "time since start (s)",
+                "compensated − truth (nT)",
+            )
+            .with_series(Series::line(
+                "residual",
+                tt.clone(),
+                res.iter().map(|v| v - rm).collect(),
+            ))
+            .to_svg()?;
+            r.figure(svg, "Compensated field minus the true external field (sensor lag term removed), mean removed.");
+        }
+
+        // Welch spectra over the longest finite run of each signal.
+        let fs = 1.0 / median_step(time);
+        let longest = |x: &[f64]| -> Vec<f64> {
+            let mut best = (0, 0);
+            let mut start = 0;
+            for i in 0..=x.len() {
+                if i == x.len() || !x[i].is_finite() {
+                    if i - start > best.1 - best.0 {
+                        best = (start, i);
+                    }
+                    start = i + 1;
+                }
+            }
+            x[best.0..best.1].to_vec()
+        };
+        let nperseg = 1024usize.min(comp.len() / 4).max(16);
+        let mut sp = LinePlot::new(
+            "Power spectral density (Welch)",
+            "frequency (Hz)",
+            "PSD (nT²/Hz)",
+        )
+        .log_log();
+        for (name, x) in [("uncompensated", mag), ("compensated", comp)] {
+            let seg = longest(x);
+            if seg.len() >= nperseg {
+                let psd = welch(&seg, &WelchConfig::new(fs, nperseg))?;
+                sp = sp.with_series(Series::line(name, psd.freqs_hz, psd.values));
+            }
+        }
+        if !sp.series.is_empty() {
+            r.figure(
+                sp.to_svg()?,
+                "Welch spectra (Hann window, 50 % overlap) of the longest uninterrupted stretch.",
+            );
+        }
+
+        if let (Some(before), Some(after)) = (&fig.fom_before, &fig.fom_after) {
+            let rows = before
+                .windows
+                .iter()
+                .zip(&after.windows)
+                .map(|(b, a)| {
+                    vec![
+                        format!("{:.0}", b.maneuver.heading_deg),
+                        b.maneuver.axis.name().to_string(),
+                        format!("{:.1}", tt[b.maneuver.start]),
+                        format!("{:.1}", tt[b.maneuver.end - 1]),
+                        format!("{:.3}", b.peak_to_peak_nt),
+                        format!("{:.3}", a.peak_to_peak_nt),
+                    ]
+                })
+                .collect();
+            r.table(Table::new(
+                [
+                    "heading (°)",
+                    "manoeuvre",
+                    "start (s)",
+                    "end (s)",
+                    "p-p before (nT)",
+                    "p-p after (nT)",
+                ]
+                .map(String::from)
+                .to_vec(),
+                rows,
+                "Figure of merit: detrended peak-to-peak amplitude per manoeuvre window.",
+            ));
+        }
+        if !fig.lines.is_empty() {
+            let rows = fig
+                .lines
+                .iter()
+                .map(|l| {
+                    vec![
+                        format!("{}", l.line),
+                        l.samples.to_string(),
+                        format!("{:.3}", l.mean_nt),
+                        format!("{:.4}", l.rms_nt),
+                    ]
+                })
+                .collect();
+            r.table(Table::new(
+                ["line", "samples", "mean offset (nT)", "RMS about mean (nT)"]
+                    .map(String::from)
+                    .to_vec(),
+                rows,
+                "Residual versus truth per line (simulation).",
+            ));
+        }
+        if let Some(m) = model {
+            let rows = m
+                .coefficients
+                .iter()
+                .map(|c| {
+                    vec![
+                        c.name.clone(),
+                        format!("{:.6}", c.value),
+                        format!("{:.2e}", c.std),
+                    ]
+                })
+                .collect();
+            r.table(Table::new(
+                ["term", "coefficient", "standard deviation"]
+                    .map(String::from)
+                    .to_vec(),
+                rows,
+                format!(
+                    "Model coefficients ({}, method {}, convention {:?}).",
+                    m.design.terms, m.method, m.design.convention
+                ),
+            ));
+            if !m.fit.warnings.is_empty() {
+                r.paragraph(format!("Fit warnings: {}", m.fit.warnings.join(" | ")));
+            }
+        }
+        Ok(r)
+    }
+}

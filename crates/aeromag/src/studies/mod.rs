@@ -1,0 +1,115 @@
+//! Studies: each subsystem's demonstration on simulated data with known
+//! truth, run at a size, giving a typed summary (its group of the demo's
+//! `summary.json`, and its rows of the printed table) and a report section.
+//!
+//! `aeromag demo` runs every study ([`demo`]); the `study` subcommands
+//! (`aeromag rotor study`, `aeromag em study`) run one.
+//!
+//! A study implements [`Study`]; its result implements [`StudyOutcome`].
+
+use crate::error::Result;
+use crate::observer::Observer;
+use aeromag_report::ReportSection;
+use serde::Serialize;
+
+mod demo;
+mod em;
+mod fixed_wing;
+mod gradiometry;
+mod pod;
+mod rotor;
+
+pub use demo::{Demo, DemoOutcome, DemoSummary};
+pub use em::{EmOutcome, EmStudy, EmSummary};
+pub use fixed_wing::{
+    CompensationSummary, FixedWingOutcome, FixedWingStudy, FixedWingSummary, GeologySummary,
+    LevellingSummary, PlanningSummary,
+};
+pub use gradiometry::{GradiometryOutcome, GradiometryStudy, GradiometrySummary};
+pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
+pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};
+
+/// How much work a study does: the demo's `--quick` or the full run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StudySize {
+    /// Fewer trials, epochs or grid points; same steps.
+    Quick,
+    /// The documented figures.
+    #[default]
+    Full,
+}
+
+impl StudySize {
+    /// `Quick` when `quick` holds.
+    pub fn quick_if(quick: bool) -> Self {
+        if quick { Self::Quick } else { Self::Full }
+    }
+}
+
+/// A demonstration of one subsystem on simulated data.
+pub trait Study {
+    /// What a run produces: the full result, with the series its report
+    /// section draws.
+    type Outcome: StudyOutcome;
+
+    /// Run the study. Progress goes to `observer`.
+    fn run(&self, size: StudySize, observer: &mut dyn Observer) -> Result<Self::Outcome>;
+}
+
+/// The result of a [`Study`].
+pub trait StudyOutcome {
+    /// The figures of the study: its group of `summary.json` (units in the
+    /// field names).
+    type Summary: Serialize + Clone + std::fmt::Debug;
+
+    /// The figures.
+    fn summary(&self) -> Self::Summary;
+
+    /// The main report section (text, tables, figures).
+    fn section(&self) -> Result<ReportSection>;
+
+    /// Every report section of the study, the main one first (a study with
+    /// one section need not implement it).
+    fn sections(&self) -> Result<Vec<ReportSection>> {
+        Ok(vec![self.section()?])
+    }
+}
+
+/// One row of a printed summary table: the figure's key in
+/// `summary.json` (dotted) and its value as printed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PrintedFigure {
+    /// Dotted key, e.g. `rotor.residual_model_nt`.
+    pub key: String,
+    /// Formatted value.
+    pub value: String,
+}
+
+impl PrintedFigure {
+    /// A row.
+    pub fn new(key: impl Into<String>, value: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            value: value.into(),
+        }
+    }
+}
+
+/// A summary that contributes rows to the demo's printed table, read from
+/// its typed fields.
+pub trait PrintedSummary {
+    /// The rows, in order.
+    fn printed(&self) -> Vec<PrintedFigure>;
+}
+
+/// A number with `digits` decimals, or `—` when there is none (a figure
+/// that cannot be computed on this flight).
+pub fn fixed(v: Option<f64>, digits: usize) -> String {
+    v.map_or("—".into(), |x| format!("{x:.digits$}"))
+}
+
+/// A small number in scientific notation with 3 decimals.
+pub fn sci(v: f64) -> String {
+    format!("{v:.3e}")
+}

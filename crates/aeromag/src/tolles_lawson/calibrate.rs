@@ -1,0 +1,324 @@
+//! `calibrate`: fit a Tolles-Lawson model on a calibration flight by band-pass
+//! least squares or by the Kalman method.
+
+use super::kalman::{KalmanOptions, KalmanOutcome, fit_kalman_flight};
+use super::lags::choose_terms;
+use crate::error::{Error, InFile, Result};
+use crate::flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, TlInputs};
+use crate::flight::{reduced, reference_sum};
+use crate::observer::{Note, Notes, Observer};
+use aeromag_compensation::model_file::{
+    Coefficient, FitStats, LsSettings, MODEL_FORMAT, MethodSettings, TL_KIND, TlModel,
+};
+use aeromag_compensation::tolles_lawson::Convention;
+use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
+use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// How the coefficients are estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum Method {
+    /// Band-pass least squares (Butterworth, zero-phase, legs trimmed): the
+    /// industry and MagNav.jl baseline (spec `compensation.md`, Method 1).
+    #[default]
+    Ls,
+    /// The Kalman filter and smoother with a stochastic model of the
+    /// external field along the track (the thesis' method, Method 2).
+    Kalman,
+}
+
+impl Method {
+    /// `ls` or `kalman`, as in the model file and the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Ls => "ls",
+            Method::Kalman => "kalman",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "ls" => Ok(Method::Ls),
+            "kalman" => Ok(Method::Kalman),
+            m => Err(Error::bad_input(format!(
+                "method `{m}`: use `ls` or `kalman`"
+            ))),
+        }
+    }
+}
+
+/// How the lagged eddy-current terms (`l9`) are chosen.
+///
+/// ```
+/// use aeromag::EddyLag;
+/// assert_eq!("auto".parse::<EddyLag>()?, EddyLag::Auto);
+/// assert_eq!("0.3,0.8".parse::<EddyLag>()?, EddyLag::Fixed(vec![0.3, 0.8]));
+/// assert!("-1".parse::<EddyLag>().is_err());
+/// # Ok::<(), aeromag::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EddyLag {
+    /// The classical model, no lagged terms.
+    None,
+    /// Up to two lags of
+    /// [`DEFAULT_LAG_GRID_S`](aeromag_compensation::tolles_lawson::lag_select::DEFAULT_LAG_GRID_S),
+    /// kept when a likelihood-ratio test finds them significant.
+    Auto,
+    /// These lags, s.
+    Fixed(Vec<f64>),
+}
+
+impl EddyLag {
+    /// The default for a derivative convention: `none` with MagNav's (its
+    /// model exactly), `auto` otherwise.
+    pub fn default_for(convention: Convention) -> Self {
+        match convention {
+            Convention::MagNav => EddyLag::None,
+            _ => EddyLag::Auto,
+        }
+    }
+}
+
+impl FromStr for EddyLag {
+    type Err = Error;
+    /// `auto`, `none` (or empty) or lags in seconds such as `0.3,0.8`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "auto" => Ok(EddyLag::Auto),
+            "none" | "" => Ok(EddyLag::None),
+            list => list
+                .split(',')
+                .map(|t| match t.trim().parse::<f64>() {
+                    Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+                    _ => Err(Error::bad_input(format!(
+                        "eddy lag `{s}`: expected auto, none or lags in seconds > 0 such as 0.3,0.8"
+                    ))),
+                })
+                .collect::<Result<Vec<f64>>>()
+                .map(EddyLag::Fixed),
+        }
+    }
+}
+
+/// Everything `calibrate` is told besides the flight.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrateOptions {
+    /// Band-pass LS or the Kalman method.
+    pub method: Method,
+    /// Terms, derivative convention and `bt_scale` of both methods, and the
+    /// band-pass settings of the LS method (band, order, trim, ridge λ).
+    pub ls: LsConfig,
+    /// Settings of the Kalman method.
+    pub kalman: KalmanOptions,
+    /// The lagged eddy-current terms.
+    pub eddy_lag: EddyLag,
+    /// Split the flight into legs at changes of `line`.
+    pub split_lines: bool,
+    /// Known external-field channels subtracted from `mag` first.
+    pub reference: ReferenceChannels,
+    /// The scalar sensor's lever arm from the navigation point: moves the
+    /// `igrf` reference to the sensor and, for the Kalman method, the
+    /// altitude of the vertical-gradient term.
+    pub lever_arm: Option<LeverArm>,
+}
+
+impl Default for CalibrateOptions {
+    /// Band-pass LS with the 16 observable terms (`p3,i5,e8`), the physical
+    /// convention, 0.1–0.9 Hz, lags `auto`, references `auto`, legs split
+    /// at lines, no lever arm.
+    fn default() -> Self {
+        Self {
+            method: Method::Ls,
+            ls: LsConfig::default(),
+            kalman: KalmanOptions::default(),
+            eddy_lag: EddyLag::Auto,
+            split_lines: true,
+            reference: ReferenceChannels::Auto,
+            lever_arm: None,
+        }
+    }
+}
+
+impl CalibrateOptions {
+    /// The Kalman method with its defaults.
+    pub fn kalman() -> Self {
+        Self {
+            method: Method::Kalman,
+            ..Self::default()
+        }
+    }
+}
+
+/// The result of [`calibrate`]: the model and what the fit found on the way.
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// The model (what `aeromag calibrate` writes as the model file).
+    pub model: TlModel,
+    /// How `auto` chose the eddy-current lags (also in the model file).
+    pub lag_selection: Option<LagSelection>,
+    /// The Kalman method's fit details (noise intensities, tuning,
+    /// likelihood, series), with that method.
+    pub kalman: Option<KalmanOutcome>,
+    /// Notes and warnings raised while fitting, in order.
+    pub notes: Vec<Note>,
+}
+
+/// Fit a Tolles-Lawson model on a calibration flight.
+///
+/// Reads `time`, `flux_x/y/z`, `mag` (and `line`, the reference channels,
+/// and for the Kalman method `alt`, ground speed from `vn`, `ve` or the
+/// positions, `vd` when recorded); never a `true_` column. Progress and notes
+/// go to `observer`; the notes are also kept in the result.
+///
+/// ```no_run
+/// use aeromag::{CalibrateOptions, Flight, Silent, calibrate};
+/// let flight = Flight::read("cal/calibration.csv")?;
+/// let cal = calibrate(&flight, &CalibrateOptions::kalman(), &mut Silent)?;
+/// std::fs::write("model.json", cal.model.to_json()?).unwrap();
+/// # Ok::<(), aeromag::Error>(())
+/// ```
+pub fn calibrate(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    observer: &mut dyn Observer,
+) -> Result<Calibration> {
+    let mut notes = Notes::new(observer);
+    let (model, lag_selection, kalman) = match opts.method {
+        Method::Ls => {
+            let (model, sel) = fit_ls_flight(flight, opts, &mut notes)?;
+            (model, sel, None)
+        }
+        Method::Kalman => {
+            let (model, sel, outcome) = fit_kalman_flight(flight, opts, &mut notes)?;
+            (model, sel, Some(outcome))
+        }
+    };
+    Ok(Calibration {
+        model,
+        lag_selection,
+        kalman,
+        notes: notes.into_notes(),
+    })
+}
+
+/// The reference channels of `opts` and `mag` reduced by their sum.
+pub(super) fn reduced_mag(
+    flight: &Flight,
+    inputs: &TlInputs,
+    opts: &CalibrateOptions,
+) -> Result<(Vec<String>, Vec<f64>)> {
+    let ref_cols = opts.reference.resolve(flight)?;
+    let sum = reference_sum(flight, &ref_cols, opts.lever_arm.as_ref())?;
+    Ok((ref_cols.clone(), reduced(inputs.mag, &sum)))
+}
+
+/// The segment rule of a fit: split at lines unless told not to.
+pub(super) fn fit_rule(opts: &CalibrateOptions) -> SegmentRule {
+    SegmentRule {
+        split_lines: opts.split_lines,
+        ..SegmentRule::default()
+    }
+}
+
+/// Canonical column name → the file's column name for the model file:
+/// `base` and the reference channels.
+pub(super) fn model_columns(
+    flight: &Flight,
+    base: &[&str],
+    ref_cols: &[String],
+) -> std::collections::BTreeMap<String, String> {
+    let names: Vec<&str> = base
+        .iter()
+        .copied()
+        .chain(ref_cols.iter().map(String::as_str))
+        .collect();
+    flight.column_map_of(&names)
+}
+
+/// The band-pass LS fit on a flight.
+fn fit_ls_flight(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    notes: &mut Notes,
+) -> Result<(TlModel, Option<LagSelection>)> {
+    let cols = TlInputs::of(flight)?;
+    let (ref_cols, y) = reduced_mag(flight, &cols, opts)?;
+    let cols = cols.with_mag(&y);
+    let segs = cols.segments(&fit_rule(opts));
+    let left_out = cols.usable().iter().filter(|u| !**u).count();
+    if left_out > 0 {
+        notes.warn(format!(
+            "{} of {} rows have missing values and are not used by the fit",
+            left_out,
+            flight.n_rows()
+        ));
+    }
+    let segments: Vec<Segment> = segs
+        .kept
+        .iter()
+        .map(|r| cols.whole().slice(r.clone()))
+        .collect();
+    let label = flight.label();
+    let (terms, selection) = choose_terms(&label, &segments, &opts.ls, &opts.eddy_lag, notes)?;
+    let cfg = &LsConfig {
+        design: opts.ls.design.with_terms(terms),
+        ..opts.ls.clone()
+    };
+    notes.stage("fitting");
+    let fit = fit_band_pass_ls(&segments, cfg).in_file(&label)?;
+    for w in &fit.warnings {
+        notes.warn(w.clone());
+    }
+    let model = TlModel {
+        format: MODEL_FORMAT.into(),
+        kind: TL_KIND.into(),
+        design: cfg.design.clone(),
+        method: MethodSettings::Ls(LsSettings {
+            band_hz: cfg.band_hz,
+            filter_order: cfg.filter_order,
+            trim: cfg.trim,
+            lambda: cfg.lambda,
+        }),
+        coefficients: fit
+            .names
+            .iter()
+            .zip(fit.coef.iter().zip(&fit.std))
+            .map(|(n, (v, s))| Coefficient {
+                name: n.clone(),
+                value: *v,
+                std: *s,
+            })
+            .collect(),
+        fit: FitStats {
+            rows: fit.rows,
+            segments: fit.segments_used,
+            condition: fit.condition,
+            residual_rms_nt: fit.residual_rms_nt,
+            warnings: fit.warnings.clone(),
+            eddy_lag_selection: selection.clone(),
+        },
+        columns: model_columns(
+            flight,
+            &["time", "flux_x", "flux_y", "flux_z", "mag"],
+            &ref_cols,
+        ),
+        reference: ref_cols,
+        lever_arm: opts.lever_arm,
+        software_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    Ok((model, selection))
+}

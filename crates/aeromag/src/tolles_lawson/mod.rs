@@ -1,0 +1,29 @@
+//! Fixed-wing interference compensation on flights: calibrate a
+//! Tolles-Lawson model by either method, apply it, and ask what a
+//! calibration flight determines.
+//!
+//! | item | what |
+//! |---|---|
+//! | [`calibrate`] | fit a [`TlModel`] on a calibration flight ([`CalibrateOptions`], [`Method`]) → [`Calibration`] |
+//! | [`Compensator`](crate::Compensator) for [`TlModel`] | the modelled interference of every row of a flight, and the compensated reading |
+//! | [`observability`] | rank, weak combinations and estimability of the coefficients on a flight |
+//!
+//! The algorithms are in [`aeromag_compensation::tolles_lawson`] (band-pass
+//! least squares, the eddy-lag search) and
+//! [`aeromag_compensation::kalman`] (the thesis' Kalman filter and
+//! smoother); this module applies them to flights: columns, segments,
+//! reference channels, the sensor's lever arm, notes and the model file.
+
+mod calibrate;
+mod compensate;
+mod kalman;
+mod kalman_section;
+mod lags;
+mod observability;
+
+pub use calibrate::{CalibrateOptions, Calibration, EddyLag, Method, calibrate};
+pub use compensate::TL_OUTPUT;
+pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
+pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
+
+pub use aeromag_compensation::model_file::TlModel;

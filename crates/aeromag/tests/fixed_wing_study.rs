@@ -1,0 +1,107 @@
+//! The demo's fixed-wing study at full size (seed 1): the compensation,
+//! geology, planning and levelling figures of the spec.
+
+use aeromag::Silent;
+use aeromag::studies::{FixedWingStudy, Study, StudyOutcome, StudySize};
+
+#[test]
+fn the_fixed_wing_study_meets_the_compensation_figures() {
+    let d = tempfile::tempdir().unwrap();
+    let out = FixedWingStudy {
+        seed: 1,
+        out: d.path().to_path_buf(),
+    }
+    .run(StudySize::Full, &mut Silent)
+    .unwrap();
+    let s = out.summary();
+    let c = &s.compensation;
+    let g = |v: Option<f64>, k: &str| v.unwrap_or_else(|| panic!("compensation.{k}"));
+    let (res, floor) = (
+        g(c.residual_rms_ls_nt, "residual_rms_ls_nt"),
+        g(c.noise_floor_nt, "noise_floor_nt"),
+    );
+    assert!(
+        res <= 2.0 * floor,
+        "residual {res} nT > 2 × noise floor {floor} nT"
+    );
+    let (ir, before, after) = (
+        g(c.ir, "ir"),
+        g(c.fom_before_nt, "fom_before_nt"),
+        g(c.fom_after_nt, "fom_after_nt"),
+    );
+    assert!(ir >= 20.0, "IR {ir}");
+    assert!(
+        after < before / 20.0 && after <= 0.5,
+        "FOM {before} → {after} nT"
+    );
+    for f in [
+        "model_ls.json",
+        "model_kalman.json",
+        "survey_comp.csv",
+        "calibration_comp.csv",
+    ] {
+        assert!(d.path().join(f).exists(), "{f}");
+    }
+    // The spec's figure (compensation.md, "Acceptance"): over the gradient
+    // area (the box at 300 m, 8.8 nT/100 m expected there) the Kalman
+    // method's survey residual is at most half of LS's; in the quiet box it
+    // is not worse. Seed 1 measured: gradient area 0.0446 / 0.0138 nT,
+    // quiet 0.0113 / 0.0113 nT. The interference model alone: quiet 1.6 /
+    // 1.3, gradient area 42.8 / 8.4, mild area (1000 m, 1.0 nT/100 m) 4.3 /
+    // 1.9, ×10⁻³ nT.
+    let n = |v: Option<f64>| v.unwrap_or(f64::NAN);
+    let grad = &s.compensation_gradient;
+    assert!(
+        n(grad.residual_rms_kalman_nt) <= 0.5 * n(grad.residual_rms_ls_nt),
+        "{grad:?}"
+    );
+    assert!(
+        n(c.residual_rms_kalman_nt) <= n(c.residual_rms_ls_nt),
+        "{c:?}"
+    );
+    for area in [&s.compensation_gradient, &s.compensation_gradient_mild] {
+        assert!(
+            n(area.interference_rms_kalman_nt) < n(area.interference_rms_ls_nt),
+            "{area:?}"
+        );
+        for v in [
+            area.noise_floor_nt,
+            area.calibration_altitude_m,
+            area.expected_gradient_nt_per_100m,
+        ] {
+            assert!(v.is_some_and(f64::is_finite), "{area:?}");
+        }
+    }
+    assert!(
+        n(c.interference_rms_kalman_nt) <= n(c.interference_rms_ls_nt),
+        "{c:?}"
+    );
+    // Planning: the truncated pattern is shorter and leaves every
+    // coefficient estimable.
+    let p = s.planning.as_ref().expect("planning in a full run");
+    assert!(p.duration_truncated_s < p.duration_full_s, "{p:?}");
+    assert_eq!(p.estimability_full.len(), 16);
+    // Levelling of the compensated survey (seed 1's survey: k = −0.0986 ±
+    // 0.0042 s measured, truth −0.1): k within 10 % and 3σ, and the classic
+    // case (no base station) reduced more than 5×.
+    let l = &s.levelling;
+    assert_eq!(l.crossovers, 100);
+    assert!(
+        (l.k_s - l.k_true_s).abs() <= 0.1 * l.k_true_s.abs()
+            && (l.k_s - l.k_true_s).abs() <= 3.0 * l.k_std_s,
+        "{l:?}"
+    );
+    assert!(
+        l.rms_before_no_base_station_nt >= 5.0 * l.rms_after_no_base_station_nt,
+        "{l:?}"
+    );
+    // The report sections: summary, planning, calibration, Kalman, survey,
+    // levelling.
+    let headings: Vec<String> = out
+        .sections()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.heading)
+        .collect();
+    assert_eq!(headings.len(), 6, "{headings:?}");
+}

@@ -1,0 +1,419 @@
+//! Tolles-Lawson calibration and compensation through the library: the
+//! eddy-lag policy, rows kept and flagged, flights that do not determine
+//! the model, observability, and the Kalman method against band-pass LS
+//! over geology and for another aircraft.
+
+use aeromag::prelude::*;
+use aeromag::simulate::{ScenarioKind, simulate_flight};
+use aeromag::{FlightTable, KalmanOptions};
+
+/// A simulated calibration box.
+fn calibration(seed: u64) -> Flight {
+    simulate_flight(ScenarioKind::Calibration, None, Some(seed)).unwrap()
+}
+
+/// The rows of `f` on line 1 without manoeuvres: one straight heading.
+fn single_heading(f: &Flight) -> Flight {
+    let (line, man) = (f.require("line").unwrap(), f.require("manoeuvre").unwrap());
+    let keep: Vec<usize> = (0..f.n_rows())
+        .filter(|&i| line[i] == 1.0 && man[i] == 0.0)
+        .collect();
+    assert!(keep.len() > 300);
+    let mut t = FlightTable::new();
+    for c in f.columns() {
+        let v = c.values().unwrap();
+        t.add_column(c.name(), keep.iter().map(|&i| v[i]).collect())
+            .unwrap();
+    }
+    Flight::from_table(t).unwrap()
+}
+
+#[test]
+fn eddy_lags_are_chosen_when_significant_and_recorded() {
+    let cal = calibration(5);
+    let fit = calibrate(&cal, &CalibrateOptions::default(), &mut Silent).unwrap();
+    let m = &fit.model;
+    assert!(
+        !fit.notes
+            .iter()
+            .any(|n| n.message.contains("poorly determined")),
+        "{:?}",
+        fit.notes
+    );
+    // The simulated airframe's eddy currents lag (τ 0.15–0.6 s): `auto`
+    // adds one or two lagged groups of nine columns to the 16 classical ones.
+    let lags = m.design.terms.eddy_lags_s().len();
+    assert!((1..=2).contains(&lags), "{}", m.design.terms);
+    assert_eq!(m.coefficients.len(), 16 + 9 * lags);
+    assert!(
+        fit.notes
+            .iter()
+            .any(|n| n.message.contains("chosen (likelihood-ratio test)")),
+        "{:?}",
+        fit.notes
+    );
+    // The model records the search: every candidate with Λ and its threshold.
+    let sel = fit.lag_selection.as_ref().expect("lag selection");
+    assert_eq!(m.fit.eddy_lag_selection.as_ref(), Some(sel));
+    assert!(
+        sel.candidates.len() >= 7
+            && sel
+                .candidates
+                .iter()
+                .all(|c| c.lr_statistic.is_finite() && c.threshold.is_finite()),
+        "{sel:?}"
+    );
+    assert_eq!(sel.taus_s, m.design.terms.eddy_lags_s());
+    // `none`: the classical 16 terms, with a larger residual.
+    let classical = calibrate(
+        &cal,
+        &CalibrateOptions {
+            eddy_lag: EddyLag::None,
+            ..CalibrateOptions::default()
+        },
+        &mut Silent,
+    )
+    .unwrap()
+    .model;
+    assert_eq!(classical.coefficients.len(), 16);
+    assert!(
+        m.fit.residual_rms_nt < 0.8 * classical.fit.residual_rms_nt,
+        "lagged {} vs classical {}",
+        m.fit.residual_rms_nt,
+        classical.fit.residual_rms_nt
+    );
+    // MagNav's convention keeps MagNav's model unless lags are asked for.
+    let magnav = aeromag::compensation::tolles_lawson::Convention::MagNav;
+    assert_eq!(EddyLag::default_for(magnav), EddyLag::None);
+}
+
+#[test]
+fn every_row_is_kept_and_rows_with_missing_inputs_are_flagged() {
+    let cal = calibration(5);
+    let model = calibrate(
+        &cal,
+        &CalibrateOptions {
+            eddy_lag: EddyLag::None,
+            ..CalibrateOptions::default()
+        },
+        &mut Silent,
+    )
+    .unwrap()
+    .model;
+    let mut t = cal.table().clone();
+    let mut fx = t.require("flux_x").unwrap().to_vec();
+    for row in [100, 101, 2000] {
+        fx[row] = f64::NAN;
+    }
+    t.set_column("flux_x", fx).unwrap();
+    let holed = Flight::from_table(t).unwrap();
+    let out = model.compensate(&holed).unwrap();
+    assert_eq!(out.missing, 3);
+    assert_eq!(out.compensated_nt.len(), holed.n_rows());
+    let flagged: Vec<usize> = out
+        .flags()
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| **f == 1.0)
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(flagged, vec![100, 101, 2000]);
+    // The interference is the model's A c on every other row.
+    let interf = model.interference(&holed).unwrap();
+    assert_eq!(
+        interf.iter().filter(|v| v.is_finite()).count(),
+        holed.n_rows() - 3
+    );
+    let table = out.into_table(holed).unwrap();
+    for c in ["mag_interf", "mag_comp", "comp_flag"] {
+        assert!(table.column(c).is_some(), "{c}");
+    }
+}
+
+#[test]
+fn a_single_heading_without_manoeuvres_does_not_determine_the_model() {
+    let one = single_heading(&calibration(6));
+    match calibrate(&one, &CalibrateOptions::default(), &mut Silent) {
+        // Either a warning naming the undetermined terms …
+        Ok(fit) => {
+            let w: Vec<&str> = fit
+                .notes
+                .iter()
+                .filter(|n| n.is_warning())
+                .map(|n| n.message.as_str())
+                .collect();
+            assert!(
+                w.iter().any(|m| m.contains("poorly determined terms")
+                    && (m.contains("e_") || m.contains("i_"))),
+                "{w:?}"
+            );
+        }
+        // … or a failed fit, which is not the user's bad input.
+        Err(e) => assert!(!e.is_bad_input(), "{e}"),
+    }
+}
+
+/// A noise-free turning flight in a constant field fitted without a
+/// band-pass: the induced diagonal equals the bias column times |B|/bt_scale,
+/// the normal equations are singular, and that is a failed fit, not bad
+/// input.
+#[test]
+fn a_singular_fit_is_a_failure_not_bad_input() {
+    let n = 3000;
+    let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1).collect();
+    let mut t = FlightTable::new();
+    let f: Vec<[f64; 3]> = time
+        .iter()
+        .map(|t| {
+            let (a, b) = (0.4 * (1.9 * t).sin(), 0.3 * (1.3 * t + 1.0).sin());
+            [a.cos() * b.cos(), a.sin() * b.cos(), b.sin()].map(|c| 50_000.0 * c)
+        })
+        .collect();
+    t.add_column("time", time.clone()).unwrap();
+    for (k, name) in ["flux_x", "flux_y", "flux_z"].iter().enumerate() {
+        t.add_column(name, f.iter().map(|v| v[k]).collect())
+            .unwrap();
+    }
+    t.add_column(
+        "mag",
+        f.iter().map(|v| 50_000.0 + 3.0 * v[0] / 50_000.0).collect(),
+    )
+    .unwrap();
+    let flight = Flight::from_table(t).unwrap();
+    let opts = CalibrateOptions {
+        ls: aeromag::compensation::tolles_lawson::fit_ls::LsConfig {
+            design: aeromag::compensation::tolles_lawson::Design::new(
+                aeromag::compensation::tolles_lawson::TermSet::parse("p3,i6,bias").unwrap(),
+            ),
+            band_hz: None,
+            ..Default::default()
+        },
+        eddy_lag: EddyLag::None,
+        reference: ReferenceChannels::None,
+        ..CalibrateOptions::default()
+    };
+    let e = calibrate(&flight, &opts, &mut Silent).unwrap_err();
+    assert!(!e.is_bad_input(), "{e}");
+    assert!(e.to_string().contains("singular"), "{e}");
+}
+
+#[test]
+fn observability_tells_a_full_box_from_a_single_heading() {
+    let cal = calibration(8);
+    let terms = aeromag::compensation::tolles_lawson::TermSet::observable16();
+    let full = aeromag::observability(&cal, &terms, None, &mut Silent).unwrap();
+    assert_eq!(full.observability.rank, 16);
+    assert!(full.undetermined().is_empty(), "{:?}", full.undetermined());
+    // One straight leg: the permanent and induced terms are not determined.
+    let one = aeromag::observability(&single_heading(&cal), &terms, None, &mut Silent).unwrap();
+    let un = one.undetermined();
+    assert!(un.contains(&"p_x") && un.contains(&"i_xx"), "{un:?}");
+    assert_eq!(one.observability.estimability.len(), 16);
+}
+
+#[test]
+fn the_kalman_series_hold_the_smoothed_field_and_whitened_innovations() {
+    let cal = simulate_flight(ScenarioKind::CalibrationTruncated, None, Some(7)).unwrap();
+    let opts = CalibrateOptions {
+        kalman: KalmanOptions {
+            series: true,
+            ..KalmanOptions::default()
+        },
+        ..CalibrateOptions::kalman()
+    };
+    let fit = calibrate(&cal, &opts, &mut Silent).unwrap();
+    let k = fit.kalman.expect("Kalman outcome");
+    // Tuned by default.
+    assert!(k.fit.tuning.is_some());
+    let s = k.series.expect("series asked for");
+    for c in s.columns() {
+        assert_eq!(c.len(), cal.n_rows());
+    }
+    let (mut within, mut n) = (0, 0);
+    for i in 100..cal.n_rows() {
+        let (f, v, sd) = (s.field[i], s.innovation[i], s.innovation_std[i]);
+        if f.is_finite() && v.is_finite() && sd.is_finite() {
+            assert!(sd > 0.0);
+            n += 1;
+            within += usize::from(v.abs() <= sd);
+        }
+    }
+    // A noise model that fits keeps about 68 % of the innovations within ±σ.
+    assert!(
+        n > 1000 && (0.55..0.85).contains(&(within as f64 / n as f64)),
+        "{within} of {n} within ±σ"
+    );
+}
+
+/// Errors of a compensated simulated survey, nT, each the RMS over the
+/// survey/tie lines with each line's mean removed (pooled), for scoring
+/// only: `[0]` the interference model alone, `true_interf − mag_interf`;
+/// `[1]` the survey residual of the spec (`compensation.md`, Metrics),
+/// `mag_comp − true_external − true_lag`, which holds the scalar sensor's
+/// noise (0.011 nT).
+fn survey_errors(f: &FlightTable) -> [f64; 2] {
+    let c = |n: &str| f.require(n).unwrap();
+    let (ti, mi, mc, te, tl, line) = (
+        c("true_interf"),
+        c("mag_interf"),
+        c("mag_comp"),
+        c("true_external"),
+        c("true_lag"),
+        c("line"),
+    );
+    let mut by_line: std::collections::BTreeMap<i64, [Vec<f64>; 2]> = Default::default();
+    for i in 0..f.n_rows() {
+        let x = [ti[i], mi[i], mc[i], te[i], tl[i], line[i]];
+        if x.iter().any(|v| !v.is_finite()) {
+            continue;
+        }
+        if x[5] > 0.0 {
+            let e = by_line.entry(x[5] as i64).or_default();
+            e[0].push(x[0] - x[1]);
+            e[1].push(x[2] - x[3] - x[4]);
+        }
+    }
+    let mut out = [0.0; 2];
+    for (j, o) in out.iter_mut().enumerate() {
+        let (mut ss, mut n) = (0.0, 0usize);
+        for e in by_line.values() {
+            let e = &e[j];
+            let mean = e.iter().sum::<f64>() / e.len() as f64;
+            ss += e.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
+            n += e.len();
+        }
+        *o = (ss / n as f64).sqrt();
+    }
+    out
+}
+
+/// Simulate a calibration (`cal_toml`, seed `cal_seed`) and a survey
+/// (`survey_toml`; seed `survey_seed`), calibrate with band-pass LS and
+/// then with the Kalman method for each field order of `kalman_orders`
+/// (`None`: the default), compensate the survey with each model, and
+/// return the survey errors of each ([`survey_errors`]), LS first, nT.
+fn calibrate_and_compare(
+    cal_toml: &str,
+    cal_seed: u64,
+    survey_toml: Option<&str>,
+    survey_seed: u64,
+    lever_arm_m: [f64; 3],
+    kalman_orders: &[Option<usize>],
+) -> Vec<[f64; 2]> {
+    let cal = simulate_flight(ScenarioKind::Calibration, Some(cal_toml), Some(cal_seed)).unwrap();
+    let survey = simulate_flight(ScenarioKind::Survey, survey_toml, Some(survey_seed)).unwrap();
+    let lever_arm = Some(LeverArm {
+        arm_m: lever_arm_m,
+        decimal_year: aeromag::core::time::Date::parse("2025-01-01")
+            .unwrap()
+            .decimal_year(),
+    });
+    let ls = CalibrateOptions {
+        lever_arm,
+        ..CalibrateOptions::default()
+    };
+    let runs =
+        std::iter::once(ls.clone()).chain(kalman_orders.iter().map(|order| CalibrateOptions {
+            method: Method::Kalman,
+            kalman: KalmanOptions {
+                field_order: order.unwrap_or(KalmanOptions::default().field_order),
+                ..KalmanOptions::default()
+            },
+            ..ls.clone()
+        }));
+    runs.map(|opts| {
+        let model = calibrate(&cal, &opts, &mut Silent).unwrap().model;
+        let out = model.compensate(&survey).unwrap();
+        survey_errors(&out.into_table(survey.clone()).unwrap())
+    })
+    .collect()
+}
+
+/// Over realistic geology at 600 m the Kalman method (as `calibrate`
+/// runs it: two-pass lag choice, tuned noise, the default field model of
+/// order 6) leaves at most half the interference-model error of band-pass
+/// LS on an independent survey, and less than with the thesis' order-3
+/// field model. Measured on the demo surveys, seeds 1–5 (×10⁻³ nT, LS /
+/// Kalman order 6): 13.4/3.1, 17.8/2.6, 8.7/2.1, 13.7/2.4, 14.9/6.2 (the
+/// module docs of `kalman::tuning` have the other altitudes and stronger
+/// geology).
+#[test]
+fn kalman_halves_the_least_squares_error_over_geology_at_600_m() {
+    let err = calibrate_and_compare(
+        "[pattern]\naltitude_m = 600.0\n[anomaly]\narea = \"realistic\"\n",
+        4,
+        None,
+        5,
+        [-9.5, 0.0, -0.6],
+        &[None, Some(3)],
+    );
+    let e: Vec<f64> = err.iter().map(|e| e[0]).collect();
+    eprintln!(
+        "interference error LS {:.4} nT, Kalman (order 6) {:.4} nT, order 3 {:.4} nT",
+        e[0], e[1], e[2]
+    );
+    assert!(e[1] <= 0.5 * e[0], "{err:?}");
+    assert!(e[1] < e[2], "{err:?}");
+}
+
+/// Over strong geology (10 nT/100 m at 100 m above ground, the top of the
+/// survey range; ≈ 8 nT/100 m at the calibration height of 300 m) the
+/// band-pass LS model leaves several times the sensor noise on the survey,
+/// and the Kalman method halves the survey residual of the spec itself
+/// (compensated − true external field, noise included), not only the
+/// interference-model error. This needs the cleaned altitude of the
+/// vertical-gradient term and the multi-start noise tuning: with the raw
+/// GNSS altitude (0.2 m white noise) and Nelder–Mead from the defaults,
+/// the Kalman error at 600 m over this geology was 2× the LS error (module
+/// docs of `aeromag_compensation::kalman::altitude`).
+#[test]
+fn kalman_halves_the_survey_residual_over_strong_geology() {
+    let err = calibrate_and_compare(
+        "[pattern]\naltitude_m = 300.0\n[anomaly]\narea = \"realistic\"\ngradient_rms_nt_per_100m = 10.0\n",
+        6,
+        None,
+        7,
+        [-9.5, 0.0, -0.6],
+        &[None],
+    );
+    eprintln!(
+        "strong geology, LS interference {:.4} residual {:.4} nT; Kalman {:.4} / {:.4} nT",
+        err[0][0], err[0][1], err[1][0], err[1][1]
+    );
+    assert!(err[1][1] <= 0.5 * err[0][1], "{err:?}");
+    assert!(err[1][0] <= 0.5 * err[0][0], "{err:?}");
+}
+
+/// A different aircraft, not the one the defaults were tuned on: one engine
+/// in the nose, a 7 m stinger, other eddy-current circuits (a wing with
+/// τ = 0.4 s, between the lags the lag test offers), calibrated at 300 m
+/// over realistic geology. Measured (calibration seeds 1–3, surveys 41–43,
+/// ×10⁻³ nT, LS / Kalman): 300 m 23.7/6.0, 26.3/8.9, 22.1/5.6; 600 m
+/// 10.7/5.9, 16.6/5.8, 8.6/4.5 (before the cleaned altitude and the grid
+/// search of the noise tuning: 6.6, 9.3, 12.0; 6.9, 6.2, 4.4). In the
+/// quiet box at 3 km both methods gave 5.1–5.5 (not re-measured): what the
+/// Tolles-Lawson model itself leaves for this aircraft. On the full survey
+/// residual (sensor noise included) the ratio Kalman / LS is 0.49–0.51 at
+/// 300 m (the preset geology, 2.6 nT/100 m at the box) and 0.62–0.85 at
+/// 600 m.
+#[test]
+fn kalman_halves_the_least_squares_error_for_another_aircraft_at_300_m() {
+    let err = calibrate_and_compare(
+        &format!(
+            "[pattern]\naltitude_m = 300.0\n[anomaly]\narea = \"realistic\"\n{OTHER_AIRCRAFT}"
+        ),
+        1,
+        Some(OTHER_AIRCRAFT),
+        41,
+        [-7.0, 0.0, -0.4],
+        &[None],
+    );
+    eprintln!(
+        "other aircraft, interference error LS {:.4} nT, Kalman {:.4} nT",
+        err[0][0], err[1][0]
+    );
+    assert!(err[1][0] <= 0.5 * err[0][0], "{err:?}");
+}
+
+/// A single-engine aircraft with a short stinger (scenario TOML sections).
+const OTHER_AIRCRAFT: &str = include_str!("data/other_aircraft.toml");

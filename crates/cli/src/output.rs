@@ -1,0 +1,121 @@
+//! Writing a compensated flight and telling the user (`compensate`,
+//! `rotor apply`, `pod apply`).
+
+use crate::exit::bad_input;
+use aeromag::{Compensated, Flight};
+use std::path::Path;
+
+/// Add the compensation columns to the flight, write it to `out` and tell
+/// the user: a warning for the rows that could not be compensated (kept
+/// with the flag 1) and a summary naming the `model` file, with `detail` in
+/// parentheses when not empty.
+pub fn write_compensated(
+    flight: Flight,
+    out: Compensated,
+    path: &Path,
+    model: &Path,
+    detail: &str,
+) -> anyhow::Result<()> {
+    let (missing, output) = (out.missing, out.output);
+    let table = out.into_table(flight)?;
+    aeromag::io::write_csv(&table, path)?;
+    let n = table.n_rows();
+    if missing > 0 {
+        eprintln!(
+            "warning: {missing} of {n} rows could not be compensated ({}); they are kept with {} = 1",
+            output.why_missing, output.flag
+        );
+    }
+    let detail = if detail.is_empty() {
+        String::new()
+    } else {
+        format!(" ({detail})")
+    };
+    println!(
+        "compensated {} of {n} rows with {}{detail}; written to {}",
+        n - missing,
+        model.display(),
+        path.display()
+    );
+    Ok(())
+}
+
+/// `aeromag em simulate` and `aeromag simulate em` (with the default number
+/// of known positions): simulate, write, print the files.
+pub fn simulate_em(
+    config: Option<&Path>,
+    seed: Option<u64>,
+    out: Option<&Path>,
+    print_config: bool,
+    known_positions: usize,
+) -> anyhow::Result<()> {
+    if print_config {
+        print!("{}", toml::to_string(&aeromag::em::command_default())?);
+        return Ok(());
+    }
+    let text = config
+        .map(|p| std::fs::read_to_string(p).map_err(|e| aeromag::Error::read(p, e)))
+        .transpose()?;
+    let file = config.map_or_else(|| "defaults".to_string(), |p| p.display().to_string());
+    let mut cfg = aeromag::em::parse_config(text.as_deref(), &file)?;
+    if let Some(s) = seed {
+        cfg.seed = s;
+    }
+    let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
+    let spinner = crate::progress::spinner("simulating em");
+    let files = aeromag::em::simulate_to_dir(&cfg, known_positions, out)
+        .map_err(|e| anyhow::Error::new(e).context(format!("'{file}'")))?;
+    spinner.finish_and_clear();
+    println!(
+        "simulated em (seed {}): {} frames × 3 channels at {} Hz ({} s, {} epochs of {} samples)",
+        cfg.seed,
+        files.frames,
+        cfg.sample_rate_hz,
+        cfg.duration_s,
+        files.epochs,
+        aeromag::em::study::STUDY_WINDOW_LEN
+    );
+    for (what, p) in [
+        ("raw", &files.raw),
+        ("system", &files.system),
+        ("known", &files.known),
+        ("truth", &files.truth),
+        ("scenario", &files.scenario),
+    ] {
+        println!("  {what:<9} {}", p.display());
+    }
+    Ok(())
+}
+
+/// `aeromag dipole simulate` and `aeromag simulate gradiometer`.
+pub fn simulate_gradiometer(
+    config: Option<&Path>,
+    seed: Option<u64>,
+    out: Option<&Path>,
+    print_config: bool,
+) -> anyhow::Result<()> {
+    let mut cfg = aeromag::gradiometry::read_config(config)?;
+    if print_config {
+        print!("{}", cfg.to_toml()?);
+        return Ok(());
+    }
+    if let Some(s) = seed {
+        cfg.seed = s;
+        cfg.validate().map_err(|e| bad_input!("--seed: {e}"))?;
+    }
+    let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
+    let files = aeromag::gradiometry::simulate_to_dir(&cfg, out)?;
+    println!(
+        "simulated gradiometer ({:?} system, {:?} gradiometer, {:?} {} m; seed {}): {} epochs × {} columns",
+        cfg.system.motion,
+        cfg.system.gradiometer,
+        cfg.system.layout,
+        cfg.system.baseline_m,
+        cfg.seed,
+        files.rows,
+        files.columns
+    );
+    println!("  data      {}", files.csv.display());
+    println!("  scenario  {}", files.scenario.display());
+    Ok(())
+}
