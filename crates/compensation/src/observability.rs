@@ -15,9 +15,11 @@
 //!   eigenvalues are the combinations of coefficients the flight cannot
 //!   separate, spelled out by name.
 //! * **Estimability** (§12): `μ_i = √(P_ii / P⁰_ii)` — near 0 the flight
-//!   determines coefficient `i`, near 1 it leaves it at its prior.
+//!   determines coefficient `i`, near 1 it leaves it at its prior (the
+//!   project's one convention, [`aeromag_core::estimability`]).
 
 use crate::error::{CompError, Result};
+use aeromag_core::estimability::estimability;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::{Deserialize, Serialize};
 
@@ -103,7 +105,7 @@ pub fn observability(
         ));
     }
     let estimability = (0..n)
-        .map(|i| (posterior[(i, i)] / prior[(i, i)]).max(0.0).sqrt())
+        .map(|i| estimability(posterior[(i, i)], prior[(i, i)]))
         .collect();
     Ok(Observability {
         names: names.to_vec(),

@@ -17,16 +17,20 @@
 //! | module | contents |
 //! |---|---|
 //! | [`frames`] | rotations, Euler angles, WGS84 geodetic ↔ geocentric |
+//! | [`estimability`] | the estimability convention μ = σ⁺/σ⁰ (0 = determined) |
 //! | [`field`] | magnetic dipole field and gradients; IGRF-14 main field |
 //! | [`filter`] | Butterworth design, zero-phase filtering, FIR windows |
 //! | [`spectrum`] | Welch power spectral density |
+//! | [`random`] | seeded random streams (ChaCha8, one stream per purpose) |
 //! | [`time`] | calendar dates and decimal years |
 
 pub mod error;
+pub mod estimability;
 pub mod field;
 pub mod filter;
 pub mod frames;
 pub mod quadrature;
+pub mod random;
 pub mod spectrum;
 pub mod time;
 

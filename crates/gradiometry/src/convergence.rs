@@ -33,10 +33,7 @@ use crate::geometry::{Geometry, Layout};
 use crate::parallel::parallel_map;
 use crate::sr_iekf::{EpochResult, IekfConfig, SrState, iterate_epoch};
 use nalgebra::{SVector, Vector3};
-use rand::RngExt;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
+use aeromag_core::random::{normal, stream};
 
 /// Configuration of a convergence map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -134,10 +131,10 @@ impl ConvergenceCase {
         x.fixed_rows_mut::<3>(0).copy_from(&self.position_m);
         x.fixed_rows_mut::<3>(3).copy_from(&self.moment_am2);
         let (z, _) = self.model().eval(&x);
-        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        let mut rng = stream(self.seed, 0);
         // Sensor noise is white per sensor axis; the orthonormal contrasts of
         // white noise are white with the same σ.
-        z + SVector::<f64, 9>::from_fn(|_, _| self.sigma_nt * rng.sample::<f64, _>(StandardNormal))
+        z + SVector::<f64, 9>::from_fn(|_, _| self.sigma_nt * normal(&mut rng))
     }
 
     fn prior(&self, start: &Vector3<f64>) -> SrState<6> {

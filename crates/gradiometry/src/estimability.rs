@@ -1,4 +1,5 @@
-//! Estimability measures (seed `MeasureS`, tables 1–2).
+//! Estimability measures (seed `MeasureS`, tables 1–2), in the project's
+//! one convention ([`aeromag_core::estimability`]).
 //!
 //! For each state component `k`, compare the posterior standard deviation
 //! `σ⁺_k = ‖row_k(S⁺)‖` with the one the filter would have without any
@@ -6,28 +7,28 @@
 //! `PrognosisFK` alone):
 //!
 //! ```text
-//! μ_k = 1 − σ⁺_k / σ⁰_k  ∈ [0, 1]
+//! μ_k = σ⁺_k / σ⁰_k  ∈ [0, 1]
 //! ```
 //!
-//! `μ = 0`: the measurements taught nothing about the component; `μ → 1`:
-//! it is determined by the measurements, independently of the prior.
+//! `μ → 0`: the component is determined by the measurements, independently
+//! of the prior; `μ = 1`: the measurements taught nothing about it. (The
+//! seed reports `1 − μ`; aeromag uses one direction everywhere, the
+//! compensation's `√(P⁺/P⁰)`.)
 
 use crate::sr_iekf::SrState;
+use aeromag_core::estimability::estimability;
 use nalgebra::SVector;
 
-/// `MeasureS`: `μ_k = 1 − σ⁺_k/σ⁰_k` per component (0 when `σ⁰_k = 0`).
+/// `MeasureS`: `μ_k = σ⁺_k/σ⁰_k` per component (1 when `σ⁰_k = 0`).
 pub fn measure_s<const N: usize>(
     posterior: &SrState<N>,
     no_measurements: &SrState<N>,
 ) -> SVector<f64, N> {
-    let sp = posterior.sigma();
-    let s0 = no_measurements.sigma();
     SVector::from_fn(|k, _| {
-        if s0[k] > 0.0 {
-            (1.0 - sp[k] / s0[k]).clamp(0.0, 1.0)
-        } else {
-            0.0
-        }
+        estimability(
+            posterior.s.row(k).norm_squared(),
+            no_measurements.s.row(k).norm_squared(),
+        )
     })
 }
 
@@ -43,9 +44,9 @@ mod tests {
             &SVector::<f64, 2>::new(10.0, 10.0),
         );
         let mut post = prior;
-        processing(&mut post, &SVector::<f64, 2>::new(1.0, 0.0), 0.0, 1.0);
+        processing(&mut post, &SVector::<f64, 2>::new(1.0, 0.0), 0.0, 1.0).unwrap();
         let mu = measure_s(&post, &prior);
-        assert!((mu[0] - (1.0 - (1.0f64 / 101.0).sqrt() * 10.0 / 10.0)).abs() < 1e-12);
-        assert_eq!(mu[1], 0.0);
+        assert!((mu[0] - (1.0f64 / 101.0).sqrt()).abs() < 1e-12);
+        assert_eq!(mu[1], 1.0);
     }
 }

@@ -130,7 +130,7 @@ pub fn run_pass_relinearised<const N: usize, const Z: usize, F: Forward<N, Z>>(
             prior.x += e.offset;
             blind = prognosis(&blind, &e.transition, &e.s_q);
             let (hx, hj) = e.model.eval(xl);
-            state = update_linearised(&prior, &e.z, xl, &hx, &hj, sigma2);
+            state = update_linearised(&prior, &e.z, xl, &hx, &hj, sigma2)?;
             if !state.x.iter().all(|v| v.is_finite()) {
                 return Err(GradiometryError::NotFinite {
                     name: "pass estimate",

@@ -28,7 +28,9 @@
 //!   with a fixed bias `b_i ~ N(0, σ_b²)` per sensor and white noise
 //!   `n ~ N(0, σ²)`, `σ`, `σ_b` per sensor type.
 //!
-//! Randomness: `ChaCha8Rng` seeded by `seed`, one stream per purpose.
+//! Randomness: the streams of [`aeromag_core::random`] of `seed`, one per
+//! purpose (biases, noise, variations). Geodetic positions of local points:
+//! WGS84 flat-earth offsets about the origin ([`Geodetic::offset_by`]).
 
 use crate::decorrelate::{contrasts_scalar, contrasts_vector};
 use crate::error::{GradiometryError, Result, positive};
@@ -42,10 +44,8 @@ use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
 use nalgebra::{Matrix3, SVector, Vector3};
+use aeromag_core::random::{self, ChaCha8Rng, normal};
 use rand::RngExt;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use std::borrow::Borrow;
 
 /// Which body moves (`"stationary"`, `"mobile"` in scenario files).
@@ -234,23 +234,28 @@ impl std::borrow::Borrow<Epoch> for SimEpoch {
     }
 }
 
+/// Geodetic position of a local NED point (m) about `origin`: the WGS84
+/// flat-earth relation of [`Geodetic::offset_by`] (radii of curvature at
+/// the origin), the same as every other simulator of aeromag.
 fn local_to_geodetic(origin: &Geodetic, p_ned: &Vector3<f64>) -> Geodetic {
-    const R: f64 = 6_371_000.0;
-    Geodetic {
-        lat_deg: origin.lat_deg + (p_ned.x / R).to_degrees(),
-        lon_deg: origin.lon_deg + (p_ned.y / (R * origin.lat_deg.to_radians().cos())).to_degrees(),
-        alt_m: origin.alt_m - p_ned.z,
-    }
+    origin.offset_by(p_ned.x, p_ned.y, origin.alt_m - p_ned.z)
 }
 
-fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    rng.sample(StandardNormal)
+/// The random streams of a gradiometer scenario (numbers fixed: never
+/// renumber), drawn with the scheme of [`aeromag_core::random`].
+#[derive(Debug, Clone, Copy)]
+#[repr(u64)]
+enum Stream {
+    /// Sensor biases.
+    Bias = 1,
+    /// Sensor noise.
+    Noise = 2,
+    /// Geomagnetic variations.
+    Variation = 3,
 }
 
-fn rng(seed: u64, stream: u64) -> ChaCha8Rng {
-    let mut r = ChaCha8Rng::seed_from_u64(seed);
-    r.set_stream(stream);
-    r
+fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
+    random::stream(seed, stream as u64)
 }
 
 /// Simulate the scenario (deterministic for a given `seed`).
@@ -259,9 +264,9 @@ pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
     let igrf = IgrfModel::new(s.decimal_year).map_err(|_| GradiometryError::NotFinite {
         name: "decimal_year",
     })?;
-    let mut bias_rng = rng(s.seed, 1);
-    let mut noise_rng = rng(s.seed, 2);
-    let mut var_rng = rng(s.seed, 3);
+    let mut bias_rng = rng(s.seed, Stream::Bias);
+    let mut noise_rng = rng(s.seed, Stream::Noise);
+    let mut var_rng = rng(s.seed, Stream::Variation);
     let bias_v: [Vector3<f64>; 4] = std::array::from_fn(|_| {
         Vector3::new(
             normal(&mut bias_rng),

@@ -1,21 +1,29 @@
 //! Square-root iterated extended Kalman filter (seed `004_…`, tables 1–2,
 //! fig. 1/3; spec `gradiometry.md`, "Estimator").
 //!
-//! The covariance is kept as a square root, `P = S Sᵀ`.
+//! The covariance is kept as an **upper-triangular** square root,
+//! `P = S Sᵀ`, and both steps are those of the project's square-root Kalman
+//! toolkit ([`aeromag_estimation::kalman`], also used by the compensation's
+//! filter), so the factor never goes through `P`:
 //!
 //! **Prediction** ([`prognosis`], the seed's `PrognosisFK`):
-//! `x⁻ = F x⁺`, and `S⁻` is the lower-triangular factor with
-//! `S⁻ S⁻ᵀ = F S⁺ S⁺ᵀ Fᵀ + S_Q S_Qᵀ`, obtained from the QR decomposition
-//! of the stacked `2N×N` matrix `[(F S⁺)ᵀ; S_Q]` (`S⁻ = Rᵀ`), never forming
-//! `P`.
+//! `x⁻ = F x⁺`, and `S⁻` is the upper-triangular factor with
+//! `S⁻ S⁻ᵀ = F S⁺ S⁺ᵀ Fᵀ + S_Q S_Qᵀ`, obtained by re-triangularising the
+//! wide factor `[S_Q, F S⁺]` with Householder reflections
+//! ([`triangularize_upper`]).
 //!
-//! **Scalar update** ([`processing`], `ProcessingFK`, Potter's form): for a
-//! measurement `y = h x + v`, `var v = σ²`, innovation `ν`:
+//! **Scalar update** ([`processing`], `ProcessingFK`): for a measurement
+//! `y = h x + v`, `var v = σ²`, innovation `ν`, Carlson's triangular form
+//! of the square-root update ([`carlson_update`]):
 //!
 //! ```text
 //! f = Sᵀ h,  α = fᵀ f + σ²,  K = S f / α,  x ← x + K ν,
-//! S ← S − β (S f) fᵀ,  β = 1 / (α + √(α σ²))      ⇒  S Sᵀ = P − K hᵀ P
+//! S ← triangular S⁺ with S⁺ S⁺ᵀ = S (I − f fᵀ/α) Sᵀ = P − K hᵀ P
 //! ```
+//!
+//! (The seed writes the update in Potter's form, `S ← S − β (S f) fᵀ`,
+//! which gives a full factor of the same `P`; the triangular one costs half
+//! and keeps the prediction's input triangular.)
 //!
 //! **Iteration per epoch** ([`iterate_epoch`]): with prior `(x⁻, S⁻)` and
 //! the epoch's white contrasts `z` (noise σ each), relinearise at the
@@ -28,14 +36,18 @@
 
 use crate::error::{GradiometryError, Result, positive};
 use crate::forward::Forward;
-use nalgebra::{DMatrix, SMatrix, SVector};
+use aeromag_estimation::kalman::carlson::carlson_update;
+use aeromag_estimation::kalman::triangularize::triangularize_upper;
+use nalgebra::{SMatrix, SVector};
 
 /// State estimate and covariance square root (`P = S Sᵀ`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SrState<const N: usize> {
     /// State estimate (m, A·m²).
     pub x: SVector<f64, N>,
-    /// Covariance square root, same units as `x`.
+    /// Covariance square root `S` (`P = S Sᵀ`), **upper triangular** (the
+    /// entries below the diagonal are zero and never read), same units as
+    /// `x`.
     pub s: SMatrix<f64, N, N>,
 }
 
@@ -54,41 +66,57 @@ impl<const N: usize> SrState<N> {
     }
 }
 
-/// `PrognosisFK`: `x⁻ = F x`, `S⁻ = tri([F S, diag(s_q)])` (module docs).
+/// `PrognosisFK`: `x⁻ = F x`, `S⁻ = tri([diag(s_q), F S])` (module docs).
 pub fn prognosis<const N: usize>(
     state: &SrState<N>,
     f: &SMatrix<f64, N, N>,
     s_q: &SVector<f64, N>,
 ) -> SrState<N> {
     let fs = f * state.s;
-    let a = DMatrix::from_fn(2 * N, N, |i, j| {
-        if i < N {
-            fs[(j, i)]
-        } else if i - N == j {
-            s_q[j]
-        } else {
-            0.0
+    // The wide factor, row-major, N × 2N: the process-noise columns first.
+    let c = 2 * N;
+    let mut a = vec![0.0; N * c];
+    for i in 0..N {
+        a[i * c + i] = s_q[i];
+        for j in 0..N {
+            a[i * c + N + j] = fs[(i, j)];
         }
-    });
-    let r = a.qr().r();
-    let s = SMatrix::<f64, N, N>::from_fn(|i, j| r[(j, i)]);
-    SrState { x: f * state.x, s }
+    }
+    let mut work = vec![0.0; c];
+    triangularize_upper(&mut a, N, c, &mut work);
+    SrState {
+        x: f * state.x,
+        s: SMatrix::from_fn(|i, j| a[i * c + N + j]),
+    }
 }
 
-/// `ProcessingFK`: Potter scalar update with measurement row `h`,
-/// innovation `nu` and measurement variance `sigma2` (module docs).
+/// `ProcessingFK`: the scalar update with measurement row `h`, innovation
+/// `nu` and measurement variance `sigma2 > 0` (Carlson's triangular form,
+/// module docs). Errors (state untouched) on a non-finite row or
+/// innovation.
 pub fn processing<const N: usize>(
     state: &mut SrState<N>,
     h: &SVector<f64, N>,
     nu: f64,
     sigma2: f64,
-) {
-    let f = state.s.transpose() * h;
-    let alpha = f.norm_squared() + sigma2;
-    let sf = state.s * f;
-    state.x += sf * (nu / alpha);
-    let beta = 1.0 / (alpha + (alpha * sigma2).sqrt());
-    state.s -= sf * f.transpose() * beta;
+) -> Result<()> {
+    // Carlson's update takes the measurement y with ν = y − hᵀx.
+    let y = nu + h.dot(&state.x);
+    let mut gain = [0.0; N];
+    let mut work = vec![0.0; 3 * N];
+    carlson_update(
+        state.s.as_mut_slice(),
+        state.x.as_mut_slice(),
+        h.as_slice(),
+        y,
+        sigma2,
+        &mut gain,
+        &mut work,
+    )
+    .map_err(|_| GradiometryError::NotFinite {
+        name: "IEKF measurement or its row",
+    })?;
+    Ok(())
 }
 
 /// One pass of the `Z` scalar updates from `prior`, linearised about `x_lin`
@@ -101,14 +129,14 @@ pub fn update_linearised<const N: usize, const Z: usize>(
     hx: &SVector<f64, Z>,
     hj: &SMatrix<f64, Z, N>,
     sigma2: f64,
-) -> SrState<N> {
+) -> Result<SrState<N>> {
     let mut post = *prior;
     for j in 0..Z {
         let row = hj.row(j).transpose();
         let nu = z[j] - hx[j] - row.dot(&(post.x - x_lin));
-        processing(&mut post, &row, nu, sigma2);
+        processing(&mut post, &row, nu, sigma2)?;
     }
-    post
+    Ok(post)
 }
 
 /// Settings of the per-epoch iteration.
@@ -169,7 +197,7 @@ pub fn iterate_epoch<const N: usize, const Z: usize, F: Forward<N, Z>>(
     let mut converged = false;
     while iterations < cfg.max_iterations.max(1) {
         iterations += 1;
-        post = update_linearised(prior, z, &xi, &hx, &hj, sigma2);
+        post = update_linearised(prior, z, &xi, &hx, &hj, sigma2)?;
         if !post.x.iter().all(|v| v.is_finite()) {
             return Err(GradiometryError::NotFinite {
                 name: "IEKF estimate",
@@ -205,8 +233,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn potter_update_matches_the_covariance_form() {
-        let s = SMatrix::<f64, 3, 3>::new(2.0, 0.0, 0.0, 0.5, 1.0, 0.0, -0.3, 0.2, 0.7);
+    fn scalar_update_matches_the_covariance_form() {
+        let s = SMatrix::<f64, 3, 3>::new(2.0, 0.5, -0.3, 0.0, 1.0, 0.2, 0.0, 0.0, 0.7);
         let mut st = SrState {
             x: SVector::<f64, 3>::zeros(),
             s,
@@ -214,7 +242,7 @@ mod tests {
         let p = s * s.transpose();
         let h = SVector::<f64, 3>::new(0.3, -1.0, 2.0);
         let r = 0.4;
-        processing(&mut st, &h, 1.7, r);
+        processing(&mut st, &h, 1.7, r).unwrap();
         let ph = p * h;
         let k = ph / (h.dot(&ph) + r);
         let p_plus = p - k * ph.transpose();
@@ -223,11 +251,11 @@ mod tests {
     }
 
     proptest::proptest! {
-        /// Potter's update keeps `S Sᵀ` equal to the covariance-form
-        /// posterior and the estimate equal to `x + K ν` for any prior root,
-        /// measurement row and variance.
+        /// The triangular update keeps `S Sᵀ` equal to the covariance-form
+        /// posterior and the estimate equal to `x + K ν` for any upper-
+        /// triangular prior root, measurement row and variance.
         #[test]
-        fn potter_update_is_exact(
+        fn scalar_update_is_exact(
             d in proptest::collection::vec(0.1f64..10.0, 4),
             off in proptest::collection::vec(-3.0f64..3.0, 6),
             h in proptest::collection::vec(-5.0f64..5.0, 4),
@@ -238,14 +266,14 @@ mod tests {
             let mut k = 0;
             for i in 1..4 {
                 for j in 0..i {
-                    s[(i, j)] = off[k];
+                    s[(j, i)] = off[k];
                     k += 1;
                 }
             }
             let h = SVector::<f64, 4>::from_column_slice(&h);
             let p = s * s.transpose();
             let mut st = SrState { x: SVector::<f64, 4>::zeros(), s };
-            processing(&mut st, &h, nu, r);
+            processing(&mut st, &h, nu, r).unwrap();
             let ph = p * h;
             let gain = ph / (h.dot(&ph) + r);
             let p_plus = p - gain * ph.transpose();
@@ -256,7 +284,7 @@ mod tests {
 
     #[test]
     fn prognosis_matches_the_covariance_form() {
-        let s = SMatrix::<f64, 3, 3>::new(2.0, 0.0, 0.0, 0.5, 1.0, 0.0, -0.3, 0.2, 0.7);
+        let s = SMatrix::<f64, 3, 3>::new(2.0, 0.5, -0.3, 0.0, 1.0, 0.2, 0.0, 0.0, 0.7);
         let f = SMatrix::<f64, 3, 3>::new(1.0, 0.1, 0.0, 0.0, 1.0, 0.2, 0.05, 0.0, 1.0);
         let q = SVector::<f64, 3>::new(0.1, 0.2, 0.3);
         let x = SVector::<f64, 3>::new(1.0, 2.0, 3.0);
@@ -265,7 +293,7 @@ mod tests {
             f * s * s.transpose() * f.transpose() + SMatrix::from_diagonal(&q.component_mul(&q));
         assert!((out.s * out.s.transpose() - p).norm() < 1e-12);
         assert!((out.x - f * x).norm() < 1e-15);
-        // lower triangular
-        assert!(out.s[(0, 1)].abs() + out.s[(0, 2)].abs() + out.s[(1, 2)].abs() < 1e-15);
+        // upper triangular, as the scalar update needs it
+        assert_eq!(out.s[(1, 0)].abs() + out.s[(2, 0)].abs() + out.s[(2, 1)].abs(), 0.0);
     }
 }

@@ -303,7 +303,8 @@ pub struct Track {
     pub x: Vec<[f64; 6]>,
     /// Their standard deviations.
     pub sd: Vec<[f64; 6]>,
-    /// Estimability of each component (`MeasureS`).
+    /// Estimability of each component (`MeasureS`, μ = σ⁺/σ⁰: 0 =
+    /// determined by the measurements, 1 = left at its prior).
     pub mu: Vec<[f64; 6]>,
     /// Whether the object was detected at the epoch.
     pub detected: Vec<bool>,
@@ -373,7 +374,8 @@ impl Track {
 
     /// The estimates as a table: `time, detected, x_m, y_m, z_m, mx_am2,
     /// my_am2, mz_am2`, their standard deviations `sd_…`, the estimability
-    /// measures `mu_…`, `iterations, residual_nt, converged`.
+    /// measures `mu_…` (μ = σ⁺/σ⁰, 0 = determined), `iterations,
+    /// residual_nt, converged`.
     pub fn to_table(&self, time: &[f64]) -> Result<FlightTable> {
         let mut t = FlightTable::new();
         t.add_column("time", time.to_vec())?;

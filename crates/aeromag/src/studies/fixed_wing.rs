@@ -703,11 +703,12 @@ fn planning_section(p: &PlanningSummary, o: &[Observability; 2]) -> Result<Repor
     let mut r = ReportSection::new("Calibration planning: full and truncated patterns");
     r.paragraph(format!(
         "The truncated pattern takes {:.0} s against {:.0} s ({:.0} % less flight time). The estimability \
-         measure μ = sqrt(P_post/P_prior) of each coefficient (0: determined by the flight, 1: not) and the \
+         of each coefficient, {} (the project's one convention, also the gradiometer's), and the \
          residual each calibration leaves on the independent survey show what the shorter flight costs.",
         d[1],
         d[0],
-        100.0 * (1.0 - d[1] / d[0])
+        100.0 * (1.0 - d[1] / d[0]),
+        crate::core::estimability::CONVENTION
     ));
     r.table(Table::new(
         [

@@ -4,6 +4,7 @@
 //! convergence maps of the seed's fig. 2 (the demo's `gradiometry` group).
 
 use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed};
+use crate::core::estimability::CONVENTION;
 use crate::error::Result;
 use crate::gradiometry::{both_maps, locate_pass, map_figures};
 use crate::observer::Observer;
@@ -149,7 +150,7 @@ fn pass_plots() -> Result<Vec<(LinePlot, String)>> {
     let mut mu = LinePlot::new(
         "Estimability MeasureS over the pass",
         "time (s)",
-        "μ = 1 − σ⁺/σ⁰",
+        "μ = σ⁺/σ⁰",
     );
     for (k, n) in ["x", "y", "z", "Mx", "My", "Mz"].iter().enumerate() {
         mu = mu.with_series(Series::line(
@@ -160,8 +161,7 @@ fn pass_plots() -> Result<Vec<(LinePlot, String)>> {
     }
     out.push((
         mu,
-        "Estimability of each component (0: nothing learnt from the measurements, 1: determined by them)."
-            .into(),
+        format!("Estimability of each component, {CONVENTION} (the convention of the compensation's observability).",),
     ));
     Ok(out)
 }

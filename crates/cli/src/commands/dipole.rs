@@ -77,7 +77,8 @@ pub struct SimulateArgs {
 /// settings come from the scenario file (the one `simulate` writes) and the
 /// flags. Writes EST.csv: `time, detected, x_m, y_m, z_m, mx_am2, my_am2,
 /// mz_am2` (body frame), their standard deviations `sd_…`, `iterations,
-/// residual_nt, converged` and the estimability measures `mu_…`.
+/// residual_nt, converged` and the estimability measures `mu_…`
+/// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior).
 ///
 /// Example: `aeromag dipole locate --input grad/gradiometer.csv --config grad/gradiometer.toml --out est.csv`
 #[derive(Debug, clap::Args)]

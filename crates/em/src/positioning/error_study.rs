@@ -13,7 +13,6 @@ use super::{
 };
 use crate::{EmError, Result};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
@@ -92,7 +91,7 @@ pub fn error_study(
             reason: "zero half-space normal".into(),
         });
     }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut rng = aeromag_core::random::stream(seed, 0);
     let normal = Normal::new(0.0, 1.0).map_err(|e| EmError::InvalidArgument {
         reason: e.to_string(),
     })?;

@@ -6,7 +6,7 @@ use crate::positioning::Pose;
 use crate::{EmError, Result};
 use aeromag_core::frames::Attitude;
 use nalgebra::{Matrix3, Vector3};
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
 
@@ -160,7 +160,8 @@ impl EmScenario {
                 });
             }
         }
-        let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+        // Stream 0 of the seed: the system's couplings and distortions.
+        let mut rng = aeromag_core::random::stream(c.seed, 0);
         let [lo, hi] = c.cross_coupling;
         let hi = hi.max(lo + 1e-12);
         let chi = [0, 1, 2].map(|_| {

@@ -14,8 +14,7 @@ use crate::detection::Complex64;
 use crate::positioning::Pose;
 use aeromag_core::field::dipole::dipole_matrix;
 use nalgebra::{Matrix3, Vector3};
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::RngExt;
 use rand_distr::{Distribution, Exp, LogNormal, Normal};
 use std::f64::consts::TAU;
 
@@ -72,6 +71,13 @@ fn amplitudes(
     out
 }
 
+/// Stream number ([`aeromag_core::random`]) of the noise and interference
+/// of a record that starts at frame `n₀` of the flight: `2³² + n₀`, so that
+/// records starting at different frames draw independent noise.
+pub fn noise_stream(start_frame: u64) -> u64 {
+    (1 << 32) + start_frame
+}
+
 /// Synthesize the record of `scenario`.
 ///
 /// Errors only through invalid distributions (non-finite configuration).
@@ -116,8 +122,8 @@ pub fn synthesize(scenario: &EmScenario) -> Result<EmRecording> {
         a0 = a1;
     }
 
-    // Noise and interference from a separate stream of the same seed.
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed ^ 0x5EED_0E11 ^ start_index.rotate_left(17));
+    // Noise and interference: the record's own stream of the seed.
+    let mut rng = aeromag_core::random::stream(c.seed, noise_stream(start_index));
     let normal = Normal::new(0.0, 1.0).map_err(|e| bad(&e))?;
     for v in samples.iter_mut() {
         *v += (c.coil_noise_v * normal.sample(&mut rng)) as f32;

@@ -3,7 +3,7 @@
 //!
 //! Every random draw of the simulator comes from a [`ChaCha8Rng`] seeded with
 //! the scenario seed and switched to a component-specific *stream*
-//! ([`Stream`]). Streams are independent, so that adding a component or
+//! ([`Stream`]), the scheme of [`aeromag_core::random`]. Streams are independent, so that adding a component or
 //! changing the length of one process does not change the draws of another:
 //! the anomaly of a survey area stays the same when the diurnal settings
 //! change. The same seed gives bit-identical output on the same build and
@@ -17,10 +17,8 @@
 pub mod gauss_markov;
 pub mod spectral;
 
-use rand::RngExt;
-use rand::SeedableRng;
+pub use aeromag_core::random::{normal, normals};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 
 /// The independent random streams of the simulator (the discriminant is the
 /// ChaCha stream number; never renumber an existing entry).
@@ -57,20 +55,7 @@ pub enum Stream {
 
 /// A generator for `stream` of the scenario `seed`.
 pub fn rng_for(seed: u64, stream: Stream) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(stream as u64);
-    rng
-}
-
-/// One standard normal draw.
-#[inline]
-pub fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    rng.sample(StandardNormal)
-}
-
-/// `n` independent standard normal draws.
-pub fn normals(rng: &mut ChaCha8Rng, n: usize) -> Vec<f64> {
-    (0..n).map(|_| normal(rng)).collect()
+    aeromag_core::random::stream(seed, stream as u64)
 }
 
 #[cfg(test)]
