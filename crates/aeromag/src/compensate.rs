@@ -32,6 +32,19 @@ pub const COMPENSATED: &str = "mag_comp";
 ///
 /// Implementors provide [`Compensator::output`] and
 /// [`Compensator::interference_observed`]; the rest follows.
+///
+/// ```
+/// use aeromag::prelude::*;
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// let cal = simulate_flight(ScenarioKind::Calibration, None, Some(1))?;
+/// let model: TlModel = calibrate(&cal, &CalibrateOptions::default(), &mut Silent)?.model;
+/// // Any model (Tolles-Lawson, rotor, pod file) applies itself to a flight.
+/// let survey = simulate_flight(ScenarioKind::Survey, None, Some(2))?;
+/// let out = model.compensate(&survey)?;
+/// let table = out.into_flight(survey)?; // + mag_interf, mag_comp, comp_flag
+/// assert!(table.column("mag_comp").is_some());
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub trait Compensator {
     /// The columns this model's compensation adds.
     fn output(&self) -> OutputColumns;

@@ -147,6 +147,21 @@ impl Levelled {
 /// Reads `time`, `lat`, `lon`, `alt`, `line`, the value and rate columns,
 /// the reference channels, and the attitude with a lever arm. Bad input if
 /// the flight already has the output columns.
+///
+/// ```
+/// use aeromag::level::{LevelOptions, level};
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// use aeromag::Silent;
+/// // A small simulated survey: five lines and three ties, levelled as recorded.
+/// let pattern = "[pattern]\nline_count = 5\nline_length_m = 5000.0\ntie_count = 3\n";
+/// let survey = simulate_flight(ScenarioKind::Survey, Some(pattern), Some(7))?;
+/// let lev = level(&survey, &LevelOptions::default(), &mut Silent)?;
+/// let fit = &lev.levelling.fit;
+/// assert!(!lev.levelling.crossovers.crossovers.is_empty());
+/// assert!(fit.rms_after_nt <= fit.rms_before_nt);
+/// println!("k = {:.3} ± {:.3} s", fit.k_s, fit.k_std_s);
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn level(
     flight: &Flight,
     opts: &LevelOptions,

@@ -258,6 +258,26 @@ fn rates(model: &PodModelFile, hs: &[Heading]) -> Result<(Vec<HeadingRate>, f64)
 /// `sources`: equivalent source points of the dipole array (body axes, m;
 /// `None`: the library's default points). The model records the
 /// compensation rate of each learning heading.
+///
+/// ```
+/// use aeromag::pod::{PodMethod, PodSetup, apply_pod, fit_pod};
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// // The seed's installation: 40 m cable, 45° inclination.
+/// let setup = PodSetup {
+///     cable_length_m: 40.0,
+///     attach_m: [0.0, 0.0, 1.2],
+///     inclination_deg: 45.0,
+///     declination_deg: 0.0,
+///     grad_north_nt_per_km: 5.91,
+///     grad_up_nt_per_km: -25.91,
+/// };
+/// let learn = simulate_flight(ScenarioKind::Pod, Some("swing_sine = true\n"), None)?;
+/// let model = fit_pod(&learn, &setup, PodMethod::DipoleArray, None)?;
+/// let test = simulate_flight(ScenarioKind::Pod, Some("swing_sine = true\n"), Some(1001))?;
+/// let applied = apply_pod(&model, &test)?;
+/// assert!(applied.per_heading.iter().all(|h| h.rate > 0.9)); // > 90 % removed
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn fit_pod(
     t: &Flight,
     setup: &PodSetup,

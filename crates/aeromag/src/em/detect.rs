@@ -59,6 +59,23 @@ pub struct Detection {
 /// receiver axes. With a 4-term window every tone on the bin grid f_s/N at
 /// least 4 bins from a detector is rejected exactly; a plan off the grid is
 /// a warning.
+///
+/// ```
+/// use aeromag::em::files::{load_table, read_system};
+/// use aeromag::em::{DetectOptions, HalfSpace, calibrate, command_default, detect, known_points, locate, simulate_to_dir};
+/// use aeromag::Silent;
+/// let dir = std::env::temp_dir().join(format!("aeromag-doc-em-{}", std::process::id()));
+/// // Simulate a record with 8 known positions, then the file chain.
+/// let files = simulate_to_dir(&command_default(), 8, &dir)?;
+/// let detected = detect(&files.raw, &DetectOptions::default(), &mut Silent)?;
+/// let known = known_points(&load_table(&files.known)?, &detected.epochs)?;
+/// let cal = calibrate(&detected.epochs, &known, &read_system(&files.system)?, &HalfSpace::default())?;
+/// let poses = locate(&detected.epochs, &cal.file, &HalfSpace::default(), &mut Silent)?;
+/// assert_eq!(poses.failed(), 0);
+/// assert!(cal.polarization_ratio_after < cal.polarization_ratio_before);
+/// # std::fs::remove_dir_all(&dir).ok();
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) -> Result<Detection> {
     let mut notes = Notes::new(observer);
     let file = path.display().to_string();

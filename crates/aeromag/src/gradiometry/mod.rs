@@ -115,6 +115,16 @@ pub struct CrlbReport {
 /// The Cramér–Rao bound (standard deviation of each parameter) of the
 /// configured pass: geometry, sensor noise, trajectory and object of the
 /// scenario, the known motion, white contrasts.
+///
+/// ```
+/// use aeromag::gradiometry::config::GradiometerConfig;
+/// use aeromag::gradiometry::{STATE_NAMES, crlb};
+/// let bound = crlb(&GradiometerConfig::default())?;
+/// for (name, sd) in STATE_NAMES.iter().zip(bound.end.std) {
+///     assert!(sd > 0.0 && sd.is_finite(), "{name}");
+/// }
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn crlb(cfg: &GradiometerConfig) -> Result<CrlbReport> {
     let sim = simulate(&cfg.scenario()?)?;
     let closest = (0..sim.len())
@@ -403,6 +413,26 @@ impl Track {
 /// square-root IEKF: detection, multi-start or the seed's plain IEKF,
 /// filter or re-linearised passes). `positions` is the object's known
 /// position (body frame, m), used by the scalar gradiometer.
+///
+/// ```
+/// use aeromag::gradiometry::config::GradiometerConfig;
+/// use aeromag::gradiometry::sim::simulate;
+/// use aeromag::gradiometry::{locate_pass, pass_table, read_pass};
+/// use aeromag::{Flight, FlightTable};
+/// // The default pass as a survey would record it: without its truth columns.
+/// let cfg = GradiometerConfig::default();
+/// let table = pass_table(&cfg, &simulate(&cfg.scenario()?)?)?;
+/// let mut recorded = FlightTable::new();
+/// for c in table.columns().iter().filter(|c| !c.name().starts_with("true_")) {
+///     recorded.add_column(c.name(), c.values().unwrap_or_default().to_vec())?;
+/// }
+/// let pass = read_pass(&Flight::from_table(recorded)?, &cfg)?;
+/// let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
+/// let last = track.x.len() - 1;
+/// assert!(track.detected[last]);
+/// println!("object at {:?} m (body frame)", &track.x[last][..3]);
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn locate_pass<E: Borrow<Epoch>>(
     cfg: &GradiometerConfig,
     epochs: &[E],

@@ -170,6 +170,19 @@ fn phase_refinement(window_s: f64) -> SlowAngleOptions {
 /// offset by the fit residual, a slowly varying correction). Dropouts of up
 /// to 0.1 s are bridged by linear interpolation; with several stretches of
 /// at least 10 s the parameters are refined on all of them.
+///
+/// ```
+/// use aeromag::prelude::*;
+/// use aeromag::rotor::{RotorOptions, RotorPreset, fit_rotor};
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// // Learn on one simulated helicopter flight, apply to another.
+/// let learn = simulate_flight(ScenarioKind::Helicopter, None, Some(11))?;
+/// let other = simulate_flight(ScenarioKind::Helicopter, None, Some(12))?;
+/// let fit = fit_rotor(&learn, &RotorOptions::preset(RotorPreset::AeromagSimHelicopter), &mut Silent)?;
+/// let interference = fit.model.interference(&other)?; // nT, one per row
+/// assert_eq!(interference.len(), other.n_rows());
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn fit_rotor(
     flight: &Flight,
     opts: &RotorOptions,

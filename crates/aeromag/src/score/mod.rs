@@ -79,6 +79,19 @@ fn segments(t: &Flight, comp: &[f64]) -> Result<Vec<Range<usize>>> {
 /// moved to the sensor ([`reference_sum`]).
 ///
 /// Truth columns are read only to score, never to compute a result.
+///
+/// ```
+/// use aeromag::prelude::*;
+/// use aeromag::score::score;
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// let cal = simulate_flight(ScenarioKind::Calibration, None, Some(1))?;
+/// let model = calibrate(&cal, &CalibrateOptions::default(), &mut Silent)?.model;
+/// let flight = model.compensate(&cal)?.into_flight(cal)?;
+/// let figures = score(&flight, &[], None)?;
+/// assert!(figures.ir.unwrap() > 1.0); // the compensation helps
+/// println!("FOM {:?} → {:?} nT", figures.fom_before_nt, figures.fom_after_nt);
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub fn score(t: &Flight, reference: &[String], lever: Option<&LeverArm>) -> Result<Figures> {
     let time = t.require("time")?;
     let ref_sum = reference_sum(t, reference, lever)?;

@@ -48,6 +48,19 @@ impl StudySize {
 }
 
 /// A demonstration of one subsystem on simulated data.
+///
+/// ```
+/// use aeromag::studies::{PrintedSummary, RotorStudyRun, Study, StudyOutcome, StudySize};
+/// use aeromag::Silent;
+/// let outcome = RotorStudyRun::default().run(StudySize::Quick, &mut Silent)?;
+/// let summary = outcome.summary();
+/// // The printed table comes from the same typed summary as summary.json.
+/// for row in summary.printed() {
+///     println!("{:<40} {:>12}", row.key, row.value);
+/// }
+/// assert!(summary.residual_model_nt < summary.rotor_rms_nt);
+/// # Ok::<(), aeromag::Error>(())
+/// ```
 pub trait Study {
     /// What a run produces: the full result, with the series its report
     /// section draws.

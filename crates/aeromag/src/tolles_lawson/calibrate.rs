@@ -184,11 +184,19 @@ pub struct Calibration {
 /// positions, `vd` when recorded); never a `true_` column. Progress and notes
 /// go to `observer`; the notes are also kept in the result.
 ///
-/// ```no_run
-/// use aeromag::{CalibrateOptions, Flight, Silent, calibrate};
-/// let flight = Flight::read("cal/calibration.csv")?;
+/// ```
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// use aeromag::{CalibrateOptions, ModelFile, Silent, calibrate};
+/// // A flight from a file is `Flight::read("cal/calibration.csv")?`.
+/// let flight = simulate_flight(ScenarioKind::Calibration, None, Some(1))?;
 /// let cal = calibrate(&flight, &CalibrateOptions::kalman(), &mut Silent)?;
-/// std::fs::write("model.json", cal.model.to_json()?).unwrap();
+/// assert_eq!(cal.model.method.name(), "kalman");
+/// for note in &cal.notes {
+///     println!("{note}"); // warnings are data, the library prints nothing
+/// }
+/// let path = std::env::temp_dir().join(format!("aeromag-doc-model-{}.json", std::process::id()));
+/// cal.model.write(&path)?; // the file `aeromag calibrate --method kalman` writes
+/// # std::fs::remove_file(&path).ok();
 /// # Ok::<(), aeromag::Error>(())
 /// ```
 pub fn calibrate(
