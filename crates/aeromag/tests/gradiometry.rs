@@ -13,32 +13,7 @@ use aeromag::{Flight, FlightTable, Silent};
 /// A well-posed pass: mobile system (tilted), no bias, no variations,
 /// object heading fixed, IGRF background, deterministic motion model,
 /// multi-start and re-linearised passes.
-const WELL_POSED: &str = r#"
-[system]
-motion = "mobile"
-gradiometer = "GRAD"
-attitude_deg = [3.0, -2.0, 10.0]
-[sensors.vector]
-noise_nt = 0.5
-bias_sigma_nt = 0.0
-[sensors.scalar]
-noise_nt = 0.02
-bias_sigma_nt = 0.0
-[environment]
-variation_nt = 0.0
-[object]
-yaw_rate_rad_s = 0.0
-[trajectory]
-epochs = 100
-[estimator]
-quiet_epochs = 0
-position_random_walk_m_per_sqrt_s = 0.0
-moment_random_walk_am2_per_sqrt_s = 0.0
-induced_per_rad = 0.0
-detection_factor = 10.0
-prior_sigma_moment_am2 = 5000.0
-passes = 10
-"#;
+const WELL_POSED: &str = include_str!("data/well_posed_pass.toml");
 
 /// Simulate `cfg`, write the pass as a table without its truth columns,
 /// read it back and locate the object: the track and the truth table.

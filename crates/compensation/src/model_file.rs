@@ -104,6 +104,22 @@ pub struct Coefficient {
     pub std: f64,
 }
 
+impl Coefficient {
+    /// The named coefficients of a fit: `names`, `values` and standard
+    /// deviations `std` in the same (column) order.
+    pub fn list(names: &[String], values: &[f64], std: &[f64]) -> Vec<Coefficient> {
+        names
+            .iter()
+            .zip(values.iter().zip(std))
+            .map(|(n, (v, s))| Coefficient {
+                name: n.clone(),
+                value: *v,
+                std: *s,
+            })
+            .collect()
+    }
+}
+
 /// Fit statistics recorded in the model file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct FitStats {

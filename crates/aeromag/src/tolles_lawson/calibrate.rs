@@ -301,16 +301,7 @@ fn fit_ls_flight(
             trim: cfg.trim,
             lambda: cfg.lambda,
         }),
-        coefficients: fit
-            .names
-            .iter()
-            .zip(fit.coef.iter().zip(&fit.std))
-            .map(|(n, (v, s))| Coefficient {
-                name: n.clone(),
-                value: *v,
-                std: *s,
-            })
-            .collect(),
+        coefficients: Coefficient::list(&fit.names, &fit.coef, &fit.std),
         fit: FitStats {
             rows: fit.rows,
             segments: fit.segments_used,

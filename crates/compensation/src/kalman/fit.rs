@@ -600,16 +600,7 @@ impl KalmanFit {
                 field_order: Some(self.field_order),
                 noise: Some(self.noise),
             }),
-            coefficients: self
-                .names
-                .iter()
-                .zip(self.coef.iter().zip(&self.std))
-                .map(|(n, (v, s))| Coefficient {
-                    name: n.clone(),
-                    value: *v,
-                    std: *s,
-                })
-                .collect(),
+            coefficients: Coefficient::list(&self.names, &self.coef, &self.std),
             fit: FitStats {
                 rows: self.rows,
                 segments: self.segments_used,

@@ -22,6 +22,7 @@ use std::path::Path;
 
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
+use super::section::{Block, ReportSection};
 use crate::error::Result;
 
 /// The stylesheet inlined into every report.
@@ -50,21 +51,14 @@ impl Table {
     }
 }
 
-/// One piece of report content.
-#[derive(Debug, Clone, PartialEq)]
-enum Block {
-    Section(String),
-    Paragraph(String),
-    Table(Table),
-    KeyValues(Vec<(String, String)>),
-    Figure { svg: String, caption: String },
-}
-
 /// A report under construction; see the module docs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Report {
     title: String,
-    blocks: Vec<Block>,
+    /// Content before the first section (untitled introduction).
+    intro: ReportSection,
+    /// The numbered sections, in order.
+    sections: Vec<ReportSection>,
 }
 
 impl Report {
@@ -72,41 +66,49 @@ impl Report {
     pub fn new(title: impl Into<String>) -> Self {
         Report {
             title: title.into(),
-            blocks: Vec::new(),
+            intro: ReportSection::default(),
+            sections: Vec::new(),
         }
     }
 
     /// Starts a new numbered section (listed in the table of contents).
     /// Content added before the first section forms an untitled introduction.
     pub fn section(&mut self, heading: impl Into<String>) -> &mut Self {
-        self.blocks.push(Block::Section(heading.into()));
+        self.sections.push(ReportSection::new(heading));
         self
+    }
+
+    /// Appends a section built apart ([`ReportSection::append_to`]).
+    pub(super) fn push_section(&mut self, section: ReportSection) {
+        self.sections.push(section);
+    }
+
+    /// The section content goes into: the last one, or the introduction.
+    fn current(&mut self) -> &mut ReportSection {
+        self.sections.last_mut().unwrap_or(&mut self.intro)
     }
 
     /// A paragraph of plain text.
     pub fn paragraph(&mut self, text: impl Into<String>) -> &mut Self {
-        self.blocks.push(Block::Paragraph(text.into()));
+        self.current().paragraph(text);
         self
     }
 
     /// A numbered table.
     pub fn table(&mut self, table: Table) -> &mut Self {
-        self.blocks.push(Block::Table(table));
+        self.current().table(table);
         self
     }
 
     /// A two-column list of names and values (e.g. figures of merit).
     pub fn key_values(&mut self, pairs: Vec<(String, String)>) -> &mut Self {
-        self.blocks.push(Block::KeyValues(pairs));
+        self.current().key_values(pairs);
         self
     }
 
     /// A numbered figure: trusted SVG markup (inserted verbatim) and a caption.
     pub fn figure(&mut self, svg: impl Into<String>, caption: impl Into<String>) -> &mut Self {
-        self.blocks.push(Block::Figure {
-            svg: svg.into(),
-            caption: caption.into(),
-        });
+        self.current().figure(svg, caption);
         self
     }
 
@@ -177,19 +179,18 @@ impl Report {
         crate::write_file(path.as_ref(), self.to_html().as_bytes())
     }
 
-    /// Blocks grouped under their section heading (`None` = introduction).
+    /// Blocks grouped under their section heading (`None` = introduction,
+    /// present only when it has content).
     fn groups(&self) -> Vec<(Option<&str>, Vec<&Block>)> {
-        let mut groups: Vec<(Option<&str>, Vec<&Block>)> = Vec::new();
-        for b in &self.blocks {
-            match b {
-                Block::Section(h) => groups.push((Some(h.as_str()), Vec::new())),
-                other => match groups.last_mut() {
-                    Some(g) => g.1.push(other),
-                    None => groups.push((None, vec![other])),
-                },
-            }
-        }
-        groups
+        let intro = (!self.intro.blocks.is_empty()).then(|| (None, self.intro.blocks.iter().collect()));
+        intro
+            .into_iter()
+            .chain(
+                self.sections
+                    .iter()
+                    .map(|s| (Some(s.heading.as_str()), s.blocks.iter().collect())),
+            )
+            .collect()
     }
 }
 
@@ -235,7 +236,6 @@ fn render_blocks(blocks: &[&Block], counters: &mut Counters) -> Markup {
     html! {
         @for b in blocks {
             @match b {
-                Block::Section(_) => {},
                 Block::Paragraph(text) => p { (text) },
                 Block::KeyValues(pairs) => table class="kv" {
                     tbody {

@@ -78,22 +78,6 @@ impl ReportSection {
 
     /// Append the section to `r`.
     pub fn append_to(self, r: &mut Report) {
-        r.section(self.heading);
-        for b in self.blocks {
-            match b {
-                Block::Paragraph(p) => {
-                    r.paragraph(p);
-                }
-                Block::Figure { svg, caption } => {
-                    r.figure(svg, caption);
-                }
-                Block::Table(t) => {
-                    r.table(t);
-                }
-                Block::KeyValues(kv) => {
-                    r.key_values(kv);
-                }
-            }
-        }
+        r.push_section(self);
     }
 }
