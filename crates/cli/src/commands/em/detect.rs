@@ -45,26 +45,44 @@ pub struct DetectArgs {
     #[arg(long, value_name = "N", default_value_t = DetectOptions::default().window_len)]
     window_len: usize,
     /// Weighting window: blackman-harris or nuttall (4-term: zeros at ≥ 4 bins).
-    #[arg(long, value_name = "NAME", default_value = "blackman-harris", value_parser = window)]
-    window: Window,
+    #[arg(long, value_name = "NAME", default_value_t = WindowName(DetectOptions::default().window),
+          value_parser = window)]
+    window: WindowName,
     /// Instrument constants (JSON, as em.system.json) instead of the raw
     /// header's.
     #[arg(long, value_name = "FILE.json")]
     system: Option<PathBuf>,
 }
 
-fn window(name: &str) -> Result<Window, String> {
-    match name {
-        "blackman-harris" => Ok(Window::BlackmanHarris),
-        "nuttall" => Ok(Window::Nuttall),
-        _ => Err("expected blackman-harris or nuttall".into()),
+/// The detector windows by their names on the command line.
+const WINDOWS: [(&str, Window); 2] = [
+    ("blackman-harris", Window::BlackmanHarris),
+    ("nuttall", Window::Nuttall),
+];
+
+/// A detector window as named on the command line.
+#[derive(Debug, Clone, Copy)]
+struct WindowName(Window);
+
+impl std::fmt::Display for WindowName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = WINDOWS.iter().find(|(_, w)| *w == self.0).map_or("?", |(n, _)| n);
+        f.write_str(name)
     }
+}
+
+fn window(name: &str) -> Result<WindowName, String> {
+    WINDOWS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|&(_, w)| WindowName(w))
+        .ok_or_else(|| "expected blackman-harris or nuttall".into())
 }
 
 pub fn run(a: DetectArgs) -> anyhow::Result<()> {
     let opts = DetectOptions {
         window_len: a.window_len,
-        window: a.window,
+        window: a.window.0,
         pilot: !a.no_pilot,
         system: a.system.as_deref().map(read_system).transpose()?,
     };
