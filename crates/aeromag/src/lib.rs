@@ -41,7 +41,7 @@
 //! | [`simulate`] | simulated flights with truth, in memory |
 //! | [`rotor`] | helicopter main-rotor model: [`rotor::fit_rotor`] on a flight, [`rotor::RotorModelFile`] as a [`Compensator`] |
 //! | [`pod`] | towed pod: [`pod::fit_pod`] by three solves, [`pod::apply_pod`] with the rates per heading |
-//! | [`gradiometry`] | gradiometer passes on files: [`gradiometry::read_pass`], [`gradiometry::locate_pass`], [`gradiometry::crlb`], convergence maps |
+//! | [`gradiometry`] | gradiometer passes on files: [`gradiometry::read_pass`], [`gradiometry::locate_pass`], [`gradiometry::crlb()`], convergence maps |
 //! | [`em`] | EM positioning on files: [`em::detect`], [`em::calibrate`], [`em::locate`], [`em::simulate_to_dir`] |
 //! | [`level`] | levelling at crossovers ([`level::level`]) |
 //! | [`score`] | FOM, IR and residual against truth of a compensated flight, and its report section |

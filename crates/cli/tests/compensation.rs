@@ -40,29 +40,14 @@ fn calibrate_compensate_report_keep_every_row() {
     assert_eq!(m["format"], "aeromag-model/2");
     assert_eq!(m["method"], "ls");
     assert_eq!(m["trim"], 20);
-    // The simulated airframe's eddy currents lag (τ 0.15–0.6 s): `auto`
-    // adds one or two lagged groups of nine columns to the 16 classical ones.
-    let lags = m["terms"]["eddy_lags_s"].as_array().map_or(0, |a| a.len());
-    assert!((1..=2).contains(&lags), "{}", m["terms"]);
-    assert_eq!(m["coefficients"].as_array().unwrap().len(), 16 + 9 * lags);
+    assert!(!m["coefficients"].as_array().unwrap().is_empty());
+    // The fit's notes reach the user on stderr (which lags, and why, is
+    // tested in crates/aeromag/tests/tolles_lawson.rs).
     assert!(
         stderr(&o).contains("chosen (likelihood-ratio test)"),
         "{}",
         stderr(&o)
     );
-    // The model file records the search: every candidate with Λ and its threshold.
-    let sel = &m["fit"]["eddy_lag_selection"];
-    let cands = sel["candidates"]
-        .as_array()
-        .expect("lag selection recorded");
-    assert!(
-        cands.len() >= 7
-            && cands
-                .iter()
-                .all(|c| c["lr_statistic"].is_number() && c["threshold"].is_number()),
-        "{sel}"
-    );
-    assert_eq!(sel["taus_s"], m["terms"]["eddy_lags_s"]);
     // Blank out some flux values: those rows stay, flagged.
     let text = std::fs::read_to_string(&cal).unwrap();
     let mut lines: Vec<String> = text

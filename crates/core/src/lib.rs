@@ -23,6 +23,8 @@
 //! | [`spectrum`] | Welch power spectral density |
 //! | [`random`] | seeded random streams (ChaCha8, one stream per purpose) |
 //! | [`time`] | calendar dates and decimal years |
+//! | [`quadrature`] | composite Simpson's rule (reference integrals in tests) |
+//! | [`error`] | [`CoreError`], with `is_bad_input()` |
 
 pub mod error;
 pub mod estimability;

@@ -27,6 +27,7 @@
 //! | [`detection`] | FIR-weighted synchronous detection, its frequency response, pilot correction, polarisation ellipse |
 //! | [`calibration`] | three-stage calibration (polarisation, transmitter geometry, attitude), JSON, run-time application |
 //! | [`sim`] | the `em` scenario: ADC-level three-channel coil voltages with all distortions, binary raw format |
+//! | [`error`] | [`EmError`], with `is_bad_input()` |
 //! | [`study`] | the full-chain flight study (simulation → detection → calibration → positioning) shared by tests, CLI and demo; error curves versus range and noise |
 //!
 //! ## Pipeline (what `aeromag em simulate|detect|calibrate|locate` wires together)

@@ -7,15 +7,19 @@
 //! - [`geometry`] — four-sensor layouts (tetrahedron, cross, planar);
 //! - [`decorrelate`] — the orthonormal contrasts that whiten the differences;
 //! - [`forward`] — `ForwardMT` / `ForwardMV` with analytic Jacobians;
-//! - [`sr_iekf`] — square-root IEKF (`PrognosisFK`, `ProcessingFK`, per-epoch iteration);
+//! - [`sr_iekf`] — square-root IEKF (`PrognosisFK`, `ProcessingFK`, per-epoch iteration) on
+//!   the triangular toolkit of `aeromag_estimation::kalman`;
+//! - [`pass`] — the filter over the epochs of a pass, re-linearised passes;
 //! - [`motion`] — `MotionMT` / `MotionMV`;
-//! - [`estimability`] — `MeasureS`;
+//! - [`estimability`] — `MeasureS`, as μ = σ⁺/σ⁰ (0 = determined; `aeromag_core::estimability`);
 //! - [`crlb`] — Cramér–Rao bound;
 //! - [`efficiency`] — Monte-Carlo efficiency RMS/CRLB of the pass estimator;
 //! - [`locate`] — detection, initialisation and the filter over a pass;
 //! - [`config`] — the `gradiometer` scenario file (TOML);
 //! - [`convergence`] — the seed's fig. 2 convergence map and a multi-start initialisation;
-//! - [`sim`] — the simulator scenario `gradiometer`.
+//! - [`sim`] — the simulator scenario `gradiometer`;
+//! - [`parallel`] — index-parallel map over scoped threads (results independent of the thread count);
+//! - [`error`] — [`GradiometryError`], with `is_bad_input()`.
 
 #![warn(missing_docs)]
 

@@ -46,6 +46,16 @@
 //! let html = r.to_html();
 //! assert!(html.contains("Figures of merit"));
 //! ```
+//!
+//! A [`ReportSection`] is a section built apart (each study builds its
+//! own) and appended to a report later.
+//!
+//! | module | contents |
+//! |---|---|
+//! | [`plot`] | line plots, heat maps, colour maps, ticks, PNG/SVG output |
+//! | [`html`] | the report and its sections |
+//! | [`style`] | colours, the series palette, the plot theme and the embedded font |
+//! | [`error`] | [`ReportError`], with `is_bad_input()` |
 
 mod encode;
 pub mod error;

@@ -49,6 +49,8 @@
 //! | [`environment`] | IGRF-14 main field, random anomaly continued upward by FFT + dipoles, diurnal + micropulsations |
 //! | [`platform`] | aircraft parts: permanent, induced (full matrix), eddy-current loops (first-order lags), on-board currents |
 //! | [`sensor`] | scalar (exact modulus, heading error, lag, noise), fluxgate (misalignment, non-orthogonality, scale, bias, noise), GNSS/INS, base station |
+//! | [`output`] | a simulation's result: named columns, scenario file, truth metadata, writing them |
+//! | [`error`] | `SimError`, with `is_bad_input()` |
 //! | [`random`], [`numerics`] | seeded ChaCha streams, coloured noise, 2-D FFT, interpolation, exact lag discretisation |
 //!
 //! ## Default magnitudes (documented on each model)

@@ -2,7 +2,7 @@
 //! `gradiometry.md`, seed 004; algorithms in [`aeromag_gradiometry`]):
 //! the pass file format ([`pass_table`], [`read_pass`]), locating the
 //! object over a pass ([`locate_pass`] → [`Track`]), the Cramér–Rao bound
-//! of a configured pass ([`crlb`]), the convergence maps of the seed's
+//! of a configured pass ([`crlb()`]), the convergence maps of the seed's
 //! fig. 2 ([`both_maps`]) and simulating a pass to a folder
 //! ([`simulate_to_dir`]). The algorithms' modules are re-exported here
 //! (`aeromag::gradiometry::sim`, `::locate`, `::crlb`, …).

@@ -2,7 +2,7 @@
 //! truth, run at a size, giving a typed summary (its group of the demo's
 //! `summary.json`, and its rows of the printed table) and a report section.
 //!
-//! `aeromag demo` runs every study ([`demo`]); the `study` subcommands
+//! `aeromag demo` runs every study ([`Demo`]); the `study` subcommands
 //! (`aeromag rotor study`, `aeromag em study`) run one.
 //!
 //! A study implements [`Study`]; its result implements [`StudyOutcome`].

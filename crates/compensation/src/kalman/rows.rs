@@ -1,8 +1,8 @@
 //! Streaming Tolles-Lawson design rows over a run of samples, in chunks, so
 //! that a 10⁷-sample flight never holds its `N × n` design matrix.
 //!
-//! Row `i` is [`TermSet::row`] of the vector field and its derivative under
-//! the [`Convention`], exactly as [`crate::tolles_lawson::design::design_columns`]
+//! Row `i` is the design row of the vector field and its derivative under
+//! the design's convention, exactly as [`Design::columns`]
 //! builds it over the same run: the derivatives come from
 //! [`crate::tolles_lawson::terms::derivative`] applied to each chunk extended
 //! by one neighbour on each side (at least three samples), so interior

@@ -5,7 +5,7 @@
 //!
 //! For every contiguous segment (leg) of the calibration flight:
 //! 1. build the design matrix `A` from the vector magnetometer
-//!    ([`super::design::design_columns`]);
+//!    ([`super::design::Design::columns`]);
 //! 2. band-pass every non-constant column of `A` and the scalar reading `y`
 //!    with a zero-phase Butterworth filter (order 4, 0.1–0.9 Hz by default),
 //!    so that the slowly varying external field (main field, geology,
