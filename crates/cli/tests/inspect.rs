@@ -181,3 +181,63 @@ fn column_mapping_of_magnav_names() {
     assert_code(&o, 2);
     assert!(stderr(&o).contains("nothere"));
 }
+
+/// A file of our own in the layout of the SGL surveys' Geosoft XYZ export
+/// (spec `data-formats.md`, "Real survey files"; the values are made up):
+/// `/` header, upper-case names, `*` dummies, labels such as 1003.01, INS
+/// position in radians and velocity west/up.
+const SGL_XYZ: &str = "/\n/\n\
+/   LINE   FLT    TIME       UTM-Z   LAT          LONG        PITCH  ROLL  AZIMUTH DIURNAL  IGRFMAG1  UNCOMPMAG1 UNCOMPMAG2 FLUXA_X  FLUXA_Y  FLUXA_Z  FLUXB_X  FLUXB_Y  FLUXB_Z  INS_LAT    INS_LON     INS_VEL_N INS_VEL_W INS_VEL_V CUR_STRB  V_BAT1\n\
+ 1003.01  1003  49820.00  190.0  45.3147665  -75.6633086  9.22   6.18  130.74  -5.009  -183.066  53620.756  51721.735  -5460.8  46219.7  -21467.0  40991.1  31304.5  11463.4  0.7909039  -1.3205527  -29.36  -33.31  2.92  2.507  25.757\n\
+ 1003.01  1003  49820.10  190.3  45.3147401  -75.6632662  9.18   6.16  130.83  -5.008  -183.522  53620.219  51726.489  -5467.9  46224.1  -21452.8  40995.3  31300.6  11449.8  0.7909034  -1.3205520  -29.43  -33.25  2.92  2.508  25.759\n\
+ 1003.02  1003  50713.00  384.3  44.8750983  -76.0921488  6.27  -0.70  125.58  -4.551   -87.226  53580.163  51262.653  -12787.6 46804.1  -17682.7  45836.5  24991.9  7956.7   0.7832354  -1.3280286  -43.70  -56.49  2.15  2.507  25.795\n\
+ 1003.02  1003  50713.10  384.5  44.8750590  -76.0920775  6.31  -0.70  125.63  -4.551   -86.141  53581.140  51269.450  *        46792.3  -17734.8  45820.8  25006.8  8008.1   0.7832347  -1.3280273  -43.65  -56.48  2.23  2.507  25.793\n";
+
+#[test]
+fn contractor_xyz_names_are_recognised_with_their_units() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "flt1003.xyz", SGL_XYZ.as_bytes());
+    let o = aeromag(&["inspect", "--input", p.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    for mapped in [
+        "time=TIME [s]",
+        "lat=LAT [deg]",
+        "lon=LONG [deg]",
+        "yaw=AZIMUTH [deg]",
+        "mag=UNCOMPMAG1 [nT]",
+        "line=LINE [—]",
+        "flux_x=FLUXA_X [nT]",
+    ] {
+        assert!(s.contains(mapped), "{mapped} in\n{s}");
+    }
+    assert!(s.contains("1003.01 (2 samples), 1003.02 (2 samples)"), "{s}");
+    // The JSON gives every recognised column its unit; radians stay radians
+    // and are not mapped onto lat/lon.
+    let j = aeromag(&["inspect", "--input", p.to_str().unwrap(), "--json"]);
+    assert_code(&j, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    let col = |name: &str| {
+        v["columns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["name"] == name)
+            .cloned()
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    for (name, unit) in [
+        ("UNCOMPMAG2", "nT"),
+        ("FLUXB_Z", "nT"),
+        ("INS_LAT", "rad"),
+        ("INS_VEL_W", "m/s"),
+        ("CUR_STRB", "A"),
+        ("V_BAT1", "V"),
+        ("IGRFMAG1", "nT"),
+    ] {
+        assert_eq!(col(name)["unit"], unit, "{name}");
+    }
+    assert!(col("INS_LAT")["canonical"].is_null());
+    assert!(col("IGRFMAG1")["canonical"].is_null());
+    assert_eq!(col("FLUXA_X")["missing_total"], 1);
+}

@@ -34,23 +34,28 @@
 //! [`FlightTable::column`](crate::FlightTable::column) resolves. An explicit
 //! mapping wins over a file column that happens to have the canonical name.
 //!
-//! # The MagNav preset
+//! # Names are matched without regard to case; the MagNav/SGL preset
 //!
-//! Files exported from the MagNav.jl / SGL (Signal Geophysics Ltd.) HDF5
-//! flight data use MagNav's field names (MagNav.jl `get_XYZ20`, `get_XYZ0`
-//! docs): `tt` time (s), `lat`/`lon` (deg) (GPS), `utm_z` (GPS altitude used
-//! by MagNav as trajectory altitude) or `ins_alt` (m), `ins_lat`/`ins_lon`
-//! (deg), `ins_roll`/`ins_pitch`/`ins_yaw` (deg), `ins_vn`/`ins_ve`/`ins_vd`
-//! (m/s), `mag_1_uc`…`mag_5_uc` (nT) (uncompensated scalar magnetometers),
-//! `flux_a_x`…`flux_d_z` (nT) (vector magnetometers A–D), `line`, `diurnal`,
-//! `igrf`. When [`ReadOptions::magnav_preset`](crate::ReadOptions) is on
-//! (default) and a canonical column is neither in the file nor mapped by the
-//! user, the first present candidate of [`MAGNAV_PRESET`] is used, and the
-//! table records it (origin [`MapOrigin::MagNavPreset`]) so the command line
-//! can report what was mapped. The flux triplet is taken from the first
-//! magnetometer (A, B, C, D) that has all three components. The SGL raw
-//! velocities `ins_vw`/`ins_vu` (west/up) are not mapped: they need a sign
-//! change, and velocities are derived from positions when absent.
+//! A header column that differs from a canonical name only in case
+//! (`TIME`, `LAT`, `LINE`) plays that role. Files of the SGL (Signal
+//! Geophysics Ltd.) surveys that MagNav.jl uses name their fields
+//! differently, in the HDF5 layout (`tt`, `mag_1_uc`, `flux_a_x`, …) and in
+//! the contractor's Geosoft XYZ export (`TIME`, `LONG`, `UNCOMPMAG1`,
+//! `FLUXA_X`, `AZIMUTH`, …; spec `data-formats.md`, "Real survey files").
+//! When [`ReadOptions::magnav_preset`](crate::ReadOptions) is on (default)
+//! and a canonical column is neither in the file nor mapped by the user, the
+//! first present candidate of [`MAGNAV_PRESET`] (compared without regard to
+//! case) is used, and the table records it (origin
+//! [`MapOrigin::MagNavPreset`]) so the command line can report what was
+//! mapped. The flux triplet is taken from the first vector magnetometer (A,
+//! B, C, D; `flux_a_x` or `FLUXA_X`) that has all three components.
+//!
+//! Fields in another unit are **not** mapped, because an alias cannot
+//! convert: `ins_lat`/`ins_lon` (`INS_LAT`/`INS_LON`) are radians, and
+//! `ins_vw`/`ins_vu` (`INS_VEL_W`/`INS_VEL_V`) point west and up. They are
+//! recognised with their units ([`known_field`](crate::known_field)), and
+//! mapping one of them onto a degree or NED column by hand is caught by the
+//! unit checks ([`check_units`](crate::check_units)).
 
 use serde::Serialize;
 
@@ -66,29 +71,45 @@ pub const CANONICAL_COLUMNS: [&str; 17] = [
 /// [`check_units`](crate::check_units).
 pub const MAGNETIC_COLUMNS: [&str; 6] = ["mag", "flux_x", "flux_y", "flux_z", "diurnal", "igrf"];
 
-/// MagNav/SGL preset: canonical name → candidate file columns, first present wins.
-/// The flux components are handled as a triplet (see the module docs).
+/// MagNav/SGL preset: canonical name → candidate file columns (SGL HDF5
+/// names, then the Geosoft XYZ export's), first present wins, compared
+/// without regard to case. Every candidate is in the canonical column's
+/// unit. The flux components are handled as a triplet (see the module docs).
 pub const MAGNAV_PRESET: [(&str, &[&str]); 13] = [
     ("time", &["tt"]),
-    ("lat", &["ins_lat"]),
-    ("lon", &["ins_lon"]),
-    ("alt", &["utm_z", "ins_alt"]),
-    ("vn", &["ins_vn"]),
+    ("lat", &[]),
+    ("lon", &["long"]),
+    ("alt", &["utm_z", "utm-z", "ins_alt", "ins_hgt"]),
+    ("vn", &["ins_vn", "ins_vel_n"]),
     ("ve", &["ins_ve"]),
     ("vd", &["ins_vd"]),
     ("roll", &["ins_roll"]),
     ("pitch", &["ins_pitch"]),
-    ("yaw", &["ins_yaw"]),
+    ("yaw", &["ins_yaw", "azimuth"]),
     (
         "mag",
-        &["mag_1_uc", "mag_2_uc", "mag_3_uc", "mag_4_uc", "mag_5_uc"],
+        &[
+            "mag_1_uc",
+            "mag_2_uc",
+            "mag_3_uc",
+            "mag_4_uc",
+            "mag_5_uc",
+            "uncompmag1",
+            "uncompmag2",
+            "uncompmag3",
+            "uncompmag4",
+            "uncompmag5",
+        ],
     ),
-    ("diurnal", &["diurnal"]),
-    ("igrf", &["igrf"]),
+    ("diurnal", &[]),
+    ("igrf", &[]),
 ];
 
-/// MagNav vector magnetometer prefixes, in order of preference (`flux_a_x`, …).
-const MAGNAV_FLUX_PREFIXES: [&str; 4] = ["flux_a", "flux_b", "flux_c", "flux_d"];
+/// Vector magnetometer prefixes, in order of preference: SGL HDF5
+/// (`flux_a_x`, …) and XYZ export (`FLUXA_X`, …).
+const MAGNAV_FLUX_PREFIXES: [&str; 8] = [
+    "flux_a", "flux_b", "flux_c", "flux_d", "fluxa", "fluxb", "fluxc", "fluxd",
+];
 
 /// True for the canonical names of [`CANONICAL_COLUMNS`].
 pub fn is_canonical(name: &str) -> bool {
@@ -246,6 +267,14 @@ pub(crate) fn resolve(
     preset: bool,
 ) -> Result<Vec<MappedColumn>> {
     let has = |name: &str| header.iter().any(|h| h == name);
+    // The header's spelling of `name`, compared without regard to case
+    // (an exact match first).
+    let find = |name: &str| -> Option<&String> {
+        header
+            .iter()
+            .find(|h| *h == name)
+            .or_else(|| header.iter().find(|h| h.eq_ignore_ascii_case(name)))
+    };
     let mut out: Vec<MappedColumn> = Vec::new();
     for (canonical, file_column) in map.pairs() {
         if !has(file_column) {
@@ -265,43 +294,53 @@ pub(crate) fn resolve(
     if !preset {
         return Ok(out);
     }
-    let taken = |out: &[MappedColumn], canonical: &str, file_column: &str| {
-        has(canonical)
-            || out
-                .iter()
-                .any(|m| m.canonical == canonical || m.file_column == file_column)
+    let taken = |out: &[MappedColumn], file_column: &str| {
+        out.iter().any(|m| m.file_column == file_column)
+    };
+    let wanted = |out: &[MappedColumn], canonical: &str| {
+        !has(canonical) && !out.iter().any(|m| m.canonical == canonical)
     };
     for (canonical, candidates) in MAGNAV_PRESET {
-        if let Some(c) = candidates
-            .iter()
-            .find(|c| has(c) && !taken(&out, canonical, c))
-            && *c != canonical
+        if !wanted(&out, canonical) {
+            continue;
+        }
+        let hit = std::iter::once(canonical)
+            .chain(candidates.iter().copied())
+            .filter_map(|c| find(c))
+            .find(|c| !taken(&out, c.as_str()) && !is_canonical(c));
+        if let Some(c) = hit {
+            out.push(MappedColumn {
+                canonical: canonical.to_string(),
+                file_column: c.clone(),
+                origin: MapOrigin::MagNavPreset,
+            });
+        }
+    }
+    // `line` and the names of the spec in another case (`LINE`).
+    for canonical in CANONICAL_COLUMNS {
+        if wanted(&out, canonical)
+            && let Some(c) = find(canonical).filter(|c| !taken(&out, c.as_str()))
         {
             out.push(MappedColumn {
                 canonical: canonical.to_string(),
-                file_column: c.to_string(),
+                file_column: c.clone(),
                 origin: MapOrigin::MagNavPreset,
             });
         }
     }
     let flux = ["flux_x", "flux_y", "flux_z"];
-    if flux
-        .iter()
-        .all(|f| !has(f) && !out.iter().any(|m| m.canonical == *f))
-    {
+    if flux.iter().all(|f| wanted(&out, f)) {
         for prefix in MAGNAV_FLUX_PREFIXES {
-            let names: Vec<String> = ["x", "y", "z"]
+            let names: Vec<&String> = ["x", "y", "z"]
                 .iter()
-                .map(|a| format!("{prefix}_{a}"))
+                .filter_map(|a| find(&format!("{prefix}_{a}")))
+                .filter(|n| !taken(&out, n.as_str()))
                 .collect();
-            if names
-                .iter()
-                .all(|n| has(n) && !out.iter().any(|m| &m.file_column == n))
-            {
+            if names.len() == 3 {
                 for (canonical, file_column) in flux.iter().zip(names) {
                     out.push(MappedColumn {
                         canonical: canonical.to_string(),
-                        file_column,
+                        file_column: file_column.clone(),
                         origin: MapOrigin::MagNavPreset,
                     });
                 }
@@ -396,6 +435,52 @@ mod tests {
             s.contains("mag_9_uc") && s.contains("f.csv") && s.contains("time, mag_1_uc"),
             "{s}"
         );
+    }
+
+    #[test]
+    fn xyz_export_names_are_mapped_without_regard_to_case_and_radians_are_not() {
+        // The header of the SGL surveys' Geosoft XYZ export (spec
+        // "Real survey files"), shortened.
+        let h = header(&[
+            "LINE", "FLT", "TIME", "UTM-Z", "LAT", "LONG", "PITCH", "ROLL", "AZIMUTH", "DIURNAL",
+            "COMPMAG1", "IGRFMAG1", "UNCOMPMAG1", "UNCOMPMAG2", "FLUXA_X", "FLUXA_Y", "FLUXA_Z",
+            "FLUXA_TOT", "FLUXB_X", "FLUXB_Y", "FLUXB_Z", "INS_LAT", "INS_LON", "INS_HGT",
+            "INS_VEL_N", "INS_VEL_W", "INS_VEL_V", "CUR_ACHi",
+        ]);
+        let m = resolve("f", &h, &ColumnMap::new(), true).unwrap();
+        let get = |c: &str| {
+            m.iter()
+                .find(|x| x.canonical == c)
+                .map(|x| x.file_column.as_str())
+        };
+        for (canonical, file) in [
+            ("time", "TIME"),
+            ("lat", "LAT"),
+            ("lon", "LONG"),
+            ("alt", "UTM-Z"),
+            ("roll", "ROLL"),
+            ("pitch", "PITCH"),
+            ("yaw", "AZIMUTH"),
+            ("mag", "UNCOMPMAG1"),
+            ("diurnal", "DIURNAL"),
+            ("line", "LINE"),
+            ("vn", "INS_VEL_N"),
+            ("flux_x", "FLUXA_X"),
+            ("flux_z", "FLUXA_Z"),
+        ] {
+            assert_eq!(get(canonical), Some(file), "{canonical}");
+        }
+        // West and up velocities and radian positions need a conversion:
+        // never aliases. IGRFMAG1 is the anomaly, not the main field.
+        for file in ["INS_LAT", "INS_LON", "INS_VEL_W", "INS_VEL_V", "IGRFMAG1"] {
+            assert!(m.iter().all(|x| x.file_column != file), "{file}");
+        }
+        assert_eq!(get("ve"), None);
+        assert_eq!(get("igrf"), None);
+        // A file with only the INS position has no lat/lon at all.
+        let ins_only = header(&["tt", "ins_lat", "ins_lon", "mag_1_uc"]);
+        let m = resolve("f", &ins_only, &ColumnMap::new(), true).unwrap();
+        assert!(m.iter().all(|x| x.canonical != "lat" && x.canonical != "lon"));
     }
 
     #[test]

@@ -36,6 +36,7 @@ pub mod columns;
 mod csv_read;
 mod csv_write;
 mod error;
+mod fields;
 mod sniff;
 mod summary;
 mod table;
@@ -51,6 +52,7 @@ pub use columns::{
 pub use csv_read::read_csv;
 pub use csv_write::{write_csv, write_csv_to};
 pub use error::{IoError, Result};
+pub use fields::{KnownField, known_field};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
 pub use validate::{MEDIAN_SAMPLES, Warning, check_time, check_units, convert_tesla_to_nt};

@@ -20,6 +20,7 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::columns::MappedColumn;
+use crate::fields::known_field;
 use crate::table::{ColumnData, FlightTable, Missing};
 use crate::validate::median_in_place;
 
@@ -70,6 +71,9 @@ pub struct ColumnSummary {
     pub name: String,
     /// Canonical name this column is mapped to, if any.
     pub canonical: Option<String>,
+    /// Unit: the canonical column's, else that of a recognised field
+    /// ([`known_field`](crate::known_field)); `None` for unknown names.
+    pub unit: Option<&'static str>,
     /// Numeric or text.
     pub kind: ColumnKind,
     /// Missing samples by reason.
@@ -133,12 +137,14 @@ pub fn summarize(table: &FlightTable) -> Summary {
                 .iter()
                 .find(|m| m.file_column == c.name())
                 .map(|m| m.canonical.clone());
+            let unit = known_field(canonical.as_deref().unwrap_or(c.name())).map(|k| k.unit);
             match c.data() {
                 ColumnData::Numeric { values, missing } => {
                     let (min, max, mean) = min_max_mean(values);
                     ColumnSummary {
                         name: c.name().to_string(),
                         canonical,
+                        unit,
                         kind: ColumnKind::Numeric,
                         missing: *missing,
                         missing_total: missing.total(),
@@ -150,6 +156,7 @@ pub fn summarize(table: &FlightTable) -> Summary {
                 ColumnData::Text(_) => ColumnSummary {
                     name: c.name().to_string(),
                     canonical,
+                    unit,
                     kind: ColumnKind::Text,
                     missing: Missing::default(),
                     missing_total: 0,

@@ -110,22 +110,26 @@ pub fn render(s: &Summary) -> String {
             "mapped   {}",
             s.mapping
                 .iter()
-                .map(|m| format!("{}={}", m.canonical, m.file_column))
+                .map(|m| {
+                    let unit = aeromag_io::known_field(&m.canonical).map_or("", |k| k.unit);
+                    format!("{}={} [{unit}]", m.canonical, m.file_column)
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         );
     }
     let _ = writeln!(
         o,
-        "\n{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}",
-        "column", "canonical", "missing", "min", "max", "mean"
+        "\n{:<22} {:<10} {:<6} {:>9} {:>14} {:>14} {:>14}",
+        "column", "canonical", "unit", "missing", "min", "max", "mean"
     );
     for c in &s.columns {
         let _ = writeln!(
             o,
-            "{:<22} {:<10} {:>9} {:>14} {:>14} {:>14}",
+            "{:<22} {:<10} {:<6} {:>9} {:>14} {:>14} {:>14}",
             c.name,
             c.canonical.as_deref().unwrap_or(""),
+            c.unit.unwrap_or(""),
             c.missing_total,
             fmt_opt(c.min),
             fmt_opt(c.max),
