@@ -306,7 +306,7 @@ pub(crate) fn resolve(
         }
         let hit = std::iter::once(canonical)
             .chain(candidates.iter().copied())
-            .filter_map(|c| find(c))
+            .filter_map(find)
             .find(|c| !taken(&out, c.as_str()) && !is_canonical(c));
         if let Some(c) = hit {
             out.push(MappedColumn {
