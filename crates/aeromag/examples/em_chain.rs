@@ -34,6 +34,10 @@ fn main() -> Result<(), Error> {
             );
         }
     }
-    println!("{} of {} epochs located", poses.poses.len() - poses.failed(), poses.poses.len());
+    println!(
+        "{} of {} epochs located",
+        poses.poses.len() - poses.failed(),
+        poses.poses.len()
+    );
     Ok(())
 }

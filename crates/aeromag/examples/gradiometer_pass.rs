@@ -22,7 +22,11 @@ fn main() -> Result<(), Error> {
     // The file a survey would record: the pass without the truth.
     let table = pass_table(&cfg, &sim)?;
     let mut recorded = FlightTable::new();
-    for c in table.columns().iter().filter(|c| !c.name().starts_with("true_")) {
+    for c in table
+        .columns()
+        .iter()
+        .filter(|c| !c.name().starts_with("true_"))
+    {
         recorded.add_column(c.name(), c.values().unwrap_or_default().to_vec())?;
     }
     let pass = read_pass(&Flight::from_table(recorded)?, &cfg)?;

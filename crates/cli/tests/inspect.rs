@@ -211,7 +211,10 @@ fn contractor_xyz_names_are_recognised_with_their_units() {
     ] {
         assert!(s.contains(mapped), "{mapped} in\n{s}");
     }
-    assert!(s.contains("1003.01 (2 samples), 1003.02 (2 samples)"), "{s}");
+    assert!(
+        s.contains("1003.01 (2 samples), 1003.02 (2 samples)"),
+        "{s}"
+    );
     // The JSON gives every recognised column its unit; radians stay radians
     // and are not mapped onto lat/lon.
     let j = aeromag(&["inspect", "--input", p.to_str().unwrap(), "--json"]);

@@ -32,8 +32,8 @@ use crate::forward::{Background, Forward, TensorForward};
 use crate::geometry::{Geometry, Layout};
 use crate::parallel::parallel_map;
 use crate::sr_iekf::{EpochResult, IekfConfig, SrState, iterate_epoch};
-use nalgebra::{SVector, Vector3};
 use aeromag_core::random::{normal, stream};
+use nalgebra::{SVector, Vector3};
 
 /// Configuration of a convergence map.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -43,8 +43,8 @@ use aeromag_core::field::dipole::dipole_field;
 use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
-use nalgebra::{Matrix3, SVector, Vector3};
 use aeromag_core::random::{self, ChaCha8Rng, normal};
+use nalgebra::{Matrix3, SVector, Vector3};
 use rand::RngExt;
 use std::borrow::Borrow;
 

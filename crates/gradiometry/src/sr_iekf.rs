@@ -294,6 +294,9 @@ mod tests {
         assert!((out.s * out.s.transpose() - p).norm() < 1e-12);
         assert!((out.x - f * x).norm() < 1e-15);
         // upper triangular, as the scalar update needs it
-        assert_eq!(out.s[(1, 0)].abs() + out.s[(2, 0)].abs() + out.s[(2, 1)].abs(), 0.0);
+        assert_eq!(
+            out.s[(1, 0)].abs() + out.s[(2, 0)].abs() + out.s[(2, 1)].abs(),
+            0.0
+        );
     }
 }

@@ -72,6 +72,8 @@ enum ColState {
     Numeric {
         values: Vec<f64>,
         missing: Missing,
+        /// Every value so far was written as an integer (`1003`).
+        integers: bool,
     },
     /// Text from row `from_row` on; rows before it need the second pass.
     Text {
@@ -150,6 +152,7 @@ impl TableBuilder {
             .map(|_| ColState::Numeric {
                 values: Vec::new(),
                 missing: Missing::default(),
+                integers: true,
             })
             .collect();
         Ok(TableBuilder {
@@ -185,8 +188,15 @@ impl TableBuilder {
         for (i, col) in self.cols.iter_mut().enumerate() {
             let bytes = src.field(i);
             match col {
-                ColState::Numeric { values, missing } => match parse_cell(bytes) {
-                    Ok(Cell::Value(v)) => values.push(v),
+                ColState::Numeric {
+                    values,
+                    missing,
+                    integers,
+                } => match parse_cell(bytes) {
+                    Ok(Cell::Value(v)) => {
+                        *integers = *integers && is_integer_text(bytes);
+                        values.push(v)
+                    }
                     Ok(Cell::Missing(kind)) => {
                         values.push(f64::NAN);
                         match kind {
@@ -326,16 +336,19 @@ impl TableBuilder {
                     ColState::Numeric {
                         mut values,
                         missing,
+                        integers,
                     } => {
                         shrink(&mut values);
-                        ColumnData::Numeric { values, missing }
+                        // A column with no value at all has no form to keep.
+                        let integers = integers && missing.total() < values.len();
+                        (ColumnData::Numeric { values, missing }, integers)
                     }
                     ColState::Text { mut values, .. } => {
                         shrink(&mut values);
-                        ColumnData::Text(values)
+                        (ColumnData::Text(values), false)
                     }
                 };
-                (name, data)
+                (name, data.0, data.1)
             })
             .collect();
         Ok(FlightTable::from_parts(
@@ -392,4 +405,15 @@ pub(crate) fn cell_error(
             }
         }
     }
+}
+
+/// True for a cell written as an integer: optional sign and decimal digits
+/// (surrounding spaces allowed), e.g. `1003`, `-7`; not `1003.0`, `1e3`.
+fn is_integer_text(bytes: &[u8]) -> bool {
+    let b = bytes.trim_ascii();
+    let digits = b
+        .strip_prefix(b"-")
+        .or_else(|| b.strip_prefix(b"+"))
+        .unwrap_or(b);
+    !digits.is_empty() && digits.len() <= 15 && digits.iter().all(u8::is_ascii_digit)
 }

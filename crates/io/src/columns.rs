@@ -294,9 +294,8 @@ pub(crate) fn resolve(
     if !preset {
         return Ok(out);
     }
-    let taken = |out: &[MappedColumn], file_column: &str| {
-        out.iter().any(|m| m.file_column == file_column)
-    };
+    let taken =
+        |out: &[MappedColumn], file_column: &str| out.iter().any(|m| m.file_column == file_column);
     let wanted = |out: &[MappedColumn], canonical: &str| {
         !has(canonical) && !out.iter().any(|m| m.canonical == canonical)
     };
@@ -442,10 +441,34 @@ mod tests {
         // The header of the SGL surveys' Geosoft XYZ export (spec
         // "Real survey files"), shortened.
         let h = header(&[
-            "LINE", "FLT", "TIME", "UTM-Z", "LAT", "LONG", "PITCH", "ROLL", "AZIMUTH", "DIURNAL",
-            "COMPMAG1", "IGRFMAG1", "UNCOMPMAG1", "UNCOMPMAG2", "FLUXA_X", "FLUXA_Y", "FLUXA_Z",
-            "FLUXA_TOT", "FLUXB_X", "FLUXB_Y", "FLUXB_Z", "INS_LAT", "INS_LON", "INS_HGT",
-            "INS_VEL_N", "INS_VEL_W", "INS_VEL_V", "CUR_ACHi",
+            "LINE",
+            "FLT",
+            "TIME",
+            "UTM-Z",
+            "LAT",
+            "LONG",
+            "PITCH",
+            "ROLL",
+            "AZIMUTH",
+            "DIURNAL",
+            "COMPMAG1",
+            "IGRFMAG1",
+            "UNCOMPMAG1",
+            "UNCOMPMAG2",
+            "FLUXA_X",
+            "FLUXA_Y",
+            "FLUXA_Z",
+            "FLUXA_TOT",
+            "FLUXB_X",
+            "FLUXB_Y",
+            "FLUXB_Z",
+            "INS_LAT",
+            "INS_LON",
+            "INS_HGT",
+            "INS_VEL_N",
+            "INS_VEL_W",
+            "INS_VEL_V",
+            "CUR_ACHi",
         ]);
         let m = resolve("f", &h, &ColumnMap::new(), true).unwrap();
         let get = |c: &str| {
@@ -480,7 +503,10 @@ mod tests {
         // A file with only the INS position has no lat/lon at all.
         let ins_only = header(&["tt", "ins_lat", "ins_lon", "mag_1_uc"]);
         let m = resolve("f", &ins_only, &ColumnMap::new(), true).unwrap();
-        assert!(m.iter().all(|x| x.canonical != "lat" && x.canonical != "lon"));
+        assert!(
+            m.iter()
+                .all(|x| x.canonical != "lat" && x.canonical != "lon")
+        );
     }
 
     #[test]

@@ -74,7 +74,10 @@ const EXACT: &[(&str, KnownField)] = &[
     ("mag_1_c", f("nT", "contractor's compensated Mag 1")),
     ("mag_1_lag", f("nT", "contractor's lag-corrected Mag 1")),
     ("mag_1_dc", f("nT", "contractor's diurnal-corrected Mag 1")),
-    ("mag_1_igrf", f("nT", "contractor's IGRF-corrected Mag 1 (anomaly)")),
+    (
+        "mag_1_igrf",
+        f("nT", "contractor's IGRF-corrected Mag 1 (anomaly)"),
+    ),
     ("ogs_mag", f("nT", "OGS magnetic anomaly map")),
     ("ogs_alt", f("m", "altitude of the OGS map")),
     // Geosoft XYZ export of the same surveys
@@ -88,7 +91,10 @@ const EXACT: &[(&str, KnownField)] = &[
     ("compmag1", f("nT", "contractor's compensated Mag 1")),
     ("lagmag1", f("nT", "contractor's lag-corrected Mag 1")),
     ("dcmag1", f("nT", "contractor's diurnal-corrected Mag 1")),
-    ("igrfmag1", f("nT", "contractor's IGRF-corrected Mag 1 (anomaly)")),
+    (
+        "igrfmag1",
+        f("nT", "contractor's IGRF-corrected Mag 1 (anomaly)"),
+    ),
     ("ogs_hgt", f("m", "altitude of the OGS map")),
     ("ins_acc_x", f("m/s²", "INS acceleration x")),
     ("ins_acc_y", f("m/s²", "INS acceleration y")),

@@ -54,12 +54,22 @@ pub enum ColumnData {
 pub struct Column {
     name: String,
     data: ColumnData,
+    /// Every value was written as an integer in the file it was read from
+    /// (`1003`, not `1003.0` or `1.003e3`): written back the same way.
+    integer_text: bool,
 }
 
 impl Column {
     /// Column name as in the file (or as added).
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// True when the column was read from a file where every value was
+    /// written as an integer (`1003`); writers then keep that form. False
+    /// for columns computed or changed in memory.
+    pub fn integer_text(&self) -> bool {
+        self.integer_text
     }
 
     /// The values.
@@ -222,6 +232,7 @@ impl FlightTable {
         self.push_column(Column {
             name: name.to_string(),
             data: ColumnData::Numeric { values, missing },
+            integer_text: false,
         })
     }
 
@@ -230,6 +241,7 @@ impl FlightTable {
         self.push_column(Column {
             name: name.to_string(),
             data: ColumnData::Text(values),
+            integer_text: false,
         })
     }
 
@@ -244,6 +256,7 @@ impl FlightTable {
                     ..Missing::default()
                 };
                 self.columns[i].data = ColumnData::Numeric { values, missing };
+                self.columns[i].integer_text = false;
                 Ok(())
             }
             None => self.add_column(name, values),
@@ -309,7 +322,7 @@ impl FlightTable {
     pub(crate) fn from_parts(
         source: PathBuf,
         n_rows: usize,
-        columns: Vec<(String, ColumnData)>,
+        columns: Vec<(String, ColumnData, bool)>,
         aliases: Vec<MappedColumn>,
         row_lines: Vec<(usize, u64)>,
     ) -> Self {
@@ -318,7 +331,11 @@ impl FlightTable {
             n_rows,
             columns: columns
                 .into_iter()
-                .map(|(name, data)| Column { name, data })
+                .map(|(name, data, integer_text)| Column {
+                    name,
+                    data,
+                    integer_text,
+                })
                 .collect(),
             aliases,
             row_lines,
@@ -330,14 +347,14 @@ impl FlightTable {
         let Some(target) = self.resolve(name).map(str::to_string) else {
             return false;
         };
-        match self
-            .columns
-            .iter_mut()
-            .find(|c| c.name == target)
-            .map(|c| &mut c.data)
-        {
-            Some(ColumnData::Numeric { values, .. }) => {
+        match self.columns.iter_mut().find(|c| c.name == target) {
+            Some(Column {
+                data: ColumnData::Numeric { values, .. },
+                integer_text,
+                ..
+            }) => {
                 values.iter_mut().for_each(|v| *v *= factor);
+                *integer_text = false;
                 true
             }
             _ => false,
@@ -411,6 +428,7 @@ mod tests {
                     values: vec![1.0, 2.0, 3.0, 4.0],
                     missing: Missing::default(),
                 },
+                false,
             ),
             (
                 "mag".to_string(),
@@ -418,6 +436,7 @@ mod tests {
                     values: vec![9.0; 4],
                     missing: Missing::default(),
                 },
+                false,
             ),
         ];
         let aliases = vec![MappedColumn {

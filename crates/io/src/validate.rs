@@ -139,7 +139,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
 }
 
 /// Multiplies the magnetic columns present (`mag`, `flux_*`, `diurnal`,
-/// `igrf`) by 1e9, converting tesla to nT (for `--mag-units T`). Returns the
+/// `igrf`) by 1e9, converting tesla to nT. Returns the
 /// names converted.
 pub fn convert_tesla_to_nt(table: &mut FlightTable) -> Vec<String> {
     MAGNETIC_COLUMNS
@@ -184,7 +184,7 @@ impl Ctx<'_> {
         if m < 1.0 {
             let guess = if (1e-6..1e-3).contains(&m) {
                 format!(
-                    "looks like tesla (Earth's field is 2e-5 to 7e-5 T), {fix} (multiply by 1e9 or pass --mag-units T)"
+                    "looks like tesla (Earth's field is 2e-5 to 7e-5 T), {fix} (multiply by 1e9)"
                 )
             } else if (0.05..1.0).contains(&m) {
                 format!("looks like gauss (Earth's field is 0.2 to 0.7 G), {fix} (multiply by 1e5)")
@@ -221,7 +221,7 @@ impl Ctx<'_> {
         if max > 0.0 && max < 1e-3 {
             return Err(self.units(
                 name,
-                format!("all values are below 1e-3 in magnitude (max |value| = {max:e}): looks like tesla, expected nT (multiply by 1e9 or pass --mag-units T)"),
+                format!("all values are below 1e-3 in magnitude (max |value| = {max:e}): looks like tesla, expected nT (multiply by 1e9)"),
             ));
         }
         if let Some(m) = median(v.iter().map(|x| x.abs()))

@@ -99,3 +99,35 @@ fn write_error_names_the_file() {
     );
     assert!(e.to_string().contains("out.csv"), "{e}");
 }
+
+/// A pass-through column keeps the form it was written in: integers stay
+/// integers (`1003`, not `1003.0`), other numbers are written exactly
+/// (shortest form), and a column changed in memory loses the integer form.
+#[test]
+fn integers_are_written_back_as_integers() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("in.csv");
+    std::fs::write(
+        &src,
+        "time,line,flt,mixed,big\n0.0,1003.01,1003,7,123456789012345\n0.1,1003.02,1003,7.5,-42\n0.2,L1020,+1004,,9\n",
+    )
+    .unwrap();
+    let mut t = read_csv(&src, &ReadOptions::default()).unwrap();
+    let col = |t: &FlightTable, n: &str| {
+        t.columns()
+            .iter()
+            .find(|c| c.name() == n)
+            .unwrap()
+            .integer_text()
+    };
+    assert!(col(&t, "flt") && col(&t, "big"));
+    assert!(!col(&t, "mixed") && !col(&t, "time"));
+    let out = dir.path().join("out.csv");
+    write_csv(&t, &out).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap(),
+        "time,line,flt,mixed,big\n0.0,1003.01,1003,7.0,123456789012345\n0.1,1003.02,1003,7.5,-42\n0.2,L1020,1004,,9\n"
+    );
+    t.set_column("flt", vec![1.0, 2.0, 3.0]).unwrap();
+    assert!(!col(&t, "flt"));
+}

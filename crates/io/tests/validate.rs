@@ -111,7 +111,7 @@ fn tesla_gauss_and_picotesla_are_errors() {
     let t = table(&[("igrf", vec![5.2e-5; 3])]);
     assert_mentions(
         &check_units(&t).unwrap_err().to_string(),
-        &["'igrf'", "multiply by 1e9 or pass --mag-units T"],
+        &["'igrf'", "multiply by 1e9)"],
     );
 }
 

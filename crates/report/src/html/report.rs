@@ -182,7 +182,8 @@ impl Report {
     /// Blocks grouped under their section heading (`None` = introduction,
     /// present only when it has content).
     fn groups(&self) -> Vec<(Option<&str>, Vec<&Block>)> {
-        let intro = (!self.intro.blocks.is_empty()).then(|| (None, self.intro.blocks.iter().collect()));
+        let intro =
+            (!self.intro.blocks.is_empty()).then(|| (None, self.intro.blocks.iter().collect()));
         intro
             .into_iter()
             .chain(

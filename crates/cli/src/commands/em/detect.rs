@@ -66,7 +66,10 @@ struct WindowName(Window);
 
 impl std::fmt::Display for WindowName {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let name = WINDOWS.iter().find(|(_, w)| *w == self.0).map_or("?", |(n, _)| n);
+        let name = WINDOWS
+            .iter()
+            .find(|(_, w)| *w == self.0)
+            .map_or("?", |(n, _)| n);
         f.write_str(name)
     }
 }
