@@ -2,7 +2,7 @@
 
 use super::Figures;
 use crate::error::Result;
-use crate::flight::Flight;
+use crate::flight::{Flight, GAP_FACTOR};
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::segments::median_step;
 use aeromag_core::spectrum::{WelchConfig, welch};
@@ -10,6 +10,32 @@ use aeromag_report::{LinePlot, ReportSection, Series, Table};
 
 fn f3(v: Option<f64>) -> String {
     v.map_or("—".into(), |x| format!("{x:.3}"))
+}
+
+/// A FOM or IR cell: the value, or why there is none.
+fn fom_cell(v: Option<f64>, windows: usize) -> String {
+    match v {
+        Some(_) => f3(v),
+        None if windows == 0 => "— (no manoeuvre windows found)".into(),
+        None => "— (windows too short or not finite)".into(),
+    }
+}
+
+/// `(t, y)` with a NaN point inserted at every time gap (a step longer
+/// than [`GAP_FACTOR`] × the median step), so that a line plot breaks
+/// there instead of drawing a straight line across the gap.
+fn gapped(t: &[f64], y: &[f64], step: f64) -> (Vec<f64>, Vec<f64>) {
+    let mut tt = Vec::with_capacity(t.len());
+    let mut yy = Vec::with_capacity(y.len());
+    for i in 0..t.len().min(y.len()) {
+        if i > 0 && t[i] - t[i - 1] > GAP_FACTOR * step {
+            tt.push(0.5 * (t[i] + t[i - 1]));
+            yy.push(f64::NAN);
+        }
+        tt.push(t[i]);
+        yy.push(y[i]);
+    }
+    (tt, yy)
 }
 
 impl Figures {
@@ -30,13 +56,28 @@ impl Figures {
         let comp = t.require("mag_comp")?;
         let t0 = time.first().copied().unwrap_or(0.0);
         let tt: Vec<f64> = time.iter().map(|v| v - t0).collect();
+        let step = median_step(time);
+        // A series over the time axis, broken at the time gaps.
+        let series = |name: &str, y: Vec<f64>| {
+            let (x, y) = gapped(&tt, &y, step);
+            Series::line(name, x, y)
+        };
         let mut r = ReportSection::new(title);
         let mut kv = vec![
             ("rows".to_string(), t.n_rows().to_string()),
-            ("FOM before (nT)".into(), f3(fig.fom_before_nt)),
-            ("FOM after (nT)".into(), f3(fig.fom_after_nt)),
+            (
+                "FOM before (nT)".into(),
+                fom_cell(fig.fom_before_nt, fig.fom_windows),
+            ),
+            (
+                "FOM after (nT)".into(),
+                fom_cell(fig.fom_after_nt, fig.fom_windows),
+            ),
             ("manoeuvre windows".into(), fig.fom_windows.to_string()),
-            ("improvement ratio".into(), f3(fig.ir)),
+            (
+                "improvement ratio".into(),
+                fom_cell(fig.ir, fig.fom_windows),
+            ),
         ];
         if let Some(v) = fig.residual_rms_nt {
             kv.push(("residual vs truth, RMS (nT)".into(), format!("{v:.4}")));
@@ -56,43 +97,40 @@ impl Figures {
             "time since start (s)",
             "field (nT)",
         )
-        .with_series(Series::line(
+        .with_series(series(
             "uncompensated",
-            tt.clone(),
             mag.iter().map(|v| v - mm).collect(),
         ))
-        .with_series(Series::line(
-            "compensated",
-            tt.clone(),
-            comp.iter().map(|v| v - cm).collect(),
-        ))
+        .with_series(series("compensated", comp.iter().map(|v| v - cm).collect()))
         .to_svg()?;
         r.figure(svg, "Scalar magnetometer before and after compensation.");
 
         if let Some(model_interf) = t.column("mag_interf") {
             let mi = mean(model_interf);
-            let mut p = LinePlot::new(
-                "Aircraft interference: model and truth (means removed)",
-                "time since start (s)",
-                "interference (nT)",
-            )
-            .with_series(Series::line(
-                "model",
-                tt.clone(),
-                model_interf.iter().map(|v| v - mi).collect(),
-            ));
-            if let Some(ti) = t.column("true_interf") {
+            let truth = t.column("true_interf");
+            let (title, caption) = if truth.is_some() {
+                (
+                    "Aircraft interference: model and truth (means removed)",
+                    "Modelled interference against the simulator's truth.",
+                )
+            } else {
+                (
+                    "Aircraft interference: model (mean removed)",
+                    "Modelled interference (the file has no truth to compare with).",
+                )
+            };
+            let mut p =
+                LinePlot::new(title, "time since start (s)", "interference (nT)").with_series(
+                    series("model", model_interf.iter().map(|v| v - mi).collect()),
+                );
+            if let Some(ti) = truth {
                 let m = mean(ti);
-                p = p.with_series(Series::line(
+                p = p.with_series(series(
                     "truth (simulation)",
-                    tt.clone(),
                     ti.iter().map(|v| v - m).collect(),
                 ));
             }
-            r.figure(
-                p.to_svg()?,
-                "Modelled interference against the simulator's truth where available.",
-            );
+            r.figure(p.to_svg()?, caption);
         }
 
         if let Some(ext) = t.column("true_external") {
@@ -106,17 +144,13 @@ impl Figures {
                 "time since start (s)",
                 "compensated − truth (nT)",
             )
-            .with_series(Series::line(
-                "residual",
-                tt.clone(),
-                res.iter().map(|v| v - rm).collect(),
-            ))
+            .with_series(series("residual", res.iter().map(|v| v - rm).collect()))
             .to_svg()?;
             r.figure(svg, "Compensated field minus the true external field (sensor lag term removed), mean removed.");
         }
 
         // Welch spectra over the longest finite run of each signal.
-        let fs = 1.0 / median_step(time);
+        let fs = 1.0 / step;
         let longest = |x: &[f64]| -> Vec<f64> {
             let mut best = (0, 0);
             let mut start = 0;
@@ -230,5 +264,30 @@ impl Figures {
             }
         }
         Ok(r)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_break_at_time_gaps() {
+        let t = [0.0, 0.1, 0.2, 10.0, 10.1];
+        let y = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let (tt, yy) = gapped(&t, &y, 0.1);
+        assert_eq!(tt.len(), 6);
+        assert!(yy[3].is_nan() && tt[3] > 0.2 && tt[3] < 10.0);
+        assert_eq!(&yy[..3], &[1.0, 2.0, 3.0]);
+        assert_eq!(&yy[4..], &[4.0, 5.0]);
+        // a regular record is left alone
+        assert_eq!(gapped(&t[..3], &y[..3], 0.1).1, y[..3].to_vec());
+    }
+
+    #[test]
+    fn missing_fom_says_why() {
+        assert_eq!(fom_cell(Some(1.23456), 3), "1.235");
+        assert!(fom_cell(None, 0).contains("no manoeuvre windows"));
+        assert!(fom_cell(None, 2).contains("too short"));
     }
 }
