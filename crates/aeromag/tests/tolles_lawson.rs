@@ -7,6 +7,15 @@ use aeromag::prelude::*;
 use aeromag::simulate::{ScenarioKind, simulate_flight};
 use aeromag::{FlightTable, KalmanOptions};
 
+/// The classical 16-term LS model of `cal` (no eddy-current lags).
+fn classical_model(cal: &Flight) -> TlModel {
+    let opts = CalibrateOptions {
+        eddy_lag: EddyLag::None,
+        ..CalibrateOptions::default()
+    };
+    calibrate(cal, &opts, &mut Silent).unwrap().model
+}
+
 /// A simulated calibration box.
 fn calibration(seed: u64) -> Flight {
     simulate_flight(ScenarioKind::Calibration, None, Some(seed)).unwrap()
@@ -65,16 +74,7 @@ fn eddy_lags_are_chosen_when_significant_and_recorded() {
     );
     assert_eq!(sel.taus_s, m.design.terms.eddy_lags_s());
     // `none`: the classical 16 terms, with a larger residual.
-    let classical = calibrate(
-        &cal,
-        &CalibrateOptions {
-            eddy_lag: EddyLag::None,
-            ..CalibrateOptions::default()
-        },
-        &mut Silent,
-    )
-    .unwrap()
-    .model;
+    let classical = classical_model(&cal);
     assert_eq!(classical.coefficients.len(), 16);
     assert!(
         m.fit.residual_rms_nt < 0.8 * classical.fit.residual_rms_nt,
@@ -90,16 +90,7 @@ fn eddy_lags_are_chosen_when_significant_and_recorded() {
 #[test]
 fn every_row_is_kept_and_rows_with_missing_inputs_are_flagged() {
     let cal = calibration(5);
-    let model = calibrate(
-        &cal,
-        &CalibrateOptions {
-            eddy_lag: EddyLag::None,
-            ..CalibrateOptions::default()
-        },
-        &mut Silent,
-    )
-    .unwrap()
-    .model;
+    let model = classical_model(&cal);
     let mut t = cal.table().clone();
     let mut fx = t.require("flux_x").unwrap().to_vec();
     for row in [100, 101, 2000] {

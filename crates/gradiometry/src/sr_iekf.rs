@@ -66,6 +66,9 @@ impl<const N: usize> SrState<N> {
     }
 }
 
+/// Largest state dimension of the filter (position and moment: 6).
+const MAX_STATES: usize = 8;
+
 /// `PrognosisFK`: `x⁻ = F x`, `S⁻ = tri([diag(s_q), F S])` (module docs).
 pub fn prognosis<const N: usize>(
     state: &SrState<N>,
@@ -73,17 +76,23 @@ pub fn prognosis<const N: usize>(
     s_q: &SVector<f64, N>,
 ) -> SrState<N> {
     let fs = f * state.s;
-    // The wide factor, row-major, N × 2N: the process-noise columns first.
+    // The wide factor, row-major, N × 2N: the process-noise columns first
+    // (stack buffers: this runs for every epoch of every start of a map).
     let c = 2 * N;
-    let mut a = vec![0.0; N * c];
+    assert!(
+        N <= MAX_STATES,
+        "the gradiometer filter has at most {MAX_STATES} states"
+    );
+    let mut buf = [0.0; 2 * MAX_STATES * MAX_STATES];
+    let a = &mut buf[..N * c];
     for i in 0..N {
         a[i * c + i] = s_q[i];
         for j in 0..N {
             a[i * c + N + j] = fs[(i, j)];
         }
     }
-    let mut work = vec![0.0; c];
-    triangularize_upper(&mut a, N, c, &mut work);
+    let mut work = [0.0; 2 * MAX_STATES];
+    triangularize_upper(a, N, c, &mut work);
     SrState {
         x: f * state.x,
         s: SMatrix::from_fn(|i, j| a[i * c + N + j]),
@@ -103,7 +112,11 @@ pub fn processing<const N: usize>(
     // Carlson's update takes the measurement y with ν = y − hᵀx.
     let y = nu + h.dot(&state.x);
     let mut gain = [0.0; N];
-    let mut work = vec![0.0; 3 * N];
+    assert!(
+        N <= MAX_STATES,
+        "the gradiometer filter has at most {MAX_STATES} states"
+    );
+    let mut work = [0.0; 3 * MAX_STATES];
     carlson_update(
         state.s.as_mut_slice(),
         state.x.as_mut_slice(),
@@ -111,7 +124,7 @@ pub fn processing<const N: usize>(
         y,
         sigma2,
         &mut gain,
-        &mut work,
+        &mut work[..3 * N],
     )
     .map_err(|_| GradiometryError::NotFinite {
         name: "IEKF measurement or its row",

@@ -94,7 +94,7 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
                     } else if c.integer_text() && v.fract() == 0.0 {
                         // Read as `1003`: written back as `1003`, not `1003.0`
                         // (at most 15 digits, so exact).
-                        line.extend_from_slice((v as i64).to_string().as_bytes());
+                        let _ = write!(line, "{}", v as i64); // into a Vec: cannot fail
                     } else {
                         line.extend_from_slice(ryu.format(v).as_bytes());
                     }
