@@ -3,7 +3,7 @@
 //! (algorithms: [`aeromag_compensation::levelling`]).
 
 use crate::error::{Error, InFile, Result};
-use crate::flight::{Flight, ReferenceChannels, reduced, reference_sum, sensor_track};
+use crate::flight::{Flight, LineLabels, ReferenceChannels, reduced, reference_sum, sensor_track};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::levelling::{
     Crossover, LevellingConfig, RowFlag, SurveyLevelling, SurveyTracks, TrackConfig, level_survey,
@@ -31,6 +31,9 @@ pub struct LevelOptions {
     pub tracks: TrackConfig,
     /// The fit (k, drift, ridge λ, altitude term, robust weights).
     pub fit: LevellingConfig,
+    /// Labels of the tie lines, when neither a `line_type` column nor the
+    /// labels (`L…`/`T…`) tell ([`LineLabels`]). Empty: not declared.
+    pub ties: Vec<String>,
 }
 
 impl Default for LevelOptions {
@@ -42,6 +45,7 @@ impl Default for LevelOptions {
             reference: ReferenceChannels::None,
             tracks: TrackConfig::default(),
             fit: LevellingConfig::default(),
+            ties: Vec::new(),
         }
     }
 }
@@ -58,6 +62,8 @@ pub struct Levelled {
     pub reference_columns: Vec<String>,
     /// The column whose derivative is the `d|B0|/dt` regressor.
     pub rate_column: String,
+    /// The line labels: the fit's and the crossovers' `label`s are their ids.
+    pub lines: LineLabels,
     /// Notes and warnings.
     pub notes: Vec<Note>,
 }
@@ -105,9 +111,20 @@ impl Levelled {
         let xs = &self.levelling.crossovers.crossovers;
         let fit = &self.levelling.fit;
         let col = |f: &dyn Fn(&Crossover) -> f64| -> Vec<f64> { xs.iter().map(f).collect() };
+        let mut t = FlightTable::new();
+        if self.lines.numbers.is_some() {
+            t.add_column("line_a", col(&|x| self.lines.number(x.a.label)))?;
+            t.add_column("line_b", col(&|x| self.lines.number(x.b.label)))?;
+        } else {
+            let text = |id: &dyn Fn(&Crossover) -> i64| -> Vec<String> {
+                xs.iter()
+                    .map(|x| self.lines.label(id(x)).unwrap_or("").to_string())
+                    .collect()
+            };
+            t.add_text_column("line_a", text(&|x| x.a.label))?;
+            t.add_text_column("line_b", text(&|x| x.b.label))?;
+        }
         let columns: Vec<(&str, Vec<f64>)> = vec![
-            ("line_a", col(&|x| x.a.label as f64)),
-            ("line_b", col(&|x| x.b.label as f64)),
             ("north_m", col(&|x| x.north_m)),
             ("east_m", col(&|x| x.east_m)),
             ("angle_deg", col(&|x| x.angle_deg)),
@@ -131,7 +148,6 @@ impl Levelled {
             ("residual_nt", fit.residuals_nt.clone()),
             ("weight", fit.weights.clone()),
         ];
-        let mut t = FlightTable::new();
         for (name, v) in columns {
             t.add_column(name, v)?;
         }
@@ -214,16 +230,21 @@ pub fn level(
         .estimate_k
         .then(|| flight.require(&rate_column))
         .transpose()?;
+    let lines = LineLabels::of(flight, &opts.ties)?;
     let tracks = SurveyTracks {
         time: flight.require("time")?,
         lat,
         lon,
         alt,
-        line: flight.require("line")?,
+        line: &lines.ids,
         value: &value,
         sensed,
     };
-    let levelling = level_survey(&tracks, &opts.tracks, &opts.fit).in_file(&flight.label())?;
+    let track_config = TrackConfig {
+        pairing: lines.pairing(),
+        ..opts.tracks.clone()
+    };
+    let levelling = level_survey(&tracks, &track_config, &opts.fit).in_file(&flight.label())?;
     let f = &levelling.fit;
     if opts.fit.altitude_term && !f.altitude_term_used {
         notes.warn(
@@ -241,6 +262,7 @@ pub fn level(
         value_column,
         reference_columns,
         rate_column,
+        lines,
         notes: notes.into_notes(),
     })
 }

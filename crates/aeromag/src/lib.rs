@@ -86,10 +86,10 @@ pub use aeromag_io as io;
 pub use aeromag_report as report;
 pub use aeromag_sim as sim;
 
-pub use aeromag_io::{ColumnMap, FlightTable, ReadOptions};
+pub use aeromag_io::{ColumnMap, FlightTable, ReadOptions, RowSelection, Sensors};
 pub use compensate::{Compensated, Compensator, OutputColumns};
 pub use error::{Error, InFile, Result};
-pub use flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, TlInputs};
+pub use flight::{Flight, LeverArm, LineLabels, ReferenceChannels, SegmentRule, TlInputs};
 pub use model_file::ModelFile;
 pub use observer::{Note, NoteLevel, Observer, Silent};
 pub use tolles_lawson::{

@@ -2,6 +2,7 @@
 //! by line levels, and `k` of the `k·d|B0|/dt` term recovered with the base
 //! station removed.
 
+use aeromag::FlightTable;
 use aeromag::compensation::levelling::LevellingConfig;
 use aeromag::level::{LevelOptions, Levelled, level};
 use aeromag::prelude::*;
@@ -120,5 +121,104 @@ fn with_the_base_station_removed_k_is_recovered() {
         "model residual {} nT (Ḃ of mag) vs {} nT (Ḃ of mag_comp)",
         r(&lev),
         r(&of_comp)
+    );
+}
+
+/// Line labels are labels: the default survey (lines 1001…, ties 2001…)
+/// relabelled as text (`L1001`, `T2001`), as SGL-style decimals
+/// (`1001.01`), or with a `line_type` column levels to the same k and line
+/// levels as with its integer labels; declared ties keep only line–tie
+/// crossings.
+#[test]
+fn text_decimal_and_typed_labels_level_like_integer_labels() {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
+    let opts = LevelOptions::default();
+    let base = level(&survey, &opts, &mut Silent).unwrap();
+    let line = survey.require("line").unwrap().to_vec();
+    let relabelled = |edit: &dyn Fn(&mut FlightTable)| {
+        let mut t = survey.table().clone();
+        edit(&mut t);
+        Flight::from_table(t).unwrap()
+    };
+    let text: Vec<String> = line
+        .iter()
+        .map(|&l| match l {
+            0.0 => String::new(),
+            l if l >= 2001.0 => format!("T{l}"),
+            l => format!("L{l}"),
+        })
+        .collect();
+    let as_text = relabelled(&|t| {
+        // Replace the numeric labels by text ones under the same name.
+        let mut fresh = FlightTable::new();
+        for c in t.columns() {
+            match c.name() {
+                "line" => fresh.add_text_column("line", text.clone()).unwrap(),
+                n => fresh.add_column(n, c.values().unwrap().to_vec()).unwrap(),
+            }
+        }
+        *t = fresh;
+    });
+    let decimal = relabelled(&|t| {
+        let v = line
+            .iter()
+            .map(|&l| if l == 0.0 { 0.0 } else { l + 0.01 })
+            .collect();
+        t.set_column("line", v).unwrap();
+    });
+    let typed = relabelled(&|t| {
+        let v = line.iter().map(|&l| f64::from(l >= 2001.0)).collect();
+        t.add_column("line_type", v).unwrap();
+    });
+    let declared = LevelOptions {
+        ties: (2001..=2005).map(|l| l.to_string()).collect(),
+        ..LevelOptions::default()
+    };
+    let runs = [
+        level(&as_text, &opts, &mut Silent).unwrap(),
+        level(&decimal, &opts, &mut Silent).unwrap(),
+        level(&typed, &opts, &mut Silent).unwrap(),
+        level(&survey, &declared, &mut Silent).unwrap(),
+    ];
+    let n = base.levelling.crossovers.crossovers.len();
+    assert!(n >= 90, "{n} crossovers");
+    for (k, lev) in runs.iter().enumerate() {
+        let (a, b) = (&base.levelling.fit, &lev.levelling.fit);
+        assert_eq!(lev.levelling.crossovers.crossovers.len(), n, "run {k}");
+        assert_eq!(a.k_s, b.k_s, "run {k}");
+        assert_eq!(a.lines.len(), b.lines.len(), "run {k}");
+        for (la, lb) in a.lines.iter().zip(&b.lines) {
+            assert_eq!(la.offset_nt, lb.offset_nt, "run {k}");
+        }
+    }
+    // Labels come back as written, in the crossover table too.
+    assert_eq!(runs[0].lines.label(1), Some("L1001"));
+    let xt = runs[0].crossover_table().unwrap();
+    assert!(xt.text_column("line_b").unwrap()[0].starts_with('T'));
+    let xd = runs[1].crossover_table().unwrap();
+    assert!(
+        xd.column("line_a")
+            .unwrap()
+            .iter()
+            .all(|l| (l * 100.0).round() % 100.0 == 1.0)
+    );
+    // Ties declared among the lines: line–line crossings are not formed,
+    // and a tie label that matches nothing is bad input.
+    let wrong = LevelOptions {
+        ties: vec!["1001".into()],
+        ..LevelOptions::default()
+    };
+    // (line 1001 as the only "tie": only its 5 crossings with the real ties
+    // are left, which cannot determine k and the levels).
+    let e = level(&survey, &wrong, &mut Silent).unwrap_err();
+    assert!(e.to_string().contains("5 crossovers"), "{e}");
+    let missing = LevelOptions {
+        ties: vec!["9999".into()],
+        ..LevelOptions::default()
+    };
+    assert!(
+        level(&survey, &missing, &mut Silent)
+            .unwrap_err()
+            .is_bad_input()
     );
 }

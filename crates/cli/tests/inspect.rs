@@ -244,3 +244,71 @@ fn contractor_xyz_names_are_recognised_with_their_units() {
     assert!(col("IGRFMAG1")["canonical"].is_null());
     assert_eq!(col("FLUXA_X")["missing_total"], 1);
 }
+
+/// A contractor's XYZ export with several sensors (our own numbers, SGL
+/// names): `--mag`/`--vector` choose the sensors by their SGL names,
+/// `--lines`/`--time-range` the rows, radians and west velocities are
+/// derived, and every mistake exits 2 naming the option.
+#[test]
+fn sensors_and_segments_of_a_whole_flight() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from(
+        "/ XYZ EXPORT\n/ LINE TIME LAT LONG INS_LAT INS_LON INS_VEL_W UNCOMPMAG1 UNCOMPMAG2 FLUXA_X FLUXA_Y FLUXA_Z FLUXB_X FLUXB_Y FLUXB_Z\n",
+    );
+    for i in 0..9 {
+        let line = ["1002.01", "1002.02", "1003.01"][i / 3];
+        let t = 100.0 + i as f64 * 0.1;
+        text.push_str(&format!(
+            "{line} {t:.1} 45.0 -75.0 0.785398 -1.308997 -60.0 5300{i}.0 5310{i}.0 30000 1000 42000 31000 900 41000\n"
+        ));
+    }
+    let f = write(&dir, "flight.xyz", text.as_bytes());
+    let f = f.to_str().unwrap();
+    let o = aeromag(&[
+        "inspect",
+        "-i",
+        f,
+        "--mag",
+        "mag_2_uc",
+        "--vector",
+        "flux_b",
+        "--lines",
+        "1002.02,1003.01",
+        "--time-range",
+        "100.35,101",
+    ]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("rows     5"), "{s}");
+    assert!(
+        s.contains("mag=UNCOMPMAG2 [nT]") && s.contains("flux_x=FLUXB_X [nT]"),
+        "{s}"
+    );
+    assert!(
+        s.contains("lines    2: 1002.02 (2 samples), 1003.01 (3 samples)"),
+        "{s}"
+    );
+    assert!(s.contains("derived  ve=INS_VEL_W (× −1) [m/s]"), "{s}");
+    for (args, needle) in [
+        (vec!["--mag", "mag_4_uc"], "--mag mag_4_uc: no such column"),
+        (vec!["--vector", "flux_c"], "--vector flux_c"),
+        (
+            vec!["--lines", "1004.01"],
+            "labels present: 1002.01, 1002.02, 1003.01",
+        ),
+        (
+            vec!["--time-range", "5,1"],
+            "--time-range: start 5 is after end 1",
+        ),
+        (
+            vec!["--time-range", "0,50"],
+            "the file's time runs from 100 to 100.8 s",
+        ),
+    ] {
+        let mut a = vec!["inspect", "-i", f];
+        a.extend(args);
+        let o = aeromag(&a);
+        assert_code(&o, 2);
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    }
+}

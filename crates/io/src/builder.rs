@@ -128,7 +128,13 @@ impl TableBuilder {
                 });
             }
         }
-        let aliases = resolve(&file, &names, &opts.columns, opts.magnav_preset)?;
+        let aliases = resolve(
+            &file,
+            &names,
+            &opts.columns,
+            &opts.sensors,
+            opts.magnav_preset,
+        )?;
         let role_of = |name: &str| {
             aliases
                 .iter()

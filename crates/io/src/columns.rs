@@ -137,6 +137,8 @@ pub enum MapOrigin {
     User,
     /// The built-in MagNav/SGL preset ([`MAGNAV_PRESET`]).
     MagNavPreset,
+    /// The sensor chosen with `--mag` or `--vector` ([`Sensors`]).
+    Selected,
 }
 
 /// One resolved alias: the canonical name `canonical` reads the file column `file_column`.
@@ -264,17 +266,13 @@ pub(crate) fn resolve(
     file: &str,
     header: &[String],
     map: &ColumnMap,
+    sensors: &Sensors,
     preset: bool,
 ) -> Result<Vec<MappedColumn>> {
     let has = |name: &str| header.iter().any(|h| h == name);
     // The header's spelling of `name`, compared without regard to case
     // (an exact match first).
-    let find = |name: &str| -> Option<&String> {
-        header
-            .iter()
-            .find(|h| *h == name)
-            .or_else(|| header.iter().find(|h| h.eq_ignore_ascii_case(name)))
-    };
+    let find = |name: &str| -> Option<&String> { find_in(header, name) };
     let mut out: Vec<MappedColumn> = Vec::new();
     for (canonical, file_column) in map.pairs() {
         if !has(file_column) {
@@ -291,6 +289,7 @@ pub(crate) fn resolve(
             origin: MapOrigin::User,
         });
     }
+    sensors.resolve(file, header, map, &mut out)?;
     if !preset {
         return Ok(out);
     }
@@ -348,6 +347,162 @@ pub(crate) fn resolve(
         }
     }
     Ok(out)
+}
+
+/// The header's spelling of `name`: an exact match, else one that differs
+/// only in case.
+fn find_in<'h>(header: &'h [String], name: &str) -> Option<&'h String> {
+    header
+        .iter()
+        .find(|h| *h == name)
+        .or_else(|| header.iter().find(|h| h.eq_ignore_ascii_case(name)))
+}
+
+/// The sensors of a flight with several magnetometers that a command uses
+/// (`--mag NAME`, `--vector PREFIX`); `None` leaves the choice to the
+/// column map and the preset (the first scalar and the first complete vector
+/// magnetometer).
+///
+/// Names are the SGL HDF5 names (`mag_3_uc`, `flux_b`), which also find the
+/// same sensor under its Geosoft XYZ export name (`UNCOMPMAG3`, `FLUXB_X`…),
+/// or any column of the file (`--mag my_mag`, `--vector vec` for
+/// `vec_x/vec_y/vec_z`), compared without regard to case.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Sensors {
+    /// The scalar magnetometer that plays `mag`.
+    pub mag: Option<String>,
+    /// The prefix of the vector magnetometer whose `_x`, `_y`, `_z` play
+    /// `flux_x`, `flux_y`, `flux_z`.
+    pub vector: Option<String>,
+}
+
+impl Sensors {
+    /// Adds the chosen sensors to `out` (after the user map, before the
+    /// preset). Errors: a sensor the map also sets, or one the file lacks.
+    fn resolve(
+        &self,
+        file: &str,
+        header: &[String],
+        map: &ColumnMap,
+        out: &mut Vec<MappedColumn>,
+    ) -> Result<()> {
+        let conflict = |option: &str, name: &str, canonical: &str| IoError::ColumnMap {
+            text: format!("{option} {name}"),
+            reason: format!("'{canonical}' is also mapped by --columns; choose the sensor one way"),
+        };
+        let mut push = |canonical: &str, file_column: &String| {
+            out.push(MappedColumn {
+                canonical: canonical.to_string(),
+                file_column: file_column.clone(),
+                origin: MapOrigin::Selected,
+            })
+        };
+        if let Some(name) = &self.mag {
+            if map.get("mag").is_some() {
+                return Err(conflict("--mag", name, "mag"));
+            }
+            let hit = sensor_names(name)
+                .iter()
+                .find_map(|n| find_in(header, n))
+                .ok_or_else(|| IoError::SensorAbsent {
+                    file: file.to_string(),
+                    option: "--mag",
+                    name: name.clone(),
+                    candidates: candidates(header, |h| {
+                        let l = h.to_ascii_lowercase();
+                        (l.starts_with("mag") || l.contains("mag")) && !l.starts_with("flux")
+                    }),
+                })?;
+            push("mag", hit);
+        }
+        if let Some(prefix) = &self.vector {
+            if ["flux_x", "flux_y", "flux_z"]
+                .iter()
+                .any(|c| map.get(c).is_some())
+            {
+                return Err(conflict("--vector", prefix, "flux_x/y/z"));
+            }
+            let triplet = sensor_names(prefix).iter().find_map(|p| {
+                let names: Vec<&String> = ["x", "y", "z"]
+                    .iter()
+                    .filter_map(|a| find_in(header, &format!("{p}_{a}")))
+                    .collect();
+                (names.len() == 3).then_some(names)
+            });
+            let Some(names) = triplet else {
+                return Err(IoError::SensorAbsent {
+                    file: file.to_string(),
+                    option: "--vector",
+                    name: format!("{prefix} ({prefix}_x, {prefix}_y, {prefix}_z)"),
+                    candidates: candidates(header, |h| {
+                        let l = h.to_ascii_lowercase();
+                        l.ends_with("_x") || l.ends_with("_y") || l.ends_with("_z")
+                    }),
+                });
+            };
+            for (canonical, file_column) in ["flux_x", "flux_y", "flux_z"].iter().zip(names) {
+                push(canonical, file_column);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The names one sensor goes by: as given, and its SGL HDF5 / Geosoft XYZ
+/// counterpart (`mag_3_uc` ↔ `UNCOMPMAG3`, `mag_1_c` ↔ `COMPMAG1`,
+/// `flux_b` ↔ `FLUXB`).
+pub fn sensor_names(name: &str) -> Vec<String> {
+    let lower = name.to_ascii_lowercase();
+    let mut names = vec![name.to_string()];
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    // mag_<k>_<kind> (HDF5) ↔ <KIND>MAG<k> (XYZ)
+    const KINDS: [(&str, &str); 5] = [
+        ("uc", "uncompmag"),
+        ("c", "compmag"),
+        ("lag", "lagmag"),
+        ("dc", "dcmag"),
+        ("igrf", "igrfmag"),
+    ];
+    let parts: Vec<&str> = lower.split('_').collect();
+    if let ["mag", k, kind] = parts[..]
+        && digits(k)
+        && let Some((_, xyz)) = KINDS.iter().find(|(h, _)| *h == kind)
+    {
+        names.push(format!("{xyz}{k}"));
+    }
+    for (h, xyz) in KINDS {
+        if let Some(k) = lower.strip_prefix(xyz)
+            && digits(k)
+        {
+            names.push(format!("mag_{k}_{h}"));
+        }
+    }
+    // flux_<s> ↔ flux<s>
+    if let Some(s) = lower.strip_prefix("flux_")
+        && s.len() == 1
+    {
+        names.push(format!("flux{s}"));
+    } else if let Some(s) = lower.strip_prefix("flux")
+        && s.len() == 1
+        && s != "_"
+    {
+        names.push(format!("flux_{s}"));
+    }
+    names
+}
+
+/// The header names that pass `keep`, for a "present are …" hint.
+fn candidates(header: &[String], keep: impl Fn(&str) -> bool) -> String {
+    let c: Vec<&str> = header
+        .iter()
+        .map(String::as_str)
+        .filter(|h| keep(h))
+        .collect();
+    if c.is_empty() {
+        "none that looks like one".to_string()
+    } else {
+        c.join(", ")
+    }
 }
 
 /// The canonical name closest to `name` (case-insensitive edit distance ≤ 2).
@@ -427,7 +582,14 @@ mod tests {
     #[test]
     fn user_map_requires_present_column() {
         let m = ColumnMap::parse("mag=mag_9_uc").unwrap();
-        let e = resolve("f.csv", &header(&["time", "mag_1_uc"]), &m, true).unwrap_err();
+        let e = resolve(
+            "f.csv",
+            &header(&["time", "mag_1_uc"]),
+            &m,
+            &Sensors::default(),
+            true,
+        )
+        .unwrap_err();
         let s = e.to_string();
         assert!(matches!(e, IoError::MappedColumnAbsent { .. }));
         assert!(
@@ -470,7 +632,7 @@ mod tests {
             "INS_VEL_V",
             "CUR_ACHi",
         ]);
-        let m = resolve("f", &h, &ColumnMap::new(), true).unwrap();
+        let m = resolve("f", &h, &ColumnMap::new(), &Sensors::default(), true).unwrap();
         let get = |c: &str| {
             m.iter()
                 .find(|x| x.canonical == c)
@@ -502,7 +664,7 @@ mod tests {
         assert_eq!(get("igrf"), None);
         // A file with only the INS position has no lat/lon at all.
         let ins_only = header(&["tt", "ins_lat", "ins_lon", "mag_1_uc"]);
-        let m = resolve("f", &ins_only, &ColumnMap::new(), true).unwrap();
+        let m = resolve("f", &ins_only, &ColumnMap::new(), &Sensors::default(), true).unwrap();
         assert!(
             m.iter()
                 .all(|x| x.canonical != "lat" && x.canonical != "lon")
@@ -530,7 +692,7 @@ mod tests {
             "flux_b_z",
             "line",
         ]);
-        let m = resolve("f", &h, &ColumnMap::new(), true).unwrap();
+        let m = resolve("f", &h, &ColumnMap::new(), &Sensors::default(), true).unwrap();
         let get = |c: &str| {
             m.iter()
                 .find(|x| x.canonical == c)
@@ -547,14 +709,96 @@ mod tests {
         assert!(m.iter().all(|x| x.origin == MapOrigin::MagNavPreset));
         // User map wins and the preset does not reuse its column.
         let user = ColumnMap::parse("mag=mag_3_uc").unwrap();
-        let m = resolve("f", &h, &user, true).unwrap();
+        let m = resolve("f", &h, &user, &Sensors::default(), true).unwrap();
         assert_eq!(m.iter().filter(|x| x.canonical == "mag").count(), 1);
         assert_eq!(m[0].origin, MapOrigin::User);
         assert!(
-            resolve("f", &h, &ColumnMap::new(), false)
+            resolve("f", &h, &ColumnMap::new(), &Sensors::default(), false)
                 .unwrap()
                 .is_empty()
         );
+    }
+
+    #[test]
+    fn sensors_are_chosen_by_sgl_or_xyz_name() {
+        let xyz = header(&[
+            "TIME",
+            "UNCOMPMAG1",
+            "UNCOMPMAG3",
+            "FLUXA_X",
+            "FLUXA_Y",
+            "FLUXA_Z",
+            "FLUXB_X",
+            "FLUXB_Y",
+            "FLUXB_Z",
+        ]);
+        let choose = |mag: &str, vector: &str| Sensors {
+            mag: Some(mag.into()),
+            vector: Some(vector.into()),
+        };
+        for (mag, vector) in [
+            ("mag_3_uc", "flux_b"),
+            ("UNCOMPMAG3", "FLUXB"),
+            ("uncompmag3", "fluxb"),
+        ] {
+            let m = resolve("f", &xyz, &ColumnMap::new(), &choose(mag, vector), true).unwrap();
+            let get = |c: &str| m.iter().find(|x| x.canonical == c).unwrap();
+            assert_eq!(get("mag").file_column, "UNCOMPMAG3", "{mag}");
+            assert_eq!(get("mag").origin, MapOrigin::Selected);
+            assert_eq!(get("flux_y").file_column, "FLUXB_Y", "{vector}");
+            assert_eq!(m.iter().filter(|x| x.canonical == "mag").count(), 1);
+        }
+        let h5 = header(&[
+            "tt", "mag_1_uc", "mag_3_uc", "flux_b_x", "flux_b_y", "flux_b_z",
+        ]);
+        let m = resolve(
+            "f",
+            &h5,
+            &ColumnMap::new(),
+            &choose("UNCOMPMAG3", "FLUXB"),
+            true,
+        )
+        .unwrap();
+        assert_eq!(m[0].file_column, "mag_3_uc");
+        assert_eq!(m[1].file_column, "flux_b_x");
+        // Absent sensors name the candidates; the map and the option cannot both choose.
+        let e = resolve(
+            "f",
+            &h5,
+            &ColumnMap::new(),
+            &choose("mag_5_uc", "flux_b"),
+            true,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("--mag mag_5_uc") && e.contains("mag_1_uc, mag_3_uc"),
+            "{e}"
+        );
+        let e = resolve(
+            "f",
+            &h5,
+            &ColumnMap::new(),
+            &choose("mag_1_uc", "flux_c"),
+            true,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("--vector flux_c") && e.contains("flux_b_x"),
+            "{e}"
+        );
+        let map = ColumnMap::parse("mag=mag_1_uc").unwrap();
+        assert!(resolve("f", &h5, &map, &choose("mag_3_uc", "flux_b"), true).is_err());
+    }
+
+    #[test]
+    fn sensor_names_pair_hdf5_and_xyz() {
+        assert_eq!(sensor_names("mag_4_uc"), ["mag_4_uc", "uncompmag4"]);
+        assert_eq!(sensor_names("COMPMAG1"), ["COMPMAG1", "mag_1_c"]);
+        assert_eq!(sensor_names("flux_d"), ["flux_d", "fluxd"]);
+        assert_eq!(sensor_names("FLUXA"), ["FLUXA", "flux_a"]);
+        assert_eq!(sensor_names("my_mag"), ["my_mag"]);
     }
 
     #[test]

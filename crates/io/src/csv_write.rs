@@ -25,7 +25,7 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::error::{IoError, Result};
-use crate::table::{ColumnData, FlightTable};
+use crate::table::{Column, ColumnData, FlightTable};
 
 /// Writes `table` as CSV to the file `path` (created or replaced).
 ///
@@ -66,7 +66,14 @@ fn temporary_path(path: &Path) -> std::path::PathBuf {
 /// Writes `table` as CSV to any writer (wrap unbuffered writers in a `BufWriter`).
 pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Result<()> {
     let mut line: Vec<u8> = Vec::with_capacity(4096);
-    for (i, c) in table.columns().iter().enumerate() {
+    // Derived columns (`lat` from `ins_lat` in radians) are not the input's:
+    // left out, so the output is the input plus the results.
+    let columns: Vec<&Column> = table
+        .columns()
+        .iter()
+        .filter(|c| !table.is_derived(c.name()))
+        .collect();
+    for (i, c) in columns.iter().enumerate() {
         if i > 0 {
             line.push(b',');
         }
@@ -75,14 +82,10 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     line.push(b'\n');
     out.write_all(&line)?;
     let mut ryu = ryu::Buffer::new();
-    let missing: &[u8] = if table.columns().len() == 1 {
-        b"NaN"
-    } else {
-        b""
-    };
+    let missing: &[u8] = if columns.len() == 1 { b"NaN" } else { b"" };
     for row in 0..table.n_rows() {
         line.clear();
-        for (i, c) in table.columns().iter().enumerate() {
+        for (i, c) in columns.iter().enumerate() {
             if i > 0 {
                 line.push(b',');
             }

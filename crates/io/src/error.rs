@@ -172,6 +172,31 @@ pub enum IoError {
         /// Comma-separated list of the columns present.
         present: String,
     },
+    /// `--mag` / `--vector` names a sensor the file does not have.
+    #[error(
+        "'{file}': {option} {name}: no such column in the file; candidates present: {candidates}"
+    )]
+    SensorAbsent {
+        /// File as given.
+        file: String,
+        /// `--mag` or `--vector`.
+        option: &'static str,
+        /// The sensor asked for.
+        name: String,
+        /// Comma-separated columns that look like sensors of that kind.
+        candidates: String,
+    },
+    /// A row selection (`--lines`, `--time-range`) that is malformed or
+    /// selects nothing.
+    #[error("{}{option}: {reason}", file_prefix(file))]
+    Selection {
+        /// File as given (empty while parsing the option).
+        file: String,
+        /// `--lines` or `--time-range`.
+        option: &'static str,
+        /// What is wrong, with what the file holds.
+        reason: String,
+    },
     /// Malformed `--columns` text.
     #[error("invalid column map '{text}': {reason}")]
     ColumnMap {
@@ -284,6 +309,15 @@ impl IoError {
                 | IoError::LengthMismatch { .. }
                 | IoError::ColumnExists { .. }
         )
+    }
+}
+
+/// "'FILE': " or "" when there is no file yet.
+fn file_prefix(file: &str) -> String {
+    if file.is_empty() {
+        String::new()
+    } else {
+        format!("'{file}': ")
     }
 }
 

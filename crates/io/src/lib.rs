@@ -35,8 +35,10 @@ mod cell;
 pub mod columns;
 mod csv_read;
 mod csv_write;
+pub mod derive;
 mod error;
 mod fields;
+pub mod select;
 mod sniff;
 mod summary;
 mod table;
@@ -47,15 +49,20 @@ use std::path::Path;
 
 pub use columns::{
     CANONICAL_COLUMNS, ColumnMap, MAGNAV_PRESET, MAGNETIC_COLUMNS, MapOrigin, MappedColumn,
-    is_canonical, is_truth_column,
+    Sensors, is_canonical, is_truth_column, sensor_names,
 };
 pub use csv_read::read_csv;
 pub use csv_write::{write_csv, write_csv_to};
+pub use derive::{Conversion, DerivedColumn, derive_columns};
 pub use error::{IoError, Result};
 pub use fields::{KnownField, known_field};
+pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
-pub use validate::{MEDIAN_SAMPLES, Warning, check_time, check_units, convert_tesla_to_nt};
+pub use validate::{
+    EARTH_FIELD_NT, MEDIAN_SAMPLES, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind, check_time,
+    check_units, convert_tesla_to_nt,
+};
 pub use xyz::read_xyz;
 
 /// File formats [`read_table`] can read.
@@ -71,7 +78,7 @@ pub enum Format {
 }
 
 /// How to read a table.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ReadOptions {
     /// User column map (`--columns`); empty by default.
     pub columns: ColumnMap,
@@ -82,6 +89,11 @@ pub struct ReadOptions {
     pub delimiter: Option<u8>,
     /// File format; [`Format::Auto`] by default.
     pub format: Format,
+    /// The scalar and vector magnetometers to use (`--mag`, `--vector`);
+    /// by default the map and the preset choose.
+    pub sensors: Sensors,
+    /// The rows to keep (`--lines`, `--time-range`); all by default.
+    pub rows: RowSelection,
 }
 
 impl Default for ReadOptions {
@@ -91,6 +103,8 @@ impl Default for ReadOptions {
             magnav_preset: true,
             delimiter: None,
             format: Format::Auto,
+            sensors: Sensors::default(),
+            rows: RowSelection::default(),
         }
     }
 }
@@ -101,15 +115,22 @@ impl Default for ReadOptions {
 /// CSV; `.h5`/`.hdf5`/`.mat` → [`IoError::Unsupported`] (export to CSV
 /// first); anything else (including `.txt`) → by content: XYZ if the first
 /// non-blank line starts with `/`, else CSV.
+///
+/// Then the canonical columns in another unit are derived
+/// ([`derive_columns`]: `lat` from `ins_lat` in radians, …) and the rows of
+/// [`ReadOptions::rows`] kept ([`RowSelection::apply`]).
 pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     let format = match opts.format {
         Format::Auto => detect_format(path)?,
         f => f,
     };
-    match format {
+    let mut table = match format {
         Format::Xyz => read_xyz(path, opts),
         _ => read_csv(path, opts),
-    }
+    }?;
+    opts.rows.apply(&mut table)?;
+    derive_columns(&mut table)?;
+    Ok(table)
 }
 
 fn detect_format(path: &Path) -> Result<Format> {

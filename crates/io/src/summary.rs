@@ -20,6 +20,7 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::columns::MappedColumn;
+use crate::derive::DerivedColumn;
 use crate::fields::known_field;
 use crate::table::{ColumnData, FlightTable, Missing};
 use crate::validate::median_in_place;
@@ -35,6 +36,9 @@ pub struct Summary {
     pub columns: Vec<ColumnSummary>,
     /// Canonical aliases in effect.
     pub mapping: Vec<MappedColumn>,
+    /// Canonical columns computed from fields in another unit
+    /// ([`derive`](crate::derive)), listed among the columns too.
+    pub derived: Vec<DerivedColumn>,
     /// Sampling of `time`; `None` without a numeric `time` column or with fewer than two finite times.
     pub time: Option<TimeSummary>,
     /// Distinct values of `line` in order of first appearance; `None` without a `line` column.
@@ -182,6 +186,7 @@ pub fn summarize(table: &FlightTable) -> Summary {
         rows: table.n_rows(),
         columns,
         mapping: table.mapping().to_vec(),
+        derived: table.derived().to_vec(),
         time: table.column("time").and_then(time_summary),
         lines: line_counts(table),
         mag_range_nt: table.column("mag").and_then(|v| range(v.iter().copied())),

@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::columns::MappedColumn;
+use crate::derive::DerivedColumn;
 use crate::error::{IoError, Result};
 
 /// Why samples of a numeric column are missing (`NaN`), counted per reason.
@@ -119,6 +120,7 @@ pub struct FlightTable {
     /// Breakpoints `(row, line)`: from `row` on, row `r` is on file line
     /// `line + (r - row)`, until the next breakpoint. Empty for in-memory tables.
     row_lines: Vec<(usize, u64)>,
+    derived: Vec<DerivedColumn>,
 }
 
 /// Name used in messages for tables that were not read from a file.
@@ -339,7 +341,79 @@ impl FlightTable {
                 .collect(),
             aliases,
             row_lines,
+            derived: Vec::new(),
         }
+    }
+
+    /// Keeps the rows `i` with `keep[i]` (in order), with their file lines.
+    /// Missing counts are recounted; their reasons are kept when a column
+    /// had only one kind of missing value, else counted as `nan`.
+    ///
+    /// # Panics
+    /// If `keep.len()` differs from [`FlightTable::n_rows`] (a programming error).
+    pub fn retain_rows(&mut self, keep: &[bool]) {
+        assert_eq!(keep.len(), self.n_rows, "retain_rows: mask length");
+        fn filter<T>(v: &mut Vec<T>, keep: &[bool]) {
+            let mut k = keep.iter();
+            v.retain(|_| *k.next().unwrap_or(&false));
+        }
+        for c in &mut self.columns {
+            match &mut c.data {
+                ColumnData::Numeric { values, missing } => {
+                    filter(values, keep);
+                    let n = values.iter().filter(|v| v.is_nan()).count();
+                    *missing = match (missing.blank, missing.nan, missing.dummy) {
+                        (_, 0, 0) => Missing {
+                            blank: n,
+                            ..Missing::default()
+                        },
+                        (0, 0, _) => Missing {
+                            dummy: n,
+                            ..Missing::default()
+                        },
+                        _ => Missing {
+                            nan: n,
+                            ..Missing::default()
+                        },
+                    };
+                }
+                ColumnData::Text(t) => filter(t, keep),
+            }
+        }
+        let mut row_lines: Vec<(usize, u64)> = Vec::new();
+        if !self.row_lines.is_empty() {
+            let mut prev: Option<u64> = None;
+            let kept = keep.iter().enumerate().filter(|(_, k)| **k);
+            for (j, (i, _)) in kept.enumerate() {
+                let line = self.line_of_row(i);
+                if let Some(l) = line
+                    && prev.is_none_or(|p| p + 1 != l)
+                {
+                    row_lines.push((j, l));
+                }
+                prev = line;
+            }
+        }
+        self.row_lines = row_lines;
+        self.n_rows = keep.iter().filter(|k| **k).count();
+    }
+
+    /// Columns computed from file columns in another unit ([`crate::derive`]);
+    /// writers leave them out.
+    pub fn derived(&self) -> &[DerivedColumn] {
+        &self.derived
+    }
+
+    /// Adds a derived column (see [`FlightTable::derived`]).
+    pub(crate) fn add_derived(&mut self, d: DerivedColumn, values: Vec<f64>) -> Result<()> {
+        self.add_column(&d.canonical, values)?;
+        self.derived.push(d);
+        Ok(())
+    }
+
+    /// Whether column `name` (no alias resolution) is derived.
+    pub fn is_derived(&self, name: &str) -> bool {
+        self.derived.iter().any(|d| d.canonical == name)
     }
 
     /// Multiplies the numeric column `name` (alias resolved) by `factor` in place.

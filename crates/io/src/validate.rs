@@ -8,12 +8,14 @@
 //!   suspicious. Statistics use the finite values only; medians are taken
 //!   over at most [`MEDIAN_SAMPLES`] evenly strided samples (deterministic).
 //!
-//! Rules of [`check_units`] (Earth's total field is about 22 000–67 000 nT):
+//! Rules of [`check_units`] (Earth's total field is about 22 000–67 000 nT).
+//! Every warning is named by its [`WarningKind`], printed after the message
+//! (`[field-range]`):
 //!
 //! | columns | error | warning |
 //! |---|---|---|
-//! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 10 000–100 000 nT |
-//! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 10 000–100 000 nT |
+//! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
+//! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 15 000–75 000 nT; median relative difference from `mag` above 10 % (`vector-vs-scalar`) |
 //! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
 //! | `lat` | \|lat\| > 90 | all \|lat\| ≤ π/2 and \|lon\| ≤ π (radians?) |
 //! | `lon` | \|lon\| > 360 | (see `lat`) |
@@ -40,6 +42,8 @@ pub const MEDIAN_SAMPLES: usize = 100_000;
 /// A suspicion about the input that does not stop a command.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Warning {
+    /// Which check raised it.
+    pub kind: WarningKind,
     /// File (or `"<in-memory table>"`).
     pub file: String,
     /// Column concerned, if one.
@@ -64,9 +68,52 @@ impl fmt::Display for Warning {
         if let Some(l) = self.line {
             write!(f, " (line {l})")?;
         }
-        write!(f, ": {}", self.message)
+        write!(f, ": {} [{}]", self.message, self.kind.name())
     }
 }
+
+/// The named checks that raise [`Warning`]s.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WarningKind {
+    /// A total field outside Earth's (15 000–75 000 nT): anomaly, corrected
+    /// data or another unit.
+    FieldRange,
+    /// The vector magnetometer's magnitude disagrees with the scalar
+    /// magnetometer by more than [`VECTOR_SCALAR_TOLERANCE`].
+    VectorVsScalar,
+    /// Angles that look like radians in a degree column.
+    Radians,
+    /// A yaw outside ±360°.
+    YawRange,
+    /// An altitude that looks like feet or km.
+    AltitudeUnit,
+}
+
+impl WarningKind {
+    /// The name printed after the message (`field-range`).
+    pub fn name(self) -> &'static str {
+        match self {
+            WarningKind::FieldRange => "field-range",
+            WarningKind::VectorVsScalar => "vector-vs-scalar",
+            WarningKind::Radians => "radians",
+            WarningKind::YawRange => "yaw-range",
+            WarningKind::AltitudeUnit => "altitude-unit",
+        }
+    }
+}
+
+/// Relative difference (median over rows) between the vector
+/// magnetometer's magnitude and the scalar reading above which
+/// [`check_units`] warns. Uncalibrated fluxgates differ from the scalar by a
+/// few per cent: on the SGL sample `Flt1003_sample.xyz` the four fluxgates
+/// differ from the five scalar magnetometers by 0.2–9.5 % (FLUXC vs
+/// UNCOMPMAG2 the most); a wrong column, a component in another unit or a
+/// total channel mapped as a component gives tens of per cent or more.
+pub const VECTOR_SCALAR_TOLERANCE: f64 = 0.10;
+
+/// Earth's total field, nT: a `mag` median outside is warned about.
+pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
 
 /// Checks that `time` exists, has no missing value and strictly increases.
 ///
@@ -120,8 +167,32 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
         }
     }
     if let [x, y, z] = flux[..] {
-        let norm = (0..table.n_rows()).map(|i| (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt());
-        ctx.total_field("flux_x/flux_y/flux_z", norm, &mut warnings)?;
+        let norm = |i: usize| (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt();
+        ctx.total_field(
+            "flux_x/flux_y/flux_z",
+            (0..table.n_rows()).map(norm),
+            &mut warnings,
+        )?;
+        if let Some(mag) = table.column("mag")
+            && let Some(d) = median((0..table.n_rows()).map(|i| (norm(i) - mag[i]) / mag[i]))
+            && d.abs() > VECTOR_SCALAR_TOLERANCE
+        {
+            let names = |c: &str| table.resolve(c).unwrap_or(c).to_string();
+            warnings.push(ctx.warn(
+                WarningKind::VectorVsScalar,
+                "flux_x/flux_y/flux_z",
+                None,
+                format!(
+                    "the vector magnetometer's magnitude ({}, {}, {}) differs from the scalar magnetometer ({}) by {:+.1} % (median); expected within {:.0} %: another sensor's or a total channel mapped as a component, or another unit?",
+                    names("flux_x"),
+                    names("flux_y"),
+                    names("flux_z"),
+                    names("mag"),
+                    100.0 * d,
+                    100.0 * VECTOR_SCALAR_TOLERANCE
+                ),
+            ));
+        }
     }
     ctx.position(&mut warnings)?;
     ctx.attitude(&mut warnings)?;
@@ -130,6 +201,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
         && m > 20_000.0
     {
         warnings.push(ctx.warn(
+            WarningKind::AltitudeUnit,
             "alt",
             None,
             format!("median altitude {m} m is above 20 km: feet or another unit? expected m"),
@@ -162,8 +234,15 @@ impl Ctx<'_> {
         }
     }
 
-    fn warn(&self, column: &str, row: Option<usize>, message: String) -> Warning {
+    fn warn(
+        &self,
+        kind: WarningKind,
+        column: &str,
+        row: Option<usize>,
+        message: String,
+    ) -> Warning {
         Warning {
+            kind,
             file: self.table.file_label(),
             column: Some(column.to_string()),
             row,
@@ -199,8 +278,10 @@ impl Ctx<'_> {
                 format!("median |value| = {m:e} is far above Earth's field in nT (22 000 to 67 000 nT): picotesla? {fix} (divide by 1000)"),
             ));
         }
-        if !(10_000.0..=100_000.0).contains(&m) {
+        let (lo, hi) = EARTH_FIELD_NT;
+        if !(lo..=hi).contains(&m) {
             w.push(self.warn(
+                WarningKind::FieldRange,
                 name,
                 None,
                 format!("median |value| = {m} nT is outside Earth's total field (22 000 to 67 000 nT): anomaly or corrected data, or other units?"),
@@ -265,6 +346,7 @@ impl Ctx<'_> {
             if a <= std::f64::consts::FRAC_PI_2 && o <= std::f64::consts::PI && (a > 0.0 || o > 0.0)
             {
                 w.push(self.warn(
+                    WarningKind::Radians,
                     "lat",
                     None,
                     format!(
@@ -296,6 +378,7 @@ impl Ctx<'_> {
             && let Some((i, x)) = first_where(yaw, |x| x.abs() > 360.0)
         {
             w.push(self.warn(
+                WarningKind::YawRange,
                 "yaw",
                 Some(i),
                 format!("yaw {x} is outside ±360°: expected degrees"),
@@ -322,6 +405,7 @@ impl Ctx<'_> {
             && hi - lo > PI
         {
             w.push(self.warn(
+                WarningKind::Radians,
                 "yaw",
                 None,
                 format!(
@@ -400,6 +484,7 @@ mod tests {
     #[test]
     fn warning_display_names_everything() {
         let w = Warning {
+            kind: WarningKind::YawRange,
             file: "f.csv".into(),
             column: Some("yaw".into()),
             row: Some(4),
@@ -408,7 +493,7 @@ mod tests {
         };
         assert_eq!(
             w.to_string(),
-            "'f.csv': column 'yaw' at data row 5 (line 7): odd"
+            "'f.csv': column 'yaw' at data row 5 (line 7): odd [yaw-range]"
         );
     }
 }

@@ -2,7 +2,7 @@
 
 mod common;
 
-use aeromag_io::{FlightTable, IoError, check_time, check_units, convert_tesla_to_nt};
+use aeromag_io::{FlightTable, IoError, WarningKind, check_time, check_units, convert_tesla_to_nt};
 use common::{Fixtures, assert_mentions};
 
 #[test]
@@ -156,6 +156,35 @@ fn earth_field_in_nt_passes_and_odd_magnitudes_warn() {
         "{}",
         w[0]
     );
+}
+
+#[test]
+fn field_range_and_vector_against_scalar_are_named_warnings() {
+    // 80 000 nT is outside Earth's 15 000–75 000 nT.
+    let w = check_units(&table(&[("mag", vec![80_000.0, 80_100.0])])).unwrap();
+    assert_eq!(w.len(), 1);
+    assert_eq!(w[0].kind, WarningKind::FieldRange);
+    assert!(w[0].to_string().ends_with("[field-range]"), "{}", w[0]);
+    // A vector magnitude 9 % from the scalar passes (real fluxgates differ
+    // by up to 9.5 %), 14 % is warned about, naming both sensors.
+    let field = |scale: f64| {
+        table(&[
+            ("mag", vec![50_000.0, 50_000.0, 50_000.0]),
+            ("flux_x", vec![30_000.0 * scale; 3]),
+            ("flux_y", vec![0.0; 3]),
+            ("flux_z", vec![40_000.0 * scale; 3]),
+        ])
+    };
+    assert!(check_units(&field(1.09)).unwrap().is_empty());
+    let w = check_units(&field(1.14)).unwrap();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(w[0].kind, WarningKind::VectorVsScalar);
+    assert!(
+        w[0].message.contains("+14.0 %") && w[0].message.contains("(mag)"),
+        "{}",
+        w[0]
+    );
+    assert!(check_units(&field(0.85)).unwrap().len() == 1);
 }
 
 #[test]

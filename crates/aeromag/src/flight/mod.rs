@@ -14,11 +14,13 @@
 //! `spec/data-formats.md` (`time`, `lat`, `lon`, `alt`, `roll`, `pitch`,
 //! `yaw`, `mag`, `flux_x`, …) after the column map.
 
+mod line_labels;
 mod reference;
 mod segments;
 mod tl_inputs;
 
 pub use aeromag_compensation::reference_field::LeverArm;
+pub use line_labels::LineLabels;
 pub(crate) use reference::reduced;
 pub use reference::{ReferenceChannels, reference_sum};
 pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};

@@ -205,7 +205,7 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
     }
     cfg.validate()
         .map_err(|e| bad_input!("settings (scenario file and flags): {e}"))?;
-    let table = crate::input::load(&a.input, None)?;
+    let table = crate::input::load(&a.input)?;
     let pass = read_pass(&table, &cfg)?;
     let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
     let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();

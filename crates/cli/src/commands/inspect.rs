@@ -118,6 +118,25 @@ pub fn render(s: &Summary) -> String {
                 .join(", ")
         );
     }
+    if !s.derived.is_empty() {
+        let _ = writeln!(
+            o,
+            "derived  {}",
+            s.derived
+                .iter()
+                .map(|d| {
+                    let unit = aeromag_io::known_field(&d.canonical).map_or("", |k| k.unit);
+                    format!(
+                        "{}={} ({}) [{unit}]",
+                        d.canonical,
+                        d.from,
+                        d.conversion.describe()
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let _ = writeln!(
         o,
         "\n{:<22} {:<10} {:<6} {:>9} {:>14} {:>14} {:>14}",

@@ -63,6 +63,13 @@ pub struct Args {
     #[arg(long, default_value_t = ReferenceChannels::None, value_name = "none|auto|COLS",
           value_parser = args::parsed::<ReferenceChannels>)]
     reference: ReferenceChannels,
+    /// Labels of the tie lines (e.g. `901,902`), for files whose labels
+    /// do not say it: crossovers are then formed only between a line and a
+    /// tie. Not needed with a `line_type` column (Geosoft XYZ `Line`/`Tie`
+    /// records) or labels such as `L1020`/`T901`; without any of these,
+    /// any two crossing lines form a crossover.
+    #[arg(long, value_name = "LABEL,LABEL", value_delimiter = ',')]
+    ties: Vec<String>,
     /// Also write the crossover table to this CSV: one row per crossover
     /// with both lines, position, times, altitudes, values, d|B0|/dt,
     /// the difference, what the fitted model leaves of it and its weight.
@@ -85,6 +92,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             robust: !a.no_robust,
             ..LevellingConfig::default()
         },
+        ties: a.ties.clone(),
         ..LevelOptions::default()
     };
     let lev = level(&flight, &opts, &mut Bars::new())?;
@@ -156,7 +164,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for l in &f.lines {
         println!(
             "{:>10} {:>11} {:>12.4} {:>10.4}",
-            l.label, l.crossovers, l.offset_nt, l.offset_std_nt
+            lev.lines.label(l.label).unwrap_or("?"),
+            l.crossovers,
+            l.offset_nt,
+            l.offset_std_nt
         );
     }
     println!(

@@ -275,7 +275,7 @@ pub fn find_crossovers(
         for p in start..end {
             for q in p + 1..end {
                 let (e, f) = (&edges[entries[p].2 as usize], &edges[entries[q].2 as usize]);
-                if e.label == f.label {
+                if e.label == f.label || !cfg.pairing.crosses(e.label, f.label) {
                     continue;
                 }
                 let Some((s, u)) = intersect(e, f) else {
@@ -409,7 +409,7 @@ fn lerp2(a: [f64; 2], b: [f64; 2], f: f64) -> [f64; 2] {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::levelling::track_derivative;
+    use crate::levelling::{Pairing, track_derivative};
 
     /// A synthetic block: `nl` north-going lines (labels 1…) `spacing` m
     /// apart and `nt` east-going ties (labels 101…), sampled every `step` m
@@ -478,6 +478,36 @@ pub(crate) mod tests {
                 sensed: None,
             }
         }
+    }
+
+    #[test]
+    fn pairing_line_with_tie_skips_crossings_of_two_lines_or_two_ties() {
+        let b = block(7, 4, 200.0, 9.0);
+        let count = |pairing: Pairing| {
+            let cfg = TrackConfig {
+                pairing,
+                ..TrackConfig::default()
+            };
+            let d = track_derivative(&b.tracks(), &cfg).unwrap();
+            find_crossovers(&b.tracks(), &d, None, &cfg)
+                .unwrap()
+                .crossovers
+                .len()
+        };
+        let ties = (101..=104).collect::<Vec<i64>>();
+        assert_eq!(count(Pairing::LineWithTie { tie_ids: ties }), 28);
+        // Declared all lines (or all ties): no line meets a tie.
+        assert_eq!(count(Pairing::LineWithTie { tie_ids: vec![] }), 0);
+        let all = (1..=7).chain(101..=104).collect::<Vec<i64>>();
+        assert_eq!(count(Pairing::LineWithTie { tie_ids: all }), 0);
+        // Lines 1 and 2 declared ties (101–104 then count as lines): only
+        // their 8 crossings with 101–104 remain.
+        assert_eq!(
+            count(Pairing::LineWithTie {
+                tie_ids: vec![1, 2]
+            }),
+            8
+        );
     }
 
     #[test]

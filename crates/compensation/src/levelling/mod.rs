@@ -74,5 +74,5 @@ pub mod vertical_gradient;
 pub use apply::{Levelled, RowFlag, SurveyLevelling, apply_levelling, level_survey};
 pub use crossovers::{Crossover, CrossoverSet, CrossoverSide, find_crossovers};
 pub use fit::{Datum, HUBER_K, LevellingConfig, LevellingFit, LineLevel, fit_levelling};
-pub use tracks::{SurveyTracks, TrackConfig, sensor_positions, track_derivative};
+pub use tracks::{Pairing, SurveyTracks, TrackConfig, sensor_positions, track_derivative};
 pub use vertical_gradient::profile_gradient;

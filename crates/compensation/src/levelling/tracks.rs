@@ -81,6 +81,32 @@ pub struct TrackConfig {
     /// Crossings at an angle below this (deg, 0–90) are skipped: the
     /// interpolated values are too sensitive to position errors. Default 20.
     pub min_crossing_angle_deg: f64,
+    /// Which pairs of lines are crossed. Default: any two different labels.
+    pub pairing: Pairing,
+}
+
+/// Which crossings of two track segments are crossovers.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum Pairing {
+    /// Any two segments of different labels (lines whose type is unknown).
+    #[default]
+    AnyTwoLines,
+    /// Only a survey line with a tie line: the labels in `tie_ids` are
+    /// ties, all others survey lines.
+    LineWithTie {
+        /// Labels of the tie lines.
+        tie_ids: Vec<i64>,
+    },
+}
+
+impl Pairing {
+    /// Whether segments labelled `a` and `b` (`a ≠ b`) are crossed.
+    pub fn crosses(&self, a: i64, b: i64) -> bool {
+        match self {
+            Pairing::AnyTwoLines => true,
+            Pairing::LineWithTie { tie_ids } => tie_ids.contains(&a) != tie_ids.contains(&b),
+        }
+    }
 }
 
 impl Default for TrackConfig {
@@ -89,6 +115,7 @@ impl Default for TrackConfig {
             max_gap_factor: 5.0,
             derivative_half_window_s: 0.2,
             min_crossing_angle_deg: 20.0,
+            pairing: Pairing::AnyTwoLines,
         }
     }
 }

@@ -1,0 +1,328 @@
+//! Picking segments out of a whole flight: rows by line label (`--lines`)
+//! and by time (`--time-range`).
+//!
+//! A whole survey flight holds take-off, transits, calibration boxes and
+//! survey lines; the line label tells them apart (SGL: `1002.02` =
+//! "Shawville calibration 1", spec `data-formats.md`, "Real survey files").
+//! MagNav's workflow calibrates on one segment and compensates the others,
+//! so every command that reads flight data can keep only some rows.
+//!
+//! **Labels are labels**, compared as text where the column is text
+//! (`L1020`, `T901`, any case) and as numbers where it is numeric: `1003.01`
+//! selects the rows whose value is the number 1003.01, and a label with
+//! leading letters (`L1020`) selects 1020 in a numeric column (the Geosoft
+//! XYZ reader keeps the number of a `Line L1020` record).
+//!
+//! The rows kept keep their file line numbers, so messages still name the
+//! file's lines; data rows are counted within the selection.
+//!
+//! ```
+//! use aeromag_io::{FlightTable, RowSelection};
+//! let mut t = FlightTable::new();
+//! t.add_column("time", vec![0.0, 1.0, 2.0, 3.0])?;
+//! t.add_column("line", vec![1002.01, 1002.02, 1002.02, 1003.01])?;
+//! let sel = RowSelection::parse(Some("1002.02"), Some("0,1.5"))?;
+//! sel.apply(&mut t)?;
+//! assert_eq!(t.column("time").unwrap(), &[1.0]);
+//! # Ok::<(), aeromag_io::IoError>(())
+//! ```
+
+use crate::error::{IoError, Result};
+use crate::table::FlightTable;
+
+/// Rows to keep: those on any of `lines` (all when empty) and, with a
+/// `time_range`, those whose `time` lies in `[t0, t1]` (s, inclusive).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RowSelection {
+    /// Line labels as typed (`1003.01`, `L1020`).
+    pub lines: Vec<String>,
+    /// `(t0, t1)` in the file's time unit (s), `t0 ≤ t1`.
+    pub time_range: Option<(f64, f64)>,
+}
+
+impl RowSelection {
+    /// Parses the texts of `--lines LABEL,LABEL` and `--time-range T0,T1`.
+    /// Errors ([`IoError::Selection`]): an empty label, a time range that is
+    /// not two finite numbers with `T0 ≤ T1`.
+    pub fn parse(lines: Option<&str>, time_range: Option<&str>) -> Result<Self> {
+        let err = |option, reason: String| IoError::Selection {
+            file: String::new(),
+            option,
+            reason,
+        };
+        let mut sel = RowSelection::default();
+        if let Some(text) = lines {
+            for label in text.split(',').map(str::trim) {
+                if label.is_empty() {
+                    return Err(err(
+                        "--lines",
+                        format!("'{text}' has an empty label (expected e.g. 1002.02,L1020)"),
+                    ));
+                }
+                sel.lines.push(label.to_string());
+            }
+        }
+        if let Some(text) = time_range {
+            let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+            let nums: Vec<Option<f64>> = parts
+                .iter()
+                .map(|p| p.parse::<f64>().ok().filter(|v| v.is_finite()))
+                .collect();
+            match nums[..] {
+                [Some(t0), Some(t1)] if t0 <= t1 => sel.time_range = Some((t0, t1)),
+                [Some(t0), Some(t1)] => {
+                    return Err(err("--time-range", format!("start {t0} is after end {t1}")));
+                }
+                _ => {
+                    return Err(err(
+                        "--time-range",
+                        format!("'{text}' must be two finite numbers T0,T1 (s)"),
+                    ));
+                }
+            }
+        }
+        Ok(sel)
+    }
+
+    /// True when every row is kept.
+    pub fn is_all(&self) -> bool {
+        self.lines.is_empty() && self.time_range.is_none()
+    }
+
+    /// Which rows of `table` are kept. Errors: no `line` (or `time`) column,
+    /// a label that matches no row (naming the labels present), or a
+    /// selection that keeps nothing.
+    pub fn mask(&self, table: &FlightTable) -> Result<Vec<bool>> {
+        let file = table.file_label();
+        let err = |option, reason: String| IoError::Selection {
+            file: file.clone(),
+            option,
+            reason,
+        };
+        let mut keep = vec![true; table.n_rows()];
+        if !self.lines.is_empty() {
+            let labels = LineLabels::of(table).ok_or_else(|| {
+                err(
+                    "--lines",
+                    "the file has no line-label column ('line', or one mapped onto it with --columns line=NAME)"
+                        .into(),
+                )
+            })?;
+            let mut on_line = vec![false; keep.len()];
+            for label in &self.lines {
+                let mut any = false;
+                for (i, k) in on_line.iter_mut().enumerate() {
+                    if labels.matches(i, label) {
+                        *k = true;
+                        any = true;
+                    }
+                }
+                if !any {
+                    return Err(err(
+                        "--lines",
+                        format!(
+                            "no row has the line label '{label}'; labels present: {}",
+                            labels.distinct(20)
+                        ),
+                    ));
+                }
+            }
+            keep = on_line;
+        }
+        if let Some((t0, t1)) = self.time_range {
+            let time = table.column("time").ok_or_else(|| {
+                err(
+                    "--time-range",
+                    "the file has no numeric 'time' column".into(),
+                )
+            })?;
+            for (k, &t) in keep.iter_mut().zip(time) {
+                *k = *k && t >= t0 && t <= t1;
+            }
+            if !keep.contains(&true) {
+                let finite = time.iter().copied().filter(|t| t.is_finite());
+                let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
+                    (a.min(t), b.max(t))
+                });
+                return Err(err(
+                    "--time-range",
+                    format!(
+                        "no selected row has a time in [{t0}, {t1}] s; the file's time runs from {lo} to {hi} s"
+                    ),
+                ));
+            }
+        }
+        Ok(keep)
+    }
+
+    /// Keeps the selected rows of `table` (see [`RowSelection::mask`]).
+    pub fn apply(&self, table: &mut FlightTable) -> Result<()> {
+        if self.is_all() {
+            return Ok(());
+        }
+        let keep = self.mask(table)?;
+        table.retain_rows(&keep);
+        Ok(())
+    }
+}
+
+/// The line labels of a table, numeric or text.
+pub(crate) enum LineLabels<'a> {
+    /// A numeric `line` column.
+    Numeric(&'a [f64]),
+    /// A text `line` column.
+    Text(&'a [String]),
+}
+
+impl<'a> LineLabels<'a> {
+    /// The `line` column (alias resolved), if any.
+    pub(crate) fn of(table: &'a FlightTable) -> Option<Self> {
+        let c = table.get("line")?;
+        Some(match (c.values(), c.text()) {
+            (Some(v), _) => LineLabels::Numeric(v),
+            (None, Some(t)) => LineLabels::Text(t),
+            (None, None) => return None,
+        })
+    }
+
+    /// Whether row `i` carries `label` (see the module docs).
+    pub(crate) fn matches(&self, i: usize, label: &str) -> bool {
+        match self {
+            LineLabels::Text(t) => t[i].trim().eq_ignore_ascii_case(label),
+            LineLabels::Numeric(v) => label_number(label).is_some_and(|x| v[i] == x),
+        }
+    }
+
+    /// Up to `max` distinct labels in order of appearance, comma-separated.
+    pub(crate) fn distinct(&self, max: usize) -> String {
+        let mut seen: Vec<String> = Vec::new();
+        let n = match self {
+            LineLabels::Numeric(v) => v.len(),
+            LineLabels::Text(t) => t.len(),
+        };
+        let mut more = false;
+        for i in 0..n {
+            let s = match self {
+                LineLabels::Numeric(v) if v[i].is_nan() => continue,
+                LineLabels::Numeric(v) => v[i].to_string(),
+                LineLabels::Text(t) => t[i].trim().to_string(),
+            };
+            if s.is_empty() || seen.contains(&s) {
+                continue;
+            }
+            if seen.len() == max {
+                more = true;
+                break;
+            }
+            seen.push(s);
+        }
+        if seen.is_empty() {
+            return "none".into();
+        }
+        let mut out = seen.join(", ");
+        if more {
+            out.push_str(", …");
+        }
+        out
+    }
+}
+
+/// The number a label stands for in a numeric column: the label itself
+/// (`1003.01`), or what follows its leading letters (`L1020` → 1020).
+pub fn label_number(label: &str) -> Option<f64> {
+    let digits = label.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+    digits.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table() -> FlightTable {
+        let mut t = FlightTable::new();
+        t.set_source("f.csv");
+        t.add_column("time", vec![0.0, 1.0, 2.0, 3.0, 4.0]).unwrap();
+        t.add_column("line", vec![1002.01, 1002.02, 1002.02, f64::NAN, 1003.01])
+            .unwrap();
+        t
+    }
+
+    #[test]
+    fn labels_select_numeric_rows_and_unknown_labels_are_errors() {
+        let sel = RowSelection::parse(Some("1002.02, 1003.01"), None).unwrap();
+        assert_eq!(
+            sel.mask(&table()).unwrap(),
+            [false, true, true, false, true]
+        );
+        let e = RowSelection::parse(Some("1002.2"), None)
+            .unwrap()
+            .mask(&table())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("'1002.2'")
+                && e.contains("1002.01, 1002.02, 1003.01")
+                && e.contains("f.csv"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn text_labels_and_letter_prefixes() {
+        let mut t = FlightTable::new();
+        t.add_text_column(
+            "line",
+            ["L1020", "T901", "l1020", ""].map(String::from).to_vec(),
+        )
+        .unwrap();
+        let sel = RowSelection::parse(Some("L1020"), None).unwrap();
+        assert_eq!(sel.mask(&t).unwrap(), [true, false, true, false]);
+        let mut n = FlightTable::new();
+        n.add_column("line", vec![1020.0, 901.0]).unwrap();
+        let sel = RowSelection::parse(Some("T901"), None).unwrap();
+        assert_eq!(sel.mask(&n).unwrap(), [false, true]);
+    }
+
+    #[test]
+    fn time_range_is_inclusive_and_checked() {
+        let sel = RowSelection::parse(None, Some("1, 3")).unwrap();
+        assert_eq!(
+            sel.mask(&table()).unwrap(),
+            [false, true, true, true, false]
+        );
+        for bad in ["3,1", "1", "a,b", "1,2,3", "nan,1"] {
+            assert!(RowSelection::parse(None, Some(bad)).is_err(), "{bad}");
+        }
+        let e = RowSelection::parse(None, Some("10,20"))
+            .unwrap()
+            .mask(&table())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("from 0 to 4 s"), "{e}");
+        assert!(RowSelection::parse(Some("1,,2"), None).is_err());
+    }
+
+    #[test]
+    fn apply_keeps_file_lines() {
+        let mut t = crate::read_csv(
+            &write("time,line\n0,1\n1,2\n2,2\n3,1\n"),
+            &crate::ReadOptions::default(),
+        )
+        .unwrap();
+        RowSelection::parse(Some("1"), None)
+            .unwrap()
+            .apply(&mut t)
+            .unwrap();
+        assert_eq!(t.column("time").unwrap(), &[0.0, 3.0]);
+        assert_eq!(t.line_of_row(0), Some(2));
+        assert_eq!(t.line_of_row(1), Some(5));
+    }
+
+    fn write(text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("aeromag-select-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.csv");
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+}
