@@ -86,7 +86,7 @@ pub use aeromag_io as io;
 pub use aeromag_report as report;
 pub use aeromag_sim as sim;
 
-pub use aeromag_io::{ColumnMap, FlightTable, ReadOptions, RowSelection, Sensors};
+pub use aeromag_io::{ColumnMap, Fields, FlightTable, ReadOptions, RowSelection, Sensors};
 pub use compensate::{Compensated, Compensator, OutputColumns};
 pub use error::{Error, InFile, Result};
 pub use flight::{Flight, LeverArm, LineLabels, ReferenceChannels, SegmentRule, TlInputs};

@@ -2,13 +2,15 @@
 //! choose sensors and segments, check (the library's `Flight`), print the
 //! warnings.
 
-use aeromag::{ColumnMap, Flight, ReadOptions, RowSelection, Sensors};
+use aeromag::{ColumnMap, Fields, Flight, ReadOptions, RowSelection, Sensors};
 use std::path::PathBuf;
 
 /// Input-file arguments shared by the commands that read flight data.
 #[derive(Debug, Clone, clap::Args)]
 pub struct InputArgs {
-    /// Flight data file: CSV (header row, `#` comments) or Geosoft XYZ (`.xyz`).
+    /// Flight data file: CSV (header row, `#` comments), Geosoft XYZ
+    /// (`.xyz`) or HDF5 in the MagNav/SGL layout (`.h5`: one dataset per
+    /// field).
     #[arg(long, short = 'i', value_name = "FILE")]
     pub input: PathBuf,
     /// Map canonical column names onto the file's names, e.g.
@@ -61,9 +63,24 @@ impl InputArgs {
         })
     }
 
-    /// Read and check the flight file; its warnings go to stderr.
+    /// Read and check the flight file (every field); its warnings go to stderr.
     pub fn load(&self) -> anyhow::Result<Flight> {
-        let flight = Flight::read_with(&self.input, &self.read_options()?)?;
+        self.load_fields(Fields::All)
+    }
+
+    /// Read and check only the canonical columns and `extra` (an HDF5
+    /// flight of 100 fields then reads about 20), for the commands that do
+    /// not write the input's columns back.
+    pub fn load_canonical(&self, extra: &[&str]) -> anyhow::Result<Flight> {
+        self.load_fields(Fields::canonical_and(extra))
+    }
+
+    fn load_fields(&self, fields: Fields) -> anyhow::Result<Flight> {
+        let opts = ReadOptions {
+            fields,
+            ..self.read_options()?
+        };
+        let flight = Flight::read_with(&self.input, &opts)?;
         for w in flight.warnings() {
             eprintln!("{w}");
         }

@@ -172,6 +172,27 @@ pub enum IoError {
         /// Comma-separated list of the columns present.
         present: String,
     },
+    /// An HDF5 file that cannot be read (not HDF5, damaged, a field of an
+    /// unsupported type).
+    #[error("'{file}'{}: {message}", dataset.as_ref().map(|d| format!(", dataset '{d}'")).unwrap_or_default())]
+    Hdf5 {
+        /// File as given.
+        file: String,
+        /// The dataset concerned, if one.
+        dataset: Option<String>,
+        /// What went wrong.
+        message: String,
+    },
+    /// An HDF5 file that is not in the MagNav/SGL layout.
+    #[error(
+        "'{file}' is not a flight file in the MagNav/SGL HDF5 layout (one 1-D dataset per field, all of one length, at the root or in one group): {found}"
+    )]
+    Hdf5Layout {
+        /// File as given.
+        file: String,
+        /// What the file holds instead.
+        found: String,
+    },
     /// `--mag` / `--vector` names a sensor the file does not have.
     #[error(
         "'{file}': {option} {name}: no such column in the file; candidates present: {candidates}"

@@ -1,11 +1,12 @@
 //! `aeromag-io`: flight-data tables in and out.
 //!
-//! Spec: `spec/data-formats.md` ("Flight data tables"). The crate reads CSV
-//! and Geosoft XYZ files into a column-major [`FlightTable`], maps file
+//! Spec: `spec/data-formats.md` ("Flight data tables", "Real survey files").
+//! The crate reads CSV, Geosoft XYZ and HDF5 files (MagNav/SGL layout,
+//! [`read_hdf5`], pure Rust) into a column-major [`FlightTable`], maps file
 //! column names onto aeromag's canonical names ([`ColumnMap`], MagNav
 //! preset), checks time and units ([`check_time`], [`check_units`]),
 //! summarizes a table for `aeromag inspect` ([`summarize`]) and writes CSV
-//! ([`write_csv`]).
+//! ([`write_csv`]) and other outputs atomically ([`atomic`]).
 //!
 //! ```no_run
 //! use aeromag_io::{ColumnMap, ReadOptions, read_table, check_time, check_units};
@@ -30,6 +31,7 @@
 //! crate does not convert anything except on request
 //! ([`convert_tesla_to_nt`]).
 
+pub mod atomic;
 mod builder;
 mod cell;
 pub mod columns;
@@ -38,6 +40,7 @@ mod csv_write;
 pub mod derive;
 mod error;
 mod fields;
+mod hdf5;
 pub mod select;
 mod sniff;
 mod summary;
@@ -56,6 +59,7 @@ pub use csv_write::{write_csv, write_csv_to};
 pub use derive::{Conversion, DerivedColumn, derive_columns};
 pub use error::{IoError, Result};
 pub use fields::{KnownField, known_field};
+pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
@@ -75,6 +79,33 @@ pub enum Format {
     Csv,
     /// Geosoft XYZ, see [`read_xyz`].
     Xyz,
+    /// HDF5 in the MagNav/SGL layout, see [`read_hdf5`].
+    Hdf5,
+}
+
+/// Which fields to read. CSV and XYZ files are read whole either way (a
+/// text file must be parsed to its end); an HDF5 file reads only the
+/// datasets asked for.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum Fields {
+    /// Every field (the commands that write the input's columns back).
+    #[default]
+    All,
+    /// The fields with these names: file names, canonical names (through
+    /// the column map, the preset or a derivation), compared without
+    /// regard to case. The `line` and `time` fields a row selection needs
+    /// are added.
+    Only(Vec<String>),
+}
+
+impl Fields {
+    /// Every canonical column, `line_type`, and `extra` names.
+    pub fn canonical_and(extra: &[&str]) -> Fields {
+        let mut names: Vec<String> = CANONICAL_COLUMNS.iter().map(|s| s.to_string()).collect();
+        names.push("line_type".into());
+        names.extend(extra.iter().map(|s| s.to_string()));
+        Fields::Only(names)
+    }
 }
 
 /// How to read a table.
@@ -94,6 +125,8 @@ pub struct ReadOptions {
     pub sensors: Sensors,
     /// The rows to keep (`--lines`, `--time-range`); all by default.
     pub rows: RowSelection,
+    /// The fields to read (HDF5 only); all by default.
+    pub fields: Fields,
 }
 
 impl Default for ReadOptions {
@@ -105,6 +138,7 @@ impl Default for ReadOptions {
             format: Format::Auto,
             sensors: Sensors::default(),
             rows: RowSelection::default(),
+            fields: Fields::All,
         }
     }
 }
@@ -112,9 +146,9 @@ impl Default for ReadOptions {
 /// Reads a flight-data table.
 ///
 /// With [`Format::Auto`]: extension `.xyz` → Geosoft XYZ; `.csv`, `.tsv` →
-/// CSV; `.h5`/`.hdf5`/`.mat` → [`IoError::Unsupported`] (export to CSV
-/// first); anything else (including `.txt`) → by content: XYZ if the first
-/// non-blank line starts with `/`, else CSV.
+/// CSV; `.h5`, `.hdf5`, `.he5` → HDF5; anything else (including `.txt` and
+/// `.mat`) → by content: HDF5 if the file has the HDF5 signature (MATLAB
+/// v7.3 files do), XYZ if the first non-blank line starts with `/`, else CSV.
 ///
 /// Then the canonical columns in another unit are derived
 /// ([`derive_columns`]: `lat` from `ins_lat` in radians, …) and the rows of
@@ -126,7 +160,8 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     };
     let mut table = match format {
         Format::Xyz => read_xyz(path, opts),
-        _ => read_csv(path, opts),
+        Format::Hdf5 => read_hdf5(path, opts),
+        Format::Csv | Format::Auto => read_csv(path, opts),
     }?;
     opts.rows.apply(&mut table)?;
     derive_columns(&mut table)?;
@@ -142,12 +177,8 @@ fn detect_format(path: &Path) -> Result<Format> {
     match ext.as_str() {
         "xyz" => Ok(Format::Xyz),
         "csv" | "tsv" => Ok(Format::Csv),
-        "h5" | "hdf5" | "mat" => Err(IoError::Unsupported {
-            file: path.display().to_string(),
-            reason: format!(
-                ".{ext} files are not supported by this build; export the fields to CSV (one column per field, names as in MagNav: tt, lat, lon, mag_1_uc, flux_a_x, …)"
-            ),
-        }),
+        "h5" | "hdf5" | "he5" => Ok(Format::Hdf5),
+        _ if hdf5::is_hdf5(path) => Ok(Format::Hdf5),
         _ => {
             let prefix = sniff::read_prefix(path)?;
             let first = sniff::first_content_line(&prefix.bytes, |_| false);

@@ -557,10 +557,10 @@ fn mapped_column_absent() {
 }
 
 #[test]
-fn hdf5_is_unsupported_with_advice() {
+fn a_damaged_h5_is_an_hdf5_error_naming_the_file() {
     let fx = Fixtures::new();
     let p = fx.file("flight.h5", b"\x89HDF");
     let e = aeromag_io::read_table(&p, &ReadOptions::default()).unwrap_err();
-    assert!(matches!(e, IoError::Unsupported { .. }), "{e:?}");
-    assert_mentions(&e.to_string(), &["flight.h5", "CSV"]);
+    assert!(matches!(e, IoError::Hdf5 { .. }), "{e:?}");
+    assert_mentions(&e.to_string(), &["flight.h5"]);
 }

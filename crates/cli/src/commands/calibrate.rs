@@ -190,7 +190,13 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = options(&a)?;
-    let flight = a.input.load()?;
+    // Only the canonical columns and named reference channels are read
+    // (an HDF5 flight's other fields stay on disk).
+    let extra: Vec<&str> = match &a.reference {
+        aeromag::ReferenceChannels::Columns(c) => c.iter().map(String::as_str).collect(),
+        _ => Vec::new(),
+    };
+    let flight = a.input.load_canonical(&extra)?;
     let cal = calibrate(&flight, &opts, &mut Bars::new())?;
     let model = &cal.model;
     if let Some(k) = &cal.kalman {

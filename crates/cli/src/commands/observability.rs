@@ -40,7 +40,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let flight = a.input.load()?;
+    let flight = a.input.load_canonical(&[])?;
     let obs = aeromag::observability(&flight, &a.terms, None, &mut Bars::new())?;
     let o = &obs.observability;
     if a.json {

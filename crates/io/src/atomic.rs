@@ -1,0 +1,200 @@
+//! Output files that never lie: every file is written to a temporary name
+//! in its target folder and renamed over the target when complete, so an
+//! interrupted command (an error, Ctrl-C, SIGTERM, a full disk) never leaves
+//! a complete-looking partial file.
+//!
+//! - [`write_atomically`] / [`write_file`]: write through a temporary
+//!   `.NAME.PID.N.tmp` beside the target, then rename (atomic on one file
+//!   system); on any error the temporary is removed.
+//! - The temporaries being written are registered; [`remove_temporaries`]
+//!   deletes them (the command-line program calls it on SIGINT/SIGTERM
+//!   before exiting with 130/143).
+//! - [`check_writable`]: before a command starts its work, make sure an
+//!   output's folder exists (it is created) and takes a file.
+//!
+//! ```
+//! let dir = std::env::temp_dir().join(format!("aeromag-atomic-doc-{}", std::process::id()));
+//! let path = dir.join("sub/out.txt");
+//! aeromag_io::atomic::check_writable(&path)?; // creates `sub/`
+//! aeromag_io::atomic::write_file(&path, b"done\n")?;
+//! assert_eq!(std::fs::read(&path)?, b"done\n");
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), std::io::Error>(())
+//! ```
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Temporaries being written (removed by [`remove_temporaries`]).
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Counter that makes temporary names unique within the process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// The folder of `path` (`.` for a bare file name).
+fn folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// A new temporary name beside `path`, registered.
+fn temporary(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let tmp = folder(path).join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+    lock().push(tmp.clone());
+    tmp
+}
+
+fn lock() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    // A panic while holding the lock leaves the list usable.
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn unregister(tmp: &Path) {
+    lock().retain(|p| p != tmp);
+}
+
+/// Writes `path` through a registered temporary beside it: `write` fills a
+/// buffered writer, which is flushed and synced, then the temporary is
+/// renamed to `path`. On any error the temporary is removed and `path` is
+/// left as it was.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let tmp = temporary(path);
+    let result = File::create(&tmp).and_then(|f| {
+        let mut w = BufWriter::with_capacity(1 << 20, f);
+        write(&mut w)?;
+        w.flush()?;
+        let f = w.into_inner().map_err(|e| e.into_error())?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    unregister(&tmp);
+    result
+}
+
+/// Writes `bytes` to `path` atomically ([`write_atomically`]).
+pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
+    write_atomically(path, |w| w.write_all(bytes.as_ref()))
+}
+
+/// Removes every temporary still being written; returns how many. For a
+/// signal handler (the process exits right after).
+pub fn remove_temporaries() -> usize {
+    let list = std::mem::take(&mut *lock());
+    list.iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// Checks, before any work, that `path` can be written: its folder is
+/// created if missing, must be a folder, and must take a new file (a probe
+/// file is created and removed); `path` itself must not be a folder.
+pub fn check_writable(path: &Path) -> std::io::Result<()> {
+    let err = |kind, msg: String| std::io::Error::new(kind, msg);
+    if path.is_dir() {
+        return Err(err(
+            std::io::ErrorKind::IsADirectory,
+            "is a folder, expected a file name".into(),
+        ));
+    }
+    let dir = folder(path);
+    if !dir.exists() {
+        std::fs::create_dir_all(dir)?;
+    } else if !dir.is_dir() {
+        return Err(err(
+            std::io::ErrorKind::NotADirectory,
+            format!("'{}' is not a folder", dir.display()),
+        ));
+    }
+    let probe = temporary(path);
+    let made = File::create(&probe);
+    let _ = std::fs::remove_file(&probe);
+    unregister(&probe);
+    made.map(|_| ())
+}
+
+/// Checks that folder `dir` exists (created if missing) and takes new files.
+pub fn check_writable_folder(dir: &Path) -> std::io::Result<()> {
+    check_writable(&dir.join(".aeromag-probe"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("aeromag-atomic-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn entries(d: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let d = dir("fail");
+        let p = d.join("out.csv");
+        write_file(&p, "old").unwrap();
+        let e = write_atomically(&p, |w| {
+            w.write_all(b"partial")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert_eq!(e.to_string(), "disk full");
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "old");
+        assert_eq!(entries(&d), ["out.csv"]);
+    }
+
+    #[test]
+    fn temporaries_in_progress_are_removed_on_request() {
+        let d = dir("signal");
+        let p = d.join("big.csv");
+        write_atomically(&p, |w| {
+            w.write_all(b"half")?;
+            w.flush()?;
+            assert_eq!(entries(&d).len(), 1, "the temporary exists while writing");
+            // What the signal handler does mid-write.
+            assert!(remove_temporaries() >= 1);
+            assert!(entries(&d).is_empty());
+            Ok(())
+        })
+        .unwrap_err(); // the rename finds no temporary
+        assert!(entries(&d).is_empty(), "{:?}", entries(&d));
+    }
+
+    #[test]
+    fn check_writable_creates_folders_and_rejects_folders_and_files_as_folders() {
+        let d = dir("check");
+        check_writable(&d.join("a/b/out.json")).unwrap();
+        assert!(d.join("a/b").is_dir());
+        assert!(entries(&d.join("a/b")).is_empty(), "the probe is removed");
+        assert!(check_writable(&d.join("a")).is_err());
+        write_file(&d.join("f"), "x").unwrap();
+        assert!(check_writable(&d.join("f/out.csv")).is_err());
+        check_writable_folder(&d.join("report")).unwrap();
+        assert!(d.join("report").is_dir());
+    }
+}
