@@ -12,7 +12,7 @@
 # Needs about SIZE_MB of free space in $TMPDIR (the files are removed).
 # Too slow for the test suite; crates/io/tests/limits.rs checks the limits
 # themselves on smaller files.
-set -euo pipefail
+set -eu  # no pipefail: `yes | head` ends by SIGPIPE
 cd "$(dirname "$0")/.."
 size_mb=${1:-1024}
 [ -x /usr/bin/time ] || { echo "needs /usr/bin/time (apt-get install time)" >&2; exit 2; }
