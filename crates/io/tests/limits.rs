@@ -86,7 +86,10 @@ fn xyz_line_over_the_limit_is_an_error() {
 }
 
 fn header(n: usize, sep: &str) -> String {
-    (0..n).map(|i| format!("c{i}")).collect::<Vec<_>>().join(sep)
+    (0..n)
+        .map(|i| format!("c{i}"))
+        .collect::<Vec<_>>()
+        .join(sep)
 }
 
 #[test]
@@ -111,7 +114,10 @@ fn a_header_at_the_column_limit_is_read() {
     let start = std::time::Instant::now();
     let row = vec!["1"; MAX_COLUMNS].join(",");
     let t = fx
-        .read("limit.csv", format!("{}\n{row}\n{row}\n", header(MAX_COLUMNS, ",")))
+        .read(
+            "limit.csv",
+            format!("{}\n{row}\n{row}\n", header(MAX_COLUMNS, ",")),
+        )
         .unwrap();
     assert_eq!((t.n_rows(), t.columns().len()), (2, MAX_COLUMNS));
     assert!(start.elapsed().as_secs() < 20, "{:?}", start.elapsed());

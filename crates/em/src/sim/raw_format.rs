@@ -300,7 +300,10 @@ mod tests {
     fn header_claiming_1e12_frames_is_streamed_in_bounded_chunks() {
         let b = with(&[("frames", 1_000_000_000_000u64.into())], &[0u8; 120]);
         let e = read_raw(&b).unwrap_err().to_string();
-        assert!(e.contains("truncated body") && e.contains("frame 10"), "{e}");
+        assert!(
+            e.contains("truncated body") && e.contains("frame 10"),
+            "{e}"
+        );
         let mut r = RawReader::new(&b[..]).unwrap();
         let mut out = Vec::new();
         assert_eq!(r.read_frames(4, &mut out).unwrap(), 4);
