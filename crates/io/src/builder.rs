@@ -40,6 +40,38 @@ use crate::table::{ColumnData, FlightTable, Missing};
 /// Rows read before the capacity of the columns is estimated.
 pub(crate) const RESERVE_AFTER_ROWS: usize = 1024;
 
+/// Longest line the readers accept, in bytes (16 MiB; for CSV, a quoted
+/// field spanning lines counts as one line). A longer one is an
+/// [`IoError::TooLarge`] error, so that a file without line ends (or a
+/// hostile 1 GB line) is not read into memory whole.
+pub const MAX_LINE_BYTES: u64 = 16 << 20;
+
+/// Most columns a header may have (100 000); more is an
+/// [`IoError::TooLarge`] error (every column costs a few hundred bytes
+/// before the first data row is read).
+pub const MAX_COLUMNS: usize = 100_000;
+
+/// The error for a header of more than [`MAX_COLUMNS`] columns.
+pub(crate) fn too_many_columns(file: &str, line: u64, n: usize) -> IoError {
+    IoError::TooLarge {
+        file: file.to_string(),
+        line,
+        what: format!("the header has {n} columns, more than the limit of {MAX_COLUMNS}"),
+    }
+}
+
+/// The error for a line longer than [`MAX_LINE_BYTES`].
+pub(crate) fn line_too_long(file: &str, line: u64) -> IoError {
+    IoError::TooLarge {
+        file: file.to_string(),
+        line,
+        what: format!(
+            "line longer than {} MiB (the limit of the reader)",
+            MAX_LINE_BYTES >> 20
+        ),
+    }
+}
+
 /// A stream of data rows whose field count already matches the header.
 pub(crate) trait RowSource {
     /// Advances to the next data row; `false` at the end of the input.
@@ -117,8 +149,14 @@ impl TableBuilder {
                 }
             })
             .collect();
+        if names.len() > MAX_COLUMNS {
+            return Err(too_many_columns(&file, layout.header_line, names.len()));
+        }
+        // A map, not a scan of the names before each one: a wide header
+        // (10^5 columns) is checked in linear time.
+        let mut seen = std::collections::HashMap::with_capacity(names.len());
         for (j, name) in names.iter().enumerate() {
-            if let Some(i) = names[..j].iter().position(|n| n == name) {
+            if let Some(i) = seen.insert(name.as_str(), j) {
                 return Err(IoError::DuplicateHeader {
                     file,
                     line: layout.header_line,

@@ -33,12 +33,16 @@
 //! per-column vectors of the [`TableBuilder`](crate::builder); see there for
 //! the memory bound.
 
+use std::cell::Cell;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
+use std::rc::Rc;
 
 use crate::ReadOptions;
-use crate::builder::{Layout, RowSource, TableBuilder};
+use crate::builder::{
+    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowSource, TableBuilder, line_too_long, too_many_columns,
+};
 use crate::cell::check_text;
 use crate::error::{IoError, Result};
 use crate::sniff::{BOM, first_content_line, read_prefix};
@@ -163,6 +167,34 @@ fn last_byte(file: &str, path: &Path, size: u64) -> Result<Option<u8>> {
     Ok(Some(b[0]))
 }
 
+/// Bytes the csv reader may read ahead of the record it returns (its buffer).
+const READ_AHEAD: u64 = 256 * 1024;
+
+/// The message of the I/O error [`Budget`] returns, recognised by [`CsvSource::read_record`].
+const OVER_BUDGET: &str = "record longer than the line limit";
+
+/// A reader that fails once more than a budget of bytes has been read since
+/// the budget was last set: [`CsvSource`] sets it to [`MAX_LINE_BYTES`] plus
+/// the read-ahead after every record, so a record (a line, or a quoted field
+/// spanning lines) never grows beyond the limit in memory.
+struct Budget<R> {
+    inner: R,
+    left: Rc<Cell<u64>>,
+}
+
+impl<R: Read> Read for Budget<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let left = self.left.get();
+        if left == 0 {
+            return Err(std::io::Error::other(OVER_BUDGET));
+        }
+        let n = buf.len().min(usize::try_from(left).unwrap_or(usize::MAX));
+        let got = self.inner.read(&mut buf[..n])?;
+        self.left.set(left - got as u64);
+        Ok(got)
+    }
+}
+
 /// Rows of a CSV file through `csv::Reader` (see [`RowSource`]). The
 /// terminator is `\n` alone so that every record consumes its own line end
 /// and csv-core's line counter gives exact line numbers (comments and blank
@@ -170,7 +202,8 @@ fn last_byte(file: &str, path: &Path, size: u64) -> Result<Option<u8>> {
 /// left on the last field of each row is trimmed (so a quoted text cell
 /// ending in `\r` in the last column of a CRLF file loses that `\r`).
 struct CsvSource {
-    rdr: csv::Reader<BufReader<File>>,
+    rdr: csv::Reader<Budget<BufReader<File>>>,
+    budget: Rc<Cell<u64>>,
     rec: csv::ByteRecord,
     file: String,
     delimiter: u8,
@@ -201,6 +234,11 @@ impl CsvSource {
         let bom = if head.starts_with(BOM) { BOM.len() } else { 0 };
         reader.consume(bom);
         let ends_with_newline = last_byte(&file, path, file_size)? == Some(b'\n');
+        let budget = Rc::new(Cell::new(MAX_LINE_BYTES + READ_AHEAD));
+        let reader = Budget {
+            inner: reader,
+            left: Rc::clone(&budget),
+        };
         let rdr = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -208,13 +246,14 @@ impl CsvSource {
             .delimiter(delimiter)
             .terminator(csv::Terminator::Any(b'\n'))
             .buffer_capacity(if file_size > (1 << 20) {
-                256 * 1024
+                READ_AHEAD as usize
             } else {
                 16 * 1024
             })
             .from_reader(reader);
         Ok(CsvSource {
             rdr,
+            budget,
             rec: csv::ByteRecord::new(),
             file,
             delimiter,
@@ -239,6 +278,10 @@ impl CsvSource {
                 Err(e) => {
                     let line = e.position().map_or(self.line + 1, |p| p.line());
                     let source = match e.into_kind() {
+                        csv::ErrorKind::Io(io) if io.to_string() == OVER_BUDGET => {
+                            // csv-core has not counted the record's lines yet.
+                            return Err(line_too_long(&self.file, self.line + 1));
+                        }
                         csv::ErrorKind::Io(io) => io,
                         other => std::io::Error::other(format!("{other:?}")),
                     };
@@ -249,6 +292,12 @@ impl CsvSource {
                     });
                 }
             }
+            self.budget.set(MAX_LINE_BYTES + READ_AHEAD);
+            // The budget allows up to READ_AHEAD more; the limit itself is
+            // on the record's text (fields and delimiters, quotes excluded).
+            let cr = self.rec.as_slice().ends_with(b"\r");
+            let record_bytes =
+                self.rec.as_slice().len() + self.rec.len().saturating_sub(1) - usize::from(cr);
             // The line counter of csv-core counts every '\n' consumed. The
             // record's own '\n' has been consumed unless it is the unterminated
             // last line; quoted fields may contain more line ends.
@@ -257,6 +306,9 @@ impl CsvSource {
             let last_line = pos.line() - u64::from(!at_end || self.ends_with_newline);
             let embedded = self.rec.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
             self.line = last_line.saturating_sub(embedded).max(1);
+            if record_bytes as u64 > MAX_LINE_BYTES {
+                return Err(line_too_long(&self.file, self.line));
+            }
             if self.rec.len() == 1 && self.rec[0].trim_ascii().is_empty() {
                 continue;
             }
@@ -272,6 +324,9 @@ impl CsvSource {
             });
         }
         self.header_line = self.line;
+        if self.rec.len() > MAX_COLUMNS {
+            return Err(too_many_columns(&self.file, self.line, self.rec.len()));
+        }
         self.last = self.rec.len().saturating_sub(1);
         self.crlf = self.rec.get(self.last).is_some_and(|f| f.ends_with(b"\r"));
         self.rec

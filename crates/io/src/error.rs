@@ -78,6 +78,19 @@ pub enum IoError {
         /// The delimiter used, in words ("comma", "tab", …).
         delimiter: String,
     },
+    /// A line (or a quoted field spanning lines) or a header beyond the
+    /// reader's limits ([`MAX_LINE_BYTES`](crate::MAX_LINE_BYTES),
+    /// [`MAX_COLUMNS`](crate::MAX_COLUMNS)), which keep memory bounded on
+    /// hostile files.
+    #[error("'{file}' line {line}: {what}; this is not a flight-data table (or it must be split)")]
+    TooLarge {
+        /// File as given.
+        file: String,
+        /// Line where the limit was reached.
+        line: u64,
+        /// What is too large, with the limit.
+        what: String,
+    },
     /// A column name appears twice in the header.
     #[error(
         "'{file}' line {line}: column name '{column}' appears twice in the header (columns {first} and {second}, counted from 1)"

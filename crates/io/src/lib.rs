@@ -50,6 +50,7 @@ mod xyz;
 
 use std::path::Path;
 
+pub use builder::{MAX_COLUMNS, MAX_LINE_BYTES};
 pub use columns::{
     CANONICAL_COLUMNS, ColumnMap, MAGNAV_PRESET, MAGNETIC_COLUMNS, MapOrigin, MappedColumn,
     Sensors, is_canonical, is_truth_column, sensor_names,

@@ -45,11 +45,13 @@
 //! [`read_csv`](crate::read_csv) hands over when it detects them.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader};
-use std::path::Path;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
 
 use crate::ReadOptions;
-use crate::builder::{Layout, RowSource, TableBuilder};
+use crate::builder::{
+    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowSource, TableBuilder, line_too_long, too_many_columns,
+};
 use crate::error::{IoError, Result};
 use crate::sniff::{BOM, read_prefix};
 use crate::table::FlightTable;
@@ -116,6 +118,7 @@ enum Kind {
 /// Whitespace-separated rows (see [`RowSource`]).
 struct TokenSource {
     reader: BufReader<File>,
+    path: PathBuf,
     buf: Vec<u8>,
     spans: Vec<(usize, usize)>,
     file: String,
@@ -137,13 +140,25 @@ impl TokenSource {
     /// Opens the file and reads up to the first data line; returns the source
     /// (positioned so that the first `next_row` yields that line) and the header names.
     fn open(path: &Path, dialect: Dialect) -> Result<(Self, Vec<String>)> {
+        let mut src = Self::new(path, dialect)?;
+        let names = match dialect {
+            Dialect::Geosoft => src.geosoft_header()?,
+            Dialect::Whitespace => src.plain_header()?,
+        };
+        src.n_fields = names.len();
+        Ok((src, names))
+    }
+
+    /// A source at the start of the file.
+    fn new(path: &Path, dialect: Dialect) -> Result<Self> {
         let file = path.display().to_string();
         let f = File::open(path).map_err(|source| IoError::Open {
             file: file.clone(),
             source,
         })?;
-        let mut src = TokenSource {
+        Ok(TokenSource {
             reader: BufReader::with_capacity(256 * 1024, f),
+            path: path.to_path_buf(),
             buf: Vec::with_capacity(1024),
             spans: Vec::new(),
             file,
@@ -159,24 +174,18 @@ impl TokenSource {
             any_record: false,
             line_values: Vec::new(),
             line_types: Vec::new(),
-        };
-        let names = match dialect {
-            Dialect::Geosoft => src.geosoft_header()?,
-            Dialect::Whitespace => src.plain_header()?,
-        };
-        src.n_fields = names.len();
-        Ok((src, names))
+        })
     }
 
     /// Scans comments and records up to the first data line and applies the header rule.
     fn geosoft_header(&mut self) -> Result<Vec<String>> {
-        let mut comments: Vec<(u64, bool, Vec<String>)> = Vec::new();
+        let mut last_comment = None;
         loop {
             if !self.read_line()? {
-                return Err(match comments.last() {
-                    Some((line, _, _)) => IoError::NoData {
+                return Err(match last_comment {
+                    Some(line) => IoError::NoData {
                         file: self.file.clone(),
-                        header_line: *line,
+                        header_line: line,
                     },
                     None => IoError::Empty {
                         file: self.file.clone(),
@@ -186,15 +195,8 @@ impl TokenSource {
             match self.classify()? {
                 Kind::Blank => {}
                 Kind::Comment => {
-                    if let Ok(text) = std::str::from_utf8(&self.buf) {
-                        let double = text.starts_with("//");
-                        let names: Vec<String> = text
-                            .trim_start_matches('/')
-                            .split(|c: char| c.is_whitespace() || c == ',')
-                            .filter(|t| !t.is_empty())
-                            .map(str::to_string)
-                            .collect();
-                        comments.push((self.line, double, names));
+                    if std::str::from_utf8(&self.buf).is_ok() {
+                        last_comment = Some(self.line);
                     }
                 }
                 Kind::Record { number, tie } => self.set_record(number, tie),
@@ -203,13 +205,13 @@ impl TokenSource {
         }
         self.tokenize();
         let n = self.spans.len();
-        let name_like = |t: &String| t.starts_with(|c: char| c.is_alphabetic() || c == '_');
-        let fits = |double: bool| {
-            comments.iter().rev().find(|(_, d, names)| {
-                *d == double && names.len() == n && names.iter().all(name_like)
-            })
-        };
-        let Some((line, _, names)) = fits(false).or_else(|| fits(true)) else {
+        if n > MAX_COLUMNS {
+            return Err(too_many_columns(&self.file, self.line, n));
+        }
+        // The comment lines are read again rather than kept: memory stays
+        // bounded by one line however many comments precede the data.
+        let (single, double) = self.header_candidates(n)?;
+        let Some((line, names)) = single.or(double) else {
             return Err(IoError::XyzHeader {
                 file: self.file.clone(),
                 line: self.line,
@@ -218,9 +220,44 @@ impl TokenSource {
                 ),
             });
         };
-        self.header_line = *line;
+        self.header_line = line;
         self.replay = true;
-        Ok(names.clone())
+        Ok(names)
+    }
+
+    /// The last `/` and the last `//` comment line before the first data line
+    /// (line `self.line`) with `n` names that all start with a letter or `_`.
+    #[allow(clippy::type_complexity)]
+    fn header_candidates(
+        &self,
+        n: usize,
+    ) -> Result<(Option<(u64, Vec<String>)>, Option<(u64, Vec<String>)>)> {
+        let mut again = TokenSource::new(&self.path, self.dialect)?;
+        let (mut single, mut double) = (None, None);
+        while again.line + 1 < self.line && again.read_line()? {
+            let Ok(text) = std::str::from_utf8(&again.buf) else {
+                continue;
+            };
+            // A comment as `classify` says; its names as the header rule says.
+            if !text.trim_ascii_start().starts_with('/') {
+                continue;
+            }
+            let names = || {
+                text.trim_start_matches('/')
+                    .split(|c: char| c.is_whitespace() || c == ',')
+                    .filter(|t| !t.is_empty())
+            };
+            let name_like = |t: &str| t.starts_with(|c: char| c.is_alphabetic() || c == '_');
+            if names().count() == n && names().all(name_like) {
+                let found = Some((again.line, names().map(str::to_string).collect()));
+                if text.starts_with("//") {
+                    double = found;
+                } else {
+                    single = found;
+                }
+            }
+        }
+        Ok((single, double))
     }
 
     /// The first content line (not blank, not `#`) is the header.
@@ -241,14 +278,20 @@ impl TokenSource {
             line: self.line,
             what: "invalid bytes in the header row".to_string(),
         })?;
+        let n = text.split_whitespace().count();
+        if n > MAX_COLUMNS {
+            return Err(too_many_columns(&self.file, self.line, n));
+        }
         Ok(text.split_whitespace().map(str::to_string).collect())
     }
 
     /// Reads the next physical line into `buf` without its line end; `false` at the end.
     fn read_line(&mut self) -> Result<bool> {
         self.buf.clear();
-        let n = self
-            .reader
+        // At most the limit plus "\r\n": a longer line is an error, not a
+        // buffer of the whole file.
+        let n = (&mut self.reader)
+            .take(MAX_LINE_BYTES + 2)
             .read_until(b'\n', &mut self.buf)
             .map_err(|source| IoError::Read {
                 file: self.file.clone(),
@@ -258,6 +301,9 @@ impl TokenSource {
         if n == 0 {
             return Ok(false);
         }
+        if n as u64 == MAX_LINE_BYTES + 2 && self.buf.last() != Some(&b'\n') {
+            return Err(line_too_long(&self.file, self.line + 1));
+        }
         self.bytes += n as u64;
         self.line += 1;
         if self.line == 1 && self.buf.starts_with(BOM) {
@@ -265,6 +311,9 @@ impl TokenSource {
         }
         while matches!(self.buf.last(), Some(b'\n' | b'\r')) {
             self.buf.pop();
+        }
+        if self.buf.len() as u64 > MAX_LINE_BYTES {
+            return Err(line_too_long(&self.file, self.line));
         }
         Ok(true)
     }

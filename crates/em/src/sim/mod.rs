@@ -25,7 +25,7 @@ pub mod synthesis;
 pub mod truth_csv;
 
 pub use detected_csv::{detected_csv, field_epoch_from_values, value_columns};
-pub use raw_format::{RawHeader, RawReader, read_raw, write_raw};
+pub use raw_format::{MAX_CHANNELS, RawHeader, RawReader, read_raw, write_raw};
 pub use scenario::{EmScenario, EmSimConfig};
 pub use synthesis::{EmRecording, synthesize};
 pub use truth_csv::{known_csv, truth_csv};

@@ -15,6 +15,11 @@ use std::io::{Read, Write};
 /// The 8-byte magic at the start of a raw file.
 pub const MAGIC: &[u8; 8] = b"AEMRAW1\n";
 
+/// Most channels a raw file may declare (the receiver has 3): a header
+/// claiming more is an error, so that a hostile header cannot make a
+/// reader allocate frames × channels buffers out of proportion to the file.
+pub const MAX_CHANNELS: usize = 1024;
+
 /// JSON header of a raw record.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RawHeader {
@@ -127,8 +132,13 @@ impl<R: Read> RawReader<R> {
             ));
         }
         let len = u32::from_le_bytes([pre[8], pre[9], pre[10], pre[11]]) as usize;
-        let mut json = vec![0u8; len];
-        let got = read_full(&mut inner, &mut json)?;
+        // Read what is there (not a buffer of the announced length: bytes
+        // 8..12 may claim 4 GiB in a file of a few bytes).
+        let mut json = Vec::new();
+        let got = (&mut inner)
+            .take(len as u64)
+            .read_to_end(&mut json)
+            .map_err(|e| bad(format!("read error: {e}")))?;
         if got < len {
             return Err(bad(format!(
                 "truncated header: bytes 8..12 announce {len} header bytes, the file has {got} after them"
@@ -141,6 +151,12 @@ impl<R: Read> RawReader<R> {
             return Err(bad(format!(
                 "header field 'layout' is \"{}\", expected \"f32le-interleaved\"",
                 header.layout
+            )));
+        }
+        if header.channels > MAX_CHANNELS {
+            return Err(bad(format!(
+                "header field 'channels' = {} is more than {MAX_CHANNELS}",
+                header.channels
             )));
         }
         if header.channels == 0 || !crate::positive_finite(header.sample_rate_hz) {
@@ -194,9 +210,15 @@ impl<R: Read> RawReader<R> {
             }
             return Ok(0);
         }
-        self.bytes.resize(frames * ch * 4, 0);
-        let got = read_full(&mut self.inner, &mut self.bytes)?;
-        if got < self.bytes.len() {
+        // Read what is there rather than allocate the requested size first:
+        // a header claiming 10^12 frames meets a short body.
+        let len = (frames as u64).saturating_mul(ch as u64 * 4);
+        self.bytes.clear();
+        let got = (&mut self.inner)
+            .take(len)
+            .read_to_end(&mut self.bytes)
+            .map_err(|e| bad(format!("read error: {e}")))?;
+        if (got as u64) < len {
             let at = self.frames_read + (got / (4 * ch)) as u64;
             return Err(bad(format!(
                 "truncated body: the header says {} frames × {ch} channels, the file ends in frame {at} (byte {})",
@@ -223,12 +245,89 @@ pub fn read_raw(bytes: &[u8]) -> Result<(RawHeader, Vec<f32>)> {
     let frames = usize::try_from(r.header().frames)
         .map_err(|_| bad("header field 'frames' too large".into()))?;
     if frames.checked_mul(r.header().channels * 4) != Some(bytes.len() - r.body_offset() as usize) {
-        // Same errors as streaming, without allocating a wrong-sized buffer.
+        // Same errors as streaming, without allocating a wrong-sized buffer
+        // (chunks of at most 1 MiB).
+        let chunk = ((1 << 20) / (4 * r.header().channels)).max(1);
         let mut out = Vec::new();
-        while r.read_frames(1 << 16, &mut out)? > 0 {}
+        while r.read_frames(chunk, &mut out)? > 0 {}
     }
     let mut samples = Vec::new();
     r.read_frames(frames, &mut samples)?;
     r.read_frames(1, &mut Vec::new())?;
     Ok((r.header.clone(), samples))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A raw record of 0 frames written by `aeromag em simulate` (cut).
+    const RAW0: &[u8] = include_bytes!("../../tests/data/raw_0_frames.raw");
+
+    /// RAW0 with header fields replaced and `body` appended.
+    fn with(fields: &[(&str, serde_json::Value)], body: &[u8]) -> Vec<u8> {
+        let len = u32::from_le_bytes(RAW0[8..12].try_into().unwrap()) as usize;
+        let mut h: serde_json::Value = serde_json::from_slice(&RAW0[12..12 + len]).unwrap();
+        for (k, v) in fields {
+            h[*k] = v.clone();
+        }
+        let json = serde_json::to_vec(&h).unwrap();
+        let mut out = MAGIC.to_vec();
+        out.extend((json.len() as u32).to_le_bytes());
+        out.extend(json);
+        out.extend(body);
+        out
+    }
+
+    #[test]
+    fn seed_reads() {
+        let (h, s) = read_raw(RAW0).unwrap();
+        assert_eq!((h.channels, h.frames, s.len()), (3, 0, 0));
+    }
+
+    #[test]
+    fn header_length_claiming_4_gib_is_an_error_without_allocating_it() {
+        let mut b = RAW0[..40].to_vec();
+        b[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+        let e = read_raw(&b).unwrap_err().to_string();
+        assert!(
+            e.contains("announce 4294967295 header bytes, the file has 28"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn header_claiming_1e12_frames_is_streamed_in_bounded_chunks() {
+        let b = with(&[("frames", 1_000_000_000_000u64.into())], &[0u8; 120]);
+        let e = read_raw(&b).unwrap_err().to_string();
+        assert!(
+            e.contains("truncated body") && e.contains("frame 10"),
+            "{e}"
+        );
+        let mut r = RawReader::new(&b[..]).unwrap();
+        let mut out = Vec::new();
+        assert_eq!(r.read_frames(4, &mut out).unwrap(), 4);
+        assert!(r.read_frames(1 << 16, &mut out).is_err());
+    }
+
+    #[test]
+    fn absurd_channel_counts_are_errors() {
+        for ch in [1_000_000_000_000_000u64, u64::MAX, MAX_CHANNELS as u64 + 1] {
+            let b = with(&[("channels", ch.into()), ("frames", 1u64.into())], &[]);
+            let e = read_raw(&b).unwrap_err().to_string();
+            assert!(e.contains("'channels'"), "{ch}: {e}");
+        }
+        // At the limit: 10^12 frames of 1024 channels in a 4 KiB body.
+        let b = with(
+            &[
+                ("channels", MAX_CHANNELS.into()),
+                ("frames", 1_000_000_000_000u64.into()),
+            ],
+            &[0u8; 4096],
+        );
+        let e = read_raw(&b).unwrap_err().to_string();
+        assert!(e.contains("truncated body"), "{e}");
+        let mut r = RawReader::new(&b[..]).unwrap();
+        assert!(r.read_frames(usize::MAX, &mut Vec::new()).is_err());
+    }
 }
