@@ -82,27 +82,20 @@ pub fn write_streamed(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<()>,
 ) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = std::fs::File::create(&tmp)
-        .map_err(|e| Error::write(path, e))
-        .and_then(|f| {
-            let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
-            write(&mut w)?;
-            w.flush().map_err(|e| Error::write(path, e))
+    // The library error of `write`, kept while the I/O layer sees a plain
+    // I/O error.
+    let mut failure: Option<Error> = None;
+    let written = aeromag_io::atomic::write_atomically(path, |w| {
+        write(w).map_err(|e| {
+            failure = Some(e);
+            std::io::Error::other("write failed")
         })
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::write(path, e)));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    });
+    match (written, failure) {
+        (_, Some(e)) => Err(e),
+        (Err(e), None) => Err(Error::write(path, e)),
+        (Ok(()), None) => Ok(()),
     }
-    result
 }
 
 #[cfg(test)]

@@ -57,8 +57,47 @@ fn restore_sigpipe() {
     }
 }
 
+/// Ctrl-C and SIGTERM: remove the output files being written (their
+/// temporaries; complete outputs are renamed into place atomically, see
+/// `aeromag::io::atomic`) and exit with 130 (SIGINT) or 143 (SIGTERM).
+///
+/// The two signals are blocked in every thread (threads inherit the mask of
+/// the main thread, which sets it first) and taken by one thread with
+/// `sigwait`, so the clean-up runs as ordinary code, not in a signal handler.
+fn handle_interrupts() {
+    #[cfg(unix)]
+    // SAFETY: sigset_t is plain data initialised by sigemptyset; the mask is
+    // set at start-up before any other thread exists; the waiting thread
+    // only reads its own copy of the set.
+    unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        libc::sigaddset(&mut set, libc::SIGINT);
+        libc::sigaddset(&mut set, libc::SIGTERM);
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        std::thread::spawn(move || {
+            let mut sig: libc::c_int = 0;
+            if libc::sigwait(&set, &mut sig) == 0 {
+                let removed = aeromag::io::atomic::remove_temporaries();
+                let name = if sig == libc::SIGINT {
+                    "SIGINT"
+                } else {
+                    "SIGTERM"
+                };
+                eprintln!(
+                    "interrupted ({name}); {removed} unfinished output file(s) removed, complete outputs kept"
+                );
+                std::process::exit(128 + sig);
+            }
+        });
+    }
+}
+
 fn main() {
     restore_sigpipe();
+    handle_interrupts();
     let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Demo(a) => commands::demo::run(a),

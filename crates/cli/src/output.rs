@@ -2,6 +2,7 @@
 //! `rotor apply`, `pod apply`).
 
 use crate::exit::bad_input;
+use aeromag::io::atomic::{check_writable, check_writable_folder};
 use aeromag::{Compensated, Flight};
 use std::path::Path;
 
@@ -118,4 +119,19 @@ pub fn simulate_gradiometer(
     println!("  data      {}", files.csv.display());
     println!("  scenario  {}", files.scenario.display());
     Ok(())
+}
+
+/// Check, before any work, that every output file can be written (its
+/// folder is created if missing): bad input otherwise, so a long run never
+/// ends on an unwritable path.
+pub fn check_files<'a>(paths: impl IntoIterator<Item = &'a Path>) -> anyhow::Result<()> {
+    for p in paths {
+        check_writable(p).map_err(|e| bad_input!("cannot write '{}': {e}", p.display()))?;
+    }
+    Ok(())
+}
+
+/// As [`check_files`] for an output folder.
+pub fn check_folder(dir: &Path) -> anyhow::Result<()> {
+    check_writable_folder(dir).map_err(|e| bad_input!("cannot write into '{}': {e}", dir.display()))
 }

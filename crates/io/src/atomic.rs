@@ -26,12 +26,14 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Temporaries being written (removed by [`remove_temporaries`]).
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Counter that makes temporary names unique within the process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
+/// Set by [`remove_temporaries`]: no file is completed after it.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// The folder of `path` (`.` for a bare file name).
 fn folder(path: &Path) -> &Path {
@@ -70,6 +72,17 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    let interrupted = || {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "interrupted",
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    interrupted()?;
     let tmp = temporary(path);
     let result = File::create(&tmp).and_then(|f| {
         let mut w = BufWriter::with_capacity(1 << 20, f);
@@ -78,6 +91,7 @@ pub fn write_atomically(
         let f = w.into_inner().map_err(|e| e.into_error())?;
         f.sync_all()?;
         drop(f);
+        interrupted()?;
         std::fs::rename(&tmp, path)
     });
     if result.is_err() {
@@ -92,9 +106,11 @@ pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
     write_atomically(path, |w| w.write_all(bytes.as_ref()))
 }
 
-/// Removes every temporary still being written; returns how many. For a
-/// signal handler (the process exits right after).
+/// Removes every temporary still being written and stops any file from
+/// being completed afterwards; returns how many were removed. For a signal
+/// handler (the process exits right after).
 pub fn remove_temporaries() -> usize {
+    INTERRUPTED.store(true, Ordering::SeqCst);
     let list = std::mem::take(&mut *lock());
     list.iter()
         .filter(|p| std::fs::remove_file(p).is_ok())
@@ -181,8 +197,11 @@ mod tests {
             assert!(entries(&d).is_empty());
             Ok(())
         })
-        .unwrap_err(); // the rename finds no temporary
+        .unwrap_err(); // nothing is completed after an interruption
         assert!(entries(&d).is_empty(), "{:?}", entries(&d));
+        assert!(write_file(&p, "x").is_err());
+        assert!(entries(&d).is_empty());
+        INTERRUPTED.store(false, Ordering::SeqCst); // for the other tests
     }
 
     #[test]

@@ -20,8 +20,7 @@
 //!
 //! The writer streams row by row into a 1 MiB buffer.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 use crate::error::{IoError, Result};
@@ -29,38 +28,16 @@ use crate::table::{Column, ColumnData, FlightTable};
 
 /// Writes `table` as CSV to the file `path` (created or replaced).
 ///
-/// The table is written to a temporary file in the same folder
-/// (`.NAME.PID.tmp`) and renamed to `path` when complete, so an interrupted
-/// or failed write never leaves a complete-looking partial file; on failure
-/// the temporary file is removed.
+/// The table is written to a temporary file in the same folder and renamed
+/// to `path` when complete ([`crate::atomic`]), so an interrupted or failed
+/// write never leaves a complete-looking partial file.
 pub fn write_csv(table: &FlightTable, path: &Path) -> Result<()> {
-    let file = path.display().to_string();
-    let write_err = |source| IoError::Write {
-        file: file.clone(),
-        source,
-    };
-    let tmp = temporary_path(path);
-    let written = File::create(&tmp).and_then(|f| {
-        let mut out = BufWriter::with_capacity(1 << 20, f);
-        write_csv_to(table, &mut out)?;
-        out.flush()?;
-        drop(out);
-        std::fs::rename(&tmp, path)
-    });
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(write_err(e));
-    }
-    Ok(())
-}
-
-/// The temporary file [`write_csv`] writes before renaming it to `path`.
-fn temporary_path(path: &Path) -> std::path::PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    crate::atomic::write_atomically(path, |w| write_csv_to(table, w)).map_err(|source| {
+        IoError::Write {
+            file: path.display().to_string(),
+            source,
+        }
+    })
 }
 
 /// Writes `table` as CSV to any writer (wrap unbuffered writers in a `BufWriter`).

@@ -81,10 +81,11 @@ pub const MIN_SIZE_PX: u32 = 160;
 /// Largest accepted image width or height, pixels.
 pub const MAX_SIZE_PX: u32 = 8192;
 
-/// Writes `bytes` to `path`, creating missing parent folders.
+/// Writes `bytes` to `path` atomically (a temporary renamed when complete,
+/// [`aeromag_io::atomic`]), creating missing parent folders.
 pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| ReportError::io(dir, e))?;
     }
-    std::fs::write(path, bytes).map_err(|e| ReportError::io(path, e))
+    aeromag_io::atomic::write_file(path, bytes).map_err(|e| ReportError::io(path, e))
 }

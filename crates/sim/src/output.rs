@@ -138,18 +138,27 @@ impl Simulation {
                 source: e,
             }
         };
-        let f = std::fs::File::create(&files.csv).map_err(werr(&files.csv))?;
-        let mut bw = std::io::BufWriter::with_capacity(1 << 20, f);
-        self.write_csv(&mut bw).map_err(|e| match e {
-            SimError::Write { source, .. } => SimError::Write {
+        // Each file through a temporary renamed when complete.
+        let mut failure: Option<SimError> = None;
+        aeromag_io::atomic::write_atomically(&files.csv, |w| {
+            self.write_csv(w).map_err(|e| {
+                let io = std::io::Error::other(e.to_string());
+                failure = Some(e);
+                io
+            })
+        })
+        .map_err(|e| match failure.take() {
+            Some(SimError::Write { source, .. }) => SimError::Write {
                 path: files.csv.clone(),
                 source,
             },
-            other => other,
+            Some(other) => other,
+            None => werr(&files.csv)(e),
         })?;
-        bw.flush().map_err(werr(&files.csv))?;
-        std::fs::write(&files.scenario, &self.scenario_toml).map_err(werr(&files.scenario))?;
-        std::fs::write(&files.truth, &self.truth_json).map_err(werr(&files.truth))?;
+        aeromag_io::atomic::write_file(&files.scenario, &self.scenario_toml)
+            .map_err(werr(&files.scenario))?;
+        aeromag_io::atomic::write_file(&files.truth, &self.truth_json)
+            .map_err(werr(&files.truth))?;
         Ok(files)
     }
 }

@@ -190,6 +190,7 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = options(&a)?;
+    crate::output::check_files(std::iter::once(a.model.as_path()).chain(a.series.as_deref()))?;
     // Only the canonical columns and named reference channels are read
     // (an HDF5 flight's other fields stay on disk).
     let extra: Vec<&str> = match &a.reference {
@@ -229,7 +230,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             fit.log_likelihood, fit.normalized_innovation_variance
         );
     }
-    std::fs::write(&a.model, model.to_json()?).map_err(|e| aeromag::Error::write(&a.model, e))?;
+    aeromag::io::atomic::write_file(&a.model, model.to_json()?)
+        .map_err(|e| aeromag::Error::write(&a.model, e))?;
     println!(
         "fitted {} terms ({}, method {}) on {} rows in {} legs: residual {:.4} nT RMS, condition {:.2e}",
         model.coefficients.len(),

@@ -29,6 +29,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let model = TlModel::read(&a.model)?;
     let flight = a.input.load()?;
     let out = model.compensate(&flight)?;

@@ -35,6 +35,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    crate::output::check_folder(&a.out)?;
     let start = Instant::now();
     std::fs::create_dir_all(a.out.join("data"))
         .map_err(|e| aeromag::Error::write(a.out.join("data"), e))?;

@@ -171,6 +171,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 fn locate(a: LocateArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let mut cfg = read_config(a.config.as_deref())?;
     let parse = |flag: &str, v: &str| -> anyhow::Result<toml::Value> {
         toml::Value::try_from(v).map_err(|e| bad_input!("{flag} {v}: {e}"))

@@ -92,6 +92,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 fn study(a: StudyArgs) -> anyhow::Result<()> {
+    crate::output::check_folder(&a.out)?;
     let mut run = EmStudy::default();
     run.config.seed = a.seed;
     let out = run.run(StudySize::quick_if(a.quick), &mut Bars::new())?;
@@ -111,7 +112,7 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
     );
     std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
     let write = |name: &str, text: String| {
-        std::fs::write(a.out.join(name), text)
+        aeromag::io::atomic::write_file(&a.out.join(name), text)
             .map_err(|e| aeromag::Error::write(a.out.join(name), e))
     };
     write(

@@ -78,6 +78,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    crate::output::check_files(std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()))?;
     let flight = a.input.load()?;
     let opts = LevelOptions {
         value: a.value.clone(),

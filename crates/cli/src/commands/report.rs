@@ -35,6 +35,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    crate::output::check_folder(&a.out)?;
     let flight = a.input.load()?;
     let model = a.model.as_deref().map(TlModel::read).transpose()?;
     let reference = match (&a.reference, &model) {
@@ -49,8 +50,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .append_to(&mut r);
     let path = a.out.join("index.html");
     r.write_html(&path)?;
-    std::fs::write(
-        a.out.join("figures.json"),
+    aeromag::io::atomic::write_file(
+        &a.out.join("figures.json"),
         serde_json::to_string_pretty(&fig)?,
     )
     .map_err(|e| aeromag::Error::write(a.out.join("figures.json"), e))?;

@@ -186,6 +186,7 @@ fn options(a: &FitArgs) -> RotorOptions {
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.model.as_path()])?;
     let opts = options(&a);
     let flight = a.input.load()?;
     let fit = fit_rotor(&flight, &opts, &mut Bars::new())?;
@@ -214,6 +215,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 }
 
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let model = aeromag::rotor::RotorModelFile::read(&a.model)?;
     let flight = a.input.load()?;
     let out = model.compensate_observed(&flight, &mut Bars::new())?;
@@ -221,6 +223,7 @@ fn apply(a: ApplyArgs) -> anyhow::Result<()> {
 }
 
 fn study(a: StudyArgs) -> anyhow::Result<()> {
+    crate::output::check_folder(&a.out)?;
     let out = RotorStudyRun { seed: a.seed }.run(StudySize::Full, &mut Bars::new())?;
     let s = &out.study;
     println!(
@@ -240,8 +243,8 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
     let summary = serde_json::json!({ "rotor": out.summary() });
-    std::fs::write(
-        a.out.join("summary.json"),
+    aeromag::io::atomic::write_file(
+        &a.out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
     )
     .map_err(|e| aeromag::Error::write(a.out.join("summary.json"), e))?;

@@ -59,6 +59,7 @@ pub struct CalibrateArgs {
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let system = read_system(&a.system)?;
     let epochs = read_detected(&a.input)?;
     let known = known_points(&load_table(&a.known)?, &epochs)?;
@@ -69,7 +70,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             a.known.display()
         ))
     })?;
-    std::fs::write(&a.out, cal.file.to_json()?).map_err(|e| aeromag::Error::write(&a.out, e))?;
+    aeromag::io::atomic::write_file(&a.out, cal.file.to_json()?)
+        .map_err(|e| aeromag::Error::write(&a.out, e))?;
     let c = &cal.file.fit;
     println!(
         "calibrated from {} epochs, {} known positions, {} known attitude(s)",

@@ -83,6 +83,7 @@ fn window(name: &str) -> Result<WindowName, String> {
 }
 
 pub fn run(a: DetectArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let opts = DetectOptions {
         window_len: a.window_len,
         window: a.window.0,
@@ -90,7 +91,7 @@ pub fn run(a: DetectArgs) -> anyhow::Result<()> {
         system: a.system.as_deref().map(read_system).transpose()?,
     };
     let d = detect(&a.input, &opts, &mut Bars::new())?;
-    std::fs::write(&a.out, detected_csv(&d.epochs))
+    aeromag::io::atomic::write_file(&a.out, detected_csv(&d.epochs))
         .map_err(|e| aeromag::Error::write(&a.out, e))?;
     let n = d.window_len;
     println!(

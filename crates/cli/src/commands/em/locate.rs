@@ -49,13 +49,15 @@ pub struct LocateArgs {
 }
 
 pub fn run(a: LocateArgs) -> anyhow::Result<()> {
+    crate::output::check_files([a.out.as_path()])?;
     let text = std::fs::read_to_string(&a.calibration)
         .map_err(|e| aeromag::Error::read(&a.calibration, e))?;
     let file = CalibrationFile::from_json(&text)
         .map_err(|e| bad_input!("'{}': {e}", a.calibration.display()))?;
     let epochs = read_detected(&a.input)?;
     let poses = locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new())?;
-    std::fs::write(&a.out, poses.to_csv()).map_err(|e| aeromag::Error::write(&a.out, e))?;
+    aeromag::io::atomic::write_file(&a.out, poses.to_csv())
+        .map_err(|e| aeromag::Error::write(&a.out, e))?;
     println!(
         "located {} of {} epochs ({} by continuity near the half-space plane)",
         epochs.len() - poses.failed(),

@@ -1,0 +1,137 @@
+//! A whole simulated flight in the SGL HDF5 layout (calibration box
+//! 1002.02, transit gap, survey lines 1003.01… and ties 1003.51…; written by
+//! `tools/reference/sgl_flight.py` with h5py, SGL names, INS position in
+//! radians and velocity north/west/up) is calibrated on its box with
+//! `--lines` and compensated on its survey lines with `--lines`, giving the
+//! numbers of the same flight as CSV (canonical names, degrees, NED).
+//!
+//! Needs python3 with numpy and h5py (`scripts/test.sh` installs them).
+
+mod common;
+use common::*;
+use std::path::Path;
+use std::process::Command;
+
+fn python_flight(dir: &Path) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for (scenario, seed) in [("calibration", "1"), ("survey", "2")] {
+        let o = aeromag(&[
+            "simulate",
+            scenario,
+            "--seed",
+            seed,
+            "--out",
+            dir.join(scenario).to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+    }
+    let o = Command::new("python3")
+        .arg(root.join("tools/reference/sgl_flight.py"))
+        .arg(dir.join("calibration/calibration.csv"))
+        .arg(dir.join("survey/survey.csv"))
+        .arg(dir)
+        .output()
+        .expect("python3");
+    assert!(
+        o.status.success(),
+        "tools/reference/sgl_flight.py failed (needs numpy and h5py: run scripts/test.sh, or pip install numpy h5py):\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn read_json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+fn column(p: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("{name}"));
+    lines
+        .map(|l| {
+            l.split(',')
+                .nth(k)
+                .unwrap()
+                .parse::<f64>()
+                .unwrap_or(f64::NAN)
+        })
+        .collect()
+}
+
+#[test]
+fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    python_flight(d);
+    let (csv, h5) = (d.join("whole_flight.csv"), d.join("whole_flight.h5"));
+    let survey_lines = "1003.01,1003.02,1003.03,1003.04,1003.05,1003.51,1003.52";
+    let mut models = Vec::new();
+    let mut outputs = Vec::new();
+    for (k, input) in [&csv, &h5].into_iter().enumerate() {
+        let model = d.join(format!("model{k}.json"));
+        let o = aeromag(&[
+            "calibrate",
+            "-i",
+            input.to_str().unwrap(),
+            "--lines",
+            "1002.02",
+            "--model",
+            model.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        let out = d.join(format!("comp{k}.csv"));
+        let o = aeromag(&[
+            "compensate",
+            "-i",
+            input.to_str().unwrap(),
+            "--lines",
+            survey_lines,
+            "--model",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        models.push(read_json(&model));
+        outputs.push(out);
+    }
+    // The same coefficients (the HDF5 latitude went through radians and
+    // back: equal to ~1e-15 relative).
+    let coef = |m: &serde_json::Value| -> Vec<f64> {
+        m["coefficients"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["value"].as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (coef(&models[0]), coef(&models[1]));
+    assert!(a.len() >= 16 && a.len() == b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-3), "{x} vs {y}");
+    }
+    // The same compensated survey, row for row.
+    let (ca, cb) = (
+        column(&outputs[0], "mag_comp"),
+        column(&outputs[1], "mag_comp"),
+    );
+    assert_eq!(ca.len(), cb.len());
+    assert!(ca.len() > 1000, "{} survey rows", ca.len());
+    let worst = ca
+        .iter()
+        .zip(&cb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f64, f64::max);
+    assert!(worst < 1e-6, "largest difference {worst} nT");
+    // Every survey row is written, none of the box or the transit.
+    let lines = column(&outputs[1], "line");
+    assert!(
+        lines.iter().all(|&l| l > 1003.0 && l < 1004.0),
+        "{:?}",
+        &lines[..5]
+    );
+}
