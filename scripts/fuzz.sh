@@ -17,8 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# TODO(hdf5): add an `hdf5` target once the HDF5 reader is chosen (issue 18).
-TARGETS=(csv xyz model_json scenario_toml em_raw)
+TARGETS=(csv xyz model_json scenario_toml em_raw hdf5)
 
 usage() {
     sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//' >&2
@@ -49,7 +48,7 @@ sanitizer=${FUZZ_SANITIZER:-none}
 # so that executions are fast.
 max_len() {
     case $1 in
-        csv | xyz) echo 65536 ;;
+        csv | xyz | hdf5) echo 65536 ;;
         em_raw) echo 16384 ;;
         *) echo 32768 ;;
     esac

@@ -134,4 +134,31 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         "{:?}",
         &lines[..5]
     );
+    // Levelled with its decimal labels (ties declared), and reported: the
+    // report reads the levelling columns.
+    let levelled = d.join("level.csv");
+    let o = aeromag(&[
+        "level",
+        "-i",
+        outputs[1].to_str().unwrap(),
+        "--ties",
+        "1003.51,1003.52",
+        "--out",
+        levelled.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("1003.51"), "{}", stdout(&o));
+    let rep = d.join("report");
+    let o = aeromag(&[
+        "report",
+        "-i",
+        levelled.to_str().unwrap(),
+        "--out",
+        rep.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    for k in ["Levelling correction per line", "rows levelled", "1003.52"] {
+        assert!(html.contains(k), "{k} missing in the report");
+    }
 }

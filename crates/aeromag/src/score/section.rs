@@ -263,8 +263,91 @@ impl Figures {
                 r.paragraph(format!("Fit warnings: {}", m.fit.warnings.join(" | ")));
             }
         }
+        levelling_part(&mut r, t, &series)?;
         Ok(r)
     }
+}
+
+/// The levelling columns of a file written by `aeromag level`
+/// (`<value>_level` and `level_flag`), when present: the rows by flag, the
+/// correction (levelled − value) along the flight and per line.
+fn levelling_part(
+    r: &mut ReportSection,
+    t: &Flight,
+    series: &dyn Fn(&str, Vec<f64>) -> Series,
+) -> Result<()> {
+    let Some(flag) = t.column(crate::level::LEVEL_FLAG) else {
+        return Ok(());
+    };
+    let Some((value, levelled)) = t.column_names().iter().find_map(|n| {
+        let base = n.strip_suffix("_level")?;
+        Some((t.column(base)?, t.column(n)?))
+    }) else {
+        return Ok(());
+    };
+    let count = |f: f64| flag.iter().filter(|&&x| x == f).count().to_string();
+    r.key_values(vec![
+        ("rows levelled".into(), count(0.0)),
+        ("rows on a line without crossovers".into(), count(1.0)),
+        ("rows not on a line".into(), count(2.0)),
+        ("rows with a missing value".into(), count(3.0)),
+    ]);
+    let correction: Vec<f64> = levelled.iter().zip(value).map(|(l, v)| l - v).collect();
+    let svg = LinePlot::new(
+        "Levelling correction",
+        "time since start (s)",
+        "levelled − value (nT)",
+    )
+    .with_series(series("correction", correction.clone()))
+    .to_svg()?;
+    r.figure(
+        svg,
+        "The correction levelling applied (line level, drift and the k·d|B0|/dt term).",
+    );
+    if let Ok(labels) = crate::flight::LineLabels::of(t, &[]) {
+        let rows = labels
+            .labels
+            .iter()
+            .enumerate()
+            .map(|(k, label)| {
+                let id = (k + 1) as f64;
+                let c: Vec<f64> = (0..correction.len())
+                    .filter(|&i| labels.ids[i] == id && correction[i].is_finite())
+                    .map(|i| correction[i])
+                    .collect();
+                let mean = c.iter().sum::<f64>() / c.len().max(1) as f64;
+                let spread =
+                    c.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / c.len().max(1) as f64;
+                vec![
+                    label.clone(),
+                    c.len().to_string(),
+                    if c.is_empty() {
+                        "—".into()
+                    } else {
+                        format!("{mean:.3}")
+                    },
+                    if c.is_empty() {
+                        "—".into()
+                    } else {
+                        format!("{:.3}", spread.sqrt())
+                    },
+                ]
+            })
+            .collect();
+        r.table(Table::new(
+            [
+                "line",
+                "levelled samples",
+                "mean correction (nT)",
+                "std along the line (nT)",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+            "Levelling correction per line.",
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
