@@ -28,6 +28,10 @@
 //! gzip file took twice the memory). Reads are still wrapped in
 //! `catch_unwind`, and one read is capped at [`MAX_READ_BYTES`].
 //!
+//! A dataset's `units` attribute, where present, must agree with the unit
+//! the layout gives that field (`ins_lat` rad, `mag_1_uc` nT, …): a
+//! contradiction is an error, never a silent mis-conversion.
+//!
 //! Rows have no file line: messages name the data row (the dataset index + 1).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -41,9 +45,9 @@ use crate::error::{IoError, Result};
 use crate::table::{ColumnData, FlightTable, Missing};
 use crate::{Fields, ReadOptions};
 
-/// Largest single read, bytes (16 GiB): far above any flight's field, far
+/// Largest single read, bytes (4 GiB, 5·10⁸ float64 values): far above any flight's field, far
 /// below what a forged header could claim.
-pub const MAX_READ_BYTES: usize = 16 << 30;
+pub const MAX_READ_BYTES: usize = 4 << 30;
 
 /// The first 8 bytes of an HDF5 file (at offset 0, 512, 1024, … when the
 /// file has a user block, as MATLAB v7.3 files do).
@@ -158,8 +162,9 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         if !want {
             continue;
         }
-        let (values, integer) =
-            read_f64(&ds).map_err(|e| h5err(Some(&format!("{prefix}{name}")), e))?;
+        let path = format!("{prefix}{name}");
+        check_units_attribute(file, &path, &name, &ds)?;
+        let (values, integer) = read_f64(&ds).map_err(|e| h5err(Some(&path), e))?;
         let missing = Missing {
             nan: values.iter().filter(|v| v.is_nan()).count(),
             ..Missing::default()
@@ -215,6 +220,54 @@ fn wanted_fields(
             })
         })
         .collect()
+}
+
+/// A `units` attribute that contradicts the unit the layout gives the field
+/// ([`known_field`](crate::known_field): `ins_lat` in rad, `mag_1_uc` in
+/// nT, …) is an error: the file is then not in the SGL layout, and reading
+/// it as if it were would silently convert (or not convert) wrongly. An
+/// attribute that cannot be read, or a field the layout does not know, is
+/// not checked.
+fn check_units_attribute(file: &str, path: &str, name: &str, ds: &Dataset) -> Result<()> {
+    let Some(declared) = ds
+        .attribute("units")
+        .ok()
+        .and_then(|a| a.read_string().ok())
+    else {
+        return Ok(());
+    };
+    let Some(known) = crate::known_field(name) else {
+        return Ok(());
+    };
+    match (normalise_unit(&declared), normalise_unit(known.unit)) {
+        (Some(d), Some(k)) if d != k => Err(IoError::Hdf5 {
+            file: file.to_string(),
+            dataset: Some(path.to_string()),
+            message: format!(
+                "declares units '{declared}', but in the SGL layout '{name}' is in {} ({}); convert the file, or map the field with --columns onto a canonical column in that unit",
+                known.unit, known.meaning
+            ),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// A unit name in one spelling (`None` for units this check does not know).
+fn normalise_unit(u: &str) -> Option<&'static str> {
+    Some(match u.trim().to_ascii_lowercase().as_str() {
+        "deg" | "degree" | "degrees" | "°" | "decimal degrees" => "deg",
+        "rad" | "radian" | "radians" => "rad",
+        "nt" | "nanotesla" | "nanoteslas" => "nT",
+        "t" | "tesla" => "T",
+        "ut" | "µt" | "microtesla" => "uT",
+        "m/s" | "m s-1" | "m s^-1" | "meters per second" | "metres per second" => "m/s",
+        "m" | "meter" | "meters" | "metre" | "metres" => "m",
+        "ft" | "feet" => "ft",
+        "s" | "sec" | "second" | "seconds" => "s",
+        "a" | "amp" | "amps" | "ampere" | "amperes" => "A",
+        "v" | "volt" | "volts" => "V",
+        _ => return None,
+    })
 }
 
 /// A 1-D numeric dataset as `f64` (exact for f32 and integers up to 2⁵³),

@@ -139,3 +139,68 @@ fn hdf5_is_recognised_by_content_whatever_the_extension() {
     let t = read_table(&p, &ReadOptions::default()).unwrap();
     assert_eq!(t.n_rows(), 250);
 }
+
+/// Dataspaces patched to claim 2⁴⁰ values (8 TiB of f64) in a 60 KB file:
+/// refused before anything is allocated (the reader caps allocations by
+/// the file's size), never an out-of-memory abort.
+#[test]
+fn a_header_claiming_a_trillion_values_is_refused_without_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 250u64.to_le_bytes();
+    let huge = (1u64 << 40).to_le_bytes();
+    for file in ["root_contig.h5", "group_gzip.h5", "root_gzip_latest.h5"] {
+        let mut b = std::fs::read(data(file)).unwrap();
+        let mut patched = 0;
+        // Dataspace messages v1 and v2, with and without max dims.
+        let patterns: [(Vec<u8>, usize); 4] = [
+            ([&[1u8, 1, 1, 0, 0, 0, 0, 0][..], &n, &n].concat(), 2),
+            ([&[1u8, 1, 0, 0, 0, 0, 0, 0][..], &n].concat(), 1),
+            ([&[2u8, 1, 1, 1][..], &n, &n].concat(), 2),
+            ([&[2u8, 1, 0, 1][..], &n].concat(), 1),
+        ];
+        for (pat, dims) in &patterns {
+            let head = pat.len() - 8 * dims;
+            let mut i = 0;
+            while let Some(k) = b[i..].windows(pat.len()).position(|w| w == &pat[..]) {
+                let at = i + k + head;
+                for d in 0..*dims {
+                    b[at + 8 * d..at + 8 * d + 8].copy_from_slice(&huge);
+                }
+                patched += 1;
+                i = i + k + 1;
+            }
+        }
+        assert!(patched >= 5, "{file}: {patched} dataspaces patched");
+        let p = dir.path().join(format!("huge_{file}"));
+        std::fs::write(&p, &b).unwrap();
+        let e = read_table(&p, &ReadOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("huge_"), "{file}: {e}");
+        assert!(e.is_bad_input(), "{e}");
+    }
+}
+
+/// A `units` attribute that contradicts the layout (a latitude in degrees
+/// under the radian field `ins_lat`) is refused, naming file and dataset.
+#[test]
+fn a_units_attribute_that_contradicts_the_layout_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut b = std::fs::read(data("root_contig.h5")).unwrap();
+    // The variable-length or fixed "rad" of /ins_lat's attribute becomes "deg".
+    let at = b
+        .windows(3)
+        .position(|w| w == b"rad")
+        .expect("a 'rad' attribute");
+    b[at..at + 3].copy_from_slice(b"deg");
+    let p = dir.path().join("deg_as_rad.h5");
+    std::fs::write(&p, &b).unwrap();
+    let e = read_table(&p, &ReadOptions::default()).unwrap_err();
+    let s = e.to_string();
+    assert!(
+        s.contains("deg_as_rad.h5")
+            && s.contains("ins_lat")
+            && s.contains("'deg'")
+            && s.contains("rad"),
+        "{s}"
+    );
+    assert!(e.is_bad_input());
+}
