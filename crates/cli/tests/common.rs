@@ -65,3 +65,20 @@ fn with_model(command: &[&str], model: &Path, input: &Path, out: &Path) -> Outpu
     ]);
     aeromag(&args)
 }
+
+/// `aeromag simulate SCENARIO --seed SEED --out DIR/SCENARIO`; the CSV written.
+pub fn simulate(dir: &Path, scenario: &str, seed: &str) -> std::path::PathBuf {
+    let out = dir.join(scenario);
+    assert_code(
+        &aeromag(&[
+            "simulate",
+            scenario,
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        0,
+    );
+    out.join(format!("{}.csv", scenario.replace('-', "_")))
+}

@@ -5,22 +5,6 @@
 mod common;
 use common::*;
 
-fn simulate(dir: &std::path::Path, scenario: &str, seed: &str) -> std::path::PathBuf {
-    let out = dir.join(scenario);
-    assert_code(
-        &aeromag(&[
-            "simulate",
-            scenario,
-            "--seed",
-            seed,
-            "--out",
-            out.to_str().unwrap(),
-        ]),
-        0,
-    );
-    out.join(format!("{}.csv", scenario.replace('-', "_")))
-}
-
 #[test]
 fn calibrate_compensate_report_keep_every_row() {
     let d = tempfile::tempdir().unwrap();

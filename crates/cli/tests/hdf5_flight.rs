@@ -14,21 +14,12 @@ use std::process::Command;
 
 fn python_flight(dir: &Path) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    for (scenario, seed) in [("calibration", "1"), ("survey", "2")] {
-        let o = aeromag(&[
-            "simulate",
-            scenario,
-            "--seed",
-            seed,
-            "--out",
-            dir.join(scenario).to_str().unwrap(),
-        ]);
-        assert_code(&o, 0);
-    }
+    let cal = simulate(dir, "calibration", "1");
+    let survey = simulate(dir, "survey", "2");
     let o = Command::new("python3")
         .arg(root.join("tools/reference/sgl_flight.py"))
-        .arg(dir.join("calibration/calibration.csv"))
-        .arg(dir.join("survey/survey.csv"))
+        .arg(cal)
+        .arg(survey)
         .arg(dir)
         .output()
         .expect("python3");
