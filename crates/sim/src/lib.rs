@@ -109,6 +109,18 @@
 //! | `true_flux_x`, `true_flux_y`, `true_flux_z` | nT | true total field at the fluxgate, body axes, before sensor errors |
 //! | `true_current_<name>` | A | true current of an on-board loop |
 //!
+//! Optional extra sensors (`[[extra_scalars]]`, `[[extra_fluxgates]]` in the
+//! scenario file, none by default; see [`scenario::fixed_wing`], "Extra
+//! sensors"; `k` = 2, 3, …, `j` = b, c, d, …):
+//!
+//! | column | unit | meaning |
+//! |---|---|---|
+//! | `mag_<k>` | nT | extra scalar magnetometer k, uncompensated (after `flux_z`) |
+//! | `flux_<j>_x`, `flux_<j>_y`, `flux_<j>_z` | nT | extra fluxgate j, body axes, with its errors |
+//! | `true_interf_<k>` | nT | \|B_ext + ΔB\| − \|B_ext\| at extra scalar sensor k (exact) |
+//! | `true_external_<k>` | nT | \|B_ext\| at extra scalar sensor k |
+//! | `true_flux_<j>_x`, `true_flux_<j>_y`, `true_flux_<j>_z` | nT | true total field at extra fluxgate j, body axes, before sensor errors |
+//!
 //! The `helicopter` scenario adds `rotor_phase` (deg, recorded),
 //! `true_rotor_phase` (deg), `true_rotor_hz` (Hz), `true_coning`,
 //! `true_tilt_lon`, `true_tilt_lat` (deg), `true_rotor`, `true_fuselage`

@@ -164,7 +164,7 @@ impl Simulation {
 }
 
 /// Units and descriptions of the fixed columns (current channels are added
-/// per loop). The crate docs list the same table.
+/// per loop, extra sensors' columns per sensor: [`EXTRA_SENSOR_CATALOGUE`]). The crate docs list the same table.
 pub const COLUMN_CATALOGUE: &[(&str, &str, &str)] = &[
     (
         "time",
@@ -337,10 +337,94 @@ pub const COLUMN_CATALOGUE: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// Unit and description of a column name (current channels included).
+/// Units and descriptions of the columns of the optional extra sensors
+/// (`<k>`: 2, 3, … for scalar sensors; `<j>`: b, c, … for fluxgates; `<a>`:
+/// x, y, z). The crate docs list the same table.
+pub const EXTRA_SENSOR_CATALOGUE: &[(&str, &str, &str)] = &[
+    (
+        "mag_<k>",
+        "nT",
+        "extra scalar magnetometer k (k = 2, 3, …), uncompensated",
+    ),
+    (
+        "flux_<j>_<a>",
+        "nT",
+        "extra fluxgate j (j = b, c, …), body axis a, with its sensor errors",
+    ),
+    (
+        "true_interf_<k>",
+        "nT",
+        "|B_ext + ΔB| − |B_ext| at extra scalar sensor k (exact)",
+    ),
+    (
+        "true_external_<k>",
+        "nT",
+        "|B_ext| at extra scalar sensor k: what a perfect compensation of mag_<k> yields",
+    ),
+    (
+        "true_flux_<j>_<a>",
+        "nT",
+        "true total field at extra fluxgate j (external + aircraft), body axis a, before sensor errors",
+    ),
+];
+
+/// The sensor index `k ≥ 2` of a name `<prefix><k>`.
+fn extra_scalar_index(name: &str, prefix: &str) -> Option<u32> {
+    let k = name.strip_prefix(prefix)?;
+    if k.is_empty() || !k.bytes().all(|b| b.is_ascii_digit()) || k.starts_with('0') {
+        return None;
+    }
+    k.parse().ok().filter(|k| *k >= 2)
+}
+
+/// The letter `b..=z` and axis of a name `<prefix><j>_<a>`.
+fn extra_fluxgate_axis(name: &str, prefix: &str) -> Option<(char, char)> {
+    let rest = name.strip_prefix(prefix)?.as_bytes();
+    match rest {
+        [j @ b'b'..=b'z', b'_', a @ (b'x' | b'y' | b'z')] => Some((*j as char, *a as char)),
+        _ => None,
+    }
+}
+
+/// Unit and description of a column name (current channels and extra
+/// sensors included).
 pub fn describe(name: &str) -> Option<(&'static str, String)> {
     if let Some(&(_, u, d)) = COLUMN_CATALOGUE.iter().find(|(n, _, _)| *n == name) {
         return Some((u, d.to_string()));
+    }
+    if let Some(k) = extra_scalar_index(name, "mag_") {
+        return Some((
+            "nT",
+            format!("extra scalar magnetometer {k}, uncompensated"),
+        ));
+    }
+    if let Some(k) = extra_scalar_index(name, "true_interf_") {
+        return Some((
+            "nT",
+            format!("|B_ext + ΔB| − |B_ext| at extra scalar sensor {k} (mag_{k}, exact)"),
+        ));
+    }
+    if let Some(k) = extra_scalar_index(name, "true_external_") {
+        return Some((
+            "nT",
+            format!(
+                "|B_ext| at extra scalar sensor {k}: what a perfect compensation of mag_{k} yields"
+            ),
+        ));
+    }
+    if let Some((j, a)) = extra_fluxgate_axis(name, "flux_") {
+        return Some((
+            "nT",
+            format!("extra fluxgate {j} {a} (body axes, with sensor errors)"),
+        ));
+    }
+    if let Some((j, a)) = extra_fluxgate_axis(name, "true_flux_") {
+        return Some((
+            "nT",
+            format!(
+                "true total field at extra fluxgate {j} (external + aircraft), body {a}, before sensor errors"
+            ),
+        ));
     }
     if let Some(loop_name) = name.strip_prefix("true_current_") {
         return Some((

@@ -121,6 +121,18 @@ pub struct FixedWingConfig<P> {
     pub scalar: ScalarSensorConfig,
     /// Fluxgate.
     pub fluxgate: FluxgateConfig,
+    /// Extra scalar magnetometers (`[[extra_scalars]]` tables, each a
+    /// [`ScalarSensorConfig`]; unset fields take that type's defaults — lag
+    /// 0 s, the stinger position — so set `position_m`). The first is
+    /// recorded as `mag_2`, the next `mag_3`, … Default none. See
+    /// [`super::fixed_wing`] ("Extra sensors").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub extra_scalars: Vec<ScalarSensorConfig>,
+    /// Extra fluxgates (`[[extra_fluxgates]]` tables, each a
+    /// [`FluxgateConfig`]), recorded as `flux_b_x/y/z`, `flux_c_…`, … (at
+    /// most 25). Default none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub extra_fluxgates: Vec<FluxgateConfig>,
     /// GNSS/INS.
     pub nav: NavConfig,
     /// Base-station magnetometer.
@@ -140,6 +152,8 @@ impl<P: Default> Default for FixedWingConfig<P> {
             aircraft: AircraftConfig::default(),
             scalar: ScalarSensorConfig::default(),
             fluxgate: FluxgateConfig::default(),
+            extra_scalars: Vec::new(),
+            extra_fluxgates: Vec::new(),
             nav: NavConfig::default(),
             base_station: BaseStationConfig::default(),
         }
@@ -164,6 +178,28 @@ impl<P: Pattern> FixedWingConfig<P> {
         self.aircraft.validate("aircraft")?;
         self.scalar.validate("scalar")?;
         self.fluxgate.validate("fluxgate")?;
+        if self.extra_scalars.len() > MAX_EXTRA_SCALARS {
+            return Err(invalid(
+                "extra_scalars",
+                format!("at most {MAX_EXTRA_SCALARS} extra scalar sensors"),
+            ));
+        }
+        if self.extra_fluxgates.len() > MAX_EXTRA_FLUXGATES {
+            return Err(invalid(
+                "extra_fluxgates",
+                format!("at most {MAX_EXTRA_FLUXGATES} extra fluxgates (flux_b … flux_z)"),
+            ));
+        }
+        for (i, s) in self.extra_scalars.iter().enumerate() {
+            let p = format!("extra_scalars[{i}]");
+            s.validate(&p)?;
+            check_lever_arm(&p, s.position_m)?;
+        }
+        for (i, f) in self.extra_fluxgates.iter().enumerate() {
+            let p = format!("extra_fluxgates[{i}]");
+            f.validate(&p)?;
+            check_lever_arm(&p, f.position_m)?;
+        }
         self.nav.validate("nav")?;
         self.base_station.validate("base_station")
     }
@@ -220,6 +256,31 @@ impl<P: Pattern> FixedWingConfig<P> {
             kind.name()
         ))
     }
+}
+
+/// Most extra scalar sensors (`mag_2` … `mag_99`).
+pub const MAX_EXTRA_SCALARS: usize = 98;
+/// Most extra fluxgates (`flux_b` … `flux_z`).
+pub const MAX_EXTRA_FLUXGATES: usize = 25;
+/// Longest lever arm of an extra sensor, m: the anomaly grid is sized on the
+/// main sensors' tracks, and an extra sensor must lie well inside its
+/// margin and its continuation levels.
+pub const MAX_EXTRA_LEVER_ARM_M: f64 = 50.0;
+
+fn check_lever_arm(p: &str, r: [f64; 3]) -> Result<()> {
+    let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    if len > MAX_EXTRA_LEVER_ARM_M {
+        return Err(invalid(
+            format!("{p}.position_m"),
+            format!("must be within {MAX_EXTRA_LEVER_ARM_M} m of the body origin"),
+        ));
+    }
+    Ok(())
+}
+
+/// The column letter of extra fluxgate `j` (0-based): `b`, `c`, …
+pub fn extra_fluxgate_letter(j: usize) -> char {
+    (b'b' + j as u8) as char
 }
 
 /// If `[anomaly]` sets `area` but not the gradient, insert the preset.

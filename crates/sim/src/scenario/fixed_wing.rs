@@ -16,6 +16,61 @@
 //! 5. Sensor models: scalar (exact modulus, heading error, lag, noise),
 //!    fluxgate, GNSS/INS, base station.
 //! 6. Columns, filled-in scenario file and truth metadata.
+//!
+//! ## Extra sensors
+//!
+//! A survey aircraft may carry more magnetometers than the stinger pair:
+//! SGL's fixed-wing installation has five scalar sensors (one in the tail
+//! stinger, four in the cabin) and four fluxgates. The optional lists
+//! `extra_scalars` and `extra_fluxgates` of the scenario file
+//! ([`super::config::FixedWingConfig`]) add them; both are empty by default,
+//! and then nothing below changes the output. Each extra sensor gets
+//!
+//! * the external field at its own lever arm: the anomaly evaluated at the
+//!   sensor, the main field and the diurnal variation as at the main scalar
+//!   sensor (step 3);
+//! * the aircraft's field at its position ([`InterferenceAt`], the parts
+//!   induced by the external field at the sensor, the same eddy and
+//!   on-board currents);
+//! * its own sensor model and random stream
+//!   ([`Stream::ExtraScalarNoise`]`(k)`, [`Stream::ExtraFluxgateNoise`]`(j)`),
+//!   so adding sensors changes no existing column, main sensors included
+//!   (the anomaly grid is sized on the main sensors' tracks; extra lever
+//!   arms are limited to 50 m, well inside its margin).
+//!
+//! Columns: extra scalar `k` = 2, 3, … → `mag_k` (recorded, nT),
+//! `true_interf_k` (`|B_ext + ΔB| − |B_ext|` at the sensor, nT) and
+//! `true_external_k` (`|B_ext|` at the sensor, nT); extra fluxgate
+//! `j` = b, c, d, … → `flux_j_x/y/z` (recorded, body axes, nT) and
+//! `true_flux_j_x/y/z` (true total field there, before sensor errors). The
+//! truth JSON lists them under `sensors.extra_scalars` and
+//! `sensors.extra_fluxgates` with their configuration (position), their
+//! interference coefficients and statistics.
+//!
+//! An example in the spirit of the SGL installation (stinger sensor at the
+//! default `(−9.5, 0, −0.6)` m; four cabin sensors and three more
+//! fluxgates between x = −2 and +2 m, a metre or two from the engines and
+//! the landing gear, so their interference is several times the stinger's):
+//!
+//! ```toml
+//! [[extra_scalars]]
+//! position_m = [-2.0, 0.0, -0.3]
+//! [[extra_scalars]]
+//! position_m = [-1.0, -0.4, -0.3]
+//! [[extra_scalars]]
+//! position_m = [0.5, 0.4, -0.3]
+//! [[extra_scalars]]
+//! position_m = [1.5, 0.0, -0.4]
+//! [[extra_fluxgates]]
+//! position_m = [-2.0, 0.3, -0.3]
+//! [[extra_fluxgates]]
+//! position_m = [0.0, -0.3, -0.3]
+//! [[extra_fluxgates]]
+//! position_m = [1.5, 0.3, -0.4]
+//! ```
+//!
+//! Unset fields of each table take the sensor type's defaults (for a scalar
+//! sensor lag 0 s, whatever the scenario's main sensor uses).
 
 use aeromag_core::NT_PER_T;
 use aeromag_core::frames::Geodetic;
@@ -24,7 +79,7 @@ use nalgebra::Vector3;
 use serde_json::json;
 
 use super::ScenarioKind;
-use super::config::{FixedWingConfig, Pattern};
+use super::config::{FixedWingConfig, Pattern, extra_fluxgate_letter};
 use crate::environment::anomaly::{AnomalyField, Extent};
 use crate::environment::main_field::{MainField, decimal_year};
 use crate::error::{Result, SimError, invalid};
@@ -98,6 +153,16 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     // 2. Sensor positions.
     let (sn, se, sa) = lever_arm_positions(&tr, cfg.scalar.position_m);
     let (fn_, fe, fa) = lever_arm_positions(&tr, cfg.fluxgate.position_m);
+    let xs_pos: Vec<_> = cfg
+        .extra_scalars
+        .iter()
+        .map(|s| lever_arm_positions(&tr, s.position_m))
+        .collect();
+    let xf_pos: Vec<_> = cfg
+        .extra_fluxgates
+        .iter()
+        .map(|f| lever_arm_positions(&tr, f.position_m))
+        .collect();
 
     // 3. External field.
     let extent = Extent::of_points(&sn, &se, &sa).union(&Extent::of_points(&fn_, &fe, &fa));
@@ -125,6 +190,9 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     let mut true_anomaly = Vec::with_capacity(n);
     let mut true_diurnal = Vec::with_capacity(n);
     let mut true_external = Vec::with_capacity(n);
+    // External fields at the extra sensors, body axes, nT.
+    let mut xs_b: Vec<Vec<Vector3<f64>>> = xs_pos.iter().map(|_| Vec::with_capacity(n)).collect();
+    let mut xf_b: Vec<Vec<Vector3<f64>>> = xf_pos.iter().map(|_| Vec::with_capacity(n)).collect();
     for k in 0..n {
         let pos = geodetic(fl.origin_lat_deg, fl.origin_lon_deg, sn[k], se[k], sa[k]);
         let bm = main.field_nt(&pos, tr.t_s[k]);
@@ -137,6 +205,12 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         let c_bn = tr.attitude(k).c_bn();
         b_s.push(c_bn * ext_s);
         b_f.push(c_bn * ext_f);
+        for (out, (pn, pe, pa)) in xs_b.iter_mut().zip(&xs_pos) {
+            out.push(c_bn * (bm + anomaly.field_nt(pn[k], pe[k], pa[k]) + bd));
+        }
+        for (out, (pn, pe, pa)) in xf_b.iter_mut().zip(&xf_pos) {
+            out.push(c_bn * (bm + anomaly.field_nt(pn[k], pe[k], pa[k]) + bd));
+        }
         let f_main = bm.norm();
         let f_ma = (bm + ba_s).norm();
         let f_ext = ext_s.norm();
@@ -187,6 +261,35 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         interf_vec.push(d_s);
         total_f.push(b_f[k] + nt(c_f.total()));
     }
+    // The extra sensors: the same parts and currents at their positions.
+    let extra_total =
+        |pos: [f64; 3], ext: &[Vector3<f64>]| -> Result<(InterferenceAt, Vec<Vector3<f64>>)> {
+            let at = InterferenceAt::new(ac, pos)?;
+            let (mut i_e, mut i_c) = (vec![0.0; eddy.len()], vec![0.0; cur.len()]);
+            let mut total = Vec::with_capacity(n);
+            for (k, b) in ext.iter().enumerate() {
+                for (slot, series) in i_e.iter_mut().zip(&eddy) {
+                    *slot = series[k];
+                }
+                for (slot, series) in i_c.iter_mut().zip(&cur) {
+                    *slot = series.true_a[k];
+                }
+                total.push(b + nt(at.contributions(&(b / NT_PER_T), &i_e, &i_c).total()));
+            }
+            Ok((at, total))
+        };
+    let xs_total = cfg
+        .extra_scalars
+        .iter()
+        .zip(&xs_b)
+        .map(|(s, b)| extra_total(s.position_m, b))
+        .collect::<Result<Vec<_>>>()?;
+    let xf_total = cfg
+        .extra_fluxgates
+        .iter()
+        .zip(&xf_b)
+        .map(|(f, b)| extra_total(f.position_m, b))
+        .collect::<Result<Vec<_>>>()?;
 
     // 5. Sensors.
     let scalar = cfg
@@ -195,6 +298,32 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     let flux = cfg
         .fluxgate
         .measure(&total_f, dt, &mut rng_for(seed, Stream::FluxgateNoise));
+    let xs_read: Vec<_> = cfg
+        .extra_scalars
+        .iter()
+        .zip(&xs_total)
+        .enumerate()
+        .map(|(i, (s, (_, tot)))| {
+            s.measure(
+                tot,
+                dt,
+                &mut rng_for(seed, Stream::ExtraScalarNoise(i as u32 + 2)),
+            )
+        })
+        .collect();
+    let xf_read: Vec<_> = cfg
+        .extra_fluxgates
+        .iter()
+        .zip(&xf_total)
+        .enumerate()
+        .map(|(j, (f, (_, tot)))| {
+            f.measure(
+                tot,
+                dt,
+                &mut rng_for(seed, Stream::ExtraFluxgateNoise(j as u32 + 1)),
+            )
+        })
+        .collect();
     let nav = cfg.nav.measure(&tr, &mut rng_for(seed, Stream::Navigation));
     let base = cfg
         .base_station
@@ -249,6 +378,15 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     push("flux_x", comp(&flux, 0));
     push("flux_y", comp(&flux, 1));
     push("flux_z", comp(&flux, 2));
+    for (i, r) in xs_read.iter().enumerate() {
+        push(&format!("mag_{}", i + 2), r.mag.clone());
+    }
+    for (j, r) in xf_read.iter().enumerate() {
+        let l = extra_fluxgate_letter(j);
+        for (i, a) in ["x", "y", "z"].iter().enumerate() {
+            push(&format!("flux_{l}_{a}"), comp(r, i));
+        }
+    }
     push("line", tr.line.clone());
     push("manoeuvre", tr.manoeuvre.clone());
     push("diurnal", base);
@@ -287,6 +425,25 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     }
     for (i, a) in ["x", "y", "z"].iter().enumerate() {
         push(&format!("true_flux_{a}"), comp(&total_f, i));
+    }
+    for (i, ((_, tot), ext)) in xs_total.iter().zip(&xs_b).enumerate() {
+        push(
+            &format!("true_interf_{}", i + 2),
+            tot.iter()
+                .zip(ext)
+                .map(|(t, b)| t.norm() - b.norm())
+                .collect(),
+        );
+        push(
+            &format!("true_external_{}", i + 2),
+            ext.iter().map(|b| b.norm()).collect(),
+        );
+    }
+    for (j, (_, tot)) in xf_total.iter().enumerate() {
+        let l = extra_fluxgate_letter(j);
+        for (i, a) in ["x", "y", "z"].iter().enumerate() {
+            push(&format!("true_flux_{l}_{a}"), comp(tot, i));
+        }
     }
     for (c, s) in ac.currents.iter().zip(&cur) {
         push(&format!("true_current_{}", c.name), s.true_a.clone());
@@ -386,6 +543,48 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         "turbulence": &cfg.turbulence,
         "columns": columns.iter().map(|c| json!({ "name": c.name, "unit": c.unit, "description": c.description })).collect::<Vec<_>>(),
     });
+    // Extra sensors (only when configured, so that the default file is
+    // unchanged).
+    let mut truth = truth;
+    if !cfg.extra_scalars.is_empty() {
+        truth["sensors"]["extra_scalars"] = cfg
+            .extra_scalars
+            .iter()
+            .zip(&xs_total)
+            .enumerate()
+            .map(|(i, (s, (at, _)))| {
+                json!({
+                    "column": format!("mag_{}", i + 2),
+                    "position_m": s.position_m,
+                    "config": s,
+                    "noise_rms_nt": white_rms(s.noise_density_nt_per_rthz, rate),
+                    "interference": sensor_json(at),
+                    "true_interf_stats_nt": stats(col_of(&format!("true_interf_{}", i + 2))),
+                })
+            })
+            .collect();
+    }
+    if !cfg.extra_fluxgates.is_empty() {
+        truth["sensors"]["extra_fluxgates"] = cfg
+            .extra_fluxgates
+            .iter()
+            .zip(&xf_total)
+            .zip(&xf_b)
+            .enumerate()
+            .map(|(j, ((f, (at, tot)), ext))| {
+                let mag: Vec<f64> = tot.iter().zip(ext).map(|(t, b)| (t - b).norm()).collect();
+                json!({
+                    "columns": format!("flux_{}_x/y/z", extra_fluxgate_letter(j)),
+                    "position_m": f.position_m,
+                    "config": f,
+                    "matrix": m3(&f.matrix()),
+                    "noise_rms_nt": white_rms(f.noise_density_nt_per_rthz, rate),
+                    "interference": sensor_json(at),
+                    "interference_magnitude_stats_nt": stats(&mag),
+                })
+            })
+            .collect();
+    }
     let truth_json = serde_json::to_string_pretty(&truth).map_err(|e| SimError::Serialize {
         what: "truth metadata",
         reason: e.to_string(),

@@ -191,6 +191,13 @@ fn set(cols: &mut [Column], name: &str, f: impl Fn(usize, f64) -> f64) {
 /// Run the helicopter scenario (module docs).
 pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
     cfg.rotor.validate("rotor")?;
+    if !cfg.base.extra_scalars.is_empty() || !cfg.base.extra_fluxgates.is_empty() {
+        return Err(crate::error::invalid(
+            "extra_scalars",
+            "extra sensors are not supported by the helicopter scenario \
+             (the rotor's field is added at the main sensors only)",
+        ));
+    }
     let mut sim = fixed_wing::run(&cfg.base, ScenarioKind::Helicopter)?;
     let dt = 1.0 / cfg.base.flight.sample_rate_hz;
     let cols = &sim.columns;
