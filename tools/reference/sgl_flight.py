@@ -11,8 +11,8 @@ Writes into OUT_DIR:
 
   whole_flight.csv  canonical aeromag names and units (time, lat, lon, ...)
   whole_flight.h5   the SGL HDF5 layout (MagNav get_XYZ20): one 1-D dataset
-                    per field at the root, SGL names (tt, mag_1_uc,
-                    flux_b_x, ins_roll, ...), INS position in radians
+                    per field at the root, SGL names (tt, mag_1_uc … mag_5_uc,
+                    flux_a_x … flux_d_z, cur_*, ins_roll, ...), INS position in radians
                     (ins_lat, ins_lon) and velocity north/west/up (ins_vn,
                     ins_vw, ins_vu) instead of lat/lon/ve/vd, chunked with
                     gzip + shuffle, `units` attributes; `line` and the truth
@@ -46,16 +46,38 @@ SGL = {
     "pitch": ("ins_pitch", 1.0),
     "yaw": ("ins_yaw", 1.0),
     "mag": ("mag_1_uc", 1.0),
-    "flux_x": ("flux_b_x", 1.0),
-    "flux_y": ("flux_b_y", 1.0),
-    "flux_z": ("flux_b_z", 1.0),
+    "flux_x": ("flux_a_x", 1.0),
+    "flux_y": ("flux_a_y", 1.0),
+    "flux_z": ("flux_a_z", 1.0),
     "lat": ("ins_lat", np.pi / 180.0),
     "lon": ("ins_lon", np.pi / 180.0),
 }
 UNITS = {"tt": "s", "ins_lat": "rad", "ins_lon": "rad", "utm_z": "m", "ins_vn": "m/s",
          "ins_vw": "m/s", "ins_vu": "m/s", "ins_roll": "deg", "ins_pitch": "deg",
-         "ins_yaw": "deg", "mag_1_uc": "nT", "flux_b_x": "nT", "flux_b_y": "nT",
-         "flux_b_z": "nT", "diurnal": "nT", "igrf": "nT"}
+         "ins_yaw": "deg", "diurnal": "nT", "igrf": "nT"}
+
+
+def sgl_name(n):
+    """The SGL name and factor of a simulator column: the table above, the
+    further scalar magnetometers mag_k -> mag_k_uc, currents current_X ->
+    cur_X, everything else (extra fluxgates flux_b_x..., line, truth) as is."""
+    if n in SGL:
+        return SGL[n]
+    if n.startswith("mag_") and n[4:].isdigit():
+        return f"{n}_uc", 1.0
+    if n.startswith("current_"):
+        return "cur_" + n[len("current_"):], 1.0
+    return n, 1.0
+
+
+def sgl_unit(name):
+    if name in UNITS:
+        return UNITS[name]
+    if name.startswith("mag_") or name.startswith("flux_"):
+        return "nT"
+    if name.startswith("cur_"):
+        return "A"
+    return None
 
 
 def read_csv(path):
@@ -94,11 +116,12 @@ def main():
             f.write(",".join("" if np.isnan(v) else repr(float(v)) for v in row) + "\n")
     with h5py.File(os.path.join(a.out_dir, "whole_flight.h5"), "w") as h:
         for k, n in enumerate(names):
-            name, factor = SGL.get(n, (n, 1.0))
+            name, factor = sgl_name(n)
             ds = h.create_dataset(name, data=flight[:, k] * factor, chunks=True,
                                   compression="gzip", shuffle=True)
-            if name in UNITS:
-                ds.attrs["units"] = UNITS[name]
+            unit = sgl_unit(name)
+            if unit and not name.startswith("true_"):
+                ds.attrs["units"] = unit
 
 
 if __name__ == "__main__":

@@ -12,10 +12,53 @@ use common::*;
 use std::path::Path;
 use std::process::Command;
 
+const SENSORS: &str = "\
+[[extra_scalars]]
+position_m = [-2.0, 0.0, -0.3]
+[[extra_scalars]]
+position_m = [-1.0, -0.4, -0.3]
+[[extra_scalars]]
+position_m = [0.5, 0.4, -0.3]
+[[extra_scalars]]
+position_m = [1.5, 0.0, -0.4]
+[[extra_fluxgates]]
+position_m = [-2.0, 0.3, -0.3]
+[[extra_fluxgates]]
+position_m = [0.0, -0.3, -0.3]
+[[extra_fluxgates]]
+position_m = [1.5, 0.3, -0.4]
+[[aircraft.currents]]
+name = \"strb\"
+position_m = [-1.0, 0.0, -0.5]
+[[aircraft.currents]]
+name = \"flap\"
+position_m = [0.5, 2.0, 0.0]
+";
+
 fn python_flight(dir: &Path) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let cal = simulate(dir, "calibration", "1");
-    let survey = simulate(dir, "survey", "2");
+    // Four more scalar magnetometers and three more fluxgates in the cabin
+    // (mag_2 … mag_5, flux_b … flux_d), as on the SGL aircraft, and two
+    // recorded currents.
+    let config = dir.join("sensors.toml");
+    std::fs::write(&config, SENSORS).unwrap();
+    let mut csv = Vec::new();
+    for (scenario, seed) in [("calibration", "1"), ("survey", "2")] {
+        let out = dir.join(scenario);
+        let o = aeromag(&[
+            "simulate",
+            scenario,
+            "--seed",
+            seed,
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        csv.push(out.join(format!("{scenario}.csv")));
+    }
+    let (cal, survey) = (&csv[0], &csv[1]);
     let o = Command::new("python3")
         .arg(root.join("tools/reference/sgl_flight.py"))
         .arg(cal)
@@ -59,6 +102,14 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
     let d = dir.path();
     python_flight(d);
     let (csv, h5) = (d.join("whole_flight.csv"), d.join("whole_flight.h5"));
+    // Every sensor and current of the HDF5 flight is recognised with its unit.
+    let o = aeromag(&["inspect", "-i", h5.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    for field in ["mag_5_uc", "flux_d_z", "cur_strb", "ins_lat", "ins_vw"] {
+        assert!(s.lines().any(|l| l.starts_with(field)), "{field} in\n{s}");
+    }
+    assert!(s.contains("derived  lat=ins_lat (rad → deg) [deg]"), "{s}");
     let survey_lines = "1003.01,1003.02,1003.03,1003.04,1003.05,1003.51,1003.52";
     let mut models = Vec::new();
     let mut outputs = Vec::new();
@@ -124,6 +175,38 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         lines.iter().all(|&l| l > 1003.0 && l < 1004.0),
         "{:?}",
         &lines[..5]
+    );
+    // Another sensor pair of the whole flight, chosen by its canonical name
+    // in the CSV and by its SGL name in the HDF5 file: the same model.
+    let mut chosen = Vec::new();
+    for (k, (input, mag)) in [(&csv, "mag_3"), (&h5, "mag_3_uc")].into_iter().enumerate() {
+        let model = d.join(format!("model_mag3_{k}.json"));
+        let o = aeromag(&[
+            "calibrate",
+            "-i",
+            input.to_str().unwrap(),
+            "--lines",
+            "1002.02",
+            "--mag",
+            mag,
+            "--vector",
+            "flux_c",
+            "--model",
+            model.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        chosen.push(coef(&read_json(&model)));
+    }
+    assert_eq!(chosen[0].len(), chosen[1].len());
+    for (x, y) in chosen[0].iter().zip(&chosen[1]) {
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-3), "{x} vs {y}");
+    }
+    assert!(
+        chosen[0]
+            .iter()
+            .zip(&a)
+            .any(|(x, y)| (x - y).abs() > 1e-3 * y.abs().max(1.0)),
+        "the cabin sensor pair has its own model"
     );
     // Levelled with its decimal labels (ties declared), and reported: the
     // report reads the levelling columns.
