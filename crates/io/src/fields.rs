@@ -8,7 +8,8 @@
 //! assert_eq!(known_field("UNCOMPMAG3").unwrap().unit, "nT");
 //! assert_eq!(known_field("ins_lat").unwrap().unit, "rad"); // not degrees
 //! assert_eq!(known_field("CUR_ACHi").unwrap().unit, "A");
-//! assert!(known_field("PITOT_P").is_none());
+//! assert_eq!(known_field("PITOT_P").unwrap().unit, "kPa");
+//! assert!(known_field("MY_CHANNEL").is_none());
 //! ```
 
 use serde::Serialize;
