@@ -156,7 +156,13 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         &opts.sensors,
         opts.magnav_preset,
     )?;
-    let wanted = wanted_fields(&header, &aliases, opts);
+    let mut wanted = wanted_fields(&header, &aliases, opts);
+    // The row count comes from data actually read, never from headers alone
+    // (a forged header could claim 10^12 rows that nothing then checks): with
+    // none of the fields asked for present, the first field is read.
+    if !wanted.contains(&true) {
+        wanted[0] = true;
+    }
     let mut columns = Vec::new();
     for ((name, ds, _), want) in fields.into_iter().zip(wanted) {
         if !want {
@@ -171,10 +177,22 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         };
         columns.push((name, ColumnData::Numeric { values, missing }, integer));
     }
-    let n_rows = usize::try_from(n_rows).map_err(|_| IoError::Hdf5Layout {
-        file: file.to_string(),
-        found: format!("{n_rows} rows"),
-    })?;
+    // The rows are the values read (at least one field was), which must
+    // match the headers' length.
+    let len = |c: &ColumnData| match c {
+        ColumnData::Numeric { values, .. } => values.len(),
+        ColumnData::Text(t) => t.len(),
+    };
+    if let Some((name, data, _)) = columns.iter().find(|c| len(&c.1) as u64 != n_rows) {
+        return Err(IoError::Hdf5Layout {
+            file: file.to_string(),
+            found: format!(
+                "dataset '{prefix}{name}' holds {} values where its header says {n_rows}",
+                len(data)
+            ),
+        });
+    }
+    let n_rows = columns.first().map_or(0, |c| len(&c.1));
     let aliases = aliases
         .into_iter()
         .filter(|m| columns.iter().any(|c| c.0 == m.file_column))

@@ -204,3 +204,24 @@ fn a_units_attribute_that_contradicts_the_layout_is_an_error() {
     );
     assert!(e.is_bad_input());
 }
+
+/// Found by the fuzzer (`fuzz/fuzz_targets/hdf5.rs`): a file whose fields
+/// claim a huge length, read for fields it does not have, once gave a
+/// table of that many rows without data, and a row selection then tried to
+/// allocate them. Rows now come from data actually read.
+#[test]
+fn fuzz_crash_rows_claimed_but_not_read() {
+    let p = data("fuzz-crash-rows-claimed.h5");
+    let len = std::fs::metadata(&p).unwrap().len() as usize;
+    for fields in [Fields::All, Fields::Only(vec!["time".into(), "mag".into()])] {
+        let opts = ReadOptions {
+            fields,
+            rows: RowSelection::parse(Some("1001"), None).unwrap(),
+            ..ReadOptions::default()
+        };
+        match read_table(&p, &opts) {
+            Ok(t) => assert!(t.n_rows() <= 8 * len, "{} rows", t.n_rows()),
+            Err(e) => assert!(e.to_string().contains("fuzz-crash-rows-claimed.h5"), "{e}"),
+        }
+    }
+}
