@@ -68,17 +68,28 @@ fn with_model(command: &[&str], model: &Path, input: &Path, out: &Path) -> Outpu
 
 /// `aeromag simulate SCENARIO --seed SEED --out DIR/SCENARIO`; the CSV written.
 pub fn simulate(dir: &Path, scenario: &str, seed: &str) -> std::path::PathBuf {
+    simulate_with(dir, scenario, seed, None)
+}
+
+/// [`simulate`] with a scenario file (`--config`).
+pub fn simulate_with(
+    dir: &Path,
+    scenario: &str,
+    seed: &str,
+    config: Option<&Path>,
+) -> std::path::PathBuf {
     let out = dir.join(scenario);
-    assert_code(
-        &aeromag(&[
-            "simulate",
-            scenario,
-            "--seed",
-            seed,
-            "--out",
-            out.to_str().unwrap(),
-        ]),
-        0,
-    );
+    let mut args = vec![
+        "simulate",
+        scenario,
+        "--seed",
+        seed,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    if let Some(c) = config {
+        args.extend(["--config", c.to_str().unwrap()]);
+    }
+    assert_code(&aeromag(&args), 0);
     out.join(format!("{}.csv", scenario.replace('-', "_")))
 }

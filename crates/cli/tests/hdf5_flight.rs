@@ -42,23 +42,8 @@ fn python_flight(dir: &Path) {
     // recorded currents.
     let config = dir.join("sensors.toml");
     std::fs::write(&config, SENSORS).unwrap();
-    let mut csv = Vec::new();
-    for (scenario, seed) in [("calibration", "1"), ("survey", "2")] {
-        let out = dir.join(scenario);
-        let o = aeromag(&[
-            "simulate",
-            scenario,
-            "--seed",
-            seed,
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_code(&o, 0);
-        csv.push(out.join(format!("{scenario}.csv")));
-    }
-    let (cal, survey) = (&csv[0], &csv[1]);
+    let cal = &simulate_with(dir, "calibration", "1", Some(&config));
+    let survey = &simulate_with(dir, "survey", "2", Some(&config));
     let o = Command::new("python3")
         .arg(root.join("tools/reference/sgl_flight.py"))
         .arg(cal)
