@@ -19,3 +19,25 @@ fi
 cargo nextest run --workspace --release --no-fail-fast "$@"
 # nextest does not run doc tests
 cargo test --workspace --release --doc
+# The Python package: built once (release, the workspace's target folder)
+# and installed into this Python, then its tests (pytest), which compare
+# with the CLI binary the Rust tests built.
+export PIP_ROOT_USER_ACTION=ignore
+missing=$(python3 - <<'PY'
+import importlib.util
+def missing(mod):
+    try:
+        return importlib.util.find_spec(mod) is None
+    except ModuleNotFoundError:
+        return True
+print(" ".join(spec for spec, mod in [("maturin", "maturin"), ("pytest", "pytest"), ("pandas", "pandas"),
+                                      ("dask[distributed]", "dask.distributed")] if missing(mod)))
+PY
+)
+if [ -n "$missing" ]; then
+    echo "installing $missing from PyPI for the Python package and its tests" >&2
+    # shellcheck disable=SC2086
+    python3 -m pip install --quiet $missing
+fi
+python3 -m pip install --quiet --no-build-isolation ./python
+AEROMAG_BIN="$PWD/target/release/aeromag" python3 -m pytest -q python/tests

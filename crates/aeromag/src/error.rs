@@ -15,6 +15,7 @@
 //! classification) and, where they do not know it, given the file they
 //! concern ([`Error::InFile`]).
 
+use aeromag_io::Location;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in a workflow of this crate.
@@ -147,6 +148,36 @@ impl Error {
             Error::Estimation(e) => e.is_bad_input(),
             Error::Read { .. } => true,
             Error::Write { .. } | Error::Serialize { .. } => false,
+        }
+    }
+
+    /// Where the error is (file, line, data row, column), as far as it
+    /// says; Python's `BadInputError` carries these.
+    pub fn location(&self) -> Location {
+        match self {
+            Error::Io(e) => e.location(),
+            Error::BadInput {
+                file,
+                line,
+                row,
+                column,
+                ..
+            } => Location {
+                file: file.clone(),
+                line: *line,
+                row: *row,
+                column: column.clone(),
+            },
+            Error::InFile { file, error } => {
+                let mut at = error.location();
+                at.file.get_or_insert_with(|| file.clone());
+                at
+            }
+            Error::Read { path, .. } | Error::Write { path, .. } => Location {
+                file: Some(path.display().to_string()),
+                ..Location::default()
+            },
+            _ => Location::default(),
         }
     }
 

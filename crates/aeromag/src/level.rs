@@ -50,6 +50,49 @@ impl Default for LevelOptions {
     }
 }
 
+/// The levelling fit as a user states it: the `aeromag level` flags and
+/// the keywords of Python's `aeromag.level`, turned into the library's
+/// [`LevellingConfig`] by one rule.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelFitChoices {
+    /// Classic tie-line levelling: no `k·d|B0|/dt` term, no altitude term.
+    pub tie_only: bool,
+    /// A linear drift per line besides its level.
+    pub drift: bool,
+    /// Leave out the altitude (vertical-gradient) term.
+    pub no_altitude_term: bool,
+    /// Least squares without the Huber weights.
+    pub no_robust: bool,
+    /// Ridge parameter λ ≥ 0 of the line levels.
+    pub ridge_lambda: f64,
+}
+
+impl Default for LevelFitChoices {
+    fn default() -> Self {
+        Self {
+            tie_only: false,
+            drift: false,
+            no_altitude_term: false,
+            no_robust: false,
+            ridge_lambda: LevellingConfig::default().lambda,
+        }
+    }
+}
+
+impl LevelFitChoices {
+    /// The fit configuration these choices mean.
+    pub fn config(&self) -> LevellingConfig {
+        LevellingConfig {
+            estimate_k: !self.tie_only,
+            drift: self.drift,
+            lambda: self.ridge_lambda,
+            altitude_term: !(self.tie_only || self.no_altitude_term),
+            robust: !self.no_robust,
+            ..LevellingConfig::default()
+        }
+    }
+}
+
 /// A levelled survey ([`level`]).
 #[derive(Debug, Clone)]
 pub struct Levelled {

@@ -53,7 +53,7 @@
 //! | crate | holds |
 //! |---|---|
 //! | [`core`] (`aeromag-core`) | frames and rotations, dipole fields, IGRF-14, filters, spectra |
-//! | [`io`] (`aeromag-io`) | flight tables: CSV and Geosoft XYZ, column maps, validation, CSV writing |
+//! | [`io`] (`aeromag-io`) | flight tables: CSV, Geosoft XYZ and HDF5, column maps, validation, CSV writing |
 //! | [`sim`] (`aeromag-sim`) | the physical simulator (truth in `true_` columns) |
 //! | [`estimation`] (`aeromag-estimation`) | least squares, square-root Kalman filters and smoothers |
 //! | [`compensation`] (`aeromag-compensation`) | Tolles-Lawson terms and fits, the Kalman method, levelling, rotor and pod models, metrics |
@@ -86,6 +86,7 @@ pub use aeromag_io as io;
 pub use aeromag_report as report;
 pub use aeromag_sim as sim;
 
+pub use aeromag_io::Location;
 pub use aeromag_io::{ColumnMap, Fields, FlightTable, ReadOptions, RowSelection, Sensors};
 pub use compensate::{Compensated, Compensator, OutputColumns};
 pub use error::{Error, InFile, Result};
@@ -93,8 +94,8 @@ pub use flight::{Flight, LeverArm, LineLabels, ReferenceChannels, SegmentRule, T
 pub use model_file::ModelFile;
 pub use observer::{Note, NoteLevel, Observer, Silent};
 pub use tolles_lawson::{
-    CalibrateOptions, Calibration, EddyLag, KalmanOptions, Method, TlModel, calibrate,
-    observability,
+    CalibrateOptions, CalibrateSettings, Calibration, EddyLag, KalmanOptions, Method, TlModel,
+    calibrate, observability,
 };
 
 /// The names most programs need: `use aeromag::prelude::*;`.

@@ -118,6 +118,10 @@ fn check_range(t: &Flight, name: &str, v: &[f64], lo: f64, hi: f64) -> Result<()
     Ok(())
 }
 
+/// The columns [`fit_pod`] and [`apply_pod`] read besides the canonical
+/// ones (for a lazy read, [`Fields::canonical_and`](aeromag_io::Fields::canonical_and)).
+pub const POD_COLUMNS: [&str; 2] = ["cable_inclination", "cable_azimuth"];
+
 /// Split `t` into headings and build the model inputs of each with the
 /// pod trajectory of `method`. Returns the headings and the sample rate.
 fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Heading>, f64)> {

@@ -1,7 +1,6 @@
 //! Parsers of option values shared by several commands (clap value
 //! parsers: a bad value is a usage error, exit code 2, naming the flag).
 
-use aeromag::LeverArm;
 use std::fmt;
 use std::str::FromStr;
 
@@ -36,15 +35,6 @@ pub fn decimal_year(s: &str) -> Result<f64, String> {
     aeromag::core::time::Date::parse(s)
         .map(|d| d.decimal_year())
         .map_err(|e| e.to_string())
-}
-
-/// The lever arm of `--lever-arm X,Y,Z` with the main-field date of
-/// `--date` (decimal year).
-pub fn lever_arm(arm_m: Option<[f64; 3]>, decimal_year: f64) -> Option<LeverArm> {
-    arm_m.map(|arm_m| LeverArm {
-        arm_m,
-        decimal_year,
-    })
 }
 
 /// A finite number ≥ 0.

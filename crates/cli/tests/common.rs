@@ -93,3 +93,17 @@ pub fn simulate_with(
     assert_code(&aeromag(&args), 0);
     out.join(format!("{}.csv", scenario.replace('-', "_")))
 }
+
+/// The installation of the simulated towed pod (`pod fit` arguments).
+pub const POD_SETUP: [&str; 10] = [
+    "--cable-length-m",
+    "40",
+    "--attach-m",
+    "0,0,1.2",
+    "--inclination-deg",
+    "45",
+    "--grad-north-nt-per-km",
+    "5.91",
+    "--grad-up-nt-per-km",
+    "-25.91",
+];

@@ -220,4 +220,73 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
     for k in ["Levelling correction per line", "rows levelled", "1003.52"] {
         assert!(html.contains(k), "{k} missing in the report");
     }
+    // The report of an HDF5 copy reads only the fields it needs (the
+    // compensated, modelled, truth and levelling columns): the same figures.
+    let h5 = h5_copy(&levelled);
+    let rep5 = d.join("report5");
+    let o = aeromag(&[
+        "report",
+        "-i",
+        h5.to_str().unwrap(),
+        "--out",
+        rep5.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let figures = |r: &Path| read_json(&r.join("figures.json"));
+    assert_eq!(figures(&rep), figures(&rep5));
+    assert!(
+        figures(&rep)["interference_rms_nt"].is_number(),
+        "truth was read"
+    );
+    let html5 = std::fs::read_to_string(rep5.join("index.html")).unwrap();
+    assert!(html5.contains("Levelling correction per line"));
+}
+
+/// An HDF5 copy of an aeromag CSV file (tools/reference/csv_h5.py: every
+/// column a dataset under its own name).
+fn h5_copy(csv: &Path) -> std::path::PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let h5 = csv.with_extension("h5");
+    let o = Command::new("python3")
+        .arg(root.join("tools/reference/csv_h5.py"))
+        .arg(csv)
+        .arg(&h5)
+        .output()
+        .expect("python3");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    h5
+}
+
+/// The rotor and pod fits read only the fields they need from an HDF5
+/// flight (canonical columns and their own: the rotor phase, the cable
+/// angles): the same model file as from the CSV.
+#[test]
+fn rotor_and_pod_fits_read_their_fields_from_hdf5() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fit = |family: &str, input: &Path, model: &Path, setup: &[&str]| {
+        let mut args = vec![
+            family,
+            "fit",
+            "-i",
+            input.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+        ];
+        args.extend_from_slice(setup);
+        let o = aeromag(&args);
+        assert_code(&o, 0);
+        std::fs::read_to_string(model).unwrap()
+    };
+    let csv = simulate(d, "helicopter", "11");
+    let setup = ["--preset", "aeromag-sim-helicopter"];
+    let a = fit("rotor", &csv, &d.join("r.json"), &setup);
+    let b = fit("rotor", &h5_copy(&csv), &d.join("r5.json"), &setup);
+    assert!(a.contains("\"rotor_phase\""), "the phase channel was used");
+    assert_eq!(a, b);
+    let pod = simulate(d, "pod", "1");
+    let a = fit("pod", &pod, &d.join("p.json"), &POD_SETUP);
+    let b = fit("pod", &h5_copy(&pod), &d.join("p5.json"), &POD_SETUP);
+    assert!(a.contains("cable_inclination"));
+    assert_eq!(a, b);
 }

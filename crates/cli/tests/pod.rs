@@ -29,19 +29,6 @@ fn column(h: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
         .collect()
 }
 
-const SETUP: [&str; 10] = [
-    "--cable-length-m",
-    "40",
-    "--attach-m",
-    "0,0,1.2",
-    "--inclination-deg",
-    "45",
-    "--grad-north-nt-per-km",
-    "5.91",
-    "--grad-up-nt-per-km",
-    "-25.91",
-];
-
 /// The seed's stated conditions (swing a 5° sinusoid): a learning flight on
 /// the seed's headings (sim seed 1) and the independent heading set (1001).
 fn simulate_pair(d: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
@@ -105,7 +92,7 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
         "--model",
         model.to_str().unwrap(),
     ];
-    args.extend(SETUP);
+    args.extend(POD_SETUP);
     let o = aeromag(&args);
     assert_code(&o, 0);
     assert!(stdout(&o).contains("learning heading"), "{}", stdout(&o));

@@ -319,6 +319,15 @@ pub enum IoError {
         #[source]
         source: std::io::Error,
     },
+    /// Columns given in memory (Python's `Flight.from_dict`) that do not
+    /// form a table: a repeated name, lengths that differ.
+    #[error("'<in-memory table>': column '{column}': {reason}")]
+    Columns {
+        /// The column concerned.
+        column: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// A file format this build cannot read.
     #[error("'{file}': {reason}")]
     Unsupported {
@@ -330,6 +339,105 @@ pub enum IoError {
 }
 
 impl IoError {
+    /// Where in which file the error is, as far as it says: for the
+    /// errors of a cell, a row or a column. Rows are the file's data rows
+    /// (0-based), lines 1-based.
+    pub fn location(&self) -> Location {
+        use IoError::*;
+        let mut at = Location::default();
+        match self {
+            Open { file, .. }
+            | Empty { file }
+            | NoData { file, .. }
+            | Hdf5 { file, .. }
+            | Hdf5Layout { file, .. }
+            | SensorAbsent { file, .. }
+            | Selection { file, .. }
+            | Write { file, .. }
+            | Unsupported { file, .. } => at.file = Some(file.clone()),
+            Read { file, line, .. }
+            | Binary { file, line, .. }
+            | WrongDelimiter { file, line, .. }
+            | TooLarge { file, line, .. }
+            | XyzHeader { file, line, .. } => {
+                at.file = Some(file.clone());
+                at.line = Some(*line);
+            }
+            DuplicateHeader {
+                file, line, column, ..
+            } => {
+                at.file = Some(file.clone());
+                at.line = Some(*line);
+                at.column = Some(column.clone());
+            }
+            FieldCount {
+                file, line, row, ..
+            } => {
+                at.file = Some(file.clone());
+                at.line = Some(*line);
+                at.row = Some(*row);
+            }
+            ParseNumber {
+                file,
+                line,
+                row,
+                column,
+                ..
+            } => {
+                at.file = Some(file.clone());
+                at.line = Some(*line);
+                at.row = Some(*row);
+                // The label of a message: `'name'` or `'name' (mapped to 'role')`.
+                let name = column.strip_prefix('\'').and_then(|c| c.split('\'').next());
+                at.column = Some(name.unwrap_or(column).to_string());
+            }
+            MissingColumn { file, column, .. }
+            | NotNumeric { file, column, .. }
+            | Units { file, column, .. } => {
+                at.file = Some(file.clone());
+                at.column = Some(column.clone());
+            }
+            MappedColumnAbsent {
+                file, file_column, ..
+            } => {
+                at.file = Some(file.clone());
+                at.column = Some(file_column.clone());
+            }
+            NotIncreasing {
+                file,
+                column,
+                row_b,
+                line_b,
+                ..
+            } => {
+                at.file = Some(file.clone());
+                at.column = Some(column.clone());
+                at.row = Some(*row_b);
+                at.line = *line_b;
+            }
+            MissingValue {
+                file,
+                column,
+                row,
+                line,
+            } => {
+                at.file = Some(file.clone());
+                at.column = Some(column.clone());
+                at.row = Some(*row);
+                at.line = *line;
+            }
+            Columns { column, .. } => {
+                at.file = Some(crate::IN_MEMORY.to_string());
+                at.column = Some(column.clone());
+            }
+            LengthMismatch { column, .. } | ColumnExists { column } => {
+                at.column = Some(column.clone())
+            }
+            ColumnMap { .. } => {}
+        }
+        at
+    }
+
     /// True when the error is caused by the user's input (a file, a column,
     /// a column map, a value): the command line exits with code 2 for these.
     /// False for failures of the machine (I/O errors while reading an opened
@@ -365,3 +473,17 @@ fn fmt_line(line: Option<u64>) -> String {
 
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, IoError>;
+
+/// Where an error is: file, 1-based line, 0-based data row of the file,
+/// column; each when known ([`IoError::location`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Location {
+    /// The file (as named in messages).
+    pub file: Option<String>,
+    /// 1-based line of a text file.
+    pub line: Option<u64>,
+    /// 0-based data row of the file (messages print it 1-based).
+    pub row: Option<usize>,
+    /// The column (or field) concerned.
+    pub column: Option<String>,
+}

@@ -228,7 +228,7 @@ fn wanted_fields(
         .iter()
         .map(|h| {
             asked.iter().any(|a| {
-                h.eq_ignore_ascii_case(a)
+                name_matches(h, a)
                     || aliases
                         .iter()
                         .any(|m| m.canonical == *a && m.file_column == *h)
@@ -238,6 +238,25 @@ fn wanted_fields(
             })
         })
         .collect()
+}
+
+/// `name` against an asked name without regard to case; an asked name
+/// ending in `*` is a prefix (`true_*`), one starting with `*` a suffix
+/// (`*_level`).
+fn name_matches(name: &str, asked: &str) -> bool {
+    let same = |a: Option<&str>, b: &str| a.is_some_and(|a| a.eq_ignore_ascii_case(b));
+    if let Some(prefix) = asked.strip_suffix('*') {
+        same(name.get(..prefix.len()), prefix)
+    } else if let Some(suffix) = asked.strip_prefix('*') {
+        same(
+            name.len()
+                .checked_sub(suffix.len())
+                .and_then(|i| name.get(i..)),
+            suffix,
+        )
+    } else {
+        name.eq_ignore_ascii_case(asked)
+    }
 }
 
 /// A `units` attribute that contradicts the unit the layout gives the field

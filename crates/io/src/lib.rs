@@ -58,7 +58,7 @@ pub use columns::{
 pub use csv_read::read_csv;
 pub use csv_write::{write_csv, write_csv_to};
 pub use derive::{Conversion, DerivedColumn, derive_columns};
-pub use error::{IoError, Result};
+pub use error::{IoError, Location, Result};
 pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use select::{RowSelection, label_number};
@@ -94,8 +94,9 @@ pub enum Fields {
     All,
     /// The fields with these names: file names, canonical names (through
     /// the column map, the preset or a derivation), compared without
-    /// regard to case. The `line` and `time` fields a row selection needs
-    /// are added.
+    /// regard to case; a name ending in `*` matches by prefix (`true_*`),
+    /// one starting with `*` by suffix (`*_level`). The `line` and `time`
+    /// fields a row selection needs are added.
     Only(Vec<String>),
 }
 
@@ -164,6 +165,78 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         Format::Hdf5 => read_hdf5(path, opts),
         Format::Csv | Format::Auto => read_csv(path, opts),
     }?;
+    opts.rows.apply(&mut table)?;
+    derive_columns(&mut table)?;
+    Ok(table)
+}
+
+/// A table from columns held in memory (Python's `Flight.from_dict`),
+/// named as in files: the column map, the chosen sensors, the MagNav
+/// preset, the row selection and the derived columns of `opts` apply as
+/// they do to a file read by [`read_table`] (`opts.fields` and the format
+/// options do not). Numeric columns count their NaN as missing.
+///
+/// Errors: no column or no row, a repeated name or columns of different
+/// lengths ([`IoError::Columns`]), and the
+/// mapping and selection errors of a file.
+pub fn table_from_columns(
+    columns: Vec<(String, ColumnData)>,
+    opts: &ReadOptions,
+) -> Result<FlightTable> {
+    let len = |d: &ColumnData| match d {
+        ColumnData::Numeric { values, .. } => values.len(),
+        ColumnData::Text(t) => t.len(),
+    };
+    let Some(n_rows) = columns.first().map(|c| len(&c.1)) else {
+        return Err(IoError::Empty {
+            file: IN_MEMORY.into(),
+        });
+    };
+    let mut header: Vec<String> = Vec::with_capacity(columns.len());
+    for (name, data) in &columns {
+        if header.iter().any(|h| h == name) {
+            return Err(IoError::Columns {
+                column: name.clone(),
+                reason: "given twice".into(),
+            });
+        }
+        if len(data) != n_rows {
+            return Err(IoError::Columns {
+                column: name.clone(),
+                reason: format!(
+                    "{} values, but '{}' has {n_rows}: columns must have one length",
+                    len(data),
+                    header[0]
+                ),
+            });
+        }
+        header.push(name.clone());
+    }
+    if n_rows == 0 {
+        return Err(IoError::NoData {
+            file: IN_MEMORY.into(),
+            header_line: 0,
+        });
+    }
+    let aliases = columns::resolve(
+        IN_MEMORY,
+        &header,
+        &opts.columns,
+        &opts.sensors,
+        opts.magnav_preset,
+    )?;
+    let parts = columns
+        .into_iter()
+        .map(|(name, data)| (name, data, false))
+        .collect();
+    let mut table = FlightTable::from_parts(
+        std::path::PathBuf::new(),
+        n_rows,
+        parts,
+        aliases,
+        Vec::new(),
+    );
+    table.forget_source();
     opts.rows.apply(&mut table)?;
     derive_columns(&mut table)?;
     Ok(table)

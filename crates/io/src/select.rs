@@ -316,10 +316,53 @@ mod tests {
         assert_eq!(t.column("time").unwrap(), &[0.0, 3.0]);
         assert_eq!(t.line_of_row(0), Some(2));
         assert_eq!(t.line_of_row(1), Some(5));
+        assert_eq!((t.file_row(0), t.file_row(1)), (0, 3));
+    }
+
+    /// Messages name the file's data row and line, not the row's place in
+    /// the selection, also after two selections.
+    #[test]
+    fn messages_count_data_rows_of_the_file() {
+        let mut t = crate::read_csv(
+            &write(
+                "time,line,lat
+0,1,45
+1,2,45
+2,2,45
+3,1,45
+4,1,45
+5,1,145
+",
+            ),
+            &crate::ReadOptions::default(),
+        )
+        .unwrap();
+        RowSelection::parse(Some("1"), None)
+            .unwrap()
+            .apply(&mut t)
+            .unwrap();
+        RowSelection::parse(None, Some("3,5"))
+            .unwrap()
+            .apply(&mut t)
+            .unwrap();
+        assert_eq!(t.column("time").unwrap(), &[3.0, 4.0, 5.0]);
+        assert_eq!((0..3).map(|r| t.file_row(r)).collect::<Vec<_>>(), [3, 4, 5]);
+        let e = crate::check_units(&t).unwrap_err().to_string();
+        assert!(e.contains("at data row 6 (line 7)"), "{e}");
+        let mut bad = t.clone();
+        bad.set_column("time", vec![3.0, 4.0, 4.0]).unwrap();
+        let e = crate::check_time(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("data row 6 (line 7) has 4 after data row 5 (line 6)"),
+            "{e}"
+        );
     }
 
     fn write(text: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("aeromag-select-{}", std::process::id()));
+        // One folder per call: tests may run as threads of one process.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("aeromag-select-{}-{k}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("t.csv");
         std::fs::write(&p, text).unwrap();

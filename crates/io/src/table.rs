@@ -120,6 +120,10 @@ pub struct FlightTable {
     /// Breakpoints `(row, line)`: from `row` on, row `r` is on file line
     /// `line + (r - row)`, until the next breakpoint. Empty for in-memory tables.
     row_lines: Vec<(usize, u64)>,
+    /// Breakpoints `(row, data_row)` after a row selection: from `row` on,
+    /// row `r` is the file's data row `data_row + (r - row)`. Empty when
+    /// every row of the file is kept (row `r` is data row `r`).
+    row_origin: Vec<(usize, usize)>,
     derived: Vec<DerivedColumn>,
 }
 
@@ -276,6 +280,19 @@ impl FlightTable {
         Some(l0 + (row - r0) as u64)
     }
 
+    /// The file's data row (0-based) of table row `row`: the same number
+    /// unless a row selection ([`FlightTable::retain_rows`], `--lines`,
+    /// `--time-range`) dropped rows before it. Messages print it 1-based as
+    /// "data row N", so that it agrees with the file line whatever rows
+    /// were kept.
+    pub fn file_row(&self, row: usize) -> usize {
+        let k = self.row_origin.partition_point(|(r, _)| *r <= row);
+        match k.checked_sub(1).and_then(|k| self.row_origin.get(k)) {
+            Some(&(r0, d0)) => d0 + (row - r0),
+            None => row,
+        }
+    }
+
     /// ` (data row R, line L: 'value')` for the first cell of a text column
     /// that is neither a number nor a missing marker (the reader's rule),
     /// data rows counted from 1; empty if there is none.
@@ -291,7 +308,7 @@ impl FlightTable {
                 let line = self
                     .line_of_row(k)
                     .map_or(String::new(), |l| format!(", line {l}"));
-                format!(" (data row {}{line}: '{}')", k + 1, text[k])
+                format!(" (data row {}{line}: '{}')", self.file_row(k) + 1, text[k])
             }
             None => String::new(),
         }
@@ -341,11 +358,19 @@ impl FlightTable {
                 .collect(),
             aliases,
             row_lines,
+            row_origin: Vec::new(),
             derived: Vec::new(),
         }
     }
 
-    /// Keeps the rows `i` with `keep[i]` (in order), with their file lines.
+    /// Makes a table assembled by [`FlightTable::from_parts`] an in-memory
+    /// one (no source file).
+    pub(crate) fn forget_source(&mut self) {
+        self.source = None;
+    }
+
+    /// Keeps the rows `i` with `keep[i]` (in order), with their file lines
+    /// and data-row numbers ([`FlightTable::file_row`]).
     /// Missing counts are recounted; their reasons are kept when a column
     /// had only one kind of missing value, else counted as `nan`.
     ///
@@ -395,6 +420,17 @@ impl FlightTable {
             }
         }
         self.row_lines = row_lines;
+        let mut row_origin: Vec<(usize, usize)> = Vec::new();
+        let mut prev: Option<usize> = None;
+        let kept = keep.iter().enumerate().filter(|(_, k)| **k);
+        for (j, (i, _)) in kept.enumerate() {
+            let d = self.file_row(i);
+            if prev.is_none_or(|p| p + 1 != d) {
+                row_origin.push((j, d));
+            }
+            prev = Some(d);
+        }
+        self.row_origin = row_origin;
         self.n_rows = keep.iter().filter(|k| **k).count();
     }
 

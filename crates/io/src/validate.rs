@@ -127,7 +127,7 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
             return Err(IoError::MissingValue {
                 file: table.file_label(),
                 column: "time".into(),
-                row: i,
+                row: table.file_row(i),
                 line: table.line_of_row(i),
             });
         }
@@ -135,10 +135,10 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
             return Err(IoError::NotIncreasing {
                 file: table.file_label(),
                 column: "time".into(),
-                row_a: i - 1,
+                row_a: table.file_row(i - 1),
                 line_a: table.line_of_row(i - 1),
                 value_a: t[i - 1],
-                row_b: i,
+                row_b: table.file_row(i),
                 line_b: table.line_of_row(i),
                 value_b: v,
             });
@@ -245,7 +245,7 @@ impl Ctx<'_> {
             kind,
             file: self.table.file_label(),
             column: Some(column.to_string()),
-            row,
+            row: row.map(|r| self.table.file_row(r)),
             line: row.and_then(|r| self.table.line_of_row(r)),
             message,
         }
@@ -324,20 +324,19 @@ impl Ctx<'_> {
         {
             return Err(self.units(
                     "lat",
-                    format!("latitude {v} at data row {}{} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", i + 1, at_line(self.table, i)),
+                    format!("latitude {v} at {} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", data_row(self.table, i)),
                 ));
         }
         if let Some(lon) = lon
             && let Some((i, v)) = first_where(lon, |v| v.abs() > 360.0)
         {
             return Err(self.units(
-                    "lon",
-                    format!(
-                        "longitude {v} at data row {}{} is outside ±360°: projected coordinates? expected degrees",
-                        i + 1,
-                        at_line(self.table, i)
-                    ),
-                ));
+                "lon",
+                format!(
+                    "longitude {v} at {} is outside ±360°: projected coordinates? expected degrees",
+                    data_row(self.table, i)
+                ),
+            ));
         }
         if let (Some(lat), Some(lon)) = (lat, lon) {
             let (Some(a), Some(o)) = (max_abs(lat), max_abs(lon)) else {
@@ -367,9 +366,8 @@ impl Ctx<'_> {
                 return Err(self.units(
                     name,
                     format!(
-                        "{name} {x} at data row {}{} is outside ±{limit}°: expected degrees",
-                        i + 1,
-                        at_line(t, i)
+                        "{name} {x} at {} is outside ±{limit}°: expected degrees",
+                        data_row(t, i)
                     ),
                 ));
             }
@@ -417,12 +415,14 @@ impl Ctx<'_> {
     }
 }
 
-/// " (line N)" for a row of a table read from a file.
-fn at_line(table: &FlightTable, row: usize) -> String {
-    table
+/// "data row R (line L)" for a row of a table: the file's data row, and
+/// its line when the table was read from a text file.
+fn data_row(table: &FlightTable, row: usize) -> String {
+    let line = table
         .line_of_row(row)
         .map(|l| format!(" (line {l})"))
-        .unwrap_or_default()
+        .unwrap_or_default();
+    format!("data row {}{line}", table.file_row(row) + 1)
 }
 
 fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {

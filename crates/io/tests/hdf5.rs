@@ -74,6 +74,15 @@ fn only_the_fields_asked_for_are_read() {
         let mut names = t.column_names();
         names.sort();
         assert_eq!(names, ["ins_vn", "mag_1_uc", "tt"], "{file}");
+        // Patterns: a prefix and a suffix.
+        let opts = ReadOptions {
+            fields: Fields::Only(vec!["MAG_*".into(), "*_vn".into()]),
+            ..ReadOptions::default()
+        };
+        let t = read_table(&data(file), &opts).unwrap();
+        let mut names = t.column_names();
+        names.sort();
+        assert_eq!(names, ["ins_vn", "mag_1_uc", "mag_2_uc"], "{file}");
         // A row selection brings its `line` and `time`.
         let opts = ReadOptions {
             fields: Fields::Only(vec!["mag_2_uc".into()]),

@@ -148,7 +148,7 @@ impl Flight {
         Error::BadInput {
             file: Some(self.label()),
             line: self.line_of_row(row),
-            row: Some(row),
+            row: Some(self.file_row(row)),
             column: Some(column.to_string()),
             reason: reason.into(),
         }
@@ -219,4 +219,29 @@ pub fn sensor_track_at(flight: &Flight, alt: &[f64], arm_m: [f64; 3]) -> Result<
     let [lat, lon, _, roll, pitch, yaw] = flight.nav_and_attitude()?;
     aeromag_compensation::levelling::sensor_positions(lat, lon, alt, roll, pitch, yaw, arm_m)
         .in_file(&flight.label())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// After `--lines`, a bad cell is named by the file's data row and line.
+    #[test]
+    fn bad_values_name_the_files_data_row_after_a_selection() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.csv");
+        std::fs::write(
+            &path,
+            "time,line,mag\n0,1,50000\n1,1,50000\n2,2,50000\n3,2,\n4,2,50000\n",
+        )
+        .unwrap();
+        let opts = ReadOptions {
+            rows: aeromag_io::RowSelection::parse(Some("2"), None).unwrap(),
+            ..ReadOptions::default()
+        };
+        let f = Flight::read_with(&path, &opts).unwrap();
+        assert_eq!(f.n_rows(), 3);
+        let e = f.finite("mag").unwrap_err().to_string();
+        assert!(e.contains("line 5 (data row 4), column 'mag'"), "{e}");
+    }
 }

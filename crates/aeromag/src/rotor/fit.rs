@@ -38,6 +38,33 @@ pub enum PhaseChoice {
     Estimate,
 }
 
+/// The rotor fit as a user states it (see [`RotorOptions::from_choices`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RotorChoices {
+    /// A named installation.
+    pub preset: Option<RotorPreset>,
+    /// Rotor hub position (body frame, m).
+    pub hub_m: Option<[f64; 3]>,
+    /// Sensor position (body frame, m).
+    pub sensor_m: Option<[f64; 3]>,
+    /// Blade root and tip radius, m.
+    pub blade_span_m: Option<[f64; 2]>,
+    /// Number of blades.
+    pub blades: Option<usize>,
+    /// Nominal coning angle, degrees.
+    pub coning_deg: Option<f64>,
+    /// Nominal longitudinal tilt, degrees.
+    pub tilt_lon_deg: Option<f64>,
+    /// Phase channel (degrees).
+    pub phase_column: Option<String>,
+    /// Estimate the phase even if a channel exists.
+    pub estimate_phase: bool,
+    /// Search band of the rotor frequency, Hz.
+    pub rotor_hz: Option<[f64; 2]>,
+    /// Window of constant cone angles, s.
+    pub window_s: Option<f64>,
+}
+
 /// What the rotor fit is told: the installation (geometry, required) and
 /// how to find the phase.
 #[derive(Debug, Clone, PartialEq)]
@@ -68,6 +95,63 @@ impl RotorOptions {
             rotor_hz_range: [4.0, 6.0],
             window_s: 1.0,
         }
+    }
+
+    /// The columns the fit reads besides the canonical ones: the phase
+    /// channel it may use (for a lazy read, [`Fields::canonical_and`](aeromag_io::Fields::canonical_and)).
+    pub fn extra_columns(&self) -> Vec<&str> {
+        match &self.phase {
+            PhaseChoice::Auto => vec!["rotor_phase"],
+            PhaseChoice::Column(c) => vec![c.as_str()],
+            PhaseChoice::Estimate => vec![],
+        }
+    }
+
+    /// The options a user states (the `aeromag rotor fit` flags, Python's
+    /// `fit_rotor` keywords): a preset or the whole geometry, each value
+    /// given overriding the preset's. Bad input: no preset and an
+    /// incomplete geometry.
+    pub fn from_choices(c: &RotorChoices) -> Result<Self> {
+        let mut o = match c.preset {
+            Some(p) => RotorOptions::preset(p),
+            None => match (c.hub_m, c.sensor_m, c.blade_span_m, c.blades) {
+                (Some(hub_m), Some(sensor_m), Some([root_m, tip_m]), Some(blades)) => {
+                    RotorOptions::new(RotorGeometry {
+                        hub_m,
+                        sensor_m,
+                        root_m,
+                        tip_m,
+                        blades,
+                    })
+                }
+                _ => {
+                    return Err(crate::Error::bad_input(
+                        "the rotor geometry needs a preset, or all of hub_m, sensor_m, blade_span_m and blades (--hub-m, --sensor-m, --blade-span-m, --blades)",
+                    ));
+                }
+            },
+        };
+        let g = &mut o.geometry;
+        g.hub_m = c.hub_m.unwrap_or(g.hub_m);
+        g.sensor_m = c.sensor_m.unwrap_or(g.sensor_m);
+        if let Some([root, tip]) = c.blade_span_m {
+            (g.root_m, g.tip_m) = (root, tip);
+        }
+        g.blades = c.blades.unwrap_or(g.blades);
+        if let Some(d) = c.coning_deg {
+            o.nominal_angles.coning_rad = d.to_radians();
+        }
+        if let Some(d) = c.tilt_lon_deg {
+            o.nominal_angles.tilt_lon_rad = d.to_radians();
+        }
+        o.phase = match (&c.phase_column, c.estimate_phase) {
+            (_, true) => PhaseChoice::Estimate,
+            (Some(col), false) => PhaseChoice::Column(col.clone()),
+            (None, false) => PhaseChoice::Auto,
+        };
+        o.rotor_hz_range = c.rotor_hz.unwrap_or(o.rotor_hz_range);
+        o.window_s = c.window_s.unwrap_or(o.window_s);
+        Ok(o)
     }
 
     /// The options of a named installation.

@@ -20,7 +20,7 @@ mod fit;
 pub use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile};
 pub use aeromag_compensation::rotor::{FlapAngles, RotorGeometry};
 pub use apply::ROTOR_OUTPUT;
-pub use fit::{PhaseChoice, RotorFitResult, RotorOptions, fit_rotor};
+pub use fit::{PhaseChoice, RotorChoices, RotorFitResult, RotorOptions, fit_rotor};
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

@@ -22,6 +22,19 @@ use aeromag_core::filter::BandPass;
 use serde::Serialize;
 use std::ops::Range;
 
+/// The columns [`score`] and the report section read besides the canonical
+/// ones and the reference channels (for a lazy read, as patterns of
+/// [`Fields::Only`](aeromag_io::Fields::Only)): the compensated and
+/// modelled signal, simulation truth, and the levelling columns of
+/// `aeromag level`.
+pub const SCORED_COLUMNS: [&str; 5] = [
+    "mag_comp",
+    "mag_interf",
+    "true_*",
+    crate::level::LEVEL_FLAG,
+    "*_level",
+];
+
 /// The figures of one compensated flight.
 #[derive(Debug, Clone, Serialize)]
 pub struct Figures {

@@ -4,6 +4,7 @@
 //!
 //! | item | what |
 //! |---|---|
+//! | [`CalibrateSettings`] | the choices as the CLI's flags and Python's keyword options state them → [`CalibrateOptions`] |
 //! | [`calibrate`] | fit a [`TlModel`] on a calibration flight ([`CalibrateOptions`], [`Method`]) → [`Calibration`] |
 //! | [`Compensator`](crate::Compensator) for [`TlModel`] | the modelled interference of every row of a flight, and the compensated reading |
 //! | [`observability`] | rank, weak combinations and estimability of the coefficients on a flight |
@@ -20,10 +21,12 @@ mod kalman;
 mod kalman_section;
 mod lags;
 mod observability;
+mod settings;
 
 pub use calibrate::{CalibrateOptions, Calibration, EddyLag, Method, calibrate};
 pub use compensate::TL_OUTPUT;
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
+pub use settings::{CalibrateSettings, DEFAULT_DECIMAL_YEAR};
 
 pub use aeromag_compensation::model_file::TlModel;

@@ -2,13 +2,12 @@
 //! (library: [`aeromag::calibrate`]).
 
 use crate::args::{self, Band, parsed};
-use crate::exit::bad_input;
 use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::compensation::kalman::{NoiseModel, q1_unit};
 use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag::compensation::tolles_lawson::{Convention, Design, TermSet};
-use aeromag::{CalibrateOptions, EddyLag, KalmanOptions, Method, ReferenceChannels, calibrate};
+use aeromag::{CalibrateOptions, CalibrateSettings, EddyLag, Method, ReferenceChannels, calibrate};
 use std::path::PathBuf;
 
 /// Fit the aircraft's magnetic interference model (Tolles-Lawson / Leliak)
@@ -148,44 +147,29 @@ fn noise(s: &str) -> Result<NoiseModel, String> {
 
 /// The library's options from the flags.
 fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
-    if a.method != Method::Kalman {
-        for (given, flag) in [
-            (a.series.is_some(), "--series"),
-            (a.field_order.is_some(), "--field-order"),
-        ] {
-            if given {
-                return Err(bad_input!("{flag} needs --method kalman"));
-            }
-        }
-    }
-    let defaults = KalmanOptions::default();
-    Ok(CalibrateOptions {
+    let settings = CalibrateSettings {
         method: a.method,
-        ls: LsConfig {
-            design: Design {
-                terms: a.terms.clone(),
-                convention: a.convention,
-                bt_scale_nt: a.bt_scale,
-            },
-            band_hz: a.band.0,
-            trim: a.trim,
-            lambda: a.lambda,
-            ..LsConfig::default()
-        },
-        kalman: KalmanOptions {
-            field_order: a.field_order.unwrap_or(defaults.field_order),
-            noise: a.kalman_noise,
-            tune: a.tune || !(a.no_tune || a.kalman_noise.is_some()),
-            series: a.series.is_some(),
-        },
-        eddy_lag: a
-            .eddy_lag
-            .clone()
-            .unwrap_or_else(|| EddyLag::default_for(a.convention)),
-        split_lines: !a.no_split_lines,
+        terms: Some(a.terms.clone()),
+        convention: Some(a.convention),
+        ridge_lambda: Some(a.lambda),
+        band_hz: Some(a.band.0),
+        trim: Some(a.trim),
+        bt_scale_nt: Some(a.bt_scale),
+        no_split_lines: a.no_split_lines,
         reference: a.reference.clone(),
-        lever_arm: args::lever_arm(a.lever_arm, a.date),
-    })
+        eddy_lag: a.eddy_lag.clone(),
+        lever_arm_m: a.lever_arm,
+        decimal_year: Some(a.date),
+        tune: match (a.tune, a.no_tune) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
+        kalman_noise: a.kalman_noise,
+        field_order: a.field_order,
+        series: a.series.is_some(),
+    };
+    Ok(settings.options()?)
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

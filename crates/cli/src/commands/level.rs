@@ -6,7 +6,7 @@ use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::ReferenceChannels;
 use aeromag::compensation::levelling::{HUBER_K, LevellingConfig};
-use aeromag::level::{LevelOptions, level};
+use aeromag::level::{LevelFitChoices, LevelOptions, level};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]
@@ -85,14 +85,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         rate_of: a.rate_of.clone(),
         lever_arm_m: a.lever_arm,
         reference: a.reference.clone(),
-        fit: LevellingConfig {
-            estimate_k: !a.tie_only,
+        fit: LevelFitChoices {
+            tie_only: a.tie_only,
             drift: a.drift,
-            lambda: a.lambda,
-            altitude_term: !(a.tie_only || a.no_altitude_term),
-            robust: !a.no_robust,
-            ..LevellingConfig::default()
-        },
+            no_altitude_term: a.no_altitude_term,
+            no_robust: a.no_robust,
+            ridge_lambda: a.lambda,
+        }
+        .config(),
         ties: a.ties.clone(),
         ..LevelOptions::default()
     };

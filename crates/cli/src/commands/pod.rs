@@ -128,7 +128,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
         grad_north_nt_per_km: a.grad_north_nt_per_km,
         grad_up_nt_per_km: a.grad_up_nt_per_km,
     };
-    let t = a.input.load()?;
+    let t = a.input.load_canonical(&aeromag::pod::POD_COLUMNS)?;
     let sources = a.source_points.as_ref().map(|p| p.0.as_slice());
     let model = fit_pod(&t, &setup, a.method, sources)?;
     model.write(&a.model)?;

@@ -36,8 +36,15 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_folder(&a.out)?;
-    let flight = a.input.load()?;
     let model = a.model.as_deref().map(TlModel::read).transpose()?;
+    // Only the columns the report reads (an HDF5 flight of 100 fields).
+    let mut extra: Vec<&str> = aeromag::score::SCORED_COLUMNS.to_vec();
+    match (&a.reference, &model) {
+        (Some(ReferenceChannels::Columns(c)), _) => extra.extend(c.iter().map(String::as_str)),
+        (None, Some(m)) => extra.extend(m.reference.iter().map(String::as_str)),
+        _ => {}
+    }
+    let flight = a.input.load_canonical(&extra)?;
     let reference = match (&a.reference, &model) {
         (Some(r), _) => r.resolve(&flight)?,
         (None, Some(m)) => m.reference.clone(),

@@ -6,7 +6,7 @@ use crate::args;
 use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::report::Report;
-use aeromag::rotor::{PhaseChoice, RotorGeometry, RotorOptions, RotorPreset, fit_rotor};
+use aeromag::rotor::{RotorChoices, RotorOptions, RotorPreset, fit_rotor};
 use aeromag::studies::{RotorStudyRun, Study, StudyOutcome, StudySize, pct};
 use aeromag::{Compensator, ModelFile};
 use std::path::PathBuf;
@@ -150,45 +150,26 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 /// The library's options from the flags: the preset's values (if any)
 /// overridden by the flags given.
-fn options(a: &FitArgs) -> RotorOptions {
-    let mut o = match a.preset {
-        Some(p) => RotorOptions::preset(p),
-        // Every geometry flag is required without a preset (clap).
-        None => RotorOptions::new(RotorGeometry {
-            hub_m: a.hub_m.unwrap_or_default(),
-            sensor_m: a.sensor_m.unwrap_or_default(),
-            root_m: a.blade_span_m.map_or(0.0, |s| s[0]),
-            tip_m: a.blade_span_m.map_or(0.0, |s| s[1]),
-            blades: a.blades.unwrap_or_default(),
-        }),
-    };
-    let g = &mut o.geometry;
-    g.hub_m = a.hub_m.unwrap_or(g.hub_m);
-    g.sensor_m = a.sensor_m.unwrap_or(g.sensor_m);
-    if let Some([root, tip]) = a.blade_span_m {
-        (g.root_m, g.tip_m) = (root, tip);
-    }
-    g.blades = a.blades.unwrap_or(g.blades);
-    if let Some(c) = a.coning_deg {
-        o.nominal_angles.coning_rad = c.to_radians();
-    }
-    if let Some(t) = a.tilt_lon_deg {
-        o.nominal_angles.tilt_lon_rad = t.to_radians();
-    }
-    o.phase = match (&a.phase_column, a.estimate_phase) {
-        (_, true) => PhaseChoice::Estimate,
-        (Some(c), false) => PhaseChoice::Column(c.clone()),
-        (None, false) => PhaseChoice::Auto,
-    };
-    o.rotor_hz_range = a.rotor_hz.unwrap_or(o.rotor_hz_range);
-    o.window_s = a.window_s.unwrap_or(o.window_s);
-    o
+fn options(a: &FitArgs) -> anyhow::Result<RotorOptions> {
+    Ok(RotorOptions::from_choices(&RotorChoices {
+        preset: a.preset,
+        hub_m: a.hub_m,
+        sensor_m: a.sensor_m,
+        blade_span_m: a.blade_span_m,
+        blades: a.blades,
+        coning_deg: a.coning_deg,
+        tilt_lon_deg: a.tilt_lon_deg,
+        phase_column: a.phase_column.clone(),
+        estimate_phase: a.estimate_phase,
+        rotor_hz: a.rotor_hz,
+        window_s: a.window_s,
+    })?)
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<()> {
     crate::output::check_files([a.model.as_path()])?;
-    let opts = options(&a);
-    let flight = a.input.load()?;
+    let opts = options(&a)?;
+    let flight = a.input.load_canonical(&opts.extra_columns())?;
     let fit = fit_rotor(&flight, &opts, &mut Bars::new())?;
     let model = &fit.model;
     model.write(&a.model)?;

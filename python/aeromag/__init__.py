@@ -1,0 +1,248 @@
+"""aeromag: magnetic and low-frequency EM measurements from moving platforms.
+
+The Python face of the aeromag Rust library: the same code as the
+``aeromag`` command line, with NumPy arrays in and out.
+
+Quick start (see ``examples/quickstart.py``)::
+
+    import aeromag
+    cal = aeromag.simulate("calibration", seed=1)       # or aeromag.read_flight("cal.h5", lines="1002.02")
+    tl = aeromag.TollesLawson(method="ls").fit(cal)
+    tl.coef_, tl.coef_std_, tl.terms_                      # fitted coefficients
+    survey = aeromag.simulate("survey", seed=2)
+    compensated = tl.transform(survey)                     # nT, NaN where not computable
+    tl.save("model.json")                                  # the CLI's model file
+
+Units: magnetic values in nT, positions in degrees and m (WGS84 ellipsoidal
+height), attitude in degrees, time in s. Files keep their own names
+(``mag_1_uc``, ``INS_LAT`` …); the canonical names (``time``, ``mag``,
+``flux_x`` …) are mapped onto them as the CLI maps them.
+
+Errors: :class:`BadInputError` (a ``ValueError``, with ``file``, ``line``,
+``row``, ``column``) for input that cannot be used, :class:`AeromagError`
+for methods that failed, ``OSError`` for outputs that could not be written.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _aeromag
+from ._aeromag import Flight, Levelled, Model, TlModel, fit_pod, fit_rotor
+from ._aeromag import __version__
+from .errors import AeromagError, BadInputError
+from .tolles_lawson import TollesLawson, load_model
+
+__all__ = [
+    "AeromagError",
+    "BadInputError",
+    "Flight",
+    "Levelled",
+    "Model",
+    "fit_pod",
+    "fit_rotor",
+    "level",
+    "observability",
+    "score",
+    "TlModel",
+    "TollesLawson",
+    "decimal_year",
+    "igrf",
+    "load_model",
+    "read_flight",
+    "simulate",
+    "__version__",
+    "batch",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def read_flight(
+    path: PathLike,
+    columns: Union[None, str, Mapping[str, str]] = None,
+    mag: Optional[str] = None,
+    vector: Optional[str] = None,
+    lines: Union[None, str, float, Iterable[Any]] = None,
+    time_range: Optional[Tuple[float, float]] = None,
+) -> Flight:
+    """Read a flight file: CSV, Geosoft XYZ or HDF5 (MagNav/SGL layout).
+
+    Parameters are the CLI's reading options:
+
+    - ``columns``: canonical name → the file's column, as a dict
+      (``{"mag": "mag_1_uc"}``) or the CLI's text (``"mag=mag_1_uc"``);
+      MagNav/SGL and Geosoft XYZ names are recognised without it;
+    - ``mag``: the scalar magnetometer (``"mag_3_uc"``; XYZ's
+      ``UNCOMPMAG3`` is found by that name too);
+    - ``vector``: the vector magnetometer by prefix (``"flux_b"``);
+    - ``lines``: keep only the rows on these line labels (``"1002.02"``,
+      ``[1003.01, 1003.02]``, ``"L1020,T901"``);
+    - ``time_range``: keep only the rows with ``t0 ≤ time ≤ t1`` (s).
+
+    Raises :class:`BadInputError` naming file, line, row and column.
+    """
+    return _aeromag.read_flight(
+        os.fspath(path), columns=columns, mag=mag, vector=vector, lines=lines, time_range=time_range
+    )
+
+
+def decimal_year(date: str) -> float:
+    """The decimal year of a date ``YYYY-MM-DD`` (``2025-07-02`` → 2025.5)."""
+    return _aeromag.decimal_year(date)
+
+
+def igrf(
+    lat: Any, lon: Any, alt: Any = 0.0, time: Union[str, float, Any] = "2025-01-01"
+) -> Dict[str, np.ndarray]:
+    """The IGRF-14 main field at geodetic points, vectorised.
+
+    ``lat``, ``lon`` in degrees, ``alt`` in m above the WGS84 ellipsoid,
+    ``time`` a date ``"YYYY-MM-DD"``, a decimal year, or an array of
+    decimal years; arrays broadcast against each other (NumPy rules).
+
+    Returns a dict of arrays of the broadcast shape: ``x`` (north), ``y``
+    (east), ``z`` (down), ``f`` (total) in nT, ``declination`` and
+    ``inclination`` in degrees.
+    """
+    if isinstance(time, str):
+        time = decimal_year(time)
+    la, lo, al, ti = np.broadcast_arrays(
+        np.asarray(lat, dtype=np.float64),
+        np.asarray(lon, dtype=np.float64),
+        np.asarray(alt, dtype=np.float64),
+        np.asarray(time, dtype=np.float64),
+    )
+    shape = la.shape
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in (la, lo, al, ti)]
+    x, y, z = _aeromag.igrf(*flat)
+    h = np.hypot(x, y)
+    out = {
+        "x": x,
+        "y": y,
+        "z": z,
+        "f": np.hypot(h, z),
+        "declination": np.degrees(np.arctan2(y, x)),
+        "inclination": np.degrees(np.arctan2(z, h)),
+    }
+    return {k: v.reshape(shape) for k, v in out.items()}
+
+
+def simulate(
+    scenario: str, seed: Optional[int] = None, config: Union[None, str, PathLike] = None
+) -> Flight:
+    """Simulate a flight with truth (``aeromag simulate``).
+
+    ``scenario``: ``"calibration"``, ``"calibration_truncated"``,
+    ``"survey"``, ``"helicopter"`` or ``"pod"``; ``seed`` the random seed
+    (the scenario's default when None); ``config`` a scenario file (TOML)
+    by path, or its text. The flight carries ``true_…`` columns (truth:
+    estimators never read them).
+    """
+    text = None
+    if config is not None:
+        path = os.fspath(config)
+        text = open(path, encoding="utf-8").read() if os.path.isfile(path) else str(config)
+    return _aeromag.simulate(scenario, seed=seed, config=text)
+
+
+def _year(date: Union[None, str, float]) -> Optional[float]:
+    return decimal_year(date) if isinstance(date, str) else date
+
+
+def score(
+    flight: Flight,
+    reference: Union[None, str, Sequence[str]] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    date: Union[None, str, float] = None,
+) -> Dict[str, Any]:
+    """The figures of a compensated flight (``aeromag report``'s figures.json).
+
+    ``flight`` must have ``mag_comp`` (``model.apply(flight)`` adds it).
+    ``reference``: external-field channels removed before the FOM and IR
+    (None/``"auto"``: ``diurnal`` and ``igrf`` when present; ``"none"``; a
+    list). Returns ``fom_before_nt``, ``fom_after_nt``, ``fom_windows``,
+    ``ir`` (None with a reason when they cannot be computed), and for
+    simulated flights ``residual_rms_nt``, ``interference_rms_nt``,
+    ``noise_floor_nt`` and per-line residuals.
+    """
+    import json
+
+    return json.loads(_aeromag.score(flight, reference=reference, lever_arm=lever_arm, decimal_year=_year(date)))
+
+
+def observability(
+    flight: Flight,
+    terms: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    date: Union[None, str, float] = None,
+    progress: Any = None,
+) -> Dict[str, Any]:
+    """What a calibration flight determines (``aeromag observability``).
+
+    Returns ``rank``, ``condition``, ``eigenvalues``, ``weak_combinations``,
+    ``undetermined`` (term names) and ``coefficients``: per term ``name``,
+    ``mu`` (estimability: 0 determined by the flight, 1 left at its prior),
+    ``std``, ``effect_std_nt`` and ``verdict``.
+    """
+    import json
+
+    from .tolles_lawson import progress_callback
+
+    return json.loads(
+        _aeromag.observability(
+            flight, terms=terms, lever_arm=lever_arm, decimal_year=_year(date), progress=progress_callback(progress)
+        )
+    )
+
+
+def level(
+    flight: Flight,
+    value: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    rate_of: Optional[str] = None,
+    tie_only: bool = False,
+    drift: bool = False,
+    no_altitude_term: bool = False,
+    no_robust: bool = False,
+    ridge_lambda: Optional[float] = None,
+    reference: Union[None, str, Sequence[str]] = None,
+    ties: Optional[Sequence[str]] = None,
+    progress: Any = None,
+) -> Levelled:
+    """Level a survey at its line/tie-line crossovers (``aeromag level``).
+
+    The keywords are the command's flags (``--lambda`` → ``ridge_lambda``):
+    ``value`` the column to level (default ``mag_comp``, else ``mag``),
+    ``lever_arm`` the sensor's position (m, body frame), ``rate_of`` the
+    column whose derivative is the ``k·d|B0|/dt`` regressor, ``tie_only``
+    classic tie-line levelling, ``drift`` a linear drift per line,
+    ``reference`` channels removed first (default none), ``ties`` the tie
+    line labels when neither ``line_type`` nor ``L``/``T`` labels say.
+
+    Returns a :class:`Levelled`: ``levelled`` (nT), ``flags``, ``k_s``
+    (k, σ in s), ``rms_nt``, ``line_levels``, ``crossovers()`` (the
+    crossover table as a Flight), ``to_flight()``.
+    """
+    from .tolles_lawson import progress_callback
+
+    return _aeromag.level(
+        flight,
+        value=value,
+        lever_arm=lever_arm,
+        rate_of=rate_of,
+        tie_only=tie_only,
+        drift=drift,
+        no_altitude_term=no_altitude_term,
+        no_robust=no_robust,
+        ridge_lambda=ridge_lambda,
+        reference=reference,
+        ties=None if ties is None else [str(t) for t in ties],
+        progress=progress_callback(progress),
+    )
+
+
+from .batch import batch  # noqa: E402

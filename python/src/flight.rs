@@ -1,0 +1,312 @@
+//! `aeromag.Flight`: a flight record (columns of equal length) read from a
+//! file or built from arrays, checked as the CLI checks it.
+
+use crate::errors::{IntoPy, bad_argument};
+use aeromag::io::{ColumnData, Missing, table_from_columns};
+use aeromag::{ColumnMap, Flight, ReadOptions, RowSelection, Sensors};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyKeyError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+
+/// A flight record: named columns of equal length (numbers, or text such
+/// as line labels `L1010`), with the canonical names (`time`, `mag`,
+/// `flux_x`, …) mapped onto the file's names.
+#[pyclass(name = "Flight", module = "aeromag._aeromag", frozen)]
+pub struct PyFlight {
+    pub inner: Flight,
+}
+
+impl PyFlight {
+    pub fn new(inner: Flight) -> Self {
+        Self { inner }
+    }
+}
+
+/// How to read: the `--columns`, `--mag`, `--vector`, `--lines` and
+/// `--time-range` choices of the CLI, parsed by the same library calls.
+pub fn read_options(
+    columns: Option<&str>,
+    mag: Option<String>,
+    vector: Option<String>,
+    lines: Option<&str>,
+    time_range: Option<&str>,
+) -> PyResult<ReadOptions> {
+    Ok(ReadOptions {
+        columns: match columns {
+            Some(m) => ColumnMap::parse(m).py_err()?,
+            None => ColumnMap::new(),
+        },
+        sensors: Sensors { mag, vector },
+        rows: RowSelection::parse(lines, time_range).py_err()?,
+        ..ReadOptions::default()
+    })
+}
+
+/// A label or a list of labels as the CLI's comma list.
+fn comma_list(v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<String>> {
+    let Some(v) = v.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    if v.is_instance_of::<pyo3::types::PyString>() || v.extract::<f64>().is_ok() {
+        return Ok(Some(v.str()?.to_string()));
+    }
+    let parts: Vec<String> = v
+        .try_iter()?
+        .map(|x| x.and_then(|x| x.str().map(|s| s.to_string())))
+        .collect::<PyResult<_>>()?;
+    Ok(Some(parts.join(",")))
+}
+
+/// `{"mag": "mag_1_uc"}` or `"mag=mag_1_uc"` as the CLI's `--columns`.
+fn column_map(v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<String>> {
+    let Some(v) = v.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    if let Ok(d) = v.cast::<PyDict>() {
+        let pairs: Vec<String> = d
+            .iter()
+            .map(|(k, v)| Ok(format!("{}={}", k.str()?, v.str()?)))
+            .collect::<PyResult<_>>()?;
+        return Ok(Some(pairs.join(",")));
+    }
+    Ok(Some(v.str()?.to_string()))
+}
+
+/// The library's reading options for Python's arguments.
+fn python_read_options(
+    columns: Option<&Bound<'_, PyAny>>,
+    mag: Option<String>,
+    vector: Option<String>,
+    lines: Option<&Bound<'_, PyAny>>,
+    time_range: Option<(f64, f64)>,
+) -> PyResult<ReadOptions> {
+    let range = time_range.map(|(a, b)| format!("{a:?},{b:?}"));
+    read_options(
+        column_map(columns)?.as_deref(),
+        mag,
+        vector,
+        comma_list(lines)?.as_deref(),
+        range.as_deref(),
+    )
+}
+
+/// Read a flight file (CSV, Geosoft XYZ or HDF5) with the Python layer's
+/// choices already turned into the CLI's strings.
+#[pyfunction]
+#[pyo3(signature = (path, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+pub fn read_flight(
+    py: Python<'_>,
+    path: PathBuf,
+    columns: Option<Bound<'_, PyAny>>,
+    mag: Option<String>,
+    vector: Option<String>,
+    lines: Option<Bound<'_, PyAny>>,
+    time_range: Option<(f64, f64)>,
+) -> PyResult<PyFlight> {
+    let opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
+    let flight = py.detach(|| Flight::read_with(&path, &opts)).py_err()?;
+    Ok(PyFlight::new(flight))
+}
+
+#[pymethods]
+impl PyFlight {
+    /// A flight from arrays named as in the files (`{"tt": …, "mag_1_uc":
+    /// …}` or canonical names): numbers as float64 (NaN = missing), text
+    /// columns (str arrays or lists) kept as text. The same mapping,
+    /// selection and checks as a file.
+    #[staticmethod]
+    #[pyo3(signature = (data, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+    fn from_dict(
+        py: Python<'_>,
+        data: &Bound<'_, PyDict>,
+        columns: Option<Bound<'_, PyAny>>,
+        mag: Option<String>,
+        vector: Option<String>,
+        lines: Option<Bound<'_, PyAny>>,
+        time_range: Option<(f64, f64)>,
+    ) -> PyResult<PyFlight> {
+        let opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
+        let np = py.import("numpy")?;
+        let mut cols: Vec<(String, ColumnData)> = Vec::with_capacity(data.len());
+        for (k, v) in data.iter() {
+            let name: String = k
+                .extract()
+                .map_err(|_| bad_argument(format!("column names must be str, got {k}")))?;
+            let arr = np.call_method1("asarray", (&v,))?;
+            let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+            let col = match kind.as_str() {
+                "f" | "i" | "u" | "b" => {
+                    let a = np
+                        .call_method1("ascontiguousarray", (&arr, "float64"))?
+                        .cast_into::<PyArray1<f64>>()
+                        .map_err(|_| {
+                            bad_argument(format!("column '{name}' must be one-dimensional"))
+                        })?;
+                    let values = a.readonly().as_slice()?.to_vec();
+                    let nan = values.iter().filter(|x| x.is_nan()).count();
+                    ColumnData::Numeric {
+                        values,
+                        missing: Missing {
+                            nan,
+                            ..Missing::default()
+                        },
+                    }
+                }
+                "U" | "S" | "O" => {
+                    if arr.getattr("ndim")?.extract::<usize>()? != 1 {
+                        return Err(bad_argument(format!(
+                            "column '{name}' must be one-dimensional"
+                        )));
+                    }
+                    let text: Vec<String> = arr
+                        .call_method0("tolist")?
+                        .try_iter()?
+                        .map(|x| x.and_then(|x| x.str().map(|s| s.to_string())))
+                        .collect::<PyResult<_>>()?;
+                    ColumnData::Text(text)
+                }
+                other => {
+                    return Err(bad_argument(format!(
+                        "column '{name}' has NumPy dtype kind '{other}'; give numbers or text"
+                    )));
+                }
+            };
+            cols.push((name, col));
+        }
+        let flight = py
+            .detach(|| {
+                table_from_columns(cols, &opts)
+                    .map_err(aeromag::Error::from)
+                    .and_then(Flight::from_table)
+            })
+            .py_err()?;
+        Ok(PyFlight::new(flight))
+    }
+
+    /// A flight from a pandas DataFrame, its columns named as in the files
+    /// (`Flight.from_dict` of its columns).
+    #[staticmethod]
+    #[pyo3(signature = (df, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+    fn from_pandas(
+        py: Python<'_>,
+        df: &Bound<'_, PyAny>,
+        columns: Option<Bound<'_, PyAny>>,
+        mag: Option<String>,
+        vector: Option<String>,
+        lines: Option<Bound<'_, PyAny>>,
+        time_range: Option<(f64, f64)>,
+    ) -> PyResult<PyFlight> {
+        let data = PyDict::new(py);
+        for name in df.getattr("columns")?.try_iter()? {
+            let name = name?;
+            let values = df.get_item(&name)?.call_method0("to_numpy")?;
+            data.set_item(name.str()?, values)?;
+        }
+        Self::from_dict(py, &data, columns, mag, vector, lines, time_range)
+    }
+
+    /// Every column as a dict of NumPy arrays (file names).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for name in self.inner.column_names() {
+            d.set_item(name, self.__getitem__(py, name)?)?;
+        }
+        Ok(d)
+    }
+
+    /// A pandas DataFrame of every column (needs pandas).
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pd = py.import("pandas")?;
+        pd.call_method1("DataFrame", (self.to_dict(py)?,))
+    }
+
+    /// A polars DataFrame of every column (needs polars).
+    fn to_polars<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pl = py.import("polars")?;
+        pl.call_method1("DataFrame", (self.to_dict(py)?,))
+    }
+
+    /// Write the flight as CSV (as the CLI writes tables: atomically,
+    /// numbers in their shortest exact form, integer columns as read).
+    fn to_csv(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| aeromag::io::write_csv(self.inner.table(), &path))
+            .py_err()
+    }
+
+    /// Number of rows.
+    fn __len__(&self) -> usize {
+        self.inner.n_rows()
+    }
+
+    /// The column `name` (a file name, or a canonical name such as `mag`
+    /// through the mapping) as a new NumPy array: float64 for numbers, str
+    /// for text columns.
+    fn __getitem__<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(v) = self.inner.column(name) {
+            return Ok(PyArray1::from_slice(py, v).into_any());
+        }
+        if let Some(t) = self.inner.text_column(name) {
+            let list = PyList::new(py, t)?;
+            return py.import("numpy")?.call_method1("array", (list,));
+        }
+        Err(PyKeyError::new_err(format!(
+            "no column '{name}' in {} (columns: {})",
+            self.inner.label(),
+            self.inner.column_names().join(", ")
+        )))
+    }
+
+    fn __contains__(&self, name: &str) -> bool {
+        self.inner.get(name).is_some()
+    }
+
+    /// The columns, as the file names them (derived canonical columns,
+    /// such as `lat` from the radians of `ins_lat`, included).
+    #[getter]
+    fn columns(&self) -> Vec<String> {
+        self.inner
+            .column_names()
+            .into_iter()
+            .map(String::from)
+            .collect()
+    }
+
+    /// Canonical name → the file's column that plays it (`{"mag":
+    /// "mag_1_uc", …}`).
+    #[getter]
+    fn mapping(&self) -> Vec<(String, String)> {
+        self.inner
+            .mapping()
+            .iter()
+            .map(|m| (m.canonical.clone(), m.file_column.clone()))
+            .collect()
+    }
+
+    /// The file read (None for a flight built in memory).
+    #[getter]
+    fn file(&self) -> Option<String> {
+        self.inner.source().map(|p| p.display().to_string())
+    }
+
+    /// The warnings raised when the flight was read and checked (named
+    /// kinds: field range, radians, …).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner
+            .warnings()
+            .iter()
+            .map(|n| n.message.clone())
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<aeromag.Flight {}: {} rows, {} columns>",
+            self.inner.label(),
+            self.inner.n_rows(),
+            self.inner.columns().len()
+        )
+    }
+}

@@ -1,0 +1,51 @@
+//! The Rust extension of the `aeromag` Python package (`aeromag._aeromag`).
+//!
+//! Thin bindings over the `aeromag` library: every function calls one
+//! library entry point, as the CLI does, so Python and CLI give the same
+//! numbers from the same code. The Pythonic layer (estimator classes,
+//! pandas, progress bars) is in `python/aeromag/*.py`.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`flight`] | `Flight`, `read_flight` |
+//! | [`tolles_lawson`] | `calibrate`, `TlModel`, `load_model`, `observability` |
+//! | [`level`] | `level`, `Levelled`, `score` |
+//! | [`rotor_pod`] | `fit_rotor`, `fit_pod`, `Model` |
+//! | [`fields`] | `igrf` |
+//! | [`simulate`] | `simulate` |
+//! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
+//! | [`progress`] | progress callbacks from the library's observer |
+
+mod errors;
+mod fields;
+mod flight;
+mod level;
+mod progress;
+mod rotor_pod;
+mod simulate;
+mod tolles_lawson;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<flight::PyFlight>()?;
+    m.add_function(wrap_pyfunction!(flight::read_flight, m)?)?;
+    m.add_class::<tolles_lawson::PyTlModel>()?;
+    m.add_function(wrap_pyfunction!(tolles_lawson::calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(tolles_lawson::check_calibrate_options, m)?)?;
+    m.add_function(wrap_pyfunction!(tolles_lawson::calibrate_defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(tolles_lawson::load_model, m)?)?;
+    m.add_function(wrap_pyfunction!(tolles_lawson::observability, m)?)?;
+    m.add_class::<rotor_pod::PyModel>()?;
+    m.add_function(wrap_pyfunction!(rotor_pod::fit_rotor, m)?)?;
+    m.add_function(wrap_pyfunction!(rotor_pod::fit_pod, m)?)?;
+    m.add_class::<level::PyLevelled>()?;
+    m.add_function(wrap_pyfunction!(level::level, m)?)?;
+    m.add_function(wrap_pyfunction!(level::score, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::igrf, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::decimal_year, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,264 @@
+//! Helicopter rotor and towed-pod models (`aeromag rotor fit|apply`,
+//! `aeromag pod fit|apply`): fitted on a flight, they apply themselves to
+//! flights like the Tolles-Lawson model.
+
+use crate::errors::{IntoPy, bad_argument};
+use crate::flight::PyFlight;
+use crate::progress::PyProgress;
+use aeromag::pod::{PodModelFile, PodSetup, apply_pod, fit_pod as lib_fit_pod};
+use aeromag::rotor::{
+    RotorChoices, RotorModelFile, RotorOptions, RotorPreset, fit_rotor as lib_fit_rotor,
+};
+use aeromag::{Compensator, Flight, ModelFile, Note};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// A rotor or a pod model.
+pub enum AnyModel {
+    Rotor(RotorModelFile),
+    Pod(PodModelFile),
+}
+
+impl AnyModel {
+    fn compensator(&self) -> &dyn Compensator {
+        match self {
+            AnyModel::Rotor(m) => m,
+            AnyModel::Pod(m) => m,
+        }
+    }
+
+    fn json(&self) -> aeromag::Result<String> {
+        match self {
+            AnyModel::Rotor(m) => m.json(),
+            AnyModel::Pod(m) => m.json(),
+        }
+    }
+
+    fn write(&self, path: &std::path::Path) -> aeromag::Result<()> {
+        match self {
+            AnyModel::Rotor(m) => m.write(path),
+            AnyModel::Pod(m) => m.write(path),
+        }
+    }
+}
+
+/// A fitted helicopter-rotor or towed-pod model (the model file of `aeromag
+/// rotor fit` / `aeromag pod fit`); it applies itself to flights.
+#[pyclass(name = "Model", module = "aeromag._aeromag", frozen)]
+pub struct PyModel {
+    pub model: AnyModel,
+    pub notes: Vec<Note>,
+}
+
+#[pymethods]
+impl PyModel {
+    /// `helicopter-rotor` or `towed-pod`.
+    #[getter]
+    fn kind(&self) -> &'static str {
+        match &self.model {
+            AnyModel::Rotor(_) => "helicopter-rotor",
+            AnyModel::Pod(_) => "towed-pod",
+        }
+    }
+
+    /// The fitted parameters (rotor: the blade model's; pod: the method's
+    /// coefficients).
+    #[getter]
+    fn coef<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v = match &self.model {
+            AnyModel::Rotor(m) => m.model.params.clone(),
+            AnyModel::Pod(m) => m.coefficients.clone(),
+        };
+        PyArray1::from_vec(py, v)
+    }
+
+    /// Notes and warnings of the fit.
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.notes.iter().map(|n| n.to_string()).collect()
+    }
+
+    /// The modelled interference of every row of `flight`, nT (NaN where
+    /// it cannot be computed).
+    fn interference<'py>(
+        &self,
+        py: Python<'py>,
+        flight: &PyFlight,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let v = py
+            .detach(|| self.model.compensator().interference(&flight.inner))
+            .py_err()?;
+        Ok(PyArray1::from_vec(py, v))
+    }
+
+    /// `mag` minus the modelled interference, nT.
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        flight: &PyFlight,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let c = py
+            .detach(|| self.model.compensator().compensate(&flight.inner))
+            .py_err()?;
+        Ok(PyArray1::from_vec(py, c.compensated_nt))
+    }
+
+    /// The flight with the model's output columns added, as `apply --out`
+    /// writes it.
+    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
+        let f = py
+            .detach(|| {
+                self.model
+                    .compensator()
+                    .compensate(&flight.inner)
+                    .and_then(|c| c.into_flight(flight.inner.clone()))
+            })
+            .py_err()?;
+        Ok(PyFlight::new(f))
+    }
+
+    /// Per heading of a pod flight: (heading °, first row, end row, rate of
+    /// interference removed); empty for a rotor model.
+    fn heading_rates(&self, flight: &PyFlight) -> PyResult<Vec<(f64, usize, usize, f64)>> {
+        let AnyModel::Pod(m) = &self.model else {
+            return Ok(Vec::new());
+        };
+        let a = apply_pod(m, &flight.inner).py_err()?;
+        Ok(a.per_heading
+            .iter()
+            .map(|h| (h.heading_deg, h.rows[0], h.rows[1], h.rate))
+            .collect())
+    }
+
+    /// The model file's text (JSON), what the CLI writes.
+    fn to_json(&self) -> PyResult<String> {
+        self.model.json().py_err()
+    }
+
+    /// Write the model file (atomically).
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        self.model.write(&path).py_err()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<aeromag.Model {}>", self.kind())
+    }
+}
+
+/// Fit the helicopter main-rotor model (`aeromag rotor fit`; the keywords
+/// are its flags).
+#[pyfunction]
+#[pyo3(signature = (flight, preset=None, hub_m=None, sensor_m=None, blade_span_m=None, blades=None,
+    coning_deg=None, tilt_lon_deg=None, phase_column=None, estimate_phase=false, rotor_hz=None,
+    window_s=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit_rotor(
+    py: Python<'_>,
+    flight: &PyFlight,
+    preset: Option<&str>,
+    hub_m: Option<[f64; 3]>,
+    sensor_m: Option<[f64; 3]>,
+    blade_span_m: Option<[f64; 2]>,
+    blades: Option<usize>,
+    coning_deg: Option<f64>,
+    tilt_lon_deg: Option<f64>,
+    phase_column: Option<String>,
+    estimate_phase: bool,
+    rotor_hz: Option<[f64; 2]>,
+    window_s: Option<f64>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<PyModel> {
+    let preset = preset
+        .map(|p| {
+            RotorPreset::ALL
+                .into_iter()
+                .find(|k| k.name() == p)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = RotorPreset::ALL.iter().map(|k| k.name()).collect();
+                    bad_argument(format!(
+                        "unknown rotor preset '{p}' (presets: {})",
+                        names.join(", ")
+                    ))
+                })
+        })
+        .transpose()?;
+    let opts = RotorOptions::from_choices(&RotorChoices {
+        preset,
+        hub_m,
+        sensor_m,
+        blade_span_m,
+        blades,
+        coning_deg,
+        tilt_lon_deg,
+        phase_column,
+        estimate_phase,
+        rotor_hz,
+        window_s,
+    })
+    .py_err()?;
+    let mut obs = PyProgress::new(progress);
+    let result = py.detach(|| lib_fit_rotor(&flight.inner, &opts, &mut obs));
+    obs.finish()?;
+    let fit = result.py_err()?;
+    Ok(PyModel {
+        model: AnyModel::Rotor(fit.model),
+        notes: fit.notes,
+    })
+}
+
+/// Fit the towed-pod model (`aeromag pod fit`; the keywords are its flags;
+/// `method` is `dipole-array` (default), `two-step` or `joint`;
+/// `source_points` the dipole positions (m) of the dipole-array method).
+#[pyfunction]
+#[pyo3(signature = (flight, cable_length_m, inclination_deg, attach_m=None, declination_deg=0.0,
+    grad_north_nt_per_km=0.0, grad_up_nt_per_km=0.0, method="dipole-array", source_points=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit_pod(
+    py: Python<'_>,
+    flight: &PyFlight,
+    cable_length_m: f64,
+    inclination_deg: f64,
+    attach_m: Option<[f64; 3]>,
+    declination_deg: f64,
+    grad_north_nt_per_km: f64,
+    grad_up_nt_per_km: f64,
+    method: &str,
+    source_points: Option<Vec<[f64; 3]>>,
+) -> PyResult<PyModel> {
+    let method = aeromag::pod::PodMethod::ALL
+        .into_iter()
+        .find(|m| m.name() == method)
+        .ok_or_else(|| {
+            bad_argument(format!(
+                "method must be dipole-array, two-step or joint, got '{method}'"
+            ))
+        })?;
+    let setup = PodSetup {
+        cable_length_m,
+        attach_m: attach_m.unwrap_or_default(),
+        inclination_deg,
+        declination_deg,
+        grad_north_nt_per_km,
+        grad_up_nt_per_km,
+    };
+    let model = py
+        .detach(|| lib_fit_pod(&flight.inner, &setup, method, source_points.as_deref()))
+        .py_err()?;
+    Ok(PyModel {
+        model: AnyModel::Pod(model),
+        notes: Vec::new(),
+    })
+}
+
+/// A rotor or pod model file by its `kind`.
+pub fn read_model(path: &std::path::Path, kind: &str) -> PyResult<PyModel> {
+    let model = match kind {
+        "helicopter-rotor" => AnyModel::Rotor(RotorModelFile::read(path).py_err()?),
+        _ => AnyModel::Pod(PodModelFile::read(path).py_err()?),
+    };
+    Ok(PyModel {
+        model,
+        notes: Vec::new(),
+    })
+}

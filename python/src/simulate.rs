@@ -1,0 +1,35 @@
+//! The physical simulator (`aeromag simulate`): flights with truth.
+
+use crate::errors::{IntoPy, bad_argument};
+use crate::flight::PyFlight;
+use aeromag::sim::ScenarioKind;
+use aeromag::simulate::simulate_flight;
+use pyo3::prelude::*;
+
+/// Simulate a scenario (`calibration`, `calibration_truncated`, `survey`,
+/// `helicopter`, `pod`) with a seed and a scenario configuration (TOML
+/// text); the flight carries the `true_…` columns.
+#[pyfunction]
+#[pyo3(signature = (scenario, seed=None, config=None))]
+pub fn simulate(
+    py: Python<'_>,
+    scenario: &str,
+    seed: Option<u64>,
+    config: Option<String>,
+) -> PyResult<PyFlight> {
+    let wanted = scenario.replace('-', "_");
+    let kind = ScenarioKind::ALL
+        .into_iter()
+        .find(|k| k.name() == wanted)
+        .ok_or_else(|| {
+            let names: Vec<&str> = ScenarioKind::ALL.iter().map(|k| k.name()).collect();
+            bad_argument(format!(
+                "unknown scenario '{scenario}' (scenarios: {})",
+                names.join(", ")
+            ))
+        })?;
+    let flight = py
+        .detach(|| simulate_flight(kind, config.as_deref(), seed))
+        .py_err()?;
+    Ok(PyFlight::new(flight))
+}

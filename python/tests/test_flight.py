@@ -1,0 +1,103 @@
+"""Reading flights, building them from arrays and DataFrames."""
+
+import pathlib
+
+import numpy as np
+import pytest
+
+import aeromag
+from conftest import ROOT
+
+HDF5 = ROOT / "crates" / "io" / "tests" / "data" / "hdf5"
+
+
+def test_read_csv_columns_and_arrays(cal, cal_csv):
+    assert len(cal) > 1000
+    assert cal.file == str(cal_csv)
+    for c in ["time", "mag", "flux_x", "line", "true_interf"]:
+        assert c in cal.columns and c in cal
+    mag = cal["mag"]
+    assert isinstance(mag, np.ndarray) and mag.dtype == np.float64 and mag.shape == (len(cal),)
+    # A new array each time: changing it does not change the flight.
+    mag[0] = 0.0
+    assert cal["mag"][0] != 0.0
+    with pytest.raises(KeyError, match="no column 'nosuch'"):
+        cal["nosuch"]
+
+
+def test_hdf5_sgl_layout_with_sensor_and_line_choice():
+    path = HDF5 / "root_gzip.h5"
+    f = aeromag.read_flight(path)
+    # SGL names mapped onto canonical ones; lat derived from ins_lat (rad).
+    assert dict(f.mapping)["mag"] == "mag_1_uc"
+    assert np.array_equal(f["mag"], f["mag_1_uc"])
+    g = aeromag.read_flight(path, mag="mag_2_uc", lines=[1001])
+    assert dict(g.mapping)["mag"] == "mag_2_uc"
+    assert 0 < len(g) < len(f)
+    assert np.all(g["line"] == 1001)
+    # The same selection as text, as the CLI's --lines.
+    assert len(aeromag.read_flight(path, lines="1001")) == len(g)
+
+
+def test_time_range_and_column_map(cal_csv):
+    f = aeromag.read_flight(cal_csv)
+    t0 = f["time"][0]
+    g = aeromag.read_flight(cal_csv, time_range=(t0, t0 + 10.0))
+    assert np.all((g["time"] >= t0) & (g["time"] <= t0 + 10.0)) and len(g) > 10
+    h = aeromag.read_flight(cal_csv, columns={"mag": "true_interf"})
+    assert np.array_equal(h["mag"], f["true_interf"])
+
+
+def test_from_dict_maps_file_names_and_checks():
+    n = 200
+    t = np.arange(n) * 0.1
+    data = {
+        "tt": t,
+        "ins_lat": np.full(n, np.radians(45.0)),
+        "ins_lon": np.full(n, np.radians(10.0)),
+        "mag_1_uc": np.full(n, 50000.0),
+        "line": np.where(t < 10, 1001.0, 1002.0),
+    }
+    f = aeromag.Flight.from_dict(data)
+    assert f.file is None and len(f) == n
+    # The SGL preset: time from tt, lat/lon in degrees from radians.
+    assert np.allclose(f["time"], t) and np.allclose(f["lat"], 45.0)
+    g = aeromag.Flight.from_dict(data, lines=[1002])
+    assert len(g) == 100
+    # Time going backwards is bad input naming the row.
+    bad = dict(data, tt=t[::-1].copy())
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.Flight.from_dict(bad)
+    assert e.value.column == "tt" or e.value.column == "time"
+    assert e.value.row == 1
+    with pytest.raises(aeromag.BadInputError):
+        aeromag.Flight.from_dict({"a": np.zeros(3), "b": np.zeros(4)})
+
+
+def test_pandas_round_trip(cal):
+    pd = pytest.importorskip("pandas")
+    df = cal.to_pandas()
+    assert isinstance(df, pd.DataFrame) and df.shape == (len(cal), len(cal.columns))
+    back = aeromag.Flight.from_pandas(df)
+    assert back.columns == cal.columns
+    for c in cal.columns:
+        np.testing.assert_array_equal(back[c], cal[c])
+    # Text columns (line labels) stay text.
+    df["line"] = ["L" + str(int(x)) for x in df["line"]]
+    f = aeromag.Flight.from_pandas(df)
+    assert f["line"][0].startswith("L")
+
+
+def test_polars_when_installed(cal):
+    pl = pytest.importorskip("polars")
+    df = cal.to_polars()
+    assert df.height == len(cal)
+
+
+def test_simulate_with_config_and_truth():
+    f = aeromag.simulate("calibration", seed=3)
+    assert "true_interf" in f.columns
+    g = aeromag.simulate("calibration", seed=3)
+    np.testing.assert_array_equal(f["mag"], g["mag"])  # seeded: identical
+    with pytest.raises(aeromag.BadInputError, match="unknown scenario"):
+        aeromag.simulate("nosuch")
