@@ -16,9 +16,12 @@ if ! python3 -c "import numpy, h5py" >/dev/null 2>&1; then
     echo "numpy/h5py not found; installing them from PyPI for the HDF5 tests" >&2
     python3 -m pip install --quiet --user numpy h5py || python3 -m pip install --quiet numpy h5py
 fi
+phase() { echo "== $1 (${SECONDS}s since start)" >&2; }
 cargo nextest run --workspace --release --no-fail-fast "$@"
+phase "Rust tests done"
 # nextest does not run doc tests
 cargo test --workspace --release --doc
+phase "doc tests done"
 # The Python package: built once (release, the workspace's target folder)
 # and installed into this Python, then its tests (pytest), which compare
 # with the CLI binary the Rust tests built.
@@ -31,7 +34,8 @@ def missing(mod):
     except ModuleNotFoundError:
         return True
 print(" ".join(spec for spec, mod in [("maturin", "maturin"), ("pytest", "pytest"), ("pandas", "pandas"),
-                                      ("dask[distributed]", "dask.distributed")] if missing(mod)))
+                                      ("dask[distributed]", "dask.distributed"), ("mypy", "mypy")]
+               if missing(mod)))
 PY
 )
 if [ -n "$missing" ]; then
@@ -40,4 +44,6 @@ if [ -n "$missing" ]; then
     python3 -m pip install --quiet $missing
 fi
 python3 -m pip install --quiet --no-build-isolation ./python
+phase "Python package built"
 AEROMAG_BIN="$PWD/target/release/aeromag" python3 -m pytest -q python/tests
+phase "Python tests done"

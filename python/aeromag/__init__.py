@@ -31,7 +31,7 @@ from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, T
 import numpy as np
 
 from . import _aeromag
-from ._aeromag import Flight, Levelled, Model, TlModel, fit_pod, fit_rotor
+from ._aeromag import Flight, Levelled, Model, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
 from .errors import AeromagError, BadInputError
 from .tolles_lawson import TollesLawson, load_model
@@ -44,6 +44,9 @@ __all__ = [
     "Model",
     "fit_pod",
     "fit_rotor",
+    "dipole_crlb",
+    "locate_dipole",
+    "simulate_gradiometer",
     "level",
     "observability",
     "score",
@@ -246,3 +249,13 @@ def level(
 
 
 from .batch import batch  # noqa: E402
+
+
+def dipole_crlb(config: Union[None, PathLike] = None) -> Dict[str, Any]:
+    """The Cramér–Rao bound of a gradiometer pass (``aeromag dipole crlb --json``):
+    standard deviations of position (m) and moment (A·m²) from every epoch up
+    to the closest approach and to the end of the pass; ``config`` a
+    gradiometer scenario file (default: the built-in pass)."""
+    import json
+
+    return json.loads(_aeromag.dipole_crlb(None if config is None else os.fspath(config)))

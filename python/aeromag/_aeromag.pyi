@@ -1,17 +1,41 @@
 """Type stubs of the Rust extension (aeromag._aeromag). Units: nT, degrees,
 m, s; rows are the file's data rows, 0-based."""
 
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = [
+    "__version__",
+    "Flight",
+    "read_flight",
+    "TlModel",
+    "calibrate",
+    "check_calibrate_options",
+    "calibrate_defaults",
+    "load_model",
+    "observability",
+    "Model",
+    "fit_rotor",
+    "fit_pod",
+    "locate_dipole",
+    "dipole_crlb",
+    "simulate_gradiometer",
+    "Levelled",
+    "level",
+    "score",
+    "igrf",
+    "decimal_year",
+    "simulate",
+]
 
-Labels = Union[None, str, float, Sequence[Union[str, float]]]
-ColumnMapLike = Union[None, str, Mapping[str, str]]
-Progress = Optional[Callable[[str, int, int], Any]]
+_Labels = Union[None, str, float, Sequence[Union[str, float]]]
+_ColumnMapLike = Union[None, str, Mapping[str, str]]
+_Progress = Optional[Callable[[str, int, int], Any]]
 
+@final
 class Flight:
     """A flight record: named columns of equal length, canonical names
     (time, mag, flux_x, …) mapped onto the file's names."""
@@ -19,27 +43,28 @@ class Flight:
     @staticmethod
     def from_dict(
         data: Mapping[str, Any],
-        columns: ColumnMapLike = None,
+        columns: _ColumnMapLike = None,
         mag: Optional[str] = None,
         vector: Optional[str] = None,
-        lines: Labels = None,
+        lines: _Labels = None,
         time_range: Optional[Tuple[float, float]] = None,
     ) -> "Flight": ...
     @staticmethod
     def from_pandas(
         df: Any,
-        columns: ColumnMapLike = None,
+        columns: _ColumnMapLike = None,
         mag: Optional[str] = None,
         vector: Optional[str] = None,
-        lines: Labels = None,
+        lines: _Labels = None,
         time_range: Optional[Tuple[float, float]] = None,
     ) -> "Flight": ...
     def to_dict(self) -> Dict[str, np.ndarray]: ...
+    def to_csv(self, path: str) -> None: ...
     def to_pandas(self) -> Any: ...
     def to_polars(self) -> Any: ...
     def __len__(self) -> int: ...
-    def __getitem__(self, name: str) -> np.ndarray: ...
-    def __contains__(self, name: str) -> bool: ...
+    def __getitem__(self, name: str, /) -> np.ndarray: ...
+    def __contains__(self, name: str, /) -> bool: ...
     @property
     def columns(self) -> List[str]: ...
     @property
@@ -49,6 +74,7 @@ class Flight:
     @property
     def warnings(self) -> List[str]: ...
 
+@final
 class TlModel:
     """A fitted Tolles-Lawson model (the model file of `aeromag calibrate`)."""
 
@@ -68,21 +94,22 @@ class TlModel:
     def series(self) -> Optional[Dict[str, npt.NDArray[np.float64]]]: ...
     def interference(self, flight: Flight) -> npt.NDArray[np.float64]: ...
     def compensate(self, flight: Flight) -> npt.NDArray[np.float64]: ...
+    def apply(self, flight: Flight) -> Flight: ...
     def to_json(self) -> str: ...
     def save(self, path: str) -> None: ...
 
 def read_flight(
     path: str,
-    columns: ColumnMapLike = None,
+    columns: _ColumnMapLike = None,
     mag: Optional[str] = None,
     vector: Optional[str] = None,
-    lines: Labels = None,
+    lines: _Labels = None,
     time_range: Optional[Tuple[float, float]] = None,
 ) -> Flight: ...
-def calibrate(flight: Flight, params: Mapping[str, Any], progress: Progress = None) -> TlModel: ...
+def calibrate(flight: Flight, params: Mapping[str, Any], progress: _Progress = None) -> TlModel: ...
 def check_calibrate_options(params: Mapping[str, Any]) -> None: ...
 def calibrate_defaults() -> Dict[str, Any]: ...
-def load_model(path: str) -> TlModel: ...
+def load_model(path: str) -> Union[TlModel, "Model"]: ...
 def decimal_year(date: str) -> float: ...
 def igrf(
     lat_deg: npt.NDArray[np.float64],
@@ -91,3 +118,109 @@ def igrf(
     decimal_year: npt.NDArray[np.float64],
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def simulate(scenario: str, seed: Optional[int] = None, config: Optional[str] = None) -> Flight: ...
+
+@final
+class Model:
+    """A fitted helicopter-rotor or towed-pod model (`aeromag rotor fit`, `aeromag pod fit`)."""
+
+    @property
+    def kind(self) -> str: ...
+    @property
+    def coef(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def notes(self) -> List[str]: ...
+    def interference(self, flight: Flight) -> npt.NDArray[np.float64]: ...
+    def compensate(self, flight: Flight) -> npt.NDArray[np.float64]: ...
+    def apply(self, flight: Flight) -> Flight: ...
+    def heading_rates(self, flight: Flight) -> List[Tuple[float, int, int, float]]: ...
+    def to_json(self) -> str: ...
+    def save(self, path: str) -> None: ...
+
+@final
+class Levelled:
+    """A levelled survey (`aeromag level`)."""
+
+    @property
+    def value_column(self) -> str: ...
+    @property
+    def output_column(self) -> str: ...
+    @property
+    def levelled(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def flags(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def k_s(self) -> Tuple[float, float]: ...
+    @property
+    def rms_nt(self) -> Dict[str, float]: ...
+    @property
+    def line_levels(self) -> List[Tuple[str, int, float, float, float, float]]: ...
+    @property
+    def notes(self) -> List[str]: ...
+    def crossovers(self) -> Flight: ...
+    def to_flight(self) -> Flight: ...
+
+def fit_rotor(
+    flight: Flight,
+    preset: Optional[str] = None,
+    hub_m: Optional[Tuple[float, float, float]] = None,
+    sensor_m: Optional[Tuple[float, float, float]] = None,
+    blade_span_m: Optional[Tuple[float, float]] = None,
+    blades: Optional[int] = None,
+    coning_deg: Optional[float] = None,
+    tilt_lon_deg: Optional[float] = None,
+    phase_column: Optional[str] = None,
+    estimate_phase: bool = False,
+    rotor_hz: Optional[Tuple[float, float]] = None,
+    window_s: Optional[float] = None,
+    progress: _Progress = None,
+) -> Model: ...
+def fit_pod(
+    flight: Flight,
+    cable_length_m: float,
+    inclination_deg: float,
+    attach_m: Optional[Tuple[float, float, float]] = None,
+    declination_deg: float = 0.0,
+    grad_north_nt_per_km: float = 0.0,
+    grad_up_nt_per_km: float = 0.0,
+    method: str = "dipole-array",
+    source_points: Optional[Sequence[Tuple[float, float, float]]] = None,
+) -> Model: ...
+def level(
+    flight: Flight,
+    value: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    rate_of: Optional[str] = None,
+    tie_only: bool = False,
+    drift: bool = False,
+    no_altitude_term: bool = False,
+    no_robust: bool = False,
+    ridge_lambda: Optional[float] = None,
+    reference: Union[None, str, Sequence[str]] = None,
+    ties: Optional[Sequence[str]] = None,
+    progress: _Progress = None,
+) -> Levelled: ...
+def score(
+    flight: Flight,
+    reference: Union[None, str, Sequence[str]] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    decimal_year: Optional[float] = None,
+) -> str: ...
+def observability(
+    flight: Flight,
+    terms: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    decimal_year: Optional[float] = None,
+    progress: _Progress = None,
+) -> str: ...
+def locate_dipole(
+    flight: Flight,
+    config: Optional[str] = None,
+    gradiometer: Optional[str] = None,
+    layout: Optional[str] = None,
+    baseline_m: Optional[float] = None,
+    noise_nt: Optional[float] = None,
+    passes: Optional[int] = None,
+    multistart: Optional[bool] = None,
+) -> Flight: ...
+def dipole_crlb(config: Optional[str] = None) -> str: ...
+def simulate_gradiometer(config: Optional[str] = None, seed: Optional[int] = None) -> Flight: ...

@@ -11,6 +11,7 @@
 //! | [`tolles_lawson`] | `calibrate`, `TlModel`, `load_model`, `observability` |
 //! | [`level`] | `level`, `Levelled`, `score` |
 //! | [`rotor_pod`] | `fit_rotor`, `fit_pod`, `Model` |
+//! | [`gradiometry`] | `locate_dipole`, `dipole_crlb`, `simulate_gradiometer` |
 //! | [`fields`] | `igrf` |
 //! | [`simulate`] | `simulate` |
 //! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
@@ -19,6 +20,7 @@
 mod errors;
 mod fields;
 mod flight;
+mod gradiometry;
 mod level;
 mod progress;
 mod rotor_pod;
@@ -41,6 +43,9 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<rotor_pod::PyModel>()?;
     m.add_function(wrap_pyfunction!(rotor_pod::fit_rotor, m)?)?;
     m.add_function(wrap_pyfunction!(rotor_pod::fit_pod, m)?)?;
+    m.add_function(wrap_pyfunction!(gradiometry::locate_dipole, m)?)?;
+    m.add_function(wrap_pyfunction!(gradiometry::dipole_crlb, m)?)?;
+    m.add_function(wrap_pyfunction!(gradiometry::simulate_gradiometer, m)?)?;
     m.add_class::<level::PyLevelled>()?;
     m.add_function(wrap_pyfunction!(level::level, m)?)?;
     m.add_function(wrap_pyfunction!(level::score, m)?)?;

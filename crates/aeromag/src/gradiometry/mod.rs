@@ -48,6 +48,76 @@ pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
     }
 }
 
+/// The `aeromag dipole locate` choices that override a scenario file's
+/// (Python's `locate_dipole` keywords): every value given replaces the
+/// file's.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LocateSettings {
+    /// `tensor` or `scalar` gradiometer.
+    pub gradiometer: Option<Gradiometer>,
+    /// Sensor layout.
+    pub layout: Option<aeromag_gradiometry::geometry::Layout>,
+    /// Baseline between sensors, m.
+    pub baseline_m: Option<f64>,
+    /// Sensor noise, nT (of the vector sensors for a tensor gradiometer,
+    /// of the scalar ones otherwise).
+    pub noise_nt: Option<f64>,
+    /// Filter passes over the epochs.
+    pub passes: Option<usize>,
+    /// Multi-start initialisation on (`Some(true)`) or off.
+    pub multistart: Option<bool>,
+}
+
+impl LocateSettings {
+    /// Apply these choices to `cfg` and check the result (bad input naming
+    /// what is wrong).
+    pub fn apply(&self, cfg: &mut GradiometerConfig) -> Result<()> {
+        if let Some(g) = self.gradiometer {
+            cfg.system.gradiometer = g;
+        }
+        if let Some(l) = self.layout {
+            cfg.system.layout = l;
+        }
+        if let Some(b) = self.baseline_m {
+            cfg.system.baseline_m = b;
+        }
+        if let Some(s) = self.noise_nt {
+            match cfg.system.gradiometer {
+                Gradiometer::Tensor => cfg.sensors.vector.noise_nt = s,
+                Gradiometer::Scalar => cfg.sensors.scalar.noise_nt = s,
+            }
+        }
+        if let Some(p) = self.passes {
+            cfg.estimator.passes = p;
+        }
+        if let Some(m) = self.multistart {
+            cfg.estimator.multistart = m;
+        }
+        cfg.validate()
+            .map_err(|e| Error::bad_input(format!("settings (scenario file and choices): {e}")))
+    }
+}
+
+/// A gradiometer or layout by its scenario-file name (`tensor`,
+/// `tetrahedron`, …); bad input listing the names otherwise.
+pub fn parse_name<T: serde::de::DeserializeOwned>(
+    what: &str,
+    name: &str,
+    names: &str,
+) -> Result<T> {
+    serde_json::from_value(serde_json::Value::String(name.to_string()))
+        .map_err(|_| Error::bad_input(format!("{what} '{name}': expected {names}")))
+}
+
+/// A simulated gradiometer pass as the table `aeromag simulate
+/// gradiometer` writes (sensor columns, navigation, `true_` columns).
+pub fn simulate_pass(cfg: &GradiometerConfig) -> Result<FlightTable> {
+    cfg.validate()
+        .map_err(|e| Error::bad_input(format!("scenario: {e}")))?;
+    let sim = simulate(&cfg.scenario()?)?;
+    pass_table(cfg, &sim)
+}
+
 /// The files [`simulate_to_dir`] writes.
 #[derive(Debug, Clone)]
 pub struct SimulatedPass {
@@ -66,8 +136,7 @@ pub struct SimulatedPass {
 pub fn simulate_to_dir(cfg: &GradiometerConfig, out: &Path) -> Result<SimulatedPass> {
     cfg.validate()
         .map_err(|e| Error::bad_input(format!("scenario: {e}")))?;
-    let sim = simulate(&cfg.scenario()?)?;
-    let table = pass_table(cfg, &sim)?;
+    let table = simulate_pass(cfg)?;
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     let csv = out.join("gradiometer.csv");
     let scenario = out.join("gradiometer.toml");
@@ -110,6 +179,31 @@ pub struct CrlbReport {
     pub closest_approach: CrlbAt,
     /// At the end of the pass.
     pub end: CrlbAt,
+}
+
+impl CrlbReport {
+    /// The report as `aeromag dipole crlb --json` prints it: gradiometer,
+    /// system motion, sensor σ (nT), and at the closest approach and the
+    /// end of the pass the epoch, time (s), range (m) and the standard
+    /// deviation of each determined state (m, A·m²).
+    pub fn to_json(&self) -> serde_json::Value {
+        let entry = |at: &CrlbAt| {
+            let std: serde_json::Map<String, serde_json::Value> = STATE_NAMES
+                .iter()
+                .zip(&at.std)
+                .filter(|(_, v)| v.is_finite())
+                .map(|(n, v)| (n.to_string(), serde_json::json!(v)))
+                .collect();
+            serde_json::json!({ "epoch": at.epoch, "time_s": at.time_s, "range_m": at.range_m, "std": std })
+        };
+        serde_json::json!({
+            "gradiometer": self.config.system.gradiometer,
+            "system": self.config.system.motion,
+            "sigma_nt": self.config.sensor_sigma_nt(),
+            "closest_approach": entry(&self.closest_approach),
+            "end": entry(&self.end),
+        })
+    }
 }
 
 /// The Cramér–Rao bound (standard deviation of each parameter) of the

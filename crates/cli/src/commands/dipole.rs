@@ -8,12 +8,11 @@
 
 use crate::exit::bad_input;
 use aeromag::gradiometry::{
-    CrlbAt, STATE_NAMES, both_maps, locate_pass, map_figures, read_config, read_pass,
+    LocateSettings, STATE_NAMES, both_maps, locate_pass, map_figures, parse_name, read_config,
+    read_pass,
 };
 use aeromag::report::{Report, ReportSection, Table};
 use aeromag_gradiometry::convergence::ConvergenceCase;
-use aeromag_gradiometry::sim::Gradiometer;
-use serde_json::json;
 use std::path::PathBuf;
 
 /// Magnetic dipole (object) parameters from tensor or scalar gradiometer
@@ -173,39 +172,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 fn locate(a: LocateArgs) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()])?;
     let mut cfg = read_config(a.config.as_deref())?;
-    let parse = |flag: &str, v: &str| -> anyhow::Result<toml::Value> {
-        toml::Value::try_from(v).map_err(|e| bad_input!("{flag} {v}: {e}"))
+    let settings = LocateSettings {
+        gradiometer: a
+            .gradiometer
+            .as_deref()
+            .map(|g| parse_name("--gradiometer", g, "tensor or scalar"))
+            .transpose()?,
+        layout: a
+            .layout
+            .as_deref()
+            .map(|l| parse_name("--layout", l, "tetrahedron, cross or planar"))
+            .transpose()?,
+        baseline_m: a.baseline_m,
+        noise_nt: a.noise_nt,
+        passes: a.passes,
+        multistart: match (a.multistart, a.plain) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
     };
-    if let Some(g) = &a.gradiometer {
-        cfg.system.gradiometer = parse("--gradiometer", g)?
-            .try_into()
-            .map_err(|_| bad_input!("--gradiometer {g}: expected tensor or scalar"))?;
-    }
-    if let Some(l) = &a.layout {
-        cfg.system.layout = parse("--layout", l)?
-            .try_into()
-            .map_err(|_| bad_input!("--layout {l}: expected tetrahedron, cross or planar"))?;
-    }
-    if let Some(b) = a.baseline_m {
-        cfg.system.baseline_m = b;
-    }
-    if let Some(s) = a.noise_nt {
-        match cfg.system.gradiometer {
-            Gradiometer::Tensor => cfg.sensors.vector.noise_nt = s,
-            Gradiometer::Scalar => cfg.sensors.scalar.noise_nt = s,
-        }
-    }
-    if let Some(p) = a.passes {
-        cfg.estimator.passes = p;
-    }
-    if a.multistart {
-        cfg.estimator.multistart = true;
-    }
-    if a.plain {
-        cfg.estimator.multistart = false;
-    }
-    cfg.validate()
-        .map_err(|e| bad_input!("settings (scenario file and flags): {e}"))?;
+    settings.apply(&mut cfg)?;
     let table = crate::input::load(&a.input)?;
     let pass = read_pass(&table, &cfg)?;
     let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
@@ -245,22 +232,7 @@ fn crlb(a: CrlbArgs) -> anyhow::Result<()> {
         ("end", &report.end),
     ];
     if a.json {
-        let entry = |(_, at): &(&str, &CrlbAt)| {
-            let std: serde_json::Map<String, serde_json::Value> = NAMES
-                .iter()
-                .zip(&at.std)
-                .filter(|(_, v)| v.is_finite())
-                .map(|(n, v)| (n.to_string(), json!(v)))
-                .collect();
-            json!({ "epoch": at.epoch, "time_s": at.time_s, "range_m": at.range_m, "std": std })
-        };
-        let v = json!({
-            "gradiometer": cfg.system.gradiometer,
-            "system": cfg.system.motion,
-            "sigma_nt": cfg.sensor_sigma_nt(),
-            "closest_approach": entry(&rows[0]),
-            "end": entry(&rows[1]),
-        });
+        let v = report.to_json();
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
