@@ -9,7 +9,7 @@ use aeromag::pod::{PodModelFile, PodSetup, apply_pod, fit_pod as lib_fit_pod};
 use aeromag::rotor::{
     RotorChoices, RotorModelFile, RotorOptions, RotorPreset, fit_rotor as lib_fit_rotor,
 };
-use aeromag::{Compensator, Flight, ModelFile, Note};
+use aeromag::{Compensator, ModelFile, Note};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use std::path::PathBuf;
