@@ -14,9 +14,11 @@
 //! | [`gradiometry`] | `locate_dipole`, `dipole_crlb`, `simulate_gradiometer` |
 //! | [`fields`] | `igrf` |
 //! | [`simulate`] | `simulate` |
+//! | [`apply`] | what every model does to a flight (interference, compensate, apply) |
 //! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
 //! | [`progress`] | progress callbacks from the library's observer |
 
+mod apply;
 mod errors;
 mod fields;
 mod flight;

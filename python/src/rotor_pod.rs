@@ -21,7 +21,7 @@ pub enum AnyModel {
 }
 
 impl AnyModel {
-    fn compensator(&self) -> &dyn Compensator {
+    fn compensator(&self) -> &(dyn Compensator + Sync) {
         match self {
             AnyModel::Rotor(m) => m,
             AnyModel::Pod(m) => m,
@@ -86,10 +86,7 @@ impl PyModel {
         py: Python<'py>,
         flight: &PyFlight,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let v = py
-            .detach(|| self.model.compensator().interference(&flight.inner))
-            .py_err()?;
-        Ok(PyArray1::from_vec(py, v))
+        crate::apply::interference(py, self.model.compensator(), flight)
     }
 
     /// `mag` minus the modelled interference, nT.
@@ -98,24 +95,13 @@ impl PyModel {
         py: Python<'py>,
         flight: &PyFlight,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let c = py
-            .detach(|| self.model.compensator().compensate(&flight.inner))
-            .py_err()?;
-        Ok(PyArray1::from_vec(py, c.compensated_nt))
+        crate::apply::compensate(py, self.model.compensator(), flight)
     }
 
     /// The flight with the model's output columns added, as `apply --out`
     /// writes it.
     fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
-        let f = py
-            .detach(|| {
-                self.model
-                    .compensator()
-                    .compensate(&flight.inner)
-                    .and_then(|c| c.into_flight(flight.inner.clone()))
-            })
-            .py_err()?;
-        Ok(PyFlight::new(f))
+        crate::apply::apply(py, self.model.compensator(), flight)
     }
 
     /// Per heading of a pod flight: (heading °, first row, end row, rate of

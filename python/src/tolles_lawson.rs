@@ -10,8 +10,8 @@ use aeromag::compensation::kalman::NoiseModel;
 use aeromag::compensation::tolles_lawson::{Convention, TermSet};
 use aeromag::core::time::Date;
 use aeromag::{
-    CalibrateOptions, CalibrateSettings, Compensator, EddyLag, Method, ModelFile, Note,
-    ReferenceChannels, TlModel, calibrate as lib_calibrate,
+    CalibrateOptions, CalibrateSettings, EddyLag, Method, ModelFile, Note, ReferenceChannels,
+    TlModel, calibrate as lib_calibrate,
 };
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -292,10 +292,7 @@ impl PyTlModel {
         py: Python<'py>,
         flight: &PyFlight,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let v = py
-            .detach(|| self.model.interference(&flight.inner))
-            .py_err()?;
-        Ok(PyArray1::from_vec(py, v))
+        crate::apply::interference(py, &self.model, flight)
     }
 
     /// `mag` minus the modelled interference, nT (NaN where it cannot be
@@ -305,23 +302,13 @@ impl PyTlModel {
         py: Python<'py>,
         flight: &PyFlight,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let c = py
-            .detach(|| self.model.compensate(&flight.inner))
-            .py_err()?;
-        Ok(PyArray1::from_vec(py, c.compensated_nt))
+        crate::apply::compensate(py, &self.model, flight)
     }
 
     /// The flight with the compensation columns added (`mag_comp`,
     /// `mag_interf`, `comp_flag`), as `aeromag compensate --out` writes it.
     fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
-        let f = py
-            .detach(|| {
-                self.model
-                    .compensate(&flight.inner)
-                    .and_then(|c| c.into_flight(flight.inner.clone()))
-            })
-            .py_err()?;
-        Ok(PyFlight::new(f))
+        crate::apply::apply(py, &self.model, flight)
     }
 
     /// The model file's text (JSON), byte for byte what the CLI writes.
