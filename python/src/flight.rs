@@ -2,13 +2,14 @@
 //! file or built from arrays, checked as the CLI checks it.
 
 use crate::errors::{IntoPy, bad_argument};
-use aeromag::io::{ColumnData, Missing, table_from_columns};
+use aeromag::io::{ColumnData, Missing, SharedBuffer, Values, table_from_columns};
 use aeromag::{ColumnMap, Flight, ReadOptions, RowSelection, Sensors};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// A flight record: named columns of equal length (numbers, or text such
 /// as line labels `L1010`), with the canonical names (`time`, `mag`,
@@ -21,6 +22,53 @@ pub struct PyFlight {
 impl PyFlight {
     pub fn new(inner: Flight) -> Self {
         Self { inner }
+    }
+}
+
+/// The memory of a one-dimensional contiguous float64 NumPy array, read by
+/// a column in place (no copy): the array is kept alive by the reference
+/// held here, and the column never writes it (changes copy first). Like
+/// every zero-copy library, this assumes Python does not change the array
+/// while an aeromag call is reading it.
+#[derive(Debug)]
+struct NumpyBuffer {
+    _array: Py<PyArray1<f64>>,
+    ptr: *const f64,
+    len: usize,
+}
+
+// SAFETY: the buffer only reads memory that the held array keeps alive and
+// in place (a NumPy array referenced from elsewhere cannot be resized);
+// `Py` itself is Send + Sync.
+unsafe impl Send for NumpyBuffer {}
+unsafe impl Sync for NumpyBuffer {}
+
+impl SharedBuffer for NumpyBuffer {
+    fn values(&self) -> &[f64] {
+        // SAFETY: `ptr` and `len` describe the contiguous data of the array
+        // held in `_array` (taken from NumPy's own slice of it), valid
+        // while it lives.
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+impl NumpyBuffer {
+    /// The array's values as column values without a copy (an empty array
+    /// as an empty vector).
+    fn share(array: Bound<'_, PyArray1<f64>>) -> PyResult<Values> {
+        let (ptr, len) = {
+            let view = array.readonly();
+            let s = view.as_slice()?;
+            (s.as_ptr(), s.len())
+        };
+        if len == 0 {
+            return Ok(Values::Owned(Vec::new()));
+        }
+        Ok(Values::Shared(Arc::new(NumpyBuffer {
+            _array: array.unbind(),
+            ptr,
+            len,
+        })))
     }
 }
 
@@ -116,6 +164,12 @@ impl PyFlight {
     /// …}` or canonical names): numbers as float64 (NaN = missing), text
     /// columns (str arrays or lists) kept as text. The same mapping,
     /// selection and checks as a file.
+    ///
+    /// One-dimensional contiguous float64 arrays are not copied: the flight
+    /// reads them in place (other numeric arrays are converted once). Do not
+    /// change them while an aeromag call runs on the flight; aeromag itself
+    /// never writes them (a unit conversion or row selection works on its
+    /// own copy).
     #[staticmethod]
     #[pyo3(signature = (data, columns=None, mag=None, vector=None, lines=None, time_range=None))]
     fn from_dict(
@@ -144,7 +198,7 @@ impl PyFlight {
                         .map_err(|_| {
                             bad_argument(format!("column '{name}' must be one-dimensional"))
                         })?;
-                    let values = a.readonly().as_slice()?.to_vec();
+                    let values = NumpyBuffer::share(a)?;
                     let nan = values.iter().filter(|x| x.is_nan()).count();
                     ColumnData::Numeric {
                         values,

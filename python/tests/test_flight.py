@@ -60,8 +60,15 @@ def test_from_dict_maps_file_names_and_checks():
     }
     f = aeromag.Flight.from_dict(data)
     assert f.file is None and len(f) == n
-    # The SGL preset: time from tt, lat/lon in degrees from radians.
+    # The SGL preset: time from tt, lat/lon in degrees from radians; the
+    # conversion works on a copy, never on the caller's array.
     assert np.allclose(f["time"], t) and np.allclose(f["lat"], 45.0)
+    assert np.allclose(data["ins_lat"], np.radians(45.0))
+    # float64 arrays are read in place, not copied: the flight sees a change
+    # made to the caller's array afterwards (what "no copy" means).
+    data["mag_1_uc"][3] = 50001.0
+    assert f["mag"][3] == 50001.0
+    data["mag_1_uc"][3] = 50000.0
     g = aeromag.Flight.from_dict(data, lines=[1002])
     assert len(g) == 100
     # Time going backwards is bad input naming the row.

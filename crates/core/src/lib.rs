@@ -24,6 +24,7 @@
 //! | [`random`] | seeded random streams (ChaCha8, one stream per purpose) |
 //! | [`time`] | calendar dates and decimal years |
 //! | [`quadrature`] | composite Simpson's rule (reference integrals in tests) |
+//! | [`simd`] | kernels compiled with and without AVX, chosen at run time |
 //! | [`error`] | [`CoreError`], with `is_bad_input()` |
 
 pub mod error;
@@ -33,6 +34,7 @@ pub mod filter;
 pub mod frames;
 pub mod quadrature;
 pub mod random;
+pub mod simd;
 pub mod spectrum;
 pub mod time;
 

@@ -46,6 +46,7 @@ mod sniff;
 mod summary;
 mod table;
 mod validate;
+mod values;
 mod xyz;
 
 use std::path::Path;
@@ -68,6 +69,7 @@ pub use validate::{
     EARTH_FIELD_NT, MEDIAN_SAMPLES, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind, check_time,
     check_units, convert_tesla_to_nt,
 };
+pub use values::{SharedBuffer, Values};
 pub use xyz::read_xyz;
 
 /// File formats [`read_table`] can read.

@@ -17,6 +17,7 @@ use serde::Serialize;
 use crate::columns::MappedColumn;
 use crate::derive::DerivedColumn;
 use crate::error::{IoError, Result};
+use crate::values::Values;
 
 /// Why samples of a numeric column are missing (`NaN`), counted per reason.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -41,8 +42,8 @@ impl Missing {
 pub enum ColumnData {
     /// Numbers; missing samples are `NaN`.
     Numeric {
-        /// One value per row.
-        values: Vec<f64>,
+        /// One value per row (owned, or shared memory: [`Values`]).
+        values: Values,
         /// Missing samples by reason; `missing.total()` equals the number of `NaN`s.
         missing: Missing,
     },
@@ -231,6 +232,7 @@ impl FlightTable {
     /// Errors if the name exists or the length differs from [`FlightTable::n_rows`]
     /// (any length is accepted for the first column).
     pub fn add_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        let values = Values::Owned(values);
         let missing = Missing {
             nan: values.iter().filter(|v| v.is_nan()).count(),
             ..Missing::default()
@@ -254,6 +256,7 @@ impl FlightTable {
     /// Replaces the values of column `name` (no alias resolution) or adds it
     /// when absent. Errors only on a length mismatch.
     pub fn set_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        let values = Values::Owned(values);
         match self.columns.iter().position(|c| c.name == name) {
             Some(i) => {
                 self.check_len(name, values.len())?;
@@ -265,7 +268,7 @@ impl FlightTable {
                 self.columns[i].integer_text = false;
                 Ok(())
             }
-            None => self.add_column(name, values),
+            None => self.add_column(name, values.into_vec()),
         }
     }
 
@@ -385,7 +388,7 @@ impl FlightTable {
         for c in &mut self.columns {
             match &mut c.data {
                 ColumnData::Numeric { values, missing } => {
-                    filter(values, keep);
+                    filter(values.to_mut(), keep);
                     let n = values.iter().filter(|v| v.is_nan()).count();
                     *missing = match (missing.blank, missing.nan, missing.dummy) {
                         (_, 0, 0) => Missing {
@@ -463,7 +466,7 @@ impl FlightTable {
                 integer_text,
                 ..
             }) => {
-                values.iter_mut().for_each(|v| *v *= factor);
+                values.to_mut().iter_mut().for_each(|v| *v *= factor);
                 *integer_text = false;
                 true
             }
@@ -535,7 +538,7 @@ mod tests {
             (
                 "tt".to_string(),
                 ColumnData::Numeric {
-                    values: vec![1.0, 2.0, 3.0, 4.0],
+                    values: vec![1.0, 2.0, 3.0, 4.0].into(),
                     missing: Missing::default(),
                 },
                 false,
@@ -543,7 +546,7 @@ mod tests {
             (
                 "mag".to_string(),
                 ColumnData::Numeric {
-                    values: vec![9.0; 4],
+                    values: vec![9.0; 4].into(),
                     missing: Missing::default(),
                 },
                 false,

@@ -6,7 +6,7 @@
 //! exactly the rows it was fitted on.
 
 use super::eddy_lag::LagBank;
-use super::terms::{Convention, DEFAULT_BT_SCALE_NT, TermSet, derivative};
+use super::terms::{Convention, DEFAULT_BT_SCALE_NT, TermSet, derivative_into};
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
 
@@ -94,53 +94,130 @@ impl Design {
     /// segment's length) for the vector-magnetometer series `flux` (nT,
     /// body frame) and time stamps `time` (s) of one contiguous segment.
     pub fn columns(&self, time: &[f64], flux: [&[f64]; 3]) -> Vec<Vec<f64>> {
-        let n = time.len();
-        let mut cols = vec![vec![0.0; n]; self.n_columns()];
-        self.for_each_row(time, flux, |i, row| {
-            for (c, v) in cols.iter_mut().zip(row) {
-                c[i] = *v;
-            }
-        });
-        cols
+        let mut block = DesignBlock::default();
+        self.columns_into(time, flux, &mut block);
+        block.columns
     }
 
-    /// Modelled interference `A c` (nT) over one contiguous segment.
+    /// [`Design::columns`] into `block.columns`, reusing the block's
+    /// allocations (a fit builds one block after another of the same size:
+    /// fresh multi-megabyte buffers each time would cost more in page
+    /// faults than the arithmetic).
+    pub fn columns_into(&self, time: &[f64], flux: [&[f64]; 3], block: &mut DesignBlock) {
+        self.derivatives_into(time, flux, &mut block.db);
+        let mut lags = LagBank::new(self.terms.eddy_lags_s());
+        let DesignBlock {
+            columns,
+            db,
+            lagged,
+            e,
+        } = block;
+        self.block_columns(0..time.len(), time, flux, db, &mut lags, lagged, e, columns);
+    }
+
+    /// Modelled interference `A c` (nT) over one contiguous segment, built
+    /// in blocks of rows (memory: the derivatives and one block of columns).
+    /// Each sample is `Σ_k A_k c_k` summed in column order, as a row's dot
+    /// product with `c`.
     pub fn interference(&self, coef: &[f64], time: &[f64], flux: [&[f64]; 3]) -> Vec<f64> {
-        let mut out = vec![0.0; time.len()];
-        self.for_each_row(time, flux, |i, row| {
-            out[i] = row.iter().zip(coef).map(|(a, c)| a * c).sum();
-        });
+        const BLOCK: usize = 4096;
+        let n = time.len();
+        let mut db = Default::default();
+        self.derivatives_into(time, flux, &mut db);
+        let mut lags = LagBank::new(self.terms.eddy_lags_s());
+        let (mut lagged, mut e, mut cols) = (Vec::new(), Default::default(), Vec::new());
+        let mut out = Vec::with_capacity(n);
+        for start in (0..n).step_by(BLOCK) {
+            let r = start..(start + BLOCK).min(n);
+            self.block_columns(
+                r.clone(),
+                time,
+                flux,
+                &db,
+                &mut lags,
+                &mut lagged,
+                &mut e,
+                &mut cols,
+            );
+            // −0.0 is the identity of f64 addition (what `Iterator::sum`
+            // starts from), so this is the bits of `row · c`.
+            let mut acc = vec![-0.0; r.len()];
+            for (col, c) in cols.iter().zip(coef) {
+                for (a, v) in acc.iter_mut().zip(col) {
+                    *a += v * c;
+                }
+            }
+            out.extend(acc);
+        }
         out
     }
 
-    /// Call `f(i, row)` for every sample of one contiguous segment, in
-    /// order: derivatives over the segment ([`derivative`]), lagged
-    /// derivatives started at its first sample ([`LagBank`]).
-    fn for_each_row(&self, time: &[f64], flux: [&[f64]; 3], mut f: impl FnMut(usize, &[f64])) {
-        let db = self.derivatives(time, flux);
-        let mut lags = LagBank::new(self.terms.eddy_lags_s());
-        let mut row = vec![0.0; self.n_columns()];
-        for i in 0..time.len() {
-            let d = [db[0][i], db[1][i], db[2][i]];
-            let lagged = lags.step(time[i], d);
-            self.terms.row(
-                [flux[0][i], flux[1][i], flux[2][i]],
-                d,
-                lagged,
-                self.bt_scale_nt,
-                &mut row,
-            );
-            f(i, &row);
+    /// The columns of rows `r` of a segment into `out` (derivatives `db`
+    /// over the whole segment; `lags` stepped through every earlier row,
+    /// so that the lagged derivatives start at the segment's first sample;
+    /// `lagged` and `e` are scratch).
+    #[allow(clippy::too_many_arguments)]
+    fn block_columns(
+        &self,
+        r: std::ops::Range<usize>,
+        time: &[f64],
+        flux: [&[f64]; 3],
+        db: &[Vec<f64>; 3],
+        lags: &mut LagBank,
+        lagged: &mut Vec<[Vec<f64>; 3]>,
+        e: &mut [Vec<f64>; 3],
+        out: &mut Vec<Vec<f64>>,
+    ) {
+        let n_lags = self.terms.eddy_lags_s().len();
+        lagged.resize_with(n_lags, Default::default);
+        for l in lagged.iter_mut() {
+            l.iter_mut().for_each(Vec::clear);
         }
+        if n_lags > 0 {
+            for i in r.clone() {
+                let d = [db[0][i], db[1][i], db[2][i]];
+                for (l, g) in lagged.iter_mut().zip(lags.step(time[i], d)) {
+                    for (axis, v) in l.iter_mut().zip(g) {
+                        axis.push(*v);
+                    }
+                }
+            }
+        }
+        let lagged: Vec<[&[f64]; 3]> = lagged
+            .iter()
+            .map(|l| [&l[0][..], &l[1][..], &l[2][..]])
+            .collect();
+        self.terms.columns_into(
+            flux.map(|f| &f[r.clone()]),
+            [&db[0][r.clone()], &db[1][r.clone()], &db[2][r.clone()]],
+            &lagged,
+            self.bt_scale_nt,
+            e,
+            out,
+        )
     }
 
-    /// Field derivatives for the eddy columns (zeros when no eddy group is used).
-    fn derivatives(&self, time: &[f64], flux: [&[f64]; 3]) -> [Vec<f64>; 3] {
-        if self.terms.has_eddy() {
-            [0, 1, 2].map(|k| derivative(flux[k], time, self.convention))
-        } else {
-            let n = time.len();
-            [vec![0.0; n], vec![0.0; n], vec![0.0; n]]
+    /// Field derivatives for the eddy columns into `db` (zeros when no
+    /// eddy group is used).
+    fn derivatives_into(&self, time: &[f64], flux: [&[f64]; 3], db: &mut [Vec<f64>; 3]) {
+        for (k, d) in db.iter_mut().enumerate() {
+            if self.terms.has_eddy() {
+                derivative_into(flux[k], time, self.convention, d);
+            } else {
+                d.clear();
+                d.resize(time.len(), 0.0);
+            }
         }
     }
+}
+
+/// Reusable buffers of [`Design::columns_into`]: the design columns of the
+/// last block (`columns[k][n]`) and the scratch they are built from.
+#[derive(Debug, Clone, Default)]
+pub struct DesignBlock {
+    /// The columns of the last block built.
+    pub columns: Vec<Vec<f64>>,
+    db: [Vec<f64>; 3],
+    lagged: Vec<[Vec<f64>; 3]>,
+    e: [Vec<f64>; 3],
 }

@@ -30,12 +30,12 @@
 //! flight does not separate them from the other terms: typically one heading
 //! or missing manoeuvres), and near-null combinations are spelled out.
 
-use super::design::Design;
+use super::design::{Design, DesignBlock};
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
-use aeromag_core::filter::{Band, butter, sosfiltfilt_in_place};
+use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_with};
 use aeromag_estimation::least_squares::{LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
@@ -183,6 +183,7 @@ fn for_each_filtered_block(
     let overlap = filter_overlap + lag_overlap;
     let block = cfg.block_len.max(1);
     let mut start = keep_lo;
+    let (mut design, mut y, mut scratch) = (DesignBlock::default(), Vec::new(), Vec::new());
     while start < keep_hi {
         let end = (start + block).min(keep_hi);
         let (a, b) = if keep_lo == 0 && keep_hi == n && block >= n {
@@ -192,15 +193,14 @@ fn for_each_filtered_block(
         };
         let time = &seg.time[a..b];
         let flux = [&seg.flux[0][a..b], &seg.flux[1][a..b], &seg.flux[2][a..b]];
-        let mut cols = cfg.design.columns(time, flux);
-        let mut y = seg.mag[a..b].to_vec();
+        cfg.design.columns_into(time, flux, &mut design);
+        y.clear();
+        y.extend_from_slice(&seg.mag[a..b]);
         if let Some(sos) = sos {
-            cols.push(std::mem::take(&mut y));
-            filter_columns(sos, &mut cols)?;
-            y = cols.pop().unwrap_or_default();
+            filter_columns(sos, &mut design.columns, &mut y, &mut scratch)?;
         }
         let (ca, cb) = (start - a, end - a);
-        let refs: Vec<&[f64]> = cols.iter().map(|c| &c[ca..cb]).collect();
+        let refs: Vec<&[f64]> = design.columns.iter().map(|c| &c[ca..cb]).collect();
         sink(&refs, &y[ca..cb])?;
         start = end;
     }
@@ -396,31 +396,44 @@ fn validate(cfg: &LsConfig) -> Result<()> {
 /// standard deviation ≤ ε means constant), spread over the available cores.
 /// Each column is filtered independently, so the result does not depend on
 /// the number of threads.
-fn filter_columns(sos: &Sos, cols: &mut [Vec<f64>]) -> Result<()> {
+fn filter_columns(
+    sos: &Sos,
+    cols: &mut [Vec<f64>],
+    y: &mut [f64],
+    scratch: &mut Vec<Vec<[f64; FILTER_LANES]>>,
+) -> Result<()> {
+    // Constant columns (the permanent terms on a straight leg) stay as
+    // they are; the others go through the filter FILTER_LANES at a time,
+    // the groups shared out over the threads (each with its scratch buffer,
+    // kept for the next block). Each column's result is the same bits
+    // whatever the grouping and the thread count.
+    let mut varying: Vec<&mut [f64]> = cols
+        .iter_mut()
+        .map(|c| c.as_mut_slice())
+        .chain(std::iter::once(y))
+        .filter(|c| std_dev(c) > f64::EPSILON)
+        .collect();
     let threads = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
         .clamp(1, 8);
-    let per = cols.len().div_ceil(threads).max(1);
+    let groups = varying.len().div_ceil(FILTER_LANES);
+    let per = groups.div_ceil(threads).max(1) * FILTER_LANES;
+    scratch.resize_with(threads, Vec::new);
     std::thread::scope(|scope| {
-        let handles: Vec<_> = cols
+        let handles: Vec<_> = varying
             .chunks_mut(per)
-            .map(|chunk| {
-                scope.spawn(move || -> Result<()> {
-                    for c in chunk.iter_mut() {
-                        if std_dev(c) > f64::EPSILON {
-                            sosfiltfilt_in_place(sos, c)?;
-                        }
-                    }
-                    Ok(())
-                })
-            })
+            .zip(scratch.iter_mut())
+            .map(|(chunk, ext)| scope.spawn(move || sosfiltfilt_columns_with(sos, chunk, ext)))
             .collect();
         handles.into_iter().try_for_each(|h| {
-            h.join().unwrap_or_else(|_| {
-                Err(CompError::Failed {
-                    reason: "filter thread failed".into(),
-                })
-            })
+            h.join().map_or_else(
+                |_| {
+                    Err(CompError::Failed {
+                        reason: "filter thread failed".into(),
+                    })
+                },
+                |r| r.map_err(CompError::from),
+            )
         })
     })
 }
@@ -430,8 +443,21 @@ fn std_dev(x: &[f64]) -> f64 {
     if x.len() < 2 {
         return 0.0;
     }
-    let m = x.iter().sum::<f64>() / n;
-    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)).sqrt()
+    // Sums in four lanes: one add chain per value would wait on the
+    // adder's latency (this runs on every column of every block).
+    fn sum4(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
+        let mut s = [0.0; 4];
+        let chunks = x.chunks_exact(4);
+        let tail: f64 = chunks.remainder().iter().map(|&v| f(v)).sum();
+        for c in chunks {
+            for l in 0..4 {
+                s[l] += f(c[l]);
+            }
+        }
+        (s[0] + s[1]) + (s[2] + s[3]) + tail
+    }
+    let m = sum4(x, |v| v) / n;
+    (sum4(x, |v| (v - m) * (v - m)) / (n - 1.0)).sqrt()
 }
 
 #[cfg(test)]

@@ -155,6 +155,51 @@ pub struct TermSet {
 const XYZ: [&str; 3] = ["x", "y", "z"];
 const PAIRS6: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
+/// One design-matrix column: what it multiplies (the module's table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Column {
+    /// `e_i`.
+    Direction(usize),
+    /// `e_i s_j / bt_scale`, `s` the field, its derivative or a lagged
+    /// derivative.
+    Product {
+        /// Axis of the direction cosine.
+        i: usize,
+        /// What `s` is.
+        source: Source,
+        /// Axis of `s`.
+        j: usize,
+    },
+    /// `1`.
+    Bias,
+}
+
+/// The second factor of a [`Column::Product`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The vector field `B_j`, nT.
+    Field,
+    /// Its derivative `dB_j`.
+    Derivative,
+    /// The derivative through the lag of index `k` of
+    /// [`TermSet::eddy_lags_s`].
+    Lagged(usize),
+}
+
+/// `e s / bt_scale`: the one formula of every product column, shared by
+/// the row-wise ([`TermSet::row`]) and column-wise ([`TermSet::columns`])
+/// builders so that they give the same bits.
+#[inline(always)]
+fn product(e: f64, s: f64, bt_scale: f64) -> f64 {
+    e * s / bt_scale
+}
+
+/// `|B|`, as both builders compute it.
+#[inline(always)]
+fn magnitude(b: [f64; 3]) -> f64 {
+    (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt()
+}
+
 impl TermSet {
     /// The thesis' 16 observable parameters: `p3, i5, e8`.
     pub fn observable16() -> Self {
@@ -357,42 +402,122 @@ impl TermSet {
         bt_scale: f64,
         out: &mut [f64],
     ) {
-        let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        let bt = magnitude(b);
         let e = [b[0] / bt, b[1] / bt, b[2] / bt];
         let mut k = 0;
+        self.for_each_column(|c| {
+            out[k] = match c {
+                Column::Direction(i) => e[i],
+                Column::Product { i, source, j } => {
+                    let s = match source {
+                        Source::Field => b[j],
+                        Source::Derivative => db[j],
+                        Source::Lagged(l) => lagged.get(l).map_or(f64::NAN, |g| g[j]),
+                    };
+                    product(e[i], s, bt_scale)
+                }
+                Column::Bias => 1.0,
+            };
+            k += 1;
+        });
+    }
+
+    /// The design matrix column by column (`out[k][n]`, the same values as
+    /// [`TermSet::row`] for every sample `n`, bit for bit), from the vector
+    /// field `b[axis][n]`, its derivative `db` and the lagged derivatives
+    /// `lagged[lag][axis][n]`; all slices of equal length. Each column is one
+    /// loop over the samples, which the compiler vectorises.
+    pub fn columns(
+        &self,
+        b: [&[f64]; 3],
+        db: [&[f64]; 3],
+        lagged: &[[&[f64]; 3]],
+        bt_scale: f64,
+    ) -> Vec<Vec<f64>> {
+        let mut out = Vec::new();
+        self.columns_into(b, db, lagged, bt_scale, &mut Default::default(), &mut out);
+        out
+    }
+
+    /// [`TermSet::columns`] into `out`, reusing its allocations and those of
+    /// the direction-cosine scratch `e` (one allocation per column for the
+    /// first block, none for the next blocks of the same length).
+    pub fn columns_into(
+        &self,
+        b: [&[f64]; 3],
+        db: [&[f64]; 3],
+        lagged: &[[&[f64]; 3]],
+        bt_scale: f64,
+        e: &mut [Vec<f64>; 3],
+        out: &mut Vec<Vec<f64>>,
+    ) {
+        let n = b[0].len();
+        e[0].clear();
+        e[0].extend((0..n).map(|k| magnitude([b[0][k], b[1][k], b[2][k]])));
+        let (bt, rest) = e.split_first_mut().expect("three axes");
+        for (i, ei) in rest.iter_mut().enumerate() {
+            ei.clear();
+            ei.extend(b[i + 1].iter().zip(bt.iter()).map(|(v, t)| v / t));
+        }
+        for (v, t) in bt.iter_mut().zip(b[0]) {
+            *v = t / *v;
+        }
+        out.resize_with(self.n_columns(), Vec::new);
+        let mut cols = out.iter_mut();
+        self.for_each_column(|c| {
+            let col = cols.next().expect("n_columns columns");
+            col.clear();
+            match c {
+                Column::Direction(i) => col.extend_from_slice(&e[i]),
+                Column::Product { i, source, j } => {
+                    let s = match source {
+                        Source::Field => b[j],
+                        Source::Derivative => db[j],
+                        Source::Lagged(l) => match lagged.get(l) {
+                            Some(g) => g[j],
+                            None => {
+                                col.resize(n, f64::NAN);
+                                return;
+                            }
+                        },
+                    };
+                    col.extend(
+                        e[i].iter()
+                            .zip(&s[..n])
+                            .map(|(&ei, &sj)| product(ei, sj, bt_scale)),
+                    )
+                }
+                Column::Bias => col.resize(n, 1.0),
+            }
+        });
+    }
+
+    /// Every column in order, as a [`Column`] (the module's table).
+    pub fn for_each_column(&self, mut f: impl FnMut(Column)) {
+        let products = |i: usize, source: Source, j: usize| Column::Product { i, source, j };
         for g in &self.groups {
             match g {
-                TermGroup::P3 => {
-                    out[k..k + 3].copy_from_slice(&e);
-                    k += 3;
-                }
+                TermGroup::P3 => (0..3).for_each(|i| f(Column::Direction(i))),
                 TermGroup::I6 | TermGroup::I5 => {
                     let n = if *g == TermGroup::I6 { 6 } else { 5 };
                     for &(i, j) in &PAIRS6[..n] {
-                        out[k] = e[i] * b[j] / bt_scale;
-                        k += 1;
+                        f(products(i, Source::Field, j));
                     }
                 }
                 TermGroup::E9 | TermGroup::E8 => {
                     let n = if *g == TermGroup::E9 { 9 } else { 8 };
                     for m in 0..n {
-                        out[k] = e[m / 3] * db[m % 3] / bt_scale;
-                        k += 1;
+                        f(products(m / 3, Source::Derivative, m % 3));
                     }
                 }
                 TermGroup::L9 => {
                     for lag in 0..self.eddy_lags_s.len() {
-                        let g = lagged.get(lag).copied().unwrap_or([f64::NAN; 3]);
                         for m in 0..9 {
-                            out[k] = e[m / 3] * g[m % 3] / bt_scale;
-                            k += 1;
+                            f(products(m / 3, Source::Lagged(lag), m % 3));
                         }
                     }
                 }
-                TermGroup::Bias => {
-                    out[k] = 1.0;
-                    k += 1;
-                }
+                TermGroup::Bias => f(Column::Bias),
             }
         }
     }
@@ -411,10 +536,18 @@ impl std::fmt::Display for TermSet {
 /// per sample (MagNav.jl `fdm(x; scheme=:central)`). Series of fewer than
 /// 3 samples give zeros (MagNav's behaviour for the central scheme).
 pub fn derivative(x: &[f64], t: &[f64], convention: Convention) -> Vec<f64> {
+    let mut d = Vec::new();
+    derivative_into(x, t, convention, &mut d);
+    d
+}
+
+/// [`derivative`] into `d` (resized to `x.len()`, its allocation reused).
+pub fn derivative_into(x: &[f64], t: &[f64], convention: Convention, d: &mut Vec<f64>) {
     let n = x.len();
-    let mut d = vec![0.0; n];
+    d.clear();
+    d.resize(n, 0.0);
     if n < 3 {
-        return d;
+        return;
     }
     match convention {
         Convention::MagNav => {
@@ -432,7 +565,6 @@ pub fn derivative(x: &[f64], t: &[f64], convention: Convention) -> Vec<f64> {
             d[n - 1] = (x[n - 1] - x[n - 2]) / (t[n - 1] - t[n - 2]);
         }
     }
-    d
 }
 
 #[cfg(test)]

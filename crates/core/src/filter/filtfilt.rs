@@ -50,6 +50,79 @@ pub fn sosfiltfilt_in_place(sos: &Sos, x: &mut [f64]) -> Result<()> {
     zero_phase_in_place(sos, x)
 }
 
+/// Signals filtered together by [`sosfiltfilt_columns_in_place`]: four
+/// lanes of `f64` (one AVX register, two SSE2 registers; 8 lanes measured
+/// no faster per signal on this machine, `cargo bench --bench filters`).
+pub const FILTER_LANES: usize = 4;
+
+/// [`sosfiltfilt_in_place`] on several signals of equal length, each result
+/// bit-identical to filtering that signal alone, `FILTER_LANES` signals at
+/// a time in interleaved lanes (several times faster than one at a time:
+/// a single biquad chain is bound by the latency of its recurrence, not by
+/// arithmetic). Scratch memory: `FILTER_LANES × (n + 2·padlen)` samples.
+///
+/// Errors, before anything is written: `TooShort` for a signal shorter than
+/// `sos.padlen() + 1`, `NonFinite` for a non-finite sample (the first
+/// offending signal in order), `InvalidArgument` for unequal lengths.
+pub fn sosfiltfilt_columns_in_place(sos: &Sos, columns: &mut [&mut [f64]]) -> Result<()> {
+    sosfiltfilt_columns_with(sos, columns, &mut Vec::new())
+}
+
+/// [`sosfiltfilt_columns_in_place`] with the scratch buffer `ext` (resized
+/// as needed, its allocation reused by the next call).
+pub fn sosfiltfilt_columns_with(
+    sos: &Sos,
+    columns: &mut [&mut [f64]],
+    ext: &mut Vec<[f64; FILTER_LANES]>,
+) -> Result<()> {
+    let pad = sos.padlen();
+    let n = columns.first().map_or(0, |c| c.len());
+    for c in columns.iter() {
+        if c.len() != n {
+            return Err(crate::CoreError::InvalidArgument {
+                name: "columns",
+                reason: "signals of unequal length".into(),
+            });
+        }
+        check_len("x", n, pad + 1)?;
+        check_finite("x", c)?;
+    }
+    let zi = sos.steady_state()?;
+    ext.clear();
+    ext.resize(n + 2 * pad, [0.0; FILTER_LANES]);
+    let mut state = vec![[0.0; FILTER_LANES]; zi.len()];
+    for group in columns.chunks_mut(FILTER_LANES) {
+        // The odd extension of every signal (see the module docs).
+        // Lanes beyond the group's signals repeat its first signal (their
+        // results are not used).
+        let src: [&[f64]; FILTER_LANES] =
+            std::array::from_fn(|l| &group.get(l).unwrap_or(&group[0])[..n]);
+        for (k, e) in ext[pad..pad + n].iter_mut().enumerate() {
+            *e = std::array::from_fn(|l| src[l][k]);
+        }
+        for j in 1..=pad {
+            ext[pad - j] = std::array::from_fn(|l| 2.0 * src[l][0] - src[l][j]);
+            ext[pad + n - 1 + j] = std::array::from_fn(|l| 2.0 * src[l][n - 1] - src[l][n - 1 - j]);
+        }
+        let start = ext[0];
+        for (s, z) in state.iter_mut().zip(&zi) {
+            *s = start.map(|v| z * v);
+        }
+        sos.run_lanes(ext, &mut state, false);
+        let end = ext[ext.len() - 1];
+        for (s, z) in state.iter_mut().zip(&zi) {
+            *s = end.map(|v| z * v);
+        }
+        sos.run_lanes(ext, &mut state, true);
+        for (l, x) in group.iter_mut().enumerate() {
+            for (v, e) in x.iter_mut().zip(&ext[pad..pad + n]) {
+                *v = e[l];
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Zero-phase filtering with a transfer function, equal to SciPy's
 /// `filtfilt(b, a, x)` (odd padding of `3·max(len a, len b)` samples).
 ///
@@ -107,6 +180,32 @@ mod tests {
 
     fn sos() -> Sos {
         Sos::new(vec![[0.2, 0.4, 0.2, 1.0, -0.5, 0.3]]).unwrap()
+    }
+
+    #[test]
+    fn columns_errors_leave_every_column_unchanged() {
+        let s = sos();
+        let good = vec![1.0; 40];
+        let mut bad = vec![1.0; 40];
+        bad[7] = f64::NAN;
+        let (mut a, mut b) = (good.clone(), bad.clone());
+        let err = sosfiltfilt_columns_in_place(&s, &mut [&mut a, &mut b]).unwrap_err();
+        assert_eq!(
+            err,
+            CoreError::NonFinite {
+                name: "x",
+                index: 7
+            }
+        );
+        assert_eq!((a, b.len()), (good.clone(), 40));
+        let mut short = vec![1.0; 5];
+        let mut a = good.clone();
+        assert!(matches!(
+            sosfiltfilt_columns_in_place(&s, &mut [&mut a, &mut short]),
+            Err(CoreError::InvalidArgument { .. })
+        ));
+        assert_eq!(a, good);
+        assert!(sosfiltfilt_columns_in_place(&s, &mut []).is_ok());
     }
 
     #[test]
@@ -217,6 +316,24 @@ mod invariants {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Filtering columns together in lanes gives, for every column,
+        /// exactly the bits of filtering it alone (whatever the number of
+        /// columns: full groups, a partial last group, one column).
+        #[test]
+        fn columns_in_lanes_equal_one_at_a_time(
+            sos in filter_spec(),
+            xs in proptest::collection::vec(signal(300), 1..10),
+        ) {
+            let mut together = xs.clone();
+            let mut refs: Vec<&mut [f64]> = together.iter_mut().map(|c| c.as_mut_slice()).collect();
+            sosfiltfilt_columns_in_place(&sos, &mut refs).unwrap();
+            for (x, y) in xs.iter().zip(&together) {
+                let alone = sosfiltfilt(&sos, x).unwrap();
+                prop_assert!(alone.iter().zip(y).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+
 
         /// filtfilt(a x + b y) = a filtfilt(x) + b filtfilt(y), to rounding.
         #[test]
