@@ -347,19 +347,15 @@ impl aeromag_core::simd::Kernel for Dot4<'_> {
             }
         }
         let tail = 4 * (m / 4);
-        [s0, s1, s2, s3]
-            .iter()
-            .zip(b)
-            .map(|(s, bt)| {
-                let mut v = (s[0] + s[1]) + (s[2] + s[3]);
-                for k in tail..m {
-                    v += self.a[k] * bt[k];
-                }
-                v
-            })
-            .collect::<Vec<_>>()
-            .try_into()
-            .expect("four sums")
+        let sums = [s0, s1, s2, s3];
+        std::array::from_fn(|t| {
+            let s = sums[t];
+            let mut v = (s[0] + s[1]) + (s[2] + s[3]);
+            for (x, y) in self.a[tail..].iter().zip(&b[t][tail..]) {
+                v += x * y;
+            }
+            v
+        })
     }
 }
 
