@@ -31,6 +31,7 @@ from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, T
 import numpy as np
 
 from . import _aeromag
+from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulate_em
 from ._aeromag import Flight, Levelled, Model, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
 from .errors import AeromagError, BadInputError
@@ -47,6 +48,13 @@ __all__ = [
     "dipole_crlb",
     "locate_dipole",
     "simulate_gradiometer",
+    "EmCalibration",
+    "EmDetection",
+    "EmPoses",
+    "calibrate_em",
+    "detect_em",
+    "locate_em",
+    "simulate_em",
     "level",
     "observability",
     "score",
@@ -200,6 +208,63 @@ def observability(
             flight, terms=terms, lever_arm=lever_arm, decimal_year=_year(date), progress=progress_callback(progress)
         )
     )
+
+
+def detect_em(
+    raw: PathLike,
+    window_len: Optional[int] = None,
+    window: str = "blackman-harris",
+    pilot: bool = True,
+    system: Optional[PathLike] = None,
+    progress: Any = None,
+) -> EmDetection:
+    """Detect the complex field vectors of a raw EM record (``aeromag em detect``).
+
+    Synchronous detection in blocks of ``window_len`` samples (default the
+    library's) weighted by ``window`` (``"blackman-harris"`` or
+    ``"nuttall"``), divided by the pilot-measured channel sensitivity
+    (``pilot=False`` shows the drift); instrument constants from the raw
+    header or ``system`` (JSON). Returns an :class:`EmDetection`:
+    ``len()`` epochs, ``to_dict()`` (``time_s`` in s, fields
+    ``h{i}_{x,y,z}_{re,im}_t`` in T, ``pol_ratio_{i}``), ``save(path)``
+    (the CLI's CSV), ``polarization_ratio_rms``, ``notes``.
+    """
+    from .tolles_lawson import progress_callback
+
+    return _aeromag.detect_em(
+        os.fspath(raw),
+        window_len=window_len,
+        window=window,
+        pilot=pilot,
+        system=None if system is None else os.fspath(system),
+        progress=progress_callback(progress),
+    )
+
+
+def locate_em(
+    detected: Union[EmDetection, PathLike],
+    calibration: Union[EmCalibration, PathLike],
+    half_space: Tuple[float, float, float] = (-1.0, 0.0, 1.0),
+    progress: Any = None,
+) -> EmPoses:
+    """Locate the towed bird at every epoch (``aeromag em locate``).
+
+    ``detected``: an :class:`EmDetection` or a detected-vector CSV;
+    ``calibration``: an :class:`EmCalibration` or a calibration file;
+    ``half_space``: the normal n of the prior half-space r·n > 0
+    (transmitter frame, default behind and below). Returns
+    :class:`EmPoses`: ``to_dict()`` with ``x_m, y_m, z_m`` (m, transmitter
+    frame), ``range_m``, ``roll_deg, pitch_deg, yaw_deg`` (Z-Y-X, deg),
+    quality figures and ``status``; ``save(path)`` (the CLI's CSV);
+    ``failed``.
+    """
+    from .tolles_lawson import progress_callback
+
+    if not isinstance(detected, EmDetection):
+        detected = os.fspath(detected)
+    if not isinstance(calibration, EmCalibration):
+        calibration = os.fspath(calibration)
+    return _aeromag.locate_em(detected, calibration, half_space=half_space, progress=progress_callback(progress))
 
 
 def level(

@@ -23,6 +23,13 @@ __all__ = [
     "locate_dipole",
     "dipole_crlb",
     "simulate_gradiometer",
+    "EmDetection",
+    "EmCalibration",
+    "EmPoses",
+    "simulate_em",
+    "detect_em",
+    "calibrate_em",
+    "locate_em",
     "Levelled",
     "level",
     "score",
@@ -224,3 +231,69 @@ def locate_dipole(
 ) -> Flight: ...
 def dipole_crlb(config: Optional[str] = None) -> str: ...
 def simulate_gradiometer(config: Optional[str] = None, seed: Optional[int] = None) -> Flight: ...
+@final
+class EmDetection:
+    """Detected complex field vectors of a raw EM record (T)."""
+
+    @property
+    def sample_rate_hz(self) -> float: ...
+    @property
+    def window_len(self) -> int: ...
+    @property
+    def polarization_ratio_rms(self) -> float: ...
+    @property
+    def notes(self) -> List[str]: ...
+    def __len__(self) -> int: ...
+    def to_dict(self) -> Dict[str, np.ndarray]: ...
+    def save(self, path: str) -> None: ...
+
+@final
+class EmCalibration:
+    """The three calibration stages of an EM positioning system."""
+
+    @property
+    def polarization_ratio_before(self) -> float: ...
+    @property
+    def polarization_ratio_after(self) -> float: ...
+    @property
+    def transmitter_distortion(self) -> float: ...
+    @property
+    def attitude_correction_deg(self) -> float: ...
+    def to_json(self) -> str: ...
+    def save(self, path: str) -> None: ...
+
+@final
+class EmPoses:
+    """The pose of the towed bird at every epoch (m, deg)."""
+
+    @property
+    def failed(self) -> int: ...
+    @property
+    def by_continuity(self) -> int: ...
+    def __len__(self) -> int: ...
+    def to_dict(self) -> Dict[str, np.ndarray]: ...
+    def save(self, path: str) -> None: ...
+
+def simulate_em(
+    out: str, config: Optional[str] = None, seed: Optional[int] = None, known_positions: int = 8
+) -> Dict[str, Any]: ...
+def detect_em(
+    raw: str,
+    window_len: Optional[int] = None,
+    window: str = "blackman-harris",
+    pilot: bool = True,
+    system: Optional[str] = None,
+    progress: _Progress = None,
+) -> EmDetection: ...
+def calibrate_em(
+    detected: Union[EmDetection, str],
+    known: str,
+    system: str,
+    half_space: Tuple[float, float, float] = (-1.0, 0.0, 1.0),
+) -> EmCalibration: ...
+def locate_em(
+    detected: Union[EmDetection, str],
+    calibration: Union[EmCalibration, str],
+    half_space: Tuple[float, float, float] = (-1.0, 0.0, 1.0),
+    progress: _Progress = None,
+) -> EmPoses: ...

@@ -12,6 +12,7 @@
 //! | [`level`] | `level`, `Levelled`, `score` |
 //! | [`rotor_pod`] | `fit_rotor`, `fit_pod`, `Model` |
 //! | [`gradiometry`] | `locate_dipole`, `dipole_crlb`, `simulate_gradiometer` |
+//! | [`em`] | `simulate_em`, `detect_em`, `calibrate_em`, `locate_em` |
 //! | [`fields`] | `igrf` |
 //! | [`simulate`] | `simulate` |
 //! | [`apply`] | what every model does to a flight (interference, compensate, apply) |
@@ -19,6 +20,7 @@
 //! | [`progress`] | progress callbacks from the library's observer |
 
 mod apply;
+mod em;
 mod errors;
 mod fields;
 mod flight;
@@ -54,5 +56,12 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fields::igrf, m)?)?;
     m.add_function(wrap_pyfunction!(fields::decimal_year, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_class::<em::PyEmDetection>()?;
+    m.add_class::<em::PyEmCalibration>()?;
+    m.add_class::<em::PyEmPoses>()?;
+    m.add_function(wrap_pyfunction!(em::simulate_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::detect_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::calibrate_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::locate_em, m)?)?;
     Ok(())
 }
