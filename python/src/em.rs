@@ -8,6 +8,7 @@
 
 use crate::errors::{IntoPy, bad_argument};
 use crate::progress::PyProgress;
+use aeromag::Note;
 use aeromag::core::filter::Window;
 use aeromag::em::calibration::CalibrationFile;
 use aeromag::em::detection::FieldEpoch;
@@ -17,7 +18,6 @@ use aeromag::em::{
     DetectOptions, EmCalibration, HalfSpace, Poses, calibrate, detect, known_points, locate,
     parse_config, simulate_to_dir,
 };
-use aeromag::Note;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -385,7 +385,13 @@ impl TableBuilder {
                         shrink(&mut values);
                         // A column with no value at all has no form to keep.
                         let integers = integers && missing.total() < values.len();
-                        (ColumnData::Numeric { values: values.into(), missing }, integers)
+                        (
+                            ColumnData::Numeric {
+                                values: values.into(),
+                                missing,
+                            },
+                            integers,
+                        )
                     }
                     ColState::Text { mut values, .. } => {
                         shrink(&mut values);

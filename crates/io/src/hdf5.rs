@@ -175,7 +175,14 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
             nan: values.iter().filter(|v| v.is_nan()).count(),
             ..Missing::default()
         };
-        columns.push((name, ColumnData::Numeric { values: values.into(), missing }, integer));
+        columns.push((
+            name,
+            ColumnData::Numeric {
+                values: values.into(),
+                missing,
+            },
+            integer,
+        ));
     }
     // The rows are the values read (at least one field was), which must
     // match the headers' length.

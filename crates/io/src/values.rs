@@ -112,6 +112,10 @@ mod tests {
         v.to_mut()[0] = 10.0;
         assert!(!v.is_shared());
         assert_eq!(&v[..], &[10.0, 2.0, 3.0]);
-        assert_eq!(buf.0, vec![1.0, 2.0, 3.0], "the shared memory is never written");
+        assert_eq!(
+            buf.0,
+            vec![1.0, 2.0, 3.0],
+            "the shared memory is never written"
+        );
     }
 }

@@ -144,6 +144,119 @@ pub struct CurrentLoop {
     pub fluctuation_tau_s: f64,
     /// White noise of the recorded current channel, A RMS.
     pub channel_noise_a: f64,
+    /// How the switched load `switched_a` varies in time (default: on and
+    /// off at random, `switches_per_hour`).
+    pub pattern: CurrentPattern,
+    /// Time constant of an eddy-like lagged field response, s: the loop's
+    /// field follows the current through a first-order lag (currents induced
+    /// in nearby structure by a switching load). 0: the field follows the
+    /// current at once.
+    pub field_lag_s: f64,
+}
+
+/// The time pattern of a current loop's switched load, as on-board
+/// equipment draws it (seed and spec: currents that "switch and ramp").
+/// The load is `switched_a × p(t)` with `p` below.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum CurrentPattern {
+    /// `p ∈ {0, 1}`, toggled at the events of a Poisson process of rate
+    /// `switches_per_hour` (de-icing, a transmitter).
+    #[default]
+    Telegraph,
+    /// Strobe light: `p = 1` for `pulse_s` every `period_s` (random phase).
+    Strobe {
+        /// Flash period, s.
+        period_s: f64,
+        /// Flash length, s (less than the period).
+        pulse_s: f64,
+    },
+    /// Motor runs (flaps, trim): runs start at the events of a Poisson
+    /// process of rate `runs_per_hour`, last `run_s`, and ramp up and down
+    /// linearly over `ramp_s` at each end.
+    Runs {
+        /// Mean number of runs per hour.
+        runs_per_hour: f64,
+        /// Length of a run, s (at least twice `ramp_s`).
+        run_s: f64,
+        /// Ramp time at start and end, s.
+        ramp_s: f64,
+    },
+    /// Pump or compressor cycle: on for `duty × period_s` every `period_s`
+    /// (random phase).
+    Cycle {
+        /// Cycle period, s.
+        period_s: f64,
+        /// Fraction of the period on, 0–1.
+        duty: f64,
+    },
+    /// Fan or heater levels: `p` jumps to one of `levels` (drawn at random)
+    /// at the events of a Poisson process of rate `changes_per_hour`.
+    Levels {
+        /// The levels, as fractions of `switched_a`.
+        levels: Vec<f64>,
+        /// Mean number of level changes per hour.
+        changes_per_hour: f64,
+    },
+    /// Servo activity: `p` is a first-order Gauss–Markov process of unit
+    /// RMS and bandwidth `bandwidth_hz` (correlation time `1/(2π·bw)`).
+    Servo {
+        /// Bandwidth, Hz.
+        bandwidth_hz: f64,
+    },
+}
+
+impl CurrentPattern {
+    /// Error naming the first invalid field (`path` names the pattern).
+    fn validate(&self, path: &str) -> Result<()> {
+        let bad =
+            |field: &str, reason: &str| Err(invalid(format!("{path}.{field}"), reason.to_string()));
+        match self {
+            CurrentPattern::Telegraph => {}
+            CurrentPattern::Strobe { period_s, pulse_s } => {
+                require_positive(&format!("{path}.period_s"), *period_s)?;
+                if !(*pulse_s > 0.0 && pulse_s < period_s) {
+                    return bad("pulse_s", "must be > 0 and less than period_s");
+                }
+            }
+            CurrentPattern::Runs {
+                runs_per_hour,
+                run_s,
+                ramp_s,
+            } => {
+                crate::error::require_non_negative(
+                    &format!("{path}.runs_per_hour"),
+                    *runs_per_hour,
+                )?;
+                crate::error::require_non_negative(&format!("{path}.ramp_s"), *ramp_s)?;
+                if !(run_s.is_finite() && *run_s > 0.0 && *run_s >= 2.0 * ramp_s) {
+                    return bad("run_s", "must be finite, > 0 and at least twice ramp_s");
+                }
+            }
+            CurrentPattern::Cycle { period_s, duty } => {
+                require_positive(&format!("{path}.period_s"), *period_s)?;
+                if !(0.0..=1.0).contains(duty) {
+                    return bad("duty", "must be between 0 and 1");
+                }
+            }
+            CurrentPattern::Levels {
+                levels,
+                changes_per_hour,
+            } => {
+                crate::error::require_non_negative(
+                    &format!("{path}.changes_per_hour"),
+                    *changes_per_hour,
+                )?;
+                if levels.is_empty() || !levels.iter().all(|l| l.is_finite()) {
+                    return bad("levels", "must be a non-empty list of finite numbers");
+                }
+            }
+            CurrentPattern::Servo { bandwidth_hz } => {
+                require_positive(&format!("{path}.bandwidth_hz"), *bandwidth_hz)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Default for CurrentLoop {
@@ -159,6 +272,8 @@ impl Default for CurrentLoop {
             fluctuation_a: 0.5,
             fluctuation_tau_s: 30.0,
             channel_noise_a: 0.02,
+            pattern: CurrentPattern::Telegraph,
+            field_lag_s: 0.0,
         }
     }
 }
@@ -377,6 +492,8 @@ impl AircraftConfig {
                 crate::error::require_non_negative(&format!("{f}.{n}"), v)?;
             }
             require_positive(&format!("{f}.fluctuation_tau_s"), c.fluctuation_tau_s)?;
+            crate::error::require_non_negative(&format!("{f}.field_lag_s"), c.field_lag_s)?;
+            c.pattern.validate(&format!("{f}.pattern"))?;
         }
         Ok(())
     }

@@ -1,18 +1,23 @@
-//! On-board electric currents: true current `I(t)` of each loop and its
-//! recorded channel.
+//! On-board electric currents: true current `I(t)` of each loop, the
+//! current its field follows, and its recorded channel.
 //!
-//! `I(t) = I_mean + I_sw s(t) + f(t)` with a telegraph switching state
-//! `s ∈ {0, 1}` that toggles at the events of a Poisson process of rate
-//! `switches_per_hour` (a load switched on and off: de-icing, transmitter,
-//! pumps), and a first-order Gauss–Markov fluctuation `f` (RMS
-//! `fluctuation_a`, time constant `fluctuation_tau_s`). The recorded channel
-//! adds white noise `channel_noise_a`. Spec `simulator.md`: "optional fields
-//! of on-board electrical currents recorded on current channels".
+//! `I(t) = I_mean + I_sw p(t) + f(t)`: the switched load `I_sw` times the
+//! loop's time pattern `p` ([`CurrentPattern`]: a telegraph on/off at random
+//! times — de-icing, a transmitter —, strobe flashes, motor runs with
+//! ramps, pump cycles, fan levels, servo activity), and a first-order
+//! Gauss–Markov fluctuation `f` (RMS `fluctuation_a`, time constant
+//! `fluctuation_tau_s`). The loop's field follows `I` directly or, with
+//! `field_lag_s = τ > 0`, through the first-order lag `τ dI_f/dt + I_f = I`
+//! (eddy currents induced in nearby structure by the switching load). The
+//! recorded channel adds white noise `channel_noise_a` to `I`. Spec
+//! `simulator.md`: "optional fields of on-board electrical currents
+//! recorded on current channels".
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use super::aircraft::CurrentLoop;
+use super::aircraft::{CurrentLoop, CurrentPattern};
+use crate::numerics::lag::lag_linear;
 use crate::random::gauss_markov::gauss_markov;
 use crate::random::normal;
 
@@ -23,24 +28,137 @@ pub struct CurrentSeries {
     pub true_a: Vec<f64>,
     /// Recorded channel, A.
     pub recorded_a: Vec<f64>,
+    /// The current the loop's field follows when it lags the true current
+    /// (`field_lag_s > 0`), A.
+    lagged_a: Option<Vec<f64>>,
+}
+
+impl CurrentSeries {
+    /// The current that produces the loop's field, A: the true current,
+    /// or its lagged response.
+    pub fn field_a(&self) -> &[f64] {
+        self.lagged_a.as_deref().unwrap_or(&self.true_a)
+    }
 }
 
 /// Generate `n` samples at step `dt_s` of the current of `lp`.
 pub fn generate(lp: &CurrentLoop, n: usize, dt_s: f64, rng: &mut ChaCha8Rng) -> CurrentSeries {
-    let p_switch = (lp.switches_per_hour / 3600.0 * dt_s).min(1.0);
-    let mut on: bool = rng.random_bool(0.5);
-    let fluct = gauss_markov(rng, n, dt_s, lp.fluctuation_a, lp.fluctuation_tau_s);
-    let mut true_a = Vec::with_capacity(n);
-    let mut recorded_a = Vec::with_capacity(n);
-    for f in fluct {
-        if p_switch > 0.0 && rng.random_bool(p_switch) {
-            on = !on;
+    if lp.pattern == CurrentPattern::Telegraph {
+        // The original draw order (one stream: start state, fluctuation,
+        // then switch and noise per sample), kept so that scenarios written
+        // before the other patterns existed give the same bits.
+        let p_switch = (lp.switches_per_hour / 3600.0 * dt_s).min(1.0);
+        let mut on: bool = rng.random_bool(0.5);
+        let fluct = gauss_markov(rng, n, dt_s, lp.fluctuation_a, lp.fluctuation_tau_s);
+        let mut true_a = Vec::with_capacity(n);
+        let mut recorded_a = Vec::with_capacity(n);
+        for f in fluct {
+            if p_switch > 0.0 && rng.random_bool(p_switch) {
+                on = !on;
+            }
+            let i = lp.mean_a + if on { lp.switched_a } else { 0.0 } + f;
+            true_a.push(i);
+            recorded_a.push(i + lp.channel_noise_a * normal(rng));
         }
-        let i = lp.mean_a + if on { lp.switched_a } else { 0.0 } + f;
-        true_a.push(i);
-        recorded_a.push(i + lp.channel_noise_a * normal(rng));
+        return with_lag(lp, dt_s, true_a, recorded_a);
     }
-    CurrentSeries { true_a, recorded_a }
+    let p = pattern(&lp.pattern, n, dt_s, rng);
+    let fluct = gauss_markov(rng, n, dt_s, lp.fluctuation_a, lp.fluctuation_tau_s);
+    let true_a: Vec<f64> = p
+        .iter()
+        .zip(&fluct)
+        .map(|(p, f)| lp.mean_a + lp.switched_a * p + f)
+        .collect();
+    let recorded_a = true_a
+        .iter()
+        .map(|i| i + lp.channel_noise_a * normal(rng))
+        .collect();
+    with_lag(lp, dt_s, true_a, recorded_a)
+}
+
+fn with_lag(lp: &CurrentLoop, dt_s: f64, true_a: Vec<f64>, recorded_a: Vec<f64>) -> CurrentSeries {
+    let lagged_a = (lp.field_lag_s > 0.0).then(|| lag_linear(&true_a, dt_s, lp.field_lag_s));
+    CurrentSeries {
+        true_a,
+        recorded_a,
+        lagged_a,
+    }
+}
+
+/// Probability of at least one event of a Poisson process of rate
+/// `per_hour` in `dt_s`.
+fn event_probability(per_hour: f64, dt_s: f64) -> f64 {
+    (per_hour / 3600.0 * dt_s).min(1.0)
+}
+
+/// `n` samples of the pattern `p(t)` (every pattern but the telegraph).
+fn pattern(pat: &CurrentPattern, n: usize, dt_s: f64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let t = |k: usize| k as f64 * dt_s;
+    match pat {
+        CurrentPattern::Telegraph => unreachable!("generated by the caller"),
+        CurrentPattern::Strobe { period_s, pulse_s } => {
+            let phase = rng.random::<f64>() * period_s;
+            (0..n)
+                .map(|k| f64::from(u8::from((t(k) + phase).rem_euclid(*period_s) < *pulse_s)))
+                .collect()
+        }
+        CurrentPattern::Cycle { period_s, duty } => {
+            let phase = rng.random::<f64>() * period_s;
+            (0..n)
+                .map(|k| {
+                    f64::from(u8::from(
+                        (t(k) + phase).rem_euclid(*period_s) < duty * period_s,
+                    ))
+                })
+                .collect()
+        }
+        CurrentPattern::Runs {
+            runs_per_hour,
+            run_s,
+            ramp_s,
+        } => {
+            let p_start = event_probability(*runs_per_hour, dt_s);
+            // Time since the current run started (None: idle).
+            let mut since: Option<f64> = None;
+            (0..n)
+                .map(|_| {
+                    if since.is_none() && p_start > 0.0 && rng.random_bool(p_start) {
+                        since = Some(0.0);
+                    }
+                    let Some(s) = since else { return 0.0 };
+                    let v = if *ramp_s > 0.0 {
+                        (s / ramp_s).min((run_s - s) / ramp_s).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    since = (s + dt_s < *run_s).then_some(s + dt_s);
+                    v
+                })
+                .collect()
+        }
+        CurrentPattern::Levels {
+            levels,
+            changes_per_hour,
+        } => {
+            let p_change = event_probability(*changes_per_hour, dt_s);
+            let mut level = levels[rng.random_range(0..levels.len())];
+            (0..n)
+                .map(|_| {
+                    if p_change > 0.0 && rng.random_bool(p_change) {
+                        level = levels[rng.random_range(0..levels.len())];
+                    }
+                    level
+                })
+                .collect()
+        }
+        CurrentPattern::Servo { bandwidth_hz } => gauss_markov(
+            rng,
+            n,
+            dt_s,
+            1.0,
+            1.0 / (2.0 * std::f64::consts::PI * bandwidth_hz),
+        ),
+    }
 }
 
 #[cfg(test)]
@@ -72,5 +190,185 @@ mod tests {
             .sum::<f64>()
             / 36_000.0;
         assert!((noise.sqrt() / lp.channel_noise_a - 1.0).abs() < 0.03);
+    }
+
+    /// A loop with only the switched load (no mean, fluctuation or noise),
+    /// so the true current is `switched_a × p(t)`.
+    fn bare(pattern: CurrentPattern) -> CurrentLoop {
+        CurrentLoop {
+            mean_a: 0.0,
+            switched_a: 10.0,
+            fluctuation_a: 0.0,
+            channel_noise_a: 0.0,
+            pattern,
+            ..Default::default()
+        }
+    }
+
+    fn on_fraction(i: &[f64]) -> f64 {
+        i.iter().filter(|&&v| v > 0.0).count() as f64 / i.len() as f64
+    }
+
+    #[test]
+    fn strobe_and_cycle_are_on_for_their_share_of_each_period() {
+        let dt = 0.1;
+        let strobe = bare(CurrentPattern::Strobe {
+            period_s: 1.5,
+            pulse_s: 0.3,
+        });
+        let s = generate(&strobe, 36_000, dt, &mut rng_for(5, Stream::Currents));
+        assert!(s.true_a.iter().all(|&v| v == 0.0 || v == 10.0));
+        assert!(
+            (on_fraction(&s.true_a) - 0.2).abs() < 0.01,
+            "{}",
+            on_fraction(&s.true_a)
+        );
+        // Every flash is 3 samples long (0.3 s at 10 Hz), up to the record's ends.
+        let runs: Vec<usize> = s
+            .true_a
+            .split(|&v| v == 0.0)
+            .map(<[f64]>::len)
+            .filter(|&l| l > 0)
+            .collect();
+        assert!(
+            runs[1..runs.len() - 1]
+                .iter()
+                .all(|&l| (2..=4).contains(&l)),
+            "{runs:?}"
+        );
+        let pump = bare(CurrentPattern::Cycle {
+            period_s: 120.0,
+            duty: 0.35,
+        });
+        let s = generate(&pump, 36_000, dt, &mut rng_for(6, Stream::Currents));
+        assert!((on_fraction(&s.true_a) - 0.35).abs() < 0.01);
+    }
+
+    #[test]
+    fn motor_runs_ramp_and_last_their_length() {
+        let dt = 0.1;
+        let flap = bare(CurrentPattern::Runs {
+            runs_per_hour: 20.0,
+            run_s: 12.0,
+            ramp_s: 2.0,
+        });
+        let s = generate(&flap, 72_000, dt, &mut rng_for(7, Stream::Currents));
+        // The load never jumps: at most a full ramp step per sample.
+        let max_step = s
+            .true_a
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(max_step <= 10.0 * dt / 2.0 + 1e-9, "{max_step}");
+        assert!(s.true_a.contains(&10.0), "the full load is reached");
+        // Each run is 12 s: (run_s − ramps) at full load …
+        let runs: Vec<usize> = s
+            .true_a
+            .split(|&v| v == 0.0)
+            .map(<[f64]>::len)
+            .filter(|&l| l > 0)
+            .collect();
+        assert!(
+            runs.len() > 20,
+            "about 40 runs in two hours, got {}",
+            runs.len()
+        );
+        assert!(
+            runs[..runs.len() - 1]
+                .iter()
+                .all(|&l| (110..=120).contains(&l)),
+            "{runs:?}"
+        );
+    }
+
+    #[test]
+    fn fan_levels_and_servo_activity() {
+        let fan = bare(CurrentPattern::Levels {
+            levels: vec![0.0, 0.4, 1.0],
+            changes_per_hour: 30.0,
+        });
+        let s = generate(&fan, 36_000, 0.1, &mut rng_for(8, Stream::Currents));
+        for level in [0.0, 4.0, 10.0] {
+            assert!(s.true_a.contains(&level), "level {level} occurs");
+        }
+        assert!(s.true_a.iter().all(|v| [0.0, 4.0, 10.0].contains(v)));
+        let servo = bare(CurrentPattern::Servo { bandwidth_hz: 0.5 });
+        let s = generate(&servo, 36_000, 0.1, &mut rng_for(9, Stream::Currents));
+        let rms = (s.true_a.iter().map(|v| v * v).sum::<f64>() / 36_000.0).sqrt();
+        assert!(
+            (rms / 10.0 - 1.0).abs() < 0.1,
+            "RMS {rms} A for 10 A of activity"
+        );
+    }
+
+    /// With `field_lag_s`, the field's current rises after a switch-on as
+    /// `1 − exp(−t/τ)` (63 % after τ), while the channel records the step.
+    #[test]
+    fn lagged_field_response_follows_a_step_with_its_time_constant() {
+        let dt = 0.01;
+        let tau = 0.5;
+        let lp = CurrentLoop {
+            field_lag_s: tau,
+            ..bare(CurrentPattern::Cycle {
+                period_s: 20.0,
+                duty: 0.5,
+            })
+        };
+        let s = generate(&lp, 4_000, dt, &mut rng_for(10, Stream::Currents));
+        let on = s
+            .true_a
+            .windows(2)
+            .position(|w| w[0] == 0.0 && w[1] == 10.0)
+            .unwrap()
+            + 1;
+        let k = (tau / dt).round() as usize;
+        let f = s.field_a();
+        assert!(f[on - 1].abs() < 1e-6 && f[on + 2 * k] < 10.0);
+        // The input is sampled, so the step is a ramp over one sample: allow that.
+        let expected = 10.0 * (1.0 - (-(k as f64 - 0.5) * dt / tau).exp());
+        assert!(
+            (f[on + k - 1] - expected).abs() < 0.15,
+            "{} vs {expected}",
+            f[on + k - 1]
+        );
+        assert_eq!(
+            s.true_a, s.recorded_a,
+            "the channel records the step itself"
+        );
+        // Without a lag the field follows the current.
+        let direct = generate(
+            &bare(CurrentPattern::Servo { bandwidth_hz: 1.0 }),
+            100,
+            dt,
+            &mut rng_for(1, Stream::Currents),
+        );
+        assert_eq!(direct.field_a(), &direct.true_a[..]);
+    }
+
+    #[test]
+    fn patterns_read_from_toml_and_bad_ones_are_named() {
+        let lp: CurrentLoop = toml::from_str(
+            "name = \"strb\"\npattern = { kind = \"strobe\", period_s = 1.5, pulse_s = 0.2 }\nfield_lag_s = 0.3",
+        )
+        .unwrap();
+        assert_eq!(
+            lp.pattern,
+            CurrentPattern::Strobe {
+                period_s: 1.5,
+                pulse_s: 0.2
+            }
+        );
+        let bad = crate::platform::aircraft::AircraftConfig {
+            currents: vec![CurrentLoop {
+                pattern: CurrentPattern::Strobe {
+                    period_s: 1.0,
+                    pulse_s: 2.0,
+                },
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let err = bad.validate("aircraft").unwrap_err().to_string();
+        assert!(err.contains("currents[0].pattern.pulse_s"), "{err}");
     }
 }

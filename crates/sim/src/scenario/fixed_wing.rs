@@ -242,7 +242,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             *slot = series[k];
         }
         for (slot, series) in i_c.iter_mut().zip(&cur) {
-            *slot = series.true_a[k];
+            *slot = series.field_a()[k];
         }
         let bt_s = b_s[k] / NT_PER_T;
         let c_s = at_s.contributions(&bt_s, &i_e, &i_c);
@@ -272,7 +272,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
                     *slot = series[k];
                 }
                 for (slot, series) in i_c.iter_mut().zip(&cur) {
-                    *slot = series.true_a[k];
+                    *slot = series.field_a()[k];
                 }
                 total.push(b + nt(at.contributions(&(b / NT_PER_T), &i_e, &i_c).total()));
             }
