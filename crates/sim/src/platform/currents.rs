@@ -205,6 +205,14 @@ mod tests {
         }
     }
 
+    /// Lengths (samples) of the stretches where the current is not zero.
+    fn on_runs(i: &[f64]) -> Vec<usize> {
+        i.split(|&v| v == 0.0)
+            .map(<[f64]>::len)
+            .filter(|&l| l > 0)
+            .collect()
+    }
+
     fn on_fraction(i: &[f64]) -> f64 {
         i.iter().filter(|&&v| v > 0.0).count() as f64 / i.len() as f64
     }
@@ -224,12 +232,7 @@ mod tests {
             on_fraction(&s.true_a)
         );
         // Every flash is 3 samples long (0.3 s at 10 Hz), up to the record's ends.
-        let runs: Vec<usize> = s
-            .true_a
-            .split(|&v| v == 0.0)
-            .map(<[f64]>::len)
-            .filter(|&l| l > 0)
-            .collect();
+        let runs = on_runs(&s.true_a);
         assert!(
             runs[1..runs.len() - 1]
                 .iter()
@@ -262,12 +265,7 @@ mod tests {
         assert!(max_step <= 10.0 * dt / 2.0 + 1e-9, "{max_step}");
         assert!(s.true_a.contains(&10.0), "the full load is reached");
         // Each run is 12 s: (run_s − ramps) at full load …
-        let runs: Vec<usize> = s
-            .true_a
-            .split(|&v| v == 0.0)
-            .map(<[f64]>::len)
-            .filter(|&l| l > 0)
-            .collect();
+        let runs = on_runs(&s.true_a);
         assert!(
             runs.len() > 20,
             "about 40 runs in two hours, got {}",
