@@ -452,6 +452,8 @@ impl TermSet {
         out: &mut Vec<Vec<f64>>,
     ) {
         let n = b[0].len();
+        // e[0] holds |B| until e[1] and e[2] are divided by it, then
+        // becomes B_x/|B| in place (no fourth buffer).
         e[0].clear();
         e[0].extend((0..n).map(|k| magnitude([b[0][k], b[1][k], b[2][k]])));
         let (bt, rest) = e.split_first_mut().expect("three axes");

@@ -100,9 +100,8 @@ pub fn sosfiltfilt_columns_with(
         for (k, e) in ext[pad..pad + n].iter_mut().enumerate() {
             *e = std::array::from_fn(|l| src[l][k]);
         }
-        for j in 1..=pad {
-            ext[pad - j] = std::array::from_fn(|l| 2.0 * src[l][0] - src[l][j]);
-            ext[pad + n - 1 + j] = std::array::from_fn(|l| 2.0 * src[l][n - 1] - src[l][n - 1 - j]);
+        for i in (0..pad).chain(pad + n..n + 2 * pad) {
+            ext[i] = std::array::from_fn(|l| odd_extended(src[l], pad, i));
         }
         let start = ext[0];
         for (s, z) in state.iter_mut().zip(&zi) {
@@ -133,6 +132,21 @@ pub fn filtfilt(b: &[f64], a: &[f64], x: &[f64]) -> Result<Vec<f64>> {
     zero_phase(&TransferFunction::new(b.to_vec(), a.to_vec())?, x)
 }
 
+/// Sample `i` of `x` extended by `pad` samples at both ends with the odd
+/// extension of the module docs (`i < pad`: before the start; `i ≥ pad +
+/// n`: after the end), shared by the one- and many-signal filters.
+#[inline(always)]
+fn odd_extended(x: &[f64], pad: usize, i: usize) -> f64 {
+    let n = x.len();
+    if i < pad {
+        2.0 * x[0] - x[pad - i]
+    } else if i < pad + n {
+        x[i - pad]
+    } else {
+        2.0 * x[n - 1] - x[n - 1 - (i + 1 - pad - n)]
+    }
+}
+
 /// Forward–backward pass over the odd-extended signal; returns the extended
 /// buffer (filtered) and the pad length.
 fn filter_extended(f: &impl LinearFilter, x: &[f64]) -> Result<(Vec<f64>, usize)> {
@@ -142,11 +156,9 @@ fn filter_extended(f: &impl LinearFilter, x: &[f64]) -> Result<(Vec<f64>, usize)
     check_finite("x", x)?;
     let zi = f.steady_state()?;
 
-    let mut ext = Vec::with_capacity(n + 2 * pad);
-    let (first, last) = (x[0], x[n - 1]);
-    ext.extend((1..=pad).rev().map(|j| 2.0 * first - x[j]));
+    let mut ext: Vec<f64> = (0..pad).map(|i| odd_extended(x, pad, i)).collect();
     ext.extend_from_slice(x);
-    ext.extend((1..=pad).map(|j| 2.0 * last - x[n - 1 - j]));
+    ext.extend((pad + n..n + 2 * pad).map(|i| odd_extended(x, pad, i)));
 
     let mut state: Vec<f64> = zi.iter().map(|z| z * ext[0]).collect();
     f.run(ext.iter_mut(), &mut state);
