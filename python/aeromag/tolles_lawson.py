@@ -83,6 +83,11 @@ class TollesLawson:
     Options (the CLI's flags; ``None`` = the library's default):
 
     - ``terms``: term groups, e.g. ``"p3,i5,e8"`` (16 terms), ``"p3,i6,e9"``;
+    - ``extra``: extra regressors, recorded channels times the direction
+      cosines, e.g. ``["cur_strb", "cur_flap:lag"]`` (``:lag``: also through
+      a first-order lag fitted on the flight); the CLI's ``--extra``;
+    - ``magnitude``: ``"first-order"`` (the Tolles-Lawson projection) or
+      ``"exact"`` (``|B + ΔB| − |B|`` by Gauss–Newton, method ``ls``);
     - ``convention``: ``"physical"`` (eddy terms in nT/s) or ``"magnav"``
       (MagNav.jl's per-sample difference);
     - ``ridge_lambda``: ridge parameter λ ≥ 0 (``--lambda``);
@@ -112,6 +117,8 @@ class TollesLawson:
         method: str = "ls",
         *,
         terms: str = "p3,i5,e8",
+        extra: Union[None, str, Sequence[str]] = None,
+        magnitude: str = "first-order",
         convention: str = "physical",
         ridge_lambda: float = 0.0,
         band: Optional[Tuple[float, float]] = (0.1, 0.9),
@@ -130,6 +137,8 @@ class TollesLawson:
     ) -> None:
         self.method = method
         self.terms = terms
+        self.extra = extra
+        self.magnitude = magnitude
         self.convention = convention
         self.ridge_lambda = ridge_lambda
         self.band = band

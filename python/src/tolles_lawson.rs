@@ -7,7 +7,7 @@ use crate::errors::{IntoPy, bad_argument};
 use crate::flight::PyFlight;
 use crate::progress::PyProgress;
 use aeromag::compensation::kalman::NoiseModel;
-use aeromag::compensation::tolles_lawson::{Convention, TermSet};
+use aeromag::compensation::tolles_lawson::{Convention, ExtraRequest, Magnitude, TermSet};
 use aeromag::core::time::Date;
 use aeromag::{
     CalibrateOptions, CalibrateSettings, EddyLag, Method, ModelFile, Note, ReferenceChannels,
@@ -19,13 +19,15 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// The keyword options, in the order of the CLI's `calibrate --help`.
-const OPTIONS: [&str; 17] = [
+const OPTIONS: [&str; 19] = [
     "method",
     "tune",
     "no_tune",
     "kalman_noise",
     "field_order",
     "series",
+    "extra",
+    "magnitude",
     "terms",
     "convention",
     "ridge_lambda",
@@ -100,6 +102,8 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
             "field_order" => s.field_order = Some(v.extract()?),
             "series" => s.series = v.extract()?,
             "terms" => s.terms = Some(TermSet::parse(&text()?).py_err()?),
+            "extra" => s.extra = ExtraRequest::parse_list(&text()?).py_err()?,
+            "magnitude" => s.magnitude = Some(text()?.parse::<Magnitude>().py_err()?),
             "convention" => s.convention = Some(text()?.parse::<Convention>().py_err()?),
             "ridge_lambda" => s.ridge_lambda = Some(number("a number ≥ 0")?),
             "band" => {

@@ -90,12 +90,15 @@ pub use aeromag_io::Location;
 pub use aeromag_io::{ColumnMap, Fields, FlightTable, ReadOptions, RowSelection, Sensors};
 pub use compensate::{Compensated, Compensator, OutputColumns};
 pub use error::{Error, InFile, Result};
-pub use flight::{Flight, LeverArm, LineLabels, ReferenceChannels, SegmentRule, TlInputs};
+pub use flight::{
+    Flight, LeverArm, LineLabels, ReferenceChannels, SegmentRule, SensorColumns, TlInputs,
+};
 pub use model_file::ModelFile;
 pub use observer::{Note, NoteLevel, Observer, Silent};
 pub use tolles_lawson::{
-    CalibrateOptions, CalibrateSettings, Calibration, EddyLag, KalmanOptions, Method, TlModel,
-    calibrate, observability,
+    CalibrateOptions, CalibrateSettings, Calibration, CompensateSensors, EddyLag, KalmanOptions,
+    Method, SensorSet, SensorsCalibration, SensorsCompensated, SensorsModel, TlModel, calibrate,
+    calibrate_sensors, observability,
 };
 
 /// The names most programs need: `use aeromag::prelude::*;`.

@@ -39,9 +39,39 @@ pub trait ModelFile: Sized {
     }
 }
 
+/// The `kind` of the model file at `path` (`tolles-lawson`,
+/// `tolles-lawson-sensors`, `rotor`, …), to choose how to read it; bad
+/// input when it cannot be read or is not a model file.
+pub fn kind_of(path: impl AsRef<Path>) -> Result<String> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        Error::bad_file(
+            path.display().to_string(),
+            format!("not a JSON model file ({e})"),
+        )
+    })?;
+    match v.get("kind").and_then(|k| k.as_str()) {
+        Some(k) => Ok(k.to_string()),
+        None => Err(Error::bad_file(
+            path.display().to_string(),
+            "no \"kind\" key; not an aeromag model file",
+        )),
+    }
+}
+
 impl ModelFile for TlModel {
     fn parse(text: &str, origin: &str) -> Result<Self> {
         Ok(TlModel::from_json(text, origin)?)
+    }
+    fn json(&self) -> Result<String> {
+        Ok(self.to_json()?)
+    }
+}
+
+impl ModelFile for aeromag_compensation::model_file::SensorsModel {
+    fn parse(text: &str, origin: &str) -> Result<Self> {
+        Ok(Self::from_json(text, origin)?)
     }
     fn json(&self) -> Result<String> {
         Ok(self.to_json()?)

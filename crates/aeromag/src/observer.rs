@@ -142,6 +142,16 @@ impl<'o> Notes<'o> {
     pub(crate) fn into_notes(self) -> Vec<Note> {
         self.kept
     }
+
+    /// Number of notes raised so far.
+    pub(crate) fn len(&self) -> usize {
+        self.kept.len()
+    }
+
+    /// Copies of the notes raised after the first `start`.
+    pub(crate) fn since(&self, start: usize) -> Vec<Note> {
+        self.kept[start.min(self.kept.len())..].to_vec()
+    }
 }
 
 /// A [`Notes`] collector is itself an observer: a nested workflow's notes

@@ -5,7 +5,10 @@
 
 use aeromag::prelude::*;
 use aeromag::simulate::{ScenarioKind, simulate_flight};
-use aeromag::{FlightTable, KalmanOptions};
+use aeromag::{
+    CompensateSensors, FlightTable, KalmanOptions, SensorColumns, SensorSet, SensorsModel,
+    calibrate_sensors,
+};
 
 /// The classical 16-term LS model of `cal` (no eddy-current lags).
 fn classical_model(cal: &Flight) -> TlModel {
@@ -408,3 +411,181 @@ fn kalman_halves_the_least_squares_error_for_another_aircraft_at_300_m() {
 
 /// A single-engine aircraft with a short stinger (scenario TOML sections).
 const OTHER_AIRCRAFT: &str = include_str!("data/other_aircraft.toml");
+
+/// A cabin installation: a scalar sensor and a fluxgate 1.5 m forward of
+/// the navigation point (hundreds of nT of interference), a strobe and a
+/// flap motor whose field lags its current by 0.4 s.
+const CABIN: &str = r#"
+[[extra_scalars]]
+position_m = [1.5, 0.0, -0.4]
+[[extra_fluxgates]]
+position_m = [1.5, 0.3, -0.4]
+[[aircraft.currents]]
+name = "strb"
+position_m = [1.0, 0.5, -0.3]
+normal = [0.0, 0.3, 1.0]
+area_m2 = 0.05
+mean_a = 0.0
+switched_a = 6.0
+fluctuation_a = 0.05
+fluctuation_tau_s = 5.0
+channel_noise_a = 0.02
+pattern = { kind = "strobe", period_s = 1.3, pulse_s = 0.2 }
+[[aircraft.currents]]
+name = "flap"
+position_m = [2.0, -0.5, -0.2]
+normal = [1.0, 0.2, 0.3]
+area_m2 = 0.1
+mean_a = 0.5
+switched_a = 10.0
+fluctuation_a = 0.1
+fluctuation_tau_s = 10.0
+channel_noise_a = 0.05
+field_lag_s = 0.4
+pattern = { kind = "runs", runs_per_hour = 60.0, run_s = 8.0, ramp_s = 1.0 }
+[pattern]
+line_count = 6
+"#;
+
+/// `CABIN` for the calibration box (its pattern has no `line_count`).
+fn cabin_calibration() -> Flight {
+    let toml = CABIN.split("[pattern]").next().unwrap();
+    simulate_flight(ScenarioKind::Calibration, Some(toml), Some(3)).unwrap()
+}
+
+/// RMS about the mean of `comp − true_external<suffix>` on the survey.
+fn survey_error(f: &Flight, comp: &[f64], suffix: &str) -> f64 {
+    let t = f.require(&format!("true_external{suffix}")).unwrap();
+    let d: Vec<f64> = comp.iter().zip(t).map(|(c, t)| c - t).collect();
+    let m = d.iter().sum::<f64>() / d.len() as f64;
+    (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+}
+
+/// Current terms on a cabin sensor (issue 20): the 16-term model leaves
+/// tens of nT of the currents' field, the current terms (the channel times
+/// the direction cosines, the flap also through its fitted lag) take it
+/// out, on independent survey lines. Measured: 16 terms 143 nT, with the
+/// current terms 0.63 nT, τ = 0.402 s (truth 0.4 s); the same model fitted
+/// to the survey's own true interference (the oracle) leaves 0.29 nT.
+#[test]
+fn current_terms_compensate_a_cabin_sensor() {
+    use aeromag::compensation::tolles_lawson::ExtraRequest;
+    let cal = cabin_calibration();
+    let survey = simulate_flight(ScenarioKind::Survey, Some(CABIN), Some(4)).unwrap();
+    let cabin = SensorColumns::find(&cal, "mag_2", Some("flux_b")).unwrap();
+    let fit = |extra: &str| {
+        let opts = CalibrateOptions {
+            sensor: cabin.clone(),
+            extra: ExtraRequest::parse_list(extra).unwrap(),
+            ..CalibrateOptions::default()
+        };
+        let set = SensorSet {
+            sensors: vec![cabin.clone()],
+            reference: None,
+        };
+        let cal = calibrate_sensors(&cal, &set, &opts, &mut Silent).unwrap();
+        let comp = cal.model.compensate(&survey).unwrap();
+        (cal, survey_error(&survey, &comp.sensors[0].2, "_2"))
+    };
+    let (_, plain) = fit("");
+    let (with, current) = fit("cur_strb,cur_flap:lag");
+    let terms = &with.model.sensors[0].model.design.terms;
+    let tau = terms.extras()[1].lag_s.unwrap();
+    assert!((tau - 0.4).abs() < 0.02, "{terms:?}");
+    assert_eq!(terms.extras()[0].lag_s, None);
+    assert!(plain > 50.0, "16 terms: {plain} nT");
+    assert!(
+        current < 1.0 && current * 10.0 < plain,
+        "{current} vs {plain} nT"
+    );
+}
+
+/// Several sensors in one run give each sensor the model it gets alone,
+/// bit for bit; `compensate` writes every sensor's columns and the
+/// gradient; in reference-sensor mode the cabin sensor, fitted on every
+/// row of the flight against the compensated stinger, reaches what the
+/// band-passed fit does (measured: 0.70 nT against 0.63 nT).
+#[test]
+fn several_sensors_and_the_reference_sensor_mode() {
+    use aeromag::compensation::tolles_lawson::ExtraRequest;
+    let cal = cabin_calibration();
+    let survey = simulate_flight(ScenarioKind::Survey, Some(CABIN), Some(4)).unwrap();
+    let opts = CalibrateOptions {
+        extra: ExtraRequest::parse_list("cur_strb,cur_flap:lag").unwrap(),
+        ..CalibrateOptions::default()
+    };
+    let set = SensorSet {
+        sensors: vec![
+            SensorColumns::find(&cal, "mag", None).unwrap(),
+            SensorColumns::find(&cal, "MAG_2", Some("flux_b")).unwrap(),
+        ],
+        reference: None,
+    };
+    let both = calibrate_sensors(&cal, &set, &opts, &mut Silent).unwrap();
+    for (k, s) in set.sensors.iter().enumerate() {
+        let alone = calibrate(
+            &cal,
+            &CalibrateOptions {
+                sensor: s.clone(),
+                ..opts.clone()
+            },
+            &mut Silent,
+        )
+        .unwrap();
+        assert_eq!(alone.model, both.model.sensors[k].model);
+    }
+    assert_eq!(both.model.sensors[1].mag, "mag_2");
+    assert_eq!(both.model.sensors[1].model.columns["mag"], "mag_2");
+    let text = both.model.to_json().unwrap();
+    assert_eq!(SensorsModel::parse(&text, "m.json").unwrap(), both.model);
+    let comp = both.model.compensate(&survey).unwrap();
+    let names: Vec<String> = comp.columns().into_iter().map(|c| c.0).collect();
+    assert_eq!(
+        names,
+        [
+            "mag_interf",
+            "mag_comp",
+            "mag_2_interf",
+            "mag_2_comp",
+            "mag_2_grad"
+        ]
+    );
+    let band_passed = survey_error(&survey, &comp.sensors[1].2, "_2");
+
+    let reference = SensorSet {
+        reference: Some("mag".into()),
+        ..set.clone()
+    };
+    let r = calibrate_sensors(&cal, &reference, &opts, &mut Silent).unwrap();
+    assert_eq!(r.model.sensors[0].model, both.model.sensors[0].model);
+    assert_eq!(r.model.sensors[1].reference_sensor.as_deref(), Some("mag"));
+    let m = &r.model.sensors[1].model;
+    assert!(
+        m.reference.is_empty()
+            && m.design
+                .terms
+                .groups()
+                .contains(&aeromag::compensation::tolles_lawson::TermGroup::Bias)
+    );
+    let rc = r.model.compensate(&survey).unwrap();
+    let ref_mode = survey_error(&survey, &rc.sensors[1].2, "_2");
+    assert!(
+        ref_mode < 1.2 * band_passed.max(0.5),
+        "{ref_mode} vs {band_passed} nT"
+    );
+    // A sensor given twice, or absent, is bad input.
+    let twice = SensorSet {
+        sensors: vec![set.sensors[1].clone(), set.sensors[1].clone()],
+        reference: None,
+    };
+    assert!(
+        calibrate_sensors(&cal, &twice, &opts, &mut Silent)
+            .unwrap_err()
+            .is_bad_input()
+    );
+    let e = SensorColumns::find(&cal, "mag_7_uc", None).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("mag_7_uc"),
+        "{e}"
+    );
+}

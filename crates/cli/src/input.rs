@@ -20,11 +20,13 @@ pub struct InputArgs {
     pub columns: Option<String>,
     /// The scalar magnetometer to use, e.g. `mag_3_uc` (SGL names also find
     /// the XYZ export's `UNCOMPMAG3`), or any column. Default: the first of
-    /// mag_1_uc … mag_5_uc present.
+    /// mag_1_uc … mag_5_uc present. `calibrate` takes several,
+    /// comma-separated (one model per sensor).
     #[arg(long, value_name = "NAME")]
     pub mag: Option<String>,
     /// The vector magnetometer to use, by prefix: `flux_b` reads
     /// flux_b_x/y/z (or FLUXB_X/Y/Z). Default: the first complete of A–D.
+    /// With several --mag sensors: one prefix for all, or one per sensor.
     #[arg(long, value_name = "PREFIX")]
     pub vector: Option<String>,
     /// Keep only the rows on these line labels, e.g. `1002.02` or
@@ -54,13 +56,60 @@ impl InputArgs {
                 Some(m) => ColumnMap::parse(m)?,
                 None => ColumnMap::new(),
             },
-            sensors: Sensors {
-                mag: self.mag.clone(),
-                vector: self.vector.clone(),
+            // Several sensors are chosen per model, not at reading.
+            sensors: if self.several_sensors() {
+                Sensors::default()
+            } else {
+                Sensors {
+                    mag: self.mag.clone(),
+                    vector: self.vector.clone(),
+                }
             },
             rows: RowSelection::parse(self.lines.as_deref(), self.time_range.as_deref())?,
             ..ReadOptions::default()
         })
+    }
+
+    /// Whether --mag or --vector names several sensors.
+    pub fn several_sensors(&self) -> bool {
+        [&self.mag, &self.vector]
+            .iter()
+            .any(|s| s.as_deref().is_some_and(|s| s.contains(',')))
+    }
+
+    /// The sensors of --mag and --vector in `flight` (one per --mag name;
+    /// --vector gives one prefix for all or one per sensor).
+    pub fn sensor_columns(&self, flight: &Flight) -> anyhow::Result<Vec<aeromag::SensorColumns>> {
+        let split = |s: &Option<String>| -> Vec<String> {
+            s.as_deref()
+                .map(|s| {
+                    s.split(',')
+                        .map(|t| t.trim().to_string())
+                        .filter(|t| !t.is_empty())
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        let (mags, vectors) = (split(&self.mag), split(&self.vector));
+        if mags.is_empty() {
+            anyhow::bail!(aeromag::Error::bad_input(
+                "give the scalar sensors with --mag A,B,…"
+            ));
+        }
+        if vectors.len() > 1 && vectors.len() != mags.len() {
+            anyhow::bail!(aeromag::Error::bad_input(format!(
+                "--vector names {} vector magnetometers for {} scalar sensors: give one for all or one per sensor",
+                vectors.len(),
+                mags.len()
+            )));
+        }
+        mags.iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let v = vectors.get(k).or(vectors.first()).map(String::as_str);
+                Ok(aeromag::SensorColumns::find(flight, m, v)?)
+            })
+            .collect()
     }
 
     /// Read and check the flight file (every field); its warnings go to stderr.

@@ -50,6 +50,8 @@ fn bench(c: &mut Criterion) {
         time: &t,
         flux: [&f[0], &f[1], &f[2]],
         mag: &m,
+        channels: Default::default(),
+        direction: None,
     };
     let cfg = LsConfig::default();
     let mut g = c.benchmark_group("fit_band_pass_ls");

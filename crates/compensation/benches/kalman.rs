@@ -72,6 +72,7 @@ fn flight(n: usize) -> Flight {
             [f.flux[0][i], f.flux[1][i], f.flux[2][i]],
             [db[0][i], db[1][i], db[2][i]],
             &[],
+            &[],
             DEFAULT_BT_SCALE_NT,
             &mut row,
         );
@@ -118,6 +119,8 @@ fn bench(c: &mut Criterion) {
             time: &f.time,
             flux: [&f.flux[0], &f.flux[1], &f.flux[2]],
             mag: &f.mag,
+            channels: Default::default(),
+            direction: None,
         },
         alt_m: &f.alt,
         speed_m_s: &f.speed,

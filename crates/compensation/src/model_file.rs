@@ -139,6 +139,10 @@ pub struct FitStats {
     /// likelihood-ratio statistic and threshold (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eddy_lag_selection: Option<crate::tolles_lawson::lag_select::LagSelection>,
+    /// How the lags of the extra regressors asked for with `:lag` were
+    /// chosen (absent without them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub extra_lag_selection: Vec<crate::tolles_lawson::lag_select::ExtraLagSelection>,
 }
 
 /// JSON has no ∞: `serde_json` writes it as `null`; read `null` back as ∞.
@@ -271,6 +275,96 @@ impl TlModel {
     }
 }
 
+/// `kind` of a model file holding one Tolles-Lawson model per scalar
+/// sensor (`aeromag calibrate --mag mag_1_uc,mag_3_uc,…`).
+pub const TL_SENSORS_KIND: &str = "tolles-lawson-sensors";
+
+/// One scalar sensor's model in a [`SensorsModel`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorModel {
+    /// Stem of the output columns: `<name>_comp`, `<name>_interf`
+    /// (`mag_3` for the sensor `mag_3_uc`).
+    pub name: String,
+    /// The scalar magnetometer's column.
+    pub mag: String,
+    /// The vector magnetometer's columns (x, y, z).
+    pub flux: [String; 3],
+    /// The sensor whose compensated reading was the external-field
+    /// reference of this fit (reference-sensor mode), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_sensor: Option<String>,
+    /// The model.
+    pub model: TlModel,
+}
+
+/// One Tolles-Lawson model per scalar sensor (kind [`TL_SENSORS_KIND`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorsModel {
+    /// Always [`MODEL_FORMAT`] in memory.
+    pub format: String,
+    /// [`TL_SENSORS_KIND`].
+    pub kind: String,
+    /// The sensors, in the order they were given.
+    pub sensors: Vec<SensorModel>,
+    /// Version of aeromag that wrote the file.
+    pub software_version: String,
+}
+
+impl SensorsModel {
+    /// The file of `sensors`.
+    pub fn new(sensors: Vec<SensorModel>) -> Self {
+        Self {
+            format: MODEL_FORMAT.into(),
+            kind: TL_SENSORS_KIND.into(),
+            sensors,
+            software_version: env!("CARGO_PKG_VERSION").into(),
+        }
+    }
+
+    /// Serialize to pretty JSON.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| CompError::Serialize {
+            what: "model",
+            reason: e.to_string(),
+        })
+    }
+
+    /// Parse and check the file's text: each sensor's model as
+    /// [`TlModel::from_json`] checks it, names unique.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self> {
+        let v = parse_model_json(
+            text,
+            origin,
+            TL_SENSORS_KIND,
+            "aeromag calibrate --mag A,B,…",
+        )?;
+        let mut m: SensorsModel = serde_json::from_value(v)
+            .map_err(|e| model_error(origin, format!("invalid model file: {e}")))?;
+        m.format = MODEL_FORMAT.into();
+        if m.sensors.is_empty() {
+            return Err(model_error(origin, "no sensor"));
+        }
+        for s in m.sensors.iter_mut() {
+            let json =
+                serde_json::to_string(&s.model).map_err(|e| model_error(origin, e.to_string()))?;
+            s.model = TlModel::from_json(&json, &format!("{origin}, sensor {}", s.name))?;
+        }
+        let names: Vec<&str> = m.sensors.iter().map(|s| s.name.as_str()).collect();
+        if let Some(d) = names
+            .iter()
+            .enumerate()
+            .find(|(k, n)| names[..*k].contains(n))
+        {
+            return Err(model_error(
+                origin,
+                format!("sensor `{}` appears twice", d.1),
+            ));
+        }
+        Ok(m)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -301,6 +395,7 @@ mod tests {
                 terms,
                 convention: Convention::Physical,
                 bt_scale_nt: 50_000.0,
+                magnitude: Default::default(),
             },
             fit: FitStats::default(),
             columns: Default::default(),

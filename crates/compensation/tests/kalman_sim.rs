@@ -95,6 +95,8 @@ impl<'a> Flight<'a> {
                 &col(s, "flux_z")[r.clone()],
             ],
             mag: &self.mag[r],
+            channels: Default::default(),
+            direction: None,
         }
     }
     fn kalman_segment(&self, r: Range<usize>) -> KalmanSegment<'_> {

@@ -47,7 +47,7 @@ proptest! {
         let db = -omega.cross(&b);
         let terms = TermSet::full18();
         let mut row = vec![0.0; terms.n_columns()];
-        terms.row([b.x, b.y, b.z], [db.x, db.y, db.z], &[], DEFAULT_BT_SCALE_NT, &mut row);
+        terms.row([b.x, b.y, b.z], [db.x, db.y, db.z], &[], &[], DEFAULT_BT_SCALE_NT, &mut row);
         let e2: f64 = row[0..3].iter().map(|v| v * v).sum();
         prop_assert!((e2 - 1.0).abs() < 1e-14, "eᵀe = {e2}");
         // i6 order: xx, xy, xz, yy, yz, zz.
@@ -100,7 +100,8 @@ proptest! {
     /// The column-wise design (what the fit filters) and the block-wise
     /// interference (what `compensate` subtracts) are the row-wise design
     /// bit for bit, with lagged eddy columns (whose lags run across the
-    /// interference's blocks) and in both derivative conventions.
+    /// interference's blocks), extra regressors (one lagged) and in both
+    /// derivative conventions.
     #[test]
     fn columns_and_interference_are_the_rows_bit_for_bit(
         (roll, pitch, yaw) in attitude(),
@@ -110,7 +111,7 @@ proptest! {
         magnav in any::<bool>(),
         coef_seed in 0u64..1000,
     ) {
-        use aeromag_compensation::tolles_lawson::{Convention, eddy_lag::LagBank, terms::derivative};
+        use aeromag_compensation::tolles_lawson::{Convention, ExtraTerm, design::Channels, eddy_lag::{FirstOrderLag, LagBank}, terms::derivative};
         let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1 + 0.003 * (k % 7) as f64).collect();
         let mut flux = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         for (k, t) in time.iter().enumerate() {
@@ -120,20 +121,26 @@ proptest! {
                 flux[j][k] = b[j];
             }
         }
-        let terms = TermSet::parse("p3,i6,e9,bias").unwrap().with_eddy_lags(&[0.3, 1.1]).unwrap();
+        let strobe: Vec<f64> = (0..n).map(|k| 4.0 * ((k / 11) % 2) as f64 + 0.5).collect();
+        let ramp: Vec<f64> = (0..n).map(|k| ((k + coef_seed as usize) % 97) as f64 * 0.03).collect();
+        let chs = [&strobe[..], &ramp[..]];
+        let terms = TermSet::parse("p3,i6,e9,bias").unwrap().with_eddy_lags(&[0.3, 1.1]).unwrap()
+            .with_extras(&[ExtraTerm::new("strobe"), ExtraTerm::lagged("ramp", 0.6)]).unwrap();
         let mut design = Design::new(terms.clone());
         design.convention = if magnav { Convention::MagNav } else { Convention::Physical };
         let f = [&flux[0][..], &flux[1][..], &flux[2][..]];
-        let cols = design.columns(&time, f);
+        let cols = design.columns_with(&time, f, Channels::new(&chs));
         let coef: Vec<f64> = (0..terms.n_columns()).map(|k| ((k as u64 * 7919 + coef_seed) % 201) as f64 - 100.0).collect();
-        let interference = design.interference(&coef, &time, f);
+        let interference = design.interference_with(&coef, &time, f, Channels::new(&chs));
         let db = [0, 1, 2].map(|k| derivative(&flux[k], &time, design.convention));
         let mut lags = LagBank::new(terms.eddy_lags_s());
+        let mut ramp_lag = FirstOrderLag::new(0.6);
         let mut row = vec![0.0; terms.n_columns()];
         for k in 0..n {
             let d = [db[0][k], db[1][k], db[2][k]];
             let lagged = lags.step(time[k], d);
-            terms.row([flux[0][k], flux[1][k], flux[2][k]], d, lagged, DEFAULT_BT_SCALE_NT, &mut row);
+            let extra = [[strobe[k], f64::NAN], [ramp[k], ramp_lag.step(time[k], ramp[k])]];
+            terms.row([flux[0][k], flux[1][k], flux[2][k]], d, lagged, &extra, DEFAULT_BT_SCALE_NT, &mut row);
             for (c, v) in cols.iter().zip(&row) {
                 prop_assert_eq!(c[k].to_bits(), v.to_bits());
             }

@@ -89,7 +89,7 @@
 //! | `manoeuvre` | – | 0 none, 1 roll, 2 pitch, 3 yaw |
 //! | `diurnal` | nT | base-station record of the diurnal variation (relative to take-off) |
 //! | `igrf` | nT | IGRF-14 total field at the recorded position |
-//! | `current_<name>` | A | recorded current of an on-board loop (only if configured) |
+//! | `cur_<name>` | A | recorded current of an on-board loop (only if configured) |
 //! | `true_lat`, `true_lon` | deg | true position of the reference point |
 //! | `true_alt` | m | true height of the reference point |
 //! | `true_sensor_alt` | m | true height of the scalar sensor |
@@ -107,7 +107,7 @@
 //! | `true_ext_x`, `true_ext_y`, `true_ext_z` | nT | external field at the scalar sensor, body axes |
 //! | `true_interf_x`, `true_interf_y`, `true_interf_z` | nT | aircraft field ΔB at the scalar sensor, body axes |
 //! | `true_flux_x`, `true_flux_y`, `true_flux_z` | nT | true total field at the fluxgate, body axes, before sensor errors |
-//! | `true_current_<name>` | A | true current of an on-board loop |
+//! | `true_cur_<name>` | A | true current of an on-board loop |
 //!
 //! Optional extra sensors (`[[extra_scalars]]`, `[[extra_fluxgates]]` in the
 //! scenario file, none by default; see [`scenario::fixed_wing`], "Extra
@@ -120,6 +120,14 @@
 //! | `true_interf_<k>` | nT | \|B_ext + ΔB\| − \|B_ext\| at extra scalar sensor k (exact) |
 //! | `true_external_<k>` | nT | \|B_ext\| at extra scalar sensor k |
 //! | `true_flux_<j>_x`, `true_flux_<j>_y`, `true_flux_<j>_z` | nT | true total field at extra fluxgate j, body axes, before sensor errors |
+//!
+//! With `installation = "sgl"` (an SGL-like installation: a stinger and
+//! four cabin scalar sensors, four fluxgates, 14 current loops; see
+//! [`scenario::installation`]) the columns follow the SGL HDF5 layout:
+//! `mag_1_uc` … `mag_5_uc`, `flux_a_x` … `flux_d_z`, `cur_<name>`, and per
+//! scalar sensor `k` = 1 … 5 `true_interf_<k>`, `true_external_<k>` and
+//! `true_interf_current_<k>` (nT: the currents' part of the interference,
+//! projected on the external field).
 //!
 //! The `helicopter` scenario adds `rotor_phase` (deg, recorded),
 //! `true_rotor_phase` (deg), `true_rotor_hz` (Hz), `true_coning`,

@@ -426,16 +426,31 @@ pub fn describe(name: &str) -> Option<(&'static str, String)> {
             ),
         ));
     }
-    if let Some(loop_name) = name.strip_prefix("true_current_") {
+    if let Some(k) = extra_scalar_index(name, "true_interf_current_") {
+        return Some((
+            "nT",
+            format!(
+                "on-board currents' part of the interference at extra scalar sensor {k}, projected on B_ext/|B_ext|"
+            ),
+        ));
+    }
+    if let Some(loop_name) = name.strip_prefix("true_cur_") {
         return Some((
             "A",
             format!("true current of the on-board loop `{loop_name}`"),
         ));
     }
-    name.strip_prefix("current_").map(|loop_name| {
-        (
+    if let Some(loop_name) = name.strip_prefix("cur_") {
+        return Some((
             "A",
             format!("recorded current of the on-board loop `{loop_name}`"),
-        )
-    })
+        ));
+    }
+    // The SGL installation's names of the stinger sensors' columns.
+    let stinger = crate::scenario::installation::stinger_name(name)?;
+    let (unit, what) = describe(&stinger)?;
+    Some((
+        unit,
+        format!("{what} (SGL layout: `{stinger}` of the stinger installation)"),
+    ))
 }

@@ -471,8 +471,8 @@ fn fluxgate_records_its_documented_errors() {
 fn onboard_current_appears_in_its_channel_and_in_the_interference() {
     let cfg = "[[aircraft.currents]]\nname = \"deicer\"\nposition_m = [-6.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\narea_m2 = 0.2\nmean_a = 10.0\nswitched_a = 30.0\nswitches_per_hour = 60.0\n";
     let s = simulate(ScenarioKind::Calibration, Some(cfg), Some(7)).unwrap();
-    let rec = col(&s, "current_deicer");
-    let tru = col(&s, "true_current_deicer");
+    let rec = col(&s, "cur_deicer");
+    let tru = col(&s, "true_cur_deicer");
     let part = col(&s, "true_interf_current");
     assert!(rms(part) > 0.1, "current interference {}", rms(part));
     // the interference follows the current: correlation close to 1 in magnitude

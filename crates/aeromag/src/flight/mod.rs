@@ -24,7 +24,7 @@ pub use line_labels::LineLabels;
 pub(crate) use reference::reduced;
 pub use reference::{ReferenceChannels, reference_sum};
 pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};
-pub use tl_inputs::TlInputs;
+pub use tl_inputs::{SensorColumns, TlInputs};
 
 use crate::error::{Error, InFile, Result};
 use crate::observer::Note;

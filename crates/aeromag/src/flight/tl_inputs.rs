@@ -2,11 +2,14 @@
 
 use super::{Flight, SegmentRule, Segments};
 use crate::error::Result;
+use aeromag_compensation::tolles_lawson::ExtraTerm;
+use aeromag_compensation::tolles_lawson::design::Channels;
 use aeromag_compensation::tolles_lawson::fit_ls::Segment;
 
-/// `time` (s), `flux_x/y/z` (nT, body frame), `mag` (nT) and `line` (when
-/// numeric) of a flight: what the Tolles-Lawson model reads.
-#[derive(Debug, Clone, Copy)]
+/// `time` (s), `flux_x/y/z` (nT, body frame), `mag` (nT), `line` (when
+/// numeric) and the channels of the extra regressors of a flight: what the
+/// Tolles-Lawson model reads.
+#[derive(Debug, Clone)]
 pub struct TlInputs<'a> {
     /// Time, s.
     pub time: &'a [f64],
@@ -16,21 +19,123 @@ pub struct TlInputs<'a> {
     pub mag: &'a [f64],
     /// Line labels, when the flight has them.
     pub line: Option<&'a [f64]>,
+    /// The channels of the extra regressors, in the terms' order
+    /// ([`TlInputs::with_extras`]).
+    pub channels: Vec<&'a [f64]>,
+}
+
+/// The columns of one scalar magnetometer and the vector magnetometer its
+/// model reads (a flight may carry several of each: SGL's aircraft has five
+/// scalars and four fluxgates).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SensorColumns {
+    /// The scalar magnetometer.
+    pub mag: String,
+    /// The vector magnetometer's x, y, z (body frame).
+    pub flux: [String; 3],
+}
+
+impl Default for SensorColumns {
+    /// The canonical `mag` and `flux_x/y/z` (whatever the flight's column
+    /// map or sensor choice made them).
+    fn default() -> Self {
+        Self {
+            mag: "mag".into(),
+            flux: ["flux_x".into(), "flux_y".into(), "flux_z".into()],
+        }
+    }
+}
+
+impl SensorColumns {
+    /// The scalar magnetometer `mag` and the vector magnetometer of prefix
+    /// `vector` (`flux_b` → `flux_b_x/y/z`; `None`: the flight's
+    /// `flux_x/y/z`), found in `flight` by the rules of `--mag` and
+    /// `--vector` (SGL HDF5 and Geosoft XYZ names of one sensor, without
+    /// regard to case). A sensor the flight lacks is bad input naming the
+    /// file and the sensor.
+    pub fn find(flight: &Flight, mag: &str, vector: Option<&str>) -> Result<Self> {
+        let names = flight.column_names();
+        let find = |name: &str| -> Option<String> {
+            aeromag_io::sensor_names(name).iter().find_map(|n| {
+                names
+                    .iter()
+                    .find(|h| h.eq_ignore_ascii_case(n))
+                    .map(|h| h.to_string())
+            })
+        };
+        let absent = |what: &str, name: &str| {
+            crate::Error::bad_file(
+                flight.label(),
+                format!(
+                    "has no {what} `{name}`; columns present: {}",
+                    names.join(", ")
+                ),
+            )
+        };
+        let mag = find(mag).ok_or_else(|| absent("scalar magnetometer", mag))?;
+        let flux = match vector {
+            None => Self::default().flux,
+            Some(p) => {
+                let axis = |a: &str| {
+                    find(&format!("{p}_{a}")).ok_or_else(|| absent("vector magnetometer", p))
+                };
+                [axis("x")?, axis("y")?, axis("z")?]
+            }
+        };
+        Ok(Self { mag, flux })
+    }
+
+    /// Stem of the sensor's output columns: `mag_3_uc` → `mag_3`,
+    /// `UNCOMPMAG3` → `mag_3`, any other name as it is.
+    pub fn stem(&self) -> String {
+        let lower = self.mag.to_ascii_lowercase();
+        let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+        if let Some(k) = lower
+            .strip_prefix("mag_")
+            .and_then(|r| r.strip_suffix("_uc"))
+            && digits(k)
+        {
+            return format!("mag_{k}");
+        }
+        if let Some(k) = lower.strip_prefix("uncompmag")
+            && digits(k)
+        {
+            return format!("mag_{k}");
+        }
+        self.mag.clone()
+    }
 }
 
 impl<'a> TlInputs<'a> {
     /// The columns of `flight`; a missing one is bad input naming the file.
     pub fn of(flight: &'a Flight) -> Result<Self> {
+        Self::of_sensor(flight, &SensorColumns::default())
+    }
+
+    /// The columns of `flight` with the scalar and vector magnetometers of
+    /// `sensor`.
+    pub fn of_sensor(flight: &'a Flight, sensor: &SensorColumns) -> Result<Self> {
         Ok(Self {
             time: flight.require("time")?,
             flux: [
-                flight.require("flux_x")?,
-                flight.require("flux_y")?,
-                flight.require("flux_z")?,
+                flight.require(&sensor.flux[0])?,
+                flight.require(&sensor.flux[1])?,
+                flight.require(&sensor.flux[2])?,
             ],
-            mag: flight.require("mag")?,
+            mag: flight.require(&sensor.mag)?,
             line: flight.column("line"),
+            channels: Vec::new(),
         })
+    }
+
+    /// These columns with the channels of the extra regressors `extras`
+    /// (a missing channel is bad input naming the file and the column).
+    pub fn with_extras(self, flight: &'a Flight, extras: &[ExtraTerm]) -> Result<Self> {
+        let channels = extras
+            .iter()
+            .map(|x| flight.require(&x.channel))
+            .collect::<std::result::Result<_, _>>()?;
+        Ok(Self { channels, ..self })
     }
 
     /// The same columns with another scalar series (same length).
@@ -38,17 +143,22 @@ impl<'a> TlInputs<'a> {
     where
         'a: 'b,
     {
-        TlInputs { mag, ..*self }
+        TlInputs {
+            mag,
+            ..self.clone()
+        }
     }
 
-    /// The usable-row rule: time, `mag` and the three flux components
-    /// finite, and the flux not exactly zero (a dropped-out fluxgate).
+    /// The usable-row rule: time, `mag`, the three flux components and the
+    /// extra channels finite, and the flux not exactly zero (a dropped-out
+    /// fluxgate).
     pub fn usable(&self) -> Vec<bool> {
         (0..self.time.len())
             .map(|i| {
                 self.time[i].is_finite()
                     && self.mag[i].is_finite()
                     && self.flux.iter().all(|f| f[i].is_finite())
+                    && self.channels.iter().all(|c| c[i].is_finite())
                     && (self.flux[0][i] != 0.0 || self.flux[1][i] != 0.0 || self.flux[2][i] != 0.0)
             })
             .collect()
@@ -60,11 +170,13 @@ impl<'a> TlInputs<'a> {
     }
 
     /// All rows as one fitting segment, to be sliced into legs.
-    pub fn whole(&self) -> Segment<'a> {
+    pub fn whole(&self) -> Segment<'_> {
         Segment {
             time: self.time,
             flux: self.flux,
             mag: self.mag,
+            channels: Channels::new(&self.channels),
+            direction: None,
         }
     }
 }

@@ -4,15 +4,15 @@
 use super::kalman::{KalmanOptions, KalmanOutcome, fit_kalman_flight};
 use super::lags::choose_terms;
 use crate::error::{Error, InFile, Result};
-use crate::flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, TlInputs};
+use crate::flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, SensorColumns, TlInputs};
 use crate::flight::{reduced, reference_sum};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::model_file::{
     Coefficient, FitStats, LsSettings, MODEL_FORMAT, MethodSettings, TL_KIND, TlModel,
 };
-use aeromag_compensation::tolles_lawson::Convention;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
 use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
+use aeromag_compensation::tolles_lawson::{Convention, ExtraRequest, ExtraTerm};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -134,6 +134,14 @@ pub struct CalibrateOptions {
     /// `igrf` reference to the sensor and, for the Kalman method, the
     /// altitude of the vertical-gradient term.
     pub lever_arm: Option<LeverArm>,
+    /// Extra regressors (`--extra cur_strb,cur_flap:lag`): recorded
+    /// channels times the direction cosines, with a lag chosen on the
+    /// flight for those asked with `:lag`
+    /// ([`aeromag_compensation::tolles_lawson::terms`]).
+    pub extra: Vec<ExtraRequest>,
+    /// The scalar and vector magnetometers fitted (default: the canonical
+    /// `mag` and `flux_x/y/z`).
+    pub sensor: SensorColumns,
 }
 
 impl Default for CalibrateOptions {
@@ -149,6 +157,8 @@ impl Default for CalibrateOptions {
             split_lines: true,
             reference: ReferenceChannels::Auto,
             lever_arm: None,
+            extra: Vec::new(),
+            sensor: SensorColumns::default(),
         }
     }
 }
@@ -160,6 +170,26 @@ impl CalibrateOptions {
             method: Method::Kalman,
             ..Self::default()
         }
+    }
+
+    /// The LS settings with the extra regressors in the terms, without
+    /// lags (the lags are chosen on the flight).
+    pub(super) fn ls_with_extras(&self) -> Result<LsConfig> {
+        let extras: Vec<ExtraTerm> = self
+            .extra
+            .iter()
+            .map(|r| ExtraTerm::new(r.channel.clone()))
+            .collect();
+        let terms = self
+            .ls
+            .design
+            .terms
+            .with_extras(&extras)
+            .map_err(|e| Error::bad_input(format!("extra regressors: {e}")))?;
+        Ok(LsConfig {
+            design: self.ls.design.with_terms(terms),
+            ..self.ls.clone()
+        })
     }
 }
 
@@ -205,13 +235,26 @@ pub fn calibrate(
     observer: &mut dyn Observer,
 ) -> Result<Calibration> {
     let mut notes = Notes::new(observer);
+    calibrate_with(flight, opts, None, &mut notes)
+}
+
+/// [`calibrate`] with `reference_nt` (a series subtracted from the scalar
+/// reading besides the reference channels: the compensated reading of a
+/// reference sensor), notes into `notes`.
+pub(super) fn calibrate_with(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
+    notes: &mut Notes,
+) -> Result<Calibration> {
+    let before = notes.len();
     let (model, lag_selection, kalman) = match opts.method {
         Method::Ls => {
-            let (model, sel) = fit_ls_flight(flight, opts, &mut notes)?;
+            let (model, sel) = fit_ls_flight(flight, opts, reference_nt, notes)?;
             (model, sel, None)
         }
         Method::Kalman => {
-            let (model, sel, outcome) = fit_kalman_flight(flight, opts, &mut notes)?;
+            let (model, sel, outcome) = fit_kalman_flight(flight, opts, reference_nt, notes)?;
             (model, sel, Some(outcome))
         }
     };
@@ -219,18 +262,58 @@ pub fn calibrate(
         model,
         lag_selection,
         kalman,
-        notes: notes.into_notes(),
+        notes: notes.since(before),
     })
 }
 
-/// The reference channels of `opts` and `mag` reduced by their sum.
+/// The second-order term above which [`second_order_note`] recommends the
+/// exact magnitude, nT (peak to peak over the flight).
+pub const SECOND_ORDER_NOTE_NT: f64 = 0.1;
+
+/// Say when the first-order projection is not enough: the peak-to-peak of
+/// its second-order remainder over the flight's rows, under the fitted
+/// coefficients (the vector model they imply), when it exceeds
+/// [`SECOND_ORDER_NOTE_NT`].
+pub(super) fn second_order_note(
+    design: &aeromag_compensation::tolles_lawson::Design,
+    coef: &[f64],
+    segments: &[Segment],
+    notes: &mut Notes,
+) {
+    use aeromag_compensation::tolles_lawson::Magnitude;
+    if design.magnitude != Magnitude::FirstOrder {
+        return;
+    }
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in segments {
+        for v in design.second_order_nt(coef, s.time, s.flux, s.channels) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if hi - lo > SECOND_ORDER_NOTE_NT {
+        notes.note(format!(
+            "the second-order term of the projection varies by {:.2} nT over this flight (interference ≳ 1 % of the field): --magnitude exact fits |B + ΔB| − |B|",
+            hi - lo
+        ));
+    }
+}
+
+/// The reference channels of `opts` and `mag` reduced by their sum and by
+/// `reference_nt` when given.
 pub(super) fn reduced_mag(
     flight: &Flight,
     inputs: &TlInputs,
     opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
 ) -> Result<(Vec<String>, Vec<f64>)> {
     let ref_cols = opts.reference.resolve(flight)?;
-    let sum = reference_sum(flight, &ref_cols, opts.lever_arm.as_ref())?;
+    let mut sum = reference_sum(flight, &ref_cols, opts.lever_arm.as_ref())?;
+    if let Some(r) = reference_nt {
+        for (s, v) in sum.iter_mut().zip(r) {
+            *s += v;
+        }
+    }
     Ok((ref_cols.clone(), reduced(inputs.mag, &sum)))
 }
 
@@ -243,9 +326,11 @@ pub(super) fn fit_rule(opts: &CalibrateOptions) -> SegmentRule {
 }
 
 /// Canonical column name → the file's column name for the model file:
-/// `base` and the reference channels.
+/// `base` and the reference channels, with `mag` and `flux_x/y/z` read
+/// from `sensor`.
 pub(super) fn model_columns(
     flight: &Flight,
+    sensor: &SensorColumns,
     base: &[&str],
     ref_cols: &[String],
 ) -> std::collections::BTreeMap<String, String> {
@@ -254,17 +339,28 @@ pub(super) fn model_columns(
         .copied()
         .chain(ref_cols.iter().map(String::as_str))
         .collect();
-    flight.column_map_of(&names)
+    let mut map = flight.column_map_of(&names);
+    let canonical = SensorColumns::default();
+    for (c, s) in std::iter::once((&canonical.mag, &sensor.mag))
+        .chain(canonical.flux.iter().zip(&sensor.flux))
+        .filter(|(c, s)| c != s)
+    {
+        map.insert(c.clone(), s.clone());
+    }
+    map
 }
 
 /// The band-pass LS fit on a flight.
 fn fit_ls_flight(
     flight: &Flight,
     opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
     notes: &mut Notes,
 ) -> Result<(TlModel, Option<LagSelection>)> {
-    let cols = TlInputs::of(flight)?;
-    let (ref_cols, y) = reduced_mag(flight, &cols, opts)?;
+    let ls = opts.ls_with_extras()?;
+    let cols =
+        TlInputs::of_sensor(flight, &opts.sensor)?.with_extras(flight, ls.design.terms.extras())?;
+    let (ref_cols, y) = reduced_mag(flight, &cols, opts, reference_nt)?;
     let cols = cols.with_mag(&y);
     let segs = cols.segments(&fit_rule(opts));
     let left_out = cols.usable().iter().filter(|u| !**u).count();
@@ -281,16 +377,18 @@ fn fit_ls_flight(
         .map(|r| cols.whole().slice(r.clone()))
         .collect();
     let label = flight.label();
-    let (terms, selection) = choose_terms(&label, &segments, &opts.ls, &opts.eddy_lag, notes)?;
+    let choice = choose_terms(&label, &segments, &ls, &opts.eddy_lag, &opts.extra, notes)?;
+    let selection = choice.eddy;
     let cfg = &LsConfig {
-        design: opts.ls.design.with_terms(terms),
-        ..opts.ls.clone()
+        design: ls.design.with_terms(choice.terms),
+        ..ls.clone()
     };
     notes.stage("fitting");
     let fit = fit_band_pass_ls(&segments, cfg).in_file(&label)?;
     for w in &fit.warnings {
         notes.warn(w.clone());
     }
+    second_order_note(&cfg.design, &fit.coef, &segments, notes);
     let model = TlModel {
         format: MODEL_FORMAT.into(),
         kind: TL_KIND.into(),
@@ -309,9 +407,11 @@ fn fit_ls_flight(
             residual_rms_nt: fit.residual_rms_nt,
             warnings: fit.warnings.clone(),
             eddy_lag_selection: selection.clone(),
+            extra_lag_selection: choice.extras,
         },
         columns: model_columns(
             flight,
+            &opts.sensor,
             &["time", "flux_x", "flux_y", "flux_z", "mag"],
             &ref_cols,
         ),

@@ -2,7 +2,7 @@
 
 use crate::compensate::{Compensator, OutputColumns};
 use crate::error::Result;
-use crate::flight::{Flight, SegmentRule, TlInputs};
+use crate::flight::{Flight, SegmentRule, SensorColumns, TlInputs};
 use crate::observer::Observer;
 use aeromag_compensation::model_file::TlModel;
 
@@ -20,26 +20,38 @@ impl Compensator for TlModel {
 
     /// `A c` on every stretch without gaps or missing values (the
     /// derivatives of the eddy terms must not cross them; line changes do
-    /// not matter), NaN elsewhere. Reads `time`, `flux_x/y/z` and `mag`.
+    /// not matter), NaN elsewhere. Reads `time`, `flux_x/y/z`, `mag` and
+    /// the channels of the extra regressors.
     fn interference_observed(
         &self,
         flight: &Flight,
         _observer: &mut dyn Observer,
     ) -> Result<Vec<f64>> {
-        let cols = TlInputs::of(flight)?;
-        let mut out = vec![f64::NAN; flight.n_rows()];
-        let segs = cols.segments(&SegmentRule::ignoring_lines());
-        debug_assert!(segs.short.is_empty());
-        let coef = self.coef();
-        for r in segs.kept {
-            let f = [
-                &cols.flux[0][r.clone()],
-                &cols.flux[1][r.clone()],
-                &cols.flux[2][r.clone()],
-            ];
-            let v = self.design.interference(&coef, &cols.time[r.clone()], f);
-            out[r].copy_from_slice(&v);
-        }
-        Ok(out)
+        tl_interference(self, flight, &SensorColumns::default())
     }
+}
+
+/// The interference `A c` (nT) of `model` at the sensor `sensor` of
+/// `flight`, NaN on rows it cannot be applied to (see
+/// [`Compensator::interference_observed`]).
+pub(super) fn tl_interference(
+    model: &TlModel,
+    flight: &Flight,
+    sensor: &SensorColumns,
+) -> Result<Vec<f64>> {
+    let cols =
+        TlInputs::of_sensor(flight, sensor)?.with_extras(flight, model.design.terms.extras())?;
+    let whole = cols.whole();
+    let mut out = vec![f64::NAN; flight.n_rows()];
+    let segs = cols.segments(&SegmentRule::ignoring_lines());
+    debug_assert!(segs.short.is_empty());
+    let coef = model.coef();
+    for r in segs.kept {
+        let s = whole.slice(r.clone());
+        let v = model
+            .design
+            .interference_with(&coef, s.time, s.flux, s.channels);
+        out[r].copy_from_slice(&v);
+    }
+    Ok(out)
 }

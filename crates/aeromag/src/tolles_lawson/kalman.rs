@@ -15,6 +15,7 @@ use aeromag_compensation::kalman::{
     X2Prior, fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
 };
 use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::tolles_lawson::ExtraRequest;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
 use aeromag_io::FlightTable;
@@ -159,12 +160,15 @@ const PASS1_LAGS_S: [f64; 2] = [0.15, 0.5];
 pub(super) fn fit_kalman_flight(
     flight: &Flight,
     opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
     notes: &mut Notes,
 ) -> Result<(TlModel, Option<LagSelection>, KalmanOutcome)> {
-    let cfg = opts.kalman.config(&opts.ls)?;
+    let ls = opts.ls_with_extras()?;
+    let cfg = opts.kalman.config(&ls)?;
     let file = flight.label();
-    let cols = TlInputs::of(flight)?;
-    let (ref_cols, y) = reduced_mag(flight, &cols, opts)?;
+    let cols =
+        TlInputs::of_sensor(flight, &opts.sensor)?.with_extras(flight, ls.design.terms.extras())?;
+    let (ref_cols, y) = reduced_mag(flight, &cols, opts, reference_nt)?;
     let cols = cols.with_mag(&y);
     let segs = cols.segments(&fit_rule(opts)).kept;
     let (alt, altitude) = sensor_altitude(flight, &segs, opts.lever_arm.as_ref(), notes)?;
@@ -187,7 +191,40 @@ pub(super) fn fit_kalman_flight(
         design: cfg.design.clone(),
         ..LsConfig::default()
     };
-    let (terms, selection, tuned) = match opts.eddy_lag {
+    // The lags of the extra regressors first, by the band-pass search on
+    // the data as recorded: a first pass without them would leave a lagged
+    // current's field to its field model and its eddy terms, and the
+    // searches below would see what that left.
+    let (cfg, ls, extra_lags, requests) = if opts.extra.iter().any(|r| r.lag) {
+        let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
+        let pre = choose_terms(&file, &data, &ls, &EddyLag::None, &opts.extra, notes)?;
+        let terms = cfg
+            .design
+            .terms
+            .with_extras(pre.terms.extras())
+            .in_file(&file)?;
+        let design = cfg.design.with_terms(terms);
+        let requests: Vec<ExtraRequest> = opts
+            .extra
+            .iter()
+            .map(|r| ExtraRequest {
+                lag: false,
+                ..r.clone()
+            })
+            .collect();
+        (
+            KalmanConfig {
+                design: design.clone(),
+                ..cfg
+            },
+            LsConfig { design, ..ls },
+            pre.extras,
+            requests,
+        )
+    } else {
+        (cfg, ls, Vec::new(), opts.extra.clone())
+    };
+    let (choice, tuned) = match opts.eddy_lag {
         EddyLag::Auto if cfg.design.terms.has_eddy() => {
             notes.stage("Kalman pass 1: removing the field");
             let pass1 = KalmanConfig {
@@ -209,23 +246,20 @@ pub(super) fn fit_kalman_flight(
                 .iter()
                 .map(|r| reduced.whole().slice(r.clone()))
                 .collect();
-            let (terms, selection) = choose_terms(&file, &data, &ls, &opts.eddy_lag, notes)?;
-            let terms =
-                add_lags_by_kalman_likelihood(&file, &segments, &cfg, terms, &first, notes)?;
-            (
-                terms,
-                selection,
-                first.tuning.is_some().then_some(first.noise),
-            )
+            let mut choice = choose_terms(&file, &data, &ls, &opts.eddy_lag, &requests, notes)?;
+            choice.terms =
+                add_lags_by_kalman_likelihood(&file, &segments, &cfg, choice.terms, &first, notes)?;
+            (choice, first.tuning.is_some().then_some(first.noise))
         }
         _ => {
             let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
-            let (terms, selection) = choose_terms(&file, &data, &ls, &opts.eddy_lag, notes)?;
-            (terms, selection, None)
+            let choice = choose_terms(&file, &data, &ls, &opts.eddy_lag, &requests, notes)?;
+            (choice, None)
         }
     };
+    let selection = choice.eddy;
     let mut cfg = KalmanConfig {
-        design: cfg.design.with_terms(terms),
+        design: cfg.design.with_terms(choice.terms),
         ..cfg
     };
     // Pass 1 searched the likelihood globally (kalman::tuning, several
@@ -258,12 +292,14 @@ pub(super) fn fit_kalman_flight(
     let mut model = fit.to_model(&cfg);
     model.columns = model_columns(
         flight,
+        &opts.sensor,
         &["time", "flux_x", "flux_y", "flux_z", "mag", "alt"],
         &ref_cols,
     );
     model.reference = ref_cols;
     model.lever_arm = opts.lever_arm;
     model.fit.eddy_lag_selection = selection.clone();
+    model.fit.extra_lag_selection = extra_lags;
     Ok((
         model,
         selection,

@@ -6,38 +6,63 @@ use super::calibrate::EddyLag;
 use crate::error::{Error, InFile, Result};
 use crate::observer::Notes;
 use aeromag_compensation::kalman::{KalmanConfig, KalmanFit, KalmanSegment, fit_kalman};
-use aeromag_compensation::tolles_lawson::TermSet;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::{
-    DEFAULT_ALPHA, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS,
-    LagSelection, lag_threshold, select_eddy_lags, within_budget,
+    DEFAULT_ALPHA, DEFAULT_EXTRA_LAG_GRID_S, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK,
+    DEFAULT_SELECTION_ROWS, ExtraLagSelection, LagSelection, lag_threshold, select_eddy_lags,
+    select_extra_lag, within_budget,
 };
+use aeromag_compensation::tolles_lawson::{Design, ExtraRequest, Magnitude, TermSet};
+
+/// The terms a calibration fits and how their lags were chosen.
+#[derive(Debug, Clone)]
+pub(super) struct TermChoice {
+    /// The terms, with the chosen lags.
+    pub terms: TermSet,
+    /// The eddy-lag search, when `auto` ran it.
+    pub eddy: Option<LagSelection>,
+    /// The lag search of each extra regressor asked for with `:lag`.
+    pub extras: Vec<ExtraLagSelection>,
+}
 
 /// The term set of `cfg` with the eddy-current lags of `lag` (`auto`:
 /// chosen on `segments` by the band-pass LS likelihood-ratio search, on the
-/// row budget), and the search when one ran. Used by both methods; `file`
+/// row budget), then the lag of each extra regressor that `requests` asks
+/// to lag (`name:lag`; the same search, one lag at most, in the requests'
+/// order), and the searches that ran. `cfg`'s terms hold the extra
+/// regressors of `requests`, without lags. Used by both methods; `file`
 /// names the flight in errors.
 pub(super) fn choose_terms(
     file: &str,
     segments: &[Segment],
     cfg: &LsConfig,
     lag: &EddyLag,
+    requests: &[ExtraRequest],
     notes: &mut Notes,
-) -> Result<(TermSet, Option<LagSelection>)> {
+) -> Result<TermChoice> {
+    // The searches fit the first-order model (an exact-magnitude fit is
+    // Gauss–Newton steps of it; the terms it needs are the same).
+    let cfg = &LsConfig {
+        design: Design {
+            magnitude: Magnitude::FirstOrder,
+            ..cfg.design.clone()
+        },
+        ..cfg.clone()
+    };
     let with = |taus: &[f64]| {
         cfg.design
             .terms
             .with_eddy_lags(taus)
             .map_err(|e| Error::bad_input(format!("eddy lags: {e}")))
     };
-    match lag {
-        EddyLag::None => Ok((with(&[])?, None)),
-        EddyLag::Fixed(taus) => Ok((with(taus)?, None)),
-        EddyLag::Auto if !cfg.design.terms.has_eddy() => Ok((cfg.design.terms.clone(), None)),
+    let sample = || within_budget(segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
+    let (mut terms, eddy) = match lag {
+        EddyLag::None => (with(&[])?, None),
+        EddyLag::Fixed(taus) => (with(taus)?, None),
+        EddyLag::Auto if !cfg.design.terms.has_eddy() => (cfg.design.terms.clone(), None),
         EddyLag::Auto => {
             notes.stage("choosing eddy-current lags");
-            let sample = within_budget(segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
-            let sel = select_eddy_lags(&sample, cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
+            let sel = select_eddy_lags(&sample(), cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
                 .in_file(file)?;
             if sel.taus_s.is_empty() {
                 notes.note("eddy-current lags: no lag is significant; classical eddy terms kept");
@@ -47,9 +72,41 @@ pub(super) fn choose_terms(
                     sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt
                 ));
             }
-            Ok((with(&sel.taus_s)?, Some(sel)))
+            (with(&sel.taus_s)?, Some(sel))
         }
+    };
+    let mut extras = Vec::new();
+    for (k, r) in requests.iter().enumerate().filter(|(_, r)| r.lag) {
+        notes.stage(&format!("choosing the lag of {}", r.channel));
+        let c = LsConfig {
+            design: cfg.design.with_terms(terms.clone()),
+            ..cfg.clone()
+        };
+        let sel = select_extra_lag(&sample(), &c, k, &DEFAULT_EXTRA_LAG_GRID_S, DEFAULT_ALPHA)
+            .in_file(file)?;
+        match sel.taus_s.first() {
+            None => notes.note(format!(
+                "{}: no lag is significant; its instantaneous terms kept",
+                r.channel
+            )),
+            Some(tau) => notes.note(format!(
+                "{}: lag τ = {tau:.3} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
+                r.channel, sel.base_residual_rms_nt, sel.residual_rms_nt
+            )),
+        }
+        let mut x = terms.extras().to_vec();
+        x[k].lag_s = sel.taus_s.first().copied();
+        terms = terms.with_extras(&x).in_file(file)?;
+        extras.push(ExtraLagSelection {
+            channel: r.channel.clone(),
+            selection: sel,
+        });
     }
+    Ok(TermChoice {
+        terms,
+        eddy,
+        extras,
+    })
 }
 
 /// The Kalman method's own test of further lags, after the band-pass
@@ -99,7 +156,7 @@ pub(super) fn add_lags_by_kalman_likelihood(
             let mut with: Vec<f64> = lags.clone();
             with.push(tau);
             with.sort_by(f64::total_cmp);
-            let cand = cfg.design.terms.with_eddy_lags(&with).in_file(file)?;
+            let cand = terms.with_eddy_lags(&with).in_file(file)?;
             let (ll, mc) = profile(&cand)?;
             if ll.is_finite() && best.as_ref().is_none_or(|b| ll > b.0) {
                 best = Some((ll, mc, cand, tau));

@@ -8,6 +8,7 @@
 //! | [`calibrate`] | fit a [`TlModel`] on a calibration flight ([`CalibrateOptions`], [`Method`]) → [`Calibration`] |
 //! | [`Compensator`](crate::Compensator) for [`TlModel`] | the modelled interference of every row of a flight, and the compensated reading |
 //! | [`observability`] | rank, weak combinations and estimability of the coefficients on a flight |
+//! | [`calibrate_sensors`] | one model per scalar sensor ([`SensorSet`], reference-sensor mode) → [`SensorsModel`]; [`CompensateSensors`] applies it |
 //!
 //! The algorithms are in [`aeromag_compensation::tolles_lawson`] (band-pass
 //! least squares, the eddy-lag search) and
@@ -21,12 +22,16 @@ mod kalman;
 mod kalman_section;
 mod lags;
 mod observability;
+mod sensors;
 mod settings;
 
 pub use calibrate::{CalibrateOptions, Calibration, EddyLag, Method, calibrate};
 pub use compensate::TL_OUTPUT;
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
+pub use sensors::{
+    CompensateSensors, SensorSet, SensorsCalibration, SensorsCompensated, calibrate_sensors,
+};
 pub use settings::{CalibrateSettings, DEFAULT_DECIMAL_YEAR};
 
-pub use aeromag_compensation::model_file::TlModel;
+pub use aeromag_compensation::model_file::{SensorModel, SensorsModel, TlModel};

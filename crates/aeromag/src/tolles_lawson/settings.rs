@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::flight::{LeverArm, ReferenceChannels};
 use aeromag_compensation::kalman::NoiseModel;
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
-use aeromag_compensation::tolles_lawson::{Convention, Design, TermSet};
+use aeromag_compensation::tolles_lawson::{Convention, Design, ExtraRequest, Magnitude, TermSet};
 
 /// Calibration choices by name, every one optional (`None`: the default).
 ///
@@ -69,6 +69,11 @@ pub struct CalibrateSettings {
     pub field_order: Option<usize>,
     /// Kalman method: compute the per-row series.
     pub series: bool,
+    /// Extra regressors (`--extra cur_strb,cur_flap:lag`; default none).
+    pub extra: Vec<ExtraRequest>,
+    /// The first-order projection (default) or the exact magnitude
+    /// (`--magnitude exact`, method `ls`).
+    pub magnitude: Option<Magnitude>,
 }
 
 /// The date the lever arm's main-field gradient is taken at by default.
@@ -89,6 +94,11 @@ impl CalibrateSettings {
                     return Err(Error::bad_input(format!("{name} needs method kalman")));
                 }
             }
+        }
+        if self.magnitude == Some(Magnitude::Exact) && self.method != Method::Ls {
+            return Err(Error::bad_input(
+                "magnitude exact (--magnitude exact) is fitted by the ls method only",
+            ));
         }
         if let Some(l) = self.ridge_lambda
             && !(l.is_finite() && l >= 0.0)
@@ -122,6 +132,7 @@ impl CalibrateSettings {
                     terms: self.terms.clone().unwrap_or(design.terms),
                     convention,
                     bt_scale_nt: self.bt_scale_nt.unwrap_or(design.bt_scale_nt),
+                    magnitude: self.magnitude.unwrap_or_default(),
                 },
                 band_hz: self.band_hz.unwrap_or(ls.band_hz),
                 trim: self.trim.unwrap_or(ls.trim),
@@ -144,6 +155,8 @@ impl CalibrateSettings {
                 arm_m,
                 decimal_year: self.decimal_year.unwrap_or(DEFAULT_DECIMAL_YEAR),
             }),
+            extra: self.extra.clone(),
+            sensor: Default::default(),
         })
     }
 }

@@ -6,7 +6,7 @@ use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::compensation::kalman::{NoiseModel, q1_unit};
 use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
-use aeromag::compensation::tolles_lawson::{Convention, Design, TermSet};
+use aeromag::compensation::tolles_lawson::{Convention, Design, ExtraRequest, Magnitude, TermSet};
 use aeromag::{CalibrateOptions, CalibrateSettings, EddyLag, Method, ReferenceChannels, calibrate};
 use std::path::PathBuf;
 
@@ -30,6 +30,24 @@ use std::path::PathBuf;
 /// the default with --convention magnav); a list such as `0.3,0.8` fixes the
 /// lags. `auto` runs about 15 extra fits on at most 200 000 rows (a longer
 /// record is sampled: blocks spread evenly over every leg).
+///
+/// Extra regressors (--extra cur_strb,cur_flap:lag): recorded channels,
+/// typically the currents of on-board equipment, enter as the channel times
+/// the three direction cosines of the field (a current loop's field is fixed
+/// in the airframe; its effect on the total field turns with the heading).
+/// `NAME:lag` also tries the channel through a first-order lag (a field that
+/// follows its current late: eddy currents in the structure around the
+/// load), with τ from 0.05 to 2 s, kept by the same likelihood-ratio test.
+///
+/// Several scalar sensors (--mag mag_1_uc,mag_3_uc,mag_4_uc, with --vector
+/// one prefix for all or one per sensor): one model per sensor, written as
+/// one multi-sensor model file that `compensate` applies to every sensor
+/// (columns mag_N_comp, mag_N_interf, and mag_N_grad = mag_N_comp −
+/// first sensor's). --reference-sensor mag_1_uc: that sensor (the tail
+/// stinger) is fitted first and its compensated reading is the other
+/// sensors' external-field reference over the whole flight: they are fitted
+/// to mag_N − reference on every row, unfiltered, with a bias term (a
+/// column that is already compensated, such as mag_1_c, serves as it is).
 ///
 /// --lever-arm X,Y,Z: the scalar sensor's position from the navigation point
 /// (body frame, m); the `igrf` reference, computed at the navigation point,
@@ -86,6 +104,22 @@ pub struct Args {
     /// kalman_innovation_std (nT; empty where a row was not used) to this CSV.
     #[arg(long, value_name = "FILE.csv")]
     series: Option<PathBuf>,
+    /// Extra regressors: recorded channels times the direction cosines,
+    /// `NAME` or `NAME:lag` (also through a fitted lag), comma-separated,
+    /// e.g. `cur_strb,cur_flap:lag`.
+    #[arg(long, value_name = "NAME[:lag],…", value_parser = extras)]
+    extra: Option<Extras>,
+    /// How the interference vector becomes the scalar interference:
+    /// `first-order` (the Tolles-Lawson projection) or `exact` (|B + ΔB| −
+    /// |B|, fitted by Gauss–Newton; for sensors whose interference exceeds
+    /// about 1 % of the field, where the projection leaves nT; method ls).
+    #[arg(long, value_enum, default_value_t = Magnitude::FirstOrder)]
+    magnitude: Magnitude,
+    /// Reference-sensor mode: the scalar sensor (one of --mag) or compensated
+    /// column whose compensated reading is the other sensors'
+    /// external-field reference, e.g. `mag_1_uc`.
+    #[arg(long, value_name = "NAME")]
+    reference_sensor: Option<String>,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
     #[arg(long, value_parser = terms, default_value_t = Design::default().terms)]
     terms: TermSet,
@@ -135,6 +169,16 @@ fn terms(s: &str) -> Result<TermSet, String> {
     TermSet::parse(s).map_err(|e| e.to_string())
 }
 
+/// The `--extra` list.
+#[derive(Debug, Clone)]
+struct Extras(Vec<ExtraRequest>);
+
+fn extras(s: &str) -> Result<Extras, String> {
+    ExtraRequest::parse_list(s)
+        .map(Extras)
+        .map_err(|e| e.to_string())
+}
+
 /// `Q1,Q2,R` noise intensities (checked by the library for its order).
 fn noise(s: &str) -> Result<NoiseModel, String> {
     let v = args::numbers(s, 3)?;
@@ -168,6 +212,8 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
         kalman_noise: a.kalman_noise,
         field_order: a.field_order,
         series: a.series.is_some(),
+        extra: a.extra.clone().map(|x| x.0).unwrap_or_default(),
+        magnitude: Some(a.magnitude),
     };
     Ok(settings.options()?)
 }
@@ -175,12 +221,16 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
 pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = options(&a)?;
     crate::output::check_files(std::iter::once(a.model.as_path()).chain(a.series.as_deref()))?;
+    if a.input.several_sensors() || a.reference_sensor.is_some() {
+        return run_sensors(&a, &opts);
+    }
     // Only the canonical columns and named reference channels are read
     // (an HDF5 flight's other fields stay on disk).
-    let extra: Vec<&str> = match &a.reference {
+    let mut extra: Vec<&str> = match &a.reference {
         aeromag::ReferenceChannels::Columns(c) => c.iter().map(String::as_str).collect(),
         _ => Vec::new(),
     };
+    extra.extend(opts.extra.iter().map(|r| r.channel.as_str()));
     let flight = a.input.load_canonical(&extra)?;
     let cal = calibrate(&flight, &opts, &mut Bars::new())?;
     let model = &cal.model;
@@ -238,10 +288,59 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 .join(", ")
         ),
     }
+    for x in model.design.terms.extras() {
+        match x.lag_s {
+            Some(tau) => println!(
+                "extra regressor {}, and through a lag of {tau:.3} s",
+                x.channel
+            ),
+            None => println!("extra regressor {}", x.channel),
+        }
+    }
     println!("{:<8} {:>14} {:>12}", "term", "coefficient", "std");
     for c in &model.coefficients {
         println!("{:<8} {:>14.6} {:>12.3e}", c.name, c.value, c.std);
     }
     println!("model written to {}", a.model.display());
+    Ok(())
+}
+
+/// Several sensors (or the reference-sensor mode): one model each.
+fn run_sensors(a: &Args, opts: &CalibrateOptions) -> anyhow::Result<()> {
+    if a.series.is_some() {
+        anyhow::bail!(aeromag::Error::bad_input(
+            "--series is for one sensor; calibrate the sensors one by one to get it"
+        ));
+    }
+    let flight = a.input.load()?;
+    let set = aeromag::SensorSet {
+        sensors: a.input.sensor_columns(&flight)?,
+        reference: a.reference_sensor.clone(),
+    };
+    let cal = aeromag::calibrate_sensors(&flight, &set, opts, &mut Bars::new())?;
+    aeromag::io::atomic::write_file(&a.model, cal.model.to_json()?)
+        .map_err(|e| aeromag::Error::write(&a.model, e))?;
+    println!(
+        "{:<10} {:<12} {:<24} {:>6} {:>8} {:>13} {:>10}",
+        "sensor", "column", "vector", "terms", "rows", "residual_nT", "reference"
+    );
+    for s in &cal.model.sensors {
+        let m = &s.model;
+        println!(
+            "{:<10} {:<12} {:<24} {:>6} {:>8} {:>13.4} {:>10}",
+            s.name,
+            s.mag,
+            s.flux.join(","),
+            m.coefficients.len(),
+            m.fit.rows,
+            m.fit.residual_rms_nt,
+            s.reference_sensor.as_deref().unwrap_or("-")
+        );
+    }
+    println!(
+        "{} sensor models written to {}",
+        cal.model.sensors.len(),
+        a.model.display()
+    );
     Ok(())
 }

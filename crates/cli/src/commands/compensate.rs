@@ -30,9 +30,40 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()])?;
+    if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
+    {
+        return run_sensors(&a);
+    }
     let model = TlModel::read(&a.model)?;
     let flight = a.input.load()?;
     let out = model.compensate(&flight)?;
     let detail = format!("{} terms, method {}", model.design.terms, model.method);
     crate::output::write_compensated(flight, out, &a.out, &a.model, &detail)
+}
+
+/// A multi-sensor model: every sensor's columns.
+fn run_sensors(a: &Args) -> anyhow::Result<()> {
+    use aeromag::CompensateSensors;
+    let model = aeromag::SensorsModel::read(&a.model)?;
+    let flight = a.input.load()?;
+    let out = model.compensate(&flight)?;
+    let missing = out.missing();
+    let names: Vec<String> = out.columns().into_iter().map(|(n, _)| n).collect();
+    let mut table = flight.into_table();
+    out.add_to(&mut table)?;
+    aeromag::io::write_csv(&table, &a.out)?;
+    let n = table.n_rows();
+    if missing > 0 {
+        eprintln!(
+            "warning: {missing} of {n} rows could not be compensated for every sensor (missing values); their columns are empty there"
+        );
+    }
+    println!(
+        "compensated {} sensors on {n} rows with {}: {}; written to {}",
+        model.sensors.len(),
+        a.model.display(),
+        names.join(", "),
+        a.out.display()
+    );
+    Ok(())
 }

@@ -299,45 +299,38 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
             Some(o) => (Some(&mut o.innovation_nt), Some(&mut o.innovation_std_nt)),
             None => (None, None),
         };
-        for_each_design_row(
-            spec,
-            s.data.time,
-            s.data.flux,
-            run.range.clone(),
-            |i, row| {
-                if err.is_some() {
-                    return;
-                }
-                let d = if i == run.range.start {
-                    0.0
-                } else {
-                    step_length(s.data.time, s.speed_m_s, i)
-                };
-                match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
-                    Ok(inn) => {
-                        log_lik += inn.log_likelihood();
-                        if i - run.range.start >= cfg.field_prior.dim() {
-                            chi2 += inn.value * inn.value / inn.variance;
-                            ss += inn.value * inn.value;
-                            n_stat += 1;
-                        }
-                        if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut())
-                        {
-                            a[i] = inn.value;
-                            b[i] = inn.std();
-                        }
-                        let local = i - run.range.start;
-                        if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
-                            match jf.field_conditional() {
-                                Ok(c) => cps.push((local, c)),
-                                Err(e) => err = Some(e),
-                            }
+        for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+            if err.is_some() {
+                return;
+            }
+            let d = if i == run.range.start {
+                0.0
+            } else {
+                step_length(s.data.time, s.speed_m_s, i)
+            };
+            match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
+                Ok(inn) => {
+                    log_lik += inn.log_likelihood();
+                    if i - run.range.start >= cfg.field_prior.dim() {
+                        chi2 += inn.value * inn.value / inn.variance;
+                        ss += inn.value * inn.value;
+                        n_stat += 1;
+                    }
+                    if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut()) {
+                        a[i] = inn.value;
+                        b[i] = inn.std();
+                    }
+                    let local = i - run.range.start;
+                    if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                        match jf.field_conditional() {
+                            Ok(c) => cps.push((local, c)),
+                            Err(e) => err = Some(e),
                         }
                     }
-                    Err(e) => err = Some(e.at(format!("segment {}, row {i}", run.seg))),
                 }
-            },
-        );
+                Err(e) => err = Some(e.at(format!("segment {}, row {i}", run.seg))),
+            }
+        });
         if let Some(e) = err {
             return Err(e);
         }
@@ -372,16 +365,10 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
                     factor: c.factor.clone(),
                 })
                 .collect();
-            for_each_design_row(
-                spec,
-                s.data.time,
-                s.data.flux,
-                run.range.clone(),
-                |i, row| {
-                    let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
-                    out.compensated_nt[i] = s.data.mag[i] - a;
-                },
-            );
+            for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+                let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
+                out.compensated_nt[i] = s.data.mag[i] - a;
+            });
             let model = FieldModel {
                 time: s.data.time,
                 speed_m_s: s.speed_m_s,
@@ -462,25 +449,19 @@ fn decimated_subset(
     for run in runs {
         let s = &segments[run.seg];
         let mut dist = 0.0;
-        for_each_design_row(
-            spec,
-            s.data.time,
-            s.data.flux,
-            run.range.clone(),
-            |i, row| {
-                if i > run.range.start {
-                    dist += step_length(s.data.time, s.speed_m_s, i);
-                }
-                if (i - run.range.start) % dec == 0 {
-                    sub.rows.extend_from_slice(row);
-                    sub.y.push(s.data.mag[i] - y_ref);
-                    sub.dz.push(s.alt_m[i] - z0);
-                    sub.d.push(dist);
-                    sub.start.push(i == run.range.start);
-                    dist = 0.0;
-                }
-            },
-        );
+        for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+            if i > run.range.start {
+                dist += step_length(s.data.time, s.speed_m_s, i);
+            }
+            if (i - run.range.start) % dec == 0 {
+                sub.rows.extend_from_slice(row);
+                sub.y.push(s.data.mag[i] - y_ref);
+                sub.dz.push(s.alt_m[i] - z0);
+                sub.d.push(dist);
+                sub.start.push(i == run.range.start);
+                dist = 0.0;
+            }
+        });
     }
     sub
 }
@@ -608,6 +589,7 @@ impl KalmanFit {
                 residual_rms_nt: self.model_residual(),
                 warnings: self.warnings.clone(),
                 eddy_lag_selection: None,
+                extra_lag_selection: Vec::new(),
             },
             reference: Vec::new(),
             lever_arm: None,

@@ -11,25 +11,31 @@
 //! run sample by sample, as over one segment.
 
 use crate::tolles_lawson::Design;
-use crate::tolles_lawson::eddy_lag::LagBank;
+use crate::tolles_lawson::design::Lags;
+use crate::tolles_lawson::fit_ls::Segment;
 use crate::tolles_lawson::terms::derivative;
 use std::ops::Range;
 
 /// Samples per chunk.
 const CHUNK: usize = 4096;
 
-/// Call `f(i, row)` for every sample `i` of `run` (indices into `time` and
-/// `flux`, in increasing order); derivatives are taken over `run` alone.
+/// Call `f(i, row)` for every sample `i` of `run` (indices into the
+/// segment `seg`, in increasing order); derivatives are taken over `run`
+/// alone, and the lags start at its first sample.
 pub fn for_each_design_row(
     spec: &Design,
-    time: &[f64],
-    flux: [&[f64]; 3],
+    seg: &Segment,
     run: Range<usize>,
     mut f: impl FnMut(usize, &[f64]),
 ) {
+    let (time, flux) = (seg.time, seg.flux);
     let ncol = spec.terms.n_columns();
     let mut row = vec![0.0; ncol];
-    let mut lags = LagBank::new(spec.terms.eddy_lags_s());
+    let mut lags = Lags::new(&spec.terms);
+    let channels: Vec<Option<&[f64]>> = (0..spec.terms.extras().len())
+        .map(|k| seg.channels.get(k))
+        .collect();
+    let mut extra = vec![[f64::NAN; 2]; channels.len()];
     let eddy = spec.terms.has_eddy();
     let (s, e) = (run.start, run.end);
     let mut a = s;
@@ -49,11 +55,16 @@ pub fn for_each_design_row(
         for i in a..b {
             let j = i - lo;
             let d = [db[0][j], db[1][j], db[2][j]];
-            let lagged = lags.step(time[i], d);
+            for ((x, c), lag) in extra.iter_mut().zip(&channels).zip(&mut lags.extra) {
+                let v = c.map_or(f64::NAN, |c| c[i]);
+                *x = [v, lag.as_mut().map_or(f64::NAN, |l| l.step(time[i], v))];
+            }
+            let lagged = lags.eddy.step(time[i], d);
             spec.terms.row(
                 [flux[0][i], flux[1][i], flux[2][i]],
                 d,
                 lagged,
+                &extra,
                 spec.bt_scale_nt,
                 &mut row,
             );
@@ -66,7 +77,8 @@ pub fn for_each_design_row(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tolles_lawson::{Convention, TermSet};
+    use crate::tolles_lawson::design::Channels;
+    use crate::tolles_lawson::{Convention, ExtraTerm, TermSet};
 
     #[test]
     fn streamed_rows_equal_the_design_columns() {
@@ -83,23 +95,39 @@ mod tests {
         let fz: Vec<f64> = (0..n)
             .map(|k| 48_000.0 - 100.0 * (k as f64 * 0.07).sin())
             .collect();
+        // Two extra regressors, one with a lag: a switching current and a ramp.
+        let strobe: Vec<f64> = (0..n).map(|k| 5.0 * ((k / 7) % 2) as f64).collect();
+        let ramp: Vec<f64> = (0..n).map(|k| (k % 50) as f64 * 0.1).collect();
+        let chs = [&strobe[..], &ramp[..]];
+        let seg = Segment {
+            time: &time,
+            flux: [&fx, &fy, &fz],
+            mag: &fx,
+            channels: Channels::new(&chs),
+            direction: None,
+        };
         for conv in [Convention::Physical, Convention::MagNav] {
             let terms = TermSet::parse("p3,i6,e9,bias")
                 .unwrap()
                 .with_eddy_lags(&[0.2, 0.7])
+                .unwrap()
+                .with_extras(&[ExtraTerm::new("strobe"), ExtraTerm::lagged("ramp", 0.4)])
                 .unwrap();
             let spec = Design {
                 terms,
                 convention: conv,
                 bt_scale_nt: 50_000.0,
+                magnitude: Default::default(),
             };
             for run in [0..n, 5..CHUNK + 7, 10..13, 100..101] {
-                let cols = spec.columns(
+                let cols = spec.columns_with(
                     &time[run.clone()],
                     [&fx[run.clone()], &fy[run.clone()], &fz[run.clone()]],
+                    seg.channels.slice(run.clone()),
                 );
+                assert_eq!(cols.len(), 19 + 18 + 9);
                 let mut count = 0;
-                for_each_design_row(&spec, &time, [&fx, &fy, &fz], run.clone(), |i, row| {
+                for_each_design_row(&spec, &seg, run.clone(), |i, row| {
                     for (c, v) in row.iter().enumerate() {
                         assert_eq!(*v, cols[c][i - run.start], "run {run:?} row {i} col {c}");
                     }

@@ -5,8 +5,10 @@
 //! streaming row builder and the model file, so a model is applied with
 //! exactly the rows it was fitted on.
 
-use super::eddy_lag::LagBank;
-use super::terms::{Convention, DEFAULT_BT_SCALE_NT, TermSet, derivative_into};
+use super::eddy_lag::{FirstOrderLag, LagBank};
+use super::terms::{
+    Column, Convention, DEFAULT_BT_SCALE_NT, ExtraSeries, TermSet, derivative_into,
+};
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +40,64 @@ pub struct Design {
     pub convention: Convention,
     /// Scale of the induced and eddy columns, nT.
     pub bt_scale_nt: f64,
+    /// How the interference vector becomes the scalar interference: the
+    /// Tolles-Lawson projection (default) or the exact magnitude.
+    #[serde(default, skip_serializing_if = "Magnitude::is_first_order")]
+    pub magnitude: Magnitude,
+}
+
+/// How the modelled interference vector `ΔB` (body frame) becomes the
+/// scalar sensor's interference.
+///
+/// Every design column but `bias` is one component of a vector model:
+/// column `e_i s` is the contribution `s` to `ΔB_i` (`s` = 1, `B_j/bt`,
+/// `Ḃ_j/bt`, a lagged derivative or an extra channel), so that
+/// `ΔB = Σ_k c_k s_k u_{i(k)}` and the Tolles-Lawson interference is its
+/// projection `eᵀΔB`. That projection is the first order of
+/// `|B + ΔB| − |B| = eᵀΔB + |ΔB⊥|²/(2|B|) + …`: for a sensor whose
+/// interference is 1 % of the field (500 nT) the second-order term reaches
+/// 2.5 nT, for 1000 nT about 10 nT.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum Magnitude {
+    /// `eᵀΔB` (+ bias): the classical model, linear in the coefficients.
+    #[default]
+    FirstOrder,
+    /// `|B + ΔB| − |B|` (+ bias), `B` the vector magnetometer's field:
+    /// fitted by Gauss–Newton from the first-order solution
+    /// ([`super::fit_ls::fit_band_pass_ls`]).
+    Exact,
+}
+
+impl Magnitude {
+    fn is_first_order(&self) -> bool {
+        *self == Magnitude::FirstOrder
+    }
+}
+
+impl std::fmt::Display for Magnitude {
+    /// `first-order` or `exact`, as in files and on the command line.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Magnitude::FirstOrder => "first-order",
+            Magnitude::Exact => "exact",
+        })
+    }
+}
+
+impl std::str::FromStr for Magnitude {
+    type Err = CompError;
+    /// `first-order` or `exact`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "first-order" => Ok(Magnitude::FirstOrder),
+            "exact" => Ok(Magnitude::Exact),
+            o => Err(CompError::setting(format!(
+                "magnitude `{o}`: use first-order or exact"
+            ))),
+        }
+    }
 }
 
 impl Default for Design {
@@ -48,6 +108,7 @@ impl Default for Design {
             terms: TermSet::observable16(),
             convention: Convention::Physical,
             bt_scale_nt: DEFAULT_BT_SCALE_NT,
+            magnitude: Magnitude::FirstOrder,
         }
     }
 }
@@ -93,9 +154,22 @@ impl Design {
     /// The design-matrix columns (column-major, `n_columns` vectors of the
     /// segment's length) for the vector-magnetometer series `flux` (nT,
     /// body frame) and time stamps `time` (s) of one contiguous segment.
+    /// Without extra regressors (their columns, if the terms have any, are
+    /// NaN: [`Design::columns_with`]).
     pub fn columns(&self, time: &[f64], flux: [&[f64]; 3]) -> Vec<Vec<f64>> {
+        self.columns_with(time, flux, Channels::NONE)
+    }
+
+    /// [`Design::columns`] with the extra regressors' channels (one per
+    /// [`TermSet::extras`], in order, each of the segment's length).
+    pub fn columns_with(
+        &self,
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+    ) -> Vec<Vec<f64>> {
         let mut block = DesignBlock::default();
-        self.columns_into(time, flux, &mut block);
+        self.columns_into(time, flux, channels, &mut block);
         block.columns
     }
 
@@ -103,29 +177,154 @@ impl Design {
     /// allocations (a fit builds one block after another of the same size:
     /// fresh multi-megabyte buffers each time would cost more in page
     /// faults than the arithmetic).
-    pub fn columns_into(&self, time: &[f64], flux: [&[f64]; 3], block: &mut DesignBlock) {
+    pub fn columns_into(
+        &self,
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        block: &mut DesignBlock,
+    ) {
+        self.columns_along_into(time, flux, channels, None, block)
+    }
+
+    /// [`Design::columns_into`] with the direction cosines of `dir` (the
+    /// total field `B + ΔB` of a Gauss–Newton step of the exact-magnitude
+    /// model) rather than of the vector magnetometer's field.
+    pub fn columns_along_into(
+        &self,
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        dir: Option<[&[f64]; 3]>,
+        block: &mut DesignBlock,
+    ) {
         self.derivatives_into(time, flux, &mut block.db);
-        let mut lags = LagBank::new(self.terms.eddy_lags_s());
+        let mut lags = Lags::new(&self.terms);
         let DesignBlock {
             columns,
             db,
-            lagged,
-            e,
+            scratch,
         } = block;
-        self.block_columns(0..time.len(), time, flux, db, &mut lags, lagged, e, columns);
+        self.block_columns(
+            0..time.len(),
+            time,
+            flux,
+            dir,
+            channels,
+            db,
+            &mut lags,
+            scratch,
+            columns,
+        );
     }
 
     /// Modelled interference `A c` (nT) over one contiguous segment, built
     /// in blocks of rows (memory: the derivatives and one block of columns).
     /// Each sample is `Σ_k A_k c_k` summed in column order, as a row's dot
     /// product with `c`.
+    ///
+    /// Without extra regressors (their columns, if the terms have any, are
+    /// NaN: [`Design::interference_with`]).
     pub fn interference(&self, coef: &[f64], time: &[f64], flux: [&[f64]; 3]) -> Vec<f64> {
+        self.interference_with(coef, time, flux, Channels::NONE)
+    }
+
+    /// [`Design::interference`] with the extra regressors' channels, under
+    /// the design's [`Magnitude`].
+    pub fn interference_with(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+    ) -> Vec<f64> {
+        match self.magnitude {
+            Magnitude::FirstOrder => self.projected(coef, time, flux, channels, None),
+            Magnitude::Exact => {
+                let (d, bias) = self.field_vector(coef, time, flux, channels);
+                (0..time.len())
+                    .map(|k| {
+                        let b = [flux[0][k], flux[1][k], flux[2][k]];
+                        let t = [b[0] + d[0][k], b[1] + d[1][k], b[2] + d[2][k]];
+                        norm(t) - norm(b) + bias
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// The modelled interference vector `ΔB` (nT, body frame; [`Magnitude`]
+    /// docs) of every sample, and the bias coefficient (0 without a `bias`
+    /// term), which is not part of the vector.
+    pub fn field_vector(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+    ) -> ([Vec<f64>; 3], f64) {
+        let n = time.len();
+        let mut k = 0;
+        let mut bias = None;
+        self.terms.for_each_column(|c| {
+            if c == Column::Bias {
+                bias = Some(k);
+            }
+            k += 1;
+        });
+        let b = bias.and_then(|k| coef.get(k).copied()).unwrap_or(0.0);
+        let mut c = coef.to_vec();
+        if let Some(k) = bias
+            && k < c.len()
+        {
+            c[k] = 0.0;
+        }
+        // Column e_i s along the unit axis u_a is s when i = a, else 0.
+        let (one, zero) = (vec![1.0; n], vec![0.0; n]);
+        let axis = |a: usize| -> [&[f64]; 3] {
+            std::array::from_fn(|i| if i == a { &one[..] } else { &zero[..] })
+        };
+        let d = [0, 1, 2].map(|a| self.projected(&c, time, flux, channels, Some(axis(a))));
+        (d, b)
+    }
+
+    /// The second-order remainder of the projection, `|B + ΔB| − |B| −
+    /// eᵀΔB` (nT), of every sample under the coefficients `coef`: what the
+    /// first-order model leaves out (≈ `|ΔB⊥|²/2|B|`).
+    pub fn second_order_nt(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+    ) -> Vec<f64> {
+        let (d, _) = self.field_vector(coef, time, flux, channels);
+        (0..time.len())
+            .map(|k| {
+                let b = [flux[0][k], flux[1][k], flux[2][k]];
+                let bn = norm(b);
+                let dv = [d[0][k], d[1][k], d[2][k]];
+                let t = [b[0] + dv[0], b[1] + dv[1], b[2] + dv[2]];
+                norm(t) - bn - (b[0] * dv[0] + b[1] * dv[1] + b[2] * dv[2]) / bn
+            })
+            .collect()
+    }
+
+    /// `A c` with the direction cosines of `dir` (default: of `flux`).
+    fn projected(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        dir: Option<[&[f64]; 3]>,
+    ) -> Vec<f64> {
         const BLOCK: usize = 4096;
         let n = time.len();
         let mut db = Default::default();
         self.derivatives_into(time, flux, &mut db);
-        let mut lags = LagBank::new(self.terms.eddy_lags_s());
-        let (mut lagged, mut e, mut cols) = (Vec::new(), Default::default(), Vec::new());
+        let mut lags = Lags::new(&self.terms);
+        let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
         let mut out = Vec::with_capacity(n);
         for start in (0..n).step_by(BLOCK) {
             let r = start..(start + BLOCK).min(n);
@@ -133,10 +332,11 @@ impl Design {
                 r.clone(),
                 time,
                 flux,
+                dir,
+                channels,
                 &db,
                 &mut lags,
-                &mut lagged,
-                &mut e,
+                &mut scratch,
                 &mut cols,
             );
             // −0.0 is the identity of f64 addition (what `Iterator::sum`
@@ -154,20 +354,22 @@ impl Design {
 
     /// The columns of rows `r` of a segment into `out` (derivatives `db`
     /// over the whole segment; `lags` stepped through every earlier row,
-    /// so that the lagged derivatives start at the segment's first sample;
-    /// `lagged` and `e` are scratch).
+    /// so that the lagged derivatives and channels start at the segment's
+    /// first sample; the direction cosines of `dir`, default `flux`).
     #[allow(clippy::too_many_arguments)]
     fn block_columns(
         &self,
         r: std::ops::Range<usize>,
         time: &[f64],
         flux: [&[f64]; 3],
+        dir: Option<[&[f64]; 3]>,
+        channels: Channels,
         db: &[Vec<f64>; 3],
-        lags: &mut LagBank,
-        lagged: &mut Vec<[Vec<f64>; 3]>,
-        e: &mut [Vec<f64>; 3],
+        lags: &mut Lags,
+        scratch: &mut Scratch,
         out: &mut Vec<Vec<f64>>,
     ) {
+        let Scratch { lagged, extra, e } = scratch;
         let n_lags = self.terms.eddy_lags_s().len();
         lagged.resize_with(n_lags, Default::default);
         for l in lagged.iter_mut() {
@@ -176,7 +378,7 @@ impl Design {
         if n_lags > 0 {
             for i in r.clone() {
                 let d = [db[0][i], db[1][i], db[2][i]];
-                for (l, g) in lagged.iter_mut().zip(lags.step(time[i], d)) {
+                for (l, g) in lagged.iter_mut().zip(lags.eddy.step(time[i], d)) {
                     for (axis, v) in l.iter_mut().zip(g) {
                         axis.push(*v);
                     }
@@ -187,10 +389,25 @@ impl Design {
             .iter()
             .map(|l| [&l[0][..], &l[1][..], &l[2][..]])
             .collect();
+        extra.resize_with(lags.extra.len(), Vec::new);
+        for (k, (lag, out)) in lags.extra.iter_mut().zip(extra.iter_mut()).enumerate() {
+            out.clear();
+            if let (Some(lag), Some(x)) = (lag, channels.get(k)) {
+                out.extend(r.clone().map(|i| lag.step(time[i], x[i])));
+            }
+        }
+        let series: Vec<ExtraSeries> = (0..self.terms.extras().len())
+            .map(|k| ExtraSeries {
+                values: channels.get(k).map_or(&[][..], |x| &x[r.clone()]),
+                lagged: extra.get(k).map_or(&[][..], |v| &v[..]),
+            })
+            .collect();
         self.terms.columns_into(
+            dir.unwrap_or(flux).map(|f| &f[r.clone()]),
             flux.map(|f| &f[r.clone()]),
             [&db[0][r.clone()], &db[1][r.clone()], &db[2][r.clone()]],
             &lagged,
+            &series,
             self.bt_scale_nt,
             e,
             out,
@@ -211,6 +428,10 @@ impl Design {
     }
 }
 
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
 /// Reusable buffers of [`Design::columns_into`]: the design columns of the
 /// last block (`columns[k][n]`) and the scratch they are built from.
 #[derive(Debug, Clone, Default)]
@@ -218,6 +439,102 @@ pub struct DesignBlock {
     /// The columns of the last block built.
     pub columns: Vec<Vec<f64>>,
     db: [Vec<f64>; 3],
+    scratch: Scratch,
+}
+
+/// Scratch of one block: lagged derivatives, lagged extra channels and the
+/// direction cosines.
+#[derive(Debug, Clone, Default)]
+struct Scratch {
     lagged: Vec<[Vec<f64>; 3]>,
+    extra: Vec<Vec<f64>>,
     e: [Vec<f64>; 3],
+}
+
+/// The lags of a segment, stepped row by row from its first sample: the
+/// eddy lags of the derivatives and the lag of each extra regressor that
+/// has one.
+#[derive(Debug, Clone)]
+pub(crate) struct Lags {
+    pub(crate) eddy: LagBank,
+    pub(crate) extra: Vec<Option<FirstOrderLag>>,
+}
+
+impl Lags {
+    pub(crate) fn new(terms: &TermSet) -> Self {
+        Self {
+            eddy: LagBank::new(terms.eddy_lags_s()),
+            extra: terms
+                .extras()
+                .iter()
+                .map(|x| x.lag_s.map(FirstOrderLag::new))
+                .collect(),
+        }
+    }
+}
+
+/// The recorded channels of a design's extra regressors over a segment, one
+/// per [`TermSet::extras`] in order, each as long as the segment, without
+/// copying them: slicing ([`Channels::slice`]) narrows the window.
+///
+/// ```
+/// use aeromag_compensation::tolles_lawson::design::Channels;
+/// let (strobe, flap) = ([0.0, 5.0, 0.0, 5.0], [1.0, 1.0, 2.0, 2.0]);
+/// let all = [&strobe[..], &flap[..]];
+/// let c = Channels::new(&all).slice(1..3);
+/// assert_eq!(c.get(1), Some(&[1.0, 2.0][..]));
+/// assert_eq!(c.get(2), None);
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct Channels<'a> {
+    series: &'a [&'a [f64]],
+    start: usize,
+    len: Option<usize>,
+}
+
+impl<'a> Channels<'a> {
+    /// No channels.
+    pub const NONE: Channels<'static> = Channels {
+        series: &[],
+        start: 0,
+        len: None,
+    };
+
+    /// The channels `series`, whole.
+    pub fn new(series: &'a [&'a [f64]]) -> Self {
+        Self {
+            series,
+            start: 0,
+            len: None,
+        }
+    }
+
+    /// Rows `r` of the current window (relative to it).
+    pub fn slice(&self, r: std::ops::Range<usize>) -> Self {
+        Self {
+            series: self.series,
+            start: self.start + r.start,
+            len: Some(r.len()),
+        }
+    }
+
+    /// Channel `k` over the window (`None` when there is no channel `k`
+    /// or it is shorter than the window).
+    pub fn get(&self, k: usize) -> Option<&'a [f64]> {
+        let s = self.series.get(k)?;
+        let end = self.len.map_or(s.len(), |l| self.start + l);
+        s.get(self.start..end)
+    }
+
+    /// Number of channels.
+    pub fn count(&self) -> usize {
+        self.series.len()
+    }
+}
+
+impl Default for Channels<'_> {
+    /// [`Channels::NONE`].
+    fn default() -> Self {
+        Channels::NONE
+    }
 }

@@ -7,5 +7,7 @@ pub mod lag_select;
 pub mod segments;
 pub mod terms;
 
-pub use design::Design;
-pub use terms::{Convention, DEFAULT_BT_SCALE_NT, TermGroup, TermSet};
+pub use design::{Design, Magnitude};
+pub use terms::{
+    Convention, DEFAULT_BT_SCALE_NT, ExtraRequest, ExtraSeries, ExtraTerm, TermGroup, TermSet,
+};

@@ -37,6 +37,21 @@
 //! `e_z g_z` carries information the other eight columns do not (on a
 //! simulated box, dropping it leaves 4× more of the eddy field unexplained).
 //!
+//! **Extra regressors** ([`ExtraTerm`], `--extra cur_strb,cur_flap:lag`):
+//! any recorded channel `x` — typically the current of on-board equipment —
+//! enters as the three columns `e_i x` (named `<channel>:e_x`, …), after
+//! every group. A current loop fixed in the airframe makes a field `k I`
+//! fixed in body axes, whose effect on the total field is `eᵀk I = Σ_i k_i
+//! e_i I` (to first order): a plain column `I` would hold only one heading's
+//! projection, and leaves tens of nT on a cabin sensor when the aircraft
+//! turns. A loop whose field lags its current (eddy currents induced in
+//! nearby structure by a switching load, time constant `τ`) adds the columns
+//! `e_i L_τ[x]` (`<channel>:lag:e_x`, …) with the same first-order lag as
+//! the eddy terms ([`super::eddy_lag::FirstOrderLag`]); `τ` is chosen on the
+//! calibration flight by the likelihood-ratio test of the eddy lags
+//! ([`super::lag_select`]). The coefficients are in nT per unit of the
+//! channel (nT/A for a current).
+//!
 //! Derivative conventions ([`Convention`]):
 //! * `Physical` (default): `dB_j` is the time derivative in nT/s, a central
 //!   difference over the actual time stamps, first-order one-sided at the ends,
@@ -142,7 +157,7 @@ impl std::str::FromStr for Convention {
 }
 
 /// A validated, ordered set of term groups, with the eddy-current lags of
-/// the `l9`/`l8` groups.
+/// the `l9`/`l8` groups and the extra regressors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TermSet {
     groups: Vec<TermGroup>,
@@ -150,6 +165,124 @@ pub struct TermSet {
     /// without them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     eddy_lags_s: Vec<f64>,
+    /// Extra regressors, in column order (module docs); empty without them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    extras: Vec<ExtraTerm>,
+}
+
+/// An extra regressor of a fitted model: the recorded channel `channel`
+/// times the direction cosines, and with `lag_s = Some(τ)` also the channel
+/// through the first-order lag `τ` times the direction cosines (module
+/// docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtraTerm {
+    /// Column name in the flight (e.g. `cur_strb`).
+    pub channel: String,
+    /// Time constant of the lagged columns, s (`None`: no lagged columns).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lag_s: Option<f64>,
+}
+
+impl ExtraTerm {
+    /// The channel's instantaneous columns only.
+    pub fn new(channel: impl Into<String>) -> Self {
+        Self {
+            channel: channel.into(),
+            lag_s: None,
+        }
+    }
+
+    /// The channel's columns and its lagged columns of time constant
+    /// `lag_s` (s).
+    pub fn lagged(channel: impl Into<String>, lag_s: f64) -> Self {
+        Self {
+            channel: channel.into(),
+            lag_s: Some(lag_s),
+        }
+    }
+}
+
+/// An extra regressor as the user asks for it: `cur_strb` (the channel's
+/// columns) or `cur_flap:lag` (also its lagged columns, the lag to be
+/// chosen on the calibration flight).
+///
+/// ```
+/// use aeromag_compensation::tolles_lawson::ExtraRequest;
+/// let r = ExtraRequest::parse_list("cur_strb, cur_flap:lag")?;
+/// assert_eq!(r[1], ExtraRequest { channel: "cur_flap".into(), lag: true });
+/// assert!(ExtraRequest::parse_list("cur_strb:lagg").is_err());
+/// # Ok::<(), aeromag_compensation::CompError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ExtraRequest {
+    /// Column name in the flight.
+    pub channel: String,
+    /// Also through a first-order lag fitted on the calibration flight.
+    pub lag: bool,
+}
+
+impl ExtraRequest {
+    /// Parse `name[:lag],name[:lag],…` (spaces ignored; an empty text is no
+    /// request). A name may appear once.
+    pub fn parse_list(s: &str) -> Result<Vec<Self>> {
+        let mut out: Vec<Self> = Vec::new();
+        for item in s.split(',').map(str::trim).filter(|t| !t.is_empty()) {
+            let (name, lag) = match item.split_once(':') {
+                None => (item, false),
+                Some((name, "lag")) => (name.trim(), true),
+                Some((_, other)) => {
+                    return Err(CompError::InvalidTerms {
+                        reason: format!(
+                            "extra regressor `{item}`: unknown suffix `:{other}` (only `:lag`)"
+                        ),
+                    });
+                }
+            };
+            check_channel_name(name)?;
+            if out.iter().any(|r| r.channel == name) {
+                return Err(CompError::InvalidTerms {
+                    reason: format!("extra regressor `{name}` is given twice"),
+                });
+            }
+            out.push(Self {
+                channel: name.to_string(),
+                lag,
+            });
+        }
+        Ok(out)
+    }
+}
+
+impl std::fmt::Display for ExtraRequest {
+    /// `name` or `name:lag`, as on the command line.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.channel)?;
+        if self.lag {
+            f.write_str(":lag")?;
+        }
+        Ok(())
+    }
+}
+
+fn check_channel_name(name: &str) -> Result<()> {
+    if name.is_empty() || name.contains([',', ':']) || name.chars().any(char::is_whitespace) {
+        return Err(CompError::InvalidTerms {
+            reason: format!("extra regressor `{name}`: not a column name"),
+        });
+    }
+    Ok(())
+}
+
+/// The inputs of one extra regressor's columns over a run of samples: the
+/// channel and, when the term has a lag, the lagged channel (empty slice
+/// otherwise).
+#[derive(Debug, Clone, Copy)]
+pub struct ExtraSeries<'a> {
+    /// The channel.
+    pub values: &'a [f64],
+    /// The channel through the term's lag (empty without a lag).
+    pub lagged: &'a [f64],
 }
 
 const XYZ: [&str; 3] = ["x", "y", "z"];
@@ -172,6 +305,16 @@ pub enum Column {
     },
     /// `1`.
     Bias,
+    /// `e_i x`, `x` the extra regressor `k` ([`TermSet::extras`]) or, with
+    /// `lagged`, its lagged series.
+    Extra {
+        /// Axis of the direction cosine.
+        i: usize,
+        /// Index of the extra regressor.
+        k: usize,
+        /// The lagged series rather than the channel itself.
+        lagged: bool,
+    },
 }
 
 /// The second factor of a [`Column::Product`].
@@ -206,6 +349,7 @@ impl TermSet {
         Self {
             groups: vec![TermGroup::P3, TermGroup::I5, TermGroup::E8],
             eddy_lags_s: Vec::new(),
+            extras: Vec::new(),
         }
     }
 
@@ -214,6 +358,7 @@ impl TermSet {
         Self {
             groups: vec![TermGroup::P3, TermGroup::I6, TermGroup::E9],
             eddy_lags_s: Vec::new(),
+            extras: Vec::new(),
         }
     }
 
@@ -242,6 +387,7 @@ impl TermSet {
         Ok(Self {
             groups: g,
             eddy_lags_s: Vec::new(),
+            extras: Vec::new(),
         })
     }
 
@@ -259,6 +405,7 @@ impl TermSet {
             return Ok(Self {
                 groups,
                 eddy_lags_s: Vec::new(),
+                extras: self.extras.clone(),
             });
         }
         if let Some(t) = taus_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
@@ -282,7 +429,44 @@ impl TermSet {
         Ok(Self {
             groups,
             eddy_lags_s: taus,
+            extras: self.extras.clone(),
         })
+    }
+
+    /// This set with the extra regressors `extras` (replacing any it has),
+    /// in that column order. Rejects a channel named twice, an empty name
+    /// and a lag that is not finite and > 0.
+    pub fn with_extras(&self, extras: &[ExtraTerm]) -> Result<Self> {
+        let set = Self {
+            extras: extras.to_vec(),
+            ..self.clone()
+        };
+        set.validate_extras()?;
+        Ok(set)
+    }
+
+    /// The extra regressors, in column order.
+    pub fn extras(&self) -> &[ExtraTerm] {
+        &self.extras
+    }
+
+    fn validate_extras(&self) -> Result<()> {
+        for (k, x) in self.extras.iter().enumerate() {
+            check_channel_name(&x.channel)?;
+            if self.extras[..k].iter().any(|o| o.channel == x.channel) {
+                return Err(CompError::InvalidTerms {
+                    reason: format!("extra regressor `{}` is given twice", x.channel),
+                });
+            }
+            if let Some(t) = x.lag_s
+                && !(t.is_finite() && t > 0.0)
+            {
+                return Err(CompError::InvalidTerms {
+                    reason: format!("lag {t} s of `{}`: must be finite and > 0", x.channel),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// The lags `τ` (s) of the lagged eddy groups (empty without them).
@@ -306,7 +490,7 @@ impl TermSet {
                 reason: format!("eddy-current lag {t} s: must be finite and > 0"),
             });
         }
-        Ok(())
+        self.validate_extras()
     }
 
     /// Parse a comma-separated list such as `p3,i5,e8,bias`.
@@ -361,6 +545,12 @@ impl TermSet {
                 TermGroup::Bias => names.push("bias".into()),
             }
         }
+        for x in &self.extras {
+            names.extend(XYZ.iter().map(|a| format!("{}:e_{a}", x.channel)));
+            if x.lag_s.is_some() {
+                names.extend(XYZ.iter().map(|a| format!("{}:lag:e_{a}", x.channel)));
+            }
+        }
         names
     }
 
@@ -377,10 +567,21 @@ impl TermSet {
                 TermGroup::L9 => 9 * self.eddy_lags_s.len(),
                 TermGroup::Bias => 1,
             })
-            .sum()
+            .sum::<usize>()
+            + self
+                .extras
+                .iter()
+                .map(|x| if x.lag_s.is_some() { 6 } else { 3 })
+                .sum::<usize>()
     }
 
-    /// Comma-separated names, e.g. `p3,i5,e8`.
+    /// The lags of the extra regressors that have one, s.
+    pub fn extra_lags_s(&self) -> impl Iterator<Item = f64> + '_ {
+        self.extras.iter().filter_map(|x| x.lag_s)
+    }
+
+    /// Comma-separated group names, e.g. `p3,i5,e8` (the extra regressors
+    /// are not groups: [`TermSet::extras`]).
     pub fn to_spec_string(&self) -> String {
         self.groups
             .iter()
@@ -392,13 +593,16 @@ impl TermSet {
     /// One design-matrix row into `out` (length [`TermSet::n_columns`]) from
     /// the vector field `b` (nT, body frame), its derivative `db` (units of
     /// the convention) and the lagged derivatives `lagged[k] = L_τk[db]`, one
-    /// per [`TermSet::eddy_lags_s`] (missing ones give NaN columns).
-    /// Non-finite inputs give non-finite rows, never a panic.
+    /// per [`TermSet::eddy_lags_s`], and the extra regressors `extra[k] =
+    /// [x_k, L_τ[x_k]]` (the lagged value is unused without a lag; missing
+    /// inputs give NaN columns). Non-finite inputs give non-finite rows,
+    /// never a panic.
     pub fn row(
         &self,
         b: [f64; 3],
         db: [f64; 3],
         lagged: &[[f64; 3]],
+        extra: &[[f64; 2]],
         bt_scale: f64,
         out: &mut [f64],
     ) {
@@ -417,6 +621,9 @@ impl TermSet {
                     product(e[i], s, bt_scale)
                 }
                 Column::Bias => 1.0,
+                Column::Extra { i, k, lagged } => {
+                    e[i] * extra.get(k).map_or(f64::NAN, |x| x[usize::from(lagged)])
+                }
             };
             k += 1;
         });
@@ -425,28 +632,46 @@ impl TermSet {
     /// The design matrix column by column (`out[k][n]`, the same values as
     /// [`TermSet::row`] for every sample `n`, bit for bit), from the vector
     /// field `b[axis][n]`, its derivative `db` and the lagged derivatives
-    /// `lagged[lag][axis][n]`; all slices of equal length. Each column is one
-    /// loop over the samples, which the compiler vectorises.
+    /// `lagged[lag][axis][n]` and the extra regressors `extra[k]`; all
+    /// slices of equal length (missing inputs give NaN columns). Each column
+    /// is one loop over the samples, which the compiler vectorises.
     pub fn columns(
         &self,
         b: [&[f64]; 3],
         db: [&[f64]; 3],
         lagged: &[[&[f64]; 3]],
+        extra: &[ExtraSeries],
         bt_scale: f64,
     ) -> Vec<Vec<f64>> {
         let mut out = Vec::new();
-        self.columns_into(b, db, lagged, bt_scale, &mut Default::default(), &mut out);
+        self.columns_into(
+            b,
+            b,
+            db,
+            lagged,
+            extra,
+            bt_scale,
+            &mut Default::default(),
+            &mut out,
+        );
         out
     }
 
     /// [`TermSet::columns`] into `out`, reusing its allocations and those of
     /// the direction-cosine scratch `e` (one allocation per column for the
-    /// first block, none for the next blocks of the same length).
+    /// first block, none for the next blocks of the same length), with the
+    /// direction cosines `e = d/|d|` of the vector `dir` (the field `b`
+    /// itself in the Tolles-Lawson model; the total field `b + ΔB` in the
+    /// Gauss–Newton steps of the exact-magnitude model,
+    /// [`super::design::Magnitude::Exact`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn columns_into(
         &self,
+        dir: [&[f64]; 3],
         b: [&[f64]; 3],
         db: [&[f64]; 3],
         lagged: &[[&[f64]; 3]],
+        extra: &[ExtraSeries],
         bt_scale: f64,
         e: &mut [Vec<f64>; 3],
         out: &mut Vec<Vec<f64>>,
@@ -455,13 +680,13 @@ impl TermSet {
         // e[0] holds |B| until e[1] and e[2] are divided by it, then
         // becomes B_x/|B| in place (no fourth buffer).
         e[0].clear();
-        e[0].extend((0..n).map(|k| magnitude([b[0][k], b[1][k], b[2][k]])));
+        e[0].extend((0..n).map(|k| magnitude([dir[0][k], dir[1][k], dir[2][k]])));
         let (bt, rest) = e.split_first_mut().expect("three axes");
         for (i, ei) in rest.iter_mut().enumerate() {
             ei.clear();
-            ei.extend(b[i + 1].iter().zip(bt.iter()).map(|(v, t)| v / t));
+            ei.extend(dir[i + 1][..n].iter().zip(bt.iter()).map(|(v, t)| v / t));
         }
-        for (v, t) in bt.iter_mut().zip(b[0]) {
+        for (v, t) in bt.iter_mut().zip(dir[0]) {
             *v = t / *v;
         }
         out.resize_with(self.n_columns(), Vec::new);
@@ -490,6 +715,17 @@ impl TermSet {
                     )
                 }
                 Column::Bias => col.resize(n, 1.0),
+                Column::Extra { i, k, lagged } => {
+                    let x = extra
+                        .get(k)
+                        .map(|x| if lagged { x.lagged } else { x.values });
+                    match x {
+                        Some(x) if x.len() >= n => {
+                            col.extend(e[i].iter().zip(&x[..n]).map(|(&ei, &xk)| ei * xk))
+                        }
+                        _ => col.resize(n, f64::NAN),
+                    }
+                }
             }
         });
     }
@@ -520,6 +756,14 @@ impl TermSet {
                     }
                 }
                 TermGroup::Bias => f(Column::Bias),
+            }
+        }
+        for (k, x) in self.extras.iter().enumerate() {
+            for lagged in [false, true] {
+                if lagged && x.lag_s.is_none() {
+                    continue;
+                }
+                (0..3).for_each(|i| f(Column::Extra { i, k, lagged }));
             }
         }
     }
@@ -599,7 +843,7 @@ mod tests {
         let b = [20_000.0, -3_000.0, 45_000.0];
         let db = [1.5, -0.7, 0.2];
         let mut row = vec![0.0; 18];
-        t.row(b, db, &[], DEFAULT_BT_SCALE_NT, &mut row);
+        t.row(b, db, &[], &[], DEFAULT_BT_SCALE_NT, &mut row);
         let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
         let ind = row[3] + row[6] + row[8];
         assert!((ind - bt / DEFAULT_BT_SCALE_NT).abs() < 1e-15);
@@ -637,11 +881,12 @@ mod tests {
             b,
             [1.0, 2.0, 3.0],
             &[[0.5, -0.25, 2.0]],
+            &[],
             DEFAULT_BT_SCALE_NT,
             &mut row,
         );
         assert!((row[18 + 5] - b[1] / bt * 2.0 / DEFAULT_BT_SCALE_NT).abs() < 1e-18);
-        one.row(b, [1.0, 2.0, 3.0], &[], DEFAULT_BT_SCALE_NT, &mut row);
+        one.row(b, [1.0, 2.0, 3.0], &[], &[], DEFAULT_BT_SCALE_NT, &mut row);
         assert!(row[18..].iter().all(|v| v.is_nan()) && row[..18].iter().all(|v| v.is_finite()));
         // Bad lags and sets.
         assert!(
@@ -665,6 +910,64 @@ mod tests {
             serde_json::to_string(&TermSet::observable16()).unwrap(),
             r#"{"groups":["p3","i5","e8"]}"#
         );
+    }
+
+    #[test]
+    fn extra_regressors() {
+        let t = TermSet::observable16()
+            .with_extras(&[
+                ExtraTerm::new("cur_strb"),
+                ExtraTerm::lagged("cur_flap", 0.3),
+            ])
+            .unwrap();
+        assert_eq!(t.n_columns(), 16 + 3 + 6);
+        let names = t.column_names();
+        assert_eq!(names.len(), t.n_columns());
+        assert_eq!(
+            (names[16].as_str(), names[18].as_str(), names[22].as_str()),
+            ("cur_strb:e_x", "cur_strb:e_z", "cur_flap:lag:e_x")
+        );
+        // The lags survive a change of eddy lags, and the file form.
+        let l = t.with_eddy_lags(&[0.2]).unwrap();
+        assert_eq!(l.extras(), t.extras());
+        let json = serde_json::to_string(&t).unwrap();
+        assert_eq!(
+            json,
+            r#"{"groups":["p3","i5","e8"],"extras":[{"channel":"cur_strb"},{"channel":"cur_flap","lag_s":0.3}]}"#
+        );
+        assert_eq!(serde_json::from_str::<TermSet>(&json).unwrap(), t);
+        // Row: e_i x and e_i L[x]; a missing input gives NaN, never a panic.
+        let b: [f64; 3] = [20_000.0, -3_000.0, 45_000.0];
+        let bt = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        let mut row = vec![0.0; t.n_columns()];
+        t.row(b, [0.0; 3], &[], &[[2.0, 9.0], [4.0, 3.0]], 5e4, &mut row);
+        assert_eq!(row[16], b[0] / bt * 2.0);
+        assert_eq!(row[22 + 2], b[2] / bt * 3.0);
+        assert_eq!(row[19 + 1], b[1] / bt * 4.0);
+        t.row(b, [0.0; 3], &[], &[[2.0, 9.0]], 5e4, &mut row);
+        assert!(row[19..].iter().all(|v| v.is_nan()) && row[..19].iter().all(|v| v.is_finite()));
+        // Bad sets.
+        for bad in [
+            vec![ExtraTerm::new("a"), ExtraTerm::new("a")],
+            vec![ExtraTerm::new("")],
+            vec![ExtraTerm::new("a:b")],
+            vec![ExtraTerm::lagged("a", 0.0)],
+            vec![ExtraTerm::lagged("a", f64::INFINITY)],
+        ] {
+            assert!(
+                TermSet::observable16().with_extras(&bad).is_err(),
+                "{bad:?}"
+            );
+        }
+        let r = ExtraRequest::parse_list(" cur_strb ,cur_flap:lag,").unwrap();
+        assert_eq!(
+            r.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            ["cur_strb", "cur_flap:lag"]
+        );
+        assert!(ExtraRequest::parse_list("").unwrap().is_empty());
+        for bad in ["a,a:lag", "a:", "a b", ":lag"] {
+            assert!(ExtraRequest::parse_list(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -123,7 +123,7 @@ pub struct EddyLoop {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CurrentLoop {
-    /// Name; the recorded channel is `current_<name>` (A). Lower-case letters,
+    /// Name; the recorded channel is `cur_<name>` (A). Lower-case letters,
     /// digits and `_`.
     pub name: String,
     /// Centre, body frame, m.
@@ -468,7 +468,7 @@ impl AircraftConfig {
                 return Err(invalid(
                     format!("{f}.name"),
                     format!(
-                        "`{}` must be non-empty lower-case letters, digits or `_` (it names the column current_<name>)",
+                        "`{}` must be non-empty lower-case letters, digits or `_` (it names the column cur_<name>)",
                         c.name
                     ),
                 ));

@@ -19,6 +19,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use super::ScenarioKind;
+use super::installation::{Installation, sgl_currents, sgl_fluxgates, sgl_scalars};
 use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};
 use crate::environment::diurnal::DiurnalConfig;
 use crate::error::{Result, SimError, invalid, require_finite, require_positive};
@@ -103,6 +104,12 @@ pub struct FixedWingConfig<P> {
     /// Seed of every random process (ChaCha8 streams). Default 1. Must be
     /// < 2⁶³ (TOML integers are signed 64-bit).
     pub seed: u64,
+    /// The magnetometers and current loops: `stinger` (default) or `sgl`
+    /// (an SGL-like multi-sensor installation with 14 current loops,
+    /// applied to the defaults before the file's own tables; see
+    /// [`super::installation`]).
+    #[serde(skip_serializing_if = "Installation::is_stinger")]
+    pub installation: Installation,
     /// Date, time, origin and sampling.
     pub flight: FlightConfig,
     /// The flight pattern.
@@ -143,6 +150,7 @@ impl<P: Default> Default for FixedWingConfig<P> {
     fn default() -> Self {
         Self {
             seed: 1,
+            installation: Installation::Stinger,
             flight: FlightConfig::default(),
             pattern: P::default(),
             kinematics: KinematicsConfig::default(),
@@ -221,6 +229,10 @@ impl<P: Pattern> FixedWingConfig<P> {
                 let mut user: toml::Table =
                     toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
                 apply_area_preset(&mut user);
+                let mut defaults = defaults;
+                if user.get("installation").and_then(|v| v.as_str()) == Some("sgl") {
+                    defaults.apply_installation(Installation::Sgl);
+                }
                 // Pass 2: merge over the scenario defaults.
                 let mut base =
                     toml::Table::try_from(&defaults).map_err(|e| SimError::Serialize {
@@ -240,6 +252,17 @@ impl<P: Pattern> FixedWingConfig<P> {
         }
         cfg.validate()?;
         Ok(cfg)
+    }
+
+    /// Apply an installation's preset (the SGL-like sensors and currents;
+    /// nothing for the stinger pair).
+    pub fn apply_installation(&mut self, installation: Installation) {
+        self.installation = installation;
+        if installation == Installation::Sgl {
+            self.extra_scalars = sgl_scalars();
+            self.extra_fluxgates = sgl_fluxgates();
+            self.aircraft.currents = sgl_currents();
+        }
     }
 
     /// The configuration as TOML, every default filled in, with a header.

@@ -80,6 +80,7 @@ use serde_json::json;
 
 use super::ScenarioKind;
 use super::config::{FixedWingConfig, Pattern, extra_fluxgate_letter};
+use super::installation::{Installation, sgl_name};
 use crate::environment::anomaly::{AnomalyField, Extent};
 use crate::environment::main_field::{MainField, decimal_year};
 use crate::error::{Result, SimError, invalid};
@@ -262,22 +263,27 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         total_f.push(b_f[k] + nt(c_f.total()));
     }
     // The extra sensors: the same parts and currents at their positions.
-    let extra_total =
-        |pos: [f64; 3], ext: &[Vector3<f64>]| -> Result<(InterferenceAt, Vec<Vector3<f64>>)> {
-            let at = InterferenceAt::new(ac, pos)?;
-            let (mut i_e, mut i_c) = (vec![0.0; eddy.len()], vec![0.0; cur.len()]);
-            let mut total = Vec::with_capacity(n);
-            for (k, b) in ext.iter().enumerate() {
-                for (slot, series) in i_e.iter_mut().zip(&eddy) {
-                    *slot = series[k];
-                }
-                for (slot, series) in i_c.iter_mut().zip(&cur) {
-                    *slot = series.field_a()[k];
-                }
-                total.push(b + nt(at.contributions(&(b / NT_PER_T), &i_e, &i_c).total()));
+    // (The third item: the currents' part of the interference, projected
+    // on the external field's direction.)
+    type Extra = (InterferenceAt, Vec<Vector3<f64>>, Vec<f64>);
+    let extra_total = |pos: [f64; 3], ext: &[Vector3<f64>]| -> Result<Extra> {
+        let at = InterferenceAt::new(ac, pos)?;
+        let (mut i_e, mut i_c) = (vec![0.0; eddy.len()], vec![0.0; cur.len()]);
+        let mut total = Vec::with_capacity(n);
+        let mut current = Vec::with_capacity(n);
+        for (k, b) in ext.iter().enumerate() {
+            for (slot, series) in i_e.iter_mut().zip(&eddy) {
+                *slot = series[k];
             }
-            Ok((at, total))
-        };
+            for (slot, series) in i_c.iter_mut().zip(&cur) {
+                *slot = series.field_a()[k];
+            }
+            let c = at.contributions(&(b / NT_PER_T), &i_e, &i_c);
+            current.push(b.dot(&nt(c.current)) / b.norm());
+            total.push(b + nt(c.total()));
+        }
+        Ok((at, total, current))
+    };
     let xs_total = cfg
         .extra_scalars
         .iter()
@@ -303,7 +309,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         .iter()
         .zip(&xs_total)
         .enumerate()
-        .map(|(i, (s, (_, tot)))| {
+        .map(|(i, (s, (_, tot, _)))| {
             s.measure(
                 tot,
                 dt,
@@ -316,7 +322,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
         .iter()
         .zip(&xf_total)
         .enumerate()
-        .map(|(j, (f, (_, tot)))| {
+        .map(|(j, (f, (_, tot, _)))| {
             f.measure(
                 tot,
                 dt,
@@ -392,7 +398,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     push("diurnal", base);
     push("igrf", igrf);
     for (c, s) in ac.currents.iter().zip(&cur) {
-        push(&format!("current_{}", c.name), s.recorded_a.clone());
+        push(&format!("cur_{}", c.name), s.recorded_a.clone());
     }
     push("true_lat", t_lat);
     push("true_lon", t_lon);
@@ -426,7 +432,8 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
     for (i, a) in ["x", "y", "z"].iter().enumerate() {
         push(&format!("true_flux_{a}"), comp(&total_f, i));
     }
-    for (i, ((_, tot), ext)) in xs_total.iter().zip(&xs_b).enumerate() {
+    let sgl = cfg.installation == Installation::Sgl;
+    for (i, ((_, tot, current), ext)) in xs_total.iter().zip(&xs_b).enumerate() {
         push(
             &format!("true_interf_{}", i + 2),
             tot.iter()
@@ -438,19 +445,31 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             &format!("true_external_{}", i + 2),
             ext.iter().map(|b| b.norm()).collect(),
         );
+        if sgl {
+            push(&format!("true_interf_current_{}", i + 2), current.clone());
+        }
     }
-    for (j, (_, tot)) in xf_total.iter().enumerate() {
+    for (j, (_, tot, _)) in xf_total.iter().enumerate() {
         let l = extra_fluxgate_letter(j);
         for (i, a) in ["x", "y", "z"].iter().enumerate() {
             push(&format!("true_flux_{l}_{a}"), comp(tot, i));
         }
     }
     for (c, s) in ac.currents.iter().zip(&cur) {
-        push(&format!("true_current_{}", c.name), s.true_a.clone());
+        push(&format!("true_cur_{}", c.name), s.true_a.clone());
     }
+    // The installation's names (the SGL layout's under `sgl`).
+    let name_of = |name: &str| {
+        if sgl {
+            sgl_name(name)
+        } else {
+            name.to_string()
+        }
+    };
     let columns = cols
         .into_iter()
         .map(|(name, values)| {
+            let name = name_of(&name);
             let (unit, description) = describe(&name).unwrap_or(("-", String::new()));
             Column {
                 name,
@@ -525,8 +544,9 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             "at_scalar_sensor": sensor_json(&at_s),
             "at_fluxgate": sensor_json(&at_f),
             "eddy_time_constants_s": ac.eddy.iter().map(|l| l.tau_s).collect::<Vec<_>>(),
-            "true_interf_stats_nt": stats(col_of("true_interf")),
+            "true_interf_stats_nt": stats(col_of(&name_of("true_interf"))),
             "true_interf_eddy_stats_nt": stats(col_of("true_interf_eddy")),
+            "true_interf_current_stats_nt": stats(col_of(&name_of("true_interf_current"))),
             "interference_magnitude_at_fluxgate_stats_nt": stats(&interf_at_flux),
         },
         "sensors": {
@@ -552,14 +572,15 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             .iter()
             .zip(&xs_total)
             .enumerate()
-            .map(|(i, (s, (at, _)))| {
+            .map(|(i, (s, (at, _, current)))| {
                 json!({
-                    "column": format!("mag_{}", i + 2),
+                    "column": name_of(&format!("mag_{}", i + 2)),
                     "position_m": s.position_m,
                     "config": s,
                     "noise_rms_nt": white_rms(s.noise_density_nt_per_rthz, rate),
                     "interference": sensor_json(at),
                     "true_interf_stats_nt": stats(col_of(&format!("true_interf_{}", i + 2))),
+                    "true_interf_current_stats_nt": stats(current),
                 })
             })
             .collect();
@@ -571,7 +592,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             .zip(&xf_total)
             .zip(&xf_b)
             .enumerate()
-            .map(|(j, ((f, (at, tot)), ext))| {
+            .map(|(j, ((f, (at, tot, _)), ext))| {
                 let mag: Vec<f64> = tot.iter().zip(ext).map(|(t, b)| (t - b).norm()).collect();
                 json!({
                     "columns": format!("flux_{}_x/y/z", extra_fluxgate_letter(j)),
@@ -584,6 +605,9 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
                 })
             })
             .collect();
+    }
+    if sgl {
+        truth["installation"] = json!("sgl");
     }
     let truth_json = serde_json::to_string_pretty(&truth).map_err(|e| SimError::Serialize {
         what: "truth metadata",

@@ -191,6 +191,12 @@ fn set(cols: &mut [Column], name: &str, f: impl Fn(usize, f64) -> f64) {
 /// Run the helicopter scenario (module docs).
 pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
     cfg.rotor.validate("rotor")?;
+    if !cfg.base.installation.is_stinger() {
+        return Err(crate::error::invalid(
+            "installation",
+            "the helicopter scenario has the stinger installation only",
+        ));
+    }
     if !cfg.base.extra_scalars.is_empty() || !cfg.base.extra_fluxgates.is_empty() {
         return Err(crate::error::invalid(
             "extra_scalars",

@@ -21,6 +21,7 @@ pub mod calibration;
 pub mod config;
 pub mod fixed_wing;
 pub mod helicopter;
+pub mod installation;
 pub mod pod;
 pub mod survey;
 
