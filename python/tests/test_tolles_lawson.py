@@ -25,6 +25,13 @@ from aeromag import _aeromag
             dict(lever_arm=(1.5, 0.0, -0.2), date="2020-06-01", eddy_lag="none"),
         ),
         (["--method", "kalman", "--no-tune", "--field-order", "3"], dict(method="kalman", no_tune=True, field_order=3)),
+        # Any recorded channel as an extra regressor (a current on an SGL
+        # flight; here the base station's), through a fitted lag, and the
+        # exact-magnitude model.
+        (
+            ["--extra", "diurnal:lag", "--magnitude", "exact", "--eddy-lag", "none", "--reference", "none"],
+            dict(extra=["diurnal:lag"], magnitude="exact", eddy_lag="none", reference="none"),
+        ),
     ],
 )
 def test_python_and_cli_write_byte_identical_model_files(cli, cal_csv, tmp_path, flags, params):

@@ -59,14 +59,12 @@ UNITS = {"tt": "s", "ins_lat": "rad", "ins_lon": "rad", "utm_z": "m", "ins_vn": 
 
 def sgl_name(n):
     """The SGL name and factor of a simulator column: the table above, the
-    further scalar magnetometers mag_k -> mag_k_uc, currents current_X ->
-    cur_X, everything else (extra fluxgates flux_b_x..., line, truth) as is."""
+    further scalar magnetometers mag_k -> mag_k_uc, everything else (extra
+    fluxgates flux_b_x..., currents cur_X, line, truth) as is."""
     if n in SGL:
         return SGL[n]
     if n.startswith("mag_") and n[4:].isdigit():
         return f"{n}_uc", 1.0
-    if n.startswith("current_"):
-        return "cur_" + n[len("current_"):], 1.0
     return n, 1.0
 
 

@@ -589,3 +589,113 @@ fn several_sensors_and_the_reference_sensor_mode() {
         "{e}"
     );
 }
+
+/// The SGL-like installation (issue 20): a stinger and four cabin sensors,
+/// 14 recorded currents. Calibrated on the box with current terms (three
+/// of them through fitted lags), every cabin sensor's survey residual is
+/// more than 10× below the 16-term model's; in reference-sensor mode (the
+/// cabin sensors fitted over the whole survey against the box-compensated
+/// stinger) the worst cabin sensor comes within 1.2× of its oracle (the
+/// same terms fitted to the survey's own true interference). The figures
+/// are printed (`--no-capture`).
+#[test]
+fn sgl_installation_cabin_sensors() {
+    use aeromag::compensation::tolles_lawson::ExtraRequest;
+    const CURRENTS: &str = "cur_com_1,cur_ac_hi:lag,cur_ac_lo,cur_tank,cur_flap:lag,cur_strb,\
+        cur_srvo_o,cur_srvo_m,cur_srvo_i,cur_heat:lag,cur_acpwr,cur_outpwr,cur_bat_1,cur_bat_2";
+    let sgl = "installation = \"sgl\"\n";
+    let cal = simulate_flight(ScenarioKind::Calibration, Some(sgl), Some(1)).unwrap();
+    let survey = simulate_flight(
+        ScenarioKind::Survey,
+        Some(&format!("{sgl}[pattern]\nline_count = 6\n")),
+        Some(1),
+    )
+    .unwrap();
+    let sensors: Vec<SensorColumns> = (1..=5)
+        .map(|k| SensorColumns::find(&cal, &format!("mag_{k}_uc"), Some("flux_a")).unwrap())
+        .collect();
+    let set = SensorSet {
+        sensors: sensors.clone(),
+        reference: None,
+    };
+    let run = |extra: &str| {
+        let opts = CalibrateOptions {
+            extra: ExtraRequest::parse_list(extra).unwrap(),
+            ..CalibrateOptions::default()
+        };
+        let m = calibrate_sensors(&cal, &set, &opts, &mut Silent)
+            .unwrap()
+            .model;
+        let c = m.compensate(&survey).unwrap();
+        let e: Vec<f64> = (0..5)
+            .map(|k| survey_error(&survey, &c.sensors[k].2, &format!("_{}", k + 1)))
+            .collect();
+        (m, c, e)
+    };
+    let (_, _, plain) = run("");
+    let (_, comp, current) = run(CURRENTS);
+    for k in 0..5 {
+        println!(
+            "mag_{}_uc: 16 terms {:.3} nT, with current terms {:.3} nT",
+            k + 1,
+            plain[k],
+            current[k]
+        );
+    }
+    for k in 1..5 {
+        assert!(
+            current[k] * 10.0 < plain[k],
+            "mag_{}: {current:?} vs {plain:?}",
+            k + 1
+        );
+    }
+    // Reference-sensor mode over the survey, against the compensated stinger.
+    let mut t = survey.table().clone();
+    comp.add_to(&mut t).unwrap();
+    let survey_comp = Flight::from_table(t).unwrap();
+    let reference = SensorSet {
+        sensors: sensors[1..].to_vec(),
+        reference: Some("mag_1_comp".into()),
+    };
+    let opts = CalibrateOptions {
+        extra: ExtraRequest::parse_list(CURRENTS).unwrap(),
+        ..CalibrateOptions::default()
+    };
+    let r = calibrate_sensors(&survey_comp, &reference, &opts, &mut Silent).unwrap();
+    let rc = r.model.compensate(&survey).unwrap();
+    let mut worst = (0.0, 0.0, 0);
+    for (k, s) in r.model.sensors.iter().enumerate() {
+        let err = survey_error(&survey, &rc.sensors[k].2, &format!("_{}", k + 2));
+        // The oracle: the same terms (lags fixed) fitted to the truth.
+        let oracle_opts = CalibrateOptions {
+            sensor: SensorColumns::find(&survey, &format!("true_interf_{}", k + 2), Some("flux_a"))
+                .unwrap(),
+            ls: aeromag::compensation::tolles_lawson::fit_ls::LsConfig {
+                design: s.model.design.clone(),
+                band_hz: None,
+                trim: 0,
+                ..Default::default()
+            },
+            eddy_lag: EddyLag::Fixed(s.model.design.terms.eddy_lags_s().to_vec()),
+            reference: ReferenceChannels::None,
+            ..CalibrateOptions::default()
+        };
+        let oracle = calibrate(&survey, &oracle_opts, &mut Silent)
+            .unwrap()
+            .model
+            .fit
+            .residual_rms_nt;
+        println!(
+            "mag_{}_uc: reference mode {err:.3} nT, oracle {oracle:.3} nT",
+            k + 2
+        );
+        if err > worst.0 {
+            worst = (err, oracle, k + 2);
+        }
+    }
+    assert!(
+        worst.0 <= 1.2 * worst.1,
+        "worst cabin sensor mag_{}: {worst:?}",
+        worst.2
+    );
+}

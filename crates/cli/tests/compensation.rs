@@ -390,3 +390,110 @@ fn failures_that_are_not_bad_input_exit_1() {
     args.extend(common);
     assert_code(&aeromag(&args), 0);
 }
+
+/// Several sensors, current terms and the reference-sensor mode on the
+/// command line (issue 20): one multi-sensor model file, every sensor's
+/// columns from `compensate`, and bad input exiting 2 with the name.
+#[test]
+fn several_sensors_with_current_terms() {
+    let d = tempfile::tempdir().unwrap();
+    let toml = d.path().join("sgl.toml");
+    std::fs::write(&toml, "installation = \"sgl\"\n").unwrap();
+    let cal = simulate_with(d.path(), "calibration-truncated", "3", Some(&toml));
+    let (cal, m) = (cal.to_str().unwrap(), d.path().join("m.json"));
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        cal,
+        "--mag",
+        "mag_1_uc,mag_4_uc",
+        "--vector",
+        "flux_a,flux_d",
+        "--extra",
+        "cur_strb,cur_flap:lag",
+        "--model",
+        m.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let out = stdout(&o);
+    assert!(
+        out.contains("mag_4      mag_4_uc") && out.contains("flux_d_x,flux_d_y,flux_d_z"),
+        "{out}"
+    );
+    assert!(out.contains("2 sensor models written"), "{out}");
+    let model = std::fs::read_to_string(&m).unwrap();
+    assert!(
+        model.contains("\"kind\": \"tolles-lawson-sensors\"")
+            && model.contains("cur_flap:lag:e_x") == model.contains("\"lag_s\""),
+        "{model}"
+    );
+    let comp = d.path().join("c.csv");
+    let o = aeromag(&[
+        "compensate",
+        "--input",
+        cal,
+        "--model",
+        m.to_str().unwrap(),
+        "--out",
+        comp.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let header = std::fs::read_to_string(&comp).unwrap();
+    let header = header
+        .lines()
+        .find(|l| !l.starts_with('#'))
+        .unwrap()
+        .to_string();
+    for c in [
+        "mag_1_interf",
+        "mag_1_comp",
+        "mag_4_interf",
+        "mag_4_comp",
+        "mag_4_grad",
+    ] {
+        assert!(header.split(',').any(|h| h == c), "{c} in {header}");
+    }
+    // Reference-sensor mode against the compensated stinger column.
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        comp.to_str().unwrap(),
+        "--mag",
+        "mag_4_uc",
+        "--vector",
+        "flux_a",
+        "--reference-sensor",
+        "mag_1_comp",
+        "--model",
+        d.path().join("r.json").to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("mag_1_comp"), "{}", stdout(&o));
+    // Bad input: a channel the file lacks, a bad suffix, a sensor it lacks,
+    // a vector list of the wrong length.
+    for (args, needle) in [
+        (vec!["--mag", "mag_4_uc", "--extra", "cur_nope"], "cur_nope"),
+        (vec!["--extra", "cur_strb:lagg"], "lagg"),
+        (vec!["--mag", "mag_1_uc,mag_9_uc"], "mag_9_uc"),
+        (
+            vec![
+                "--mag",
+                "mag_1_uc,mag_4_uc,mag_5_uc",
+                "--vector",
+                "flux_a,flux_b",
+            ],
+            "--vector",
+        ),
+        (
+            vec!["--method", "kalman", "--magnitude", "exact"],
+            "magnitude",
+        ),
+    ] {
+        let x = d.path().join("x.json");
+        let mut a = vec!["calibrate", "--input", cal, "--model", x.to_str().unwrap()];
+        a.extend(args);
+        let o = aeromag(&a);
+        assert_code(&o, 2);
+        assert!(stderr(&o).contains(needle), "{needle}: {}", stderr(&o));
+    }
+}

@@ -223,7 +223,13 @@ impl FlightTable {
                 file: self.file_label(),
                 column: name.to_string(),
                 present: self.column_names().join(", "),
-                hint: format!(" (map a column onto it with --columns {name}=NAME)"),
+                // Only canonical and truth names can be mapped.
+                hint: if crate::columns::is_canonical(name) || crate::columns::is_truth_column(name)
+                {
+                    format!(" (map a column onto it with --columns {name}=NAME)")
+                } else {
+                    String::new()
+                },
             }),
         }
     }

@@ -172,9 +172,13 @@ impl CalibrateOptions {
         }
     }
 
-    /// The LS settings with the extra regressors in the terms, without
-    /// lags (the lags are chosen on the flight).
+    /// The LS settings with the extra regressors of [`Self::extra`] in the
+    /// terms, without lags (the lags are chosen on the flight); without
+    /// requests, the terms' own extra regressors (with their lags) stay.
     pub(super) fn ls_with_extras(&self) -> Result<LsConfig> {
+        if self.extra.is_empty() {
+            return Ok(self.ls.clone());
+        }
         let extras: Vec<ExtraTerm> = self
             .extra
             .iter()

@@ -8,9 +8,9 @@ use crate::observer::Notes;
 use aeromag_compensation::kalman::{KalmanConfig, KalmanFit, KalmanSegment, fit_kalman};
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::{
-    DEFAULT_ALPHA, DEFAULT_EXTRA_LAG_GRID_S, DEFAULT_LAG_GRID_S, DEFAULT_SELECTION_BLOCK,
-    DEFAULT_SELECTION_ROWS, ExtraLagSelection, LagSelection, lag_threshold, select_eddy_lags,
-    select_extra_lag, within_budget,
+    DEFAULT_ALPHA, DEFAULT_EXTRA_LAG_GRID_S, DEFAULT_EXTRA_SELECTION_ROWS, DEFAULT_LAG_GRID_S,
+    DEFAULT_SELECTION_BLOCK, DEFAULT_SELECTION_ROWS, ExtraLagSelection, LagSelection,
+    lag_threshold, select_eddy_lags, select_extra_lag, within_budget,
 };
 use aeromag_compensation::tolles_lawson::{Design, ExtraRequest, Magnitude, TermSet};
 
@@ -55,15 +55,21 @@ pub(super) fn choose_terms(
             .with_eddy_lags(taus)
             .map_err(|e| Error::bad_input(format!("eddy lags: {e}")))
     };
-    let sample = || within_budget(segments, DEFAULT_SELECTION_ROWS, DEFAULT_SELECTION_BLOCK);
+    let sample = |rows| within_budget(segments, rows, DEFAULT_SELECTION_BLOCK);
     let (mut terms, eddy) = match lag {
         EddyLag::None => (with(&[])?, None),
         EddyLag::Fixed(taus) => (with(taus)?, None),
         EddyLag::Auto if !cfg.design.terms.has_eddy() => (cfg.design.terms.clone(), None),
         EddyLag::Auto => {
             notes.stage("choosing eddy-current lags");
-            let sel = select_eddy_lags(&sample(), cfg, &DEFAULT_LAG_GRID_S, 2, DEFAULT_ALPHA)
-                .in_file(file)?;
+            let sel = select_eddy_lags(
+                &sample(DEFAULT_SELECTION_ROWS),
+                cfg,
+                &DEFAULT_LAG_GRID_S,
+                2,
+                DEFAULT_ALPHA,
+            )
+            .in_file(file)?;
             if sel.taus_s.is_empty() {
                 notes.note("eddy-current lags: no lag is significant; classical eddy terms kept");
             } else {
@@ -76,14 +82,21 @@ pub(super) fn choose_terms(
         }
     };
     let mut extras = Vec::new();
+    let extra_sample = sample(DEFAULT_EXTRA_SELECTION_ROWS);
     for (k, r) in requests.iter().enumerate().filter(|(_, r)| r.lag) {
         notes.stage(&format!("choosing the lag of {}", r.channel));
         let c = LsConfig {
             design: cfg.design.with_terms(terms.clone()),
             ..cfg.clone()
         };
-        let sel = select_extra_lag(&sample(), &c, k, &DEFAULT_EXTRA_LAG_GRID_S, DEFAULT_ALPHA)
-            .in_file(file)?;
+        let sel = select_extra_lag(
+            &extra_sample,
+            &c,
+            k,
+            &DEFAULT_EXTRA_LAG_GRID_S,
+            DEFAULT_ALPHA,
+        )
+        .in_file(file)?;
         match sel.taus_s.first() {
             None => notes.note(format!(
                 "{}: no lag is significant; its instantaneous terms kept",
