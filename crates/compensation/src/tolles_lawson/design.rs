@@ -243,11 +243,7 @@ impl Design {
             Magnitude::Exact => {
                 let (d, bias) = self.field_vector(coef, time, flux, channels);
                 (0..time.len())
-                    .map(|k| {
-                        let b = [flux[0][k], flux[1][k], flux[2][k]];
-                        let t = [b[0] + d[0][k], b[1] + d[1][k], b[2] + d[2][k]];
-                        norm(t) - norm(b) + bias
-                    })
+                    .map(|k| TotalField::at(flux, &d, k).change() + bias)
                     .collect()
             }
         }
@@ -301,11 +297,8 @@ impl Design {
         let (d, _) = self.field_vector(coef, time, flux, channels);
         (0..time.len())
             .map(|k| {
-                let b = [flux[0][k], flux[1][k], flux[2][k]];
-                let bn = norm(b);
-                let dv = [d[0][k], d[1][k], d[2][k]];
-                let t = [b[0] + dv[0], b[1] + dv[1], b[2] + dv[2]];
-                norm(t) - bn - (b[0] * dv[0] + b[1] * dv[1] + b[2] * dv[2]) / bn
+                let f = TotalField::at(flux, &d, k);
+                f.change() - dot(f.b, f.d) / norm(f.b)
             })
             .collect()
     }
@@ -429,7 +422,44 @@ impl Design {
 }
 
 fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    dot(v, v).sqrt()
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The field `b` of the vector magnetometer, the modelled interference
+/// `d = ΔB` and the total `t = b + d` at one sample (nT).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TotalField {
+    pub(crate) b: [f64; 3],
+    pub(crate) d: [f64; 3],
+    pub(crate) t: [f64; 3],
+}
+
+impl TotalField {
+    /// Sample `k` of the series `flux` and `d`.
+    pub(crate) fn at(flux: [&[f64]; 3], d: &[Vec<f64>; 3], k: usize) -> Self {
+        let b = [flux[0][k], flux[1][k], flux[2][k]];
+        let d = [d[0][k], d[1][k], d[2][k]];
+        Self {
+            b,
+            d,
+            t: [b[0] + d[0], b[1] + d[1], b[2] + d[2]],
+        }
+    }
+
+    /// `|b + d| − |b|`: the exact change of the magnitude.
+    pub(crate) fn change(&self) -> f64 {
+        norm(self.t) - norm(self.b)
+    }
+
+    /// `|b + d| − |b| − êᵀd` with `ê = t/|t|`: what the projection on the
+    /// total field's direction leaves out (the Gauss–Newton remainder).
+    pub(crate) fn remainder(&self) -> f64 {
+        self.change() - dot(self.t, self.d) / norm(self.t)
+    }
 }
 
 /// Reusable buffers of [`Design::columns_into`]: the design columns of the

@@ -30,7 +30,7 @@
 //! flight does not separate them from the other terms: typically one heading
 //! or missing manoeuvres), and near-null combinations are spelled out.
 
-use super::design::{Channels, Design, DesignBlock, Magnitude};
+use super::design::{Channels, Design, DesignBlock, Magnitude, TotalField};
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use crate::error::{CompError, Result};
@@ -371,14 +371,10 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
                 let mut total = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
                 let mut y = Vec::with_capacity(n);
                 for k in 0..n {
-                    let b = [s.flux[0][k], s.flux[1][k], s.flux[2][k]];
-                    let t = [b[0] + d[0][k], b[1] + d[1][k], b[2] + d[2][k]];
-                    let tn = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-                    let bn = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
-                    let proj = (t[0] * d[0][k] + t[1] * d[1][k] + t[2] * d[2][k]) / tn;
-                    y.push(s.mag[k] - (tn - bn - proj));
-                    for a in 0..3 {
-                        total[a][k] = t[a];
+                    let f = TotalField::at(s.flux, &d, k);
+                    y.push(s.mag[k] - f.remainder());
+                    for (axis, v) in total.iter_mut().zip(f.t) {
+                        axis[k] = v;
                     }
                 }
                 (total, y)
