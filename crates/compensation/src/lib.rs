@@ -42,7 +42,7 @@
 //!     .map(|k| 50_000.0 + (3.0 * fx[k] - 2.0 * fz[k]) / 50_000.0)
 //!     .collect();
 //! let cfg = LsConfig { design: Design::new(TermSet::parse("p3")?), ..LsConfig::default() };
-//! let seg = Segment { time: &time, flux: [&fx, &fy, &fz], mag: &mag };
+//! let seg = Segment::new(&time, [&fx, &fy, &fz], &mag);
 //! let fit = fit_band_pass_ls(&[seg], &cfg)?;
 //! assert!((fit.coef[0] - 3.0).abs() < 1e-6 && (fit.coef[2] + 2.0).abs() < 1e-6);
 //! let model = cfg.design.interference(&fit.coef, &time, [&fx, &fy, &fz]);
