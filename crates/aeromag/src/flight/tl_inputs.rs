@@ -88,21 +88,19 @@ impl SensorColumns {
     /// Stem of the sensor's output columns: `mag_3_uc` → `mag_3`,
     /// `UNCOMPMAG3` → `mag_3`, any other name as it is.
     pub fn stem(&self) -> String {
-        let lower = self.mag.to_ascii_lowercase();
+        // The sensor's SGL HDF5 name (the XYZ export's `UNCOMPMAG3` is
+        // `mag_3_uc`), without `_uc`.
         let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-        if let Some(k) = lower
-            .strip_prefix("mag_")
-            .and_then(|r| r.strip_suffix("_uc"))
-            && digits(k)
-        {
-            return format!("mag_{k}");
-        }
-        if let Some(k) = lower.strip_prefix("uncompmag")
-            && digits(k)
-        {
-            return format!("mag_{k}");
-        }
-        self.mag.clone()
+        aeromag_io::sensor_names(&self.mag)
+            .iter()
+            .map(|n| n.to_ascii_lowercase())
+            .find_map(|n| {
+                let stem = n.strip_suffix("_uc")?;
+                stem.strip_prefix("mag_")
+                    .is_some_and(digits)
+                    .then(|| stem.to_string())
+            })
+            .unwrap_or_else(|| self.mag.clone())
     }
 }
 
@@ -185,6 +183,23 @@ impl<'a> TlInputs<'a> {
 mod tests {
     use super::*;
     use aeromag_io::FlightTable;
+
+    #[test]
+    fn sensor_stems_are_the_sgl_names_without_uc() {
+        let stem = |mag: &str| {
+            SensorColumns {
+                mag: mag.into(),
+                ..SensorColumns::default()
+            }
+            .stem()
+        };
+        assert_eq!(stem("mag_3_uc"), "mag_3");
+        assert_eq!(stem("UNCOMPMAG4"), "mag_4");
+        assert_eq!(stem("MAG_2_UC"), "mag_2");
+        assert_eq!(stem("mag_x_uc"), "mag_x_uc");
+        assert_eq!(stem("mag_2"), "mag_2");
+        assert_eq!(stem("mag"), "mag");
+    }
 
     #[test]
     fn a_row_is_usable_with_every_input_finite_and_a_live_fluxgate() {

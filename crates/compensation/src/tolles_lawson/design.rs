@@ -296,10 +296,7 @@ impl Design {
     ) -> Vec<f64> {
         let (d, _) = self.field_vector(coef, time, flux, channels);
         (0..time.len())
-            .map(|k| {
-                let f = TotalField::at(flux, &d, k);
-                f.change() - dot(f.b, f.d) / norm(f.b)
-            })
+            .map(|k| TotalField::at(flux, &d, k).beyond_projection())
             .collect()
     }
 
@@ -453,6 +450,12 @@ impl TotalField {
     /// `|b + d| − |b|`: the exact change of the magnitude.
     pub(crate) fn change(&self) -> f64 {
         norm(self.t) - norm(self.b)
+    }
+
+    /// `|b + d| − |b| − eᵀd` with `e = b/|b|`: what the Tolles-Lawson
+    /// projection leaves out.
+    pub(crate) fn beyond_projection(&self) -> f64 {
+        self.change() - dot(self.b, self.d) / norm(self.b)
     }
 
     /// `|b + d| − |b| − êᵀd` with `ê = t/|t|`: what the projection on the
