@@ -206,6 +206,28 @@ pub enum CurrentPattern {
     },
 }
 
+impl CurrentLoop {
+    /// The loop with its switching events `factor` times as frequent: the
+    /// telegraph's switches, the motor's runs and the fan's level changes
+    /// (periodic patterns — strobe, pump cycle — and servo activity are
+    /// left as they are). Used for a calibration flight in which the crew
+    /// cycles the equipment.
+    pub fn cycled(mut self, factor: f64) -> Self {
+        self.switches_per_hour *= factor;
+        match &mut self.pattern {
+            CurrentPattern::Runs { runs_per_hour, .. } => *runs_per_hour *= factor,
+            CurrentPattern::Levels {
+                changes_per_hour, ..
+            } => *changes_per_hour *= factor,
+            CurrentPattern::Telegraph
+            | CurrentPattern::Strobe { .. }
+            | CurrentPattern::Cycle { .. }
+            | CurrentPattern::Servo { .. } => {}
+        }
+        self
+    }
+}
+
 impl CurrentPattern {
     /// Error naming the first invalid field (`path` names the pattern).
     fn validate(&self, path: &str) -> Result<()> {

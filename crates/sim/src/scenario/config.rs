@@ -19,7 +19,9 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use super::ScenarioKind;
-use super::installation::{Installation, sgl_currents, sgl_fluxgates, sgl_scalars};
+use super::installation::{
+    CALIBRATION_LOAD_CYCLING, Installation, sgl_currents, sgl_fluxgates, sgl_scalars,
+};
 use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};
 use crate::environment::diurnal::DiurnalConfig;
 use crate::error::{Result, SimError, invalid, require_finite, require_positive};
@@ -231,7 +233,7 @@ impl<P: Pattern> FixedWingConfig<P> {
                 apply_area_preset(&mut user);
                 let mut defaults = defaults;
                 if user.get("installation").and_then(|v| v.as_str()) == Some("sgl") {
-                    defaults.apply_installation(Installation::Sgl);
+                    defaults.apply_installation(Installation::Sgl, kind);
                 }
                 // Pass 2: merge over the scenario defaults.
                 let mut base =
@@ -255,13 +257,23 @@ impl<P: Pattern> FixedWingConfig<P> {
     }
 
     /// Apply an installation's preset (the SGL-like sensors and currents;
-    /// nothing for the stinger pair).
-    pub fn apply_installation(&mut self, installation: Installation) {
+    /// nothing for the stinger pair). On a calibration flight the crew
+    /// cycles the switched equipment ([`CALIBRATION_LOAD_CYCLING`]).
+    pub fn apply_installation(&mut self, installation: Installation, kind: ScenarioKind) {
         self.installation = installation;
         if installation == Installation::Sgl {
             self.extra_scalars = sgl_scalars();
             self.extra_fluxgates = sgl_fluxgates();
-            self.aircraft.currents = sgl_currents();
+            let cycling = match kind {
+                ScenarioKind::Calibration | ScenarioKind::CalibrationTruncated => {
+                    CALIBRATION_LOAD_CYCLING
+                }
+                _ => 1.0,
+            };
+            self.aircraft.currents = sgl_currents()
+                .into_iter()
+                .map(|c| c.cycled(cycling))
+                .collect();
         }
     }
 

@@ -29,6 +29,12 @@
 //!   (`com_1`), and bus and battery currents (`acpwr`, `outpwr`, `bat_1`,
 //!   `bat_2`: slow load changes, wired far from the sensors, so that they
 //!   barely matter: a real flight records channels that do not).
+//! * On a calibration flight the crew cycles the switched equipment
+//!   ([`CALIBRATION_LOAD_CYCLING`] times the survey's switching rate), as
+//!   compensation procedures for electrical loads ask: a load's three
+//!   direction terms are determined only when it switches at several
+//!   headings, and a 10-minute box at the survey's rates switches the
+//!   heater or the flap on one or two of its four legs.
 //!
 //! Columns follow the SGL HDF5 layout: the stinger sensor is `mag_1_uc`
 //! (not `mag`), the cabin sensors `mag_2_uc` … `mag_5_uc`, the fluxgates
@@ -42,6 +48,11 @@ use serde::{Deserialize, Serialize};
 use crate::platform::aircraft::{CurrentLoop, CurrentPattern};
 use crate::sensor::fluxgate::FluxgateConfig;
 use crate::sensor::scalar::ScalarSensorConfig;
+
+/// How much more often the SGL-like installation's switched equipment
+/// (telegraph loads, flap runs, fan levels) switches on a calibration
+/// flight than on a survey ([`CurrentLoop::cycled`]).
+pub const CALIBRATION_LOAD_CYCLING: f64 = 3.0;
 
 /// Which magnetometers the aircraft carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
