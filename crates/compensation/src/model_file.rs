@@ -143,6 +143,10 @@ pub struct FitStats {
     /// chosen (absent without them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub extra_lag_selection: Vec<crate::tolles_lawson::lag_select::ExtraLagSelection>,
+    /// Which of the extra regressors asked for the flight showed to matter
+    /// (absent when every one was kept without a test).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extra_channel_selection: Option<crate::tolles_lawson::extra_select::ChannelSelection>,
 }
 
 /// JSON has no ∞: `serde_json` writes it as `null`; read `null` back as ∞.

@@ -590,6 +590,7 @@ impl KalmanFit {
                 warnings: self.warnings.clone(),
                 eddy_lag_selection: None,
                 extra_lag_selection: Vec::new(),
+                extra_channel_selection: None,
             },
             reference: Vec::new(),
             lever_arm: None,

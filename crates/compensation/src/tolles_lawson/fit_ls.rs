@@ -407,8 +407,22 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
     Ok(fit)
 }
 
-/// The first-order (linear) band-pass least-squares fit.
-fn fit_first_order(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
+/// The band-passed normal equations of the first-order model over the
+/// segments, before they are solved.
+pub(crate) struct Accumulated {
+    /// The normal equations of every column of the design.
+    pub ne: NormalEquations,
+    /// Segments used.
+    pub used: usize,
+    /// [`LsFit::effective_dof`].
+    pub effective_dof: f64,
+    /// Segments skipped, and why.
+    pub warnings: Vec<String>,
+}
+
+/// Band-pass every column of `cfg`'s first-order design and `mag` on each
+/// segment and accumulate the normal equations.
+pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumulated> {
     validate(cfg)?;
     let mut ne = NormalEquations::new(cfg.design.n_columns());
     let mut warnings = Vec::new();
@@ -442,6 +456,22 @@ fn fit_first_order(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
         None => 1.0,
     };
     let effective_dof = ne.rows() as f64 * independent_fraction;
+    Ok(Accumulated {
+        ne,
+        used,
+        effective_dof,
+        warnings,
+    })
+}
+
+/// The first-order (linear) band-pass least-squares fit.
+fn fit_first_order(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
+    let Accumulated {
+        ne,
+        used,
+        effective_dof,
+        mut warnings,
+    } = accumulate(segments, cfg)?;
     let sol = ne
         .solve_with_dof(cfg.lambda, effective_dof)
         .map_err(CompError::estimation("least-squares fit failed"))?;

@@ -408,13 +408,29 @@ fn select_lags(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::tolles_lawson::Design;
     use crate::tolles_lawson::TermSet;
     use crate::tolles_lawson::fit_ls::tests::{coef_lag9, coef16, leg_n, segments_of};
 
-    fn boxed(terms: &TermSet, coef: &[f64]) -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
+    /// The segments of `legs`, each with its extra-regressor channels.
+    pub(crate) fn with_channels<'a, const N: usize>(
+        legs: &'a [(Vec<f64>, [Vec<f64>; 3], Vec<f64>)],
+        channels: &'a [[&'a [f64]; N]],
+    ) -> Vec<Segment<'a>> {
+        use super::super::design::Channels;
+        segments_of(legs)
+            .into_iter()
+            .zip(channels)
+            .map(|(s, r)| Segment {
+                channels: Channels::new(r),
+                ..s
+            })
+            .collect()
+    }
+
+    pub(crate) fn boxed(terms: &TermSet, coef: &[f64]) -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
         [0.0, 90.0, 180.0, 270.0]
             .iter()
             .enumerate()
@@ -519,7 +535,6 @@ mod tests {
     /// field does not lag gets no lag.
     #[test]
     fn finds_the_lag_of_a_current_whose_field_lags() {
-        use super::super::design::Channels;
         use super::super::eddy_lag::FirstOrderLag;
         use super::super::terms::ExtraTerm;
         let mut legs = boxed(&TermSet::observable16(), &coef16());
@@ -546,14 +561,7 @@ mod tests {
             chans.push([i1, i2]);
         }
         let refs: Vec<[&[f64]; 2]> = chans.iter().map(|[a, b]| [&a[..], &b[..]]).collect();
-        let segs: Vec<Segment> = segments_of(&legs)
-            .into_iter()
-            .zip(&refs)
-            .map(|(s, r)| Segment {
-                channels: Channels::new(r),
-                ..s
-            })
-            .collect();
+        let segs = with_channels(&legs, &refs);
         let terms = TermSet::observable16()
             .with_extras(&[ExtraTerm::new("cur_flap"), ExtraTerm::new("cur_tank")])
             .unwrap();

@@ -2,6 +2,7 @@
 
 pub mod design;
 pub mod eddy_lag;
+pub mod extra_select;
 pub mod fit_ls;
 pub mod lag_select;
 pub mod segments;

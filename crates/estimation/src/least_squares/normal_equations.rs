@@ -184,6 +184,28 @@ impl NormalEquations {
         Ok(())
     }
 
+    /// The normal equations of the columns `keep` alone (indices into the
+    /// unknowns, in the order given): the problem with the other columns
+    /// left out, without another pass over the rows. Used to test which
+    /// columns a fit needs (the residual of each sub-model is
+    /// `yᵀy − cᵀ A_kᵀy`).
+    pub fn subset(&self, keep: &[usize]) -> Result<NormalEquations> {
+        let n = self.n();
+        if let Some(&bad) = keep.iter().find(|&&j| j >= n) {
+            return Err(EstError::Dimension(format!(
+                "column {bad} of {n} unknowns"
+            )));
+        }
+        let upper = |i: usize, j: usize| self.ata[(i.min(j), i.max(j))];
+        let m = keep.len();
+        Ok(NormalEquations {
+            ata: DMatrix::from_fn(m, m, |a, b| if a <= b { upper(keep[a], keep[b]) } else { 0.0 }),
+            aty: DVector::from_fn(m, |a, _| self.aty[keep[a]]),
+            yty: self.yty,
+            rows: self.rows,
+        })
+    }
+
     /// The symmetric `AᵀA` (full matrix).
     pub fn ata(&self) -> DMatrix<f64> {
         let mut m = self.ata.clone();
@@ -416,6 +438,30 @@ mod tests {
         assert!((s.sigma2.sqrt() - 0.01).abs() < 0.001);
         // Scaling makes the badly scaled columns harmless.
         assert!(s.condition < 2.0, "condition {}", s.condition);
+    }
+
+    #[test]
+    fn a_subset_is_the_fit_of_those_columns_alone() {
+        let (cols, y, _) = problem(400, 3);
+        let refs: Vec<&[f64]> = cols.iter().map(|c| c.as_slice()).collect();
+        let mut all = NormalEquations::new(4);
+        all.add_columns(&refs, &y).unwrap();
+        let keep = [3, 0];
+        let mut direct = NormalEquations::new(2);
+        direct
+            .add_columns(&[refs[3], refs[0]], &y)
+            .unwrap();
+        let (a, b) = (
+            all.subset(&keep).unwrap().solve(0.0).unwrap(),
+            direct.solve(0.0).unwrap(),
+        );
+        for j in 0..2 {
+            assert!((a.coef[j] - b.coef[j]).abs() <= 1e-12 * b.coef[j].abs(), "{j}");
+        }
+        assert!((a.rss - b.rss).abs() <= 1e-9 * b.rss);
+        // Leaving out a column the data need raises the residual.
+        assert!(a.rss > 10.0 * all.solve(0.0).unwrap().rss);
+        assert!(all.subset(&[4]).is_err());
     }
 
     #[test]
