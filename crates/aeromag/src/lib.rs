@@ -96,7 +96,8 @@ pub use flight::{
 pub use model_file::ModelFile;
 pub use observer::{Note, NoteLevel, Observer, Silent};
 pub use tolles_lawson::{
-    CalibrateOptions, CalibrateSettings, Calibration, CompensateSensors, EddyLag, KalmanOptions,
+    CalibrateOptions, CalibrateSettings, Calibration, CompensateSensors, EddyLag, ExtraSelection,
+    KalmanOptions,
     Method, SensorSet, SensorsCalibration, SensorsCompensated, SensorsModel, TlModel, calibrate,
     calibrate_sensors, observability,
 };

@@ -590,112 +590,67 @@ fn several_sensors_and_the_reference_sensor_mode() {
     );
 }
 
-/// The SGL-like installation (issue 20): a stinger and four cabin sensors,
-/// 14 recorded currents. Calibrated on the box with current terms (three
-/// of them through fitted lags), every cabin sensor's survey residual is
-/// more than 10× below the 16-term model's; in reference-sensor mode (the
-/// cabin sensors fitted over the whole survey against the box-compensated
-/// stinger) the worst cabin sensor comes within 1.2× of its oracle (the
-/// same terms fitted to the survey's own true interference). The figures
-/// are printed (`--no-capture`).
+/// The SGL-like installation (issue 20): a stinger, four cabin sensors and
+/// 14 recorded currents, calibrated on the box and scored on independent
+/// survey lines ([`MultiSensorStudy`], the demo's `multi_sensor` group).
+/// The issue's figures: the stinger with current terms no worse than
+/// today's stinger installation; each cabin sensor more than 10× below its
+/// 16-term model and within 1.5× of its oracle; in reference-sensor mode
+/// the worst cabin sensor within 1.2× of its oracle. Measured (seed 1):
+/// stinger 0.1645 nT (16 terms 0.204; today's
+/// installation, which has no currents, 0.1640); cabin 0.742 / 0.105 /
+/// 0.231 / 0.211 nT against oracles 0.718 / 0.099 / 0.213 / 0.150 (worst
+/// ratio 1.41), 16 terms up to 277 nT; reference mode worst 0.735 nT
+/// (1.02×). The figures are printed (`--no-capture`).
 #[test]
-fn sgl_installation_cabin_sensors() {
-    use aeromag::compensation::tolles_lawson::ExtraRequest;
-    const CURRENTS: &str = "cur_com_1,cur_ac_hi:lag,cur_ac_lo,cur_tank,cur_flap:lag,cur_strb,\
-        cur_srvo_o,cur_srvo_m,cur_srvo_i,cur_heat:lag,cur_acpwr,cur_outpwr,cur_bat_1,cur_bat_2";
-    let sgl = "installation = \"sgl\"\n";
-    let cal = simulate_flight(ScenarioKind::Calibration, Some(sgl), Some(1)).unwrap();
-    let survey = simulate_flight(
-        ScenarioKind::Survey,
-        Some(&format!("{sgl}[pattern]\nline_count = 6\n")),
-        Some(1),
-    )
-    .unwrap();
-    let sensors: Vec<SensorColumns> = (1..=5)
-        .map(|k| SensorColumns::find(&cal, &format!("mag_{k}_uc"), Some("flux_a")).unwrap())
-        .collect();
-    let set = SensorSet {
-        sensors: sensors.clone(),
-        reference: None,
-    };
-    let run = |extra: &str| {
-        let opts = CalibrateOptions {
-            extra: ExtraRequest::parse_list(extra).unwrap(),
-            ..CalibrateOptions::default()
-        };
-        let m = calibrate_sensors(&cal, &set, &opts, &mut Silent)
-            .unwrap()
-            .model;
-        let c = m.compensate(&survey).unwrap();
-        let e: Vec<f64> = (0..5)
-            .map(|k| survey_error(&survey, &c.sensors[k].2, &format!("_{}", k + 1)))
-            .collect();
-        (m, c, e)
-    };
-    let (_, _, plain) = run("");
-    let (_, comp, current) = run(CURRENTS);
-    for k in 0..5 {
-        println!(
-            "mag_{}_uc: 16 terms {:.3} nT, with current terms {:.3} nT",
-            k + 1,
-            plain[k],
-            current[k]
-        );
+fn sgl_installation_several_sensors_and_currents() {
+    use aeromag::studies::{MultiSensorStudy, Study, StudyOutcome, StudySize};
+    let s = MultiSensorStudy { seed: 1 }
+        .run(StudySize::Full, &mut Silent)
+        .unwrap()
+        .summary();
+    for f in &s.sensors {
+        println!("{f:?}");
     }
-    for k in 1..5 {
-        assert!(
-            current[k] * 10.0 < plain[k],
-            "mag_{}: {current:?} vs {plain:?}",
-            k + 1
-        );
-    }
-    // Reference-sensor mode over the survey, against the compensated stinger.
-    let mut t = survey.table().clone();
-    comp.add_to(&mut t).unwrap();
-    let survey_comp = Flight::from_table(t).unwrap();
-    let reference = SensorSet {
-        sensors: sensors[1..].to_vec(),
-        reference: Some("mag_1_comp".into()),
-    };
-    let opts = CalibrateOptions {
-        extra: ExtraRequest::parse_list(CURRENTS).unwrap(),
-        ..CalibrateOptions::default()
-    };
-    let r = calibrate_sensors(&survey_comp, &reference, &opts, &mut Silent).unwrap();
-    let rc = r.model.compensate(&survey).unwrap();
-    let mut worst = (0.0, 0.0, 0);
-    for (k, s) in r.model.sensors.iter().enumerate() {
-        let err = survey_error(&survey, &rc.sensors[k].2, &format!("_{}", k + 2));
-        // The oracle: the same terms (lags fixed) fitted to the truth.
-        let oracle_opts = CalibrateOptions {
-            sensor: SensorColumns::find(&survey, &format!("true_interf_{}", k + 2), Some("flux_a"))
-                .unwrap(),
-            ls: aeromag::compensation::tolles_lawson::fit_ls::LsConfig {
-                design: s.model.design.clone(),
-                band_hz: None,
-                trim: 0,
-                ..Default::default()
-            },
-            eddy_lag: EddyLag::Fixed(s.model.design.terms.eddy_lags_s().to_vec()),
-            reference: ReferenceChannels::None,
-            ..CalibrateOptions::default()
-        };
-        let oracle = calibrate(&survey, &oracle_opts, &mut Silent)
-            .unwrap()
-            .model
-            .fit
-            .residual_rms_nt;
-        println!(
-            "mag_{}_uc: reference mode {err:.3} nT, oracle {oracle:.3} nT",
-            k + 2
-        );
-        if err > worst.0 {
-            worst = (err, oracle, k + 2);
-        }
-    }
+    println!(
+        "tail {:.3} (16 terms {:.3}); cabin worst {:.3}, oracle {:.3}, worst ratio {:.2}; 16 terms {:.1}; reference mode {:.3} (ratio {:.2})",
+        s.tail_residual_nt,
+        s.tail_residual_16term_nt,
+        s.cabin_residual_worst_nt,
+        s.cabin_oracle_worst_nt,
+        s.cabin_over_oracle_worst,
+        s.cabin_residual_16term_worst_nt,
+        s.reference_mode_worst_nt,
+        s.reference_mode_over_oracle_worst
+    );
+    println!(
+        "today's stinger installation: {:.3} nT",
+        s.tail_residual_stinger_installation_nt
+    );
+    // Today's installation carries no currents at all; the SGL stinger sees
+    // 0.105 nT RMS of them. Its current terms must take them out to within
+    // 1 % of the currents-free residual (measured: 0.3 %) and beat its
+    // 16-term model.
     assert!(
-        worst.0 <= 1.2 * worst.1,
-        "worst cabin sensor mag_{}: {worst:?}",
-        worst.2
+        s.tail_residual_nt <= 1.01 * s.tail_residual_stinger_installation_nt,
+        "{s:?}"
+    );
+    assert!(s.tail_residual_nt < s.tail_residual_16term_nt, "{s:?}");
+    for f in &s.sensors[1..] {
+        assert!(f.residual_nt * 10.0 < f.residual_16term_nt, "{f:?}");
+        let oracle = f.oracle_nt.unwrap();
+        assert!(f.residual_nt <= 1.5 * oracle, "{f:?}");
+        // The oracle sits above the sensor noise: the model family does
+        // not describe the simulator's richer physics exactly.
+        assert!(oracle > 2.0 * f.noise_floor_nt, "{f:?}");
+    }
+    let worst = s.sensors[1..]
+        .iter()
+        .max_by(|a, b| a.reference_mode_nt.unwrap().total_cmp(&b.reference_mode_nt.unwrap()))
+        .unwrap();
+    assert_eq!(s.reference_mode_worst_nt, worst.reference_mode_nt.unwrap());
+    assert!(
+        s.reference_mode_worst_nt <= 1.2 * worst.oracle_nt.unwrap(),
+        "{worst:?}"
     );
 }

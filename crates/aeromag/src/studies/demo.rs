@@ -3,7 +3,7 @@
 
 use super::{
     EmStudy, EmSummary, FixedWingStudy, FixedWingSummary, GradiometryStudy, GradiometrySummary,
-    PodStudy, PodSummary, PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, Study,
+    MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary, PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, Study,
     StudyOutcome, StudySize,
 };
 use crate::error::Result;
@@ -38,6 +38,8 @@ pub struct DemoSummary {
     pub em: EmSummary,
     /// Gradiometry.
     pub gradiometry: GradiometrySummary,
+    /// Several sensors and the aircraft's currents (SGL-like installation).
+    pub multi_sensor: MultiSensorSummary,
     /// Seed of the fixed-wing flights.
     pub seed: u64,
     /// Version of aeromag.
@@ -60,6 +62,7 @@ impl PrintedSummary for DemoSummary {
         rows.extend(self.pod.printed());
         rows.extend(self.em.printed());
         rows.extend(self.gradiometry.printed());
+        rows.extend(self.multi_sensor.printed());
         rows
     }
 }
@@ -115,11 +118,13 @@ impl Study for Demo {
         let em = EmStudy::default().run(size, observer)?;
         let gradiometry = GradiometryStudy.run(size, observer)?;
         let pod = PodStudy.run(size, observer)?;
+        let multi_sensor = MultiSensorStudy { seed: self.seed }.run(size, observer)?;
         let mut sections = fixed_wing.sections()?;
         sections.extend(rotor.sections()?);
         sections.extend(pod.sections()?);
         sections.extend(em.sections()?);
         sections.extend(gradiometry.sections()?);
+        sections.extend(multi_sensor.sections()?);
         Ok(DemoOutcome {
             summary: DemoSummary {
                 fixed_wing: fixed_wing.summary(),
@@ -127,6 +132,7 @@ impl Study for Demo {
                 pod: pod.summary(),
                 em: em.summary(),
                 gradiometry: gradiometry.summary(),
+                multi_sensor: multi_sensor.summary(),
                 seed: self.seed,
                 software_version: env!("CARGO_PKG_VERSION"),
             },

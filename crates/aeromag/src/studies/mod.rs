@@ -16,6 +16,7 @@ mod demo;
 mod em;
 mod fixed_wing;
 mod gradiometry;
+mod multi_sensor;
 mod pod;
 mod rotor;
 
@@ -26,6 +27,10 @@ pub use fixed_wing::{
     LevellingSummary, PlanningSummary,
 };
 pub use gradiometry::{GradiometryOutcome, GradiometryStudy, GradiometrySummary};
+pub use multi_sensor::{
+    CALIBRATION_CYCLES, ChannelCorrelation, GroupRms, MultiSensorOutcome, MultiSensorStudy,
+    MultiSensorSummary, SGL_CURRENTS, SensorFigures,
+};
 pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
 pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};
 

@@ -2,7 +2,7 @@
 //! least squares or by the Kalman method.
 
 use super::kalman::{KalmanOptions, KalmanOutcome, fit_kalman_flight};
-use super::lags::choose_terms;
+use super::lags::{TermChoice, choose_terms, test_extra_channels};
 use crate::error::{Error, InFile, Result};
 use crate::flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, SensorColumns, TlInputs};
 use crate::flight::{reduced, reference_sum};
@@ -10,6 +10,7 @@ use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::model_file::{
     Coefficient, FitStats, LsSettings, MODEL_FORMAT, MethodSettings, TL_KIND, TlModel,
 };
+use aeromag_compensation::tolles_lawson::extra_select::ChannelSelection;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
 use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
 use aeromag_compensation::tolles_lawson::{Convention, ExtraRequest, ExtraTerm};
@@ -114,6 +115,21 @@ impl FromStr for EddyLag {
     }
 }
 
+/// Whether the extra regressors asked for are tested.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum ExtraSelection {
+    /// Keep the channels the flight shows to matter: backward elimination
+    /// by the likelihood-ratio test
+    /// ([`aeromag_compensation::tolles_lawson::extra_select`]); the others
+    /// are dropped with a note.
+    #[default]
+    Test,
+    /// Keep every channel asked for.
+    All,
+}
+
 /// Everything `calibrate` is told besides the flight.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrateOptions {
@@ -139,6 +155,8 @@ pub struct CalibrateOptions {
     /// flight for those asked with `:lag`
     /// ([`aeromag_compensation::tolles_lawson::terms`]).
     pub extra: Vec<ExtraRequest>,
+    /// Whether [`Self::extra`] is tested channel by channel.
+    pub extra_selection: ExtraSelection,
     /// The scalar and vector magnetometers fitted (default: the canonical
     /// `mag` and `flux_x/y/z`).
     pub sensor: SensorColumns,
@@ -158,6 +176,7 @@ impl Default for CalibrateOptions {
             reference: ReferenceChannels::Auto,
             lever_arm: None,
             extra: Vec::new(),
+            extra_selection: ExtraSelection::Test,
             sensor: SensorColumns::default(),
         }
     }
@@ -252,7 +271,37 @@ pub(super) fn calibrate_with(
     notes: &mut Notes,
 ) -> Result<Calibration> {
     let before = notes.len();
-    let (model, lag_selection, kalman) = match opts.method {
+    let tested;
+    let (opts, chosen) = match opts.extra_selection {
+        ExtraSelection::Test if !opts.extra.is_empty() => {
+            // The lags are chosen and the channels tested once; the fit
+            // takes the kept channels with their lags as fixed terms.
+            let (choice, sel) = select_channels(flight, opts, reference_nt, notes)?;
+            let all = choice.terms.extras();
+            let kept: Vec<ExtraTerm> = sel.kept.iter().map(|&k| all[k].clone()).collect();
+            let terms = choice
+                .terms
+                .with_extras(&kept)
+                .map_err(|e| Error::bad_input(format!("extra regressors: {e}")))?;
+            tested = CalibrateOptions {
+                extra: Vec::new(),
+                eddy_lag: EddyLag::Fixed(terms.eddy_lags_s().to_vec()),
+                ls: LsConfig {
+                    design: opts.ls.design.with_terms(terms),
+                    ..opts.ls.clone()
+                },
+                ..opts.clone()
+            };
+            let extras = choice
+                .extras
+                .into_iter()
+                .filter(|x| kept.iter().any(|k| k.channel == x.channel))
+                .collect();
+            (&tested, Some((choice.eddy, extras, sel)))
+        }
+        _ => (opts, None),
+    };
+    let (mut model, lag_selection, kalman) = match opts.method {
         Method::Ls => {
             let (model, sel) = fit_ls_flight(flight, opts, reference_nt, notes)?;
             (model, sel, None)
@@ -262,6 +311,13 @@ pub(super) fn calibrate_with(
             (model, sel, Some(outcome))
         }
     };
+    let mut lag_selection = lag_selection;
+    if let Some((eddy, extras, sel)) = chosen {
+        lag_selection = eddy;
+        model.fit.eddy_lag_selection = lag_selection.clone();
+        model.fit.extra_lag_selection = extras;
+        model.fit.extra_channel_selection = Some(sel);
+    }
     Ok(Calibration {
         model,
         lag_selection,
@@ -354,13 +410,16 @@ pub(super) fn model_columns(
     map
 }
 
-/// The band-pass LS fit on a flight.
-fn fit_ls_flight(
+/// The LS inputs of a flight: the settings with the extra regressors, the
+/// reference channels used, and the fit's segments (the reduced scalar
+/// reading, split by [`fit_rule`]), handed to `f`.
+fn with_ls_segments<T>(
     flight: &Flight,
     opts: &CalibrateOptions,
     reference_nt: Option<&[f64]>,
     notes: &mut Notes,
-) -> Result<(TlModel, Option<LagSelection>)> {
+    f: impl FnOnce(&LsConfig, Vec<String>, &[Segment], &mut Notes) -> Result<T>,
+) -> Result<T> {
     let ls = opts.ls_with_extras()?;
     let cols =
         TlInputs::of_sensor(flight, &opts.sensor)?.with_extras(flight, ls.design.terms.extras())?;
@@ -380,19 +439,64 @@ fn fit_ls_flight(
         .iter()
         .map(|r| cols.whole().slice(r.clone()))
         .collect();
+    f(&ls, ref_cols, &segments, notes)
+}
+
+/// Choose the lags (eddy and extra regressors) on the flight's band-passed
+/// LS inputs and test the extra regressors of `opts` there, with a note
+/// for each dropped one.
+fn select_channels(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
+    notes: &mut Notes,
+) -> Result<(TermChoice, ChannelSelection)> {
     let label = flight.label();
-    let choice = choose_terms(&label, &segments, &ls, &opts.eddy_lag, &opts.extra, notes)?;
+    // The missing rows are noted again by the fit that follows.
+    let mut silent = crate::observer::Silent;
+    let mut quiet = Notes::new(&mut silent);
+    with_ls_segments(flight, opts, reference_nt, &mut quiet, |ls, _, segments, _| {
+        let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
+        notes.stage("testing the extra regressors");
+        let sel = test_extra_channels(&label, segments, ls, &choice.terms, notes)?;
+        Ok((choice, sel))
+    })
+}
+
+/// The band-pass LS fit on a flight.
+fn fit_ls_flight(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    reference_nt: Option<&[f64]>,
+    notes: &mut Notes,
+) -> Result<(TlModel, Option<LagSelection>)> {
+    with_ls_segments(flight, opts, reference_nt, notes, |ls, ref_cols, segments, notes| {
+        fit_ls_segments(flight, opts, ls, ref_cols, segments, notes)
+    })
+}
+
+/// [`fit_ls_flight`] on its segments.
+fn fit_ls_segments(
+    flight: &Flight,
+    opts: &CalibrateOptions,
+    ls: &LsConfig,
+    ref_cols: Vec<String>,
+    segments: &[Segment],
+    notes: &mut Notes,
+) -> Result<(TlModel, Option<LagSelection>)> {
+    let label = flight.label();
+    let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
     let selection = choice.eddy;
     let cfg = &LsConfig {
         design: ls.design.with_terms(choice.terms),
         ..ls.clone()
     };
     notes.stage("fitting");
-    let fit = fit_band_pass_ls(&segments, cfg).in_file(&label)?;
+    let fit = fit_band_pass_ls(segments, cfg).in_file(&label)?;
     for w in &fit.warnings {
         notes.warn(w.clone());
     }
-    second_order_note(&cfg.design, &fit.coef, &segments, notes);
+    second_order_note(&cfg.design, &fit.coef, segments, notes);
     let model = TlModel {
         format: MODEL_FORMAT.into(),
         kind: TL_KIND.into(),
@@ -412,6 +516,7 @@ fn fit_ls_flight(
             warnings: fit.warnings.clone(),
             eddy_lag_selection: selection.clone(),
             extra_lag_selection: choice.extras,
+            extra_channel_selection: None,
         },
         columns: model_columns(
             flight,

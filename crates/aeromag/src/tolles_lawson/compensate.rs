@@ -55,3 +55,40 @@ pub(super) fn tl_interference(
     }
     Ok(out)
 }
+
+/// A model's interference split by term group (nT per row, NaN where the
+/// model cannot be applied): each part is the model with the other groups'
+/// coefficients set to zero (for the exact magnitude, the part alone rather
+/// than its share of the magnitude). The `bias` term is in none of them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterferenceParts {
+    /// Permanent magnetization (`p_`).
+    pub permanent: Vec<f64>,
+    /// Induced magnetization (`i_`).
+    pub induced: Vec<f64>,
+    /// Eddy currents (`e_`, and the lagged `l1_`, `l2_`).
+    pub eddy: Vec<f64>,
+    /// Extra regressors: the currents (`<channel>:e_x`, …).
+    pub currents: Vec<f64>,
+}
+
+impl InterferenceParts {
+    /// The parts of `model` at the sensor `sensor` of `flight`.
+    pub fn of(model: &TlModel, flight: &Flight, sensor: &SensorColumns) -> Result<Self> {
+        let part = |keep: &dyn Fn(&str) -> bool| {
+            let mut m = model.clone();
+            for c in &mut m.coefficients {
+                if !keep(&c.name) {
+                    c.value = 0.0;
+                }
+            }
+            tl_interference(&m, flight, sensor)
+        };
+        Ok(Self {
+            permanent: part(&|n| n.starts_with("p_"))?,
+            induced: part(&|n| n.starts_with("i_"))?,
+            eddy: part(&|n| n.starts_with("e_") || n.starts_with('l'))?,
+            currents: part(&|n| n.contains(':'))?,
+        })
+    }
+}

@@ -25,8 +25,8 @@ mod observability;
 mod sensors;
 mod settings;
 
-pub use calibrate::{CalibrateOptions, Calibration, EddyLag, Method, calibrate};
-pub use compensate::TL_OUTPUT;
+pub use calibrate::{CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, calibrate};
+pub use compensate::{InterferenceParts, TL_OUTPUT};
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
 pub use sensors::{

@@ -8,7 +8,7 @@
 //! (MagNav.jl's model exactly); the Kalman noise intensities are tuned by
 //! maximum likelihood unless they are given.
 
-use super::calibrate::{CalibrateOptions, EddyLag, Method};
+use super::calibrate::{CalibrateOptions, EddyLag, ExtraSelection, Method};
 use super::kalman::KalmanOptions;
 use crate::error::{Error, Result};
 use crate::flight::{LeverArm, ReferenceChannels};
@@ -71,6 +71,10 @@ pub struct CalibrateSettings {
     pub series: bool,
     /// Extra regressors (`--extra cur_strb,cur_flap:lag`; default none).
     pub extra: Vec<ExtraRequest>,
+    /// Test the extra regressors channel by channel and drop those the
+    /// flight shows not to matter (`--extra-selection test`, the default),
+    /// or keep them all (`all`).
+    pub extra_selection: ExtraSelection,
     /// The first-order projection (default) or the exact magnitude
     /// (`--magnitude exact`, method `ls`).
     pub magnitude: Option<Magnitude>,
@@ -156,6 +160,7 @@ impl CalibrateSettings {
                 decimal_year: self.decimal_year.unwrap_or(DEFAULT_DECIMAL_YEAR),
             }),
             extra: self.extra.clone(),
+            extra_selection: self.extra_selection,
             sensor: Default::default(),
         })
     }

@@ -7,7 +7,9 @@ use crate::progress::Bars;
 use aeromag::compensation::kalman::{NoiseModel, q1_unit};
 use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag::compensation::tolles_lawson::{Convention, Design, ExtraRequest, Magnitude, TermSet};
-use aeromag::{CalibrateOptions, CalibrateSettings, EddyLag, Method, ReferenceChannels, calibrate};
+use aeromag::{
+    CalibrateOptions, CalibrateSettings, EddyLag, ExtraSelection, Method, ReferenceChannels, calibrate,
+};
 use std::path::PathBuf;
 
 /// Fit the aircraft's magnetic interference model (Tolles-Lawson / Leliak)
@@ -109,6 +111,11 @@ pub struct Args {
     /// e.g. `cur_strb,cur_flap:lag`.
     #[arg(long, value_name = "NAME[:lag],…", value_parser = extras)]
     extra: Option<Extras>,
+    /// Which of the --extra channels are kept, per sensor: `test` (those the
+    /// flight shows to matter, by a likelihood-ratio test; the others are
+    /// dropped with a note) or `all`.
+    #[arg(long, value_enum, default_value_t = ExtraSelection::Test)]
+    extra_selection: ExtraSelection,
     /// How the interference vector becomes the scalar interference:
     /// `first-order` (the Tolles-Lawson projection) or `exact` (|B + ΔB| −
     /// |B|, fitted by Gauss–Newton; for sensors whose interference exceeds
@@ -214,6 +221,7 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
         series: a.series.is_some(),
         extra: a.extra.clone().map(|x| x.0).unwrap_or_default(),
         magnitude: Some(a.magnitude),
+        extra_selection: a.extra_selection,
     };
     Ok(settings.options()?)
 }
