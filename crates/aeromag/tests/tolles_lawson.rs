@@ -205,6 +205,33 @@ fn observability_tells_a_full_box_from_a_single_heading() {
     assert_eq!(one.observability.estimability.len(), 16);
 }
 
+/// Current terms in the observability check (issue 20): a strobe switching
+/// all through the box is determined; a current that never changes is not
+/// (its terms are the permanent terms scaled), though its column is as
+/// large.
+#[test]
+fn observability_rates_current_terms() {
+    use aeromag::compensation::tolles_lawson::{ExtraTerm, TermSet};
+    let mut cal = calibration(8);
+    let t = cal.table().require("time").unwrap().to_vec();
+    let strobe: Vec<f64> = t
+        .iter()
+        .map(|t| if t.rem_euclid(1.2) < 0.15 { 5.0 } else { 0.0 })
+        .collect();
+    cal.add_column("cur_strb", strobe).unwrap();
+    cal.add_column("cur_const", vec![5.0; t.len()]).unwrap();
+    let terms = TermSet::observable16()
+        .with_extras(&[ExtraTerm::new("cur_strb"), ExtraTerm::new("cur_const")])
+        .unwrap();
+    let o = aeromag::observability(&cal, &terms, None, &mut Silent).unwrap();
+    assert_eq!(o.coefficients.len(), 22);
+    let un = o.undetermined();
+    for axis in ["x", "y", "z"] {
+        assert!(un.contains(&format!("cur_const:e_{axis}").as_str()), "{un:?}");
+        assert!(!un.contains(&format!("cur_strb:e_{axis}").as_str()), "{un:?}");
+    }
+}
+
 #[test]
 fn the_kalman_series_hold_the_smoothed_field_and_whitened_innovations() {
     let cal = simulate_flight(ScenarioKind::CalibrationTruncated, None, Some(7)).unwrap();

@@ -64,7 +64,10 @@ pub struct CoefficientVerdict {
     /// Effect uncertainty, nT: the standard deviation times the size of
     /// the term's design column over a full calibration (1 for permanent
     /// terms, |B|/bt_scale for induced, |B|·(0.1 rad/s)/bt_scale for eddy
-    /// terms: a 6°/s manoeuvre).
+    /// terms: a 6°/s manoeuvre; for an extra regressor `<channel>:e_i`, the
+    /// channel's RMS on the flight, A: a current that never changes is as
+    /// large a column as one that does, but the flight cannot tell its terms
+    /// from the permanent ones).
     pub effect_std_nt: f64,
     /// The verdict.
     pub verdict: Verdict,
@@ -95,7 +98,10 @@ impl FlightObservability {
 }
 
 /// Observability and estimability of the coefficients of `terms` on a
-/// calibration flight (thesis sections 10 and 12).
+/// calibration flight (thesis sections 10 and 12). `terms` may hold extra
+/// regressors ([`TermSet::with_extras`]; their channels are read from the
+/// flight): the current terms of a cabin sensor, which a flight determines
+/// only when each current changes at several headings.
 ///
 /// Runs the Kalman filter of the Kalman method with its default noise
 /// intensities, untuned, without lags (the external field is a random
@@ -155,10 +161,11 @@ pub fn observability(
         .zip(&fit.std)
         .zip(&o.estimability)
         .map(|((name, &sd), &mu)| {
-            let scale = match name.as_bytes().first() {
-                Some(b'p') => 1.0,
-                Some(b'i') => bt_mean / bt_scale,
-                Some(b'e') => 0.1 * bt_mean / bt_scale,
+            let scale = match (name.split_once(':'), name.as_bytes().first()) {
+                (Some((channel, _)), _) => channel_spread(flight, channel),
+                (None, Some(b'p')) => 1.0,
+                (None, Some(b'i')) => bt_mean / bt_scale,
+                (None, Some(b'e')) => 0.1 * bt_mean / bt_scale,
                 _ => 1.0,
             };
             let effect = sd * scale;
@@ -177,4 +184,17 @@ pub fn observability(
         rows: fit.rows,
         notes: cal.notes,
     })
+}
+
+/// RMS of the flight's column `channel` over its finite values (1 when it
+/// has none: the coefficient's own unit).
+fn channel_spread(flight: &Flight, channel: &str) -> f64 {
+    let Some(x) = flight.table().column(channel) else {
+        return 1.0;
+    };
+    let (ss, n) = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    if n == 0 { 1.0 } else { (ss / n as f64).sqrt() }
 }

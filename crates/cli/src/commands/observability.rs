@@ -3,7 +3,7 @@
 
 use crate::input::InputArgs;
 use crate::progress::Bars;
-use aeromag::compensation::tolles_lawson::{Design, TermSet};
+use aeromag::compensation::tolles_lawson::{Design, ExtraRequest, ExtraTerm, TermSet};
 
 /// Observability and estimability of the interference coefficients on a
 /// calibration flight (thesis sections 10 and 12).
@@ -24,6 +24,12 @@ use aeromag::compensation::tolles_lawson::{Design, TermSet};
 /// Use it to check a calibration flight, or a simulated pattern before
 /// flying it (`aeromag simulate calibration --config pattern.toml`).
 ///
+/// With `--extra cur_strb,cur_flap` the current terms (each channel times
+/// the direction cosines, as in `calibrate --extra`; their effect is rated
+/// with the channel's RMS on the flight) are assessed too:
+/// a flight determines them only when each current changes at several
+/// headings.
+///
 /// Example: `aeromag observability --input cal.csv --terms p3,i5,e8`
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
@@ -34,14 +40,42 @@ pub struct Args {
     #[arg(long, value_parser = |s: &str| TermSet::parse(s).map_err(|e| e.to_string()),
           default_value_t = Design::default().terms)]
     terms: TermSet,
+    /// Extra regressors: recorded channels times the direction cosines,
+    /// comma-separated (`calibrate --extra`, without `:lag`: lags are not
+    /// assessed).
+    #[arg(long, value_name = "NAME,…")]
+    extra: Option<String>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let flight = a.input.load_canonical(&[])?;
-    let obs = aeromag::observability(&flight, &a.terms, None, &mut Bars::new())?;
+    let extras = match &a.extra {
+        None => Vec::new(),
+        Some(list) => {
+            let requests = ExtraRequest::parse_list(list)
+                .map_err(|e| aeromag::Error::bad_input(format!("--extra: {e}")))?;
+            if let Some(r) = requests.iter().find(|r| r.lag) {
+                return Err(aeromag::Error::bad_input(format!(
+                    "--extra {}:lag: lags are not assessed here; give the channel alone",
+                    r.channel
+                ))
+                .into());
+            }
+            requests
+                .into_iter()
+                .map(|r| ExtraTerm::new(r.channel))
+                .collect()
+        }
+    };
+    let names: Vec<&str> = extras.iter().map(|x| x.channel.as_str()).collect();
+    let flight = a.input.load_canonical(&names)?;
+    let terms = a
+        .terms
+        .with_extras(&extras)
+        .map_err(|e| aeromag::Error::bad_input(format!("--extra: {e}")))?;
+    let obs = aeromag::observability(&flight, &terms, None, &mut Bars::new())?;
     let o = &obs.observability;
     if a.json {
         println!("{}", serde_json::to_string_pretty(o)?);
@@ -52,7 +86,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "{}: {} coefficients ({}), {} rows",
         flight.file_label(),
         n,
-        a.terms,
+        terms,
         obs.rows
     );
     println!(
@@ -71,13 +105,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for w in &o.weak_combinations {
         println!("  {w}");
     }
+    // The term column as wide as the longest name (`cur_strb:e_x`).
+    let w = obs
+        .coefficients
+        .iter()
+        .map(|c| c.name.chars().count())
+        .fold(8, usize::max);
     println!(
-        "\n{:<8} {:>10} {:>12} {:>16}  verdict",
+        "\n{:<w$} {:>10} {:>12} {:>16}  verdict",
         "term", "μ", "std", "effect σ (nT)"
     );
     for c in &obs.coefficients {
         println!(
-            "{:<8} {:>10.4} {:>12.3e} {:>16.4}  {}",
+            "{:<w$} {:>10.4} {:>12.3e} {:>16.4}  {}",
             c.name,
             c.mu,
             c.std,
