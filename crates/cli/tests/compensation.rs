@@ -484,10 +484,7 @@ fn several_sensors_with_current_terms() {
             ],
             "--vector",
         ),
-        (
-            vec!["--method", "kalman", "--magnitude", "exact"],
-            "magnitude",
-        ),
+        (vec!["--magnitude", "exactly"], "magnitude"),
     ] {
         let x = d.path().join("x.json");
         let mut a = vec!["calibrate", "--input", cal, "--model", x.to_str().unwrap()];

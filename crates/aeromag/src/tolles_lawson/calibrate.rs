@@ -312,6 +312,8 @@ pub(super) fn calibrate_with(
         }
     };
     let mut lag_selection = lag_selection;
+    // With the channels tested, the lags were chosen by that step (the
+    // Kalman method then takes them as fixed, without its own searches).
     if let Some((eddy, extras, sel)) = chosen {
         lag_selection = eddy;
         model.fit.eddy_lag_selection = lag_selection.clone();

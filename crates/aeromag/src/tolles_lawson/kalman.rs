@@ -12,10 +12,10 @@ use aeromag_compensation::kalman::altitude::{
 };
 use aeromag_compensation::kalman::{
     DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, ORDERS,
-    X2Prior, fit_kalman, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
+    X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
 };
 use aeromag_compensation::model_file::TlModel;
-use aeromag_compensation::tolles_lawson::ExtraRequest;
+use aeromag_compensation::tolles_lawson::{ExtraRequest, Magnitude};
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
 use aeromag_io::FlightTable;
@@ -270,7 +270,11 @@ pub(super) fn fit_kalman_flight(
         cfg.tuning.grid_starts = 0;
     }
     notes.stage("Kalman filter and smoother");
-    let fit = fit_kalman(&segments, &cfg).in_file(&file)?;
+    let fit = match cfg.design.magnitude {
+        Magnitude::FirstOrder => fit_kalman(&segments, &cfg),
+        Magnitude::Exact => fit_kalman_exact(&segments, &cfg),
+    }
+    .in_file(&file)?;
     let series = (!fit.series.is_empty()).then(|| {
         let compensated = on_rows(y.len(), &segs, &fit.series, |s| &s.compensated_nt);
         let reading = y

@@ -76,7 +76,7 @@ pub struct CalibrateSettings {
     /// or keep them all (`all`).
     pub extra_selection: ExtraSelection,
     /// The first-order projection (default) or the exact magnitude
-    /// (`--magnitude exact`, method `ls`).
+    /// (`--magnitude exact`, either method).
     pub magnitude: Option<Magnitude>,
 }
 
@@ -98,11 +98,6 @@ impl CalibrateSettings {
                     return Err(Error::bad_input(format!("{name} needs method kalman")));
                 }
             }
-        }
-        if self.magnitude == Some(Magnitude::Exact) && self.method != Method::Ls {
-            return Err(Error::bad_input(
-                "magnitude exact (--magnitude exact) is fitted by the ls method only",
-            ));
         }
         if let Some(l) = self.ridge_lambda
             && !(l.is_finite() && l >= 0.0)

@@ -119,7 +119,7 @@ pub struct Args {
     /// How the interference vector becomes the scalar interference:
     /// `first-order` (the Tolles-Lawson projection) or `exact` (|B + ΔB| −
     /// |B|, fitted by Gauss–Newton; for sensors whose interference exceeds
-    /// about 1 % of the field, where the projection leaves nT; method ls).
+    /// about 1 % of the field, where the projection leaves nT; either method).
     #[arg(long, value_enum, default_value_t = Magnitude::FirstOrder)]
     magnitude: Magnitude,
     /// Reference-sensor mode: the scalar sensor (one of --mag) or compensated

@@ -153,6 +153,69 @@ struct Run {
     range: Range<usize>,
 }
 
+/// The Kalman fit of the exact-magnitude model `|B + ΔB| − |B|`
+/// ([`crate::tolles_lawson::Magnitude::Exact`]) by Gauss–Newton, as the
+/// band-pass fit does it
+/// ([`crate::tolles_lawson::fit_ls::fit_exact_magnitude`]): the first-order
+/// fit of `cfg` (tuned as `cfg` says), then fits of the reading corrected by
+/// the second-order remainder on rows whose direction cosines are those of
+/// the total field `B + ΔB(c_k)`, with the noise intensities of the first
+/// fit fixed, until no coefficient moves by more than 1e-3 of its standard
+/// deviation (at most
+/// [`MAX_GAUSS_NEWTON_STEPS`](crate::tolles_lawson::fit_ls::MAX_GAUSS_NEWTON_STEPS)
+/// steps; a warning says how many). The first fit's tuning report is kept.
+pub fn fit_kalman_exact(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<KalmanFit> {
+    use crate::tolles_lawson::fit_ls::{MAX_GAUSS_NEWTON_STEPS, linearised};
+    let first = fit_kalman(segments, cfg)?;
+    let mut fixed = KalmanConfig {
+        noise: first.noise,
+        ..cfg.clone()
+    };
+    fixed.tuning.enabled = false;
+    let tuning = first.tuning.clone();
+    let mut fit = first;
+    let (mut steps, mut converged) = (0, false);
+    while steps < MAX_GAUSS_NEWTON_STEPS {
+        let lin: Vec<([Vec<f64>; 3], Vec<f64>)> = segments
+            .iter()
+            .map(|s| linearised(&cfg.design, &fit.coef, &s.data))
+            .collect();
+        let step: Vec<KalmanSegment> = segments
+            .iter()
+            .zip(&lin)
+            .map(|(s, (t, y))| KalmanSegment {
+                data: Segment {
+                    mag: y,
+                    direction: Some([&t[0], &t[1], &t[2]]),
+                    ..s.data
+                },
+                ..*s
+            })
+            .collect();
+        let next = fit_kalman(&step, &fixed)?;
+        steps += 1;
+        let moved = next
+            .coef
+            .iter()
+            .zip(&fit.coef)
+            .zip(&next.std)
+            .map(|((a, b), s)| (a - b).abs() / s.max(f64::MIN_POSITIVE))
+            .fold(0.0, f64::max);
+        fit = next;
+        if moved < 1e-3 {
+            converged = true;
+            break;
+        }
+    }
+    fit.tuning = tuning;
+    fit.warnings.push(if converged {
+        format!("exact magnitude: Gauss–Newton converged in {steps} steps")
+    } else {
+        format!("exact magnitude: Gauss–Newton did not converge in {steps} steps")
+    });
+    Ok(fit)
+}
+
 /// Runs shorter than this are skipped (the eddy derivatives need 3 samples).
 const MIN_RUN: usize = 3;
 

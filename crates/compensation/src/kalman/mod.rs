@@ -97,7 +97,7 @@ pub mod track;
 pub mod tuning;
 
 pub use anomaly_model::{DEFAULT_ORDER, NoiseModel, ORDERS, THESIS_ORDER, X2Prior, q1_unit};
-pub use fit::{KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman};
+pub use fit::{KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman, fit_kalman_exact};
 pub use joint_filter::JointFilter;
 pub use track::{ground_speed_from_positions, ground_speed_from_velocity};
 pub use tuning::{TuningConfig, TuningReport};

@@ -60,8 +60,11 @@ pub fn for_each_design_row(
                 *x = [v, lag.as_mut().map_or(f64::NAN, |l| l.step(time[i], v))];
             }
             let lagged = lags.eddy.step(time[i], d);
-            spec.terms.row(
-                [flux[0][i], flux[1][i], flux[2][i]],
+            let b = [flux[0][i], flux[1][i], flux[2][i]];
+            let dir = seg.direction.map_or(b, |v| [v[0][i], v[1][i], v[2][i]]);
+            spec.terms.row_along(
+                dir,
+                b,
                 d,
                 lagged,
                 &extra,

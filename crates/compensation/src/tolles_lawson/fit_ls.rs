@@ -363,22 +363,7 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
         // The total field and the corrected reading of every segment.
         let lin: Vec<([Vec<f64>; 3], Vec<f64>)> = segments
             .iter()
-            .map(|s| {
-                let (d, _) = linear
-                    .design
-                    .field_vector(&fit.coef, s.time, s.flux, s.channels);
-                let n = s.time.len();
-                let mut total = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-                let mut y = Vec::with_capacity(n);
-                for k in 0..n {
-                    let f = TotalField::at(s.flux, &d, k);
-                    y.push(s.mag[k] - f.remainder());
-                    for (axis, v) in total.iter_mut().zip(f.t) {
-                        axis[k] = v;
-                    }
-                }
-                (total, y)
-            })
+            .map(|s| linearised(&linear.design, &fit.coef, s))
             .collect();
         let step: Vec<Segment> = segments
             .iter()
@@ -405,6 +390,25 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
         format!("exact magnitude: Gauss–Newton did not converge in {steps} steps")
     });
     Ok(fit)
+}
+
+/// One Gauss–Newton linearisation of the exact-magnitude model at the
+/// coefficients `coef` ([`fit_exact_magnitude`]): the total field
+/// `B + ΔB(c)` of every row of `s` (x, y, z, nT) and the reading corrected
+/// by the second-order remainder, `mag − R`.
+pub(crate) fn linearised(design: &Design, coef: &[f64], s: &Segment) -> ([Vec<f64>; 3], Vec<f64>) {
+    let (d, _) = design.field_vector(coef, s.time, s.flux, s.channels);
+    let n = s.time.len();
+    let mut total = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let mut y = Vec::with_capacity(n);
+    for k in 0..n {
+        let f = TotalField::at(s.flux, &d, k);
+        y.push(s.mag[k] - f.remainder());
+        for (axis, v) in total.iter_mut().zip(f.t) {
+            axis[k] = v;
+        }
+    }
+    (total, y)
 }
 
 /// The band-passed normal equations of the first-order model over the

@@ -606,8 +606,26 @@ impl TermSet {
         bt_scale: f64,
         out: &mut [f64],
     ) {
-        let bt = magnitude(b);
-        let e = [b[0] / bt, b[1] / bt, b[2] / bt];
+        self.row_along(b, b, db, lagged, extra, bt_scale, out)
+    }
+
+    /// [`TermSet::row`] with the direction cosines `e = d/|d|` of the
+    /// vector `dir` (the total field `b + ΔB` in the Gauss–Newton steps of
+    /// the exact-magnitude model; [`TermSet::columns_into`] does the same
+    /// column by column).
+    #[allow(clippy::too_many_arguments)]
+    pub fn row_along(
+        &self,
+        dir: [f64; 3],
+        b: [f64; 3],
+        db: [f64; 3],
+        lagged: &[[f64; 3]],
+        extra: &[[f64; 2]],
+        bt_scale: f64,
+        out: &mut [f64],
+    ) {
+        let bt = magnitude(dir);
+        let e = [dir[0] / bt, dir[1] / bt, dir[2] / bt];
         let mut k = 0;
         self.for_each_column(|c| {
             out[k] = match c {
