@@ -97,9 +97,8 @@ pub use model_file::ModelFile;
 pub use observer::{Note, NoteLevel, Observer, Silent};
 pub use tolles_lawson::{
     CalibrateOptions, CalibrateSettings, Calibration, CompensateSensors, EddyLag, ExtraSelection,
-    KalmanOptions,
-    Method, SensorSet, SensorsCalibration, SensorsCompensated, SensorsModel, TlModel, calibrate,
-    calibrate_sensors, observability,
+    KalmanOptions, Method, SensorSet, SensorsCalibration, SensorsCompensated, SensorsModel,
+    TlModel, calibrate, calibrate_sensors, observability,
 };
 
 /// The names most programs need: `use aeromag::prelude::*;`.

@@ -227,8 +227,14 @@ fn observability_rates_current_terms() {
     assert_eq!(o.coefficients.len(), 22);
     let un = o.undetermined();
     for axis in ["x", "y", "z"] {
-        assert!(un.contains(&format!("cur_const:e_{axis}").as_str()), "{un:?}");
-        assert!(!un.contains(&format!("cur_strb:e_{axis}").as_str()), "{un:?}");
+        assert!(
+            un.contains(&format!("cur_const:e_{axis}").as_str()),
+            "{un:?}"
+        );
+        assert!(
+            !un.contains(&format!("cur_strb:e_{axis}").as_str()),
+            "{un:?}"
+        );
     }
 }
 
@@ -673,7 +679,11 @@ fn sgl_installation_several_sensors_and_currents() {
     }
     let worst = s.sensors[1..]
         .iter()
-        .max_by(|a, b| a.reference_mode_nt.unwrap().total_cmp(&b.reference_mode_nt.unwrap()))
+        .max_by(|a, b| {
+            a.reference_mode_nt
+                .unwrap()
+                .total_cmp(&b.reference_mode_nt.unwrap())
+        })
         .unwrap();
     assert_eq!(s.reference_mode_worst_nt, worst.reference_mode_nt.unwrap());
     assert!(

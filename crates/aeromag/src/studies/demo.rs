@@ -3,8 +3,8 @@
 
 use super::{
     EmStudy, EmSummary, FixedWingStudy, FixedWingSummary, GradiometryStudy, GradiometrySummary,
-    MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary, PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, Study,
-    StudyOutcome, StudySize,
+    MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary, PrintedFigure, PrintedSummary,
+    RotorStudyRun, RotorSummary, Study, StudyOutcome, StudySize,
 };
 use crate::error::Result;
 use crate::observer::Observer;

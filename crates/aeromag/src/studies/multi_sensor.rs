@@ -28,8 +28,8 @@ use crate::flight::{Flight, ReferenceChannels, SensorColumns};
 use crate::observer::Observer;
 use crate::simulate::{ScenarioKind, simulate_flight};
 use crate::tolles_lawson::{
-    CalibrateOptions, CompensateSensors, EddyLag, ExtraSelection, InterferenceParts, SensorSet,
-    SensorModel, SensorsModel, calibrate, calibrate_sensors,
+    CalibrateOptions, CompensateSensors, EddyLag, ExtraSelection, InterferenceParts, SensorModel,
+    SensorSet, SensorsModel, calibrate, calibrate_sensors,
 };
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag_compensation::tolles_lawson::{ExtraRequest, Magnitude};
@@ -363,7 +363,12 @@ fn noise_floor_nt(fs_hz: f64) -> f64 {
 /// The oracle of module docs for the cabin sensor `idx`: `m`'s terms (lags
 /// fixed, extras as kept, magnitude), a bias, every survey row unfiltered,
 /// against the true external field.
-fn oracle(survey: &Flight, s: &SensorColumns, m: &aeromag_compensation::model_file::TlModel, idx: usize) -> Result<f64> {
+fn oracle(
+    survey: &Flight,
+    s: &SensorColumns,
+    m: &aeromag_compensation::model_file::TlModel,
+    idx: usize,
+) -> Result<f64> {
     let mut groups = m.design.terms.groups().to_vec();
     if !groups.contains(&aeromag_compensation::tolles_lawson::TermGroup::Bias) {
         groups.push(aeromag_compensation::tolles_lawson::TermGroup::Bias);
@@ -446,7 +451,9 @@ fn summarize(sensors: Vec<SensorFigures>, today: f64) -> MultiSensorSummary {
         cabin_residual_worst_nt: worst.as_ref().map_or(nan, |s| s.residual_nt),
         cabin_over_oracle_worst: ratio(&|s| Some(s.residual_nt)),
         cabin_residual_16term_worst_nt: cabin().map(|s| s.residual_16term_nt).fold(nan, f64::max),
-        reference_mode_worst_nt: cabin().filter_map(|s| s.reference_mode_nt).fold(nan, f64::max),
+        reference_mode_worst_nt: cabin()
+            .filter_map(|s| s.reference_mode_nt)
+            .fold(nan, f64::max),
         reference_mode_over_oracle_worst: ratio(&|s| s.reference_mode_nt),
         sensors,
     }
@@ -461,7 +468,9 @@ impl StudyOutcome for MultiSensorOutcome {
 
     fn section(&self) -> Result<ReportSection> {
         let s = &self.summary;
-        let mut sec = ReportSection::new("Several sensors and the aircraft's currents (SGL-like installation)");
+        let mut sec = ReportSection::new(
+            "Several sensors and the aircraft's currents (SGL-like installation)",
+        );
         sec.blocks.push(Block::Paragraph(
             "A tail stinger (mag_1_uc) and four cabin scalar sensors, 14 recorded currents. Calibrated on the \
              box (8 manoeuvre cycles per block; the crew cycles the switched equipment), scored on independent survey lines against the \
@@ -546,12 +555,17 @@ impl StudyOutcome for MultiSensorOutcome {
 
 impl PrintedSummary for MultiSensorSummary {
     fn printed(&self) -> Vec<PrintedFigure> {
-        let row = |k: &str, v: f64, d| PrintedFigure::new(format!("multi_sensor.{k}"), fixed(Some(v), d));
+        let row =
+            |k: &str, v: f64, d| PrintedFigure::new(format!("multi_sensor.{k}"), fixed(Some(v), d));
         vec![
             row("tail_residual_nt", self.tail_residual_nt, 3),
             row("cabin_residual_worst_nt", self.cabin_residual_worst_nt, 3),
             row("cabin_oracle_worst_nt", self.cabin_oracle_worst_nt, 3),
-            row("cabin_residual_16term_worst_nt", self.cabin_residual_16term_worst_nt, 1),
+            row(
+                "cabin_residual_16term_worst_nt",
+                self.cabin_residual_16term_worst_nt,
+                1,
+            ),
             row("reference_mode_worst_nt", self.reference_mode_worst_nt, 3),
         ]
     }

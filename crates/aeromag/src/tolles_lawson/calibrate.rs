@@ -457,12 +457,18 @@ fn select_channels(
     // The missing rows are noted again by the fit that follows.
     let mut silent = crate::observer::Silent;
     let mut quiet = Notes::new(&mut silent);
-    with_ls_segments(flight, opts, reference_nt, &mut quiet, |ls, _, segments, _| {
-        let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
-        notes.stage("testing the extra regressors");
-        let sel = test_extra_channels(&label, segments, ls, &choice.terms, notes)?;
-        Ok((choice, sel))
-    })
+    with_ls_segments(
+        flight,
+        opts,
+        reference_nt,
+        &mut quiet,
+        |ls, _, segments, _| {
+            let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
+            notes.stage("testing the extra regressors");
+            let sel = test_extra_channels(&label, segments, ls, &choice.terms, notes)?;
+            Ok((choice, sel))
+        },
+    )
 }
 
 /// The band-pass LS fit on a flight.
@@ -472,9 +478,15 @@ fn fit_ls_flight(
     reference_nt: Option<&[f64]>,
     notes: &mut Notes,
 ) -> Result<(TlModel, Option<LagSelection>)> {
-    with_ls_segments(flight, opts, reference_nt, notes, |ls, ref_cols, segments, notes| {
-        fit_ls_segments(flight, opts, ls, ref_cols, segments, notes)
-    })
+    with_ls_segments(
+        flight,
+        opts,
+        reference_nt,
+        notes,
+        |ls, ref_cols, segments, notes| {
+            fit_ls_segments(flight, opts, ls, ref_cols, segments, notes)
+        },
+    )
 }
 
 /// [`fit_ls_flight`] on its segments.

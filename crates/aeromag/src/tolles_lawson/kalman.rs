@@ -12,12 +12,13 @@ use aeromag_compensation::kalman::altitude::{
 };
 use aeromag_compensation::kalman::{
     DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, ORDERS,
-    X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions, ground_speed_from_velocity, q1_unit,
+    X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions, ground_speed_from_velocity,
+    q1_unit,
 };
 use aeromag_compensation::model_file::TlModel;
-use aeromag_compensation::tolles_lawson::{ExtraRequest, Magnitude};
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
 use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
+use aeromag_compensation::tolles_lawson::{ExtraRequest, Magnitude};
 use aeromag_io::FlightTable;
 use std::ops::Range;
 

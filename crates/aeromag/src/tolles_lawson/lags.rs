@@ -96,7 +96,11 @@ pub(super) fn choose_terms(
         let before: Vec<Option<f64>> = terms.extras().iter().map(|x| x.lag_s).collect();
         extras.clear();
         for (k, r) in requests.iter().enumerate().filter(|(_, r)| r.lag) {
-            notes.stage(&format!("choosing the lag of {} (pass {})", r.channel, pass + 1));
+            notes.stage(&format!(
+                "choosing the lag of {} (pass {})",
+                r.channel,
+                pass + 1
+            ));
             let c = LsConfig {
                 design: cfg.design.with_terms(terms.clone()),
                 ..cfg.clone()

@@ -8,7 +8,8 @@ use aeromag::compensation::kalman::{NoiseModel, q1_unit};
 use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag::compensation::tolles_lawson::{Convention, Design, ExtraRequest, Magnitude, TermSet};
 use aeromag::{
-    CalibrateOptions, CalibrateSettings, EddyLag, ExtraSelection, Method, ReferenceChannels, calibrate,
+    CalibrateOptions, CalibrateSettings, EddyLag, ExtraSelection, Method, ReferenceChannels,
+    calibrate,
 };
 use std::path::PathBuf;
 

@@ -62,15 +62,8 @@ pub fn for_each_design_row(
             let lagged = lags.eddy.step(time[i], d);
             let b = [flux[0][i], flux[1][i], flux[2][i]];
             let dir = seg.direction.map_or(b, |v| [v[0][i], v[1][i], v[2][i]]);
-            spec.terms.row_along(
-                dir,
-                b,
-                d,
-                lagged,
-                &extra,
-                spec.bt_scale_nt,
-                &mut row,
-            );
+            spec.terms
+                .row_along(dir, b, d, lagged, &extra, spec.bt_scale_nt, &mut row);
             f(i, &row);
         }
         a = b;

@@ -621,12 +621,25 @@ fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
     };
     let first_err = applied(&Design::new(terms.clone()), &first.coef);
     let gn_err = applied(&exact, &gn.coef);
-    println!("first order {first_err} nT, exact {gn_err} nT, {:?}", gn.warnings);
+    println!(
+        "first order {first_err} nT, exact {gn_err} nT, {:?}",
+        gn.warnings
+    );
     assert!(first_err > 0.1, "first order {first_err} nT");
-    assert!(gn_err < 0.01, "exact {gn_err} nT, first order {first_err} nT");
-    assert!(gn.warnings.iter().any(|w| w.contains("converged in")), "{:?}", gn.warnings);
+    assert!(
+        gn_err < 0.01,
+        "exact {gn_err} nT, first order {first_err} nT"
+    );
+    assert!(
+        gn.warnings.iter().any(|w| w.contains("converged in")),
+        "{:?}",
+        gn.warnings
+    );
     // Every coefficient within 4 of its standard deviations of the truth.
     for (k, ((a, c), s)) in gn.coef.iter().zip(&coef).zip(&gn.std).enumerate() {
-        assert!((a - c).abs() < 4.0 * s, "coefficient {k}: {a} vs {c} (σ {s})");
+        assert!(
+            (a - c).abs() < 4.0 * s,
+            "coefficient {k}: {a} vs {c} (σ {s})"
+        );
     }
 }

@@ -223,6 +223,9 @@ mod tests {
         // Dropping them costs (almost) nothing; dropping the load would not.
         assert!(sel.residual_kept_nt < 1.05 * sel.residual_all_nt, "{sel:?}");
         let load_test = &sel.tests[0];
-        assert!(load_test.lr_statistic > 100.0 * load_test.threshold, "{load_test:?}");
+        assert!(
+            load_test.lr_statistic > 100.0 * load_test.threshold,
+            "{load_test:?}"
+        );
     }
 }

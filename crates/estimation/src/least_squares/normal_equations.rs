@@ -192,14 +192,16 @@ impl NormalEquations {
     pub fn subset(&self, keep: &[usize]) -> Result<NormalEquations> {
         let n = self.n();
         if let Some(&bad) = keep.iter().find(|&&j| j >= n) {
-            return Err(EstError::Dimension(format!(
-                "column {bad} of {n} unknowns"
-            )));
+            return Err(EstError::Dimension(format!("column {bad} of {n} unknowns")));
         }
         let upper = |i: usize, j: usize| self.ata[(i.min(j), i.max(j))];
         let m = keep.len();
         Ok(NormalEquations {
-            ata: DMatrix::from_fn(m, m, |a, b| if a <= b { upper(keep[a], keep[b]) } else { 0.0 }),
+            ata: DMatrix::from_fn(
+                m,
+                m,
+                |a, b| if a <= b { upper(keep[a], keep[b]) } else { 0.0 },
+            ),
             aty: DVector::from_fn(m, |a, _| self.aty[keep[a]]),
             yty: self.yty,
             rows: self.rows,
@@ -448,15 +450,16 @@ mod tests {
         all.add_columns(&refs, &y).unwrap();
         let keep = [3, 0];
         let mut direct = NormalEquations::new(2);
-        direct
-            .add_columns(&[refs[3], refs[0]], &y)
-            .unwrap();
+        direct.add_columns(&[refs[3], refs[0]], &y).unwrap();
         let (a, b) = (
             all.subset(&keep).unwrap().solve(0.0).unwrap(),
             direct.solve(0.0).unwrap(),
         );
         for j in 0..2 {
-            assert!((a.coef[j] - b.coef[j]).abs() <= 1e-12 * b.coef[j].abs(), "{j}");
+            assert!(
+                (a.coef[j] - b.coef[j]).abs() <= 1e-12 * b.coef[j].abs(),
+                "{j}"
+            );
         }
         assert!((a.rss - b.rss).abs() <= 1e-9 * b.rss);
         // Leaving out a column the data need raises the residual.
