@@ -173,7 +173,7 @@ mod tests {
     fn channels_that_explain_nothing_are_dropped() {
         let mut legs = boxed(&TermSet::observable16(), &coef16());
         let k_nt_per_a = [30.0, -12.0, 20.0];
-        let load = |t: f64| 8.0 * f64::from(u8::from((t / 3.7) as u64 % 2 == 0));
+        let load = |t: f64| 8.0 * f64::from(u8::from(((t / 3.7) as u64).is_multiple_of(2)));
         let bus = |t: f64| {
             20.0 + 2.0 * (2.0 * std::f64::consts::PI * 0.003 * t).sin()
                 + 1.3 * (2.0 * std::f64::consts::PI * 0.011 * t + 1.0).sin()
