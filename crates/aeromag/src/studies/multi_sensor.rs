@@ -148,7 +148,11 @@ pub struct MultiSensorOutcome {
 }
 
 /// RMS about the mean of `comp − true_external_<k>` over the survey lines
-/// (`line > 0`; turns left out), rows where both are finite.
+/// (`line > 0`; turns left out), rows where both are finite. One mean for
+/// all lines, not one per line as in
+/// [`aeromag_compensation::metrics::residual::residual_by_line`]: a cabin
+/// sensor's heading-dependent error shows as line-to-line offsets, which
+/// belong to the compensation here.
 fn line_error_rms(survey: &Flight, comp: &[f64], k: usize) -> Result<f64> {
     line_error_rms_against(survey, comp, &format!("true_external_{k}"))
 }
@@ -156,12 +160,8 @@ fn line_error_rms(survey: &Flight, comp: &[f64], k: usize) -> Result<f64> {
 /// [`line_error_rms`] against the truth column `truth`.
 fn line_error_rms_against(survey: &Flight, comp: &[f64], truth: &str) -> Result<f64> {
     let truth = survey.table().require(truth)?;
-    let line = survey.table().require("line")?;
-    let d: Vec<f64> = (0..comp.len())
-        .filter(|&i| line[i] > 0.0 && comp[i].is_finite() && truth[i].is_finite())
-        .map(|i| comp[i] - truth[i])
-        .collect();
-    Ok(rms_about_mean(&d))
+    let d: Vec<f64> = comp.iter().zip(truth).map(|(c, t)| c - t).collect();
+    Ok(rms_about_mean(&on_lines(survey, &d)?))
 }
 
 fn rms_about_mean(d: &[f64]) -> f64 {
@@ -170,14 +170,17 @@ fn rms_about_mean(d: &[f64]) -> f64 {
     (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n).sqrt()
 }
 
-/// The rows of the survey lines of `x`.
-fn on_lines(survey: &Flight, x: &[f64]) -> Result<Vec<f64>> {
+/// The rows on the survey lines (`line > 0`) where `x` is finite.
+fn line_rows(survey: &Flight, x: &[f64]) -> Result<Vec<usize>> {
     let line = survey.table().require("line")?;
-    Ok(x.iter()
-        .zip(line)
-        .filter(|(v, l)| **l > 0.0 && v.is_finite())
-        .map(|(v, _)| *v)
+    Ok((0..x.len())
+        .filter(|&i| line[i] > 0.0 && x[i].is_finite())
         .collect())
+}
+
+/// `x` on its [`line_rows`].
+fn on_lines(survey: &Flight, x: &[f64]) -> Result<Vec<f64>> {
+    Ok(line_rows(survey, x)?.into_iter().map(|i| x[i]).collect())
 }
 
 /// Correlation of `a` and `b` over rows where both are finite.
@@ -305,13 +308,15 @@ impl Study for MultiSensorStudy {
                 .zip(truth_e)
                 .map(|(c, e)| c - e)
                 .collect();
-            let resid = on_lines(&survey, &resid)?;
+            let rows = line_rows(&survey, &resid)?;
+            let resid: Vec<f64> = rows.iter().map(|&i| resid[i]).collect();
             let mut best = ChannelCorrelation {
                 channel: String::new(),
                 correlation: 0.0,
             };
             for r in &extra {
-                let ch = on_lines_aligned(&survey, &comp.sensors[k].2, truth_e, &r.channel)?;
+                let channel = survey.table().require(&r.channel)?;
+                let ch: Vec<f64> = rows.iter().map(|&i| channel[i]).collect();
                 let c = correlation(&resid, &ch);
                 if c.abs() > best.correlation.abs() {
                     best = ChannelCorrelation {
@@ -340,17 +345,6 @@ impl Study for MultiSensorStudy {
             summary: summarize(figures, today),
         })
     }
-}
-
-/// The channel `name` on the rows where `comp − truth` is kept by
-/// [`on_lines`] (survey lines, finite).
-fn on_lines_aligned(survey: &Flight, comp: &[f64], truth: &[f64], name: &str) -> Result<Vec<f64>> {
-    let line = survey.table().require("line")?;
-    let ch = survey.table().require(name)?;
-    Ok((0..comp.len())
-        .filter(|&i| line[i] > 0.0 && (comp[i] - truth[i]).is_finite())
-        .map(|i| ch[i])
-        .collect())
 }
 
 /// The white noise of the simulator's scalar sensors at the sampling rate

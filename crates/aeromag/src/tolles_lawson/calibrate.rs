@@ -301,7 +301,7 @@ pub(super) fn calibrate_with(
         }
         _ => (opts, None),
     };
-    let (mut model, lag_selection, kalman) = match opts.method {
+    let (mut model, mut lag_selection, kalman) = match opts.method {
         Method::Ls => {
             let (model, sel) = fit_ls_flight(flight, opts, reference_nt, notes)?;
             (model, sel, None)
@@ -311,7 +311,6 @@ pub(super) fn calibrate_with(
             (model, sel, Some(outcome))
         }
     };
-    let mut lag_selection = lag_selection;
     // With the channels tested, the lags were chosen by that step (the
     // Kalman method then takes them as fixed, without its own searches).
     if let Some((eddy, extras, sel)) = chosen {

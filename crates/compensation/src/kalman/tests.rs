@@ -589,20 +589,14 @@ fn profile_likelihood_ratio_tells_a_real_group_from_an_empty_one() {
 /// the noise level.
 #[test]
 fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
-    use crate::tolles_lawson::Magnitude;
-    let terms = TermSet::observable16();
-    let coef: Vec<f64> = coef16().iter().map(|c| 40.0 * c).collect();
-    let exact = Design {
-        magnitude: Magnitude::Exact,
-        ..Design::new(terms.clone())
+    use crate::tolles_lawson::fit_ls::tests::{
+        assert_exact_beats_first_order, exact_case, rms_of_difference, to_exact,
     };
+    let terms = TermSet::observable16();
+    let (exact, coef) = exact_case(&terms, &coef16());
     let mut b = flight(NOISE, &terms, &coef16(), 31);
     let fl = [&b.flux[0][..], &b.flux[1][..], &b.flux[2][..]];
-    let first_order = Design::new(terms.clone()).interference(&coef16(), &b.time, fl);
-    let truth = exact.interference(&coef, &b.time, fl);
-    for ((m, a), t) in b.mag.iter_mut().zip(&first_order).zip(&truth) {
-        *m += t - a;
-    }
+    let truth = to_exact(&terms, &coef16(), &coef, &b.time, fl, &mut b.mag);
     let first = fit_kalman(&[b.segment()], &no_tuning(terms.clone(), NOISE)).unwrap();
     let cfg = KalmanConfig {
         design: exact.clone(),
@@ -610,31 +604,15 @@ fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
     };
     let gn = fit_kalman_exact(&[b.segment()], &cfg).unwrap();
     let fl = [&b.flux[0][..], &b.flux[1][..], &b.flux[2][..]];
-    let applied = |d: &Design, c: &[f64]| -> f64 {
-        let e: Vec<f64> = truth
-            .iter()
-            .zip(d.interference(c, &b.time, fl))
-            .map(|(a, m)| a - m)
-            .collect();
-        let m = e.iter().sum::<f64>() / e.len() as f64;
-        (e.iter().map(|v| (v - m).powi(2)).sum::<f64>() / e.len() as f64).sqrt()
-    };
+    let applied =
+        |d: &Design, c: &[f64]| rms_of_difference(&truth, &d.interference(c, &b.time, fl));
     let first_err = applied(&Design::new(terms.clone()), &first.coef);
     let gn_err = applied(&exact, &gn.coef);
     println!(
         "first order {first_err} nT, exact {gn_err} nT, {:?}",
         gn.warnings
     );
-    assert!(first_err > 0.1, "first order {first_err} nT");
-    assert!(
-        gn_err < 0.01,
-        "exact {gn_err} nT, first order {first_err} nT"
-    );
-    assert!(
-        gn.warnings.iter().any(|w| w.contains("converged in")),
-        "{:?}",
-        gn.warnings
-    );
+    assert_exact_beats_first_order(first_err, gn_err, &gn.warnings);
     // Every coefficient within 4 of its standard deviations of the truth.
     for (k, ((a, c), s)) in gn.coef.iter().zip(&coef).zip(&gn.std).enumerate() {
         assert!(
