@@ -32,10 +32,10 @@ import numpy as np
 
 from . import _aeromag
 from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulate_em
-from ._aeromag import Flight, Levelled, Model, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
+from ._aeromag import Flight, Levelled, Model, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
 from .errors import AeromagError, BadInputError
-from .tolles_lawson import TollesLawson, load_model
+from .tolles_lawson import TollesLawson, calibrate_sensors, load_model
 
 __all__ = [
     "AeromagError",
@@ -58,8 +58,10 @@ __all__ = [
     "level",
     "observability",
     "score",
+    "SensorsModel",
     "TlModel",
     "TollesLawson",
+    "calibrate_sensors",
     "decimal_year",
     "igrf",
     "load_model",

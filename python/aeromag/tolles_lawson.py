@@ -18,7 +18,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _aeromag
-from ._aeromag import Flight, TlModel
+from ._aeromag import Flight, SensorsModel, TlModel
 
 FlightLike = Union[Flight, Dict[str, Any], Any]
 
@@ -86,6 +86,9 @@ class TollesLawson:
     - ``extra``: extra regressors, recorded channels times the direction
       cosines, e.g. ``["cur_strb", "cur_flap:lag"]`` (``:lag``: also through
       a first-order lag fitted on the flight); the CLI's ``--extra``;
+    - ``extra_selection``: ``"test"`` (keep the ``extra`` channels the
+      likelihood-ratio test finds to matter, drop the others with a note)
+      or ``"all"``; the CLI's ``--extra-selection``;
     - ``magnitude``: ``"first-order"`` (the Tolles-Lawson projection) or
       ``"exact"`` (``|B + ΔB| − |B|`` by Gauss–Newton, method ``ls``);
     - ``convention``: ``"physical"`` (eddy terms in nT/s) or ``"magnav"``
@@ -118,6 +121,7 @@ class TollesLawson:
         *,
         terms: str = "p3,i5,e8",
         extra: Union[None, str, Sequence[str]] = None,
+        extra_selection: str = "test",
         magnitude: str = "first-order",
         convention: str = "physical",
         ridge_lambda: float = 0.0,
@@ -138,6 +142,7 @@ class TollesLawson:
         self.method = method
         self.terms = terms
         self.extra = extra
+        self.extra_selection = extra_selection
         self.magnitude = magnitude
         self.convention = convention
         self.ridge_lambda = ridge_lambda
@@ -235,10 +240,50 @@ class TollesLawson:
         return est
 
 
+def calibrate_sensors(
+    flight: FlightLike,
+    mag: Union[str, Sequence[str]],
+    vector: Union[None, str, Sequence[str]] = None,
+    reference_sensor: Optional[str] = None,
+    progress: Any = None,
+    **options: Any,
+) -> SensorsModel:
+    """One Tolles-Lawson model per scalar sensor (``aeromag calibrate --mag
+    A,B,…``), returned as the multi-sensor model file (:class:`SensorsModel`).
+
+    ``mag``: the scalar sensors' columns (``["mag_1_uc", "mag_4_uc"]`` or
+    ``"mag_1_uc,mag_4_uc"``); ``vector``: the vector magnetometer by prefix,
+    one for all (``"flux_a"``) or one per sensor (default: the flight's
+    ``flux_x/y/z``); ``reference_sensor``: the reference-sensor mode, a
+    sensor of ``mag`` (fitted first; its compensated reading is the others'
+    external-field reference on every row) or an already compensated column
+    such as ``"mag_1_c"``; ``options``: the keyword options of
+    :class:`TollesLawson` (``extra=[...]``, ``extra_selection``,
+    ``magnitude="exact"``, ``method="kalman"`` …).
+
+    The model applies itself: ``model.compensate(flight)`` gives the
+    ``<name>_interf``, ``<name>_comp`` and ``<name>_grad`` arrays,
+    ``model.apply(flight)`` the flight with them, ``model.score(flight)``
+    the figures of ``aeromag report`` for it.
+    """
+    params = TollesLawson(**options).get_params()
+    names = [m.strip() for m in mag.split(",")] if isinstance(mag, str) else list(mag)
+    vectors = [v.strip() for v in vector.split(",")] if isinstance(vector, str) else vector
+    return _aeromag.calibrate_sensors(
+        as_flight(flight),
+        names,
+        params,
+        vector=None if vectors is None else list(vectors),
+        reference_sensor=reference_sensor,
+        progress=progress_callback(progress),
+    )
+
+
 def load_model(path: Union[str, "os.PathLike[str]"]) -> Any:
     """Read a model file written by the CLI or ``save``: a :class:`TlModel`
-    (``aeromag calibrate``), or a :class:`Model` (``aeromag rotor fit``,
-    ``aeromag pod fit``), by the file's ``kind``.
+    (``aeromag calibrate``), a :class:`SensorsModel` (``aeromag calibrate
+    --mag A,B,…``), or a :class:`Model` (``aeromag rotor fit``, ``aeromag
+    pod fit``), by the file's ``kind``.
 
     A model applies itself: ``model.interference(flight)``,
     ``model.compensate(flight)``, ``model.apply(flight)`` (the flight with

@@ -28,6 +28,7 @@ mod gradiometry;
 mod level;
 mod progress;
 mod rotor_pod;
+mod sensors;
 mod simulate;
 mod tolles_lawson;
 
@@ -44,6 +45,8 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::observability, m)?)?;
+    m.add_class::<sensors::PySensorsModel>()?;
+    m.add_function(wrap_pyfunction!(sensors::calibrate_sensors, m)?)?;
     m.add_class::<rotor_pod::PyModel>()?;
     m.add_function(wrap_pyfunction!(rotor_pod::fit_rotor, m)?)?;
     m.add_function(wrap_pyfunction!(rotor_pod::fit_pod, m)?)?;

@@ -10,8 +10,8 @@ use aeromag::compensation::kalman::NoiseModel;
 use aeromag::compensation::tolles_lawson::{Convention, ExtraRequest, Magnitude, TermSet};
 use aeromag::core::time::Date;
 use aeromag::{
-    CalibrateOptions, CalibrateSettings, EddyLag, Method, ModelFile, Note, ReferenceChannels,
-    TlModel, calibrate as lib_calibrate,
+    CalibrateOptions, CalibrateSettings, EddyLag, ExtraSelection, Method, ModelFile, Note,
+    ReferenceChannels, TlModel, calibrate as lib_calibrate,
 };
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -19,7 +19,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// The keyword options, in the order of the CLI's `calibrate --help`.
-const OPTIONS: [&str; 19] = [
+const OPTIONS: [&str; 20] = [
     "method",
     "tune",
     "no_tune",
@@ -27,6 +27,7 @@ const OPTIONS: [&str; 19] = [
     "field_order",
     "series",
     "extra",
+    "extra_selection",
     "magnitude",
     "terms",
     "convention",
@@ -103,6 +104,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
             "series" => s.series = v.extract()?,
             "terms" => s.terms = Some(TermSet::parse(&text()?).py_err()?),
             "extra" => s.extra = ExtraRequest::parse_list(&text()?).py_err()?,
+            "extra_selection" => s.extra_selection = text()?.parse::<ExtraSelection>().py_err()?,
             "magnitude" => s.magnitude = Some(text()?.parse::<Magnitude>().py_err()?),
             "convention" => s.convention = Some(text()?.parse::<Convention>().py_err()?),
             "ridge_lambda" => s.ridge_lambda = Some(number("a number ≥ 0")?),
@@ -161,7 +163,7 @@ fn unknown(key: &str) -> PyErr {
 
 /// The library's options for these keyword options (bad input if one is
 /// not valid), without fitting: what `TollesLawson.fit` will use.
-fn options(params: &Bound<'_, PyDict>) -> PyResult<CalibrateOptions> {
+pub fn options(params: &Bound<'_, PyDict>) -> PyResult<CalibrateOptions> {
     parse_settings(params)?.options().py_err()
 }
 
@@ -222,6 +224,18 @@ pub struct PyTlModel {
     model: TlModel,
     notes: Vec<Note>,
     series: Option<[Vec<f64>; 5]>,
+}
+
+impl PyTlModel {
+    /// A model without notes or series (read from a file, or one sensor's
+    /// of a multi-sensor model).
+    pub fn of(model: TlModel) -> Self {
+        Self {
+            model,
+            notes: Vec::new(),
+            series: None,
+        }
+    }
 }
 
 #[pymethods]
@@ -337,7 +351,8 @@ impl PyTlModel {
 }
 
 /// Read a model file written by the CLI or `save`: a Tolles-Lawson model
-/// (`TlModel`), or a rotor or pod model (`Model`), by the file's `kind`.
+/// (`TlModel`), a multi-sensor model (`SensorsModel`), or a rotor or pod
+/// model (`Model`), by the file's `kind`.
 #[pyfunction]
 pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
     let kind = std::fs::read_to_string(&path)
@@ -348,12 +363,11 @@ pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
         Some(k @ ("helicopter-rotor" | "towed-pod")) => {
             Ok(Py::new(py, crate::rotor_pod::read_model(&path, k)?)?.into_any())
         }
+        Some(aeromag::compensation::model_file::TL_SENSORS_KIND) => {
+            Ok(Py::new(py, crate::sensors::PySensorsModel::read(&path)?)?.into_any())
+        }
         _ => {
-            let model = PyTlModel {
-                model: TlModel::read(&path).py_err()?,
-                notes: Vec::new(),
-                series: None,
-            };
+            let model = PyTlModel::of(TlModel::read(&path).py_err()?);
             Ok(Py::new(py, model)?.into_any())
         }
     }

@@ -90,26 +90,11 @@ impl InputArgs {
                 })
                 .unwrap_or_default()
         };
-        let (mags, vectors) = (split(&self.mag), split(&self.vector));
-        if mags.is_empty() {
-            anyhow::bail!(aeromag::Error::bad_input(
-                "give the scalar sensors with --mag A,B,…"
-            ));
-        }
-        if vectors.len() > 1 && vectors.len() != mags.len() {
-            anyhow::bail!(aeromag::Error::bad_input(format!(
-                "--vector names {} vector magnetometers for {} scalar sensors: give one for all or one per sensor",
-                vectors.len(),
-                mags.len()
-            )));
-        }
-        mags.iter()
-            .enumerate()
-            .map(|(k, m)| {
-                let v = vectors.get(k).or(vectors.first()).map(String::as_str);
-                Ok(aeromag::SensorColumns::find(flight, m, v)?)
-            })
-            .collect()
+        Ok(aeromag::SensorColumns::list(
+            flight,
+            &split(&self.mag),
+            &split(&self.vector),
+        )?)
     }
 
     /// Read and check the flight file (every field); its warnings go to stderr.

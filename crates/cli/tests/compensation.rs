@@ -453,6 +453,66 @@ fn several_sensors_with_current_terms() {
     ] {
         assert!(header.split(',').any(|h| h == c), "{c} in {header}");
     }
+    // The report of a multi-sensor model: every sensor, its term groups'
+    // shares and its currents against what is left.
+    let rep = d.path().join("rep");
+    let report = |input: &str| {
+        aeromag(&[
+            "report",
+            "--input",
+            input,
+            "--model",
+            m.to_str().unwrap(),
+            "--out",
+            rep.to_str().unwrap(),
+        ])
+    };
+    let o = report(comp.to_str().unwrap());
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).contains("mag_4 ") && stdout(&o).contains("shares"),
+        "{}",
+        stdout(&o)
+    );
+    let fig: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(rep.join("figures.json")).unwrap()).unwrap();
+    let sensors = fig["sensors"].as_array().unwrap();
+    assert_eq!(sensors.len(), 2);
+    for s in sensors {
+        // First-order models: the shares of the groups sum to one.
+        let shares: f64 = s["groups"]["shares"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .sum();
+        assert!((shares - 1.0).abs() < 1e-9, "{s}");
+        let currents: Vec<&str> = s["currents"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["channel"].as_str().unwrap())
+            .collect();
+        assert!(
+            currents.contains(&"cur_strb") && currents.contains(&"cur_flap"),
+            "{currents:?}"
+        );
+        assert!(s["figures"]["ir"].as_f64().unwrap() > 1.0, "{s}");
+    }
+    assert_eq!(sensors[1]["column"], "mag_4_uc");
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    for needle in [
+        "Several sensors: overview",
+        "Sensor mag_4 (mag_4_uc)",
+        "r with what is left",
+    ] {
+        assert!(html.contains(needle), "{needle}");
+    }
+    // Without the compensated columns: bad input naming the column.
+    std::fs::remove_dir_all(&rep).unwrap();
+    let o = report(cal);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("mag_1_comp"), "{}", stderr(&o));
     // Reference-sensor mode against the compensated stinger column.
     let o = aeromag(&[
         "calibrate",

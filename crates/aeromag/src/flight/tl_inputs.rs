@@ -85,6 +85,32 @@ impl SensorColumns {
         Ok(Self { mag, flux })
     }
 
+    /// The sensors `mags` of `flight` with their vector magnetometers:
+    /// `vectors` gives none (the flight's `flux_x/y/z` for all), one prefix
+    /// for all, or one per sensor (`--mag A,B,… --vector P,Q,…`). Bad input
+    /// for no sensor or a vector list of another length.
+    pub fn list(flight: &Flight, mags: &[String], vectors: &[String]) -> Result<Vec<Self>> {
+        if mags.is_empty() {
+            return Err(crate::Error::bad_input(
+                "give the scalar sensors (--mag A,B,…)",
+            ));
+        }
+        if vectors.len() > 1 && vectors.len() != mags.len() {
+            return Err(crate::Error::bad_input(format!(
+                "--vector names {} vector magnetometers for {} scalar sensors: give one for all or one per sensor",
+                vectors.len(),
+                mags.len()
+            )));
+        }
+        mags.iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let v = vectors.get(k).or(vectors.first()).map(String::as_str);
+                Self::find(flight, m, v)
+            })
+            .collect()
+    }
+
     /// Stem of the sensor's output columns: `mag_3_uc` → `mag_3`,
     /// `UNCOMPMAG3` → `mag_3`, any other name as it is.
     pub fn stem(&self) -> String {

@@ -10,6 +10,11 @@
 //! compute them.
 
 mod section;
+mod sensors;
+
+pub use sensors::{
+    ChannelCorrelation, GroupRms, SensorScore, SensorsFigures, channel_correlations, score_sensors,
+};
 
 use crate::error::Result;
 use crate::flight::{Flight, LeverArm, SegmentRule, reduced, reference_sum};
@@ -65,11 +70,72 @@ pub struct Figures {
     pub fom_after: Option<FomReport>,
 }
 
-/// Segments of rows where `mag` and `mag_comp` are finite, split at lines
-/// and gaps, of at least 2 rows.
-fn segments(t: &Flight, comp: &[f64]) -> Result<Vec<Range<usize>>> {
+/// The series of one scored sensor (nT per row of the flight): what
+/// [`score_series`] and the report section read. [`SensorSeries::of`] takes
+/// the single-sensor columns of `aeromag compensate` (`mag`, `mag_comp`,
+/// `mag_interf`, `true_…`); [`score_sensors`] builds one per sensor of a
+/// multi-sensor model.
+#[derive(Debug, Clone, Copy)]
+pub struct SensorSeries<'a> {
+    /// The uncompensated reading.
+    pub mag: &'a [f64],
+    /// The compensated reading.
+    pub comp: &'a [f64],
+    /// The modelled interference, when written.
+    pub interf: Option<&'a [f64]>,
+    /// Simulation truth, used only to score.
+    pub truth: SensorTruth<'a>,
+}
+
+/// The simulator's truth of one scalar sensor (every series optional).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SensorTruth<'a> {
+    /// The external field at the sensor (`true_external`).
+    pub external: Option<&'a [f64]>,
+    /// The sensor's time-lag term (`true_lag`), not aircraft interference.
+    pub lag: Option<&'a [f64]>,
+    /// The aircraft interference at the sensor (`true_interf`).
+    pub interf: Option<&'a [f64]>,
+    /// The sensor's white noise (`true_mag_noise`).
+    pub noise: Option<&'a [f64]>,
+}
+
+impl<'a> SensorSeries<'a> {
+    /// The single-sensor columns of a compensated flight: `mag`,
+    /// `mag_comp`, and `mag_interf`, `true_external`, `true_lag`,
+    /// `true_interf`, `true_mag_noise` when present.
+    pub fn of(t: &'a Flight) -> Result<Self> {
+        Ok(Self {
+            mag: t.require("mag")?,
+            comp: t.require("mag_comp")?,
+            interf: t.column("mag_interf"),
+            truth: SensorTruth {
+                external: t.column("true_external"),
+                lag: t.column("true_lag"),
+                interf: t.column("true_interf"),
+                noise: t.column("true_mag_noise"),
+            },
+        })
+    }
+}
+
+impl SensorTruth<'_> {
+    /// What the compensated reading should be: the external field plus the
+    /// sensor's lag term (not aircraft interference: levelling handles it),
+    /// when the external field is known.
+    pub fn compensated(&self) -> Option<Vec<f64>> {
+        let ext = self.external?;
+        Some(match self.lag {
+            Some(lag) => ext.iter().zip(lag).map(|(e, l)| e + l).collect(),
+            None => ext.to_vec(),
+        })
+    }
+}
+
+/// Segments of rows where `mag` and `comp` are finite, split at lines and
+/// gaps, of at least 2 rows.
+fn segments(t: &Flight, mag: &[f64], comp: &[f64]) -> Result<Vec<Range<usize>>> {
     let time = t.require("time")?;
-    let mag = t.require("mag")?;
     let usable: Vec<bool> = (0..time.len())
         .map(|i| mag[i].is_finite() && comp[i].is_finite())
         .collect();
@@ -106,12 +172,23 @@ fn segments(t: &Flight, comp: &[f64]) -> Result<Vec<Range<usize>>> {
 /// # Ok::<(), aeromag::Error>(())
 /// ```
 pub fn score(t: &Flight, reference: &[String], lever: Option<&LeverArm>) -> Result<Figures> {
+    score_series(t, &SensorSeries::of(t)?, reference, lever)
+}
+
+/// [`score`] of the sensor series `s` of the flight `t` (which gives the
+/// time, attitude, lines and reference channels).
+pub fn score_series(
+    t: &Flight,
+    s: &SensorSeries,
+    reference: &[String],
+    lever: Option<&LeverArm>,
+) -> Result<Figures> {
     let time = t.require("time")?;
     let ref_sum = reference_sum(t, reference, lever)?;
-    let mag = reduced(t.require("mag")?, &ref_sum);
-    let comp_raw = t.require("mag_comp")?;
+    let mag = reduced(s.mag, &ref_sum);
+    let comp_raw = s.comp;
     let comp = reduced(comp_raw, &ref_sum);
-    let segs = segments(t, &comp)?;
+    let segs = segments(t, &mag, &comp)?;
     let fs = 1.0 / median_step(time);
     let bpf = BandPass::compensation_default(fs)?;
     let ir = improvement_ratio(&mag, &comp, &segs, &bpf)?;
@@ -138,24 +215,19 @@ pub fn score(t: &Flight, reference: &[String], lever: Option<&LeverArm>) -> Resu
         Some(l) => segs.iter().filter(|r| l[r.start] != 0.0).cloned().collect(),
         None => segs.clone(),
     };
-    let interference_rms_nt = match (t.column("true_interf"), t.column("mag_interf")) {
+    let interference_rms_nt = match (s.truth.interf, s.interf) {
         (Some(truth), Some(model)) => {
             let (_, pooled) = residual_by_line(model, truth, t.column("line"), &on_line);
             pooled.is_finite().then_some(pooled)
         }
         _ => None,
     };
-    if let Some(ext) = t.column("true_external") {
-        // The sensor lag is not aircraft interference: levelling handles it.
-        let truth: Vec<f64> = match t.column("true_lag") {
-            Some(lag) => ext.iter().zip(lag).map(|(e, l)| e + l).collect(),
-            None => ext.to_vec(),
-        };
+    if let Some(truth) = s.truth.compensated() {
         let (l, pooled) = residual_by_line(comp_raw, &truth, t.column("line"), &on_line);
         residual_rms_nt = pooled.is_finite().then_some(pooled);
         lines = l;
     }
-    if let Some(noise) = t.column("true_mag_noise") {
+    if let Some(noise) = s.truth.noise {
         let v: Vec<f64> = noise.iter().copied().filter(|v| v.is_finite()).collect();
         noise_floor_nt =
             Some((v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt());

@@ -1,6 +1,6 @@
 //! The report section of a scored flight.
 
-use super::Figures;
+use super::{Figures, SensorSeries};
 use crate::error::Result;
 use crate::flight::{Flight, GAP_FACTOR};
 use aeromag_compensation::model_file::TlModel;
@@ -50,10 +50,23 @@ impl Figures {
         t: &Flight,
         model: Option<&TlModel>,
     ) -> Result<ReportSection> {
+        let mut r = self.sensor_section(title, t, &SensorSeries::of(t)?, model)?;
+        levelling_part(&mut r, t)?;
+        Ok(r)
+    }
+
+    /// [`Figures::section`] of the sensor series `s` of `t` (without the
+    /// levelling part, which is the flight's).
+    pub fn sensor_section(
+        &self,
+        title: &str,
+        t: &Flight,
+        s: &SensorSeries,
+        model: Option<&TlModel>,
+    ) -> Result<ReportSection> {
         let fig = self;
         let time = t.require("time")?;
-        let mag = t.require("mag")?;
-        let comp = t.require("mag_comp")?;
+        let (mag, comp) = (s.mag, s.comp);
         let t0 = time.first().copied().unwrap_or(0.0);
         let tt: Vec<f64> = time.iter().map(|v| v - t0).collect();
         let step = median_step(time);
@@ -105,9 +118,9 @@ impl Figures {
         .to_svg()?;
         r.figure(svg, "Scalar magnetometer before and after compensation.");
 
-        if let Some(model_interf) = t.column("mag_interf") {
+        if let Some(model_interf) = s.interf {
             let mi = mean(model_interf);
-            let truth = t.column("true_interf");
+            let truth = s.truth.interf;
             let (title, caption) = if truth.is_some() {
                 (
                     "Aircraft interference: model and truth (means removed)",
@@ -133,8 +146,8 @@ impl Figures {
             r.figure(p.to_svg()?, caption);
         }
 
-        if let Some(ext) = t.column("true_external") {
-            let lag = t.column("true_lag");
+        if let Some(ext) = s.truth.external {
+            let lag = s.truth.lag;
             let res: Vec<f64> = (0..comp.len())
                 .map(|i| comp[i] - ext[i] - lag.map_or(0.0, |l| l[i]))
                 .collect();
@@ -263,19 +276,24 @@ impl Figures {
                 r.paragraph(format!("Fit warnings: {}", m.fit.warnings.join(" | ")));
             }
         }
-        levelling_part(&mut r, t, &series)?;
         Ok(r)
     }
+}
+
+/// A series over the time axis of `t` (seconds since its start), broken at
+/// the time gaps.
+pub(super) fn time_series(t: &Flight, name: &str, y: Vec<f64>) -> Result<Series> {
+    let time = t.require("time")?;
+    let t0 = time.first().copied().unwrap_or(0.0);
+    let tt: Vec<f64> = time.iter().map(|v| v - t0).collect();
+    let (x, y) = gapped(&tt, &y, median_step(time));
+    Ok(Series::line(name, x, y))
 }
 
 /// The levelling columns of a file written by `aeromag level`
 /// (`<value>_level` and `level_flag`), when present: the rows by flag, the
 /// correction (levelled − value) along the flight and per line.
-fn levelling_part(
-    r: &mut ReportSection,
-    t: &Flight,
-    series: &dyn Fn(&str, Vec<f64>) -> Series,
-) -> Result<()> {
+fn levelling_part(r: &mut ReportSection, t: &Flight) -> Result<()> {
     let Some(flag) = t.column(crate::level::LEVEL_FLAG) else {
         return Ok(());
     };
@@ -298,7 +316,7 @@ fn levelling_part(
         "time since start (s)",
         "levelled − value (nT)",
     )
-    .with_series(series("correction", correction.clone()))
+    .with_series(time_series(t, "correction", correction.clone())?)
     .to_svg()?;
     r.figure(
         svg,

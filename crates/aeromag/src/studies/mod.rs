@@ -28,8 +28,8 @@ pub use fixed_wing::{
 };
 pub use gradiometry::{GradiometryOutcome, GradiometryStudy, GradiometrySummary};
 pub use multi_sensor::{
-    CALIBRATION_CYCLES, ChannelCorrelation, GroupRms, MultiSensorOutcome, MultiSensorStudy,
-    MultiSensorSummary, SGL_CURRENTS, SensorFigures,
+    CALIBRATION_CYCLES, MultiSensorOutcome, MultiSensorStudy, MultiSensorSummary, SGL_CURRENTS,
+    SensorFigures,
 };
 pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
 pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};

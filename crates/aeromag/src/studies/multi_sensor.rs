@@ -26,6 +26,7 @@ use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed
 use crate::error::{Error, Result};
 use crate::flight::{Flight, ReferenceChannels, SensorColumns};
 use crate::observer::Observer;
+use crate::score::{ChannelCorrelation, GroupRms, channel_correlations};
 use crate::simulate::{ScenarioKind, simulate_flight};
 use crate::tolles_lawson::{
     CalibrateOptions, CompensateSensors, EddyLag, ExtraSelection, InterferenceParts, SensorModel,
@@ -89,29 +90,6 @@ pub struct SensorFigures {
     pub group_rms: GroupRms,
     /// The current channel most correlated with the residual.
     pub residual_current_correlation: ChannelCorrelation,
-}
-
-/// RMS of each term group's part of the fitted interference
-/// ([`InterferenceParts`]), nT.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct GroupRms {
-    /// Permanent magnetization.
-    pub permanent_nt: f64,
-    /// Induced magnetization.
-    pub induced_nt: f64,
-    /// Eddy currents.
-    pub eddy_nt: f64,
-    /// The currents' terms.
-    pub currents_nt: f64,
-}
-
-/// A channel and its correlation with a residual.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ChannelCorrelation {
-    /// The channel.
-    pub channel: String,
-    /// Pearson correlation over the survey lines.
-    pub correlation: f64,
 }
 
 /// The `multi_sensor` group of the demo's `summary.json`, nT.
@@ -181,32 +159,6 @@ fn line_rows(survey: &Flight, x: &[f64]) -> Result<Vec<usize>> {
 /// `x` on its [`line_rows`].
 fn on_lines(survey: &Flight, x: &[f64]) -> Result<Vec<f64>> {
     Ok(line_rows(survey, x)?.into_iter().map(|i| x[i]).collect())
-}
-
-/// Correlation of `a` and `b` over rows where both are finite.
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let p: Vec<(f64, f64)> = a
-        .iter()
-        .zip(b)
-        .filter(|(x, y)| x.is_finite() && y.is_finite())
-        .map(|(x, y)| (*x, *y))
-        .collect();
-    let n = p.len().max(1) as f64;
-    let (ma, mb) = (
-        p.iter().map(|v| v.0).sum::<f64>() / n,
-        p.iter().map(|v| v.1).sum::<f64>() / n,
-    );
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in p {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    if saa > 0.0 && sbb > 0.0 {
-        sab / (saa * sbb).sqrt()
-    } else {
-        0.0
-    }
 }
 
 impl Study for MultiSensorStudy {
@@ -293,13 +245,8 @@ impl Study for MultiSensorStudy {
                 (Some(r), Some(oracle(&survey, s, m, idx)?))
             };
             let parts = InterferenceParts::of(m, &survey, s)?;
-            let rms = |p: &[f64]| -> Result<f64> { Ok(rms_about_mean(&on_lines(&survey, p)?)) };
-            let group_rms = GroupRms {
-                permanent_nt: rms(&parts.permanent)?,
-                induced_nt: rms(&parts.induced)?,
-                eddy_nt: rms(&parts.eddy)?,
-                currents_nt: rms(&parts.currents)?,
-            };
+            let interf = &comp.sensors[k].1;
+            let group_rms = GroupRms::of(&parts, interf, &line_rows(&survey, interf)?);
             // The residual against every recorded current.
             let truth_e = survey.table().require(&format!("true_external_{idx}"))?;
             let resid: Vec<f64> = comp.sensors[k]
@@ -310,21 +257,19 @@ impl Study for MultiSensorStudy {
                 .collect();
             let rows = line_rows(&survey, &resid)?;
             let resid: Vec<f64> = rows.iter().map(|&i| resid[i]).collect();
-            let mut best = ChannelCorrelation {
-                channel: String::new(),
-                correlation: 0.0,
-            };
-            for r in &extra {
-                let channel = survey.table().require(&r.channel)?;
-                let ch: Vec<f64> = rows.iter().map(|&i| channel[i]).collect();
-                let c = correlation(&resid, &ch);
-                if c.abs() > best.correlation.abs() {
-                    best = ChannelCorrelation {
-                        channel: r.channel.clone(),
-                        correlation: c,
-                    };
-                }
-            }
+            let channels: Vec<(String, Vec<f64>)> = extra
+                .iter()
+                .map(|r| {
+                    let c = survey.table().require(&r.channel)?;
+                    Ok((r.channel.clone(), rows.iter().map(|&i| c[i]).collect()))
+                })
+                .collect::<Result<_>>()?;
+            let borrowed: Vec<(String, &[f64])> =
+                channels.iter().map(|(n, c)| (n.clone(), &c[..])).collect();
+            let best = channel_correlations(&resid, &borrowed)
+                .into_iter()
+                .next()
+                .ok_or_else(|| Error::bad_input("no current channel"))?;
             figures.push(SensorFigures {
                 sensor: s.mag.clone(),
                 interference_rms_nt: rms_about_mean(&on_lines(&survey, truth_i)?),
@@ -515,18 +460,20 @@ impl StudyOutcome for MultiSensorOutcome {
         for f in &s.sensors {
             let g = &f.group_rms;
             let r = &f.residual_current_correlation;
+            let cell = |rms: f64, share: f64| format!("{rms:.2} ({:.0} %)", 100.0 * share);
             groups.push(vec![
                 f.sensor.clone(),
-                fixed(Some(g.permanent_nt), 2),
-                fixed(Some(g.induced_nt), 2),
-                fixed(Some(g.eddy_nt), 2),
-                fixed(Some(g.currents_nt), 2),
+                cell(g.permanent_nt, g.shares[0]),
+                cell(g.induced_nt, g.shares[1]),
+                cell(g.eddy_nt, g.shares[2]),
+                cell(g.currents_nt, g.shares[3]),
                 format!("{} (r = {:.2})", r.channel, r.correlation),
             ]);
         }
         sec.blocks.push(Block::Paragraph(
-            "The interference each term group explains on the survey lines (RMS of the fitted model's part, \
-             the other groups set to zero), and the current channel most correlated with what is left."
+            "The interference each term group explains on the survey lines: RMS of the fitted model's part \
+             (the other groups set to zero) and its share cov(part, total)/var(total) of the modelled \
+             interference; and the current channel most correlated with what is left."
                 .into(),
         ));
         sec.blocks.push(Block::Table(Table::new(

@@ -130,6 +130,20 @@ pub enum ExtraSelection {
     All,
 }
 
+impl FromStr for ExtraSelection {
+    type Err = Error;
+    /// `test` or `all`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "test" => Ok(ExtraSelection::Test),
+            "all" => Ok(ExtraSelection::All),
+            m => Err(Error::bad_input(format!(
+                "extra selection `{m}`: use `test` or `all`"
+            ))),
+        }
+    }
+}
+
 /// Everything `calibrate` is told besides the flight.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrateOptions {

@@ -13,6 +13,12 @@ use std::path::PathBuf;
 /// when given the model — the coefficient table with standard deviations.
 /// Simulated files (with `true_…` columns) also get residuals versus truth.
 ///
+/// With a multi-sensor model (`calibrate --mag A,B,…`) and the file its
+/// `compensate` wrote: an overview of every sensor (before and after, the
+/// share of the interference each term group explains, the current most
+/// correlated with what is left), then each sensor's section with its
+/// currents against the residual.
+///
 /// Example:
 ///   aeromag compensate --model m.json --input cal.csv --out cal_comp.csv
 ///   aeromag report --input cal_comp.csv --model m.json --out report/
@@ -36,6 +42,11 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_folder(&a.out)?;
+    if let Some(m) = &a.model
+        && aeromag::model_file::kind_of(m)? == aeromag::compensation::model_file::TL_SENSORS_KIND
+    {
+        return run_sensors(&a, m);
+    }
     let model = a.model.as_deref().map(TlModel::read).transpose()?;
     // Only the columns the report reads (an HDF5 flight of 100 fields).
     let mut extra: Vec<&str> = aeromag::score::SCORED_COLUMNS.to_vec();
@@ -55,13 +66,49 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut r = Report::new(format!("aeromag report — {}", flight.file_label()));
     fig.section("Compensation", &flight, model.as_ref())?
         .append_to(&mut r);
+    write(&a, r, serde_json::to_string_pretty(&fig)?)
+}
+
+/// The report and `figures.json` into the output folder.
+fn write(a: &Args, r: Report, figures: String) -> anyhow::Result<()> {
     let path = a.out.join("index.html");
     r.write_html(&path)?;
-    aeromag::io::atomic::write_file(
-        &a.out.join("figures.json"),
-        serde_json::to_string_pretty(&fig)?,
-    )
-    .map_err(|e| aeromag::Error::write(a.out.join("figures.json"), e))?;
+    aeromag::io::atomic::write_file(&a.out.join("figures.json"), figures)
+        .map_err(|e| aeromag::Error::write(a.out.join("figures.json"), e))?;
     println!("report written to {}", path.display());
     Ok(())
+}
+
+/// A multi-sensor model: every sensor (library: [`aeromag::score::score_sensors`]).
+fn run_sensors(a: &Args, model_path: &std::path::Path) -> anyhow::Result<()> {
+    let model = aeromag::SensorsModel::read(model_path)?;
+    let flight = a.input.load()?;
+    let reference = match &a.reference {
+        Some(r) => r.resolve(&flight)?,
+        // The sensors fitted against the field share the reference channels.
+        None => match model.sensors.iter().find(|s| s.reference_sensor.is_none()) {
+            Some(s) => s.model.reference.clone(),
+            None => ReferenceChannels::Auto.resolve(&flight)?,
+        },
+    };
+    let fig = aeromag::score::score_sensors(&flight, &model, &reference)?;
+    let mut r = Report::new(format!("aeromag report — {}", flight.file_label()));
+    for s in fig.sections(&flight, &model)? {
+        s.append_to(&mut r);
+    }
+    for s in &fig.sensors {
+        let f = &s.figures;
+        println!(
+            "{:<8} IR {:>7}  FOM {} → {} nT  shares {}",
+            s.sensor,
+            f.ir.map_or("—".into(), |v| format!("{v:.1}")),
+            f.fom_before_nt.map_or("—".into(), |v| format!("{v:.2}")),
+            f.fom_after_nt.map_or("—".into(), |v| format!("{v:.3}")),
+            s.groups
+                .shares
+                .map(|x| format!("{:.0}%", 100.0 * x))
+                .join("/")
+        );
+    }
+    write(a, r, serde_json::to_string_pretty(&fig)?)
 }
