@@ -193,6 +193,100 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
             .any(|(x, y)| (x - y).abs() > 1e-3 * y.abs().max(1.0)),
         "the cabin sensor pair has its own model"
     );
+    // Several sensors with current terms in the reference-sensor mode
+    // (issue 20), on the whole flight's box: the same models from the CSV
+    // (canonical names) and from the HDF5 file (SGL names), the same
+    // compensated cabin sensor on the survey lines, and its report.
+    let mut sensor_models = Vec::new();
+    let mut sensor_outputs = Vec::new();
+    for (k, (input, mags, vectors, reference)) in [
+        (&csv, "mag,mag_3", "flux,flux_c", "mag"),
+        (&h5, "mag_1_uc,mag_3_uc", "flux_a,flux_c", "mag_1_uc"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let model = d.join(format!("sensors_{k}.json"));
+        let input = input.to_str().unwrap();
+        let o = aeromag(&[
+            "calibrate",
+            "-i",
+            input,
+            "--lines",
+            "1002.02",
+            "--mag",
+            mags,
+            "--vector",
+            vectors,
+            "--extra",
+            "cur_strb,cur_flap:lag",
+            "--reference-sensor",
+            reference,
+            "--model",
+            model.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        let out = d.join(format!("sensors_comp{k}.csv"));
+        let o = aeromag(&[
+            "compensate",
+            "-i",
+            input,
+            "--lines",
+            survey_lines,
+            "--model",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 0);
+        sensor_models.push(read_json(&model));
+        sensor_outputs.push(out);
+    }
+    for s in 0..2 {
+        let c = |m: &serde_json::Value| coef(&m["sensors"][s]["model"]);
+        let (x, y) = (c(&sensor_models[0]), c(&sensor_models[1]));
+        assert!(
+            x.len() > 16 && x.len() == y.len(),
+            "{} vs {}",
+            x.len(),
+            y.len()
+        );
+        for (x, y) in x.iter().zip(&y) {
+            assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-3), "{x} vs {y}");
+        }
+    }
+    assert_eq!(
+        sensor_models[1]["sensors"][1]["reference_sensor"],
+        "mag_1_uc"
+    );
+    let (ca, cb) = (
+        column(&sensor_outputs[0], "mag_3_comp"),
+        column(&sensor_outputs[1], "mag_3_comp"),
+    );
+    assert!(ca.len() == cb.len() && ca.len() > 1000);
+    let worst = ca
+        .iter()
+        .zip(&cb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f64, f64::max);
+    assert!(worst < 1e-6, "largest difference {worst} nT");
+    let rep = d.join("sensors_report");
+    let o = aeromag(&[
+        "report",
+        "-i",
+        sensor_outputs[1].to_str().unwrap(),
+        "--model",
+        d.join("sensors_1.json").to_str().unwrap(),
+        "--out",
+        rep.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let fig = read_json(&rep.join("figures.json"));
+    assert_eq!(fig["sensors"][1]["column"], "mag_3_uc");
+    assert!(
+        fig["sensors"][1]["figures"]["residual_rms_nt"].is_number(),
+        "{fig}"
+    );
     // Levelled with its decimal labels (ties declared), and reported: the
     // report reads the levelling columns.
     let levelled = d.join("level.csv");

@@ -125,7 +125,9 @@ pub struct Args {
     magnitude: Magnitude,
     /// Reference-sensor mode: the scalar sensor (one of --mag) or compensated
     /// column whose compensated reading is the other sensors'
-    /// external-field reference, e.g. `mag_1_uc`.
+    /// external-field reference, e.g. `mag_1_uc`. The other sensors are
+    /// fitted by least squares on every row whatever --method (the
+    /// reference removes the external field the Kalman method models).
     #[arg(long, value_name = "NAME")]
     reference_sensor: Option<String>,
     /// Term groups: p3, i6 or i5, e9 or e8, bias (comma-separated).
