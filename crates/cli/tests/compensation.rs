@@ -500,11 +500,17 @@ fn several_sensors_with_current_terms() {
         assert!(s["figures"]["ir"].as_f64().unwrap() > 1.0, "{s}");
     }
     assert_eq!(sensors[1]["column"], "mag_4_uc");
+    // A cabin sensor's first-order model: the report says the projection
+    // leaves out more than the threshold and recommends the exact
+    // magnitude; the stinger's does not need it.
+    let second = |k: usize| sensors[k]["second_order_nt"].as_f64().unwrap();
+    assert!(second(0) < 0.1 && second(1) > 0.1, "{sensors:?}");
     let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
     for needle in [
         "Several sensors: overview",
         "Sensor mag_4 (mag_4_uc)",
         "r with what is left",
+        "calibrate with --magnitude exact",
     ] {
         assert!(html.contains(needle), "{needle}");
     }

@@ -50,19 +50,23 @@ impl Figures {
         t: &Flight,
         model: Option<&TlModel>,
     ) -> Result<ReportSection> {
-        let mut r = self.sensor_section(title, t, &SensorSeries::of(t)?, model)?;
+        let sensor = crate::flight::SensorColumns::default();
+        let mut r = self.sensor_section(title, t, &SensorSeries::of(t)?, model, &sensor)?;
         levelling_part(&mut r, t)?;
         Ok(r)
     }
 
     /// [`Figures::section`] of the sensor series `s` of `t` (without the
-    /// levelling part, which is the flight's).
+    /// levelling part, which is the flight's); `model` is applied at
+    /// `sensor`'s columns to say whether the first-order projection is
+    /// enough there.
     pub fn sensor_section(
         &self,
         title: &str,
         t: &Flight,
         s: &SensorSeries,
         model: Option<&TlModel>,
+        sensor: &crate::flight::SensorColumns,
     ) -> Result<ReportSection> {
         let fig = self;
         let time = t.require("time")?;
@@ -98,7 +102,24 @@ impl Figures {
         if let Some(v) = fig.noise_floor_nt {
             kv.push(("scalar sensor noise floor (nT)".into(), format!("{v:.4}")));
         }
+        let second = match model {
+            Some(m) => crate::tolles_lawson::second_order_range_nt(m, t, sensor)?,
+            None => None,
+        };
+        if let Some(v) = second {
+            kv.push((
+                "second-order term of the projection, peak to peak (nT)".into(),
+                format!("{v:.3}"),
+            ));
+        }
         r.key_values(kv);
+        if let Some(v) = second.filter(|v| *v > crate::tolles_lawson::SECOND_ORDER_NOTE_NT) {
+            r.paragraph(format!(
+                "The first-order projection of the Tolles-Lawson model leaves out up to {v:.2} nT \
+                 on this flight (the second-order term |ΔB⊥|²/2|B| of an interference above about 1 % \
+                 of the field): calibrate with --magnitude exact, which fits |B + ΔB| − |B|."
+            ));
+        }
 
         let mean = |x: &[f64]| {
             let v: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();

@@ -158,6 +158,9 @@ pub struct SensorScore {
     pub in_model: Vec<String>,
     /// The channels the test dropped.
     pub dropped: Vec<String>,
+    /// Peak to peak of the second-order term the first-order projection
+    /// leaves out, nT (`None` for an exact-magnitude model).
+    pub second_order_nt: Option<f64>,
     /// The compensated reading in the compensation band (reference
     /// channels removed; NaN off the scored rows), nT.
     #[serde(skip)]
@@ -255,11 +258,9 @@ pub fn score_sensors(
         let figures = score_series(t, &series, reference, None)?;
         let segs = scored_segments(t, &series)?;
         let rows: Vec<usize> = segs.iter().flat_map(|r| r.clone()).collect();
-        let cols = SensorColumns {
-            mag: s.mag.clone(),
-            flux: s.flux.clone(),
-        };
+        let cols = columns_of(s);
         let parts = InterferenceParts::of(&s.model, t, &cols)?;
+        let second_order_nt = crate::tolles_lawson::second_order_range_nt(&s.model, t, &cols)?;
         let groups = GroupRms::of(&parts, series.interf.unwrap_or_default(), &rows);
         // What compensation left in the band of the aircraft's interference.
         let left = band_pass_segments(&reduced(series.comp, &ref_sum), &segs, &bpf)?;
@@ -305,11 +306,20 @@ pub fn score_sensors(
                     .map(|c| c.channel.clone())
                     .collect()
             }),
+            second_order_nt,
             left_nt: left,
             strongest_nt,
         });
     }
     Ok(SensorsFigures { sensors })
+}
+
+/// The columns of the sensor `s`.
+fn columns_of(s: &SensorModel) -> SensorColumns {
+    SensorColumns {
+        mag: s.mag.clone(),
+        flux: s.flux.clone(),
+    }
 }
 
 /// The scored series of the sensor `s` of the compensated flight `t`.
@@ -358,6 +368,13 @@ impl SensorsFigures {
                         )
                     }),
                     format!("{} kept, {} dropped", s.in_model.len(), s.dropped.len()),
+                    match s.second_order_nt {
+                        None => "exact magnitude".into(),
+                        Some(v) if v > crate::tolles_lawson::SECOND_ORDER_NOTE_NT => {
+                            format!("{v:.2} nT: use --magnitude exact")
+                        }
+                        Some(v) => format!("{v:.3} nT"),
+                    },
                 ]
             })
             .collect();
@@ -373,6 +390,7 @@ impl SensorsFigures {
                 "shares % (perm. / ind. / eddy / currents)",
                 "current most correlated with what is left",
                 "current channels",
+                "second-order term (p-p)",
             ]
             .map(String::from)
             .to_vec(),
@@ -380,7 +398,8 @@ impl SensorsFigures {
             "Each sensor before and after. Shares: cov(part, total)/var(total) of the modelled \
              interference on the scored rows (they sum to 100 % for the first-order model; a negative \
              share cancels part of another group). What is left: the compensated reading in the \
-             compensation band (0.1–0.9 Hz).",
+             compensation band (0.1–0.9 Hz). Second-order term: what the first-order projection leaves \
+             out, |ΔB⊥|²/2|B| peak to peak; above 0.1 nT the exact magnitude is worth fitting.",
         ));
         let mut out = vec![overview];
         for (s, m) in self.sensors.iter().zip(&model.sensors) {
@@ -390,6 +409,7 @@ impl SensorsFigures {
                 t,
                 &series,
                 Some(&m.model),
+                &columns_of(m),
             )?;
             let status = |c: &str| {
                 if s.in_model.iter().any(|n| n == c) {

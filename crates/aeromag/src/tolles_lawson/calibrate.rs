@@ -359,17 +359,14 @@ pub(super) fn second_order_note(
     if design.magnitude != Magnitude::FirstOrder {
         return;
     }
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut span = super::compensate::Span::default();
     for s in segments {
-        for v in design.second_order_nt(coef, s.time, s.flux, s.channels) {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
+        span.add(design, coef, s);
     }
-    if hi - lo > SECOND_ORDER_NOTE_NT {
+    if span.range() > SECOND_ORDER_NOTE_NT {
         notes.note(format!(
             "the second-order term of the projection varies by {:.2} nT over this flight (interference ≳ 1 % of the field): --magnitude exact fits |B + ΔB| − |B|",
-            hi - lo
+            span.range()
         ));
     }
 }

@@ -5,6 +5,8 @@ use crate::error::Result;
 use crate::flight::{Flight, SegmentRule, SensorColumns, TlInputs};
 use crate::observer::Observer;
 use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::tolles_lawson::fit_ls::Segment;
+use aeromag_compensation::tolles_lawson::{Design, Magnitude};
 
 /// The columns `compensate` adds: `mag_interf`, `mag_comp`, `comp_flag`.
 pub const TL_OUTPUT: OutputColumns = OutputColumns {
@@ -39,21 +41,88 @@ pub(super) fn tl_interference(
     flight: &Flight,
     sensor: &SensorColumns,
 ) -> Result<Vec<f64>> {
-    let cols =
-        TlInputs::of_sensor(flight, sensor)?.with_extras(flight, model.design.terms.extras())?;
-    let whole = cols.whole();
     let mut out = vec![f64::NAN; flight.n_rows()];
-    let segs = cols.segments(&SegmentRule::ignoring_lines());
-    debug_assert!(segs.short.is_empty());
     let coef = model.coef();
-    for r in segs.kept {
-        let s = whole.slice(r.clone());
+    for_model_segments(model, flight, sensor, |r, s| {
         let v = model
             .design
             .interference_with(&coef, s.time, s.flux, s.channels);
         out[r].copy_from_slice(&v);
-    }
+    })?;
     Ok(out)
+}
+
+/// Call `f` with every stretch of `flight` that `model` applies to at the
+/// sensor `sensor` (no gaps or missing values; line changes do not matter):
+/// its rows and its inputs.
+fn for_model_segments(
+    model: &TlModel,
+    flight: &Flight,
+    sensor: &SensorColumns,
+    mut f: impl FnMut(std::ops::Range<usize>, &Segment),
+) -> Result<()> {
+    let cols =
+        TlInputs::of_sensor(flight, sensor)?.with_extras(flight, model.design.terms.extras())?;
+    let whole = cols.whole();
+    let segs = cols.segments(&SegmentRule::ignoring_lines());
+    debug_assert!(segs.short.is_empty());
+    for r in segs.kept {
+        f(r.clone(), &whole.slice(r));
+    }
+    Ok(())
+}
+
+/// How much the first-order projection of a first-order `model` leaves out
+/// on `flight` at the sensor `sensor`: the peak-to-peak of its
+/// second-order remainder `|ΔB⊥|²/2|B|` (nT) under the model's
+/// coefficients; `None` for an exact-magnitude
+/// model. Above [`super::calibrate::SECOND_ORDER_NOTE_NT`] the exact
+/// magnitude is worth fitting.
+pub fn second_order_range_nt(
+    model: &TlModel,
+    flight: &Flight,
+    sensor: &SensorColumns,
+) -> Result<Option<f64>> {
+    if model.design.magnitude != Magnitude::FirstOrder {
+        return Ok(None);
+    }
+    let coef = model.coef();
+    let mut span = Span::default();
+    for_model_segments(model, flight, sensor, |_, s| {
+        span.add(&model.design, &coef, s);
+    })?;
+    Ok(Some(span.range()))
+}
+
+/// The range of the second-order remainder over segments.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Span {
+    lo: f64,
+    hi: f64,
+}
+
+impl Default for Span {
+    fn default() -> Self {
+        Self {
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        }
+    }
+}
+
+impl Span {
+    /// Widen by the remainder on the segment `s` under `coef`.
+    pub(super) fn add(&mut self, design: &Design, coef: &[f64], s: &Segment) {
+        for v in design.second_order_nt(coef, s.time, s.flux, s.channels) {
+            self.lo = self.lo.min(v);
+            self.hi = self.hi.max(v);
+        }
+    }
+
+    /// Peak to peak, nT (0 when empty).
+    pub(super) fn range(&self) -> f64 {
+        (self.hi - self.lo).max(0.0)
+    }
 }
 
 /// A model's interference split by term group (nT per row, NaN where the

@@ -25,8 +25,10 @@ mod observability;
 mod sensors;
 mod settings;
 
-pub use calibrate::{CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, calibrate};
-pub use compensate::{InterferenceParts, TL_OUTPUT};
+pub use calibrate::{
+    CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, SECOND_ORDER_NOTE_NT, calibrate,
+};
+pub use compensate::{InterferenceParts, TL_OUTPUT, second_order_range_nt};
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
 pub use sensors::{
