@@ -631,9 +631,9 @@ fn several_sensors_and_the_reference_sensor_mode() {
 /// 16-term model and within 1.5× of its oracle; in reference-sensor mode
 /// the worst cabin sensor within 1.2× of its oracle. Measured (seed 1):
 /// stinger 0.1645 nT (16 terms 0.204; today's
-/// installation, which has no currents, 0.1640); cabin 0.742 / 0.105 /
-/// 0.231 / 0.211 nT against oracles 0.718 / 0.099 / 0.213 / 0.150 (worst
-/// ratio 1.41), 16 terms up to 277 nT; reference mode worst 0.735 nT
+/// installation, which has no currents, 0.1640); cabin 0.725 / 0.104 /
+/// 0.229 / 0.184 nT against oracles 0.716 / 0.099 / 0.213 / 0.168 (worst
+/// ratio 1.09), 16 terms up to 277 nT; reference mode worst 0.730 nT
 /// (1.02×). The figures are printed (`--no-capture`).
 #[test]
 fn sgl_installation_several_sensors_and_currents() {
@@ -692,7 +692,7 @@ fn sgl_installation_several_sensors_and_currents() {
     );
     // The same chain by the Kalman method: no sensor worse than least
     // squares beyond 2 %. Measured: stinger 0.1649 against 0.1645 nT, cabin
-    // 0.742/0.107/0.233/0.208 against 0.742/0.105/0.231/0.211 (worst
+    // 0.726/0.106/0.231/0.183 against 0.725/0.104/0.229/0.184 (worst
     // mag_3_uc, +1.7 %: the cabin sensors are fitted against the
     // Kalman-compensated stinger, which differs from the LS one at the
     // 0.001 nT level). Before the reference-sensor mode fitted the cabin

@@ -348,10 +348,11 @@ fn oracle(
         eddy_lag: EddyLag::Fixed(terms.eddy_lags_s().to_vec()),
         reference: ReferenceChannels::Columns(vec![format!("true_external_{idx}")]),
         extra_selection: ExtraSelection::All,
-        // Fitted line by line (the lagged terms restart at each line in
-        // steady state). Fitted through the line changes, as the
-        // reference-sensor mode now fits, the oracle of mag_5_uc is 0.141
-        // nT instead of 0.150 and the chain's ratio to it 1.52: open.
+        // As the reference-sensor mode fits: the lagged terms run through
+        // the line changes as the compensation applies them (fitted line by
+        // line, restarting them at each line, the oracle of mag_5_uc was
+        // 0.150 nT instead of 0.141).
+        split_lines: false,
         ..CalibrateOptions::default()
     };
     let fit = calibrate(survey, &opts, &mut crate::observer::Silent)?.model;
