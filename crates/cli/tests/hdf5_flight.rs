@@ -58,6 +58,23 @@ fn python_flight(dir: &Path) {
     );
 }
 
+/// `aeromag compensate` of the rows of `lines` of `input` with `model`
+/// into `out`, which must succeed.
+fn compensate_lines(input: &Path, lines: &str, model: &Path, out: &Path) {
+    let o = aeromag(&[
+        "compensate",
+        "-i",
+        input.to_str().unwrap(),
+        "--lines",
+        lines,
+        "--model",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+}
+
 fn read_json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
@@ -111,18 +128,7 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         ]);
         assert_code(&o, 0);
         let out = d.join(format!("comp{k}.csv"));
-        let o = aeromag(&[
-            "compensate",
-            "-i",
-            input.to_str().unwrap(),
-            "--lines",
-            survey_lines,
-            "--model",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_code(&o, 0);
+        compensate_lines(input, survey_lines, &model, &out);
         models.push(read_json(&model));
         outputs.push(out);
     }
@@ -227,18 +233,7 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         ]);
         assert_code(&o, 0);
         let out = d.join(format!("sensors_comp{k}.csv"));
-        let o = aeromag(&[
-            "compensate",
-            "-i",
-            input,
-            "--lines",
-            survey_lines,
-            "--model",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_code(&o, 0);
+        compensate_lines(Path::new(input), survey_lines, &model, &out);
         sensor_models.push(read_json(&model));
         sensor_outputs.push(out);
     }

@@ -197,14 +197,7 @@ fn truth_of<'a>(t: &'a Flight, name: &str) -> SensorTruth<'a> {
 /// The current channels of `t` for `model`: its extra regressors, then
 /// the other `cur_*` columns, each once.
 fn current_channels<'a>(t: &'a Flight, model: &SensorModel) -> Vec<(String, &'a [f64])> {
-    let mut names: Vec<String> = model
-        .model
-        .design
-        .terms
-        .extras()
-        .iter()
-        .map(|e| e.channel.clone())
-        .collect();
+    let mut names = extra_channels(model);
     for n in t.column_names() {
         if n.to_ascii_lowercase().starts_with("cur_") && !names.iter().any(|m| m == n) {
             names.push(n.to_string());
@@ -291,14 +284,7 @@ pub fn score_sensors(
             figures,
             groups,
             currents,
-            in_model: s
-                .model
-                .design
-                .terms
-                .extras()
-                .iter()
-                .map(|e| e.channel.clone())
-                .collect(),
+            in_model: extra_channels(s),
             dropped: selection.map_or_else(Vec::new, |sel| {
                 sel.tests
                     .iter()
@@ -312,6 +298,17 @@ pub fn score_sensors(
         });
     }
     Ok(SensorsFigures { sensors })
+}
+
+/// The channels of the extra regressors of the sensor `s`'s model.
+fn extra_channels(s: &SensorModel) -> Vec<String> {
+    s.model
+        .design
+        .terms
+        .extras()
+        .iter()
+        .map(|e| e.channel.clone())
+        .collect()
 }
 
 /// The columns of the sensor `s`.
