@@ -75,6 +75,20 @@ fn compensate_lines(input: &Path, lines: &str, model: &Path, out: &Path) {
     assert_code(&o, 0);
 }
 
+/// The column `name` of the two outputs (the CSV and the HDF5 route) is
+/// the same row for row (to 1e-6 nT), over more than 1000 survey rows.
+fn assert_same_column(outputs: &[std::path::PathBuf], name: &str) {
+    let (ca, cb) = (column(&outputs[0], name), column(&outputs[1], name));
+    assert_eq!(ca.len(), cb.len());
+    assert!(ca.len() > 1000, "{} survey rows", ca.len());
+    let worst = ca
+        .iter()
+        .zip(&cb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f64, f64::max);
+    assert!(worst < 1e-6, "{name}: largest difference {worst} nT");
+}
+
 fn read_json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
@@ -148,18 +162,7 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-3), "{x} vs {y}");
     }
     // The same compensated survey, row for row.
-    let (ca, cb) = (
-        column(&outputs[0], "mag_comp"),
-        column(&outputs[1], "mag_comp"),
-    );
-    assert_eq!(ca.len(), cb.len());
-    assert!(ca.len() > 1000, "{} survey rows", ca.len());
-    let worst = ca
-        .iter()
-        .zip(&cb)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0f64, f64::max);
-    assert!(worst < 1e-6, "largest difference {worst} nT");
+    assert_same_column(&outputs, "mag_comp");
     // Every survey row is written, none of the box or the transit.
     let lines = column(&outputs[1], "line");
     assert!(
@@ -254,17 +257,7 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
         sensor_models[1]["sensors"][1]["reference_sensor"],
         "mag_1_uc"
     );
-    let (ca, cb) = (
-        column(&sensor_outputs[0], "mag_3_comp"),
-        column(&sensor_outputs[1], "mag_3_comp"),
-    );
-    assert!(ca.len() == cb.len() && ca.len() > 1000);
-    let worst = ca
-        .iter()
-        .zip(&cb)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0f64, f64::max);
-    assert!(worst < 1e-6, "largest difference {worst} nT");
+    assert_same_column(&sensor_outputs, "mag_3_comp");
     let rep = d.join("sensors_report");
     let o = aeromag(&[
         "report",

@@ -106,16 +106,16 @@ fn covariance(a: &[f64], b: &[f64]) -> f64 {
 /// The correlation of each channel with `residual` over the rows where
 /// both are finite, strongest (largest |r|) first; a constant channel has
 /// r = 0.
-pub fn channel_correlations(
+pub fn channel_correlations<C: AsRef<[f64]>>(
     residual: &[f64],
-    channels: &[(String, &[f64])],
+    channels: &[(String, C)],
 ) -> Vec<ChannelCorrelation> {
     let mut out: Vec<ChannelCorrelation> = channels
         .iter()
         .map(|(name, ch)| {
             let (a, b): (Vec<f64>, Vec<f64>) = residual
                 .iter()
-                .zip(ch.iter())
+                .zip(ch.as_ref())
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .map(|(x, y)| (*x, *y))
                 .unzip();
@@ -257,24 +257,22 @@ pub fn score_sensors(
         let groups = GroupRms::of(&parts, series.interf.unwrap_or_default(), &rows);
         // What compensation left in the band of the aircraft's interference.
         let left = band_pass_segments(&reduced(series.comp, &ref_sum), &segs, &bpf)?;
-        let channels: Vec<(String, Vec<f64>)> = current_channels(t, s)
+        // Each current in the same band, whole and on the scored rows.
+        let banded: Vec<(String, Vec<f64>)> = current_channels(t, s)
             .into_iter()
             .map(|(n, c)| Ok((n, band_pass_segments(c, &segs, &bpf)?)))
             .collect::<Result<_>>()?;
         let on_rows = |x: &[f64]| -> Vec<f64> { rows.iter().map(|&i| x[i]).collect() };
-        let channels_full = channels;
-        let channels: Vec<(String, Vec<f64>)> = channels_full
+        let scored: Vec<(String, Vec<f64>)> = banded
             .iter()
             .map(|(n, c)| (n.clone(), on_rows(c)))
             .collect();
-        let borrowed: Vec<(String, &[f64])> =
-            channels.iter().map(|(n, c)| (n.clone(), &c[..])).collect();
-        let currents = channel_correlations(&on_rows(&left), &borrowed);
+        let currents = channel_correlations(&on_rows(&left), &scored);
         let strongest_nt = currents.first().and_then(|c| {
-            let (_, full) = channels_full.iter().find(|(n, _)| *n == c.channel)?;
-            let sd = covariance(&on_rows(full), &on_rows(full)).sqrt();
+            let k = scored.iter().position(|(n, _)| *n == c.channel)?;
+            let sd = covariance(&scored[k].1, &scored[k].1).sqrt();
             let slope = c.explained_nt / sd * c.correlation.signum();
-            (sd > 0.0).then(|| full.iter().map(|v| v * slope).collect())
+            (sd > 0.0).then(|| banded[k].1.iter().map(|v| v * slope).collect())
         });
         let selection = s.model.fit.extra_channel_selection.as_ref();
         sensors.push(SensorScore {

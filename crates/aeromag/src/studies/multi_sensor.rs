@@ -291,9 +291,7 @@ impl Study for MultiSensorStudy {
                     Ok((r.channel.clone(), rows.iter().map(|&i| c[i]).collect()))
                 })
                 .collect::<Result<_>>()?;
-            let borrowed: Vec<(String, &[f64])> =
-                channels.iter().map(|(n, c)| (n.clone(), &c[..])).collect();
-            let best = channel_correlations(&resid, &borrowed)
+            let best = channel_correlations(&resid, &channels)
                 .into_iter()
                 .next()
                 .ok_or_else(|| Error::bad_input("no current channel"))?;
