@@ -396,7 +396,7 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
 /// coefficients `coef` ([`fit_exact_magnitude`]): the total field
 /// `B + ΔB(c)` of every row of `s` (x, y, z, nT) and the reading corrected
 /// by the second-order remainder, `mag − R`.
-pub(crate) fn linearised(design: &Design, coef: &[f64], s: &Segment) -> ([Vec<f64>; 3], Vec<f64>) {
+pub fn linearised(design: &Design, coef: &[f64], s: &Segment) -> ([Vec<f64>; 3], Vec<f64>) {
     let (d, _) = design.field_vector(coef, s.time, s.flux, s.channels);
     let n = s.time.len();
     let mut total = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
