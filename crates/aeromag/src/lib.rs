@@ -72,6 +72,7 @@ pub mod gradiometry;
 pub mod level;
 pub mod model_file;
 pub mod observer;
+pub mod online;
 pub mod pod;
 pub mod rotor;
 pub mod score;

@@ -54,7 +54,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 terms: terms.clone(),
                 convention: conv,
                 bt_scale_nt: DEFAULT_BT_SCALE_NT,
-                magnitude: Default::default(),
+                ..Design::default()
             };
             let cols = design.columns(&t, [&x, &y, &z]);
             let mut out = String::new();

@@ -147,6 +147,11 @@ pub struct FitStats {
     /// (absent when every one was kept without a test).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extra_channel_selection: Option<crate::tolles_lawson::extra_select::ChannelSelection>,
+    /// The calibration flight's sample interval (median time step), s: the
+    /// online compensator's gap rule (a step over 1.5 × this ends a run;
+    /// absent in files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_interval_s: Option<f64>,
 }
 
 /// JSON has no ∞: `serde_json` writes it as `null`; read `null` back as ∞.
@@ -399,7 +404,7 @@ mod tests {
                 terms,
                 convention: Convention::Physical,
                 bt_scale_nt: 50_000.0,
-                magnitude: Default::default(),
+                ..Design::default()
             },
             fit: FitStats::default(),
             columns: Default::default(),

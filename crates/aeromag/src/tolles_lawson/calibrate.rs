@@ -325,6 +325,7 @@ pub(super) fn calibrate_with(
             (model, sel, Some(outcome))
         }
     };
+    model.fit.sample_interval_s = Some(1.0 / flight.sample_rate_hz()?);
     // With the channels tested, the lags were chosen by that step (the
     // Kalman method then takes them as fixed, without its own searches).
     if let Some((eddy, extras, sel)) = chosen {
@@ -573,6 +574,7 @@ fn fit_ls_segments(
             eddy_lag_selection: selection.clone(),
             extra_lag_selection: choice.extras,
             extra_channel_selection: None,
+            sample_interval_s: None,
         },
         columns: model_columns(
             flight,

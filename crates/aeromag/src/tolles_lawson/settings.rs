@@ -132,6 +132,7 @@ impl CalibrateSettings {
                     convention,
                     bt_scale_nt: self.bt_scale_nt.unwrap_or(design.bt_scale_nt),
                     magnitude: self.magnitude.unwrap_or_default(),
+                    ..design
                 },
                 band_hz: self.band_hz.unwrap_or(ls.band_hz),
                 trim: self.trim.unwrap_or(ls.trim),

@@ -13,8 +13,14 @@ use std::path::PathBuf;
 /// 1 not compensated because an input value is missing). Every input row is
 /// written, in order.
 ///
-/// Example:
+/// With --causal the model is applied as an on-board compensator applies
+/// it (what `aeromag stream` gives, value for value): the eddy terms take
+/// backward differences, so no row depends on a later one, and runs break
+/// at time steps over 1.5 × the calibration's sample interval.
+///
+/// Examples:
 ///   aeromag compensate --model model.json --input survey.csv --out survey_comp.csv
+///   aeromag compensate --causal --model model.json --input survey.csv --out causal.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
@@ -26,18 +32,36 @@ pub struct Args {
     /// Output CSV file.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
+    /// Apply the model causally (backward differences; see above).
+    #[arg(long)]
+    causal: bool,
+    /// With --causal: the sample rate whose interval × 1.5 breaks a run
+    /// (default: the calibration's, recorded in the model file).
+    #[arg(long, value_name = "HZ", requires = "causal")]
+    sample_rate: Option<f64>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()])?;
     if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {
+        if a.causal {
+            return Err(aeromag::Error::bad_input(
+                "--causal applies a single-sensor model; a multi-sensor model is applied in batch only (for now)",
+            )
+            .into());
+        }
         return run_sensors(&a);
     }
     let model = TlModel::read(&a.model)?;
     let flight = a.input.load()?;
-    let out = model.compensate(&flight)?;
-    let detail = format!("{} terms, method {}", model.design.terms, model.method);
+    let (out, how) = if a.causal {
+        let causal = aeromag::online::CausalTl::new(&model, a.sample_rate)?;
+        (causal.compensate(&flight)?, ", causal")
+    } else {
+        (model.compensate(&flight)?, "")
+    };
+    let detail = format!("{} terms, method {}{how}", model.design.terms, model.method);
     crate::output::write_compensated(flight, out, &a.out, &a.model, &detail)
 }
 

@@ -13,3 +13,4 @@ pub mod pod;
 pub mod report;
 pub mod rotor;
 pub mod simulate;
+pub mod stream;

@@ -654,6 +654,7 @@ impl KalmanFit {
                 eddy_lag_selection: None,
                 extra_lag_selection: Vec::new(),
                 extra_channel_selection: None,
+                sample_interval_s: None,
             },
             reference: Vec::new(),
             lever_arm: None,

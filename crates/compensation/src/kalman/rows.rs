@@ -13,7 +13,7 @@
 use crate::tolles_lawson::Design;
 use crate::tolles_lawson::design::Lags;
 use crate::tolles_lawson::fit_ls::Segment;
-use crate::tolles_lawson::terms::derivative;
+use crate::tolles_lawson::terms::derivative_into;
 use std::ops::Range;
 
 /// Samples per chunk.
@@ -48,7 +48,17 @@ pub fn for_each_design_row(
             lo = hi.saturating_sub(3).max(s);
         }
         let db: [Vec<f64>; 3] = if eddy {
-            [0, 1, 2].map(|c| derivative(&flux[c][lo..hi], &time[lo..hi], spec.convention))
+            [0, 1, 2].map(|c| {
+                let mut d = Vec::new();
+                derivative_into(
+                    &flux[c][lo..hi],
+                    &time[lo..hi],
+                    spec.convention,
+                    spec.differencing,
+                    &mut d,
+                );
+                d
+            })
         } else {
             [vec![0.0; hi - lo], vec![0.0; hi - lo], vec![0.0; hi - lo]]
         };
@@ -113,7 +123,7 @@ mod tests {
                 terms,
                 convention: conv,
                 bt_scale_nt: 50_000.0,
-                magnitude: Default::default(),
+                ..Design::default()
             };
             for run in [0..n, 5..CHUNK + 7, 10..13, 100..101] {
                 let cols = spec.columns_with(

@@ -7,7 +7,7 @@
 
 use super::eddy_lag::{FirstOrderLag, LagBank};
 use super::terms::{
-    Column, Convention, DEFAULT_BT_SCALE_NT, ExtraSeries, TermSet, derivative_into,
+    Column, Convention, DEFAULT_BT_SCALE_NT, Differencing, ExtraSeries, TermSet, derivative_into,
 };
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
@@ -44,6 +44,11 @@ pub struct Design {
     /// Tolles-Lawson projection (default) or the exact magnitude.
     #[serde(default, skip_serializing_if = "Magnitude::is_first_order")]
     pub magnitude: Magnitude,
+    /// Central (default, batch) or backward (causal) differences for the
+    /// eddy columns' derivative: how the model is applied, not how it was
+    /// fitted ([`Design::causal`]).
+    #[serde(default, skip_serializing_if = "Differencing::is_centred")]
+    pub differencing: Differencing,
 }
 
 /// How the modelled interference vector `ΔB` (body frame) becomes the
@@ -109,6 +114,7 @@ impl Default for Design {
             convention: Convention::Physical,
             bt_scale_nt: DEFAULT_BT_SCALE_NT,
             magnitude: Magnitude::FirstOrder,
+            differencing: Differencing::Centred,
         }
     }
 }
@@ -126,6 +132,17 @@ impl Design {
     pub fn with_terms(&self, terms: TermSet) -> Self {
         Self {
             terms,
+            ..self.clone()
+        }
+    }
+
+    /// This design under the causal convention: the eddy columns take
+    /// backward differences ([`Differencing::Backward`]), so that a sample's
+    /// row needs no later sample. The lags (eddy and extra regressors) are
+    /// causal filters already.
+    pub fn causal(&self) -> Self {
+        Self {
+            differencing: Differencing::Backward,
             ..self.clone()
         }
     }
@@ -409,7 +426,7 @@ impl Design {
     fn derivatives_into(&self, time: &[f64], flux: [&[f64]; 3], db: &mut [Vec<f64>; 3]) {
         for (k, d) in db.iter_mut().enumerate() {
             if self.terms.has_eddy() {
-                derivative_into(flux[k], time, self.convention, d);
+                derivative_into(flux[k], time, self.convention, self.differencing, d);
             } else {
                 d.clear();
                 d.resize(time.len(), 0.0);
@@ -438,8 +455,14 @@ pub(crate) struct TotalField {
 impl TotalField {
     /// Sample `k` of the series `flux` and `d`.
     pub(crate) fn at(flux: [&[f64]; 3], d: &[Vec<f64>; 3], k: usize) -> Self {
-        let b = [flux[0][k], flux[1][k], flux[2][k]];
-        let d = [d[0][k], d[1][k], d[2][k]];
+        Self::of(
+            [flux[0][k], flux[1][k], flux[2][k]],
+            [d[0][k], d[1][k], d[2][k]],
+        )
+    }
+
+    /// The field `b` and the interference `d` of one sample.
+    pub(crate) fn of(b: [f64; 3], d: [f64; 3]) -> Self {
         Self {
             b,
             d,

@@ -18,13 +18,26 @@ pub fn split_segments(
     max_gap_factor: f64,
     min_len: usize,
 ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
-    let n = time.len();
     let dt = median_step(time);
     let max_gap = if dt > 0.0 {
         dt * max_gap_factor
     } else {
         f64::INFINITY
     };
+    split_at_steps(time, line, usable, max_gap, min_len)
+}
+
+/// [`split_segments`] with the longest step given, s (rather than a
+/// multiple of the median step): the rule of a stream, which cannot know
+/// its median step in advance.
+pub fn split_at_steps(
+    time: &[f64],
+    line: Option<&[f64]>,
+    usable: &[bool],
+    max_gap: f64,
+    min_len: usize,
+) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+    let n = time.len();
     let same_line = |a: usize, b: usize| match line {
         Some(l) => l[a] == l[b] || (l[a].is_nan() && l[b].is_nan()),
         None => true,

@@ -793,6 +793,27 @@ impl std::fmt::Display for TermSet {
     }
 }
 
+/// Which samples a derivative is differenced over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Differencing {
+    /// Central differences, one-sided at a segment's ends: the batch path
+    /// (every sample's neighbours are known).
+    #[default]
+    Centred,
+    /// Backward differences `x[i] − x[i−1]` (divided by `t[i] − t[i−1]`
+    /// under [`Convention::Physical`]), 0 at a segment's first sample: the
+    /// causal convention, which needs no later sample (latency 0; the
+    /// online compensator, `compensate --causal`).
+    Backward,
+}
+
+impl Differencing {
+    pub(crate) fn is_centred(&self) -> bool {
+        *self == Differencing::Centred
+    }
+}
+
 /// Derivative of a series under a convention.
 ///
 /// `Physical`: `(x[i+1] − x[i−1]) / (t[i+1] − t[i−1])`, one-sided at the
@@ -801,15 +822,29 @@ impl std::fmt::Display for TermSet {
 /// 3 samples give zeros (MagNav's behaviour for the central scheme).
 pub fn derivative(x: &[f64], t: &[f64], convention: Convention) -> Vec<f64> {
     let mut d = Vec::new();
-    derivative_into(x, t, convention, &mut d);
+    derivative_into(x, t, convention, Differencing::Centred, &mut d);
     d
 }
 
-/// [`derivative`] into `d` (resized to `x.len()`, its allocation reused).
-pub fn derivative_into(x: &[f64], t: &[f64], convention: Convention, d: &mut Vec<f64>) {
+/// The derivative of `x` under `convention` and `differencing` into `d`
+/// (resized to `x.len()`, its allocation reused): [`derivative`] when
+/// centred; backward differences otherwise ([`Differencing::Backward`]).
+pub fn derivative_into(
+    x: &[f64],
+    t: &[f64],
+    convention: Convention,
+    differencing: Differencing,
+    d: &mut Vec<f64>,
+) {
     let n = x.len();
     d.clear();
     d.resize(n, 0.0);
+    if differencing == Differencing::Backward {
+        for i in 1..n {
+            d[i] = backward_difference(convention, x[i - 1], x[i], t[i - 1], t[i]);
+        }
+        return;
+    }
     if n < 3 {
         return;
     }
@@ -828,6 +863,15 @@ pub fn derivative_into(x: &[f64], t: &[f64], convention: Convention, d: &mut Vec
             }
             d[n - 1] = (x[n - 1] - x[n - 2]) / (t[n - 1] - t[n - 2]);
         }
+    }
+}
+
+/// The backward difference of `x` from `(t0, x0)` to `(t1, x1)` under
+/// `convention`: per second ([`Convention::Physical`]) or per sample.
+pub fn backward_difference(convention: Convention, x0: f64, x1: f64, t0: f64, t1: f64) -> f64 {
+    match convention {
+        Convention::Physical => (x1 - x0) / (t1 - t0),
+        Convention::MagNav => x1 - x0,
     }
 }
 

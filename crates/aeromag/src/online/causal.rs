@@ -1,0 +1,95 @@
+//! A Tolles-Lawson model under the causal convention, on a whole flight.
+
+use crate::compensate::{Compensator, OutputColumns};
+use crate::error::{Error, Result};
+use crate::flight::{Flight, GAP_FACTOR, SensorColumns, TlInputs};
+use crate::observer::Observer;
+use crate::tolles_lawson::TL_OUTPUT;
+use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::tolles_lawson::online::OnlineTl;
+use aeromag_compensation::tolles_lawson::segments::split_at_steps;
+
+/// A model applied under the causal convention ([module docs](super)):
+/// what an on-board compensator gives, sample for sample, on a recorded
+/// flight.
+#[derive(Debug, Clone)]
+pub struct CausalTl {
+    model: TlModel,
+    max_step_s: f64,
+}
+
+impl CausalTl {
+    /// `model` under the causal convention. Runs break at time steps over
+    /// [`GAP_FACTOR`] × the sample interval: `1 / sample_rate_hz` when
+    /// given, else the calibration flight's, recorded in the model
+    /// (`fit.sample_interval_s`); a model file without it and no rate is
+    /// bad input.
+    pub fn new(model: &TlModel, sample_rate_hz: Option<f64>) -> Result<Self> {
+        let interval_s = match sample_rate_hz {
+            Some(hz) if hz > 0.0 && hz.is_finite() => 1.0 / hz,
+            Some(hz) => {
+                return Err(Error::bad_input(format!(
+                    "sample rate {hz} Hz: must be positive"
+                )));
+            }
+            None => model.fit.sample_interval_s.ok_or_else(|| {
+                Error::bad_input(
+                    "the model file does not record its calibration's sample interval \
+                     (written before it was): give the sample rate (--sample-rate HZ)",
+                )
+            })?,
+        };
+        Ok(Self {
+            model: model.clone(),
+            max_step_s: GAP_FACTOR * interval_s,
+        })
+    }
+
+    /// The longest time step within a run, s.
+    pub fn max_step_s(&self) -> f64 {
+        self.max_step_s
+    }
+
+    /// The model.
+    pub fn model(&self) -> &TlModel {
+        &self.model
+    }
+
+    /// The same compensation one sample at a time ([`OnlineTl`]).
+    pub fn online(&self) -> Result<OnlineTl> {
+        Ok(OnlineTl::new(
+            &self.model.design,
+            &self.model.coef(),
+            self.max_step_s,
+        )?)
+    }
+}
+
+impl Compensator for CausalTl {
+    fn output(&self) -> OutputColumns {
+        TL_OUTPUT
+    }
+
+    /// `A c` under the causal convention on every run (usable rows, time
+    /// steps at most [`CausalTl::max_step_s`]; line changes do not
+    /// matter), NaN elsewhere.
+    fn interference_observed(
+        &self,
+        flight: &Flight,
+        _observer: &mut dyn Observer,
+    ) -> Result<Vec<f64>> {
+        let design = self.model.design.causal();
+        let cols = TlInputs::of_sensor(flight, &SensorColumns::default())?
+            .with_extras(flight, design.terms.extras())?;
+        let (runs, _) = split_at_steps(cols.time, None, &cols.usable(), self.max_step_s, 1);
+        let whole = cols.whole();
+        let coef = self.model.coef();
+        let mut out = vec![f64::NAN; flight.n_rows()];
+        for r in runs {
+            let s = whole.slice(r.clone());
+            let v = design.interference_with(&coef, s.time, s.flux, s.channels);
+            out[r].copy_from_slice(&v);
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,486 @@
+//! The line protocol of `aeromag stream`: comma-separated lines in, each
+//! line out with `mag_interf`, `mag_comp` and `comp_flag` appended.
+
+use super::CausalTl;
+use crate::error::{Error, Result};
+use aeromag_compensation::model_file::TlModel;
+use aeromag_compensation::tolles_lawson::online::{OnlineSample, OnlineTl, SampleStatus};
+use aeromag_io::ColumnMap;
+
+/// The columns a stream's lines gain.
+pub const STREAM_OUTPUT: [&str; 3] = ["mag_interf", "mag_comp", "comp_flag"];
+
+/// `comp_flag` of an output line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StreamFlag {
+    /// 0: compensated.
+    Compensated = 0,
+    /// 1: not compensated, an input is missing (empty, `NaN`) or the field
+    /// is all zero.
+    Missing = 1,
+    /// 2: compensated, the first sample of a run (the stream's first, after
+    /// a gap or after a sample that could not be used): derivative 0, lags
+    /// restarted.
+    Started = 2,
+    /// 3: not compensated, its time does not increase (ignored: the stream
+    /// goes on as if it had not arrived).
+    TimeBackwards = 3,
+    /// 4: not compensated, the line is malformed (wrong number of fields,
+    /// text where a number is needed).
+    Malformed = 4,
+}
+
+impl From<SampleStatus> for StreamFlag {
+    fn from(s: SampleStatus) -> Self {
+        match s {
+            SampleStatus::Compensated => StreamFlag::Compensated,
+            SampleStatus::Started => StreamFlag::Started,
+            SampleStatus::Missing => StreamFlag::Missing,
+            SampleStatus::TimeBackwards => StreamFlag::TimeBackwards,
+        }
+    }
+}
+
+/// Lines of a stream by what became of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StreamCounts {
+    /// Data lines read.
+    pub lines: u64,
+    /// Compensated (flags 0 and 2).
+    pub compensated: u64,
+    /// Runs started after the first (gaps, or samples that could not be
+    /// used, in between).
+    pub restarts: u64,
+    /// Flag 1.
+    pub missing: u64,
+    /// Flag 3.
+    pub time_backwards: u64,
+    /// Flag 4.
+    pub malformed: u64,
+}
+
+impl StreamCounts {
+    fn add(&mut self, flag: StreamFlag) {
+        self.lines += 1;
+        match flag {
+            StreamFlag::Compensated => self.compensated += 1,
+            StreamFlag::Started => {
+                if self.compensated > 0 {
+                    self.restarts += 1;
+                }
+                self.compensated += 1;
+            }
+            StreamFlag::Missing => self.missing += 1,
+            StreamFlag::TimeBackwards => self.time_backwards += 1,
+            StreamFlag::Malformed => self.malformed += 1,
+        }
+    }
+}
+
+impl std::fmt::Display for StreamCounts {
+    /// One line: `N lines: C compensated (R restarts), M missing, B time
+    /// going back, X malformed`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} lines: {} compensated ({} runs restarted), {} with missing values, {} with time going back, {} malformed",
+            self.lines,
+            self.compensated,
+            self.restarts,
+            self.missing,
+            self.time_backwards,
+            self.malformed
+        )
+    }
+}
+
+/// How a stream's columns are found.
+#[derive(Debug, Clone, Default)]
+pub struct StreamOptions {
+    /// Canonical name → stream column (`--columns mag=mag_1_uc,…`).
+    pub columns: ColumnMap,
+    /// The sample rate, Hz, when the model does not record it (or to
+    /// override it): the gap rule ([`CausalTl::new`]).
+    pub sample_rate_hz: Option<f64>,
+}
+
+/// Where the inputs are in a line.
+#[derive(Debug, Clone)]
+struct Fields {
+    time: usize,
+    flux: [usize; 3],
+    mag: usize,
+    channels: Vec<usize>,
+    count: usize,
+}
+
+/// A model compensating a stream of CSV lines ([module docs](super)).
+#[derive(Debug, Clone)]
+pub struct LineCompensator {
+    online: OnlineTl,
+    fields: Fields,
+    header: String,
+    counts: StreamCounts,
+    channels: Vec<f64>,
+}
+
+impl LineCompensator {
+    /// `model` on lines laid out as `header` (comma-separated names). Each
+    /// input is found by, in order: the user's mapping (`opts.columns`),
+    /// its canonical name (`time`, `flux_x`, …, `mag`; case ignored), the
+    /// file column the model was fitted on (`model.columns`); an extra
+    /// regressor by its channel name. An input not found is bad input, as
+    /// is a model without its sample interval and no rate given.
+    pub fn new(model: &TlModel, header: &str, opts: &StreamOptions) -> Result<Self> {
+        let online = CausalTl::new(model, opts.sample_rate_hz)?.online()?;
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        let find = |canonical: &str| -> Result<usize> {
+            let by = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
+            opts.columns
+                .get(canonical)
+                .and_then(by)
+                .or_else(|| by(canonical))
+                .or_else(|| model.columns.get(canonical).and_then(|n| by(n)))
+                .ok_or_else(|| {
+                    Error::bad_input(format!(
+                        "the stream has no column for `{canonical}`{}; its columns: {} (map one with --columns {canonical}=NAME)",
+                        model
+                            .columns
+                            .get(canonical)
+                            .map(|n| format!(" (the model was fitted on `{n}`)"))
+                            .unwrap_or_default(),
+                        names.join(", ")
+                    ))
+                })
+        };
+        let fields = Fields {
+            time: find("time")?,
+            flux: [find("flux_x")?, find("flux_y")?, find("flux_z")?],
+            mag: find("mag")?,
+            channels: model
+                .design
+                .terms
+                .extras()
+                .iter()
+                .map(|x| find(&x.channel))
+                .collect::<Result<_>>()?,
+            count: names.len(),
+        };
+        for out in STREAM_OUTPUT {
+            if names.iter().any(|n| n.eq_ignore_ascii_case(out)) {
+                return Err(Error::bad_input(format!(
+                    "the stream already has a column `{out}`; drop or rename it first"
+                )));
+            }
+        }
+        Ok(Self {
+            channels: vec![0.0; fields.channels.len()],
+            online,
+            fields,
+            header: normalised(header),
+            counts: StreamCounts::default(),
+        })
+    }
+
+    /// The output header: the input's names and [`STREAM_OUTPUT`].
+    pub fn header(&self) -> String {
+        format!("{},{}", self.header, STREAM_OUTPUT.join(","))
+    }
+
+    /// Compensate one data line (without its line end) and append it to
+    /// `out` with the three values and a newline. Numbers are written as
+    /// the CSV writer writes them (shortest round trip; missing as an empty
+    /// cell).
+    pub fn line(&mut self, line: &str, out: &mut String) -> StreamFlag {
+        let line = line.trim_end_matches(['\r', '\n']);
+        let (interf, comp, flag) = match self.parse(line) {
+            None => (f64::NAN, f64::NAN, StreamFlag::Malformed),
+            Some((time_s, flux_nt, mag_nt)) => {
+                let o = self.online.push(&OnlineSample {
+                    time_s,
+                    flux_nt,
+                    mag_nt,
+                    channels: &self.channels,
+                });
+                (o.interference_nt, o.compensated_nt, o.status.into())
+            }
+        };
+        self.counts.add(flag);
+        out.push_str(line);
+        let mut ryu = ryu::Buffer::new();
+        for v in [interf, comp] {
+            out.push(',');
+            if v.is_finite() {
+                out.push_str(ryu.format(v));
+            }
+        }
+        out.push(',');
+        out.push(char::from(b'0' + flag as u8));
+        out.push('\n');
+        flag
+    }
+
+    /// A line too long to read: flagged malformed, written as an empty
+    /// line with the three values.
+    fn malformed(&mut self, out: &mut String) {
+        self.counts.add(StreamFlag::Malformed);
+        out.push_str(",,,4\n");
+    }
+
+    /// The inputs of a line (channels into `self.channels`), `None` when
+    /// the line is malformed. Empty cells and `NaN` are missing values.
+    fn parse(&mut self, line: &str) -> Option<(f64, [f64; 3], f64)> {
+        let f = &self.fields;
+        let (mut time, mut flux, mut mag) = (None, [None; 3], None);
+        let mut count = 0;
+        for (k, cell) in line.split(',').enumerate() {
+            count += 1;
+            let slot = if k == f.time {
+                &mut time
+            } else if k == f.mag {
+                &mut mag
+            } else if let Some(a) = f.flux.iter().position(|&i| i == k) {
+                &mut flux[a]
+            } else if let Some(c) = f.channels.iter().position(|&i| i == k) {
+                let v = number(cell)?;
+                self.channels[c] = v;
+                continue;
+            } else {
+                continue;
+            };
+            *slot = Some(number(cell)?);
+        }
+        if count != f.count {
+            return None;
+        }
+        Some((time?, [flux[0]?, flux[1]?, flux[2]?], mag?))
+    }
+
+    /// What became of the lines so far.
+    pub fn counts(&self) -> &StreamCounts {
+        &self.counts
+    }
+
+    /// Forget the stream's state (a new connection): the next line starts
+    /// a run whatever its time. The counts are kept.
+    pub fn reset(&mut self) {
+        self.online.reset();
+    }
+}
+
+/// The longest line read, bytes: a longer one is malformed (and skipped to
+/// its end), so a hostile peer cannot make the stream hold unbounded text.
+pub const MAX_STREAM_LINE_BYTES: usize = 1 << 20;
+
+/// A stream of lines through one model, over one or several connections
+/// (`aeromag stream`): each connection's first line is its header unless
+/// the columns were named ([`LineStream::new`]); a connection with the same
+/// header as the last continues its state (the gap rule decides whether
+/// the run goes on), another header starts afresh. The counts add up over
+/// connections.
+#[derive(Debug, Clone)]
+pub struct LineStream {
+    model: TlModel,
+    opts: StreamOptions,
+    columns_in: Option<String>,
+    comp: Option<LineCompensator>,
+    before: StreamCounts,
+}
+
+impl LineStream {
+    /// `model` on streams laid out as `columns_in` (comma-separated names;
+    /// `None`: each connection's first line). Bad input as
+    /// [`LineCompensator::new`], checked now when the columns are named.
+    pub fn new(model: &TlModel, opts: &StreamOptions, columns_in: Option<&str>) -> Result<Self> {
+        let comp = columns_in
+            .map(|h| LineCompensator::new(model, h, opts))
+            .transpose()?;
+        Ok(Self {
+            model: model.clone(),
+            opts: opts.clone(),
+            columns_in: columns_in.map(str::to_string),
+            comp,
+            before: StreamCounts::default(),
+        })
+    }
+
+    /// Serve one connection: [`LineStream::start`], then
+    /// [`LineStream::lines`] until `input` ends.
+    pub fn serve(
+        &mut self,
+        mut input: impl std::io::BufRead,
+        mut output: impl std::io::Write,
+        peer: &str,
+    ) -> Result<()> {
+        if self.start(&mut input, &mut output, peer)? {
+            self.lines(input, output, peer)?;
+        }
+        Ok(())
+    }
+
+    /// Start a connection: read its header (unless the columns were named)
+    /// and write the output header, flushed. `false` when `input` ended
+    /// before a header. `peer` names the connection in errors; a header
+    /// that does not name the model's inputs is bad input.
+    pub fn start(
+        &mut self,
+        input: &mut impl std::io::BufRead,
+        output: &mut impl std::io::Write,
+        peer: &str,
+    ) -> Result<bool> {
+        if self.columns_in.is_none() {
+            let mut buf = Vec::new();
+            if !read_line(input, &mut buf, &mut false, peer, || Ok(()))? {
+                return Ok(false);
+            }
+            let header = String::from_utf8_lossy(&buf);
+            let header = header.trim_end_matches(['\r', '\n']);
+            if self
+                .comp
+                .as_ref()
+                .is_none_or(|c| c.header != normalised(header))
+            {
+                let next = LineCompensator::new(&self.model, header, &self.opts)?;
+                if let Some(old) = self.comp.replace(next) {
+                    self.before = self.before.plus(old.counts());
+                }
+            }
+        }
+        let comp = self.comp.as_ref().expect("a header");
+        let out = format!("{}\n", comp.header());
+        write_flushed(output, &out, peer)?;
+        Ok(true)
+    }
+
+    /// Every line of `input` compensated into `output`, each flushed, until
+    /// `input` ends (after [`LineStream::start`]; a datagram's lines).
+    /// Reading or writing failing ends it with [`Error::Read`] /
+    /// [`Error::Write`].
+    pub fn lines(
+        &mut self,
+        mut input: impl std::io::BufRead,
+        mut output: impl std::io::Write,
+        peer: &str,
+    ) -> Result<()> {
+        let Some(comp) = self.comp.as_mut() else {
+            return Err(Error::bad_input(format!(
+                "{peer}: data before a header line"
+            )));
+        };
+        let (mut buf, mut out, mut drained) = (Vec::new(), String::new(), true);
+        loop {
+            // Before a read may wait for input, everything compensated so
+            // far goes out, flushed: no line is held back by one that has
+            // not arrived, and lines that arrived together go out together.
+            let got = read_line(&mut input, &mut buf, &mut drained, peer, || {
+                write_flushed(&mut output, &out, peer)?;
+                out.clear();
+                Ok(())
+            })?;
+            if !got {
+                return write_flushed(&mut output, &out, peer);
+            }
+            if buf.len() > MAX_STREAM_LINE_BYTES {
+                comp.malformed(&mut out);
+            } else {
+                comp.line(&String::from_utf8_lossy(&buf), &mut out);
+            }
+        }
+    }
+
+    /// What became of the lines so far, over every connection.
+    pub fn counts(&self) -> StreamCounts {
+        self.comp
+            .as_ref()
+            .map_or(self.before, |c| self.before.plus(c.counts()))
+    }
+}
+
+impl StreamCounts {
+    fn plus(&self, o: &StreamCounts) -> StreamCounts {
+        StreamCounts {
+            lines: self.lines + o.lines,
+            compensated: self.compensated + o.compensated,
+            restarts: self.restarts + o.restarts,
+            missing: self.missing + o.missing,
+            time_backwards: self.time_backwards + o.time_backwards,
+            malformed: self.malformed + o.malformed,
+        }
+    }
+}
+
+fn read_error(peer: &str, source: std::io::Error) -> Error {
+    Error::Read {
+        path: peer.into(),
+        source,
+    }
+}
+
+/// Write `text` and flush.
+fn write_flushed(output: &mut impl std::io::Write, text: &str, peer: &str) -> Result<()> {
+    output
+        .write_all(text.as_bytes())
+        .and_then(|()| output.flush())
+        .map_err(|source| Error::Write {
+            path: peer.into(),
+            source,
+        })
+}
+
+/// A cell's number: empty is missing (NaN); text that is not a number is
+/// `None` (a malformed line).
+fn number(cell: &str) -> Option<f64> {
+    let c = cell.trim();
+    if c.is_empty() {
+        Some(f64::NAN)
+    } else {
+        c.parse::<f64>().ok()
+    }
+}
+
+/// A header's names, trimmed, joined by commas.
+fn normalised(header: &str) -> String {
+    header
+        .split(',')
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// One line of `input` into `buf` (its end included), at most
+/// [`MAX_STREAM_LINE_BYTES`] + 1 bytes kept (the rest read and dropped);
+/// `false` at the end of the input. `before_wait` runs before the reader
+/// refills an empty buffer (which may wait for input); `drained` carries
+/// whether the buffer is empty from one call to the next (`true` at the
+/// start). `peer` names the input in errors.
+fn read_line(
+    input: &mut impl std::io::BufRead,
+    buf: &mut Vec<u8>,
+    drained: &mut bool,
+    peer: &str,
+    mut before_wait: impl FnMut() -> Result<()>,
+) -> Result<bool> {
+    buf.clear();
+    let mut any = false;
+    loop {
+        if *drained {
+            before_wait()?;
+        }
+        let chunk = input.fill_buf().map_err(|e| read_error(peer, e))?;
+        if chunk.is_empty() {
+            return Ok(any);
+        }
+        any = true;
+        let (take, done) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(k) => (k + 1, true),
+            None => (chunk.len(), false),
+        };
+        let room = (MAX_STREAM_LINE_BYTES + 1).saturating_sub(buf.len());
+        buf.extend_from_slice(&chunk[..take.min(room)]);
+        *drained = take == chunk.len();
+        input.consume(take);
+        if done {
+            return Ok(true);
+        }
+    }
+}

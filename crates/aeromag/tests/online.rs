@@ -1,0 +1,201 @@
+//! The online compensator against the batch path (issue 21): a whole
+//! simulated survey, with gaps and missing values, sample by sample and
+//! line by line, bit for bit against `compensate --causal`; the causal
+//! convention's cost in residual.
+
+use aeromag::FlightTable;
+use aeromag::online::{CausalTl, LineCompensator, OnlineSample, StreamFlag, StreamOptions};
+use aeromag::prelude::*;
+use aeromag::simulate::{ScenarioKind, simulate_flight};
+
+/// A model with eddy lags (`l9`) from the default calibration box.
+fn model() -> TlModel {
+    let cal = simulate_flight(ScenarioKind::Calibration, None, Some(1)).unwrap();
+    let m = calibrate(&cal, &CalibrateOptions::default(), &mut Silent)
+        .unwrap()
+        .model;
+    assert!(!m.design.terms.eddy_lags_s().is_empty(), "{:?}", m.design);
+    m
+}
+
+/// The survey as CSV text, with two gaps (rows removed), missing values
+/// (empty cells in `flux_y`, `mag`) and a zero field row.
+fn survey_csv(dir: &std::path::Path) -> (std::path::PathBuf, Vec<String>) {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(2)).unwrap();
+    let plain = dir.join("plain.csv");
+    aeromag::io::write_csv(survey.table(), &plain).unwrap();
+    let text = std::fs::read_to_string(&plain).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let header: Vec<String> = lines[0].split(',').map(str::to_string).collect();
+    let col = |n: &str| header.iter().position(|h| h == n).unwrap();
+    let blank = |line: &mut String, k: usize| {
+        let mut cells: Vec<&str> = line.split(',').collect();
+        cells[k] = "";
+        *line = cells.join(",");
+    };
+    blank(&mut lines[1001], col("flux_y"));
+    blank(&mut lines[1002], col("mag"));
+    blank(&mut lines[30_000], col("flux_x"));
+    {
+        let mut cells: Vec<String> = lines[40_000].split(',').map(str::to_string).collect();
+        for c in ["flux_x", "flux_y", "flux_z"] {
+            cells[col(c)] = "0".into();
+        }
+        lines[40_000] = cells.join(",");
+    }
+    lines.drain(20_000..20_030); // a 3 s gap
+    lines.drain(50_000..50_002); // 0.3 s: a gap under the 1.5 × 0.1 s rule
+    let path = dir.join("survey.csv");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    (path, lines)
+}
+
+#[test]
+fn streaming_equals_causal_batch_bit_for_bit_on_a_whole_survey() {
+    let model = model();
+    let dir = tempfile::tempdir().unwrap();
+    let (path, lines) = survey_csv(dir.path());
+    let flight = Flight::read(&path).unwrap();
+    let causal = CausalTl::new(&model, None).unwrap();
+    let batch = causal.compensate(&flight).unwrap();
+    assert_eq!(batch.missing, 4, "three missing values and a zero field");
+
+    // Sample by sample.
+    let mut online = causal.online().unwrap();
+    let (t, m) = (
+        flight.require("time").unwrap(),
+        flight.require("mag").unwrap(),
+    );
+    let f = ["flux_x", "flux_y", "flux_z"].map(|c| flight.require(c).unwrap());
+    let mut restarts = 0;
+    for k in 0..flight.n_rows() {
+        let out = online.push(&OnlineSample {
+            time_s: t[k],
+            flux_nt: [f[0][k], f[1][k], f[2][k]],
+            mag_nt: m[k],
+            channels: &[],
+        });
+        assert_eq!(
+            out.interference_nt.to_bits(),
+            batch.interference_nt[k].to_bits(),
+            "row {k}"
+        );
+        restarts += usize::from(out.status == aeromag::online::SampleStatus::Started);
+    }
+    // The start, after each gap and after each stretch of rows not
+    // compensated (rows 1001–1002, 30 000, 40 000).
+    assert_eq!(restarts, 1 + 2 + 3);
+
+    // Line by line, as `aeromag stream` reads them: the same text as the
+    // CSV writer gives the batch columns.
+    let mut table: FlightTable = flight.clone().into_table();
+    batch.clone().add_to(&mut table).unwrap();
+    let written = dir.path().join("causal.csv");
+    aeromag::io::write_csv(&table, &written).unwrap();
+    let want: Vec<String> = std::fs::read_to_string(&written)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let mut lc = LineCompensator::new(&model, &lines[0], &StreamOptions::default()).unwrap();
+    let mut got = String::new();
+    for line in &lines[1..] {
+        lc.line(line, &mut got);
+    }
+    // mag_interf and mag_comp (the flags differ: the stream says more).
+    let tail = |s: &str| {
+        s.rsplitn(4, ',')
+            .skip(1)
+            .take(2)
+            .map(str::to_string)
+            .collect::<Vec<_>>()
+    };
+    for (k, (g, w)) in got.lines().zip(&want[1..]).enumerate() {
+        assert_eq!(tail(g), tail(w), "data row {k}");
+    }
+    assert_eq!(lc.counts().missing, 4);
+    assert_eq!(lc.counts().restarts, 5);
+}
+
+/// The causal convention costs almost nothing on the survey: residual
+/// against the truth (the issue's figure: ≤ 1.05× the batch residual of
+/// the same model).
+#[test]
+fn the_causal_residual_is_within_five_percent_of_the_batch_residual() {
+    let model = model();
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(2)).unwrap();
+    let truth = survey.require("true_external").unwrap();
+    let line = survey.require("line").unwrap();
+    let rms = |comp: &[f64]| {
+        let d: Vec<f64> = (0..comp.len())
+            .filter(|&k| line[k] > 0.0)
+            .map(|k| comp[k] - truth[k])
+            .collect();
+        let m = d.iter().sum::<f64>() / d.len() as f64;
+        (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+    };
+    let batch = rms(&model.compensate(&survey).unwrap().compensated_nt);
+    let causal = rms(&CausalTl::new(&model, None)
+        .unwrap()
+        .compensate(&survey)
+        .unwrap()
+        .compensated_nt);
+    eprintln!("survey residual: batch {batch:.4} nT, causal {causal:.4} nT");
+    assert!(causal <= 1.05 * batch, "{causal} vs {batch}");
+}
+
+#[test]
+fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
+    let model = model();
+    let missing = LineCompensator::new(&model, "time,flux_x,flux_y,mag", &StreamOptions::default())
+        .unwrap_err();
+    assert!(missing.is_bad_input());
+    assert!(missing.to_string().contains("flux_z"), "{missing}");
+    let mut old = model.clone();
+    old.fit.sample_interval_s = None;
+    let e = CausalTl::new(&old, None).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("--sample-rate"),
+        "{e}"
+    );
+    assert!(CausalTl::new(&old, Some(10.0)).is_ok());
+    assert!(CausalTl::new(&old, Some(-1.0)).unwrap_err().is_bad_input());
+
+    let header = "time,flux_x,flux_y,flux_z,mag";
+    let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
+    let mut out = String::new();
+    let flags: Vec<StreamFlag> = [
+        "0.0,20000,1000,45000,49300",
+        "0.1,20001,1001,45001,49301",
+        "0.2,20001,1001,45001",
+        "0.2,20001,x,45001,49301",
+        "0.05,20001,1001,45001,49301",
+        "0.3,20002,1002,45002,",
+        "0.4,20003,1003,45003,49303",
+        "9.0,20003,1003,45003,49303",
+    ]
+    .iter()
+    .map(|l| lc.line(l, &mut out))
+    .collect();
+    use StreamFlag::*;
+    assert_eq!(
+        flags,
+        [
+            Started,
+            Compensated,
+            Malformed,
+            Malformed,
+            TimeBackwards,
+            Missing,
+            Started,
+            Started
+        ]
+    );
+    assert_eq!(out.lines().count(), 8);
+    assert!(out.lines().nth(2).unwrap().ends_with("45001,,,4"));
+    let c = lc.counts();
+    assert_eq!(
+        (c.lines, c.compensated, c.restarts, c.malformed),
+        (8, 4, 2, 2)
+    );
+}

@@ -1,0 +1,136 @@
+//! `aeromag stream`: compensate samples as they arrive (library:
+//! [`aeromag::online::LineStream`]).
+
+use aeromag::online::{LineStream, StreamOptions};
+use aeromag::{ColumnMap, ModelFile, TlModel};
+use std::io::{BufReader, Write};
+use std::path::PathBuf;
+
+/// Compensate samples as they arrive, one CSV line at a time, with a model
+/// fitted by `aeromag calibrate` (applied causally: the values of
+/// `aeromag compensate --causal`, value for value).
+///
+/// Reads lines from standard input (default), a TCP connection
+/// (--listen HOST:PORT: the compensated lines go back on the same
+/// connection; when the peer disconnects the next connection is served,
+/// the state kept when its header is the same) or UDP datagrams
+/// (--udp HOST:PORT: each datagram's lines answered to its sender).
+/// The first line is the header (the column names) unless --columns-in
+/// names the columns. Each line is written back, flushed, with
+/// `mag_interf` and `mag_comp` (nT) and `comp_flag`: 0 compensated,
+/// 1 missing value, 2 compensated after a gap (run restarted), 3 time
+/// going back (ignored), 4 malformed line. Bad lines never stop the
+/// stream; the counts go to standard error when a stream ends.
+///
+/// Examples:
+///   aeromag stream --model model.json < survey.csv > survey_comp.csv
+///   aeromag stream --model model.json --listen 127.0.0.1:5555
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// Model file written by `aeromag calibrate` (one sensor).
+    #[arg(long, value_name = "MODEL.json")]
+    model: PathBuf,
+    /// The input's column names, comma-separated, when the stream has no
+    /// header line.
+    #[arg(long, value_name = "NAMES")]
+    columns_in: Option<String>,
+    /// Map canonical names onto the stream's columns,
+    /// e.g. `mag=mag_1_uc,flux_x=flux_a_x`.
+    #[arg(long, value_name = "MAP")]
+    columns: Option<String>,
+    /// The sample rate whose interval × 1.5 breaks a run (default: the
+    /// calibration's, recorded in the model file).
+    #[arg(long, value_name = "HZ")]
+    sample_rate: Option<f64>,
+    /// Serve TCP connections on HOST:PORT instead of standard input.
+    #[arg(long, value_name = "HOST:PORT", conflicts_with = "udp")]
+    listen: Option<String>,
+    /// Serve UDP datagrams on HOST:PORT instead of standard input.
+    #[arg(long, value_name = "HOST:PORT")]
+    udp: Option<String>,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let model = TlModel::read(&a.model)?;
+    let opts = StreamOptions {
+        columns: match &a.columns {
+            Some(m) => ColumnMap::parse(m)?,
+            None => ColumnMap::new(),
+        },
+        sample_rate_hz: a.sample_rate,
+    };
+    let mut stream = LineStream::new(&model, &opts, a.columns_in.as_deref())?;
+    if let Some(addr) = &a.listen {
+        return serve_tcp(&mut stream, addr);
+    }
+    if let Some(addr) = &a.udp {
+        return serve_udp(&mut stream, addr);
+    }
+    let stdin = std::io::stdin().lock();
+    let stdout = std::io::stdout().lock();
+    let result = stream.serve(stdin, stdout, "standard input");
+    eprintln!("{}", stream.counts());
+    Ok(result?)
+}
+
+/// Serve one TCP connection after another, for ever (Ctrl-C ends it).
+fn serve_tcp(stream: &mut LineStream, addr: &str) -> anyhow::Result<()> {
+    let listener = std::net::TcpListener::bind(addr)
+        .map_err(|e| anyhow::anyhow!("cannot listen on {addr}: {e}"))?;
+    eprintln!("listening on {}", listener.local_addr()?);
+    for conn in listener.incoming() {
+        let conn = match conn {
+            Ok(c) => c,
+            Err(e) => {
+                eprintln!("warning: a connection failed: {e}");
+                continue;
+            }
+        };
+        let peer = conn
+            .peer_addr()
+            .map_or_else(|_| "a peer".to_string(), |p| p.to_string());
+        let result = conn
+            .try_clone()
+            .map_err(|e| aeromag::Error::read(&peer, e))
+            .and_then(|r| stream.serve(BufReader::new(r), &conn, &peer));
+        if let Err(e) = result {
+            eprintln!("warning: connection from {peer} ended: {e}");
+            let _ = (&conn).write_all(format!("# error: {e}\n").as_bytes());
+        }
+        eprintln!("{peer} disconnected; so far {}", stream.counts());
+    }
+    Ok(())
+}
+
+/// Serve datagrams for ever: each datagram's lines answered to its sender
+/// in one datagram (the first line of the first datagram is the header
+/// unless --columns-in named the columns).
+fn serve_udp(stream: &mut LineStream, addr: &str) -> anyhow::Result<()> {
+    let socket = std::net::UdpSocket::bind(addr)
+        .map_err(|e| anyhow::anyhow!("cannot listen on {addr}: {e}"))?;
+    eprintln!("listening on {} (UDP)", socket.local_addr()?);
+    let mut buf = vec![0u8; 65_536];
+    let mut started = false;
+    loop {
+        let (n, from) = socket.recv_from(&mut buf)?;
+        let peer = from.to_string();
+        let mut input = &buf[..n];
+        let mut out = Vec::new();
+        let result = (|| {
+            if !started {
+                started = stream.start(&mut input, &mut out, &peer)?;
+            }
+            stream.lines(input, &mut out, &peer)
+        })();
+        if let Err(e) = result {
+            eprintln!("warning: datagram from {peer}: {e}");
+            out.extend_from_slice(format!("# error: {e}\n").as_bytes());
+        }
+        for chunk in out.chunks(65_000) {
+            if let Err(e) = socket.send_to(chunk, from) {
+                eprintln!("warning: cannot answer {peer}: {e}");
+            }
+        }
+    }
+}
