@@ -32,7 +32,7 @@ import numpy as np
 
 from . import _aeromag
 from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulate_em
-from ._aeromag import Flight, Levelled, Model, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
+from ._aeromag import Flight, Levelled, Model, OnlineCompensator, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
 from .errors import AeromagError, BadInputError
 from .tolles_lawson import TollesLawson, calibrate_sensors, load_model
@@ -58,6 +58,7 @@ __all__ = [
     "level",
     "observability",
     "score",
+    "OnlineCompensator",
     "SensorsModel",
     "TlModel",
     "TollesLawson",

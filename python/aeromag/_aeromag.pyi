@@ -12,6 +12,7 @@ __all__ = [
     "Flight",
     "read_flight",
     "TlModel",
+    "OnlineCompensator",
     "calibrate",
     "check_calibrate_options",
     "calibrate_defaults",
@@ -102,10 +103,40 @@ class TlModel:
     @property
     def series(self) -> Optional[Dict[str, npt.NDArray[np.float64]]]: ...
     def interference(self, flight: Flight) -> npt.NDArray[np.float64]: ...
-    def compensate(self, flight: Flight) -> npt.NDArray[np.float64]: ...
+    def compensate(
+        self, flight: Flight, causal: bool = False, sample_rate: Optional[float] = None
+    ) -> npt.NDArray[np.float64]: ...
+    def online(self, sample_rate: Optional[float] = None) -> OnlineCompensator: ...
     def apply(self, flight: Flight) -> Flight: ...
     def to_json(self) -> str: ...
     def save(self, path: str) -> None: ...
+
+@final
+class OnlineCompensator:
+    """A Tolles-Lawson model compensating samples as they arrive (latency 0)."""
+
+    def __new__(cls, model: TlModel, sample_rate: Optional[float] = None) -> OnlineCompensator: ...
+    @property
+    def channels(self) -> List[str]: ...
+    @property
+    def max_step_s(self) -> float: ...
+    def push(
+        self,
+        time: float,
+        flux: Tuple[float, float, float],
+        mag: float,
+        channels: Sequence[float] = ...,
+    ) -> Tuple[float, float, int]: ...
+    def push_block(
+        self,
+        time: npt.NDArray[np.float64],
+        flux_x: npt.NDArray[np.float64],
+        flux_y: npt.NDArray[np.float64],
+        flux_z: npt.NDArray[np.float64],
+        mag: npt.NDArray[np.float64],
+        channels: Union[None, Sequence[npt.NDArray[np.float64]], Mapping[str, npt.NDArray[np.float64]]] = None,
+    ) -> Dict[str, npt.NDArray[Any]]: ...
+    def reset(self) -> None: ...
 
 @final
 class SensorsModel:

@@ -26,6 +26,7 @@ mod fields;
 mod flight;
 mod gradiometry;
 mod level;
+mod online;
 mod progress;
 mod rotor_pod;
 mod sensors;
@@ -40,6 +41,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<flight::PyFlight>()?;
     m.add_function(wrap_pyfunction!(flight::read_flight, m)?)?;
     m.add_class::<tolles_lawson::PyTlModel>()?;
+    m.add_class::<online::PyOnline>()?;
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::check_calibrate_options, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate_defaults, m)?)?;

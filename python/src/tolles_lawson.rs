@@ -236,6 +236,11 @@ impl PyTlModel {
             series: None,
         }
     }
+
+    /// The model.
+    pub fn inner(&self) -> &TlModel {
+        &self.model
+    }
 }
 
 #[pymethods]
@@ -314,13 +319,31 @@ impl PyTlModel {
     }
 
     /// `mag` minus the modelled interference, nT (NaN where it cannot be
-    /// computed).
+    /// computed). `causal=True`: as on board (`aeromag compensate
+    /// --causal`; the values of `OnlineCompensator`), runs broken at steps
+    /// over 1.5 / `sample_rate` (default: the calibration's interval).
+    #[pyo3(signature = (flight, causal = false, sample_rate = None))]
     fn compensate<'py>(
         &self,
         py: Python<'py>,
         flight: &PyFlight,
+        causal: bool,
+        sample_rate: Option<f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        crate::apply::compensate(py, &self.model, flight)
+        if causal {
+            let c = aeromag::online::CausalTl::new(&self.model, sample_rate).py_err()?;
+            crate::apply::compensate(py, &c, flight)
+        } else if sample_rate.is_some() {
+            Err(bad_argument("sample_rate is for causal=True"))
+        } else {
+            crate::apply::compensate(py, &self.model, flight)
+        }
+    }
+
+    /// An `OnlineCompensator` of this model.
+    #[pyo3(signature = (sample_rate = None))]
+    fn online(&self, sample_rate: Option<f64>) -> PyResult<crate::online::PyOnline> {
+        crate::online::PyOnline::of(&self.model, sample_rate)
     }
 
     /// The flight with the compensation columns added (`mag_comp`,

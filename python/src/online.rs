@@ -1,0 +1,190 @@
+//! `aeromag.OnlineCompensator`: a Tolles-Lawson model applied sample by
+//! sample (latency 0, the causal convention), pushed one sample or one
+//! block at a time ([`aeromag::online`]).
+
+use crate::errors::{IntoPy, bad_argument};
+use crate::tolles_lawson::PyTlModel;
+use aeromag::TlModel;
+use aeromag::online::{CausalTl, OnlineSample, OnlineTl, StreamFlag};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A model compensating samples as they arrive.
+///
+/// `OnlineCompensator(model, sample_rate=None)`: `model` a `TlModel`; a run
+/// breaks at time steps over 1.5 / `sample_rate` (default: the
+/// calibration's sample interval, recorded in the model). Each sample's
+/// `comp_flag` is that of `aeromag stream`: 0 compensated, 1 missing
+/// value, 2 compensated after a gap (run restarted), 3 time going back
+/// (ignored).
+#[pyclass(name = "OnlineCompensator", module = "aeromag._aeromag")]
+pub struct PyOnline {
+    online: OnlineTl,
+    channels: Vec<String>,
+    max_step_s: f64,
+}
+
+#[pymethods]
+impl PyOnline {
+    #[new]
+    #[pyo3(signature = (model, sample_rate = None))]
+    fn new(model: &PyTlModel, sample_rate: Option<f64>) -> PyResult<Self> {
+        Self::of(model.inner(), sample_rate)
+    }
+
+    /// The extra channels a sample carries, in order (the model's current
+    /// channels, e.g. `cur_strb`).
+    #[getter]
+    fn channels(&self) -> Vec<String> {
+        self.channels.clone()
+    }
+
+    /// The longest time step within a run, s.
+    #[getter]
+    fn max_step_s(&self) -> f64 {
+        self.max_step_s
+    }
+
+    /// One sample: time (s), the vector field `(x, y, z)` (body frame, nT),
+    /// the scalar reading (nT) and the channels in [`channels`] order.
+    /// Returns `(mag_interf, mag_comp, comp_flag)` (NaN when not
+    /// compensated).
+    #[pyo3(signature = (time, flux, mag, channels = Vec::new()))]
+    fn push(
+        &mut self,
+        time: f64,
+        flux: (f64, f64, f64),
+        mag: f64,
+        channels: Vec<f64>,
+    ) -> PyResult<(f64, f64, u8)> {
+        self.check_channels(channels.len())?;
+        let o = self.online.push(&OnlineSample {
+            time_s: time,
+            flux_nt: [flux.0, flux.1, flux.2],
+            mag_nt: mag,
+            channels: &channels,
+        });
+        Ok((
+            o.interference_nt,
+            o.compensated_nt,
+            StreamFlag::from(o.status) as u8,
+        ))
+    }
+
+    /// A block of samples (arrays of one length), in order, continuing the
+    /// state: `channels` a list of arrays in [`channels`] order or a dict
+    /// by name. Returns a dict of `mag_interf`, `mag_comp` (float arrays)
+    /// and `comp_flag` (uint8 array). The same values as pushing the
+    /// samples one by one, with the GIL released.
+    #[pyo3(signature = (time, flux_x, flux_y, flux_z, mag, channels = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn push_block<'py>(
+        &mut self,
+        py: Python<'py>,
+        time: PyReadonlyArray1<'py, f64>,
+        flux_x: PyReadonlyArray1<'py, f64>,
+        flux_y: PyReadonlyArray1<'py, f64>,
+        flux_z: PyReadonlyArray1<'py, f64>,
+        mag: PyReadonlyArray1<'py, f64>,
+        channels: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let chans: Vec<PyReadonlyArray1<'py, f64>> = match channels {
+            None => Vec::new(),
+            Some(c) => match c.cast::<PyDict>() {
+                Ok(d) => self
+                    .channels
+                    .iter()
+                    .map(|n| {
+                        d.get_item(n)?
+                            .ok_or_else(|| bad_argument(format!("channels has no `{n}`")))?
+                            .extract()
+                    })
+                    .collect::<PyResult<_>>()?,
+                Err(_) => c.extract()?,
+            },
+        };
+        self.check_channels(chans.len())?;
+        let cols = [&time, &flux_x, &flux_y, &flux_z, &mag].map(|a| a.as_slice());
+        let cols: Vec<&[f64]> = cols.into_iter().collect::<Result<_, _>>()?;
+        let ch: Vec<&[f64]> = chans
+            .iter()
+            .map(|a| a.as_slice())
+            .collect::<Result<_, _>>()?;
+        let n = cols[0].len();
+        if cols.iter().chain(&ch).any(|c| c.len() != n) {
+            return Err(bad_argument("the arrays of a block must have one length"));
+        }
+        let online = &mut self.online;
+        let (interf, comp, flag) = py.detach(|| {
+            let (mut interf, mut comp, mut flag) = (
+                Vec::with_capacity(n),
+                Vec::with_capacity(n),
+                Vec::with_capacity(n),
+            );
+            let mut row = vec![0.0; ch.len()];
+            for k in 0..n {
+                for (v, c) in row.iter_mut().zip(&ch) {
+                    *v = c[k];
+                }
+                let o = online.push(&OnlineSample {
+                    time_s: cols[0][k],
+                    flux_nt: [cols[1][k], cols[2][k], cols[3][k]],
+                    mag_nt: cols[4][k],
+                    channels: &row,
+                });
+                interf.push(o.interference_nt);
+                comp.push(o.compensated_nt);
+                flag.push(StreamFlag::from(o.status) as u8);
+            }
+            (interf, comp, flag)
+        });
+        let d = PyDict::new(py);
+        d.set_item("mag_interf", PyArray1::from_vec(py, interf))?;
+        d.set_item("mag_comp", PyArray1::from_vec(py, comp))?;
+        d.set_item("comp_flag", PyArray1::from_vec(py, flag))?;
+        Ok(d)
+    }
+
+    /// Forget the stream: the next sample starts a run whatever its time.
+    fn reset(&mut self) {
+        self.online.reset();
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "OnlineCompensator(channels={:?}, max_step_s={})",
+            self.channels, self.max_step_s
+        )
+    }
+}
+
+impl PyOnline {
+    /// The online compensator of `model` ([`PyOnline::new`]).
+    pub fn of(model: &TlModel, sample_rate: Option<f64>) -> PyResult<Self> {
+        let causal = CausalTl::new(model, sample_rate).py_err()?;
+        Ok(Self {
+            online: causal.online().py_err()?,
+            channels: model
+                .design
+                .terms
+                .extras()
+                .iter()
+                .map(|x| x.channel.clone())
+                .collect(),
+            max_step_s: causal.max_step_s(),
+        })
+    }
+
+    fn check_channels(&self, got: usize) -> PyResult<()> {
+        if got == self.channels.len() {
+            Ok(())
+        } else {
+            Err(bad_argument(format!(
+                "the model takes {} channels ({}), got {got}",
+                self.channels.len(),
+                self.channels.join(", ")
+            )))
+        }
+    }
+}
