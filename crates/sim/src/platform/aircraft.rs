@@ -13,7 +13,11 @@
 //! ([`aeromag_core::field::dipole::dipole_matrix`]):
 //!
 //! * **Permanent** (hard iron): moment `m_p` fixed in the body (A·m²);
-//!   field `D(r) m_p`.
+//!   field `D(r) m_p`. A part's moment may creep, `m_p(t) = m_p + ṁ_p t`
+//!   with `t` the hours since the flight's start (`permanent_creep_am2_per_h`,
+//!   default 0): the slow change of an aircraft's magnetization over a long
+//!   survey (vibration, temperature, a magnetised tool left on board) that
+//!   an adaptive compensator must follow (issue 21).
 //! * **Induced** (soft iron): `m = (X V/μ0) B` with a full, not necessarily
 //!   symmetric, susceptibility-volume matrix `X V` (m³; demagnetisation and
 //!   shape anisotropy included); field `D(r) (X V/μ0) B`.
@@ -83,8 +87,11 @@ pub struct MagneticPart {
     pub name: String,
     /// Position in the body frame, m.
     pub position_m: [f64; 3],
-    /// Permanent moment, body frame, A·m².
+    /// Permanent moment, body frame, A·m² (at the flight's start).
     pub permanent_am2: [f64; 3],
+    /// Change of the permanent moment per hour of flight, body frame,
+    /// A·m²/h (0: a fixed moment).
+    pub permanent_creep_am2_per_h: [f64; 3],
     /// Susceptibility times volume `X V`, body frame, m³ (rows of the 3×3
     /// matrix; induced moment `m = X V B/μ0`).
     pub susceptibility_volume_m3: [[f64; 3]; 3],
@@ -96,6 +103,7 @@ impl Default for MagneticPart {
             name: String::new(),
             position_m: [0.0; 3],
             permanent_am2: [0.0; 3],
+            permanent_creep_am2_per_h: [0.0; 3],
             susceptibility_volume_m3: [[0.0; 3]; 3],
         }
     }
@@ -319,6 +327,7 @@ fn part(name: &str, p: [f64; 3], m: [f64; 3], d: [f64; 3], o: [f64; 6]) -> Magne
         name: name.into(),
         position_m: p,
         permanent_am2: m,
+        permanent_creep_am2_per_h: [0.0; 3],
         susceptibility_volume_m3: [
             [d[0] / s, o[0] / s, o[1] / s],
             [o[2] / s, d[1] / s, o[3] / s],
@@ -466,6 +475,10 @@ impl AircraftConfig {
             let f = format!("{p}.parts[{i}]");
             finite3(&format!("{f}.position_m"), &m.position_m)?;
             finite3(&format!("{f}.permanent_am2"), &m.permanent_am2)?;
+            finite3(
+                &format!("{f}.permanent_creep_am2_per_h"),
+                &m.permanent_creep_am2_per_h,
+            )?;
             for (r, row) in m.susceptibility_volume_m3.iter().enumerate() {
                 finite3(&format!("{f}.susceptibility_volume_m3[{r}]"), row)?;
             }
@@ -525,8 +538,10 @@ impl AircraftConfig {
 /// `ΔB = K + L B + Σ_l f_l i_l + Σ_c g_c I_c` (all in T; `L` dimensionless).
 #[derive(Debug, Clone)]
 pub struct InterferenceAt {
-    /// Permanent field `Σ D(r) m_p`, T.
+    /// Permanent field `Σ D(r) m_p` at the flight's start, T.
     pub permanent_t: Vector3<f64>,
+    /// Its change per hour `Σ D(r) ṁ_p`, T/h.
+    pub permanent_creep_t_per_h: Vector3<f64>,
     /// Induced matrix `Σ D(r) X V/μ0` (T per T).
     pub induced: Matrix3<f64>,
     /// Field per ampere of each eddy loop `D(r) A n`, T/A.
@@ -560,10 +575,12 @@ impl InterferenceAt {
     pub fn new(cfg: &AircraftConfig, sensor_m: [f64; 3]) -> Result<Self> {
         let s = Vector3::from(sensor_m);
         let mut permanent_t = Vector3::zeros();
+        let mut permanent_creep_t_per_h = Vector3::zeros();
         let mut induced = Matrix3::zeros();
         for p in &cfg.parts {
             let d = dipole_matrix(&(s - Vector3::from(p.position_m)));
             permanent_t += d * Vector3::from(p.permanent_am2);
+            permanent_creep_t_per_h += d * Vector3::from(p.permanent_creep_am2_per_h);
             let xv = Matrix3::from_row_slice(&p.susceptibility_volume_m3.concat());
             induced += d * xv / MU0;
         }
@@ -589,16 +606,19 @@ impl InterferenceAt {
             .collect::<Result<Vec<_>>>()?;
         Ok(Self {
             permanent_t,
+            permanent_creep_t_per_h,
             induced,
             eddy_per_a,
             current_per_a,
         })
     }
 
-    /// Contributions for external body field `b_t` (T), eddy currents `eddy_a`
-    /// and on-board currents `cur_a` (A).
+    /// Contributions `hours` after the flight's start for external body
+    /// field `b_t` (T), eddy currents `eddy_a` and on-board currents `cur_a`
+    /// (A).
     pub fn contributions(
         &self,
+        hours: f64,
         b_t: &Vector3<f64>,
         eddy_a: &[f64],
         cur_a: &[f64],
@@ -612,7 +632,7 @@ impl InterferenceAt {
             current += f * *i;
         }
         Contributions {
-            permanent: self.permanent_t,
+            permanent: self.permanent_t + self.permanent_creep_t_per_h * hours,
             induced: self.induced * b_t,
             eddy,
             current,
@@ -663,8 +683,8 @@ mod tests {
         let cfg = AircraftConfig::default();
         let at = InterferenceAt::new(&cfg, [-9.5, 0.0, -0.6]).unwrap();
         let b = Vector3::new(1.5e-5, 2e-6, 4.8e-5);
-        let c1 = at.contributions(&b, &[0.0; 6], &[]);
-        let c2 = at.contributions(&(b * 2.0), &[0.0; 6], &[]);
+        let c1 = at.contributions(0.0, &b, &[0.0; 6], &[]);
+        let c2 = at.contributions(0.0, &(b * 2.0), &[0.0; 6], &[]);
         assert!((c2.induced - 2.0 * c1.induced).norm() < 1e-24);
         assert!((at.induced - at.induced.transpose()).norm() > 1e-3 * at.induced.norm());
         // the permanent part does not depend on the field

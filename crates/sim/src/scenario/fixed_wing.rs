@@ -246,8 +246,9 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             *slot = series.field_a()[k];
         }
         let bt_s = b_s[k] / NT_PER_T;
-        let c_s = at_s.contributions(&bt_s, &i_e, &i_c);
-        let c_f = at_f.contributions(&(b_f[k] / NT_PER_T), &i_e, &i_c);
+        let hours = tr.t_s[k] / 3600.0;
+        let c_s = at_s.contributions(hours, &bt_s, &i_e, &i_c);
+        let c_f = at_f.contributions(hours, &(b_f[k] / NT_PER_T), &i_e, &i_c);
         let d_s = nt(c_s.total());
         let tot = b_s[k] + d_s;
         let e = b_s[k] / b_s[k].norm();
@@ -278,7 +279,7 @@ pub fn run<P: Pattern>(cfg: &FixedWingConfig<P>, kind: ScenarioKind) -> Result<S
             for (slot, series) in i_c.iter_mut().zip(&cur) {
                 *slot = series.field_a()[k];
             }
-            let c = at.contributions(&(b / NT_PER_T), &i_e, &i_c);
+            let c = at.contributions(tr.t_s[k] / 3600.0, &(b / NT_PER_T), &i_e, &i_c);
             current.push(b.dot(&nt(c.current)) / b.norm());
             total.push(b + nt(c.total()));
         }
