@@ -53,6 +53,17 @@ fn setup(dir: &Path) -> (PathBuf, Vec<String>, Vec<String>) {
     (model, lines, want)
 }
 
+/// `aeromag stream --model MODEL` with its standard streams piped.
+fn piped_stream(model: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_aeromag"))
+        .args(["stream", "--model", model.to_str().unwrap()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// `mag_interf`, `mag_comp` of an output line.
 fn values(line: &str) -> (String, String) {
     let v: Vec<&str> = line.rsplitn(4, ',').collect();
@@ -88,13 +99,7 @@ fn a_pipe_gives_the_causal_batch_values_and_flags_bad_lines() {
             _ => {}
         }
     }
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aeromag"))
-        .args(["stream", "--model", model.to_str().unwrap()])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = piped_stream(&model);
     let mut stdin = child.stdin.take().unwrap();
     let text = input.join("\n") + "\n";
     let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()).unwrap());
@@ -224,13 +229,7 @@ fn udp_datagrams_are_answered_to_their_sender() {
 fn stream_and_causal_errors_exit_2() {
     let d = tempfile::tempdir().unwrap();
     let (model, _, _) = setup(d.path());
-    let mut child = Command::new(env!("CARGO_BIN_EXE_aeromag"))
-        .args(["stream", "--model", model.to_str().unwrap()])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = piped_stream(&model);
     child
         .stdin
         .take()

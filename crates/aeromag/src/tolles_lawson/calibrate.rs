@@ -2,7 +2,7 @@
 //! least squares or by the Kalman method.
 
 use super::kalman::{KalmanOptions, KalmanOutcome, fit_kalman_flight};
-use super::lags::{SearchSegments, TermChoice, choose_terms, searches, test_extra_channels};
+use super::lags::{TermChoice, choose_terms, test_extra_channels};
 use crate::error::{Error, InFile, Result};
 use crate::flight::{Flight, LeverArm, ReferenceChannels, SegmentRule, SensorColumns, TlInputs};
 use crate::flight::{reduced, reference_sum};
@@ -474,8 +474,6 @@ fn select_channels(
         reference_nt,
         &mut quiet,
         |ls, _, segments, _| {
-            let search = SearchSegments::new(&label, segments, ls, true)?;
-            let segments = &search.of(segments);
             let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
             notes.stage("testing the extra regressors");
             // A fit of unfiltered data (the reference-sensor mode) tests its
@@ -533,16 +531,7 @@ fn fit_ls_segments(
     notes: &mut Notes,
 ) -> Result<(TlModel, Option<LagSelection>)> {
     let label = flight.label();
-    let searching = searches(&opts.eddy_lag, &opts.extra);
-    let search = SearchSegments::new(&label, segments, ls, searching)?;
-    let choice = choose_terms(
-        &label,
-        &search.of(segments),
-        ls,
-        &opts.eddy_lag,
-        &opts.extra,
-        notes,
-    )?;
+    let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
     let selection = choice.eddy;
     let cfg = &LsConfig {
         design: ls.design.with_terms(choice.terms),

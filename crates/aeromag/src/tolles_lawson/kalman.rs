@@ -3,7 +3,7 @@
 //! and its per-row series.
 
 use super::calibrate::{CalibrateOptions, EddyLag, fit_rule, model_columns, reduced_mag};
-use super::lags::{SearchSegments, add_lags_by_kalman_likelihood, choose_terms, searches};
+use super::lags::{add_lags_by_kalman_likelihood, choose_terms};
 use crate::error::{Error, InFile, Result};
 use crate::flight::{Flight, LeverArm, TlInputs, sensor_track_at};
 use crate::observer::Notes;
@@ -198,15 +198,7 @@ pub(super) fn fit_kalman_flight(
     // searches below would see what that left.
     let (cfg, ls, extra_lags, requests) = if opts.extra.iter().any(|r| r.lag) {
         let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
-        let search = SearchSegments::new(&file, &data, &ls, true)?;
-        let pre = choose_terms(
-            &file,
-            &search.of(&data),
-            &ls,
-            &EddyLag::None,
-            &opts.extra,
-            notes,
-        )?;
+        let pre = choose_terms(&file, &data, &ls, &EddyLag::None, &opts.extra, notes)?;
         let terms = cfg
             .design
             .terms
@@ -255,31 +247,14 @@ pub(super) fn fit_kalman_flight(
                 .iter()
                 .map(|r| reduced.whole().slice(r.clone()))
                 .collect();
-            let search = SearchSegments::new(&file, &data, &ls, true)?;
-            let mut choice = choose_terms(
-                &file,
-                &search.of(&data),
-                &ls,
-                &opts.eddy_lag,
-                &requests,
-                notes,
-            )?;
+            let mut choice = choose_terms(&file, &data, &ls, &opts.eddy_lag, &requests, notes)?;
             choice.terms =
                 add_lags_by_kalman_likelihood(&file, &segments, &cfg, choice.terms, &first, notes)?;
             (choice, first.tuning.is_some().then_some(first.noise))
         }
         _ => {
             let data: Vec<Segment> = segments.iter().map(|k| k.data).collect();
-            let search =
-                SearchSegments::new(&file, &data, &ls, searches(&opts.eddy_lag, &requests))?;
-            let choice = choose_terms(
-                &file,
-                &search.of(&data),
-                &ls,
-                &opts.eddy_lag,
-                &requests,
-                notes,
-            )?;
+            let choice = choose_terms(&file, &data, &ls, &opts.eddy_lag, &requests, notes)?;
             (choice, None)
         }
     };

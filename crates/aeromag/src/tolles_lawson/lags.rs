@@ -24,15 +24,17 @@ pub const MAX_EXTRA_LAG_PASSES: usize = 3;
 /// model ([`choose_terms`], [`test_extra_channels`]); under the exact
 /// magnitude the reading they see is corrected by the second-order
 /// remainder `R = |B + ΔB| − |B| − eᵀΔB` (≈ |ΔB⊥|²/2|B|) of an
-/// exact-magnitude fit of every candidate term (instantaneous extras, the
-/// eddy terms without lags), and their direction cosines are those of the
-/// modelled total field: one Gauss–Newton linearisation at that fit. The
+/// exact-magnitude fit of every candidate term (for the lag searches the
+/// extras instantaneous and the eddy terms without lags; for the channel
+/// test the terms with their chosen lags), and their direction cosines are
+/// those of the modelled total field: one Gauss–Newton linearisation at
+/// that fit. The
 /// remainder is otherwise left in the searches' residual, where it hides
 /// the terms under test. Measured (tools/validate, seed 23: a cabin
 /// sensor with 215 nT of interference, 193 of it from currents): without
 /// the correction the band-passed residual with every current was 3.56 nT
 /// and the air conditioner's terms (15 nT on the survey) were dropped.
-pub(super) struct SearchSegments {
+struct SearchSegments {
     /// Per segment: the total field (x, y, z, nT) and the corrected reading
     /// (nT); empty under the first-order magnitude.
     linearised: Vec<([Vec<f64>; 3], Vec<f64>)>,
@@ -80,7 +82,7 @@ impl SearchSegments {
 
 /// Whether [`choose_terms`] searches anything for `lag` and `requests`
 /// (an `auto` eddy lag, or an extra regressor asked with `:lag`).
-pub(super) fn searches(lag: &EddyLag, requests: &[ExtraRequest]) -> bool {
+fn searches(lag: &EddyLag, requests: &[ExtraRequest]) -> bool {
     matches!(lag, EddyLag::Auto) || requests.iter().any(|r| r.lag)
 }
 
@@ -111,7 +113,10 @@ pub(super) fn choose_terms(
     notes: &mut Notes,
 ) -> Result<TermChoice> {
     // The searches fit the first-order model (an exact-magnitude fit is
-    // Gauss–Newton steps of it; the terms it needs are the same).
+    // Gauss–Newton steps of it; the terms it needs are the same), on the
+    // reading corrected by the second-order remainder ([`SearchSegments`]).
+    let search = SearchSegments::new(file, segments, cfg, searches(lag, requests))?;
+    let segments = &search.of(segments);
     let cfg = &LsConfig {
         design: Design {
             magnitude: Magnitude::FirstOrder,
@@ -227,6 +232,16 @@ pub(super) fn test_extra_channels(
     terms: &TermSet,
     notes: &mut Notes,
 ) -> Result<ChannelSelection> {
+    let search = SearchSegments::new(
+        file,
+        segments,
+        &LsConfig {
+            design: ls.design.with_terms(terms.clone()),
+            ..ls.clone()
+        },
+        true,
+    )?;
+    let segments = &search.of(segments);
     let cfg = LsConfig {
         design: Design {
             magnitude: Magnitude::FirstOrder,
