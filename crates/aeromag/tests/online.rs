@@ -173,6 +173,8 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
         "0.3,20002,1002,45002,",
         "0.4,20003,1003,45003,49303",
         "9.0,20003,1003,45003,49303",
+        "9.1,20003,1003,45003,49303,7",
+        "9.1,20003,1003,45003,49303",
     ]
     .iter()
     .map(|l| lc.line(l, &mut out))
@@ -188,14 +190,42 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
             TimeBackwards,
             Missing,
             Started,
-            Started
+            Started,
+            Malformed,
+            Compensated
         ]
     );
-    assert_eq!(out.lines().count(), 8);
+    assert_eq!(out.lines().count(), 10);
     assert!(out.lines().nth(2).unwrap().ends_with("45001,,,4"));
     let c = lc.counts();
     assert_eq!(
         (c.lines, c.compensated, c.restarts, c.malformed),
-        (8, 4, 2, 2)
+        (10, 5, 2, 3)
     );
+}
+
+/// A line longer than the limit is flagged malformed and skipped to its
+/// end; the stream goes on (a hostile or broken peer cannot make it hold
+/// unbounded text).
+#[test]
+fn an_overlong_line_is_malformed_and_the_stream_goes_on() {
+    use aeromag::online::{LineStream, MAX_STREAM_LINE_BYTES};
+    let model = model();
+    let mut input = String::from("time,flux_x,flux_y,flux_z,mag\n");
+    input.push_str(&"9".repeat(MAX_STREAM_LINE_BYTES + 10));
+    input.push('\n');
+    input.push_str("0.1,20001,1001,45001,49301\n");
+    let mut s = LineStream::new(&model, &StreamOptions::default(), None).unwrap();
+    let mut out = Vec::new();
+    s.serve(input.as_bytes(), &mut out, "test").unwrap();
+    let out = String::from_utf8(out).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 3, "{}", &out[..out.len().min(300)]);
+    assert_eq!(lines[1], ",,,4");
+    assert!(
+        lines[2].starts_with("0.1,") && lines[2].ends_with(",2"),
+        "{}",
+        lines[2]
+    );
+    assert_eq!(s.counts().malformed, 1);
 }

@@ -111,6 +111,9 @@ struct Fields {
     flux: [usize; 3],
     mag: usize,
     channels: Vec<usize>,
+    /// The last input's position.
+    last: usize,
+    /// Cells per line.
     count: usize,
 }
 
@@ -165,7 +168,15 @@ impl LineCompensator {
                 .map(|x| find(&x.channel))
                 .collect::<Result<_>>()?,
             count: names.len(),
+            last: 0,
         };
+        let mut fields = fields;
+        fields.last = [fields.time, fields.mag]
+            .into_iter()
+            .chain(fields.flux)
+            .chain(fields.channels.iter().copied())
+            .max()
+            .unwrap_or(0);
         for out in STREAM_OUTPUT {
             if names.iter().any(|n| n.eq_ignore_ascii_case(out)) {
                 return Err(Error::bad_input(format!(
@@ -232,9 +243,7 @@ impl LineCompensator {
     fn parse(&mut self, line: &str) -> Option<(f64, [f64; 3], f64)> {
         let f = &self.fields;
         let (mut time, mut flux, mut mag) = (None, [None; 3], None);
-        let mut count = 0;
-        for (k, cell) in line.split(',').enumerate() {
-            count += 1;
+        let mut cell = |k: usize, text: &str| -> Option<()> {
             let slot = if k == f.time {
                 &mut time
             } else if k == f.mag {
@@ -242,15 +251,30 @@ impl LineCompensator {
             } else if let Some(a) = f.flux.iter().position(|&i| i == k) {
                 &mut flux[a]
             } else if let Some(c) = f.channels.iter().position(|&i| i == k) {
-                let v = number(cell)?;
-                self.channels[c] = v;
-                continue;
+                self.channels[c] = number(text)?;
+                return Some(());
             } else {
-                continue;
+                return Some(());
             };
-            *slot = Some(number(cell)?);
+            *slot = Some(number(text)?);
+            Some(())
+        };
+        // The cells up to the last input, then only the commas counted.
+        let bytes = line.as_bytes();
+        let (mut start, mut k) = (0, 0);
+        let mut commas = memchr::memchr_iter(b',', bytes);
+        while k < f.last {
+            let end = commas.next().unwrap_or(bytes.len());
+            cell(k, &line[start..end.min(bytes.len())])?;
+            if end >= bytes.len() {
+                return None;
+            }
+            (start, k) = (end + 1, k + 1);
         }
-        if count != f.count {
+        let rest = &bytes[start..];
+        let end = memchr::memchr(b',', rest).map_or(bytes.len(), |i| start + i);
+        cell(k, &line[start..end])?;
+        if k + 1 + memchr::memchr_iter(b',', &bytes[end.min(bytes.len())..]).count() != f.count {
             return None;
         }
         Some((time?, [flux[0]?, flux[1]?, flux[2]?], mag?))
@@ -383,7 +407,10 @@ impl LineStream {
             if buf.len() > MAX_STREAM_LINE_BYTES {
                 comp.malformed(&mut out);
             } else {
-                comp.line(&String::from_utf8_lossy(&buf), &mut out);
+                match std::str::from_utf8(&buf) {
+                    Ok(text) => comp.line(text, &mut out),
+                    Err(_) => comp.line(&String::from_utf8_lossy(&buf), &mut out),
+                };
             }
         }
     }
@@ -471,7 +498,7 @@ fn read_line(
             return Ok(any);
         }
         any = true;
-        let (take, done) = match chunk.iter().position(|&b| b == b'\n') {
+        let (take, done) = match memchr::memchr(b'\n', chunk) {
             Some(k) => (k + 1, true),
             None => (chunk.len(), false),
         };
