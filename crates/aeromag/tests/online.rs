@@ -229,3 +229,59 @@ fn an_overlong_line_is_malformed_and_the_stream_goes_on() {
     );
     assert_eq!(s.counts().malformed, 1);
 }
+
+/// A multi-sensor model under the causal convention (`compensate --causal`
+/// with a `tolles-lawson-sensors` file): the batch path's columns, and on
+/// the SGL-like installation every sensor within 5 % of its batch
+/// residual.
+#[test]
+fn several_sensors_causally() {
+    use aeromag::online::CausalSensors;
+    use aeromag::{CompensateSensors, SensorColumns, SensorSet, calibrate_sensors};
+    let sgl = "installation = \"sgl\"\n";
+    let cal = simulate_flight(ScenarioKind::Calibration, Some(sgl), Some(1)).unwrap();
+    let survey = simulate_flight(ScenarioKind::Survey, Some(sgl), Some(2)).unwrap();
+    let set = SensorSet {
+        sensors: vec![
+            SensorColumns::find(&cal, "mag_1_uc", Some("flux_a")).unwrap(),
+            SensorColumns::find(&cal, "mag_4_uc", Some("flux_a")).unwrap(),
+        ],
+        reference: None,
+    };
+    let opts = CalibrateOptions {
+        extra: aeromag::compensation::tolles_lawson::ExtraRequest::parse_list(
+            "cur_strb,cur_flap,cur_heat,cur_ac_hi",
+        )
+        .unwrap(),
+        ..CalibrateOptions::default()
+    };
+    let model = calibrate_sensors(&cal, &set, &opts, &mut Silent)
+        .unwrap()
+        .model;
+    let batch = model.compensate(&survey).unwrap();
+    let causal = CausalSensors::new(&model, None)
+        .unwrap()
+        .compensate(&survey)
+        .unwrap();
+    let names = |c: &aeromag::tolles_lawson::SensorsCompensated| -> Vec<String> {
+        c.columns().into_iter().map(|(n, _)| n).collect()
+    };
+    assert_eq!(names(&batch), names(&causal));
+    let line = survey.require("line").unwrap();
+    for (k, ((name, _, b), (_, _, c))) in batch.sensors.iter().zip(&causal.sensors).enumerate() {
+        let truth = survey
+            .require(&format!("true_external_{}", [1, 4][k]))
+            .unwrap();
+        let rms = |comp: &[f64]| {
+            let d: Vec<f64> = (0..comp.len())
+                .filter(|&i| line[i] > 0.0)
+                .map(|i| comp[i] - truth[i])
+                .collect();
+            let m = d.iter().sum::<f64>() / d.len() as f64;
+            (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+        };
+        let (rb, rc) = (rms(b), rms(c));
+        eprintln!("{name}: batch {rb:.4} nT, causal {rc:.4} nT");
+        assert!(rc <= 1.05 * rb, "{name}: {rc} vs {rb}");
+    }
+}

@@ -4,7 +4,7 @@ use crate::compensate::{Compensator, OutputColumns};
 use crate::error::{Error, Result};
 use crate::flight::{Flight, GAP_FACTOR, SensorColumns, TlInputs};
 use crate::observer::Observer;
-use crate::tolles_lawson::TL_OUTPUT;
+use crate::tolles_lawson::{CompensateSensors, SensorsCompensated, SensorsModel, TL_OUTPUT};
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::online::OnlineTl;
 use aeromag_compensation::tolles_lawson::segments::split_at_steps;
@@ -78,9 +78,17 @@ impl Compensator for CausalTl {
         flight: &Flight,
         _observer: &mut dyn Observer,
     ) -> Result<Vec<f64>> {
+        self.interference_at(flight, &SensorColumns::default())
+    }
+}
+
+impl CausalTl {
+    /// The interference (nT) at the sensor `sensor` of `flight` under the
+    /// causal convention, NaN outside the runs.
+    pub fn interference_at(&self, flight: &Flight, sensor: &SensorColumns) -> Result<Vec<f64>> {
         let design = self.model.design.causal();
-        let cols = TlInputs::of_sensor(flight, &SensorColumns::default())?
-            .with_extras(flight, design.terms.extras())?;
+        let cols =
+            TlInputs::of_sensor(flight, sensor)?.with_extras(flight, design.terms.extras())?;
         let (runs, _) = split_at_steps(cols.time, None, &cols.usable(), self.max_step_s, 1);
         let whole = cols.whole();
         let coef = self.model.coef();
@@ -91,5 +99,49 @@ impl Compensator for CausalTl {
             out[r].copy_from_slice(&v);
         }
         Ok(out)
+    }
+}
+
+/// A multi-sensor model under the causal convention: each sensor's model
+/// as [`CausalTl`] (each with the sample interval its model records, or
+/// `sample_rate_hz`), the same columns as the batch path
+/// ([`crate::tolles_lawson::SensorsCompensated`]).
+#[derive(Debug, Clone)]
+pub struct CausalSensors {
+    sensors: Vec<(String, SensorColumns, CausalTl)>,
+}
+
+impl CausalSensors {
+    /// `model` under the causal convention (bad input as [`CausalTl::new`]).
+    pub fn new(model: &SensorsModel, sample_rate_hz: Option<f64>) -> Result<Self> {
+        let sensors = model
+            .sensors
+            .iter()
+            .map(|s| {
+                let cols = SensorColumns {
+                    mag: s.mag.clone(),
+                    flux: s.flux.clone(),
+                };
+                Ok((
+                    s.name.clone(),
+                    cols,
+                    CausalTl::new(&s.model, sample_rate_hz)?,
+                ))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self { sensors })
+    }
+}
+
+impl CompensateSensors for CausalSensors {
+    fn compensate(&self, flight: &Flight) -> Result<SensorsCompensated> {
+        let mut sensors = Vec::new();
+        for (name, cols, causal) in &self.sensors {
+            let interf = causal.interference_at(flight, cols)?;
+            let mag = flight.require(&cols.mag)?;
+            let comp = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
+            sensors.push((name.clone(), interf, comp));
+        }
+        Ok(SensorsCompensated { sensors })
     }
 }

@@ -4,7 +4,8 @@
 //! - [`CausalTl`] — a model under the causal convention, applied to a
 //!   whole flight (`aeromag compensate --causal`): the eddy columns take
 //!   backward differences, so no sample's value depends on a later one;
-//!   runs break at time steps over 1.5 × the model's sample interval.
+//!   runs break at time steps over 1.5 × the model's sample interval;
+//!   [`CausalSensors`] the same for a multi-sensor model.
 //! - [`OnlineTl`] — the same model one sample at a time, latency 0,
 //!   bounded memory; it gives [`CausalTl`]'s values bit for bit.
 //! - [`LineCompensator`] — the line protocol of `aeromag stream`: CSV lines
@@ -33,7 +34,7 @@ mod lines;
 pub use aeromag_compensation::tolles_lawson::online::{
     OnlineOutput, OnlineSample, OnlineTl, SampleStatus,
 };
-pub use causal::CausalTl;
+pub use causal::{CausalSensors, CausalTl};
 pub use lines::{
     LineCompensator, LineStream, MAX_STREAM_LINE_BYTES, STREAM_OUTPUT, StreamCounts, StreamFlag,
     StreamOptions,

@@ -45,12 +45,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()])?;
     if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {
-        if a.causal {
-            return Err(aeromag::Error::bad_input(
-                "--causal applies a single-sensor model; a multi-sensor model is applied in batch only (for now)",
-            )
-            .into());
-        }
         return run_sensors(&a);
     }
     let model = TlModel::read(&a.model)?;
@@ -70,7 +64,11 @@ fn run_sensors(a: &Args) -> anyhow::Result<()> {
     use aeromag::CompensateSensors;
     let model = aeromag::SensorsModel::read(&a.model)?;
     let flight = a.input.load()?;
-    let out = model.compensate(&flight)?;
+    let out = if a.causal {
+        aeromag::online::CausalSensors::new(&model, a.sample_rate)?.compensate(&flight)?
+    } else {
+        model.compensate(&flight)?
+    };
     let missing = out.missing();
     let names: Vec<String> = out.columns().into_iter().map(|(n, _)| n).collect();
     let mut table = flight.into_table();
