@@ -18,6 +18,16 @@ fn model() -> TlModel {
     m
 }
 
+/// RMS about its mean of `comp − truth` on the lines (`line > 0`), nT.
+fn line_rms(comp: &[f64], truth: &[f64], line: &[f64]) -> f64 {
+    let d: Vec<f64> = (0..comp.len())
+        .filter(|&k| line[k] > 0.0)
+        .map(|k| comp[k] - truth[k])
+        .collect();
+    let m = d.iter().sum::<f64>() / d.len() as f64;
+    (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+}
+
 /// The survey as CSV text, with two gaps (rows removed), missing values
 /// (empty cells in `flux_y`, `mag`) and a zero field row.
 fn survey_csv(dir: &std::path::Path) -> (std::path::PathBuf, Vec<String>) {
@@ -126,14 +136,7 @@ fn the_causal_residual_is_within_five_percent_of_the_batch_residual() {
     let survey = simulate_flight(ScenarioKind::Survey, None, Some(2)).unwrap();
     let truth = survey.require("true_external").unwrap();
     let line = survey.require("line").unwrap();
-    let rms = |comp: &[f64]| {
-        let d: Vec<f64> = (0..comp.len())
-            .filter(|&k| line[k] > 0.0)
-            .map(|k| comp[k] - truth[k])
-            .collect();
-        let m = d.iter().sum::<f64>() / d.len() as f64;
-        (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
-    };
+    let rms = |comp: &[f64]| line_rms(comp, truth, line);
     let batch = rms(&model.compensate(&survey).unwrap().compensated_nt);
     let causal = rms(&CausalTl::new(&model, None)
         .unwrap()
@@ -272,14 +275,7 @@ fn several_sensors_causally() {
         let truth = survey
             .require(&format!("true_external_{}", [1, 4][k]))
             .unwrap();
-        let rms = |comp: &[f64]| {
-            let d: Vec<f64> = (0..comp.len())
-                .filter(|&i| line[i] > 0.0)
-                .map(|i| comp[i] - truth[i])
-                .collect();
-            let m = d.iter().sum::<f64>() / d.len() as f64;
-            (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
-        };
+        let rms = |comp: &[f64]| line_rms(comp, truth, line);
         let (rb, rc) = (rms(b), rms(c));
         eprintln!("{name}: batch {rb:.4} nT, causal {rc:.4} nT");
         assert!(rc <= 1.05 * rb, "{name}: {rc} vs {rb}");

@@ -108,40 +108,29 @@ impl CausalTl {
 /// ([`crate::tolles_lawson::SensorsCompensated`]).
 #[derive(Debug, Clone)]
 pub struct CausalSensors {
-    sensors: Vec<(String, SensorColumns, CausalTl)>,
+    model: SensorsModel,
+    causal: Vec<CausalTl>,
 }
 
 impl CausalSensors {
     /// `model` under the causal convention (bad input as [`CausalTl::new`]).
     pub fn new(model: &SensorsModel, sample_rate_hz: Option<f64>) -> Result<Self> {
-        let sensors = model
+        let causal = model
             .sensors
             .iter()
-            .map(|s| {
-                let cols = SensorColumns {
-                    mag: s.mag.clone(),
-                    flux: s.flux.clone(),
-                };
-                Ok((
-                    s.name.clone(),
-                    cols,
-                    CausalTl::new(&s.model, sample_rate_hz)?,
-                ))
-            })
+            .map(|s| CausalTl::new(&s.model, sample_rate_hz))
             .collect::<Result<_>>()?;
-        Ok(Self { sensors })
+        Ok(Self {
+            model: model.clone(),
+            causal,
+        })
     }
 }
 
 impl CompensateSensors for CausalSensors {
     fn compensate(&self, flight: &Flight) -> Result<SensorsCompensated> {
-        let mut sensors = Vec::new();
-        for (name, cols, causal) in &self.sensors {
-            let interf = causal.interference_at(flight, cols)?;
-            let mag = flight.require(&cols.mag)?;
-            let comp = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
-            sensors.push((name.clone(), interf, comp));
-        }
-        Ok(SensorsCompensated { sensors })
+        SensorsCompensated::of(&self.model, flight, |k, cols| {
+            self.causal[k].interference_at(flight, cols)
+        })
     }
 }

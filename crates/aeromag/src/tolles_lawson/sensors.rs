@@ -267,19 +267,33 @@ pub trait CompensateSensors {
     fn compensate(&self, flight: &Flight) -> Result<SensorsCompensated>;
 }
 
-impl CompensateSensors for SensorsModel {
-    fn compensate(&self, flight: &Flight) -> Result<SensorsCompensated> {
+impl SensorsCompensated {
+    /// Every sensor of `model` on `flight`, its interference given by
+    /// `interference(sensor's model, its columns)`: the reading minus it.
+    pub(crate) fn of(
+        model: &SensorsModel,
+        flight: &Flight,
+        mut interference: impl FnMut(usize, &SensorColumns) -> Result<Vec<f64>>,
+    ) -> Result<Self> {
         let mut sensors = Vec::new();
-        for s in &self.sensors {
+        for (k, s) in model.sensors.iter().enumerate() {
             let cols = SensorColumns {
                 mag: s.mag.clone(),
                 flux: s.flux.clone(),
             };
-            let interf = tl_interference(&s.model, flight, &cols)?;
+            let interf = interference(k, &cols)?;
             let mag = flight.require(&s.mag)?;
             let comp = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
             sensors.push((s.name.clone(), interf, comp));
         }
         Ok(SensorsCompensated { sensors })
+    }
+}
+
+impl CompensateSensors for SensorsModel {
+    fn compensate(&self, flight: &Flight) -> Result<SensorsCompensated> {
+        SensorsCompensated::of(self, flight, |k, cols| {
+            tl_interference(&self.sensors[k].model, flight, cols)
+        })
     }
 }
