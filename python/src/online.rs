@@ -5,32 +5,53 @@
 use crate::errors::{IntoPy, bad_argument};
 use crate::tolles_lawson::PyTlModel;
 use aeromag::TlModel;
-use aeromag::online::{CausalTl, OnlineSample, OnlineTl, StreamFlag};
+use aeromag::online::{
+    Adapt, AdaptOptions, CausalTl, Navigation, OnlineEngine, OnlineSample, StreamFlag,
+};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// A model compensating samples as they arrive.
 ///
-/// `OnlineCompensator(model, sample_rate=None)`: `model` a `TlModel`; a run
-/// breaks at time steps over 1.5 / `sample_rate` (default: the
-/// calibration's sample interval, recorded in the model). Each sample's
-/// `comp_flag` is that of `aeromag stream`: 0 compensated, 1 missing
-/// value, 2 compensated after a gap (run restarted), 3 time going back
-/// (ignored).
+/// `OnlineCompensator(model, sample_rate=None, adapt=None)`: `model` a
+/// `TlModel`; a run breaks at time steps over 1.5 / `sample_rate` (default:
+/// the calibration's sample interval, recorded in the model). `adapt`:
+/// `None` (the model's coefficients, the values of `compensate --causal`),
+/// `"kalman"` or `"rls"` (the coefficients updated by every compensated
+/// sample, as `aeromag stream --adapt`; the Kalman filter learns only from
+/// samples with a ground speed). Each sample's `comp_flag` is that of
+/// `aeromag stream`: 0 compensated, 1 missing value, 2 compensated after a
+/// gap (run restarted), 3 time going back (ignored).
 #[pyclass(name = "OnlineCompensator", module = "aeromag._aeromag")]
 pub struct PyOnline {
-    online: OnlineTl,
+    online: OnlineEngine,
     channels: Vec<String>,
+    names: Vec<String>,
     max_step_s: f64,
 }
 
 #[pymethods]
 impl PyOnline {
     #[new]
-    #[pyo3(signature = (model, sample_rate = None))]
-    fn new(model: &PyTlModel, sample_rate: Option<f64>) -> PyResult<Self> {
-        Self::of(model.inner(), sample_rate)
+    #[pyo3(signature = (model, sample_rate = None, adapt = None))]
+    fn new(model: &PyTlModel, sample_rate: Option<f64>, adapt: Option<&str>) -> PyResult<Self> {
+        Self::of(model.inner(), sample_rate, adapt)
+    }
+
+    /// When adapting, the current coefficients: a dict of `name`, `value`
+    /// and `std` (lists in column order); `None` with the model's fixed
+    /// coefficients.
+    #[getter]
+    fn coefficients<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some((values, std)) = self.online.coefficients() else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("name", self.names.clone())?;
+        d.set_item("value", values.to_vec())?;
+        d.set_item("std", std)?;
+        Ok(Some(d))
     }
 
     /// The extra channels a sample carries, in order (the model's current
@@ -47,24 +68,32 @@ impl PyOnline {
     }
 
     /// One sample: time (s), the vector field `(x, y, z)` (body frame, nT),
-    /// the scalar reading (nT) and the channels in [`channels`] order.
-    /// Returns `(mag_interf, mag_comp, comp_flag)` (NaN when not
-    /// compensated).
-    #[pyo3(signature = (time, flux, mag, channels = Vec::new()))]
+    /// the scalar reading (nT), the channels in [`channels`] order, and when
+    /// adapting the ground speed (m/s) and altitude (m). Returns
+    /// `(mag_interf, mag_comp, comp_flag)` (NaN when not compensated).
+    #[pyo3(signature = (time, flux, mag, channels = Vec::new(), speed = f64::NAN, alt = f64::NAN))]
     fn push(
         &mut self,
         time: f64,
         flux: (f64, f64, f64),
         mag: f64,
         channels: Vec<f64>,
+        speed: f64,
+        alt: f64,
     ) -> PyResult<(f64, f64, u8)> {
         self.check_channels(channels.len())?;
-        let o = self.online.push(&OnlineSample {
-            time_s: time,
-            flux_nt: [flux.0, flux.1, flux.2],
-            mag_nt: mag,
-            channels: &channels,
-        });
+        let o = self.online.push(
+            &OnlineSample {
+                time_s: time,
+                flux_nt: [flux.0, flux.1, flux.2],
+                mag_nt: mag,
+                channels: &channels,
+            },
+            Navigation {
+                speed_m_s: speed,
+                alt_m: alt,
+            },
+        );
         Ok((
             o.interference_nt,
             o.compensated_nt,
@@ -74,10 +103,11 @@ impl PyOnline {
 
     /// A block of samples (arrays of one length), in order, continuing the
     /// state: `channels` a list of arrays in [`channels`] order or a dict
-    /// by name. Returns a dict of `mag_interf`, `mag_comp` (float arrays)
-    /// and `comp_flag` (uint8 array). The same values as pushing the
-    /// samples one by one, with the GIL released.
-    #[pyo3(signature = (time, flux_x, flux_y, flux_z, mag, channels = None))]
+    /// by name; when adapting, `speed` (m/s) and `alt` (m) arrays. Returns
+    /// a dict of `mag_interf`, `mag_comp` (float arrays) and `comp_flag`
+    /// (uint8 array). The same values as pushing the samples one by one,
+    /// with the GIL released.
+    #[pyo3(signature = (time, flux_x, flux_y, flux_z, mag, channels = None, speed = None, alt = None))]
     #[allow(clippy::too_many_arguments)]
     fn push_block<'py>(
         &mut self,
@@ -88,6 +118,8 @@ impl PyOnline {
         flux_z: PyReadonlyArray1<'py, f64>,
         mag: PyReadonlyArray1<'py, f64>,
         channels: Option<&Bound<'py, PyAny>>,
+        speed: Option<PyReadonlyArray1<'py, f64>>,
+        alt: Option<PyReadonlyArray1<'py, f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let chans: Vec<PyReadonlyArray1<'py, f64>> = match channels {
             None => Vec::new(),
@@ -111,8 +143,17 @@ impl PyOnline {
             .iter()
             .map(|a| a.as_slice())
             .collect::<Result<_, _>>()?;
+        let nav: Vec<Option<&[f64]>> = [&speed, &alt]
+            .into_iter()
+            .map(|a| a.as_ref().map(|a| a.as_slice()).transpose())
+            .collect::<Result<_, _>>()?;
         let n = cols[0].len();
-        if cols.iter().chain(&ch).any(|c| c.len() != n) {
+        if cols
+            .iter()
+            .chain(&ch)
+            .chain(nav.iter().flatten())
+            .any(|c| c.len() != n)
+        {
             return Err(bad_argument("the arrays of a block must have one length"));
         }
         let online = &mut self.online;
@@ -127,12 +168,19 @@ impl PyOnline {
                 for (v, c) in row.iter_mut().zip(&ch) {
                     *v = c[k];
                 }
-                let o = online.push(&OnlineSample {
-                    time_s: cols[0][k],
-                    flux_nt: [cols[1][k], cols[2][k], cols[3][k]],
-                    mag_nt: cols[4][k],
-                    channels: &row,
-                });
+                let at = |c: Option<&[f64]>| c.map_or(f64::NAN, |c| c[k]);
+                let o = online.push(
+                    &OnlineSample {
+                        time_s: cols[0][k],
+                        flux_nt: [cols[1][k], cols[2][k], cols[3][k]],
+                        mag_nt: cols[4][k],
+                        channels: &row,
+                    },
+                    Navigation {
+                        speed_m_s: at(nav[0]),
+                        alt_m: at(nav[1]),
+                    },
+                );
                 interf.push(o.interference_nt);
                 comp.push(o.compensated_nt);
                 flag.push(StreamFlag::from(o.status) as u8);
@@ -161,10 +209,12 @@ impl PyOnline {
 
 impl PyOnline {
     /// The online compensator of `model` ([`PyOnline::new`]).
-    pub fn of(model: &TlModel, sample_rate: Option<f64>) -> PyResult<Self> {
+    pub fn of(model: &TlModel, sample_rate: Option<f64>, adapt: Option<&str>) -> PyResult<Self> {
         let causal = CausalTl::new(model, sample_rate).py_err()?;
+        let adapt = adapt.map(str::parse::<Adapt>).transpose().py_err()?;
         Ok(Self {
-            online: causal.online().py_err()?,
+            online: causal.engine(adapt, &AdaptOptions::default()).py_err()?,
+            names: model.design.column_names(),
             channels: model
                 .design
                 .terms

@@ -340,10 +340,15 @@ impl PyTlModel {
         }
     }
 
-    /// An `OnlineCompensator` of this model.
-    #[pyo3(signature = (sample_rate = None))]
-    fn online(&self, sample_rate: Option<f64>) -> PyResult<crate::online::PyOnline> {
-        crate::online::PyOnline::of(&self.model, sample_rate)
+    /// An `OnlineCompensator` of this model (`adapt`: None, "kalman" or
+    /// "rls").
+    #[pyo3(signature = (sample_rate = None, adapt = None))]
+    fn online(
+        &self,
+        sample_rate: Option<f64>,
+        adapt: Option<&str>,
+    ) -> PyResult<crate::online::PyOnline> {
+        crate::online::PyOnline::of(&self.model, sample_rate, adapt)
     }
 
     /// The flight with the compensation columns added (`mag_comp`,

@@ -28,8 +28,8 @@ def cli():
     """Run the CLI: cli(args...) -> CompletedProcess (text)."""
     path = cli_path()
 
-    def run(*args, check=True):
-        p = subprocess.run([path, *map(str, args)], capture_output=True, text=True)
+    def run(*args, check=True, input=None):
+        p = subprocess.run([path, *map(str, args)], capture_output=True, text=True, input=input)
         if check and p.returncode != 0:
             raise AssertionError(f"aeromag {' '.join(map(str, args))} exited {p.returncode}:\n{p.stderr}")
         return p

@@ -62,3 +62,40 @@ def test_python_and_cli_give_the_same_causal_values(model, survey_csv, cli, tmp_
     written = aeromag.read_flight(out)
     py = model.compensate(aeromag.read_flight(survey_csv), causal=True)
     assert written["mag_comp"].tobytes() == py.tobytes()
+
+
+def test_adaptive_push_block_equals_push_and_the_cli(model, survey_csv, cli, tmp_path):
+    """`adapt="kalman"`: one sample at a time and in blocks give the same
+    values, which are the CLI's `stream --adapt kalman`; the coefficients
+    come with their standard deviations."""
+    survey = aeromag.read_flight(survey_csv)
+    n = 2000
+    cols = [survey[c][:n] for c in ("time", "flux_x", "flux_y", "flux_z", "mag")]
+    speed = np.hypot(survey["vn"][:n], survey["ve"][:n])
+    alt = survey["alt"][:n]
+    one = aeromag.OnlineCompensator(model, adapt="kalman")
+    assert one.coefficients is not None
+    by_sample = np.array(
+        [one.push(t, (x, y, z), m, speed=v, alt=a)[0] for (t, x, y, z, m), v, a in zip(zip(*cols), speed, alt)]
+    )
+    block = model.online(adapt="kalman")
+    out = [block.push_block(*(c[:700] for c in cols), speed=speed[:700], alt=alt[:700])]
+    out.append(block.push_block(*(c[700:] for c in cols), speed=speed[700:], alt=alt[700:]))
+    interf = np.concatenate([o["mag_interf"] for o in out])
+    assert interf.tobytes() == by_sample.tobytes()
+    coef = block.coefficients
+    assert coef["name"][0] == "p_x" and len(coef["value"]) == len(coef["std"])
+    assert coef["value"] == one.coefficients["value"]
+    assert all(s > 0 for s in coef["std"])
+    # The fixed model's values differ: the coefficients moved.
+    fixed = model.online().push_block(*cols)["mag_interf"]
+    assert not np.array_equal(fixed, interf)
+    # The CLI on the same lines.
+    path = tmp_path / "m.json"
+    model.save(path)
+    lines = [l for l in open(survey_csv) if not l.startswith("#")][: n + 1]
+    r = cli("stream", "--model", path, "--adapt", "kalman", input="".join(lines))
+    got = np.array([float(l.rsplit(",", 3)[1]) for l in r.stdout.splitlines()[1:]])
+    assert got.tobytes() == by_sample.tobytes()
+    with pytest.raises(aeromag.BadInputError, match="adaptation"):
+        aeromag.OnlineCompensator(model, adapt="lms")

@@ -55,8 +55,14 @@ fn setup(dir: &Path) -> (PathBuf, Vec<String>, Vec<String>) {
 
 /// `aeromag stream --model MODEL` with its standard streams piped.
 fn piped_stream(model: &Path) -> Child {
+    piped_stream_with(model, &[])
+}
+
+/// `aeromag stream --model MODEL ARGS…` with its standard streams piped.
+fn piped_stream_with(model: &Path, args: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_aeromag"))
         .args(["stream", "--model", model.to_str().unwrap()])
+        .args(args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -139,6 +145,10 @@ impl Drop for Server {
 }
 
 fn server(model: &Path, flag: &str) -> Server {
+    server_with(model, flag, &[])
+}
+
+fn server_with(model: &Path, flag: &str, args: &[&str]) -> Server {
     let mut child = Command::new(env!("CARGO_BIN_EXE_aeromag"))
         .args([
             "stream",
@@ -147,6 +157,7 @@ fn server(model: &Path, flag: &str) -> Server {
             flag,
             "127.0.0.1:0",
         ])
+        .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -168,14 +179,12 @@ fn server(model: &Path, flag: &str) -> Server {
     Server(child, addr)
 }
 
-#[test]
-fn tcp_on_the_loopback_survives_the_peer_reconnecting() {
-    let d = tempfile::tempdir().unwrap();
-    let (model, lines, want) = setup(d.path());
-    let srv = server(&model, "--listen");
+/// The data lines sent to a TCP server in two connections (rows 1–3000,
+/// then the rest), each with the header: the data lines that come back.
+fn over_two_connections(addr: &str, lines: &[String]) -> Vec<String> {
     let mut got = Vec::new();
     for part in [&lines[1..3001], &lines[3001..]] {
-        let mut conn = std::net::TcpStream::connect(&srv.1).unwrap();
+        let mut conn = std::net::TcpStream::connect(addr).unwrap();
         let text = format!("{}\n{}\n", lines[0], part.join("\n"));
         let mut w = conn.try_clone().unwrap();
         let writer = std::thread::spawn(move || {
@@ -189,6 +198,15 @@ fn tcp_on_the_loopback_survives_the_peer_reconnecting() {
         assert!(back[0].ends_with("mag_interf,mag_comp,comp_flag"));
         got.extend(back[1..].iter().cloned());
     }
+    got
+}
+
+#[test]
+fn tcp_on_the_loopback_survives_the_peer_reconnecting() {
+    let d = tempfile::tempdir().unwrap();
+    let (model, lines, want) = setup(d.path());
+    let srv = server(&model, "--listen");
+    let got = over_two_connections(&srv.1, &lines);
     // The second connection carries on where the first stopped (same
     // header, time step within the run): the batch values throughout.
     assert_same(&got, &want[1..]);
@@ -284,4 +302,63 @@ fn each_line_comes_back_before_the_next_is_sent() {
         got.push(answer.trim_end().to_string());
     }
     assert_same(&got, &want[1..51]);
+}
+
+/// Lines in, lines out through a piped `aeromag stream ARGS…`: stdout's
+/// lines and stderr.
+fn through_pipe(model: &Path, args: &[&str], input: &[String]) -> (Vec<String>, String) {
+    let mut child = piped_stream_with(model, args);
+    let mut stdin = child.stdin.take().unwrap();
+    let text = input.join("\n") + "\n";
+    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()).unwrap());
+    let o = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert_code(&o, 0);
+    (stdout(&o).lines().map(str::to_string).collect(), stderr(&o))
+}
+
+/// `--adapt kalman`: the same values through a pipe and through TCP with
+/// the peer reconnecting (the state goes on), the coefficients with their
+/// standard deviations on stderr, a stream without the ground speed bad
+/// input unless --speed gives it; `--adapt rls` needs no speed.
+#[test]
+fn adaptive_streams_agree_through_pipe_and_tcp() {
+    let d = tempfile::tempdir().unwrap();
+    let (model, lines, want) = setup(d.path());
+    let (piped, err) = through_pipe(&model, &["--adapt", "kalman"], &lines);
+    assert_eq!(piped.len(), lines.len());
+    assert!(err.contains("coefficients now"), "{err}");
+    assert!(err.contains("p_x") && err.contains(" ± "), "{err}");
+    // The coefficients moved: the values are not the fixed model's.
+    let moved = piped[1..]
+        .iter()
+        .zip(&want[1..])
+        .filter(|(g, w)| values(g) != values(w))
+        .count();
+    assert!(
+        moved > 5000,
+        "{moved} of 6000 lines differ from the fixed model"
+    );
+
+    let srv = server_with(&model, "--listen", &["--adapt", "kalman"]);
+    let mut got = vec![piped[0].clone()];
+    got.extend(over_two_connections(&srv.1, &lines));
+    assert_eq!(got, piped);
+
+    // Without vn, ve: bad input, unless --speed; rls needs none.
+    let cols = "time,flux_x,flux_y,flux_z,mag";
+    let short = ["1,20000,1000,45000,49300".to_string()];
+    let mut child = piped_stream_with(&model, &["--adapt", "kalman", "--columns-in", cols]);
+    drop(child.stdin.take());
+    let o = child.wait_with_output().unwrap();
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("--speed"), "{}", stderr(&o));
+    for args in [
+        &["--adapt", "kalman", "--speed", "70", "--columns-in", cols][..],
+        &["--adapt", "rls", "--columns-in", cols][..],
+    ] {
+        let (out, _) = through_pipe(&model, args, &short);
+        assert_eq!(out.len(), 2, "{args:?}");
+        assert!(out[1].ends_with(",2"), "{args:?}: {}", out[1]);
+    }
 }

@@ -11,8 +11,8 @@
 //!
 //! | module | contents |
 //! |---|---|
-//! | [`tolles_lawson`] | the Tolles-Lawson/Leliak terms (with lagged eddy currents), the design matrix, band-pass least squares, the eddy-lag search, segments |
-//! | [`kalman`] | Method 2: the joint Kalman filter and smoother with a stochastic model of the field along the track, noise tuning, altitude cleaning |
+//! | [`tolles_lawson`] | the Tolles-Lawson/Leliak terms (with lagged eddy currents), the design matrix, band-pass least squares, the eddy-lag search, segments; online application sample by sample (fixed, or adapting with RLS) |
+//! | [`kalman`] | Method 2: the joint Kalman filter and smoother with a stochastic model of the field along the track, noise tuning, altitude cleaning; the forward filter online (adaptive coefficients) |
 //! | [`observability`] | rank, weak combinations and estimability μ = √(P_post/P_prior) of the coefficients |
 //! | [`metrics`] | manoeuvre detection, figure of merit, improvement ratio, residual per line |
 //! | [`model_file`] | the Tolles-Lawson model file and the header check shared by every model file |

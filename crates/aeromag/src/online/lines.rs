@@ -2,9 +2,11 @@
 //! line out with `mag_interf`, `mag_comp` and `comp_flag` appended.
 
 use super::CausalTl;
+use super::adaptive::{Adapt, AdaptOptions, OnlineEngine};
 use crate::error::{Error, Result};
 use aeromag_compensation::model_file::TlModel;
-use aeromag_compensation::tolles_lawson::online::{OnlineSample, OnlineTl, SampleStatus};
+use aeromag_compensation::tolles_lawson::adaptive::Navigation;
+use aeromag_compensation::tolles_lawson::online::{OnlineSample, SampleStatus};
 use aeromag_io::ColumnMap;
 
 /// The columns a stream's lines gain.
@@ -102,6 +104,14 @@ pub struct StreamOptions {
     /// The sample rate, Hz, when the model does not record it (or to
     /// override it): the gap rule ([`CausalTl::new`]).
     pub sample_rate_hz: Option<f64>,
+    /// Adapt the coefficients as the samples arrive (`--adapt`); `None`:
+    /// the model's coefficients, the values of `compensate --causal`.
+    pub adapt: Option<Adapt>,
+    /// The adaptive estimators' settings.
+    pub adapt_options: AdaptOptions,
+    /// Ground speed, m/s, when the stream has no `vn`, `ve` columns (the
+    /// Kalman filter's field model runs along the track).
+    pub speed_m_s: Option<f64>,
 }
 
 /// Where the inputs are in a line.
@@ -111,6 +121,8 @@ struct Fields {
     flux: [usize; 3],
     mag: usize,
     channels: Vec<usize>,
+    /// `vn`, `ve`, `alt` (adaptive mode, when present).
+    nav: [Option<usize>; 3],
     /// The last input's position.
     last: usize,
     /// Cells per line.
@@ -120,11 +132,15 @@ struct Fields {
 /// A model compensating a stream of CSV lines ([module docs](super)).
 #[derive(Debug, Clone)]
 pub struct LineCompensator {
-    online: OnlineTl,
+    engine: OnlineEngine,
+    /// Ground speed when the stream has no velocity, m/s (NaN: none).
+    speed_m_s: f64,
     fields: Fields,
     header: String,
     counts: StreamCounts,
     channels: Vec<f64>,
+    /// `vn`, `ve`, `alt` of the current line (NaN when absent).
+    nav: [f64; 3],
 }
 
 impl LineCompensator {
@@ -133,18 +149,23 @@ impl LineCompensator {
     /// its canonical name (`time`, `flux_x`, …, `mag`; case ignored), the
     /// file column the model was fitted on (`model.columns`); an extra
     /// regressor by its channel name. An input not found is bad input, as
-    /// is a model without its sample interval and no rate given.
+    /// is a model without its sample interval and no rate given. With
+    /// [`StreamOptions::adapt`], `vn`, `ve` and `alt` are read when present;
+    /// the Kalman filter needs the ground speed: `vn` and `ve`, or
+    /// [`StreamOptions::speed_m_s`].
     pub fn new(model: &TlModel, header: &str, opts: &StreamOptions) -> Result<Self> {
-        let online = CausalTl::new(model, opts.sample_rate_hz)?.online()?;
+        let causal = CausalTl::new(model, opts.sample_rate_hz)?;
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
-        let find = |canonical: &str| -> Result<usize> {
+        let lookup = |canonical: &str| -> Option<usize> {
             let by = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
             opts.columns
                 .get(canonical)
                 .and_then(by)
                 .or_else(|| by(canonical))
                 .or_else(|| model.columns.get(canonical).and_then(|n| by(n)))
-                .ok_or_else(|| {
+        };
+        let find = |canonical: &str| -> Result<usize> {
+            lookup(canonical).ok_or_else(|| {
                     Error::bad_input(format!(
                         "the stream has no column for `{canonical}`{}; its columns: {} (map one with --columns {canonical}=NAME)",
                         model
@@ -156,6 +177,27 @@ impl LineCompensator {
                     ))
                 })
         };
+        let nav = match opts.adapt {
+            Some(_) => ["vn", "ve", "alt"].map(lookup),
+            None => [None; 3],
+        };
+        let speed_m_s = match opts.speed_m_s {
+            Some(v) if !(v >= 0.0 && v.is_finite()) => {
+                return Err(Error::bad_input(format!(
+                    "ground speed {v} m/s: must be finite and ≥ 0"
+                )));
+            }
+            Some(v) => v,
+            None => f64::NAN,
+        };
+        if opts.adapt == Some(Adapt::Kalman) && speed_m_s.is_nan() && nav[..2].contains(&None) {
+            return Err(Error::bad_input(format!(
+                "the adaptive Kalman filter needs the ground speed: the stream has no `vn` and `ve` \
+                 columns (its columns: {}); map them with --columns vn=NAME,ve=NAME or give --speed M/S",
+                names.join(", ")
+            )));
+        }
+        let engine = causal.engine(opts.adapt, &opts.adapt_options)?;
         let fields = Fields {
             time: find("time")?,
             flux: [find("flux_x")?, find("flux_y")?, find("flux_z")?],
@@ -167,6 +209,7 @@ impl LineCompensator {
                 .iter()
                 .map(|x| find(&x.channel))
                 .collect::<Result<_>>()?,
+            nav,
             count: names.len(),
             last: 0,
         };
@@ -175,6 +218,7 @@ impl LineCompensator {
             .into_iter()
             .chain(fields.flux)
             .chain(fields.channels.iter().copied())
+            .chain(fields.nav.iter().flatten().copied())
             .max()
             .unwrap_or(0);
         for out in STREAM_OUTPUT {
@@ -186,7 +230,9 @@ impl LineCompensator {
         }
         Ok(Self {
             channels: vec![0.0; fields.channels.len()],
-            online,
+            nav: [f64::NAN; 3],
+            engine,
+            speed_m_s,
             fields,
             header: normalised(header),
             counts: StreamCounts::default(),
@@ -207,12 +253,25 @@ impl LineCompensator {
         let (interf, comp, flag) = match self.parse(line) {
             None => (f64::NAN, f64::NAN, StreamFlag::Malformed),
             Some((time_s, flux_nt, mag_nt)) => {
-                let o = self.online.push(&OnlineSample {
+                let sample = OnlineSample {
                     time_s,
                     flux_nt,
                     mag_nt,
                     channels: &self.channels,
-                });
+                };
+                let [vn, ve, alt] = self.nav;
+                let speed_m_s = if self.fields.nav[0].is_some() && self.fields.nav[1].is_some() {
+                    vn.hypot(ve)
+                } else {
+                    self.speed_m_s
+                };
+                let o = self.engine.push(
+                    &sample,
+                    Navigation {
+                        speed_m_s,
+                        alt_m: alt,
+                    },
+                );
                 (o.interference_nt, o.compensated_nt, o.status.into())
             }
         };
@@ -253,6 +312,9 @@ impl LineCompensator {
             } else if let Some(c) = f.channels.iter().position(|&i| i == k) {
                 self.channels[c] = number(text)?;
                 return Some(());
+            } else if let Some(c) = f.nav.iter().position(|&i| i == Some(k)) {
+                self.nav[c] = number(text)?;
+                return Some(());
             } else {
                 return Some(());
             };
@@ -288,7 +350,13 @@ impl LineCompensator {
     /// Forget the stream's state (a new connection): the next line starts
     /// a run whatever its time. The counts are kept.
     pub fn reset(&mut self) {
-        self.online.reset();
+        self.engine.reset();
+    }
+
+    /// The current coefficients and their standard deviations (column
+    /// order) when adapting, `None` with the model's fixed coefficients.
+    pub fn coefficients(&self) -> Option<(&[f64], Vec<f64>)> {
+        self.engine.coefficients()
     }
 }
 
@@ -420,6 +488,21 @@ impl LineStream {
         self.comp
             .as_ref()
             .map_or(self.before, |c| self.before.plus(c.counts()))
+    }
+
+    /// When adapting: each coefficient's name, current value and standard
+    /// deviation (empty otherwise, or before the first header).
+    pub fn coefficients(&self) -> Vec<(String, f64, f64)> {
+        let Some((values, std)) = self.comp.as_ref().and_then(|c| c.coefficients()) else {
+            return Vec::new();
+        };
+        self.model
+            .design
+            .column_names()
+            .into_iter()
+            .zip(values.iter().zip(std))
+            .map(|(n, (v, s))| (n, *v, s))
+            .collect()
     }
 }
 

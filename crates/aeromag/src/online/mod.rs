@@ -28,12 +28,17 @@
 //! # Ok::<(), aeromag::Error>(())
 //! ```
 
+mod adaptive;
 mod causal;
 mod lines;
 
+pub use adaptive::{Adapt, AdaptOptions, AdaptedFlight, CoefficientSnapshot, OnlineEngine};
+pub use aeromag_compensation::kalman::online::OnlineKalmanSettings;
+pub use aeromag_compensation::tolles_lawson::adaptive::{AdaptiveTl, Navigation};
 pub use aeromag_compensation::tolles_lawson::online::{
     OnlineOutput, OnlineSample, OnlineTl, SampleStatus,
 };
+pub use aeromag_compensation::tolles_lawson::rls::RlsSettings;
 pub use causal::{CausalSensors, CausalTl};
 pub use lines::{
     LineCompensator, LineStream, MAX_STREAM_LINE_BYTES, STREAM_OUTPUT, StreamCounts, StreamFlag,

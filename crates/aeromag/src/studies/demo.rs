@@ -4,7 +4,7 @@
 use super::{
     EmStudy, EmSummary, FixedWingStudy, FixedWingSummary, GradiometryStudy, GradiometrySummary,
     MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary, PrintedFigure, PrintedSummary,
-    RotorStudyRun, RotorSummary, Study, StudyOutcome, StudySize,
+    RotorStudyRun, RotorSummary, StreamStudy, StreamSummary, Study, StudyOutcome, StudySize,
 };
 use crate::error::Result;
 use crate::observer::Observer;
@@ -40,6 +40,8 @@ pub struct DemoSummary {
     pub gradiometry: GradiometrySummary,
     /// Several sensors and the aircraft's currents (SGL-like installation).
     pub multi_sensor: MultiSensorSummary,
+    /// On board: causal and adaptive compensation.
+    pub stream: StreamSummary,
     /// Seed of the fixed-wing flights.
     pub seed: u64,
     /// Version of aeromag.
@@ -63,6 +65,7 @@ impl PrintedSummary for DemoSummary {
         rows.extend(self.em.printed());
         rows.extend(self.gradiometry.printed());
         rows.extend(self.multi_sensor.printed());
+        rows.extend(self.stream.printed());
         rows
     }
 }
@@ -119,12 +122,14 @@ impl Study for Demo {
         let gradiometry = GradiometryStudy.run(size, observer)?;
         let pod = PodStudy.run(size, observer)?;
         let multi_sensor = MultiSensorStudy { seed: self.seed }.run(size, observer)?;
+        let stream = StreamStudy { seed: self.seed }.run(size, observer)?;
         let mut sections = fixed_wing.sections()?;
         sections.extend(rotor.sections()?);
         sections.extend(pod.sections()?);
         sections.extend(em.sections()?);
         sections.extend(gradiometry.sections()?);
         sections.extend(multi_sensor.sections()?);
+        sections.extend(stream.sections()?);
         Ok(DemoOutcome {
             summary: DemoSummary {
                 fixed_wing: fixed_wing.summary(),
@@ -133,6 +138,7 @@ impl Study for Demo {
                 em: em.summary(),
                 gradiometry: gradiometry.summary(),
                 multi_sensor: multi_sensor.summary(),
+                stream: stream.summary(),
                 seed: self.seed,
                 software_version: env!("CARGO_PKG_VERSION"),
             },

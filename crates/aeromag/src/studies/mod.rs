@@ -19,6 +19,7 @@ mod gradiometry;
 mod multi_sensor;
 mod pod;
 mod rotor;
+mod stream;
 
 pub use demo::{Demo, DemoOutcome, DemoSummary};
 pub use em::{EmOutcome, EmStudy, EmSummary};
@@ -33,6 +34,10 @@ pub use multi_sensor::{
 };
 pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
 pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};
+pub use stream::{
+    CREEP_AM2_PER_H, CREEP_CLEARANCE_M, CREEP_LINES, StreamOutcome, StreamStudy, StreamSummary,
+    WINDOW_S, creeping_scenario,
+};
 
 /// How much work a study does: the demo's `--quick` or the full run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]

@@ -392,7 +392,7 @@ fn sensor_altitude(
 }
 
 /// Ground speed (m/s) from `vn`, `ve` when present, else from the positions.
-fn ground_speed(flight: &Flight) -> Result<Vec<f64>> {
+pub(crate) fn ground_speed(flight: &Flight) -> Result<Vec<f64>> {
     Ok(match (flight.column("vn"), flight.column("ve")) {
         (Some(vn), Some(ve)) => ground_speed_from_velocity(vn, ve),
         _ => ground_speed_from_positions(

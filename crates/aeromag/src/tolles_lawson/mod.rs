@@ -29,6 +29,7 @@ pub use calibrate::{
     CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, SECOND_ORDER_NOTE_NT, calibrate,
 };
 pub use compensate::{InterferenceParts, TL_OUTPUT, second_order_range_nt};
+pub(crate) use kalman::ground_speed;
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};
 pub use sensors::{

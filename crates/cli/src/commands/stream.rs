@@ -1,7 +1,7 @@
 //! `aeromag stream`: compensate samples as they arrive (library:
 //! [`aeromag::online::LineStream`]).
 
-use aeromag::online::{LineStream, StreamOptions};
+use aeromag::online::{Adapt, AdaptOptions, LineStream, StreamOptions};
 use aeromag::{ColumnMap, ModelFile, TlModel};
 use std::io::{BufReader, Write};
 use std::path::PathBuf;
@@ -22,8 +22,17 @@ use std::path::PathBuf;
 /// going back (ignored), 4 malformed line. Bad lines never stop the
 /// stream; the counts go to standard error when a stream ends.
 ///
+/// With --adapt the coefficients start at the model's and are updated by
+/// every compensated sample, after it is compensated: `kalman`, the
+/// thesis' forward filter with the field states (the permanent terms
+/// drifting as random walks, the field model without a base station; it
+/// needs the ground speed: `vn`, `ve` columns or --speed), or `rls`,
+/// recursive least squares with forgetting, for comparison. The final
+/// coefficients and their standard deviations go to standard error.
+///
 /// Examples:
 ///   aeromag stream --model model.json < survey.csv > survey_comp.csv
+///   aeromag stream --model model.json --adapt kalman < flight.csv > comp.csv
 ///   aeromag stream --model model.json --listen 127.0.0.1:5555
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
@@ -49,6 +58,24 @@ pub struct Args {
     /// Serve UDP datagrams on HOST:PORT instead of standard input.
     #[arg(long, value_name = "HOST:PORT")]
     udp: Option<String>,
+    /// Adapt the coefficients as samples arrive: kalman or rls.
+    #[arg(long, value_name = "METHOD")]
+    adapt: Option<Adapt>,
+    /// Ground speed, m/s, when the stream has no vn, ve columns (--adapt
+    /// kalman).
+    #[arg(long, value_name = "M/S", requires = "adapt")]
+    speed: Option<f64>,
+    /// Random-walk intensity of the permanent coefficients, nT/√h
+    /// (--adapt kalman; default 1).
+    #[arg(long, value_name = "NT_PER_SQRT_H", requires = "adapt")]
+    permanent_drift: Option<f64>,
+    /// q₁ of the field model, nT²/m^(2n−1) (--adapt kalman; default: the
+    /// on-board value of the model's order).
+    #[arg(long, value_name = "Q1", requires = "adapt")]
+    field_q1: Option<f64>,
+    /// Memory of the recursive least squares, s (--adapt rls; default 1800).
+    #[arg(long, value_name = "S", requires = "adapt")]
+    memory: Option<f64>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -59,6 +86,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None => ColumnMap::new(),
         },
         sample_rate_hz: a.sample_rate,
+        adapt: a.adapt,
+        adapt_options: adapt_options(&a),
+        speed_m_s: a.speed,
     };
     let mut stream = LineStream::new(&model, &opts, a.columns_in.as_deref())?;
     if let Some(addr) = &a.listen {
@@ -71,7 +101,34 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let stdout = std::io::stdout().lock();
     let result = stream.serve(stdin, stdout, "standard input");
     eprintln!("{}", stream.counts());
+    print_coefficients(&stream);
     Ok(result?)
+}
+
+/// The adaptive estimators' settings from the flags.
+fn adapt_options(a: &Args) -> AdaptOptions {
+    let mut o = AdaptOptions {
+        field_q1: a.field_q1,
+        ..AdaptOptions::default()
+    };
+    if let Some(d) = a.permanent_drift {
+        o.kalman.permanent_drift_nt_per_sqrt_h = d;
+    }
+    if let Some(m) = a.memory {
+        o.rls.memory_s = m;
+    }
+    o
+}
+
+/// The adapted coefficients on standard error (nothing without --adapt).
+fn print_coefficients(stream: &LineStream) {
+    let c = stream.coefficients();
+    if !c.is_empty() {
+        eprintln!("coefficients now (value ± standard deviation):");
+        for (name, v, s) in c {
+            eprintln!("  {name:<8} {v:>12.6} ± {s:.3e}");
+        }
+    }
 }
 
 /// Serve one TCP connection after another, for ever (Ctrl-C ends it).
@@ -99,6 +156,7 @@ fn serve_tcp(stream: &mut LineStream, addr: &str) -> anyhow::Result<()> {
             let _ = (&conn).write_all(format!("# error: {e}\n").as_bytes());
         }
         eprintln!("{peer} disconnected; so far {}", stream.counts());
+        print_coefficients(stream);
     }
     Ok(())
 }

@@ -45,6 +45,13 @@ pub struct JointFilter {
     fresh: bool,
     /// The step length `phi`, `g` currently hold (NaN: none).
     last_d: f64,
+    /// Random-walk intensities of the first coefficients (online
+    /// adaptation, [`Self::with_drift`]), coefficient units per √s; empty:
+    /// every coefficient constant (the thesis).
+    drift_per_sqrt_s: Vec<f64>,
+    /// `Φ`, `G` over the field states and the drifting coefficients.
+    phi_drift: DMatrix<f64>,
+    g_drift: DMatrix<f64>,
 }
 
 impl JointFilter {
@@ -103,7 +110,36 @@ impl JointFilter {
             h: vec![0.0; n],
             fresh: true,
             last_d: f64::NAN,
+            drift_per_sqrt_s: Vec::new(),
+            phi_drift: DMatrix::zeros(0, 0),
+            g_drift: DMatrix::zeros(0, 0),
         })
+    }
+
+    /// Let the first `drift_per_sqrt_s.len()` coefficients drift as random
+    /// walks, `dX1_j/dt = w_j`, `E[w_j(t) w_j(t')] = σ_j² δ(t − t')`, with
+    /// `σ_j = drift_per_sqrt_s[j]` (coefficient units per √s): their
+    /// variance grows by `σ_j² Δt` per step of [`Self::step_timed`]. The
+    /// thesis' coefficients are constant; an online filter over hours lets
+    /// the permanent terms follow a creeping magnetisation
+    /// ([`super::online`]). A negative or non-finite intensity, or more than
+    /// `m`, is [`CompError::Setting`].
+    pub fn with_drift(mut self, drift_per_sqrt_s: &[f64]) -> Result<Self> {
+        if drift_per_sqrt_s.len() > self.m
+            || drift_per_sqrt_s
+                .iter()
+                .any(|s| !(*s >= 0.0 && s.is_finite()))
+        {
+            return Err(CompError::setting(format!(
+                "coefficient drift: at most {} finite intensities ≥ 0, got {drift_per_sqrt_s:?}",
+                self.m
+            )));
+        }
+        let k = self.x2_dim + drift_per_sqrt_s.len();
+        self.drift_per_sqrt_s = drift_per_sqrt_s.to_vec();
+        self.phi_drift = DMatrix::identity(k, k);
+        self.g_drift = DMatrix::zeros(k, k);
+        Ok(self)
     }
 
     /// Number of coefficients `m`.
@@ -126,6 +162,20 @@ impl JointFilter {
     /// `m`), the altitude offset `dz_m = alt − z0` (m) and the centred
     /// reading `y_nt` (nT). Returns the innovation.
     pub fn step(&mut self, d_m: f64, h1: &[f64], dz_m: f64, y_nt: f64) -> Result<Innovation> {
+        self.step_timed(d_m, 0.0, h1, dz_m, y_nt)
+    }
+
+    /// [`Self::step`] over a step of `dt_s` seconds: the drifting
+    /// coefficients ([`Self::with_drift`]) gain their variance `σ² dt_s`
+    /// in the same time update (none at a run's first sample).
+    pub fn step_timed(
+        &mut self,
+        d_m: f64,
+        dt_s: f64,
+        h1: &[f64],
+        dz_m: f64,
+        y_nt: f64,
+    ) -> Result<Innovation> {
         if h1.len() != self.m {
             return Err(CompError::data(format!(
                 "design row of length {} for {} coefficients",
@@ -143,9 +193,26 @@ impl JointFilter {
                 self.transition.fill(d_m, &mut self.phi, &mut self.g);
                 self.last_d = d_m;
             }
-            self.filter
-                .predict_leading(&self.phi, &self.g)
-                .map_err(est)?;
+            if self.drift_per_sqrt_s.is_empty() {
+                self.filter
+                    .predict_leading(&self.phi, &self.g)
+                    .map_err(est)?;
+            } else {
+                if !(dt_s >= 0.0 && dt_s.is_finite()) {
+                    return Err(CompError::setting(format!(
+                        "time step {dt_s} s must be finite and ≥ 0"
+                    )));
+                }
+                let f = self.x2_dim;
+                self.phi_drift.view_mut((0, 0), (f, f)).copy_from(&self.phi);
+                self.g_drift.view_mut((0, 0), (f, f)).copy_from(&self.g);
+                for (j, s) in self.drift_per_sqrt_s.iter().enumerate() {
+                    self.g_drift[(f + j, f + j)] = s * dt_s.sqrt();
+                }
+                self.filter
+                    .predict_leading(&self.phi_drift, &self.g_drift)
+                    .map_err(est)?;
+            }
         }
         self.fresh = false;
         self.h[..self.x2_dim].fill(0.0);
@@ -165,6 +232,13 @@ impl JointFilter {
     /// The current field-state estimate `X2`.
     pub fn field_state(&self) -> &[f64] {
         &self.filter.state().as_slice()[..self.x2_dim]
+    }
+
+    /// The standard deviations of the coefficients, `√diag(U_c U_cᵀ)`.
+    pub fn coefficient_std(&self) -> Vec<f64> {
+        (self.x2_dim..self.x2_dim + self.m)
+            .map(|i| self.filter.variance(i).sqrt())
+            .collect()
     }
 
     /// The covariance of the coefficients, `U_c U_cᵀ` (`m × m`).

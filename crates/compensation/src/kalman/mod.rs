@@ -84,6 +84,7 @@
 //! | [`field_smoother`] | pass 2: the 5-state smoother given `X̂1` |
 //! | [`tuning`] | maximum-likelihood tuning of `q₁, q₂, r` (Nelder–Mead) |
 //! | [`fit`] | the whole method, outputs, diagnostics |
+//! | [`online`] | the forward filter run online, coefficients adapting |
 //!
 //! [`TermSet`]: crate::tolles_lawson::TermSet
 
@@ -92,6 +93,7 @@ pub mod anomaly_model;
 pub mod field_smoother;
 pub mod fit;
 pub mod joint_filter;
+pub mod online;
 pub mod rows;
 pub mod track;
 pub mod tuning;

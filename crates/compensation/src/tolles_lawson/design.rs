@@ -7,7 +7,7 @@
 
 use super::eddy_lag::{FirstOrderLag, LagBank};
 use super::terms::{
-    Column, Convention, DEFAULT_BT_SCALE_NT, Differencing, ExtraSeries, TermSet, derivative_into,
+    Convention, DEFAULT_BT_SCALE_NT, Differencing, ExtraSeries, TermSet, derivative_into,
 };
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
@@ -277,14 +277,7 @@ impl Design {
         channels: Channels,
     ) -> ([Vec<f64>; 3], f64) {
         let n = time.len();
-        let mut k = 0;
-        let mut bias = None;
-        self.terms.for_each_column(|c| {
-            if c == Column::Bias {
-                bias = Some(k);
-            }
-            k += 1;
-        });
+        let bias = self.terms.bias_column();
         let b = bias.and_then(|k| coef.get(k).copied()).unwrap_or(0.0);
         let mut c = coef.to_vec();
         if let Some(k) = bias

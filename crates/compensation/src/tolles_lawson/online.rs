@@ -44,7 +44,7 @@
 //! ```
 
 use super::design::{Lags, TotalField};
-use super::terms::{Column, backward_difference};
+use super::terms::backward_difference;
 use super::{Design, Magnitude};
 use crate::error::{CompError, Result};
 
@@ -104,63 +104,49 @@ struct Last {
     flux_nt: [f64; 3],
 }
 
-/// A Tolles-Lawson model applied sample by sample ([module docs](self)).
+/// The causal design rows of a stream, sample by sample: the run logic
+/// (gaps, missing values, time going back), the backward-difference
+/// derivative and the lag filters of [the module docs](self). After
+/// [`OnlineRows::advance`] accepts a sample, [`OnlineRows::row_along`]
+/// gives its row along any direction. [`OnlineTl`] applies fixed
+/// coefficients to these rows; the adaptive estimators
+/// ([`crate::kalman::online`], [`super::rls`]) update theirs with them.
 #[derive(Debug, Clone)]
-pub struct OnlineTl {
+pub struct OnlineRows {
     design: Design,
-    /// Coefficients; under the exact magnitude with the bias set to 0.
-    coef: Vec<f64>,
-    /// The bias coefficient under the exact magnitude (0 otherwise).
-    bias: f64,
     max_step_s: f64,
     lags: Lags,
     /// The last sample of the run, `None` between runs.
     last: Option<Last>,
     /// The last increasing time stamp seen.
     last_time_s: Option<f64>,
-    row: Vec<f64>,
+    /// The current sample's inputs: field, derivative, lagged derivatives,
+    /// extra channels `[x, L_τ[x]]`.
+    b: [f64; 3],
+    db: [f64; 3],
+    lagged: Vec<[f64; 3]>,
     extra: Vec<[f64; 2]>,
 }
 
-impl OnlineTl {
-    /// The model `design` with coefficients `coef`, runs broken at time
+impl OnlineRows {
+    /// Rows of `design` under the causal convention, runs broken at time
     /// steps over `max_step_s` (s; the batch rule is 1.5 × the sample
-    /// interval). Bad settings (coefficients not matching the design, a
-    /// step not positive) are [`CompError::Setting`].
-    pub fn new(design: &Design, coef: &[f64], max_step_s: f64) -> Result<Self> {
+    /// interval). A step not positive is [`CompError::Setting`].
+    pub fn new(design: &Design, max_step_s: f64) -> Result<Self> {
         design.validate()?;
-        let n = design.n_columns();
-        if coef.len() != n {
-            return Err(CompError::setting(format!(
-                "{} coefficients for a design of {n} columns",
-                coef.len()
-            )));
-        }
         if !(max_step_s > 0.0 && max_step_s.is_finite()) {
             return Err(CompError::setting(format!(
                 "the longest time step of a run must be positive, got {max_step_s} s"
             )));
         }
         let design = design.causal();
-        let mut coef = coef.to_vec();
-        let mut bias = 0.0;
-        if design.magnitude == Magnitude::Exact {
-            let mut k = 0;
-            design.terms.for_each_column(|c| {
-                if c == Column::Bias {
-                    bias = coef[k];
-                    coef[k] = 0.0;
-                }
-                k += 1;
-            });
-        }
         Ok(Self {
             lags: Lags::new(&design.terms),
             extra: vec![[f64::NAN; 2]; design.terms.extras().len()],
-            row: vec![0.0; n],
+            lagged: vec![[0.0; 3]; design.terms.eddy_lags_s().len()],
+            b: [f64::NAN; 3],
+            db: [0.0; 3],
             design,
-            coef,
-            bias,
             max_step_s,
             last: None,
             last_time_s: None,
@@ -172,25 +158,26 @@ impl OnlineTl {
         &self.design
     }
 
+    /// The longest time step within a run, s.
+    pub fn max_step_s(&self) -> f64 {
+        self.max_step_s
+    }
+
     /// Number of extra channels a sample must carry.
     pub fn n_channels(&self) -> usize {
         self.extra.len()
     }
 
-    /// Compensate one sample ([module docs](self)). Never fails: a sample
-    /// that cannot be compensated says why in its status. A sample with
-    /// fewer or more channels than the model's is [`SampleStatus::Missing`].
-    pub fn push(&mut self, s: &OnlineSample) -> OnlineOutput {
-        let not = |status| OnlineOutput {
-            interference_nt: f64::NAN,
-            compensated_nt: f64::NAN,
-            status,
-        };
+    /// Take the next sample ([module docs](self)): when the status
+    /// [is compensated](SampleStatus::is_compensated), its row is ready
+    /// ([`Self::row_along`], [`Self::field_nt`]). A sample with fewer or
+    /// more channels than the model's is [`SampleStatus::Missing`].
+    pub fn advance(&mut self, s: &OnlineSample) -> SampleStatus {
         if let Some(t0) = self.last_time_s
             && s.time_s.is_finite()
             && s.time_s <= t0
         {
-            return not(SampleStatus::TimeBackwards);
+            return SampleStatus::TimeBackwards;
         }
         let usable = s.time_s.is_finite()
             && s.mag_nt.is_finite()
@@ -203,14 +190,14 @@ impl OnlineTl {
         }
         if !usable {
             self.last = None;
-            return not(SampleStatus::Missing);
+            return SampleStatus::Missing;
         }
         let last = self.last.filter(|l| s.time_s - l.time_s <= self.max_step_s);
         if last.is_none() {
             self.lags = Lags::new(&self.design.terms);
         }
         let conv = self.design.convention;
-        let db = match last {
+        self.db = match last {
             Some(l) if self.design.terms.has_eddy() => [0, 1, 2]
                 .map(|k| backward_difference(conv, l.flux_nt[k], s.flux_nt[k], l.time_s, s.time_s)),
             _ => [0.0; 3],
@@ -223,44 +210,40 @@ impl OnlineTl {
         {
             *x = [v, lag.as_mut().map_or(f64::NAN, |l| l.step(s.time_s, v))];
         }
-        let lagged = if self.design.terms.eddy_lags_s().is_empty() {
-            &[][..]
-        } else {
-            self.lags.eddy.step(s.time_s, db)
-        };
-        let b = s.flux_nt;
-        let (terms, bt) = (&self.design.terms, self.design.bt_scale_nt);
-        let along = |dir: [f64; 3], row: &mut [f64]| -> f64 {
-            terms.row_along(dir, b, db, lagged, &self.extra, bt, row);
-            // −0.0 is the identity of f64 addition: the bits of `row · c`
-            // as the batch path sums them.
-            let mut acc = -0.0;
-            for (v, c) in row.iter().zip(&self.coef) {
-                acc += v * c;
-            }
-            acc
-        };
-        let interference_nt = match self.design.magnitude {
-            Magnitude::FirstOrder => along(b, &mut self.row),
-            Magnitude::Exact => {
-                let d = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-                    .map(|axis| along(axis, &mut self.row));
-                TotalField::of(b, d).change() + self.bias
-            }
-        };
+        if !self.lagged.is_empty() {
+            self.lagged
+                .copy_from_slice(self.lags.eddy.step(s.time_s, self.db));
+        }
+        self.b = s.flux_nt;
         self.last = Some(Last {
             time_s: s.time_s,
             flux_nt: s.flux_nt,
         });
-        OnlineOutput {
-            interference_nt,
-            compensated_nt: s.mag_nt - interference_nt,
-            status: if last.is_some() {
-                SampleStatus::Compensated
-            } else {
-                SampleStatus::Started
-            },
+        if last.is_some() {
+            SampleStatus::Compensated
+        } else {
+            SampleStatus::Started
         }
+    }
+
+    /// The accepted sample's vector field (body frame), nT.
+    pub fn field_nt(&self) -> [f64; 3] {
+        self.b
+    }
+
+    /// The accepted sample's design row along the direction of `dir`
+    /// ([`super::TermSet::row_along`]: `dir = b` is the first-order row, a
+    /// body axis the exact model's component along it) into `out`.
+    pub fn row_along(&self, dir: [f64; 3], out: &mut [f64]) {
+        self.design.terms.row_along(
+            dir,
+            self.b,
+            self.db,
+            &self.lagged,
+            &self.extra,
+            self.design.bt_scale_nt,
+            out,
+        );
     }
 
     /// Forget the stream: the next sample starts a run, whatever its time.
@@ -268,6 +251,119 @@ impl OnlineTl {
         self.last = None;
         self.last_time_s = None;
         self.lags = Lags::new(&self.design.terms);
+    }
+}
+
+/// `row · c`, summed from −0.0 in column order: the bits of
+/// [`Design::interference_with`]'s sum (−0.0 is the identity of f64
+/// addition).
+pub(crate) fn dot(row: &[f64], c: &[f64]) -> f64 {
+    let mut acc = -0.0;
+    for (v, c) in row.iter().zip(c) {
+        acc += v * c;
+    }
+    acc
+}
+
+/// The body axes, the directions of the exact model's three components.
+pub(crate) const AXES: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// A Tolles-Lawson model applied sample by sample ([module docs](self)).
+#[derive(Debug, Clone)]
+pub struct OnlineTl {
+    rows: OnlineRows,
+    /// Coefficients; under the exact magnitude with the bias set to 0.
+    coef: Vec<f64>,
+    /// The bias coefficient under the exact magnitude (0 otherwise).
+    bias: f64,
+    row: Vec<f64>,
+}
+
+impl OnlineTl {
+    /// The model `design` with coefficients `coef`, runs broken at time
+    /// steps over `max_step_s` (s; the batch rule is 1.5 × the sample
+    /// interval). Bad settings (coefficients not matching the design, a
+    /// step not positive) are [`CompError::Setting`].
+    pub fn new(design: &Design, coef: &[f64], max_step_s: f64) -> Result<Self> {
+        let rows = OnlineRows::new(design, max_step_s)?;
+        let n = design.n_columns();
+        if coef.len() != n {
+            return Err(CompError::setting(format!(
+                "{} coefficients for a design of {n} columns",
+                coef.len()
+            )));
+        }
+        let mut coef = coef.to_vec();
+        let bias = match (design.magnitude, design.terms.bias_column()) {
+            (Magnitude::Exact, Some(k)) => std::mem::replace(&mut coef[k], 0.0),
+            _ => 0.0,
+        };
+        Ok(Self {
+            rows,
+            coef,
+            bias,
+            row: vec![0.0; n],
+        })
+    }
+
+    /// The design the rows are built with (causal).
+    pub fn design(&self) -> &Design {
+        self.rows.design()
+    }
+
+    /// Number of extra channels a sample must carry.
+    pub fn n_channels(&self) -> usize {
+        self.rows.n_channels()
+    }
+
+    /// Compensate one sample ([module docs](self)). Never fails: a sample
+    /// that cannot be compensated says why in its status. A sample with
+    /// fewer or more channels than the model's is [`SampleStatus::Missing`].
+    pub fn push(&mut self, s: &OnlineSample) -> OnlineOutput {
+        let status = self.rows.advance(s);
+        if !status.is_compensated() {
+            return OnlineOutput::not(status);
+        }
+        let b = self.rows.field_nt();
+        let interference_nt = match self.rows.design().magnitude {
+            Magnitude::FirstOrder => {
+                self.rows.row_along(b, &mut self.row);
+                dot(&self.row, &self.coef)
+            }
+            Magnitude::Exact => {
+                let d = AXES.map(|axis| {
+                    self.rows.row_along(axis, &mut self.row);
+                    dot(&self.row, &self.coef)
+                });
+                TotalField::of(b, d).change() + self.bias
+            }
+        };
+        OnlineOutput::compensated(s.mag_nt, interference_nt, status)
+    }
+
+    /// Forget the stream: the next sample starts a run, whatever its time.
+    pub fn reset(&mut self) {
+        self.rows.reset();
+    }
+}
+
+impl OnlineOutput {
+    /// A compensated sample: reading `mag_nt` minus `interference_nt`.
+    pub(crate) fn compensated(mag_nt: f64, interference_nt: f64, status: SampleStatus) -> Self {
+        Self {
+            interference_nt,
+            compensated_nt: mag_nt - interference_nt,
+            status,
+        }
+    }
+
+    /// The output of a sample that was not compensated.
+    pub(crate) fn not(status: SampleStatus) -> Self {
+        Self {
+            interference_nt: f64::NAN,
+            compensated_nt: f64::NAN,
+            status,
+        }
     }
 }
 

@@ -515,6 +515,23 @@ impl TermSet {
             .any(|g| matches!(g, TermGroup::E9 | TermGroup::E8 | TermGroup::L9))
     }
 
+    /// The index of the `bias` column, if the terms have one.
+    pub fn bias_column(&self) -> Option<usize> {
+        self.column_indices(|c| c == Column::Bias).first().copied()
+    }
+
+    /// The indices of the columns for which `pick` holds, in column order.
+    pub fn column_indices(&self, mut pick: impl FnMut(Column) -> bool) -> Vec<usize> {
+        let (mut k, mut out) = (0, Vec::new());
+        self.for_each_column(|c| {
+            if pick(c) {
+                out.push(k);
+            }
+            k += 1;
+        });
+        out
+    }
+
     /// Column names, e.g. `p_x`, `i_xy`, `e_zy`, `bias`, in column order.
     pub fn column_names(&self) -> Vec<String> {
         let mut names = Vec::new();
