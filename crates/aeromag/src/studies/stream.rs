@@ -258,7 +258,7 @@ impl StudyOutcome for StreamOutcome {
              {:.4} nT in batch ({:.3}×). A {:.1}-hour flight of {CREEP_LINES} lines at {CREEP_CLEARANCE_M:.0} m above \
              ground, during which the left engine's permanent moment creeps by ({}, {}, {}) A·m² per hour: the model \
              held fixed goes from {:.3} nT in the first hour to {:.3} nT in the last ({:.2}×); the adaptive \
-             Kalman filter (`stream --adapt kalman`, seeded with the model, permanent terms drifting at 1 nT/√h, the on-board field model) \
+             Kalman filter (`stream --adapt kalman`, seeded with the model, permanent terms drifting at 0.5 nT/√h, the on-board field model) \
              from {:.3} to {:.3} nT ({:.2}×); recursive least squares with forgetting ({:.2}×). Residual: RMS of \
              compensated − truth on the lines about its mean, per window (a datum common to every heading that \
              changes over hours looks like the diurnal variation to any on-board method; levelling removes it).",

@@ -66,7 +66,7 @@ pub struct Args {
     #[arg(long, value_name = "M/S", requires = "adapt")]
     speed: Option<f64>,
     /// Random-walk intensity of the permanent coefficients, nT/√h
-    /// (--adapt kalman; default 1).
+    /// (--adapt kalman; default 0.5).
     #[arg(long, value_name = "NT_PER_SQRT_H", requires = "adapt")]
     permanent_drift: Option<f64>,
     /// q₁ of the field model, nT²/m^(2n−1) (--adapt kalman; default: the

@@ -192,10 +192,11 @@ impl NoiseModel {
     /// the track at 70 m/s) put power in the 1-km band that the
     /// calibration's `q₁` leaves to the coefficients. Measured on the
     /// simulator's 5-hour creeping flight at 3000 m (seed 3, 0.3 nT of
-    /// pulsations, [`super::online`]): first 30 minutes 0.62 nT with the
-    /// calibration's `q₁`, 0.155 nT with the pulsations switched off,
-    /// 0.11–0.14 nT with `q₁` × 10³ either way; × 10⁶ gave 0.15–0.5 nT
-    /// over the flight (the field then takes interference).
+    /// pulsations, [`super::online`] with a permanent drift of 1 nT/√h):
+    /// first 30 minutes 0.62 nT with the calibration's `q₁`, 0.155 nT with
+    /// the pulsations switched off, 0.11–0.14 nT with `q₁` × 10³ either
+    /// way; × 10⁶ gave 0.15–0.5 nT over the flight (the field then takes
+    /// interference).
     pub fn on_board_for(order: usize) -> Self {
         let c = Self::calibration_default_for(order);
         Self {
