@@ -74,19 +74,19 @@ const NAV: Navigation = Navigation {
     alt_m: 3000.0,
 };
 
+/// Makes a fresh compensator: a closure pushing one sample.
+type Make = Box<dyn Fn() -> Box<dyn FnMut(&Sample) -> f64>>;
+
 /// The compensators timed: name and a fresh one pushing a sample.
-fn compensators() -> Vec<(
-    &'static str,
-    Box<dyn Fn() -> Box<dyn FnMut(&Sample) -> f64>>,
-)> {
-    let fixed = |magnitude| -> Box<dyn Fn() -> Box<dyn FnMut(&Sample) -> f64>> {
+fn compensators() -> Vec<(&'static str, Make)> {
+    let fixed = |magnitude| -> Make {
         let (design, coef) = model(magnitude);
         Box::new(move || {
             let mut o = OnlineTl::new(&design, &coef, 0.15).unwrap();
             Box::new(move |s: &Sample| o.push(&sample(s)).compensated_nt)
         })
     };
-    let adaptive = |kalman: bool| -> Box<dyn Fn() -> Box<dyn FnMut(&Sample) -> f64>> {
+    let adaptive = |kalman: bool| -> Make {
         let (design, coef) = model(Magnitude::FirstOrder);
         let std = vec![1.0; coef.len()];
         Box::new(move || {
