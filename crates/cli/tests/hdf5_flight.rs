@@ -43,7 +43,11 @@ fn python_flight(dir: &Path) {
     let config = dir.join("sensors.toml");
     std::fs::write(&config, SENSORS).unwrap();
     let cal = &simulate_with(dir, "calibration", "1", Some(&config));
-    let survey = &simulate_with(dir, "survey", "2", Some(&config));
+    // Six survey lines (1003.01–1003.06) and the five ties: a third of the
+    // default survey, every kind of line the test compensates.
+    let survey_config = dir.join("survey.toml");
+    std::fs::write(&survey_config, format!("{SENSORS}[pattern]\nline_count = 6\n")).unwrap();
+    let survey = &simulate_with(dir, "survey", "2", Some(&survey_config));
     let o = Command::new("python3")
         .arg(root.join("tools/reference/sgl_flight.py"))
         .arg(cal)
