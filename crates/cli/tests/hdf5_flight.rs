@@ -46,7 +46,11 @@ fn python_flight(dir: &Path) {
     // Six survey lines (1003.01–1003.06) and the five ties: a third of the
     // default survey, every kind of line the test compensates.
     let survey_config = dir.join("survey.toml");
-    std::fs::write(&survey_config, format!("{SENSORS}[pattern]\nline_count = 6\n")).unwrap();
+    std::fs::write(
+        &survey_config,
+        format!("{SENSORS}[pattern]\nline_count = 6\n"),
+    )
+    .unwrap();
     let survey = &simulate_with(dir, "survey", "2", Some(&survey_config));
     let o = Command::new("python3")
         .arg(root.join("tools/reference/sgl_flight.py"))

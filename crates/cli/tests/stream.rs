@@ -105,14 +105,7 @@ fn a_pipe_gives_the_causal_batch_values_and_flags_bad_lines() {
             _ => {}
         }
     }
-    let mut child = piped_stream(&model);
-    let mut stdin = child.stdin.take().unwrap();
-    let text = input.join("\n") + "\n";
-    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()).unwrap());
-    let o = child.wait_with_output().unwrap();
-    writer.join().unwrap();
-    assert_code(&o, 0);
-    let out: Vec<String> = stdout(&o).lines().map(str::to_string).collect();
+    let (out, err) = through_pipe(&model, &[], &input);
     assert_eq!(
         out[0],
         format!("{},mag_interf,mag_comp,comp_flag", lines[0])
@@ -128,9 +121,8 @@ fn a_pipe_gives_the_causal_batch_values_and_flags_bad_lines() {
     assert_eq!(flags, ["4", "3", "4"]);
     assert_same(&kept, &want[1..]);
     assert!(
-        stderr(&o).contains("6003 lines: 6000 compensated (0 runs restarted), 0 with missing values, 1 with time going back, 2 malformed"),
-        "{}",
-        stderr(&o)
+        err.contains("6003 lines: 6000 compensated (0 runs restarted), 0 with missing values, 1 with time going back, 2 malformed"),
+        "{err}"
     );
 }
 
