@@ -60,6 +60,9 @@ pub enum Error {
     /// Gradiometer dipole estimation.
     #[error(transparent)]
     Gradiometry(#[from] aeromag_gradiometry::GradiometryError),
+    /// Projection, gridding and grid files.
+    #[error(transparent)]
+    Grid(#[from] aeromag_grid::GridError),
     /// Plots and reports.
     #[error(transparent)]
     Report(#[from] aeromag_report::ReportError),
@@ -144,6 +147,7 @@ impl Error {
             Error::Em(e) => e.is_bad_input(),
             Error::Gradiometry(e) => e.is_bad_input(),
             Error::Report(e) => e.is_bad_input(),
+            Error::Grid(e) => e.is_bad_input(),
             Error::Core(e) => e.is_bad_input(),
             Error::Estimation(e) => e.is_bad_input(),
             Error::Read { .. } => true,

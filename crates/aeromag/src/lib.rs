@@ -44,6 +44,7 @@
 //! | [`gradiometry`] | gradiometer passes on files: [`gradiometry::read_pass`], [`gradiometry::locate_pass`], [`gradiometry::crlb()`], convergence maps |
 //! | [`em`] | EM positioning on files: [`em::detect`], [`em::calibrate`], [`em::locate`], [`em::simulate_to_dir`] |
 //! | [`level`] | levelling at crossovers ([`level::level`]) |
+//! | [`map`] | from lines to the map: [`map::grid_flight`] (UTM, minimum curvature, blanking) → [`map::SurveyGrid`] |
 //! | [`score`] | FOM, IR and residual against truth of a compensated flight, and its report section |
 //! | [`observer`] | [`Observer`] (stages, progress, notes as they happen), [`Note`], [`Silent`] |
 //! | [`error`] | [`Error`] with [`Error::is_bad_input`] |
@@ -57,6 +58,7 @@
 //! | [`sim`] (`aeromag-sim`) | the physical simulator (truth in `true_` columns) |
 //! | [`estimation`] (`aeromag-estimation`) | least squares, square-root Kalman filters and smoothers |
 //! | [`compensation`] (`aeromag-compensation`) | Tolles-Lawson terms and fits, the Kalman method, levelling, rotor and pod models, metrics |
+//! | [`grid`] (`aeromag-grid`) | UTM projection, minimum-curvature gridding, blanking, GeoTIFF / ESRI ASCII / netCDF grid files |
 //! | [`aeromag_em`] | EM bird positioning (its file workflows are [`em`]) |
 //! | [`aeromag_gradiometry`] | dipole parameters from gradiometers (its flight-level workflows are [`gradiometry`]) |
 //! | [`report`] (`aeromag-report`) | plots and the single-file HTML report |
@@ -70,6 +72,7 @@ pub mod error;
 pub mod flight;
 pub mod gradiometry;
 pub mod level;
+pub mod map;
 pub mod model_file;
 pub mod observer;
 pub mod online;
@@ -83,6 +86,7 @@ pub mod tolles_lawson;
 pub use aeromag_compensation as compensation;
 pub use aeromag_core as core;
 pub use aeromag_estimation as estimation;
+pub use aeromag_grid as grid;
 pub use aeromag_io as io;
 pub use aeromag_report as report;
 pub use aeromag_sim as sim;

@@ -1,0 +1,240 @@
+//! A column of a survey on a grid.
+
+use super::MOST_PROCESSED;
+use super::survey::ProjectedSurvey;
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use crate::observer::{Note, Notes, Observer};
+use aeromag_grid::format::{GridFormat, write_grid};
+use aeromag_grid::gridding::{
+    Bidirectional, BlockMeans, LinePoints, MinCurvature, MinCurvatureReport, Points, blank_beyond,
+    distance_to_data,
+};
+use aeromag_grid::projection::{Crs, UtmZone};
+use aeromag_grid::{Grid, GridGeometry};
+use std::path::Path;
+
+/// How the nodes are computed from the lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum GridMethod {
+    /// Minimum curvature with tension (Smith & Wessel 1990; GMT `surface`).
+    #[default]
+    MinCurvature,
+    /// Along the traverse lines, then across them by the Akima spline
+    /// (tie lines are not used).
+    Bidirectional,
+}
+
+/// Settings of [`grid_flight`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct GridOptions {
+    /// The column to grid; `None`: the most processed magnetic column of
+    /// the file ([`MOST_PROCESSED`]).
+    pub column: Option<String>,
+    /// Node spacing, m; `None`: a quarter of the line spacing, rounded
+    /// down to 1, 2, 2.5 or 5 × 10ᵏ m.
+    pub cell_m: Option<f64>,
+    /// Nodes farther than this from the data are blank, m; `None`: the
+    /// line spacing (5 cells without lines).
+    pub blanking_m: Option<f64>,
+    /// The UTM zone; `None`: the zone of the data.
+    pub zone: Option<UtmZone>,
+    /// The method.
+    pub method: GridMethod,
+    /// Minimum-curvature settings (tension 0.25 by default).
+    pub min_curvature: MinCurvature,
+}
+
+/// A survey column on a grid ([`grid_flight`]): the grid, and how it was
+/// made.
+#[derive(Debug, Clone)]
+pub struct SurveyGrid {
+    /// The grid (CRS: the UTM zone; blank nodes NaN).
+    pub grid: Grid,
+    /// The column gridded.
+    pub column: String,
+    /// The flight's rows in the grid's coordinates, and its lines'
+    /// direction and spacing.
+    pub survey: ProjectedSurvey,
+    /// The blanking distance used, m.
+    pub blanking_m: f64,
+    /// Nodes blanked.
+    pub blanked_nodes: usize,
+    /// Rows gridded (on a line, finite position and value).
+    pub rows_used: usize,
+    /// How the minimum-curvature solution converged (no levels for the
+    /// bi-directional method).
+    pub report: MinCurvatureReport,
+    /// Notes and warnings raised.
+    pub notes: Vec<Note>,
+}
+
+impl SurveyGrid {
+    /// Write the grid; the format follows the extension (`.tif`, `.asc`,
+    /// `.nc`).
+    pub fn write(&self, path: &Path) -> Result<GridFormat> {
+        Ok(write_grid(path, &self.grid)?)
+    }
+}
+
+/// Grid a column of `flight` (module docs of [`crate::map`]).
+///
+/// Rows on a line (label ≠ 0; every row without a `line` column) with a
+/// finite position and value are projected to UTM and gridded by minimum
+/// curvature with tension over their extent; nodes farther than the
+/// blanking distance from any data are blank.
+///
+/// ```
+/// use aeromag::map::{GridOptions, grid_flight};
+/// use aeromag::simulate::{ScenarioKind, simulate_flight};
+/// use aeromag::Silent;
+/// let pattern = "[pattern]\nline_count = 6\nline_length_m = 3000.0\ntie_count = 0\n";
+/// let survey = simulate_flight(ScenarioKind::Survey, Some(pattern), Some(3))?;
+/// let g = grid_flight(&survey, &GridOptions::default(), &mut Silent)?;
+/// assert_eq!(g.column, "mag");
+/// assert!((g.survey.lines.unwrap().spacing_m - 500.0).abs() < 5.0);
+/// assert_eq!(g.grid.geometry.cell, 100.0);
+/// # Ok::<(), aeromag::Error>(())
+/// ```
+pub fn grid_flight(
+    flight: &Flight,
+    opts: &GridOptions,
+    observer: &mut dyn Observer,
+) -> Result<SurveyGrid> {
+    let mut notes = Notes::new(observer);
+    let column = match &opts.column {
+        Some(c) => c.clone(),
+        None => MOST_PROCESSED
+            .iter()
+            .find(|c| flight.get(c).is_some())
+            .map(|c| c.to_string())
+            .ok_or_else(|| {
+                Error::bad_file(
+                    flight.label(),
+                    format!(
+                        "has none of the magnetic columns {} (choose one with --column)",
+                        MOST_PROCESSED.join(", ")
+                    ),
+                )
+            })?,
+    };
+    let values = flight.require(&column)?;
+    notes.stage("projecting");
+    let survey = ProjectedSurvey::of(flight, opts.zone)?;
+    let cell = match (opts.cell_m, &survey.lines) {
+        (Some(c), _) => c,
+        (None, Some(l)) => l.default_cell_m(),
+        (None, None) => {
+            return Err(Error::bad_file(
+                flight.label(),
+                "has no survey lines to choose a cell size from (no `line` column, or fewer than two lines): give the cell size",
+            ));
+        }
+    };
+    let blanking = match (opts.blanking_m, &survey.lines) {
+        (Some(b), _) => b,
+        (None, Some(l)) => l.spacing_m,
+        (None, None) => 5.0 * cell,
+    };
+    if !(blanking.is_finite() && blanking > 0.0) {
+        return Err(Error::bad_input(format!(
+            "the blanking distance {blanking} m must be positive"
+        )));
+    }
+    let (mut x, mut y, mut z, mut line) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut missing = 0usize;
+    for k in 0..values.len() {
+        if !survey.on_line(k) {
+            continue;
+        }
+        if values[k].is_finite() && survey.x[k].is_finite() && survey.y[k].is_finite() {
+            x.push(survey.x[k]);
+            y.push(survey.y[k]);
+            z.push(values[k]);
+            line.push(survey.line_ids.as_ref().map_or(0, |ids| ids[k] as i64));
+        } else {
+            missing += 1;
+        }
+    }
+    if missing > 0 {
+        notes.note(format!(
+            "{missing} rows on lines have no {column} or no position and are not gridded"
+        ));
+    }
+    let points = Points::new(&x, &y, &z)?;
+    let (x0, x1, y0, y1) = points.extent().ok_or_else(|| {
+        Error::bad_file(
+            flight.label(),
+            format!("no row on a line has a finite {column} and position"),
+        )
+    })?;
+    let geometry = GridGeometry::covering(x0, x1, y0, y1, cell)?;
+    notes.stage("gridding");
+    let (mut grid_values, report) = match (opts.method, &survey.lines) {
+        (GridMethod::MinCurvature, _) => opts.min_curvature.grid(points, geometry)?,
+        (GridMethod::Bidirectional, Some(l)) => {
+            // Tie lines are left out: their samples go to a line id that
+            // is not a traverse line's.
+            let ids: Vec<i64> = line
+                .iter()
+                .map(|id| if l.traverse_ids.contains(id) { *id } else { -1 })
+                .collect();
+            let keep: Vec<usize> = (0..ids.len()).filter(|&k| ids[k] >= 0).collect();
+            let pick = |s: &[f64]| keep.iter().map(|&k| s[k]).collect::<Vec<f64>>();
+            let (bx, by, bz) = (pick(&x), pick(&y), pick(&z));
+            let bl: Vec<i64> = keep.iter().map(|&k| ids[k]).collect();
+            let values = Bidirectional {
+                direction_deg: l.direction_deg,
+                max_gap_cells: 4.0,
+            }
+            .grid(
+                LinePoints {
+                    x: &bx,
+                    y: &by,
+                    z: &bz,
+                    line: &bl,
+                },
+                geometry,
+            )?;
+            (
+                values,
+                MinCurvatureReport::not_run(&BlockMeans::of(points, &geometry)),
+            )
+        }
+        (GridMethod::Bidirectional, None) => {
+            return Err(Error::bad_file(
+                flight.label(),
+                "bi-directional gridding needs survey lines (a `line` column with at least two parallel lines)",
+            ));
+        }
+    };
+    if !report.converged {
+        notes.warn(format!(
+            "minimum curvature stopped after {} sweeps with a change of {:.3e} (limit {:.3e}); raise the sweep limit",
+            report.levels.last().map_or(0, |l| l.iterations),
+            report.levels.last().map_or(f64::NAN, |l| l.max_change),
+            report.convergence_limit
+        ));
+    }
+    let distance = distance_to_data(&geometry, &BlockMeans::of(points, &geometry));
+    let blanked = blank_beyond(&mut grid_values, &distance, blanking);
+    let grid = Grid {
+        geometry,
+        values: grid_values,
+        crs: Some(Crs::Utm(survey.zone)),
+        name: column.clone(),
+        unit: "nT".into(),
+    };
+    Ok(SurveyGrid {
+        grid,
+        column,
+        survey,
+        blanking_m: blanking,
+        blanked_nodes: blanked,
+        rows_used: x.len(),
+        report,
+        notes: notes.into_notes(),
+    })
+}

@@ -1,0 +1,265 @@
+//! Micro-levelling: removal of the corrugation left along the lines after
+//! tie-line levelling (Minty 1991, *Simple micro-levelling for
+//! aeromagnetic data*, Exploration Geophysics 22, 591–592).
+//!
+//! 1. The column is gridded ([`grid_flight`], minimum curvature).
+//! 2. The corrugation is isolated on the grid by a high-pass Butterworth
+//!    filter (cut-off wavelength `cutoff_line_spacings` × the line
+//!    spacing) times a directional cosine filter aligned with the lines
+//!    ([`Spectral::Corrugation`]): stripes along the lines pass, the
+//!    geology mostly does not.
+//! 3. The corrugation grid is sampled (bilinearly) at every row on a line
+//!    and low-passed along the line by a running mean over
+//!    `along_line_m` of track (level errors drift slowly; what varies
+//!    faster along a line is geology the filter let through).
+//! 4. The correction is minus that; the micro-levelled column is the
+//!    column plus the correction.
+
+use super::gridding::{GridOptions, grid_flight};
+use super::survey::LineGeometry;
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use crate::io::FlightTable;
+use crate::observer::{Note, Notes, Observer};
+use aeromag_grid::gridding::MinCurvature;
+use aeromag_grid::products::{Corrugation, Spectral, apply};
+use aeromag_grid::projection::UtmZone;
+
+/// Settings of [`microlevel`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct MicrolevelOptions {
+    /// The column (default: the most processed magnetic column, as
+    /// [`grid_flight`]).
+    pub column: Option<String>,
+    /// Cell of the working grid, m (default as [`grid_flight`]).
+    pub cell_m: Option<f64>,
+    /// UTM zone (default: the data's).
+    pub zone: Option<UtmZone>,
+    /// Cut-off wavelength of the high-pass, in line spacings (default 4).
+    pub cutoff_line_spacings: f64,
+    /// Length of the along-line running mean, m (default: 8 line spacings).
+    pub along_line_m: Option<f64>,
+    /// Power of the directional cosine filter (default 2).
+    pub cosine_power: f64,
+    /// Gridding settings.
+    pub min_curvature: MinCurvature,
+}
+
+impl Default for MicrolevelOptions {
+    fn default() -> Self {
+        Self {
+            column: None,
+            cell_m: None,
+            zone: None,
+            cutoff_line_spacings: 4.0,
+            along_line_m: None,
+            cosine_power: 2.0,
+            min_curvature: MinCurvature::default(),
+        }
+    }
+}
+
+/// The result of [`microlevel`]: the correction of every row and what it
+/// amounts to.
+#[derive(Debug, Clone)]
+pub struct Microlevelled {
+    /// The column micro-levelled.
+    pub column: String,
+    /// Per row, the correction, nT (0 off the lines).
+    pub correction: Vec<f64>,
+    /// Per row, the micro-levelled value.
+    pub values: Vec<f64>,
+    /// The lines' geometry the filter used.
+    pub lines: LineGeometry,
+    /// Cell of the working grid, m.
+    pub cell_m: f64,
+    /// The along-line running mean used, m.
+    pub along_line_m: f64,
+    /// RMS of the correction over the rows on lines, nT.
+    pub correction_rms_nt: f64,
+    /// Largest |correction|, nT.
+    pub correction_max_nt: f64,
+    /// Notes and warnings.
+    pub notes: Vec<Note>,
+}
+
+impl Microlevelled {
+    /// The micro-levelled column's name: `<column>_mlev`.
+    pub fn output_column(&self) -> String {
+        format!("{}_mlev", self.column)
+    }
+
+    /// The correction's column name: `<column>_mlev_corr`.
+    pub fn correction_column(&self) -> String {
+        format!("{}_mlev_corr", self.column)
+    }
+
+    /// Add the micro-levelled column and the correction to `table`.
+    pub fn add_to(&self, table: &mut FlightTable) -> Result<()> {
+        table.add_column(&self.output_column(), self.values.clone())?;
+        table.add_column(&self.correction_column(), self.correction.clone())?;
+        Ok(())
+    }
+}
+
+/// Micro-level a column of a levelled survey (module docs).
+pub fn microlevel(
+    flight: &Flight,
+    opts: &MicrolevelOptions,
+    observer: &mut dyn Observer,
+) -> Result<Microlevelled> {
+    let mut notes = Notes::new(observer);
+    if !(opts.cutoff_line_spacings.is_finite() && opts.cutoff_line_spacings > 0.0) {
+        return Err(Error::bad_input(format!(
+            "the cut-off {} line spacings must be positive",
+            opts.cutoff_line_spacings
+        )));
+    }
+    let gridded = grid_flight(
+        flight,
+        &GridOptions {
+            column: opts.column.clone(),
+            cell_m: opts.cell_m,
+            zone: opts.zone,
+            // The filter needs the whole grid: nothing is blanked here.
+            blanking_m: Some(f64::MAX),
+            min_curvature: opts.min_curvature,
+            ..GridOptions::default()
+        },
+        &mut notes,
+    )?;
+    let column = gridded.column.clone();
+    let out = format!("{column}_mlev");
+    if flight.get(&out).is_some() {
+        return Err(Error::bad_file(
+            flight.label(),
+            format!("already has `{out}`"),
+        ));
+    }
+    let lines = gridded.survey.lines.clone().ok_or_else(|| {
+        Error::bad_file(
+            flight.label(),
+            "micro-levelling needs survey lines (a `line` column with at least two parallel lines)",
+        )
+    })?;
+    let along = opts.along_line_m.unwrap_or(8.0 * lines.spacing_m);
+    if !(along.is_finite() && along > 0.0) {
+        return Err(Error::bad_input(format!(
+            "the along-line length {along} m must be positive"
+        )));
+    }
+    notes.stage("filtering the grid");
+    let corrugation = apply(
+        &gridded.grid,
+        Spectral::Corrugation(Corrugation {
+            line_direction_deg: lines.direction_deg,
+            cutoff_wavelength_m: opts.cutoff_line_spacings * lines.spacing_m,
+            order: 8,
+            cosine_power: opts.cosine_power,
+        }),
+    )?;
+    notes.stage("correcting the lines");
+    let survey = &gridded.survey;
+    let ids = survey.line_ids.as_deref().unwrap_or(&[]);
+    let value = flight.require(&column)?;
+    let n = value.len();
+    // Per row on a line: the corrugation there (NaN outside the grid).
+    let sampled: Vec<f64> = (0..n)
+        .map(|k| {
+            if ids.get(k).is_some_and(|&id| id != 0.0) {
+                corrugation.sample(survey.x[k], survey.y[k])
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let smooth = along_line_mean(&survey.x, &survey.y, ids, &sampled, along);
+    let mut correction = vec![0.0; n];
+    for k in 0..n {
+        if smooth[k].is_finite() {
+            correction[k] = -smooth[k];
+        }
+    }
+    let on_line: Vec<f64> = (0..n)
+        .filter(|&k| ids.get(k).is_some_and(|&id| id != 0.0))
+        .map(|k| correction[k])
+        .collect();
+    let rms = (on_line.iter().map(|c| c * c).sum::<f64>() / on_line.len().max(1) as f64).sqrt();
+    let max = on_line.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    let values = value.iter().zip(&correction).map(|(v, c)| v + c).collect();
+    Ok(Microlevelled {
+        column,
+        correction,
+        values,
+        lines,
+        cell_m: gridded.grid.geometry.cell,
+        along_line_m: along,
+        correction_rms_nt: rms,
+        correction_max_nt: max,
+        notes: notes.into_notes(),
+    })
+}
+
+/// The running mean of `v` over `window_m` of track, within each run of
+/// rows of one line (consecutive rows with the same id ≠ 0); NaN values
+/// are left out of the means, rows without any finite value in their
+/// window are NaN. O(n) with two pointers over the cumulative distance.
+fn along_line_mean(x: &[f64], y: &[f64], ids: &[f64], v: &[f64], window_m: f64) -> Vec<f64> {
+    let n = v.len();
+    let mut out = vec![f64::NAN; n];
+    let mut start = 0;
+    while start < n {
+        let id = ids.get(start).copied().unwrap_or(0.0);
+        let mut end = start + 1;
+        while end < n && ids[end] == id {
+            end += 1;
+        }
+        if id != 0.0 {
+            // Cumulative distance along the run.
+            let mut s = vec![0.0; end - start];
+            for k in start + 1..end {
+                let d = ((x[k] - x[k - 1]).powi(2) + (y[k] - y[k - 1]).powi(2)).sqrt();
+                s[k - start] = s[k - 1 - start] + if d.is_finite() { d } else { 0.0 };
+            }
+            let (mut lo, mut hi) = (0usize, 0usize);
+            let (mut sum, mut count) = (0.0, 0usize);
+            for i in 0..end - start {
+                while hi < end - start && s[hi] <= s[i] + 0.5 * window_m {
+                    if v[start + hi].is_finite() {
+                        sum += v[start + hi];
+                        count += 1;
+                    }
+                    hi += 1;
+                }
+                while s[lo] < s[i] - 0.5 * window_m {
+                    if v[start + lo].is_finite() {
+                        sum -= v[start + lo];
+                        count -= 1;
+                    }
+                    lo += 1;
+                }
+                if count > 0 {
+                    out[start + i] = sum / count as f64;
+                }
+            }
+        }
+        start = end;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_along_line_mean_stays_within_each_line() {
+        let x: Vec<f64> = (0..10).map(|k| (k % 5) as f64 * 10.0).collect();
+        let y = vec![0.0; 10];
+        let ids = [1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 2.0, 2.0];
+        let v = [1.0, 1.0, f64::NAN, 1.0, 1.0, 5.0, 5.0, 5.0, 5.0, 5.0];
+        let m = along_line_mean(&x, &y, &ids, &v, 25.0);
+        assert!(m[..5].iter().all(|&a| a == 1.0), "{m:?}");
+        assert!(m[5..].iter().all(|&a| a == 5.0), "{m:?}");
+    }
+}

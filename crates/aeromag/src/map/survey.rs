@@ -1,0 +1,232 @@
+//! A flight's lines in projected coordinates.
+//!
+//! Latitude and longitude (degrees, WGS 84) are projected to UTM in the
+//! zone of the data (the zone of the median longitude, the hemisphere of
+//! the median latitude; [`UtmZone::for_points`]) or in a zone given. Each
+//! line's direction is the principal axis of its points; the survey
+//! direction is the length-weighted circular mean of those axes (angles
+//! doubled, as axes have no sense), and lines within 30° of it are the
+//! traverse lines (the others, tie lines or turns, do not count for the
+//! spacing). The line spacing is the median gap between successive
+//! traverse lines across the survey direction, gaps below a tenth of the
+//! median (re-flown parts such as 1003.01 beside 1003) left out.
+
+use crate::error::{Error, Result};
+use crate::flight::Flight;
+use crate::flight::LineLabels;
+use aeromag_grid::projection::{Utm, UtmZone};
+
+/// A flight's rows in UTM (m) and its lines' geometry.
+#[derive(Debug, Clone)]
+pub struct ProjectedSurvey {
+    /// The UTM zone.
+    pub zone: UtmZone,
+    /// Easting of every row, m (NaN where latitude or longitude is missing).
+    pub x: Vec<f64>,
+    /// Northing of every row, m.
+    pub y: Vec<f64>,
+    /// Per row the id of its line (0: on no line), when the flight has a
+    /// `line` column.
+    pub line_ids: Option<Vec<f64>>,
+    /// The lines' geometry, when there are lines.
+    pub lines: Option<LineGeometry>,
+}
+
+/// Direction and spacing of a survey's traverse lines ([`ProjectedSurvey`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LineGeometry {
+    /// Direction of the traverse lines, degrees clockwise from grid north,
+    /// 0–180.
+    pub direction_deg: f64,
+    /// Median spacing of the traverse lines, m.
+    pub spacing_m: f64,
+    /// Lines counted as traverse lines.
+    pub traverse_lines: usize,
+    /// Other lines (ties, turns).
+    pub other_lines: usize,
+    /// The ids ([`LineLabels`] ids) of the traverse lines.
+    #[serde(skip)]
+    pub traverse_ids: Vec<i64>,
+}
+
+impl ProjectedSurvey {
+    /// Project `flight`'s `lat`/`lon` (degrees) to UTM in `zone`, or in the
+    /// zone of the data when `None`, and find its lines' geometry.
+    pub fn of(flight: &Flight, zone: Option<UtmZone>) -> Result<Self> {
+        let lat = flight.require("lat")?;
+        let lon = flight.require("lon")?;
+        let zone = match zone {
+            Some(z) => z,
+            None => UtmZone::for_points(lat, lon)
+                .map_err(|e| Error::bad_file(flight.label(), e.to_string()))?,
+        };
+        let utm = Utm::new(zone);
+        let (mut x, mut y) = (Vec::with_capacity(lat.len()), Vec::with_capacity(lat.len()));
+        for (k, (&la, &lo)) in lat.iter().zip(lon).enumerate() {
+            if !(la.is_finite() && lo.is_finite()) {
+                x.push(f64::NAN);
+                y.push(f64::NAN);
+                continue;
+            }
+            let (e, n) = utm
+                .forward(la, lo)
+                .map_err(|e| flight.bad_value(k, "lat", e.to_string()))?;
+            x.push(e);
+            y.push(n);
+        }
+        let line_ids = match flight.get("line") {
+            Some(_) => Some(LineLabels::of(flight, &[])?.ids),
+            None => None,
+        };
+        let lines = line_ids
+            .as_deref()
+            .and_then(|ids| LineGeometry::of(&x, &y, ids));
+        Ok(Self {
+            zone,
+            x,
+            y,
+            line_ids,
+            lines,
+        })
+    }
+
+    /// Whether row `k` is survey data: on a line when there are lines
+    /// (label ≠ 0), every row otherwise.
+    pub fn on_line(&self, k: usize) -> bool {
+        self.line_ids.as_ref().is_none_or(|ids| ids[k] != 0.0)
+    }
+}
+
+impl LineGeometry {
+    /// The geometry of the lines `ids` (per row, 0 = no line) through the
+    /// points `x`, `y`; `None` with fewer than two traverse lines.
+    pub fn of(x: &[f64], y: &[f64], ids: &[f64]) -> Option<Self> {
+        // Per line: sums for the centroid and the 2 × 2 covariance.
+        let mut acc: std::collections::BTreeMap<i64, [f64; 6]> = Default::default();
+        for k in 0..ids.len() {
+            if ids[k] == 0.0 || !(x[k].is_finite() && y[k].is_finite()) {
+                continue;
+            }
+            let a = acc.entry(ids[k] as i64).or_default();
+            a[0] += 1.0;
+            a[1] += x[k];
+            a[2] += y[k];
+            a[3] += x[k] * x[k];
+            a[4] += y[k] * y[k];
+            a[5] += x[k] * y[k];
+        }
+        // (id, centroid, axis angle θ from east (rad), length ~ 2√(3λ₁)).
+        let lines: Vec<(i64, [f64; 2], f64, f64)> = acc
+            .iter()
+            .filter(|(_, a)| a[0] >= 2.0)
+            .map(|(&id, a)| {
+                let n = a[0];
+                let (mx, my) = (a[1] / n, a[2] / n);
+                let sxx = a[3] / n - mx * mx;
+                let syy = a[4] / n - my * my;
+                let sxy = a[5] / n - mx * my;
+                let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+                let l1 = 0.5 * (sxx + syy) + (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+                (id, [mx, my], theta, (12.0 * l1.max(0.0)).sqrt())
+            })
+            .collect();
+        let (c, s) = lines.iter().fold((0.0, 0.0), |(c, s), l| {
+            (c + l.3 * (2.0 * l.2).cos(), s + l.3 * (2.0 * l.2).sin())
+        });
+        let theta = 0.5 * s.atan2(c);
+        let (ux, uy) = (theta.cos(), theta.sin());
+        let (mut offsets, mut traverse_ids) = (Vec::new(), Vec::new());
+        for l in &lines {
+            if (l.2 - theta).cos().abs() >= 30f64.to_radians().cos() {
+                offsets.push(-l.1[0] * uy + l.1[1] * ux);
+                traverse_ids.push(l.0);
+            }
+        }
+        if offsets.len() < 2 {
+            return None;
+        }
+        offsets.sort_by(f64::total_cmp);
+        let mut gaps: Vec<f64> = offsets.windows(2).map(|w| w[1] - w[0]).collect();
+        gaps.sort_by(f64::total_cmp);
+        let median = gaps[gaps.len() / 2];
+        let mut wide: Vec<f64> = gaps.into_iter().filter(|&g| g >= 0.1 * median).collect();
+        if wide.is_empty() {
+            return None;
+        }
+        wide.sort_by(f64::total_cmp);
+        let spacing = wide[wide.len() / 2];
+        let direction = (90.0 - theta.to_degrees()).rem_euclid(180.0);
+        (spacing > 0.0).then_some(Self {
+            direction_deg: direction,
+            spacing_m: spacing,
+            traverse_lines: offsets.len(),
+            other_lines: lines.len() - offsets.len(),
+            traverse_ids,
+        })
+    }
+
+    /// The default cell of a grid of these lines: a quarter of the line
+    /// spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m (a spacing measured
+    /// 2 % short of a round number, 499 m for 500, still gives 125 m).
+    pub fn default_cell_m(&self) -> f64 {
+        nice_below(self.spacing_m / 4.0 * 1.02)
+    }
+}
+
+/// The largest of 1, 2, 2.5, 5 × 10ᵏ not above `v` (> 0).
+pub fn nice_below(v: f64) -> f64 {
+    let p = 10f64.powf(v.log10().floor());
+    let m = v / p;
+    let step = [5.0, 2.5, 2.0, 1.0]
+        .into_iter()
+        .find(|&s| m >= s - 1e-9)
+        .unwrap_or(1.0);
+    step * p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spacing_and_direction_of_lines_with_ties_and_a_reflight() {
+        // Lines at 30° from north, 400 m apart; two ties across them; line
+        // 3 re-flown 15 m beside itself.
+        let (mut x, mut y, mut ids) = (vec![], vec![], vec![]);
+        let th = 30f64.to_radians();
+        let (along, across) = ((th.sin(), th.cos()), (th.cos(), -th.sin()));
+        let mut push = |id: f64, off: f64, dir: (f64, f64), nrm: (f64, f64)| {
+            for k in 0..200 {
+                let s = k as f64 * 25.0 - 2500.0;
+                x.push(s * dir.0 + off * nrm.0);
+                y.push(s * dir.1 + off * nrm.1);
+                ids.push(id);
+            }
+        };
+        for l in 0..10 {
+            push(l as f64 + 1.0, 400.0 * l as f64, along, across);
+        }
+        push(11.0, 3.0 * 400.0 + 15.0, along, across);
+        push(20.0, -1000.0, across, along);
+        push(21.0, 1500.0, across, along);
+        let g = LineGeometry::of(&x, &y, &ids).unwrap();
+        assert!((g.direction_deg - 30.0).abs() < 1e-6, "{g:?}");
+        assert!((g.spacing_m - 400.0).abs() < 1e-6, "{g:?}");
+        assert_eq!((g.traverse_lines, g.other_lines), (11, 2));
+        assert_eq!(g.default_cell_m(), 100.0);
+    }
+
+    #[test]
+    fn nice_cells() {
+        for (v, n) in [
+            (125.0, 100.0),
+            (62.5, 50.0),
+            (30.0, 25.0),
+            (24.0, 20.0),
+            (9.9, 5.0),
+            (1.0, 1.0),
+        ] {
+            assert_eq!(nice_below(v), n, "{v}");
+        }
+    }
+}

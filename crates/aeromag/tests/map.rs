@@ -1,0 +1,129 @@
+//! From lines to the map on simulated surveys: gridding honours the line
+//! data, micro-levelling removes line-to-line corrugation.
+
+use aeromag::Silent;
+use aeromag::flight::Flight;
+use aeromag::map::gridding::GridMethod;
+use aeromag::map::{GridOptions, MicrolevelOptions, grid_flight, microlevel};
+use aeromag::simulate::{ScenarioKind, simulate_flight};
+
+fn survey(pattern: &str, seed: u64) -> Flight {
+    simulate_flight(ScenarioKind::Survey, Some(pattern), Some(seed)).unwrap()
+}
+
+/// RMS of the grid sampled at the rows on lines minus the column there,
+/// over the column's standard deviation.
+fn misfit_at_data(flight: &Flight, g: &aeromag::map::SurveyGrid) -> f64 {
+    let v = flight.require(&g.column).unwrap();
+    let (mut e, mut n) = (0.0, 0usize);
+    for (k, vk) in v.iter().enumerate() {
+        if g.survey.on_line(k) {
+            let s = g.grid.sample(g.survey.x[k], g.survey.y[k]);
+            if s.is_finite() {
+                e += (s - vk).powi(2);
+                n += 1;
+            }
+        }
+    }
+    (e / n as f64).sqrt() / g.grid.stats().std
+}
+
+#[test]
+fn both_methods_honour_consistent_line_data() {
+    let flight = survey(
+        "[pattern]\nline_count = 10\nline_length_m = 5000.0\ntie_count = 3\n",
+        11,
+    );
+    for method in [GridMethod::MinCurvature, GridMethod::Bidirectional] {
+        let opts = GridOptions {
+            column: Some("true_anomaly".into()),
+            cell_m: Some(50.0),
+            method,
+            ..GridOptions::default()
+        };
+        let g = grid_flight(&flight, &opts, &mut Silent).unwrap();
+        let misfit = misfit_at_data(&flight, &g);
+        eprintln!(
+            "{method:?}: misfit at the data {misfit:.4} of the grid's std ({:.2} nT)",
+            g.grid.stats().std
+        );
+        assert!(misfit < 0.03, "{method:?}: {misfit}");
+        let lines = g.survey.lines.as_ref().unwrap();
+        assert_eq!((lines.traverse_lines, lines.other_lines), (10, 3));
+        assert!((lines.spacing_m - 500.0).abs() < 5.0);
+        // Blank beyond one line spacing from the lines only.
+        assert!(g.blanked_nodes < g.grid.geometry.len() / 4);
+    }
+}
+
+#[test]
+fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
+    let flight = survey(
+        "[pattern]\nline_count = 16\nline_length_m = 8000.0\ntie_count = 3\n",
+        12,
+    );
+    let (lat, lon, line) = (
+        flight.require("lat").unwrap().to_vec(),
+        flight.require("lon").unwrap().to_vec(),
+        flight.require("line").unwrap().to_vec(),
+    );
+    // A smooth regional field (wavelengths ≥ 10 km) and a level error per
+    // survey line (ties have none), alternating in sign with a random part.
+    let offset = |l: f64| {
+        if (1000.0..2000.0).contains(&l) {
+            let k = l - 1000.0;
+            2.0 * (if k as i64 % 2 == 0 { 1.0 } else { -1.0 }) + 1.5 * (k * 2.3).sin()
+        } else {
+            0.0
+        }
+    };
+    let smooth: Vec<f64> = lat
+        .iter()
+        .zip(&lon)
+        .map(|(la, lo)| 40.0 * ((la - 56.0) * 60.0).sin() + 25.0 * ((lo - 38.0) * 30.0).cos())
+        .collect();
+    let noisy: Vec<f64> = smooth
+        .iter()
+        .zip(&line)
+        .map(|(s, l)| s + offset(*l))
+        .collect();
+    let mut table = flight.into_table();
+    table.add_column("smooth", smooth.clone()).unwrap();
+    table.add_column("lev", noisy.clone()).unwrap();
+    let flight = Flight::from_table(table).unwrap();
+    let m = microlevel(
+        &flight,
+        &MicrolevelOptions {
+            column: Some("lev".into()),
+            ..MicrolevelOptions::default()
+        },
+        &mut Silent,
+    )
+    .unwrap();
+    // Per survey line, the mean error; the RMS of its line-to-line steps.
+    let steps = |v: &[f64]| {
+        let means: Vec<f64> = (1001..=1016)
+            .map(|l| {
+                let e: Vec<f64> = (0..v.len())
+                    .filter(|&k| line[k] == l as f64)
+                    .map(|k| v[k] - smooth[k])
+                    .collect();
+                e.iter().sum::<f64>() / e.len() as f64
+            })
+            .collect();
+        (means.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / 15.0).sqrt()
+    };
+    let (before, after) = (steps(&noisy), steps(&m.values));
+    eprintln!(
+        "line-to-line steps {before:.3} → {after:.3} nT; correction RMS {:.3} nT, largest {:.3}",
+        m.correction_rms_nt, m.correction_max_nt
+    );
+    assert!(after < before / 5.0, "{before} → {after}");
+    assert_eq!(m.output_column(), "lev_mlev");
+    // Off the lines nothing changes.
+    assert!(
+        (0..line.len())
+            .filter(|&k| line[k] == 0.0)
+            .all(|k| m.correction[k] == 0.0)
+    );
+}

@@ -1,0 +1,130 @@
+//! `aeromag grid`: a survey column on a grid by minimum curvature with
+//! tension, blanked away from the lines, written as GeoTIFF, ESRI ASCII
+//! or netCDF (library: [`aeromag::map::grid_flight`]).
+
+use crate::args;
+use crate::input::InputArgs;
+use crate::progress::Bars;
+use aeromag::grid::gridding::MinCurvature;
+use aeromag::grid::projection::UtmZone;
+use aeromag::map::gridding::GridMethod;
+use aeromag::map::{GridOptions, grid_flight};
+use std::path::PathBuf;
+
+/// Grid a levelled survey (or any column of it) and write the grid.
+///
+/// Latitude and longitude are projected to UTM (the zone of the data, or
+/// --utm-zone); rows on lines (line label ≠ 0) are gridded. Defaults
+/// follow the lines: the cell is a quarter of the line spacing, nodes
+/// farther than one line spacing from the data are blank.
+///
+/// Examples:
+///   aeromag grid -i levelled.csv --cell 50 --out mag.tif
+///   aeromag grid -i levelled.csv --column mag_comp --out comp.nc --tension 0.35
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output grid; the format follows the extension: `.tif` (GeoTIFF,
+    /// float32), `.asc` (ESRI ASCII grid, with a `.prj`) or `.nc` / `.grd`
+    /// (netCDF, COARDS, as GMT reads and writes it; not Surfer's or
+    /// Geosoft's binary .grd).
+    #[arg(long, value_name = "GRID")]
+    out: PathBuf,
+    /// Column to grid (default: the most processed magnetic column of the
+    /// file: mag_comp_level_mlev, mag_level_mlev, mag_comp_level,
+    /// mag_level, mag_comp, mag).
+    #[arg(long)]
+    column: Option<String>,
+    /// Cell size (node spacing), m (default: a quarter of the line
+    /// spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
+    #[arg(long, value_parser = args::positive)]
+    cell: Option<f64>,
+    /// Tension, 0 (minimum curvature) to 1 (harmonic).
+    #[arg(long, default_value_t = 0.25)]
+    tension: f64,
+    /// Gridding method.
+    #[arg(long, value_enum, default_value_t = GridMethod::MinCurvature)]
+    method: GridMethod,
+    /// Blank nodes farther than this from the data, m (default: the line
+    /// spacing).
+    #[arg(long, value_parser = args::positive)]
+    blanking: Option<f64>,
+    /// UTM zone, e.g. `37N`, `56S` or `EPSG:32637` (default: the zone of
+    /// the data's median longitude).
+    #[arg(long, value_name = "ZONE", value_parser = utm_zone)]
+    utm_zone: Option<UtmZone>,
+}
+
+fn utm_zone(s: &str) -> Result<UtmZone, String> {
+    UtmZone::parse(s).map_err(|e| e.to_string())
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    crate::output::check_files(std::iter::once(a.out.as_path()))?;
+    let flight = a.input.load()?;
+    let opts = GridOptions {
+        column: a.column.clone(),
+        cell_m: a.cell,
+        blanking_m: a.blanking,
+        zone: a.utm_zone,
+        method: a.method,
+        min_curvature: MinCurvature {
+            tension: a.tension,
+            ..MinCurvature::default()
+        },
+    };
+    let g = grid_flight(&flight, &opts, &mut Bars::new())?;
+    let format = g.write(&a.out)?;
+    let geo = &g.grid.geometry;
+    println!("gridded {} ({} rows on lines)", g.column, g.rows_used);
+    if let Some(l) = &g.survey.lines {
+        println!(
+            "lines: {} traverse lines at {:.1}° from grid north, spacing {:.1} m ({} other lines)",
+            l.traverse_lines, l.direction_deg, l.spacing_m, l.other_lines
+        );
+    }
+    println!(
+        "grid: {} × {} nodes, cell {} m, {} (EPSG:{}), x {:.1}–{:.1} m, y {:.1}–{:.1} m",
+        geo.nx,
+        geo.ny,
+        geo.cell,
+        g.grid.crs.map_or("no CRS".into(), |c| c.name()),
+        g.grid.crs.map_or(0, |c| c.epsg()),
+        geo.x0,
+        geo.x_max(),
+        geo.y0,
+        geo.y_max()
+    );
+    match (a.method, g.report.levels.last()) {
+        (GridMethod::MinCurvature, Some(last)) => println!(
+            "minimum curvature, tension {}: {} nodes hold data, {} sweeps on the final grid, {}",
+            opts.min_curvature.tension,
+            g.report.constrained_nodes,
+            last.iterations,
+            if g.report.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            }
+        ),
+        _ => println!(
+            "bi-directional: along the lines, then across them (Akima); {} nodes hold data",
+            g.report.constrained_nodes
+        ),
+    }
+    println!(
+        "blanking beyond {:.1} m: {} of {} nodes blank",
+        g.blanking_m,
+        g.blanked_nodes,
+        geo.len()
+    );
+    let s = g.grid.stats();
+    println!(
+        "values: mean {:.3}, std {:.3}, min {:.3}, max {:.3} {}",
+        s.mean, s.std, s.min, s.max, g.grid.unit
+    );
+    println!("wrote {} ({format:?})", a.out.display());
+    Ok(())
+}

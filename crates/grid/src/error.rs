@@ -1,0 +1,78 @@
+//! The crate's error type.
+
+use thiserror::Error;
+
+/// Errors of the gridding library (bad input or settings, a failed write;
+/// never a panic).
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum GridError {
+    /// A setting that must be positive and finite is not (cell size,
+    /// blanking distance, …).
+    #[error("{name} must be positive and finite, got {value}")]
+    NotPositive {
+        /// Name of the setting.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A setting outside its range.
+    #[error("{name} = {value} is out of range: {expected}")]
+    OutOfRange {
+        /// Name of the setting.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What is allowed.
+        expected: &'static str,
+    },
+    /// Input series of unequal lengths.
+    #[error("length mismatch: {what} has {got} values, expected {expected}")]
+    LengthMismatch {
+        /// What was measured.
+        what: &'static str,
+        /// Actual length.
+        got: usize,
+        /// Expected length.
+        expected: usize,
+    },
+    /// Too few usable (finite) points to grid, or a grid too large.
+    #[error("cannot grid: {0}")]
+    Data(String),
+    /// A coordinate that cannot be projected (latitude beyond ±84°/−80° of
+    /// UTM, NaN, a zone number outside 1–60).
+    #[error("projection: {0}")]
+    Projection(String),
+    /// A grid file format this crate does not write (the extension decides).
+    #[error("unknown grid format '{0}': use .tif, .asc, .nc or .grd")]
+    UnknownFormat(String),
+    /// Writing a grid file failed.
+    #[error("writing '{path}': {source}")]
+    Write {
+        /// The file.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl GridError {
+    /// Whether the caller's input caused the error (everything but a failed
+    /// write).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, GridError::Write { .. })
+    }
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, GridError>;
+
+/// `Ok(v)` when `v` is finite and > 0, else [`GridError::NotPositive`].
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(GridError::NotPositive { name, value })
+    }
+}

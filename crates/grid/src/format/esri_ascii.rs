@@ -1,0 +1,269 @@
+//! ESRI ASCII grid (`.asc`, "Arc/Info ASCII Grid") with a `.prj` sidecar.
+//!
+//! The header, one keyword and value a line:
+//!
+//! ```text
+//! ncols        5
+//! nrows        4
+//! xllcenter    500000
+//! yllcenter    6000050
+//! cellsize     50
+//! NODATA_value -99999
+//! ```
+//!
+//! `xllcenter`/`yllcenter` are the south-western NODE (node registration:
+//! the cells a GIS draws are centred on the nodes), then `nrows` lines of
+//! `ncols` values, from the NORTHERN row to the southern, west to east.
+//! Values are the shortest decimal that reads back to the same float32
+//! (at most 9 significant digits, exponent form only below 10⁻⁵ or from
+//! 10¹⁵ in magnitude): the same precision as the GeoTIFF and netCDF
+//! files. Blank nodes are [`NODATA`].
+//!
+//! When the grid's CRS is known, `<stem>.prj` holds its OGC WKT 1 on one
+//! line (GDAL and ArcGIS read both flavours); when it is not, an old
+//! `<stem>.prj` (describing the file being replaced) is removed.
+//!
+//! Reading accepts `xllcorner`/`yllcorner` too (the node then half a cell
+//! in), any order of header lines, keywords in any case and an absent
+//! `NODATA_value`.
+
+use std::fs;
+use std::io::{self, Write};
+use std::path::Path;
+
+use super::{
+    NODATA, check_grid, checked_geometry, crs_from_wkt, crs_wkt, read_error, stem, write_atomic,
+};
+use crate::error::Result;
+use crate::grid::{Grid, GridGeometry};
+
+/// Writes `grid` as an ESRI ASCII grid to `path` and, when its CRS is
+/// known, the WKT to `path` with extension `.prj` (both atomically). Errors
+/// as [`write_grid`](super::write_grid).
+pub fn write(path: &Path, grid: &Grid) -> Result<()> {
+    check_grid(grid)?;
+    write_atomic(path, |w| write_asc(w, grid))?;
+    let prj = path.with_extension("prj");
+    match &grid.crs {
+        Some(crs) => {
+            let wkt = crs_wkt(crs);
+            write_atomic(&prj, |w| writeln!(w, "{wkt}"))?;
+        }
+        None => {
+            if prj.is_file() {
+                fs::remove_file(&prj).map_err(|source| crate::GridError::Write {
+                    path: prj.display().to_string(),
+                    source,
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn write_asc(w: &mut impl Write, grid: &Grid) -> io::Result<()> {
+    let g = &grid.geometry;
+    writeln!(w, "ncols        {}", g.nx)?;
+    writeln!(w, "nrows        {}", g.ny)?;
+    writeln!(w, "xllcenter    {}", g.x0)?;
+    writeln!(w, "yllcenter    {}", g.y0)?;
+    writeln!(w, "cellsize     {}", g.cell)?;
+    writeln!(w, "NODATA_value {NODATA}")?;
+    let mut line = String::new();
+    for j in (0..g.ny).rev() {
+        line.clear();
+        for i in 0..g.nx {
+            if i > 0 {
+                line.push(' ');
+            }
+            push_f32(&mut line, grid.values[g.index(i, j)]);
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Appends the shortest decimal of `v` as float32 (NaN as [`NODATA`]).
+fn push_f32(s: &mut String, v: f64) {
+    use std::fmt::Write as _;
+    let v = if v.is_nan() { NODATA as f32 } else { v as f32 };
+    let a = v.abs();
+    // Display never uses an exponent: keep it for the tiny and the huge.
+    let _ = if a == 0.0 || (1e-5..1e15).contains(&a) || a.is_infinite() {
+        write!(s, "{v}")
+    } else {
+        write!(s, "{v:e}")
+    };
+}
+
+/// Reads an ESRI ASCII grid and its `.prj` sidecar, if any. The name is the
+/// file stem and the unit empty (the format carries neither).
+pub fn read(path: &Path) -> Result<Grid> {
+    let text = fs::read_to_string(path).map_err(|e| read_error(path, e))?;
+    let mut tokens = text.split_ascii_whitespace().peekable();
+    let (mut nx, mut ny, mut x, mut y, mut cell, mut nodata) = (None, None, None, None, None, None);
+    let mut corner = (false, false);
+    while let Some(key) = tokens.peek() {
+        // The header ends at the first number.
+        if key.parse::<f64>().is_ok() {
+            break;
+        }
+        let key = tokens.next().unwrap().to_ascii_lowercase();
+        let value = tokens
+            .next()
+            .ok_or_else(|| read_error(path, format!("no value after '{key}'")))?;
+        let number = || -> Result<f64> {
+            value
+                .parse::<f64>()
+                .map_err(|_| read_error(path, format!("'{key}' is not a number: {value}")))
+        };
+        let count = || -> Result<usize> {
+            value
+                .parse::<usize>()
+                .map_err(|_| read_error(path, format!("'{key}' is not a count: {value}")))
+        };
+        match key.as_str() {
+            "ncols" => nx = Some(count()?),
+            "nrows" => ny = Some(count()?),
+            "xllcenter" => x = Some(number()?),
+            "yllcenter" => y = Some(number()?),
+            "xllcorner" => {
+                x = Some(number()?);
+                corner.0 = true;
+            }
+            "yllcorner" => {
+                y = Some(number()?);
+                corner.1 = true;
+            }
+            "cellsize" => cell = Some(number()?),
+            "nodata_value" => nodata = Some(number()?),
+            _ => return Err(read_error(path, format!("unknown header keyword '{key}'"))),
+        }
+    }
+    let missing = |k: &str| read_error(path, format!("no '{k}' in the header"));
+    let cell = cell.ok_or_else(|| missing("cellsize"))?;
+    let half = |c: bool| if c { cell / 2.0 } else { 0.0 };
+    let geometry = checked_geometry(
+        path,
+        GridGeometry {
+            x0: x.ok_or_else(|| missing("xllcenter"))? + half(corner.0),
+            y0: y.ok_or_else(|| missing("yllcenter"))? + half(corner.1),
+            cell,
+            nx: nx.ok_or_else(|| missing("ncols"))?,
+            ny: ny.ok_or_else(|| missing("nrows"))?,
+        },
+    )?;
+    let mut grid = Grid::blank(geometry, &stem(path), "");
+    for j in (0..geometry.ny).rev() {
+        for i in 0..geometry.nx {
+            let token = tokens.next().ok_or_else(|| {
+                read_error(
+                    path,
+                    format!(
+                        "{} values, expected {}",
+                        (geometry.ny - 1 - j) * geometry.nx + i,
+                        geometry.len()
+                    ),
+                )
+            })?;
+            let v: f64 = token
+                .parse()
+                .map_err(|_| read_error(path, format!("'{token}' is not a number")))?;
+            grid.values[geometry.index(i, j)] = if Some(v) == nodata { f64::NAN } else { v };
+        }
+    }
+    if tokens.next().is_some() {
+        return Err(read_error(
+            path,
+            format!("more than {} values", geometry.len()),
+        ));
+    }
+    let prj = path.with_extension("prj");
+    if prj.is_file() {
+        let wkt = fs::read_to_string(&prj).map_err(|e| read_error(&prj, e))?;
+        grid.crs = crs_from_wkt(wkt.trim());
+    }
+    Ok(grid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{GridFormat, read_grid, write_grid};
+    use super::*;
+
+    #[test]
+    fn esri_ascii_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("tmi.asc");
+        let grid = sample_grid();
+        assert_eq!(write_grid(&path, &grid).unwrap(), GridFormat::EsriAscii);
+        let back = read_grid(&path).unwrap();
+        assert_same_grid(&grid, &back);
+        assert_eq!(back.name, "tmi");
+        let text = fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines[..6],
+            [
+                "ncols        5",
+                "nrows        4",
+                "xllcenter    500000",
+                "yllcenter    6000050",
+                "cellsize     50",
+                "NODATA_value -99999"
+            ]
+        );
+        // North row first; all float32 digits; blanks as NODATA.
+        assert_eq!(lines[6], "3000.1235 3001.1235 3002.1235 3003.1235 -99999");
+        assert_eq!(
+            lines[7],
+            "2000.1234 2001.1234 -51234.566 2003.1234 2004.1234"
+        );
+        assert_eq!(lines[9], "0.12345679 -99999 2.1234567 3.1234567 4.123457");
+        assert_eq!(lines.len(), 10);
+        let prj = fs::read_to_string(dir.path().join("tmi.prj")).unwrap();
+        assert!(prj.starts_with("PROJCS[\"WGS 84 / UTM zone 37N\""));
+        assert_eq!(entries(dir.path()), ["tmi.asc", "tmi.prj"]);
+
+        // Without a CRS: no .prj (the old one goes with the old grid).
+        let mut plain = grid.clone();
+        plain.crs = None;
+        write_grid(&path, &plain).unwrap();
+        assert_eq!(entries(dir.path()), ["tmi.asc"]);
+        assert_same_grid(&plain, &read_grid(&path).unwrap());
+    }
+
+    #[test]
+    fn esri_ascii_reads_corner_headers_and_extreme_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.asc");
+        fs::write(
+            &path,
+            "NCOLS 2\nNROWS 2\nXLLCORNER 100\nYLLCORNER 200\nCELLSIZE 10\n1e-30 -3.5e20\n0 7\n",
+        )
+        .unwrap();
+        let g = read(&path).unwrap();
+        assert_eq!(
+            (g.geometry.x0, g.geometry.y0, g.geometry.cell),
+            (105.0, 205.0, 10.0)
+        );
+        assert_eq!(g.values, [0.0, 7.0, 1e-30, -3.5e20]);
+        assert_eq!(g.crs, None);
+        let mut s = String::new();
+        for v in [1e-30, -3.5e20, 0.0, 1e-5, 123456.78] {
+            push_f32(&mut s, v);
+            s.push(' ');
+        }
+        assert_eq!(s, "1e-30 -3.5e20 0 0.00001 123456.78 ");
+        fs::write(
+            &path,
+            "ncols 2\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n1 2 3\n",
+        )
+        .unwrap();
+        assert!(read(&path).is_err());
+        fs::write(&path, "ncols 2\nnrows 1\nxllcenter 0\ncellsize 1\n1 2\n").unwrap();
+        assert!(read(&path).unwrap_err().to_string().contains("yllcenter"));
+    }
+}

@@ -1,0 +1,460 @@
+//! GeoTIFF: one float32 band, uncompressed strips, rows from the NORTH
+//! row to the southern, west to east (TIFF 6.0 and OGC GeoTIFF 1.1,
+//! written with the `tiff` crate; the GeoTIFF tags are ours).
+//!
+//! Georeferencing, **PixelIsArea** (`GTRasterTypeGeoKey` = 1): each pixel
+//! is the cell of side `cell` centred on its node, so the tie point
+//! raster (0, 0) — the north-western corner of the north-western pixel —
+//! is the model point `(x0 − cell/2, y_max + cell/2)`, half a cell out of
+//! the north-western node. Every GeoTIFF reader (also those that ignore the
+//! raster type) then puts pixel centres on the nodes, and GDAL reports the
+//! geotransform `[x0 − cell/2, cell, 0, y_max + cell/2, 0, −cell]` with
+//! `AREA_OR_POINT=Area`.
+//!
+//! | tag | value |
+//! | --- | --- |
+//! | ModelPixelScaleTag (33550) | `cell, cell, 0` |
+//! | ModelTiepointTag (33922) | `0, 0, 0, x0 − cell/2, y_max + cell/2, 0` |
+//! | GeoKeyDirectoryTag (34735) | version 1.1.0 and the keys below |
+//! | GeoAsciiParamsTag (34737) | the citation, `|`-terminated |
+//! | GDAL_METADATA (42112) | band description (grid name) and unit type (unit) |
+//! | GDAL_NODATA (42113) | `-99999` ([`NODATA`]: blank nodes) |
+//!
+//! GeoKeys: `GTModelTypeGeoKey` (1024) = 1 (projected), `GTRasterTypeGeoKey`
+//! (1025) = 1 (PixelIsArea), `GTCitationGeoKey` (1026) = the CRS name
+//! (e.g. `WGS 84 / UTM zone 37N`), `ProjectedCSTypeGeoKey` (3072) = the
+//! EPSG code, `ProjLinearUnitsGeoKey` (3076) = 9001 (metre). Without a CRS
+//! the file has no `ProjectedCSTypeGeoKey` (a user-defined projected
+//! system in metres) and the citation says so.
+//!
+//! Reading ([`read`]) accepts a single-band north-up GeoTIFF of square
+//! pixels with a tie point and a pixel scale, of either raster type (a
+//! PixelIsPoint tie point is a node), of any sample type.
+
+use std::fs::File;
+use std::io::{self, BufReader, Seek, Write};
+use std::path::Path;
+
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
+use tiff::tags::Tag;
+use tiff::{ColorType, TiffError};
+
+use super::{NODATA, check_grid, checked_geometry, crs_from_epsg, read_error, stem, write_atomic};
+use crate::error::Result;
+use crate::grid::{Grid, GridGeometry};
+
+/// GeoKey ids (OGC GeoTIFF 1.1, annex).
+mod key {
+    pub const MODEL_TYPE: u16 = 1024;
+    pub const RASTER_TYPE: u16 = 1025;
+    pub const CITATION: u16 = 1026;
+    pub const PROJECTED_CRS: u16 = 3072;
+    pub const PROJ_LINEAR_UNITS: u16 = 3076;
+    /// `ModelTypeProjected`.
+    pub const PROJECTED: u16 = 1;
+    /// `RasterPixelIsArea`.
+    pub const PIXEL_IS_AREA: u16 = 1;
+    /// `RasterPixelIsPoint`.
+    pub const PIXEL_IS_POINT: u16 = 2;
+    /// `Linear_Meter`.
+    pub const METRE: u16 = 9001;
+}
+
+/// The `GDAL_METADATA` tag (XML), not named by the `tiff` crate.
+const GDAL_METADATA: Tag = Tag::Unknown(42112);
+
+/// Writes `grid` as a GeoTIFF to `path`, atomically (module docs for the
+/// layout). Errors as
+/// [`write_grid`](super::write_grid).
+pub fn write(path: &Path, grid: &Grid) -> Result<()> {
+    check_grid(grid)?;
+    write_atomic(path, |w| encode(w, grid).map_err(tiff_to_io))
+}
+
+fn tiff_to_io(e: TiffError) -> io::Error {
+    match e {
+        TiffError::IoError(e) => e,
+        e => io::Error::other(e.to_string()),
+    }
+}
+
+/// The GeoKey directory and the GeoAsciiParams of `grid`.
+fn geokeys(grid: &Grid) -> (Vec<u16>, String) {
+    let citation = match &grid.crs {
+        Some(crs) => crs.name(),
+        None => "unknown projected coordinate system (metre)".to_string(),
+    };
+    let ascii = format!("{}|", citation.replace('|', "/"));
+    let mut keys: Vec<[u16; 4]> = vec![
+        [key::MODEL_TYPE, 0, 1, key::PROJECTED],
+        [key::RASTER_TYPE, 0, 1, key::PIXEL_IS_AREA],
+        [
+            key::CITATION,
+            Tag::GeoAsciiParamsTag.to_u16(),
+            ascii.len() as u16,
+            0,
+        ],
+    ];
+    if let Some(crs) = &grid.crs {
+        keys.push([key::PROJECTED_CRS, 0, 1, crs.epsg()]);
+    }
+    keys.push([key::PROJ_LINEAR_UNITS, 0, 1, key::METRE]);
+    let mut dir = vec![1, 1, 0, keys.len() as u16];
+    dir.extend(keys.iter().flatten());
+    (dir, ascii)
+}
+
+/// Escapes text for XML, non-ASCII as character references (the TIFF
+/// ASCII type is 7-bit).
+fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c if c.is_ascii() && !c.is_ascii_control() => out.push(c),
+            c => out.push_str(&format!("&#{};", c as u32)),
+        }
+    }
+    out
+}
+
+fn xml_unescape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(p) = rest.find('&') {
+        out.push_str(&rest[..p]);
+        rest = &rest[p..];
+        let Some(end) = rest.find(';') else { break };
+        let entity = &rest[1..end];
+        let c = match entity {
+            "amp" => Some('&'),
+            "lt" => Some('<'),
+            "gt" => Some('>'),
+            "quot" => Some('"'),
+            "apos" => Some('\''),
+            _ => entity
+                .strip_prefix("#x")
+                .and_then(|h| u32::from_str_radix(h, 16).ok())
+                .or_else(|| entity.strip_prefix('#').and_then(|d| d.parse().ok()))
+                .and_then(char::from_u32),
+        };
+        match c {
+            Some(c) => {
+                out.push(c);
+                rest = &rest[end + 1..];
+            }
+            None => {
+                out.push('&');
+                rest = &rest[1..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+fn encode<W: Write + Seek>(w: &mut W, grid: &Grid) -> std::result::Result<(), TiffError> {
+    let g = &grid.geometry;
+    let (nx, ny) = (
+        u32::try_from(g.nx).map_err(|_| TiffError::IntSizeError)?,
+        u32::try_from(g.ny).map_err(|_| TiffError::IntSizeError)?,
+    );
+    let mut tiff = TiffEncoder::new(w)?;
+    let mut image = tiff.new_image::<Gray32Float>(nx, ny)?;
+    let half = g.cell / 2.0;
+    let (geokeys, ascii) = geokeys(grid);
+    let metadata = format!(
+        concat!(
+            "<GDALMetadata>\n",
+            "  <Item name=\"DESCRIPTION\" sample=\"0\" role=\"description\">{}</Item>\n",
+            "  <Item name=\"UNITTYPE\" sample=\"0\" role=\"unittype\">{}</Item>\n",
+            "</GDALMetadata>"
+        ),
+        xml_escape(&grid.name),
+        xml_escape(&grid.unit)
+    );
+    let dir = image.encoder();
+    dir.write_tag(Tag::ModelPixelScaleTag, &[g.cell, g.cell, 0.0][..])?;
+    dir.write_tag(
+        Tag::ModelTiepointTag,
+        &[0.0, 0.0, 0.0, g.x0 - half, g.y_max() + half, 0.0][..],
+    )?;
+    dir.write_tag(Tag::GeoKeyDirectoryTag, &geokeys[..])?;
+    dir.write_tag(Tag::GeoAsciiParamsTag, ascii.as_str())?;
+    dir.write_tag(GDAL_METADATA, metadata.as_str())?;
+    dir.write_tag(Tag::GdalNodata, format!("{NODATA}").as_str())?;
+    // Strip by strip, from the northern row.
+    let nodata = NODATA as f32;
+    let mut row = g.ny;
+    let mut strip = Vec::new();
+    while row > 0 {
+        let rows = (image.next_strip_sample_count() as usize / g.nx).min(row);
+        strip.clear();
+        for j in (row - rows..row).rev() {
+            let values = &grid.values[g.index(0, j)..g.index(0, j) + g.nx];
+            strip.extend(
+                values
+                    .iter()
+                    .map(|&v| if v.is_nan() { nodata } else { v as f32 }),
+            );
+        }
+        image.write_strip(&strip)?;
+        row -= rows;
+    }
+    image.finish()
+}
+
+/// Reads a GeoTIFF (module docs for what is accepted). The name and unit
+/// come from `GDAL_METADATA` (else the file stem and no unit), the CRS
+/// from `ProjectedCSTypeGeoKey` when it is a WGS 84 / UTM code.
+pub fn read(path: &Path) -> Result<Grid> {
+    let file = File::open(path).map_err(|e| read_error(path, e))?;
+    let err = |e: TiffError| read_error(path, e);
+    let mut dec = Decoder::new(BufReader::new(file))
+        .map_err(err)?
+        .with_limits(Limits::unlimited());
+    let (nx, ny) = dec.dimensions().map_err(err)?;
+    if !matches!(dec.colortype().map_err(err)?, ColorType::Gray(_)) {
+        return Err(read_error(path, "not a single-band image"));
+    }
+    let scale = dec.get_tag_f64_vec(Tag::ModelPixelScaleTag).map_err(err)?;
+    let tie = dec.get_tag_f64_vec(Tag::ModelTiepointTag).map_err(err)?;
+    if scale.len() < 2 || tie.len() < 6 {
+        return Err(read_error(path, "no pixel scale or tie point"));
+    }
+    let (sx, sy) = (scale[0], scale[1]);
+    if (sx - sy).abs() > 1e-9 * sx.abs() {
+        return Err(read_error(
+            path,
+            format!("pixels of {sx} × {sy}: not square"),
+        ));
+    }
+    let keys = match dec.find_tag(Tag::GeoKeyDirectoryTag).map_err(err)? {
+        Some(v) => v.into_u16_vec().map_err(err)?,
+        None => vec![],
+    };
+    let geokey = |id: u16| {
+        keys.get(4..)
+            .unwrap_or_default()
+            .chunks_exact(4)
+            .find(|k| k[0] == id && k[1] == 0)
+            .map(|k| k[3])
+    };
+    let point = geokey(key::RASTER_TYPE) == Some(key::PIXEL_IS_POINT);
+    // The node of pixel (0, 0): the tie point's pixel (i, j) at (x, y).
+    let shift = if point { 0.0 } else { 0.5 };
+    let x0 = tie[3] + (shift - tie[0]) * sx;
+    let y_north = tie[4] - (shift - tie[1]) * sy;
+    let geometry = checked_geometry(
+        path,
+        GridGeometry {
+            x0,
+            y0: y_north - (ny as f64 - 1.0) * sy,
+            cell: sx,
+            nx: nx as usize,
+            ny: ny as usize,
+        },
+    )?;
+    let nodata: Option<f64> = dec
+        .find_tag(Tag::GdalNodata)
+        .map_err(err)?
+        .and_then(|v| v.into_string().ok())
+        .and_then(|s| {
+            s.trim_matches(|c: char| c == '\0' || c.is_whitespace())
+                .parse()
+                .ok()
+        });
+    let metadata = dec
+        .find_tag(GDAL_METADATA)
+        .map_err(err)?
+        .and_then(|v| v.into_string().ok())
+        .unwrap_or_default();
+    let item = |role: &str| {
+        let open = format!("role=\"{role}\">");
+        let start = metadata.find(&open)? + open.len();
+        let end = metadata[start..].find('<')?;
+        Some(xml_unescape(&metadata[start..start + end]))
+    };
+    let values: Vec<f64> = match dec.read_image().map_err(err)? {
+        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::F64(v) => v,
+        DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I8(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I16(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::I32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::U64(v) => v.into_iter().map(|x| x as f64).collect(),
+        DecodingResult::I64(v) => v.into_iter().map(|x| x as f64).collect(),
+        DecodingResult::F16(v) => v.into_iter().map(f64::from).collect(),
+    };
+    if values.len() != geometry.len() {
+        return Err(read_error(
+            path,
+            format!("{} samples for {} × {} pixels", values.len(), nx, ny),
+        ));
+    }
+    let mut grid = Grid::blank(
+        geometry,
+        &item("description").unwrap_or_else(|| stem(path)),
+        "",
+    );
+    grid.unit = item("unittype").unwrap_or_default();
+    // Nodata compared as the file's float32 (GDAL's rule for Float32).
+    let blank = |v: f64| Some(v) == nodata || nodata.is_some_and(|n| v as f32 == n as f32);
+    for (r, row) in values.chunks_exact(geometry.nx).enumerate() {
+        let j = geometry.ny - 1 - r;
+        for (i, &v) in row.iter().enumerate() {
+            grid.values[geometry.index(i, j)] = if blank(v) { f64::NAN } else { v };
+        }
+    }
+    grid.crs = geokey(key::PROJECTED_CRS).and_then(|c| crs_from_epsg(c.into()));
+    Ok(grid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{GridFormat, read_grid, write_grid};
+    use super::*;
+
+    #[test]
+    fn geotiff_tags_decode_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.tif");
+        let grid = sample_grid();
+        assert_eq!(write_grid(&path, &grid).unwrap(), GridFormat::GeoTiff);
+        let mut dec = Decoder::new(BufReader::new(File::open(&path).unwrap())).unwrap();
+        assert_eq!(dec.dimensions().unwrap(), (5, 4));
+        assert_eq!(dec.colortype().unwrap(), ColorType::Gray(32));
+        assert_eq!(dec.get_tag_u16_vec(Tag::SampleFormat).unwrap(), [3]); // IEEE float
+        assert_eq!(
+            dec.get_tag_f64_vec(Tag::ModelPixelScaleTag).unwrap(),
+            [50.0, 50.0, 0.0]
+        );
+        // PixelIsArea: the corner half a cell north-west of the NW node.
+        assert_eq!(
+            dec.get_tag_f64_vec(Tag::ModelTiepointTag).unwrap(),
+            [0.0, 0.0, 0.0, 499_975.0, 6_000_225.0, 0.0]
+        );
+        let keys = dec.get_tag_u16_vec(Tag::GeoKeyDirectoryTag).unwrap();
+        let citation = "WGS 84 / UTM zone 37N|";
+        assert_eq!(
+            keys,
+            [
+                1,
+                1,
+                0,
+                5, //
+                1024,
+                0,
+                1,
+                1, // projected
+                1025,
+                0,
+                1,
+                1, // PixelIsArea
+                1026,
+                34737,
+                citation.len() as u16,
+                0, // citation
+                3072,
+                0,
+                1,
+                32637, // EPSG
+                3076,
+                0,
+                1,
+                9001, // metre
+            ]
+        );
+        let ascii = dec
+            .get_tag(Tag::GeoAsciiParamsTag)
+            .unwrap()
+            .into_string()
+            .unwrap();
+        assert_eq!(ascii, citation);
+        let nodata = dec.get_tag(Tag::GdalNodata).unwrap().into_string().unwrap();
+        assert_eq!(nodata, "-99999");
+        let meta = dec.get_tag(GDAL_METADATA).unwrap().into_string().unwrap();
+        assert!(meta.contains("role=\"unittype\">nT</Item>"), "{meta}");
+        let DecodingResult::F32(v) = dec.read_image().unwrap() else {
+            panic!("not float32")
+        };
+        // The first row is the northern one (j = 3), its last node blank.
+        assert_eq!(
+            v[..5],
+            [3000.1235, 3001.1235, 3002.1235, 3003.1235, -99999.0]
+        );
+        // The last row is the southern one (j = 0), node 1 blank.
+        assert_eq!(
+            v[15..],
+            [0.12345679, -99999.0, 2.1234567, 3.1234567, 4.123457]
+        );
+
+        assert_same_grid(&grid, &read_grid(&path).unwrap());
+        let back = read(&path).unwrap();
+        assert_eq!(
+            (back.name.as_str(), back.unit.as_str()),
+            ("magnetic anomaly", "nT")
+        );
+    }
+
+    #[test]
+    fn geotiff_without_crs_is_user_defined() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.tiff");
+        let mut grid = sample_grid();
+        grid.crs = None;
+        grid.name = "B<&>é".into();
+        write_grid(&path, &grid).unwrap();
+        let mut dec = Decoder::new(BufReader::new(File::open(&path).unwrap())).unwrap();
+        let keys = dec.get_tag_u16_vec(Tag::GeoKeyDirectoryTag).unwrap();
+        assert_eq!(keys[3], 4);
+        assert!(!keys.chunks_exact(4).skip(1).any(|k| k[0] == 3072));
+        assert!(
+            keys.chunks_exact(4)
+                .skip(1)
+                .any(|k| k == [3076, 0, 1, 9001])
+        );
+        let back = read(&path).unwrap();
+        assert_same_grid(&grid, &back);
+        assert_eq!(back.name, grid.name);
+    }
+
+    #[test]
+    fn geotiff_of_many_strips_keeps_the_row_order() {
+        // 300 × 900 float32 rows of 1200 bytes: strips of 834 rows, so the
+        // last strip is short.
+        let geometry = GridGeometry {
+            x0: 0.0,
+            y0: 0.0,
+            cell: 1.0,
+            nx: 300,
+            ny: 900,
+        };
+        let mut grid = Grid::blank(geometry, "z", "");
+        for (k, v) in grid.values.iter_mut().enumerate() {
+            *v = k as f64;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.tif");
+        write_grid(&path, &grid).unwrap();
+        let back = read_grid(&path).unwrap();
+        assert_eq!(back.values, grid.values);
+        assert_eq!(back.geometry, geometry);
+        assert_eq!(back.crs, None);
+    }
+
+    #[test]
+    fn xml_escapes_round_trip() {
+        let s = "a<b>&\"c\" é ∂";
+        assert_eq!(xml_unescape(&xml_escape(s)), s);
+        assert!(xml_escape(s).is_ascii());
+        assert_eq!(xml_unescape("&#x41;&bogus;&"), "A&bogus;&");
+    }
+}

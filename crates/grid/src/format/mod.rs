@@ -1,0 +1,554 @@
+//! Grid files a GIS, GMT and Geosoft open: GeoTIFF, ESRI ASCII grid and
+//! netCDF (COARDS/CF, as GMT writes it), written and read back without any
+//! C library.
+//!
+//! The extension picks the format ([`GridFormat::from_path`], case
+//! insensitive):
+//!
+//! | extension | format | module |
+//! | --- | --- | --- |
+//! | `.tif`, `.tiff` | GeoTIFF, one float32 band, rows north to south | [`geotiff`] |
+//! | `.asc` | ESRI ASCII grid (+ `.prj` sidecar with the WKT) | [`esri_ascii`] |
+//! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration | [`netcdf`] |
+//!
+//! (`.grd` is GMT's netCDF grid, not Geosoft's binary `.grd`.)
+//!
+//! Every format keeps the node registration of [`Grid`]: the values are
+//! those of the nodes, and a reader that thinks in cells (GDAL, a GIS) sees
+//! cells of side `cell` centred on the nodes, so its extent is half a cell
+//! wider than the nodes' on each side and its origin (upper-left corner) is
+//! `(x0 − cell/2, y_max + cell/2)`.
+//!
+//! Values are stored as float32 in all three formats (the ESRI ASCII text
+//! holds the shortest decimal of the float32): relative precision 6·10⁻⁸,
+//! i.e. 0.004 nT at 50 000 nT. Blank (NaN) nodes are [`NODATA`] in the
+//! GeoTIFF and ESRI ASCII files and NaN (`_FillValue`) in netCDF.
+//!
+//! [`write_grid`] writes atomically: a temporary file in the destination
+//! folder, flushed to disk, then renamed over the destination, so a reader
+//! never sees half a file and a failed write leaves the old file as it was.
+
+pub mod esri_ascii;
+pub mod geotiff;
+pub mod netcdf;
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{GridError, Result};
+use crate::grid::{Grid, GridGeometry, MAX_NODES};
+use crate::projection::{Crs, UtmZone};
+
+/// The value blank nodes take in the GeoTIFF (`GDAL_NODATA` tag) and ESRI
+/// ASCII (`NODATA_value`) files: −99999, exact in float32 and far outside
+/// any magnetic field or gradient value. (A node whose value is exactly
+/// −99999 would read back as blank.)
+pub const NODATA: f64 = -99999.0;
+
+/// A grid file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum GridFormat {
+    /// GeoTIFF, float32, one band ([`geotiff`]).
+    GeoTiff,
+    /// ESRI ASCII grid with a `.prj` sidecar ([`esri_ascii`]).
+    EsriAscii,
+    /// netCDF classic, COARDS/CF as GMT reads it ([`netcdf`]).
+    NetCdf,
+}
+
+impl GridFormat {
+    /// The format of a file by its extension: `.tif`/`.tiff` GeoTIFF,
+    /// `.asc` ESRI ASCII, `.nc`/`.grd` netCDF (case insensitive); anything
+    /// else is [`GridError::UnknownFormat`].
+    pub fn from_path(path: &Path) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        match ext.as_str() {
+            "tif" | "tiff" => Ok(GridFormat::GeoTiff),
+            "asc" => Ok(GridFormat::EsriAscii),
+            "nc" | "grd" => Ok(GridFormat::NetCdf),
+            _ => Err(GridError::UnknownFormat(path.display().to_string())),
+        }
+    }
+
+    /// The usual extension, without the dot (`tif`, `asc`, `nc`).
+    pub fn extension(&self) -> &'static str {
+        match self {
+            GridFormat::GeoTiff => "tif",
+            GridFormat::EsriAscii => "asc",
+            GridFormat::NetCdf => "nc",
+        }
+    }
+
+    /// Writes `grid` to `path` in this format, atomically (module docs),
+    /// whatever the extension of `path`.
+    pub fn write(&self, path: &Path, grid: &Grid) -> Result<()> {
+        match self {
+            GridFormat::GeoTiff => geotiff::write(path, grid),
+            GridFormat::EsriAscii => esri_ascii::write(path, grid),
+            GridFormat::NetCdf => netcdf::write(path, grid),
+        }
+    }
+
+    /// Reads a grid of this format from `path`.
+    pub fn read(&self, path: &Path) -> Result<Grid> {
+        match self {
+            GridFormat::GeoTiff => geotiff::read(path),
+            GridFormat::EsriAscii => esri_ascii::read(path),
+            GridFormat::NetCdf => netcdf::read(path),
+        }
+    }
+}
+
+/// Writes `grid` to `path` in the format its extension names
+/// ([`GridFormat::from_path`]), atomically (module docs). Returns the
+/// format written.
+///
+/// Errors: [`GridError::UnknownFormat`] for another extension,
+/// [`GridError::LengthMismatch`] / [`GridError::Data`] for a grid whose
+/// values do not match its geometry or that has no node,
+/// [`GridError::Write`] when the file cannot be written (a missing folder,
+/// no permission, a full disk).
+pub fn write_grid(path: &Path, grid: &Grid) -> Result<GridFormat> {
+    let format = GridFormat::from_path(path)?;
+    format.write(path, grid)?;
+    Ok(format)
+}
+
+/// Reads a grid file written by [`write_grid`] (or a compatible one: any
+/// ESRI ASCII grid, a netCDF classic grid with 1-D `x`/`y` coordinates and
+/// square cells, a single-band north-up GeoTIFF with square pixels), the
+/// format chosen by the extension.
+///
+/// Errors: [`GridError::UnknownFormat`] for another extension,
+/// [`GridError::Data`] for a file that cannot be read or parsed (the
+/// message names the file).
+pub fn read_grid(path: &Path) -> Result<Grid> {
+    GridFormat::from_path(path)?.read(path)
+}
+
+/// Checks that a grid can be written: values match the geometry, at least
+/// one node, finite origin and positive cell.
+pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
+    let g = &grid.geometry;
+    if grid.values.len() != g.len() {
+        return Err(GridError::LengthMismatch {
+            what: "grid values",
+            got: grid.values.len(),
+            expected: g.len(),
+        });
+    }
+    crate::error::positive("cell size", g.cell)?;
+    if g.is_empty() || !(g.x0.is_finite() && g.y0.is_finite()) {
+        return Err(GridError::Data(format!(
+            "cannot write a grid of {} × {} nodes with origin ({}, {})",
+            g.nx, g.ny, g.x0, g.y0
+        )));
+    }
+    if g.nx > i32::MAX as usize || g.ny > i32::MAX as usize {
+        return Err(GridError::Data(format!(
+            "{} × {} nodes is too many for a grid file",
+            g.nx, g.ny
+        )));
+    }
+    Ok(())
+}
+
+/// Writes a file atomically: `fill` writes into a temporary file created in
+/// the folder of `path` (`.<name>.<pid>.<n>.tmp`), which is then flushed,
+/// synced and renamed to `path`. On any error the temporary file is
+/// removed and the error is [`GridError::Write`] naming `path`.
+pub(crate) fn write_atomic(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
+) -> Result<()> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let write_error = |source| GridError::Write {
+        path: path.display().to_string(),
+        source,
+    };
+    let name = path.file_name().ok_or_else(|| {
+        write_error(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a file name",
+        ))
+    })?;
+    let tmp: PathBuf = path.with_file_name(format!(
+        ".{}.{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let file = OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&tmp)
+        .map_err(write_error)?;
+    let result = (|| {
+        let mut w = BufWriter::with_capacity(1 << 16, file);
+        fill(&mut w)?;
+        w.flush()?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        drop(file);
+        fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(write_error(e));
+    }
+    Ok(())
+}
+
+/// The error of a file that cannot be read or parsed.
+pub(crate) fn read_error(path: &Path, what: impl std::fmt::Display) -> GridError {
+    GridError::Data(format!("reading '{}': {what}", path.display()))
+}
+
+/// Checks the geometry of a grid read from a file (positive cell, node
+/// count within [`MAX_NODES`]).
+pub(crate) fn checked_geometry(path: &Path, geometry: GridGeometry) -> Result<GridGeometry> {
+    let g = geometry;
+    if !(g.cell.is_finite() && g.cell > 0.0 && g.x0.is_finite() && g.y0.is_finite()) {
+        return Err(read_error(
+            path,
+            format!("bad geometry: origin ({}, {}), cell {}", g.x0, g.y0, g.cell),
+        ));
+    }
+    if g.nx == 0 || g.ny == 0 || g.nx.saturating_mul(g.ny) > MAX_NODES {
+        return Err(read_error(path, format!("{} × {} nodes", g.nx, g.ny)));
+    }
+    Ok(g)
+}
+
+/// OGC WKT 1 of a coordinate system, with its EPSG authority (the `.prj`
+/// sidecar, the netCDF `spatial_ref`/`crs_wkt`): [`UtmZone::wkt`].
+pub(crate) fn crs_wkt(crs: &Crs) -> String {
+    match crs {
+        Crs::Utm(zone) => zone.wkt(),
+    }
+}
+
+/// The coordinate system of an EPSG code this crate knows (WGS 84 / UTM:
+/// 32601–32660, 32701–32760).
+pub(crate) fn crs_from_epsg(code: u32) -> Option<Crs> {
+    let (north, number) = match code {
+        32601..=32660 => (true, code - 32600),
+        32701..=32760 => (false, code - 32700),
+        _ => return None,
+    };
+    UtmZone::new(number as u8, north).ok().map(Crs::Utm)
+}
+
+/// The coordinate system a WKT (1 or 2, OGC or ESRI flavour) names: its
+/// outermost EPSG authority, else a `UTM zone 37N`-like name on a WGS 84
+/// datum. `None` for anything else.
+pub(crate) fn crs_from_wkt(wkt: &str) -> Option<Crs> {
+    // The last authority of a WKT 1 is the outermost (the PROJCS's).
+    for (key, quote) in [("AUTHORITY[\"EPSG\",\"", true), ("ID[\"EPSG\",", false)] {
+        if let Some(pos) = wkt.rfind(key) {
+            let rest = &wkt[pos + key.len()..];
+            let end = rest
+                .find(|c: char| !c.is_ascii_digit())
+                .unwrap_or(rest.len());
+            let closes = if quote { "\"]]" } else { "]]" };
+            // Only the outermost: the authority closes the whole WKT.
+            if rest[end..].trim_end() == closes
+                && let Some(crs) = rest[..end].parse().ok().and_then(crs_from_epsg)
+            {
+                return Some(crs);
+            }
+        }
+    }
+    let upper = wkt.to_ascii_uppercase();
+    if !(upper.contains("WGS 84") || upper.contains("WGS_1984") || upper.contains("WGS84")) {
+        return None;
+    }
+    for key in ["UTM ZONE ", "UTM_ZONE_"] {
+        if let Some(pos) = upper.find(key) {
+            let rest = &upper[pos + key.len()..];
+            let end = rest
+                .find(|c: char| !c.is_ascii_digit())
+                .unwrap_or(rest.len());
+            let number: u8 = rest[..end].parse().ok()?;
+            let north = match rest[end..].chars().next()? {
+                'N' => true,
+                'S' => false,
+                _ => return None,
+            };
+            if let Ok(zone) = UtmZone::new(number, north) {
+                return Some(Crs::Utm(zone));
+            }
+        }
+    }
+    None
+}
+
+/// The file stem, for the name of a grid whose file does not carry one.
+pub(crate) fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+
+    /// WGS 84 / UTM zone 37N (EPSG 32637).
+    pub const ZONE_37N: Crs = Crs::Utm(UtmZone {
+        number: 37,
+        north: true,
+    });
+
+    /// A 5 × 4 grid at 50 m whose value tells its node, `1000 j + i + 0.1`
+    /// (j from the south) plus a fraction that needs all float32 digits,
+    /// with two blank nodes, in UTM 37N.
+    pub fn sample_grid() -> Grid {
+        let geometry = GridGeometry {
+            x0: 500_000.0,
+            y0: 6_000_050.0,
+            cell: 50.0,
+            nx: 5,
+            ny: 4,
+        };
+        let mut grid = Grid::blank(geometry, "magnetic anomaly", "nT");
+        for j in 0..geometry.ny {
+            for i in 0..geometry.nx {
+                grid.values[geometry.index(i, j)] = 1000.0 * j as f64 + i as f64 + 0.123_456_789;
+            }
+        }
+        grid.values[geometry.index(1, 0)] = f64::NAN;
+        grid.values[geometry.index(4, 3)] = f64::NAN;
+        grid.values[geometry.index(2, 2)] = -51_234.567_89;
+        grid.crs = Some(ZONE_37N);
+        grid
+    }
+
+    /// Asserts two grids have the same geometry, CRS and values to float32
+    /// precision, with the same blanks.
+    pub fn assert_same_grid(a: &Grid, b: &Grid) {
+        assert_eq!(a.geometry, b.geometry);
+        assert_eq!(a.crs, b.crs);
+        assert_eq!(a.values.len(), b.values.len());
+        for (k, (x, y)) in a.values.iter().zip(&b.values).enumerate() {
+            if x.is_nan() || y.is_nan() {
+                assert!(x.is_nan() && y.is_nan(), "node {k}: {x} vs {y}");
+            } else {
+                assert_eq!(*x as f32, *y as f32, "node {k}");
+            }
+        }
+    }
+
+    /// Every entry of a folder, for checking that no temporary is left.
+    pub fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::*;
+    use super::*;
+
+    #[test]
+    fn format_from_extension() {
+        let f = |p: &str| GridFormat::from_path(Path::new(p));
+        assert_eq!(f("a/b.tif").unwrap(), GridFormat::GeoTiff);
+        assert_eq!(f("b.TIFF").unwrap(), GridFormat::GeoTiff);
+        assert_eq!(f("b.asc").unwrap(), GridFormat::EsriAscii);
+        assert_eq!(f("b.nc").unwrap(), GridFormat::NetCdf);
+        assert_eq!(f("b.grd").unwrap(), GridFormat::NetCdf);
+        for bad in ["b.xyz", "b", "b.tif.bak", ".nc"] {
+            let e = f(bad).unwrap_err();
+            assert!(matches!(e, GridError::UnknownFormat(_)), "{bad}: {e}");
+            assert!(e.is_bad_input());
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let e = write_grid(&dir.path().join("g.png"), &sample_grid()).unwrap_err();
+        assert!(matches!(e, GridError::UnknownFormat(_)));
+        assert!(entries(dir.path()).is_empty());
+        assert!(matches!(
+            read_grid(&dir.path().join("g.png")),
+            Err(GridError::UnknownFormat(_))
+        ));
+    }
+
+    #[test]
+    fn atomic_write_leaves_only_the_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let grid = sample_grid();
+        for (name, format) in [
+            ("g.tif", GridFormat::GeoTiff),
+            ("g.asc", GridFormat::EsriAscii),
+            ("g.nc", GridFormat::NetCdf),
+        ] {
+            assert_eq!(write_grid(&dir.path().join(name), &grid).unwrap(), format);
+            // Overwriting replaces the file.
+            write_grid(&dir.path().join(name), &grid).unwrap();
+        }
+        assert_eq!(entries(dir.path()), ["g.asc", "g.nc", "g.prj", "g.tif"]);
+    }
+
+    #[test]
+    fn write_into_a_missing_folder_is_a_write_error() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["g.tif", "g.asc", "g.nc"] {
+            let path = dir.path().join("missing").join(name);
+            let e = write_grid(&path, &sample_grid()).unwrap_err();
+            match &e {
+                GridError::Write { path: p, source } => {
+                    assert!(p.ends_with(name), "{p}");
+                    assert_eq!(source.kind(), io::ErrorKind::NotFound);
+                }
+                other => panic!("{name}: {other}"),
+            }
+            assert!(!e.is_bad_input());
+        }
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_grid_not_matching_its_geometry_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut grid = sample_grid();
+        grid.values.pop();
+        let e = write_grid(&dir.path().join("g.nc"), &grid).unwrap_err();
+        assert!(matches!(e, GridError::LengthMismatch { .. }), "{e}");
+        let mut grid = sample_grid();
+        grid.geometry.nx = 0;
+        grid.values.clear();
+        assert!(matches!(
+            write_grid(&dir.path().join("g.tif"), &grid),
+            Err(GridError::Data(_))
+        ));
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn wkt_names_the_crs_and_reads_back() {
+        let wkt = crs_wkt(&ZONE_37N);
+        assert!(wkt.starts_with("PROJCS[\"WGS 84 / UTM zone 37N\""));
+        assert!(wkt.contains("PARAMETER[\"central_meridian\",39]"));
+        assert!(wkt.ends_with("AUTHORITY[\"EPSG\",\"32637\"]]"));
+        assert_eq!(crs_from_wkt(&wkt), Some(ZONE_37N));
+        let south = Crs::Utm(UtmZone {
+            number: 1,
+            north: false,
+        });
+        let wkt = crs_wkt(&south);
+        assert!(wkt.contains("PARAMETER[\"central_meridian\",-177]"));
+        assert!(wkt.contains("PARAMETER[\"false_northing\",10000000]"));
+        assert_eq!(crs_from_wkt(&wkt), Some(south));
+        // ESRI flavour (no authority), and WKT 2.
+        let esri = "PROJCS[\"WGS_1984_UTM_Zone_37N\",GEOGCS[\"GCS_WGS_1984\"]]";
+        assert_eq!(crs_from_wkt(esri), Some(ZONE_37N));
+        assert_eq!(
+            crs_from_wkt("PROJCRS[\"x\",BASEGEOGCRS[\"y\",ID[\"EPSG\",4326]],ID[\"EPSG\",32737]]"),
+            Some(Crs::Utm(UtmZone {
+                number: 37,
+                north: false
+            }))
+        );
+        assert_eq!(
+            crs_from_wkt("GEOGCS[\"WGS 84\",AUTHORITY[\"EPSG\",\"4326\"]]"),
+            None
+        );
+        assert_eq!(
+            crs_from_epsg(32660),
+            Some(Crs::Utm(UtmZone {
+                number: 60,
+                north: true
+            }))
+        );
+        assert_eq!(crs_from_epsg(32661), None);
+    }
+
+    /// `gdalinfo -json` on the three formats: origin and pixel size of
+    /// node registration, the EPSG code, the nodata value. Skipped (with a
+    /// message) when `gdalinfo` is not on PATH.
+    #[test]
+    fn gdalinfo_reads_the_three_formats() {
+        let Ok(out) = std::process::Command::new("gdalinfo")
+            .arg("--version")
+            .output()
+        else {
+            println!("SKIPPED: gdalinfo is not on PATH");
+            return;
+        };
+        assert!(out.status.success());
+        let dir = tempfile::tempdir().unwrap();
+        let grid = sample_grid();
+        let g = grid.geometry;
+        let expected = [g.x0 - 25.0, 50.0, 0.0, g.y_max() + 25.0, 0.0, -50.0];
+        for (name, nodata) in [
+            ("g.tif", Some(NODATA)),
+            ("g.asc", Some(NODATA)),
+            ("g.nc", None),
+        ] {
+            let path = dir.path().join(name);
+            write_grid(&path, &grid).unwrap();
+            let out = std::process::Command::new("gdalinfo")
+                .arg("-json")
+                .arg(&path)
+                .output()
+                .unwrap();
+            let json = String::from_utf8_lossy(&out.stdout);
+            assert!(
+                out.status.success(),
+                "{name}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let gt = json_numbers_after(&json, "\"geoTransform\"");
+            assert_eq!(gt.len(), 6, "{name}: {json}");
+            for (a, b) in gt.iter().zip(expected) {
+                assert!(
+                    (a - b).abs() < 1e-6,
+                    "{name}: geoTransform {gt:?}, expected {expected:?}"
+                );
+            }
+            assert!(
+                json.contains("ID[\\\"EPSG\\\",32637]]"),
+                "{name}: no EPSG 32637 in {json}"
+            );
+            let size = json_numbers_after(&json, "\"size\"");
+            assert_eq!(size, [5.0, 4.0], "{name}");
+            match nodata {
+                Some(v) => assert_eq!(json_numbers_after(&json, "\"noDataValue\"")[0], v, "{name}"),
+                None => assert!(json.contains("\"noDataValue\":\"NaN\""), "{name}: {json}"),
+            }
+        }
+    }
+
+    /// The numbers of the JSON value after `key` (a number or an array of
+    /// numbers), by hand: the crate has no JSON parser.
+    fn json_numbers_after(json: &str, key: &str) -> Vec<f64> {
+        let Some(pos) = json.find(key) else {
+            return vec![];
+        };
+        let rest = json[pos + key.len()..]
+            .trim_start()
+            .trim_start_matches(':')
+            .trim_start();
+        let end = if rest.starts_with('[') {
+            rest.find(']').map(|e| e + 1).unwrap_or(rest.len())
+        } else {
+            rest.find([',', '}', '\n']).unwrap_or(rest.len())
+        };
+        rest[..end]
+            .trim_matches(|c| c == '[' || c == ']')
+            .split(',')
+            .filter_map(|s| s.trim().parse().ok())
+            .collect()
+    }
+}

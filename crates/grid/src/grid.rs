@@ -1,0 +1,268 @@
+//! The grid: regularly spaced nodes in a projected coordinate system.
+//!
+//! Node `(i, j)` sits at `x = x0 + i·cell` (east, m) and `y = y0 + j·cell`
+//! (north, m): node ("gridline") registration, as GMT's default and
+//! Geosoft's grids. Values are stored row by row from the southern row
+//! (`j = 0`), west to east; a blank node (no data near it) is NaN.
+
+use crate::error::{GridError, Result, positive};
+use crate::projection::Crs;
+
+/// Where the nodes of a grid are (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridGeometry {
+    /// Easting of the western column of nodes, m.
+    pub x0: f64,
+    /// Northing of the southern row of nodes, m.
+    pub y0: f64,
+    /// Node spacing, m (the same east and north).
+    pub cell: f64,
+    /// Nodes along x (columns).
+    pub nx: usize,
+    /// Nodes along y (rows).
+    pub ny: usize,
+}
+
+/// Most nodes of one grid (2.5·10⁸: 2 GB of f64), so that a wrong cell
+/// size is an error and not an out-of-memory abort.
+pub const MAX_NODES: usize = 250_000_000;
+
+impl GridGeometry {
+    /// The smallest grid of spacing `cell` whose nodes cover
+    /// `[x_min, x_max] × [y_min, y_max]`, with its western and southern
+    /// nodes on multiples of `cell` (so grids of one survey line up).
+    pub fn covering(x_min: f64, x_max: f64, y_min: f64, y_max: f64, cell: f64) -> Result<Self> {
+        let cell = positive("cell size", cell)?;
+        if !(x_min.is_finite() && x_max.is_finite() && y_min.is_finite() && y_max.is_finite())
+            || x_max < x_min
+            || y_max < y_min
+        {
+            return Err(GridError::Data(format!(
+                "the extent [{x_min}, {x_max}] × [{y_min}, {y_max}] m is not a finite area"
+            )));
+        }
+        let x0 = (x_min / cell).floor() * cell;
+        let y0 = (y_min / cell).floor() * cell;
+        let nx = ((x_max - x0) / cell).ceil() as usize + 1;
+        let ny = ((y_max - y0) / cell).ceil() as usize + 1;
+        let g = Self {
+            x0,
+            y0,
+            cell,
+            nx,
+            ny,
+        };
+        if nx.saturating_mul(ny) > MAX_NODES {
+            return Err(GridError::Data(format!(
+                "{nx} × {ny} nodes at a {cell} m cell is more than {MAX_NODES}: choose a larger cell"
+            )));
+        }
+        Ok(g)
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// True for a grid without nodes.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Easting of column `i`, m.
+    pub fn x(&self, i: usize) -> f64 {
+        self.x0 + i as f64 * self.cell
+    }
+
+    /// Northing of row `j`, m.
+    pub fn y(&self, j: usize) -> f64 {
+        self.y0 + j as f64 * self.cell
+    }
+
+    /// Easting of the eastern column, m.
+    pub fn x_max(&self) -> f64 {
+        self.x(self.nx.saturating_sub(1))
+    }
+
+    /// Northing of the northern row, m.
+    pub fn y_max(&self) -> f64 {
+        self.y(self.ny.saturating_sub(1))
+    }
+
+    /// Index into the values of node `(i, j)`.
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        j * self.nx + i
+    }
+
+    /// Fractional node coordinates `(u, v)` of a point: `u = (x − x0)/cell`.
+    pub fn to_node(&self, x: f64, y: f64) -> (f64, f64) {
+        ((x - self.x0) / self.cell, (y - self.y0) / self.cell)
+    }
+}
+
+/// A gridded quantity (module docs for the node layout).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grid {
+    /// Node positions.
+    pub geometry: GridGeometry,
+    /// Node values, row by row from the south; NaN = blank.
+    pub values: Vec<f64>,
+    /// The coordinate system of `x`, `y` (`None`: projected metres of an
+    /// unknown system).
+    pub crs: Option<Crs>,
+    /// What is gridded (the column name), for the file's metadata.
+    pub name: String,
+    /// Its unit (e.g. `nT`).
+    pub unit: String,
+}
+
+impl Grid {
+    /// A grid of `geometry` with every node blank.
+    pub fn blank(geometry: GridGeometry, name: &str, unit: &str) -> Self {
+        Self {
+            geometry,
+            values: vec![f64::NAN; geometry.len()],
+            crs: None,
+            name: name.to_string(),
+            unit: unit.to_string(),
+        }
+    }
+
+    /// The value of node `(i, j)` (NaN when blank).
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        self.values[self.geometry.index(i, j)]
+    }
+
+    /// Bilinear interpolation at `(x, y)` (m); NaN outside the grid or
+    /// next to a blank node.
+    pub fn sample(&self, x: f64, y: f64) -> f64 {
+        let g = &self.geometry;
+        let (u, v) = g.to_node(x, y);
+        if !(u >= 0.0 && v >= 0.0) || g.nx < 2 || g.ny < 2 {
+            return f64::NAN;
+        }
+        let (i, j) = (
+            (u.floor() as usize).min(g.nx - 2),
+            (v.floor() as usize).min(g.ny - 2),
+        );
+        let (fu, fv) = (u - i as f64, v - j as f64);
+        if fu > 1.0 || fv > 1.0 {
+            return f64::NAN;
+        }
+        let z00 = self.get(i, j);
+        let z10 = self.get(i + 1, j);
+        let z01 = self.get(i, j + 1);
+        let z11 = self.get(i + 1, j + 1);
+        (1.0 - fv) * ((1.0 - fu) * z00 + fu * z10) + fv * ((1.0 - fu) * z01 + fu * z11)
+    }
+
+    /// Mean, standard deviation, minimum and maximum of the non-blank
+    /// nodes, and their count (NaN figures for an all-blank grid).
+    pub fn stats(&self) -> GridStats {
+        let mut n = 0usize;
+        let (mut sum, mut min, mut max) = (0.0, f64::INFINITY, f64::NEG_INFINITY);
+        for &v in self.values.iter().filter(|v| v.is_finite()) {
+            n += 1;
+            sum += v;
+            min = min.min(v);
+            max = max.max(v);
+        }
+        if n == 0 {
+            return GridStats {
+                count: 0,
+                mean: f64::NAN,
+                std: f64::NAN,
+                min: f64::NAN,
+                max: f64::NAN,
+            };
+        }
+        let mean = sum / n as f64;
+        let var = self
+            .values
+            .iter()
+            .filter(|v| v.is_finite())
+            .map(|v| (v - mean).powi(2))
+            .sum::<f64>()
+            / n as f64;
+        GridStats {
+            count: n,
+            mean,
+            std: var.sqrt(),
+            min,
+            max,
+        }
+    }
+
+    /// `self − other` node by node (blank where either is blank); the two
+    /// grids must have the same geometry.
+    pub fn difference(&self, other: &Grid) -> Result<Grid> {
+        if self.geometry != other.geometry {
+            return Err(GridError::Data(format!(
+                "grids of different geometry: {:?} and {:?}",
+                self.geometry, other.geometry
+            )));
+        }
+        Ok(Grid {
+            values: self
+                .values
+                .iter()
+                .zip(&other.values)
+                .map(|(a, b)| a - b)
+                .collect(),
+            name: format!("{} - {}", self.name, other.name),
+            ..self.clone()
+        })
+    }
+}
+
+/// Summary figures of a grid's non-blank nodes ([`Grid::stats`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct GridStats {
+    /// Non-blank nodes.
+    pub count: usize,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation (population).
+    pub std: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn covering_aligns_nodes_to_the_cell_and_covers_the_extent() {
+        let g = GridGeometry::covering(1013.0, 2990.0, -40.0, 460.0, 50.0).unwrap();
+        assert_eq!((g.x0, g.y0), (1000.0, -50.0));
+        assert!(g.x_max() >= 2990.0 && g.x_max() - 2990.0 < 50.0);
+        assert!(g.y_max() >= 460.0 && g.y_max() - 460.0 < 50.0);
+        assert!(GridGeometry::covering(0.0, 1.0, 0.0, 1.0, 0.0).is_err());
+        assert!(GridGeometry::covering(0.0, 1e9, 0.0, 1e9, 1.0).is_err());
+        assert!(GridGeometry::covering(f64::NAN, 1.0, 0.0, 1.0, 1.0).is_err());
+    }
+
+    #[test]
+    fn bilinear_sampling_reproduces_a_plane() {
+        let geometry = GridGeometry::covering(0.0, 400.0, 0.0, 300.0, 100.0).unwrap();
+        let mut grid = Grid::blank(geometry, "z", "nT");
+        for j in 0..geometry.ny {
+            for i in 0..geometry.nx {
+                let k = geometry.index(i, j);
+                grid.values[k] = 2.0 * geometry.x(i) - 0.5 * geometry.y(j) + 7.0;
+            }
+        }
+        for (x, y) in [(0.0, 0.0), (123.0, 45.6), (400.0, 300.0), (399.9, 1.0)] {
+            assert!((grid.sample(x, y) - (2.0 * x - 0.5 * y + 7.0)).abs() < 1e-9);
+        }
+        assert!(grid.sample(-1.0, 0.0).is_nan());
+        assert!(grid.sample(0.0, 300.5).is_nan());
+        let s = grid.stats();
+        assert_eq!(s.count, 20);
+        assert!(grid.difference(&grid).unwrap().stats().std == 0.0);
+    }
+}

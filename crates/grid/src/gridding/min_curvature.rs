@@ -1,0 +1,777 @@
+//! Minimum-curvature gridding with tension (Smith & Wessel 1990).
+//!
+//! The surface `z(x, y)` solves `(1 − T) ∇⁴z − T ∇²z = 0` away from the
+//! data, passes through the data, and meets at the grid's edges
+//! `(1 − T) ∂²z/∂n² + T ∂z/∂n = 0`, `∂(∇²z)/∂n = 0` and, at the corners,
+//! `∂²z/∂x∂y = 0` (Smith, W. H. F. & Wessel, P., 1990, *Gridding with
+//! continuous curvature splines in tension*, Geophysics 55, 293–305; the
+//! method of GMT `surface`). `T = 0` is the minimum-curvature (biharmonic)
+//! spline of Briggs (1974), which overshoots between widely spaced lines;
+//! `T = 1` is the harmonic (Laplace) surface, which has no overshoot but
+//! cusps at the data; 0.25–0.35 is usual for potential-field data.
+//!
+//! **Discretisation** (unit node spacing `h`): at a node without data,
+//! `(1 − T)(20 z₀ − 8 S₁ + 2 S₂ + S₃) − T (S₁ − 4 z₀) = 0`, with `S₁` the
+//! sum of the four nearest nodes, `S₂` of the four diagonal ones and `S₃`
+//! of the four at distance 2; this is `(1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0`
+//! with `C` the five-point Laplacian (curvature) at the node and its four
+//! neighbours. Data enter as in Briggs (1974, *Machine contouring using
+//! minimum curvature*, Geophysics 39, 39–48) and Smith & Wessel: the
+//! block mean `z_d` of the data nearest a node, at the offset `(δx, δy)`
+//! (|δ| ≤ ½ node), replaces the two neighbours on its side in the node's
+//! own curvature `C₀`. `C₀ = Σₚ aₚ (zₚ − z₀)` over the data point, the two
+//! neighbours on the far side and the two diagonal nodes beside them; the
+//! weights `aₚ` make `C₀` the exact Laplacian of every quadratic surface
+//! (the second-order Taylor expansion about the node through those five
+//! points, solved for `z_xx + z_yy`). The node then obeys the same
+//! equation with this `C₀`: it is not pinned to the data, which keeps
+//! inconsistent neighbouring data (mis-ties at crossings) from forcing
+//! overshoots. Data within 0.05 node of a node fix it. The edge conditions
+//! fill two rows of ghost nodes outside the grid before each sweep.
+//!
+//! **Solution**: a least-squares plane is removed from the data (and added
+//! back); successive over-relaxation (Gauss–Seidel in node order, factor
+//! 1.4) on a sequence of grids of spacing `2^k h`, each started from the
+//! bilinear interpolation of the coarser one, until the largest change of
+//! a sweep is below the convergence limit (default 10⁻⁴ of the data's RMS
+//! about the plane, GMT's default) or the sweep limit is reached. The
+//! sweeps run in a fixed order on one thread: the result is bit-identical
+//! from run to run.
+
+use super::points::{BlockMeans, Points};
+use crate::error::{GridError, Result};
+use crate::grid::GridGeometry;
+
+/// Settings of minimum-curvature gridding (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MinCurvature {
+    /// Tension `T`, 0–1 (default 0.25).
+    pub tension: f64,
+    /// Most sweeps on each grid of the sequence (default 500, as GMT).
+    pub max_iterations: usize,
+    /// Convergence limit: the largest change of a sweep, in the data's
+    /// unit; `None` = 10⁻⁴ × the data's RMS about their plane.
+    pub convergence: Option<f64>,
+    /// Over-relaxation factor, 1–2 (default 1.4, as GMT).
+    pub relaxation: f64,
+}
+
+impl Default for MinCurvature {
+    fn default() -> Self {
+        Self {
+            tension: 0.25,
+            max_iterations: 500,
+            convergence: None,
+            relaxation: 1.4,
+        }
+    }
+}
+
+/// How a grid of the sequence converged.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LevelReport {
+    /// Node spacing of this grid, in cells of the final grid.
+    pub spacing_cells: usize,
+    /// Nodes along x.
+    pub nx: usize,
+    /// Nodes along y.
+    pub ny: usize,
+    /// Sweeps run.
+    pub iterations: usize,
+    /// Largest change of the last sweep, data unit.
+    pub max_change: f64,
+}
+
+/// What the gridding did ([`MinCurvature::grid`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MinCurvatureReport {
+    /// The grids of the sequence, coarsest first.
+    pub levels: Vec<LevelReport>,
+    /// True when the final grid met the convergence limit.
+    pub converged: bool,
+    /// The convergence limit used, data unit.
+    pub convergence_limit: f64,
+    /// Nodes holding data (block means).
+    pub constrained_nodes: usize,
+    /// Finite points used.
+    pub points_used: usize,
+    /// Points skipped for a non-finite value or coordinate.
+    pub points_non_finite: usize,
+    /// Points more than half a cell outside the grid.
+    pub points_outside: usize,
+}
+
+impl MinCurvatureReport {
+    /// The report of a grid made otherwise (no sweeps; the data counts of
+    /// `means`).
+    pub fn not_run(means: &BlockMeans) -> Self {
+        Self {
+            levels: Vec::new(),
+            converged: true,
+            convergence_limit: 0.0,
+            constrained_nodes: means.blocks.len(),
+            points_used: means.used,
+            points_non_finite: means.non_finite,
+            points_outside: means.outside,
+        }
+    }
+}
+
+impl MinCurvature {
+    /// Check the settings.
+    pub fn validate(&self) -> Result<()> {
+        if !(0.0..=1.0).contains(&self.tension) {
+            return Err(GridError::OutOfRange {
+                name: "tension",
+                value: self.tension,
+                expected: "0 to 1",
+            });
+        }
+        if !(self.relaxation >= 1.0 && self.relaxation < 2.0) {
+            return Err(GridError::OutOfRange {
+                name: "relaxation",
+                value: self.relaxation,
+                expected: "1 to 2 (exclusive)",
+            });
+        }
+        if let Some(c) = self.convergence {
+            crate::error::positive("convergence limit", c)?;
+        }
+        if self.max_iterations == 0 {
+            return Err(GridError::OutOfRange {
+                name: "max_iterations",
+                value: 0.0,
+                expected: "at least 1",
+            });
+        }
+        Ok(())
+    }
+
+    /// Grid `points` on the nodes of `geometry` (at least 4 × 4 nodes):
+    /// the node values (row by row from the south; no node is blank) and
+    /// the report. Fewer than 3 nodes with data is an error.
+    pub fn grid(
+        &self,
+        points: Points,
+        geometry: GridGeometry,
+    ) -> Result<(Vec<f64>, MinCurvatureReport)> {
+        self.validate()?;
+        if geometry.nx < 4 || geometry.ny < 4 {
+            return Err(GridError::Data(format!(
+                "a {} × {} grid is too small for minimum curvature (at least 4 × 4 nodes)",
+                geometry.nx, geometry.ny
+            )));
+        }
+        let means = BlockMeans::of(points, &geometry);
+        if means.blocks.len() < 3 {
+            return Err(GridError::Data(format!(
+                "{} grid nodes hold data ({} finite points inside the grid); at least 3 are needed",
+                means.blocks.len(),
+                means.used
+            )));
+        }
+        let plane = Plane::fit(&means);
+        let rms = (means
+            .blocks
+            .iter()
+            .map(|b| (b.z - plane.at(b.u, b.v)).powi(2))
+            .sum::<f64>()
+            / means.blocks.len() as f64)
+            .sqrt();
+        let limit = self.convergence.unwrap_or(1e-4 * rms);
+        let mut report = MinCurvatureReport {
+            levels: Vec::new(),
+            converged: true,
+            convergence_limit: limit,
+            constrained_nodes: means.blocks.len(),
+            points_used: means.used,
+            points_non_finite: means.non_finite,
+            points_outside: means.outside,
+        };
+        let mut values = vec![0.0; geometry.len()];
+        if rms > 0.0 {
+            // Coarsest spacing: the largest power of two leaving ≥ 6 nodes
+            // along the shorter side.
+            let short = geometry.nx.min(geometry.ny) - 1;
+            let mut spacing = 1;
+            while short / (2 * spacing) >= 5 {
+                spacing *= 2;
+            }
+            let mut level: Option<Level> = None;
+            loop {
+                let mut next = Level::new(&geometry, spacing, &means, &plane);
+                match &level {
+                    Some(coarse) => next.start_from(coarse),
+                    None => next.start_from_data(),
+                }
+                let (iterations, max_change) = next.solve(self, limit);
+                report.levels.push(LevelReport {
+                    spacing_cells: spacing,
+                    nx: next.nx,
+                    ny: next.ny,
+                    iterations,
+                    max_change,
+                });
+                if spacing == 1 {
+                    report.converged = max_change < limit;
+                    for j in 0..geometry.ny {
+                        for i in 0..geometry.nx {
+                            values[geometry.index(i, j)] = next.z[next.p(i as isize, j as isize)];
+                        }
+                    }
+                    break;
+                }
+                level = Some(next);
+                spacing /= 2;
+            }
+        }
+        for j in 0..geometry.ny {
+            for i in 0..geometry.nx {
+                values[geometry.index(i, j)] += plane.at(i as f64, j as f64);
+            }
+        }
+        Ok((values, report))
+    }
+}
+
+/// The least-squares plane `z = a + b (u − ū) + c (v − v̄)` of the block
+/// means (node units).
+#[derive(Debug, Clone, Copy)]
+struct Plane {
+    a: f64,
+    b: f64,
+    c: f64,
+    u0: f64,
+    v0: f64,
+}
+
+impl Plane {
+    fn fit(m: &BlockMeans) -> Self {
+        let n = m.blocks.len() as f64;
+        let u0 = m.blocks.iter().map(|b| b.u).sum::<f64>() / n;
+        let v0 = m.blocks.iter().map(|b| b.v).sum::<f64>() / n;
+        let a = m.blocks.iter().map(|b| b.z).sum::<f64>() / n;
+        let (mut suu, mut suv, mut svv, mut suz, mut svz) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for b in &m.blocks {
+            let (du, dv, dz) = (b.u - u0, b.v - v0, b.z - a);
+            suu += du * du;
+            suv += du * dv;
+            svv += dv * dv;
+            suz += du * dz;
+            svz += dv * dz;
+        }
+        let det = suu * svv - suv * suv;
+        // Collinear data (one line) do not determine a plane: the mean only.
+        let (b, c) = if det > 1e-12 * (suu * svv).max(f64::MIN_POSITIVE) {
+            ((svv * suz - suv * svz) / det, (suu * svz - suv * suz) / det)
+        } else {
+            (0.0, 0.0)
+        };
+        Self { a, b, c, u0, v0 }
+    }
+
+    fn at(&self, u: f64, v: f64) -> f64 {
+        self.a + self.b * (u - self.u0) + self.c * (v - self.v0)
+    }
+}
+
+/// A node's data: block mean minus the plane, at the offset `(dx, dy)`
+/// from the node (node units of its level).
+#[derive(Debug, Clone, Copy)]
+struct Constraint {
+    dx: f64,
+    dy: f64,
+    z: f64,
+}
+
+/// How a node with data is updated (module docs).
+#[derive(Debug, Clone, Copy)]
+enum NodeData {
+    /// The data sit on the node: its value.
+    Fixed(f64),
+    /// The node's curvature `C₀ = Σₚ a[p] (z_p − z₀)` over the four nodes
+    /// at the padded-index offsets `at` and the data value `z` (weight
+    /// `a[4]`).
+    Curvature { at: [isize; 4], a: [f64; 5], z: f64 },
+}
+
+/// Data closer than this to a node (in node units, each axis) fix it.
+const ON_NODE: f64 = 0.05;
+
+impl NodeData {
+    /// The update rule of a node with the data `c`, for padded rows of
+    /// `width` values.
+    fn of(c: Constraint, width: usize) -> Self {
+        if c.dx.abs() < ON_NODE && c.dy.abs() < ON_NODE {
+            return NodeData::Fixed(c.z);
+        }
+        let (sx, sy) = (
+            if c.dx >= 0.0 { 1isize } else { -1 },
+            if c.dy >= 0.0 { 1isize } else { -1 },
+        );
+        // The far-side neighbours and the diagonals beside them, then the data.
+        let nodes = [(-sx, 0), (0, -sy), (sx, -sy), (-sx, sy)];
+        let mut pts = [(0.0, 0.0); 5];
+        for (q, &(i, j)) in pts.iter_mut().zip(&nodes) {
+            *q = (i as f64, j as f64);
+        }
+        pts[4] = (c.dx, c.dy);
+        match laplacian_weights(&pts) {
+            Some(a) => NodeData::Curvature {
+                at: nodes.map(|(i, j)| j * width as isize + i),
+                a,
+                z: c.z,
+            },
+            None => NodeData::Fixed(c.z),
+        }
+    }
+}
+
+/// Weights `a` with `Σₚ a[p] (z(pₚ) − z(0)) = z_xx + z_yy` for every
+/// quadratic surface `z`, through the five points `p` (node units about
+/// the node): `Mᵀ a = e`, `M`'s rows `(x, y, x²/2, y²/2, xy)`, `e` picking
+/// `z_xx + z_yy`. `None` when the points do not determine it.
+fn laplacian_weights(p: &[(f64, f64); 5]) -> Option<[f64; 5]> {
+    // Augmented Mᵀ: row r = monomial r over the points, then e[r].
+    let mut m = [[0.0f64; 6]; 5];
+    for (k, &(x, y)) in p.iter().enumerate() {
+        let mono = [x, y, 0.5 * x * x, 0.5 * y * y, x * y];
+        for r in 0..5 {
+            m[r][k] = mono[r];
+        }
+    }
+    m[2][5] = 1.0;
+    m[3][5] = 1.0;
+    // Gaussian elimination with partial pivoting.
+    for col in 0..5 {
+        let piv = (col..5).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
+        if m[piv][col].abs() < 1e-9 {
+            return None;
+        }
+        m.swap(col, piv);
+        let pivot_row = m[col];
+        for (r, row) in m.iter_mut().enumerate() {
+            if r != col {
+                let f = row[col] / pivot_row[col];
+                for (x, p) in row[col..].iter_mut().zip(&pivot_row[col..]) {
+                    *x -= f * p;
+                }
+            }
+        }
+    }
+    let mut a = [0.0; 5];
+    for (r, v) in a.iter_mut().enumerate() {
+        *v = m[r][5] / m[r][r];
+    }
+    Some(a)
+}
+
+/// One grid of the sequence, with two ghost rows and columns on each side.
+struct Level {
+    nx: usize,
+    ny: usize,
+    spacing: usize,
+    /// Padded values, `(ny + 4) × (nx + 4)`.
+    z: Vec<f64>,
+    /// Data of each node (`None`: free), unpadded, row by row.
+    data: Vec<Option<NodeData>>,
+}
+
+const PAD: usize = 2;
+
+impl Level {
+    fn new(g: &GridGeometry, spacing: usize, m: &BlockMeans, plane: &Plane) -> Self {
+        let nx = (g.nx - 1).div_ceil(spacing) + 1;
+        let ny = (g.ny - 1).div_ceil(spacing) + 1;
+        let s = spacing as f64;
+        // Blocks of the final grid merged per node of this grid (weighted
+        // by their point counts).
+        let mut sums = vec![(0.0, 0.0, 0.0, 0usize); nx * ny];
+        for b in &m.blocks {
+            let (u, v) = (b.u / s, b.v / s);
+            let (i, j) = (u.round() as usize, v.round() as usize);
+            if i < nx && j < ny {
+                let w = b.count as f64;
+                let e = &mut sums[j * nx + i];
+                e.0 += w * u;
+                e.1 += w * v;
+                e.2 += w * (b.z - plane.at(b.u, b.v));
+                e.3 += b.count;
+            }
+        }
+        let width = nx + 2 * PAD;
+        let data = sums
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                (e.3 > 0).then(|| {
+                    let w = e.3 as f64;
+                    NodeData::of(
+                        Constraint {
+                            dx: e.0 / w - (k % nx) as f64,
+                            dy: e.1 / w - (k / nx) as f64,
+                            z: e.2 / w,
+                        },
+                        width,
+                    )
+                })
+            })
+            .collect();
+        Self {
+            nx,
+            ny,
+            spacing,
+            z: vec![0.0; (nx + 2 * PAD) * (ny + 2 * PAD)],
+            data,
+        }
+    }
+
+    fn width(&self) -> usize {
+        self.nx + 2 * PAD
+    }
+
+    /// Index of node `(i, j)` in the padded values (−2 ≤ i ≤ nx + 1).
+    fn p(&self, i: isize, j: isize) -> usize {
+        ((j + PAD as isize) as usize) * self.width() + (i + PAD as isize) as usize
+    }
+
+    /// The first grid: every node at 0 (the plane), the data nodes at their
+    /// values.
+    fn start_from_data(&mut self) {
+        for j in 0..self.ny {
+            for i in 0..self.nx {
+                if let Some(NodeData::Fixed(z) | NodeData::Curvature { z, .. }) =
+                    self.data[j * self.nx + i]
+                {
+                    let p = self.p(i as isize, j as isize);
+                    self.z[p] = z;
+                }
+            }
+        }
+    }
+
+    /// Start from the bilinear interpolation of the next coarser grid.
+    fn start_from(&mut self, coarse: &Level) {
+        let r = coarse.spacing as f64 / self.spacing as f64;
+        for j in 0..self.ny {
+            for i in 0..self.nx {
+                let (u, v) = (i as f64 / r, j as f64 / r);
+                let (ci, cj) = (
+                    (u.floor() as usize).min(coarse.nx - 2),
+                    (v.floor() as usize).min(coarse.ny - 2),
+                );
+                let (fu, fv) = (u - ci as f64, v - cj as f64);
+                let at = |a: usize, b: usize| coarse.z[coarse.p(a as isize, b as isize)];
+                let val = (1.0 - fv) * ((1.0 - fu) * at(ci, cj) + fu * at(ci + 1, cj))
+                    + fv * ((1.0 - fu) * at(ci, cj + 1) + fu * at(ci + 1, cj + 1));
+                let p = self.p(i as isize, j as isize);
+                self.z[p] = val;
+            }
+        }
+    }
+
+    /// Fill the ghost nodes from the edge conditions (module docs).
+    fn fill_ghosts(&mut self, t: f64) {
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        let w = self.width() as isize;
+        // First ghost row/column: (1−T)(z₁ − 2z₀ + z₋₁) − T (z₁ − z₋₁)/2 = 0.
+        let ghost1 =
+            |z0: f64, z1: f64| ((1.0 - t) * (2.0 * z0 - z1) + 0.5 * t * z1) / (1.0 - 0.5 * t);
+        // (edge node, inward step, outward step) for the four edges.
+        for j in 0..ny {
+            for (i0, inward) in [(0, 1), (nx - 1, -1)] {
+                let p0 = self.p(i0, j) as isize;
+                let (z0, z1) = (self.z[p0 as usize], self.z[(p0 + inward) as usize]);
+                self.z[(p0 - inward) as usize] = ghost1(z0, z1);
+            }
+        }
+        for i in 0..nx {
+            for (j0, inward) in [(0, w), (ny - 1, -w)] {
+                let p0 = self.p(i, j0) as isize;
+                let (z0, z1) = (self.z[p0 as usize], self.z[(p0 + inward) as usize]);
+                self.z[(p0 - inward) as usize] = ghost1(z0, z1);
+            }
+        }
+        // Corners: ∂²z/∂x∂y = 0 ⇒ z(−1,−1) = z(−1,1) + z(1,−1) − z(1,1).
+        for (ci, si) in [(0, 1), (nx - 1, -1)] {
+            for (cj, sj) in [(0, 1), (ny - 1, -1)] {
+                let v = self.z[self.p(ci - si, cj + sj)] + self.z[self.p(ci + si, cj - sj)]
+                    - self.z[self.p(ci + si, cj + sj)];
+                let p = self.p(ci - si, cj - sj);
+                self.z[p] = v;
+            }
+        }
+        // Second ghost: ∂(∇²z)/∂n = 0 ⇒ ∇²z(−1) = ∇²z(1) across the edge.
+        let lap = |z: &[f64], p: isize, dx: isize, dy: isize| {
+            z[(p + dx) as usize]
+                + z[(p - dx) as usize]
+                + z[(p + dy) as usize]
+                + z[(p - dy) as usize]
+                - 4.0 * z[p as usize]
+        };
+        for j in 0..ny {
+            for (i0, inward) in [(0isize, 1isize), (nx - 1, -1)] {
+                let p0 = self.p(i0, j) as isize;
+                let l1 = lap(&self.z, p0 + inward, 1, w);
+                let m1 = p0 - inward;
+                let v = l1
+                    - self.z[p0 as usize]
+                    - self.z[(m1 + w) as usize]
+                    - self.z[(m1 - w) as usize]
+                    + 4.0 * self.z[m1 as usize];
+                self.z[(p0 - 2 * inward) as usize] = v;
+            }
+        }
+        for i in 0..nx {
+            for (j0, inward) in [(0isize, w), (ny - 1, -w)] {
+                let p0 = self.p(i, j0) as isize;
+                let l1 = lap(&self.z, p0 + inward, 1, w);
+                let m1 = p0 - inward;
+                let v = l1
+                    - self.z[p0 as usize]
+                    - self.z[(m1 + 1) as usize]
+                    - self.z[(m1 - 1) as usize]
+                    + 4.0 * self.z[m1 as usize];
+                self.z[(p0 - 2 * inward) as usize] = v;
+            }
+        }
+    }
+
+    /// Over-relaxed sweeps until the largest change is below `limit`:
+    /// (sweeps, largest change of the last one).
+    fn solve(&mut self, s: &MinCurvature, limit: f64) -> (usize, f64) {
+        let t = s.tension;
+        let w = self.width();
+        let denom = 20.0 * (1.0 - t) + 4.0 * t;
+        let mut change = f64::INFINITY;
+        let mut sweeps = 0;
+        while sweeps < s.max_iterations {
+            self.fill_ghosts(t);
+            change = 0.0;
+            for j in 0..self.ny {
+                let row = self.p(0, j as isize);
+                for i in 0..self.nx {
+                    let p = row + i;
+                    let z = &self.z;
+                    let s1 = z[p + 1] + z[p - 1] + z[p + w] + z[p - w];
+                    let s2 = z[p + w + 1] + z[p + w - 1] + z[p - w + 1] + z[p - w - 1];
+                    let s3 = z[p + 2] + z[p - 2] + z[p + 2 * w] + z[p - 2 * w];
+                    let around = (1.0 - t) * (4.0 * s1 - 2.0 * s2 - s3);
+                    let (target, relax) = match self.data[j * self.nx + i] {
+                        None => ((around + (4.0 - 3.0 * t) * s1) / denom, s.relaxation),
+                        Some(NodeData::Fixed(v)) => (v, 1.0),
+                        // (1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0 with
+                        // C₀ = Σ aₚ zₚ − A z₀ (module docs), solved for z₀.
+                        Some(NodeData::Curvature { at, a, z: zd }) => {
+                            let pi = p as isize;
+                            let sum = a[0] * z[(pi + at[0]) as usize]
+                                + a[1] * z[(pi + at[1]) as usize]
+                                + a[2] * z[(pi + at[2]) as usize]
+                                + a[3] * z[(pi + at[3]) as usize]
+                                + a[4] * zd;
+                            let big_a = a.iter().sum::<f64>();
+                            (
+                                (around + (4.0 - 3.0 * t) * sum)
+                                    / (4.0 * (1.0 - t) * (1.0 + big_a) + t * big_a),
+                                s.relaxation,
+                            )
+                        }
+                    };
+                    let step = relax * (target - self.z[p]);
+                    self.z[p] += step;
+                    change = f64::max(change, step.abs());
+                }
+            }
+            sweeps += 1;
+            if change < limit {
+                break;
+            }
+        }
+        (sweeps, change)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points along north–south lines every `line_cells` cells, a point
+    /// every 0.3 cell, of `f(x, y)`.
+    fn lines(
+        g: &GridGeometry,
+        line_cells: usize,
+        f: impl Fn(f64, f64) -> f64,
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (mut x, mut y, mut z) = (vec![], vec![], vec![]);
+        let mut i = 0;
+        while i < g.nx {
+            let xl = g.x(i) + 0.2 * g.cell;
+            let mut yl = g.y0;
+            while yl <= g.y_max() {
+                x.push(xl);
+                y.push(yl);
+                z.push(f(xl, yl));
+                yl += 0.3 * g.cell;
+            }
+            i += line_cells;
+        }
+        (x, y, z)
+    }
+
+    fn rms(a: &[f64]) -> f64 {
+        (a.iter().map(|v| v * v).sum::<f64>() / a.len() as f64).sqrt()
+    }
+
+    #[test]
+    fn curvature_weights_are_exact_for_quadratic_surfaces() {
+        let q = |x: f64, y: f64| 3.0 + 2.0 * x - y + 1.5 * x * x - 0.7 * y * y + 0.4 * x * y;
+        for (dx, dy) in [
+            (0.3, 0.2),
+            (-0.45, 0.1),
+            (0.0, -0.3),
+            (-0.2, -0.49),
+            (0.5, 0.5),
+        ] {
+            let c = Constraint {
+                dx,
+                dy,
+                z: q(dx, dy),
+            };
+            let NodeData::Curvature { at, a, z } = NodeData::of(c, 100) else {
+                panic!("({dx}, {dy}) fixed");
+            };
+            let pos = |o: isize| {
+                let (j, i) = (o.div_euclid(100), o.rem_euclid(100));
+                let (i, j) = if i > 50 { (i - 100, j + 1) } else { (i, j) };
+                (i as f64, j as f64)
+            };
+            let mut lap = a[4] * (z - q(0.0, 0.0));
+            for k in 0..4 {
+                let (x, y) = pos(at[k]);
+                lap += a[k] * (q(x, y) - q(0.0, 0.0));
+            }
+            assert!((lap - (3.0 - 1.4)).abs() < 1e-9, "({dx}, {dy}): {lap}");
+        }
+        let on = NodeData::of(
+            Constraint {
+                dx: 0.01,
+                dy: -0.04,
+                z: 7.0,
+            },
+            100,
+        );
+        assert!(matches!(on, NodeData::Fixed(7.0)));
+    }
+
+    #[test]
+    fn a_plane_is_reproduced_exactly() {
+        let g = GridGeometry::covering(0.0, 2000.0, 0.0, 1500.0, 50.0).unwrap();
+        let f = |x: f64, y: f64| 3.0 + 0.01 * x - 0.02 * y;
+        let (x, y, z) = lines(&g, 8, f);
+        let (v, rep) = MinCurvature::default()
+            .grid(Points::new(&x, &y, &z).unwrap(), g)
+            .unwrap();
+        assert!(rep.converged);
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                assert!((v[g.index(i, j)] - f(g.x(i), g.y(j))).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn a_smooth_field_between_lines_is_interpolated_for_every_tension() {
+        // An anomaly of wavelength ≫ the line spacing (8 cells).
+        let g = GridGeometry::covering(0.0, 6000.0, 0.0, 4000.0, 50.0).unwrap();
+        let f = |x: f64, y: f64| {
+            100.0
+                * (-((x - 3000.0).powi(2) + (y - 2000.0).powi(2)) / (2.0 * 900.0f64.powi(2))).exp()
+        };
+        let (x, y, z) = lines(&g, 8, f);
+        let mut std = 0.0;
+        let mut errors = vec![];
+        for t in [0.0, 0.25, 0.5, 1.0] {
+            let s = MinCurvature {
+                tension: t,
+                ..Default::default()
+            };
+            let (v, rep) = s.grid(Points::new(&x, &y, &z).unwrap(), g).unwrap();
+            assert!(rep.converged, "T = {t}: {rep:?}");
+            let err: Vec<f64> = (0..g.len())
+                .map(|k| v[k] - f(g.x(k % g.nx), g.y(k / g.nx)))
+                .collect();
+            let truth: Vec<f64> = (0..g.len())
+                .map(|k| f(g.x(k % g.nx), g.y(k / g.nx)))
+                .collect();
+            std = rms(&truth);
+            errors.push(rms(&err) / std);
+        }
+        eprintln!("relative RMS errors for T = 0, 0.25, 0.5, 1: {errors:?}");
+        assert!(std > 10.0);
+        // The splines in tension interpolate the smooth field to 2 %; the
+        // harmonic surface (T = 1) has cusps at the lines and does worse.
+        assert!(errors[..3].iter().all(|&e| e < 0.02), "{errors:?}");
+        assert!(errors[3] > errors[1] && errors[3] < 0.05, "{errors:?}");
+    }
+
+    #[test]
+    fn the_result_is_bit_identical_from_run_to_run() {
+        let g = GridGeometry::covering(0.0, 3000.0, 0.0, 2000.0, 50.0).unwrap();
+        let (x, y, z) = lines(&g, 6, |x, y| (x / 700.0).sin() * (y / 500.0).cos());
+        let p = Points::new(&x, &y, &z).unwrap();
+        let a = MinCurvature::default().grid(p, g).unwrap().0;
+        let b = MinCurvature::default().grid(p, g).unwrap().0;
+        assert!(a.iter().zip(&b).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn bad_settings_and_too_few_data_are_errors() {
+        let g = GridGeometry::covering(0.0, 1000.0, 0.0, 1000.0, 50.0).unwrap();
+        let (x, y, z) = (vec![100.0, 500.0], vec![100.0, 500.0], vec![1.0, 2.0]);
+        let p = Points::new(&x, &y, &z).unwrap();
+        assert!(matches!(
+            MinCurvature::default().grid(p, g),
+            Err(GridError::Data(_))
+        ));
+        for s in [
+            MinCurvature {
+                tension: 1.5,
+                ..Default::default()
+            },
+            MinCurvature {
+                relaxation: 2.0,
+                ..Default::default()
+            },
+            MinCurvature {
+                convergence: Some(0.0),
+                ..Default::default()
+            },
+        ] {
+            assert!(s.grid(p, g).unwrap_err().is_bad_input());
+        }
+        assert!(Points::new(&x, &y, &z[..1]).is_err());
+        let small = GridGeometry::covering(0.0, 100.0, 0.0, 100.0, 50.0).unwrap();
+        assert!(MinCurvature::default().grid(p, small).is_err());
+    }
+
+    #[test]
+    fn non_finite_and_outside_points_are_counted_not_used() {
+        let g = GridGeometry::covering(0.0, 2000.0, 0.0, 1500.0, 50.0).unwrap();
+        let (mut x, mut y, mut z) = lines(&g, 8, |x, _| x / 100.0);
+        x.push(f64::NAN);
+        y.push(0.0);
+        z.push(1.0);
+        x.push(0.0);
+        y.push(0.0);
+        z.push(f64::INFINITY);
+        x.push(-500.0);
+        y.push(0.0);
+        z.push(1.0);
+        let (_, rep) = MinCurvature::default()
+            .grid(Points::new(&x, &y, &z).unwrap(), g)
+            .unwrap();
+        assert_eq!(rep.points_non_finite, 2);
+        assert_eq!(rep.points_outside, 1);
+        assert_eq!(rep.points_used, x.len() - 3);
+    }
+}
