@@ -2,7 +2,7 @@
 //! geology, planning and levelling figures of the spec.
 
 use aeromag::Silent;
-use aeromag::studies::{FixedWingStudy, Study, StudyOutcome, StudySize};
+use aeromag::studies::{FixedWingStudy, MapsStudy, Study, StudyOutcome, StudySize};
 
 #[test]
 fn the_fixed_wing_study_meets_the_compensation_figures() {
@@ -104,4 +104,34 @@ fn the_fixed_wing_study_meets_the_compensation_figures() {
         .map(|s| s.heading)
         .collect();
     assert_eq!(headings.len(), 6, "{headings:?}");
+
+    // Maps of the same survey (issue 22's figures): the levelled grid
+    // against the truth grid within 2× the along-line residual; the
+    // derivative map's line-parallel corrugation ≥ 10× lower after
+    // compensation.
+    let maps = MapsStudy::of(&out, Some(d.path().to_path_buf()))
+        .unwrap()
+        .run(StudySize::Full, &mut Silent)
+        .unwrap();
+    let m = maps.summary();
+    eprintln!("{m:?}");
+    assert!(
+        m.grid_rms_vs_truth_nt <= 2.0 * m.along_line_residual_nt,
+        "{m:?}"
+    );
+    assert!(m.corrugation_reduction >= 10.0, "{m:?}");
+    assert!(m.stripe_reduction_vs_truth >= 100.0, "{m:?}");
+    assert_eq!(maps.written().len(), 6);
+    for f in maps.written() {
+        assert!(f.exists(), "{}", f.display());
+    }
+    let section = maps.section().unwrap();
+    assert_eq!(
+        section
+            .blocks
+            .iter()
+            .filter(|b| matches!(b, aeromag::report::Block::Figure { .. }))
+            .count(),
+        8
+    );
 }

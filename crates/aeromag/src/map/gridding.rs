@@ -41,6 +41,13 @@ pub struct GridOptions {
     pub blanking_m: Option<f64>,
     /// The UTM zone; `None`: the zone of the data.
     pub zone: Option<UtmZone>,
+    /// The sensor's lever arm (body frame x, y, z, m, from the navigation
+    /// point): grid at the sensor's positions. `None`: at `lat`/`lon`.
+    pub lever_arm_m: Option<[f64; 3]>,
+    /// The grid's nodes; `None`: covering the data, at `cell_m`, nodes on
+    /// multiples of the cell. Give it to grid several columns on the same
+    /// nodes.
+    pub geometry: Option<GridGeometry>,
     /// The method.
     pub method: GridMethod,
     /// Minimum-curvature settings (tension 0.25 by default).
@@ -122,8 +129,8 @@ pub fn grid_flight(
     };
     let values = flight.require(&column)?;
     notes.stage("projecting");
-    let survey = ProjectedSurvey::of(flight, opts.zone)?;
-    let cell = match (opts.cell_m, &survey.lines) {
+    let survey = ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m)?;
+    let cell = match (opts.geometry.map(|g| g.cell).or(opts.cell_m), &survey.lines) {
         (Some(c), _) => c,
         (None, Some(l)) => l.default_cell_m(),
         (None, None) => {
@@ -170,7 +177,10 @@ pub fn grid_flight(
             format!("no row on a line has a finite {column} and position"),
         )
     })?;
-    let geometry = GridGeometry::covering(x0, x1, y0, y1, cell)?;
+    let geometry = match opts.geometry {
+        Some(g) => g,
+        None => GridGeometry::covering(x0, x1, y0, y1, cell)?,
+    };
     notes.stage("gridding");
     let (mut grid_values, report) = match (opts.method, &survey.lines) {
         (GridMethod::MinCurvature, _) => opts.min_curvature.grid(points, geometry)?,

@@ -9,9 +9,12 @@
 //!    ([`Spectral::Corrugation`]): stripes along the lines pass, the
 //!    geology mostly does not.
 //! 3. The corrugation grid is sampled (bilinearly) at every row on a line
-//!    and low-passed along the line by a running mean over
-//!    `along_line_m` of track (level errors drift slowly; what varies
-//!    faster along a line is geology the filter let through).
+//!    and reduced to a correction per line: by default one level per line,
+//!    the median of the samples (level errors are constant along a line;
+//!    geology the filter let through — an anomaly crossed by one line only
+//!    is elongated along it on the grid — is local, and the median ignores
+//!    it); with `along_line_m`, a running mean over that length of track
+//!    (for level errors that drift along long lines).
 //! 4. The correction is minus that; the micro-levelled column is the
 //!    column plus the correction.
 
@@ -35,9 +38,12 @@ pub struct MicrolevelOptions {
     pub cell_m: Option<f64>,
     /// UTM zone (default: the data's).
     pub zone: Option<UtmZone>,
+    /// The sensor's lever arm, m (as [`GridOptions::lever_arm_m`]).
+    pub lever_arm_m: Option<[f64; 3]>,
     /// Cut-off wavelength of the high-pass, in line spacings (default 4).
     pub cutoff_line_spacings: f64,
-    /// Length of the along-line running mean, m (default: 8 line spacings).
+    /// Length of an along-line running mean of the correction, m; `None`
+    /// (default): one level per line, the median of its samples.
     pub along_line_m: Option<f64>,
     /// Power of the directional cosine filter (default 2).
     pub cosine_power: f64,
@@ -51,6 +57,7 @@ impl Default for MicrolevelOptions {
             column: None,
             cell_m: None,
             zone: None,
+            lever_arm_m: None,
             cutoff_line_spacings: 4.0,
             along_line_m: None,
             cosine_power: 2.0,
@@ -73,8 +80,8 @@ pub struct Microlevelled {
     pub lines: LineGeometry,
     /// Cell of the working grid, m.
     pub cell_m: f64,
-    /// The along-line running mean used, m.
-    pub along_line_m: f64,
+    /// The along-line running mean used, m (`None`: a level per line).
+    pub along_line_m: Option<f64>,
     /// RMS of the correction over the rows on lines, nT.
     pub correction_rms_nt: f64,
     /// Largest |correction|, nT.
@@ -121,6 +128,7 @@ pub fn microlevel(
             column: opts.column.clone(),
             cell_m: opts.cell_m,
             zone: opts.zone,
+            lever_arm_m: opts.lever_arm_m,
             // The filter needs the whole grid: nothing is blanked here.
             blanking_m: Some(f64::MAX),
             min_curvature: opts.min_curvature,
@@ -173,7 +181,10 @@ pub fn microlevel(
             }
         })
         .collect();
-    let smooth = along_line_mean(&survey.x, &survey.y, ids, &sampled, along);
+    let smooth = match opts.along_line_m {
+        Some(along) => along_line_mean(&survey.x, &survey.y, ids, &sampled, along),
+        None => line_medians(ids, &sampled),
+    };
     let mut correction = vec![0.0; n];
     for k in 0..n {
         if smooth[k].is_finite() {
@@ -193,11 +204,44 @@ pub fn microlevel(
         values,
         lines,
         cell_m: gridded.grid.geometry.cell,
-        along_line_m: along,
+        along_line_m: opts.along_line_m,
         correction_rms_nt: rms,
         correction_max_nt: max,
         notes: notes.into_notes(),
     })
+}
+
+/// Per row, the median of the finite `v` of its line (id ≠ 0; NaN for rows
+/// on no line or lines without a finite value).
+fn line_medians(ids: &[f64], v: &[f64]) -> Vec<f64> {
+    let mut by_line: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
+    for (id, x) in ids.iter().zip(v) {
+        if *id != 0.0 && x.is_finite() {
+            by_line.entry(*id as i64).or_default().push(*x);
+        }
+    }
+    let medians: std::collections::BTreeMap<i64, f64> = by_line
+        .into_iter()
+        .map(|(id, mut xs)| {
+            xs.sort_by(f64::total_cmp);
+            let n = xs.len();
+            let m = if n % 2 == 1 {
+                xs[n / 2]
+            } else {
+                0.5 * (xs[n / 2 - 1] + xs[n / 2])
+            };
+            (id, m)
+        })
+        .collect();
+    ids.iter()
+        .map(|id| {
+            if *id == 0.0 {
+                f64::NAN
+            } else {
+                medians.get(&(*id as i64)).copied().unwrap_or(f64::NAN)
+            }
+        })
+        .collect()
 }
 
 /// The running mean of `v` over `window_m` of track, within each run of
@@ -251,6 +295,16 @@ fn along_line_mean(x: &[f64], y: &[f64], ids: &[f64], v: &[f64], window_m: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn line_medians_ignore_a_local_anomaly() {
+        let ids = [1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 2.0, 2.0];
+        let v = [0.5, 0.5, 9.0, 0.5, 0.4, 3.0, -1.0, -2.0];
+        let m = line_medians(&ids, &v);
+        assert_eq!(&m[..5], &[0.5; 5]);
+        assert!(m[5].is_nan());
+        assert_eq!(&m[6..], &[-1.5, -1.5]);
+    }
 
     #[test]
     fn the_along_line_mean_stays_within_each_line() {

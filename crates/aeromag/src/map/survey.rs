@@ -13,7 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
-use crate::flight::LineLabels;
+use crate::flight::{LineLabels, sensor_track};
 use aeromag_grid::projection::{Utm, UtmZone};
 
 /// A flight's rows in UTM (m) and its lines' geometry.
@@ -51,10 +51,21 @@ pub struct LineGeometry {
 
 impl ProjectedSurvey {
     /// Project `flight`'s `lat`/`lon` (degrees) to UTM in `zone`, or in the
-    /// zone of the data when `None`, and find its lines' geometry.
-    pub fn of(flight: &Flight, zone: Option<UtmZone>) -> Result<Self> {
-        let lat = flight.require("lat")?;
-        let lon = flight.require("lon")?;
+    /// zone of the data when `None`, and find its lines' geometry. With a
+    /// lever arm (body frame, m, from the navigation point), the sensor's
+    /// positions are projected instead (attitude and `alt` needed).
+    pub fn of(
+        flight: &Flight,
+        zone: Option<UtmZone>,
+        lever_arm_m: Option<[f64; 3]>,
+    ) -> Result<Self> {
+        let track = lever_arm_m
+            .map(|arm| sensor_track(flight, arm))
+            .transpose()?;
+        let (lat, lon) = match &track {
+            Some([la, lo, _]) => (la.as_slice(), lo.as_slice()),
+            None => (flight.require("lat")?, flight.require("lon")?),
+        };
         let zone = match zone {
             Some(z) => z,
             None => UtmZone::for_points(lat, lon)

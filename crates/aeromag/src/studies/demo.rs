@@ -3,8 +3,9 @@
 
 use super::{
     EmStudy, EmSummary, FixedWingStudy, FixedWingSummary, GradiometryStudy, GradiometrySummary,
-    MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary, PrintedFigure, PrintedSummary,
-    RotorStudyRun, RotorSummary, StreamStudy, StreamSummary, Study, StudyOutcome, StudySize,
+    MapsStudy, MapsSummary, MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary,
+    PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, StreamStudy, StreamSummary, Study,
+    StudyOutcome, StudySize,
 };
 use crate::error::Result;
 use crate::observer::Observer;
@@ -42,6 +43,8 @@ pub struct DemoSummary {
     pub multi_sensor: MultiSensorSummary,
     /// On board: causal and adaptive compensation.
     pub stream: StreamSummary,
+    /// Maps of the survey.
+    pub maps: MapsSummary,
     /// Seed of the fixed-wing flights.
     pub seed: u64,
     /// Version of aeromag.
@@ -66,6 +69,7 @@ impl PrintedSummary for DemoSummary {
         rows.extend(self.gradiometry.printed());
         rows.extend(self.multi_sensor.printed());
         rows.extend(self.stream.printed());
+        rows.extend(self.maps.printed());
         rows
     }
 }
@@ -123,6 +127,7 @@ impl Study for Demo {
         let pod = PodStudy.run(size, observer)?;
         let multi_sensor = MultiSensorStudy { seed: self.seed }.run(size, observer)?;
         let stream = StreamStudy { seed: self.seed }.run(size, observer)?;
+        let maps = MapsStudy::of(&fixed_wing, Some(self.out.clone()))?.run(size, observer)?;
         let mut sections = fixed_wing.sections()?;
         sections.extend(rotor.sections()?);
         sections.extend(pod.sections()?);
@@ -130,6 +135,7 @@ impl Study for Demo {
         sections.extend(gradiometry.sections()?);
         sections.extend(multi_sensor.sections()?);
         sections.extend(stream.sections()?);
+        sections.extend(maps.sections()?);
         Ok(DemoOutcome {
             summary: DemoSummary {
                 fixed_wing: fixed_wing.summary(),
@@ -139,6 +145,7 @@ impl Study for Demo {
                 gradiometry: gradiometry.summary(),
                 multi_sensor: multi_sensor.summary(),
                 stream: stream.summary(),
+                maps: maps.summary(),
                 seed: self.seed,
                 software_version: env!("CARGO_PKG_VERSION"),
             },

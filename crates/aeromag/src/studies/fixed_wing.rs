@@ -214,6 +214,7 @@ pub struct FixedWingOutcome {
     plan: Option<(PlanningSummary, [Observability; 2])>,
     levelled: [Levelled; 2],
     survey_lag_s: f64,
+    lever_arm_m: [f64; 3],
     summary: FixedWingSummary,
 }
 
@@ -505,6 +506,7 @@ impl Study for FixedWingStudy {
             plan,
             levelled,
             survey_lag_s: lag,
+            lever_arm_m: opts.lever_arm.map_or([0.0; 3], |l| l.arm_m),
             summary,
         })
     }
@@ -562,6 +564,22 @@ impl PrintedSummary for FixedWingSummary {
             ),
         ]);
         rows
+    }
+}
+
+impl FixedWingOutcome {
+    /// The survey compensated by least squares (`mag_comp`) and levelled
+    /// with the base station and IGRF subtracted (`mag_comp_level`), as
+    /// `aeromag level --reference auto` writes it.
+    pub fn levelled_survey(&self) -> Result<Flight> {
+        let mut table = self.survey.table().clone();
+        self.levelled[0].add_to(&mut table)?;
+        Flight::from_table(table)
+    }
+
+    /// The scalar sensor's lever arm (body frame, m).
+    pub fn lever_arm_m(&self) -> [f64; 3] {
+        self.lever_arm_m
     }
 }
 

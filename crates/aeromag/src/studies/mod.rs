@@ -16,6 +16,7 @@ mod demo;
 mod em;
 mod fixed_wing;
 mod gradiometry;
+mod maps;
 mod multi_sensor;
 mod pod;
 mod rotor;
@@ -28,6 +29,7 @@ pub use fixed_wing::{
     LevellingSummary, PlanningSummary,
 };
 pub use gradiometry::{GradiometryOutcome, GradiometryStudy, GradiometrySummary};
+pub use maps::{MapsOutcome, MapsStudy, MapsSummary};
 pub use multi_sensor::{
     CALIBRATION_CYCLES, MultiSensorOutcome, MultiSensorStudy, MultiSensorSummary, SGL_CURRENTS,
     SensorFigures,

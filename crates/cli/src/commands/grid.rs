@@ -55,6 +55,10 @@ pub struct Args {
     /// the data's median longitude).
     #[arg(long, value_name = "ZONE", value_parser = utm_zone)]
     utm_zone: Option<UtmZone>,
+    /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
+    /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
+    lever_arm: Option<[f64; 3]>,
 }
 
 fn utm_zone(s: &str) -> Result<UtmZone, String> {
@@ -69,11 +73,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         cell_m: a.cell,
         blanking_m: a.blanking,
         zone: a.utm_zone,
+        lever_arm_m: a.lever_arm,
         method: a.method,
         min_curvature: MinCurvature {
             tension: a.tension,
             ..MinCurvature::default()
         },
+        ..GridOptions::default()
     };
     let g = grid_flight(&flight, &opts, &mut Bars::new())?;
     let format = g.write(&a.out)?;

@@ -16,9 +16,9 @@ use std::path::PathBuf;
 ///
 /// The column is gridded by minimum curvature; a high-pass Butterworth
 /// filter across the lines (cut-off: --cutoff line spacings) times a
-/// directional cosine filter isolates the stripes along the lines; their
-/// value at each row, averaged along the line over --along-line metres,
-/// is the correction.
+/// directional cosine filter isolates the stripes along the lines; the
+/// median of their value along each line (or their running mean over
+/// --along-line metres) is the line's correction.
 ///
 /// Examples:
 ///   aeromag microlevel -i levelled.csv --out micro.csv
@@ -41,8 +41,9 @@ pub struct Args {
     /// Cut-off wavelength of the high-pass filter, in line spacings.
     #[arg(long, default_value_t = 4.0, value_parser = args::positive)]
     cutoff: f64,
-    /// Length of the along-line running mean of the correction, m
-    /// (default: eight line spacings).
+    /// Length of an along-line running mean of the correction, m (for
+    /// level errors that drift along long lines; default: one level per
+    /// line, the median of the corrugation sampled along it).
     #[arg(long, value_parser = args::positive)]
     along_line: Option<f64>,
     /// Power of the directional cosine filter (higher: narrower around the
@@ -55,6 +56,10 @@ pub struct Args {
     /// UTM zone, e.g. `37N` (default: the data's).
     #[arg(long, value_name = "ZONE", value_parser = utm_zone)]
     utm_zone: Option<UtmZone>,
+    /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
+    /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
+    lever_arm: Option<[f64; 3]>,
 }
 
 fn utm_zone(s: &str) -> Result<UtmZone, String> {
@@ -68,6 +73,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         column: a.column.clone(),
         cell_m: a.cell,
         zone: a.utm_zone,
+        lever_arm_m: a.lever_arm,
         cutoff_line_spacings: a.cutoff,
         along_line_m: a.along_line,
         cosine_power: a.cosine_power,
@@ -90,10 +96,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         m.cell_m
     );
     println!(
-        "filter: high-pass cut-off {:.0} m ({} line spacings), along-line mean over {:.0} m",
+        "filter: high-pass cut-off {:.0} m ({} line spacings); correction {}",
         opts.cutoff_line_spacings * m.lines.spacing_m,
         opts.cutoff_line_spacings,
         m.along_line_m
+            .map_or("one level per line (median)".into(), |a| format!(
+                "averaged along the lines over {a:.0} m"
+            ))
     );
     println!(
         "correction {}: RMS {:.3} nT, largest {:.3} nT",

@@ -54,6 +54,14 @@ pub struct Heatmap {
     /// One metre per pixel on both axes (maps in easting/northing): the plot
     /// area shrinks to the data's aspect ratio and is centred.
     pub equal_aspect: bool,
+    /// Colour-shaded relief: each cell's colour is darkened by the
+    /// illumination of the surface from the north-east at 45° elevation
+    /// (the gradient scaled so that its RMS slope is 45°), as magnetic maps
+    /// are drawn to show short-wavelength detail and stripes.
+    pub shaded: bool,
+    /// Polylines drawn over the cells in data coordinates (flight lines),
+    /// one dark grey pixel wide.
+    pub overlay: Vec<Vec<(f64, f64)>>,
 }
 
 /// Width reserved right of the plot for the colour bar, excluding labels.
@@ -172,6 +180,50 @@ impl Heatmap {
         }
     }
 
+    /// Per cell, the brightness factor of [`Heatmap::shaded`]
+    /// (`0.55 + 0.45 · max(0, n̂·l̂)`; 1 for blank cells and unshaded maps).
+    fn shading(&self) -> Vec<f64> {
+        let (nx, ny) = (self.x.len(), self.y.len());
+        let mut f = vec![1.0; nx * ny];
+        if !self.shaded || nx < 2 || ny < 2 {
+            return f;
+        }
+        let v = |i: usize, j: usize| self.values[j * nx + i];
+        // Central (one-sided at the edges) differences, per unit of x and y.
+        let grad = |i: usize, j: usize| {
+            let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
+            let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
+            (
+                (v(i1, j) - v(i0, j)) / (self.x[i1] - self.x[i0]),
+                (v(i, j1) - v(i, j0)) / (self.y[j1] - self.y[j0]),
+            )
+        };
+        let g: Vec<(f64, f64)> = (0..nx * ny).map(|k| grad(k % nx, k / nx)).collect();
+        let finite: Vec<f64> = g
+            .iter()
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .map(|(a, b)| a * a + b * b)
+            .collect();
+        if finite.is_empty() {
+            return f;
+        }
+        let rms = (finite.iter().sum::<f64>() / finite.len() as f64).sqrt();
+        if !(rms > 0.0) {
+            return f;
+        }
+        let (az, el) = (45f64.to_radians(), 45f64.to_radians());
+        let light = (el.cos() * az.sin(), el.cos() * az.cos(), el.sin());
+        for (fk, (gx, gy)) in f.iter_mut().zip(&g) {
+            if gx.is_finite() && gy.is_finite() {
+                let (px, py) = (gx / rms, gy / rms);
+                let n = (1.0 + px * px + py * py).sqrt();
+                let cos_i = (-px * light.0 - py * light.1 + light.2) / n;
+                *fk = 0.55 + 0.45 * cos_i.max(0.0);
+            }
+        }
+        f
+    }
+
     /// The cell raster: one pixel per cell for uniform grids, else sampled
     /// at `w × h` pixels. Rows top (max y) to bottom.
     fn cell_image(
@@ -195,13 +247,17 @@ impl Heatmap {
             edges.partition_point(|&e| e <= v).clamp(1, edges.len() - 1) - 1
         };
         let cols: Vec<usize> = (0..img_w).map(|i| lookup(xe, img_w, i)).collect();
+        let shade = self.shading();
         let mut rgb = Vec::with_capacity(img_w as usize * img_h as usize * 3);
         for row in 0..img_h {
             // Image row 0 is the top = largest y.
             let iy = lookup(ye, img_h, img_h - 1 - row);
             for &ix in &cols {
-                let Rgb(r, g, b) = self.color_of(self.values[iy * nx + ix], range);
-                rgb.extend_from_slice(&[r, g, b]);
+                let k = iy * nx + ix;
+                let Rgb(r, g, b) = self.color_of(self.values[k], range);
+                let f = shade[k];
+                let dim = |c: u8| (f64::from(c) * f).round().clamp(0.0, 255.0) as u8;
+                rgb.extend_from_slice(&[dim(r), dim(g), dim(b)]);
             }
         }
         (img_w, img_h, rgb)
@@ -308,6 +364,12 @@ impl Figure for Heatmap {
                 rgb,
             },
         )?;
+        let line_style = theme::AXIS.to_plotters().stroke_width(1);
+        for line in &self.overlay {
+            chart
+                .draw_series(LineSeries::new(line.iter().copied(), line_style))
+                .map_err(ReportError::draw)?;
+        }
         canvas::draw_axes(&mut chart, &x, &y, false)?;
 
         // Colour bar: a 1 × 256 raster, top = hi.
@@ -385,6 +447,25 @@ mod tests {
         let y: Vec<f64> = (0..ny).map(|i| 10.0 * i as f64).collect();
         let values = (0..nx * ny).map(|k| k as f64).collect();
         Heatmap::new("h", "x (m)", "y (m)", x, y, values, "v (nT)")
+    }
+
+    #[test]
+    fn shading_darkens_slopes_facing_away_from_the_light() {
+        // A ramp rising to the north-east is lit head-on on its slope…
+        let x: Vec<f64> = (0..5).map(f64::from).collect();
+        let ramp = |s: f64| {
+            (0..25)
+                .map(|k| s * ((k % 5) as f64 + (k / 5) as f64))
+                .collect()
+        };
+        let mut h = Heatmap::new("h", "x", "y", x.clone(), x.clone(), ramp(-1.0), "v");
+        h.shaded = true;
+        let towards = h.shading()[12];
+        h.values = ramp(1.0);
+        let away = h.shading()[12];
+        assert!(towards > away, "{towards} {away}");
+        h.shaded = false;
+        assert!(h.shading().iter().all(|&f| f == 1.0));
     }
 
     #[test]
