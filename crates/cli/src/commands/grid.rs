@@ -5,6 +5,7 @@
 use crate::args;
 use crate::input::InputArgs;
 use crate::progress::Bars;
+use aeromag::grid::GridGeometry;
 use aeromag::grid::gridding::MinCurvature;
 use aeromag::grid::projection::UtmZone;
 use aeromag::map::gridding::GridMethod;
@@ -47,6 +48,12 @@ pub struct Args {
     /// Gridding method.
     #[arg(long, value_enum, default_value_t = GridMethod::MinCurvature)]
     method: GridMethod,
+    /// The grid's extent in the projected coordinates, m: the western and
+    /// eastern columns and the southern and northern rows of nodes
+    /// (default: the data's extent, nodes on multiples of the cell).
+    #[arg(long, value_name = "XMIN,XMAX,YMIN,YMAX", allow_hyphen_values = true,
+          value_parser = extent)]
+    extent: Option<[f64; 4]>,
     /// Blank nodes farther than this from the data, m (default: the line
     /// spacing).
     #[arg(long, value_parser = args::positive)]
@@ -61,14 +68,25 @@ pub struct Args {
     lever_arm: Option<[f64; 3]>,
 }
 
+fn extent(s: &str) -> Result<[f64; 4], String> {
+    let v = args::numbers(s, 4)?;
+    Ok([v[0], v[1], v[2], v[3]])
+}
+
 fn utm_zone(s: &str) -> Result<UtmZone, String> {
     UtmZone::parse(s).map_err(|e| e.to_string())
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files(std::iter::once(a.out.as_path()))?;
+    let geometry = match (&a.extent, a.cell) {
+        (Some(e), Some(cell)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], cell)?),
+        (Some(_), None) => return Err(crate::exit::bad_input!("--extent needs --cell")),
+        (None, _) => None,
+    };
     let flight = a.input.load()?;
     let opts = GridOptions {
+        geometry,
         column: a.column.clone(),
         cell_m: a.cell,
         blanking_m: a.blanking,

@@ -208,7 +208,7 @@ impl Heatmap {
             return f;
         }
         let rms = (finite.iter().sum::<f64>() / finite.len() as f64).sqrt();
-        if !(rms > 0.0) {
+        if rms.is_nan() || rms <= 0.0 {
             return f;
         }
         let (az, el) = (45f64.to_radians(), 45f64.to_radians());
