@@ -120,3 +120,94 @@ fn bad_arguments_and_files_exit_with_code_2() {
         0,
     );
 }
+
+#[test]
+fn derived_grids_and_micro_levelling_from_the_command_line() {
+    let d = tempfile::tempdir().unwrap();
+    let input = survey(d.path());
+    let g = d.path().join("mag.tif");
+    assert_code(&grid(&input, &g, &["--column", "true_anomaly"]), 0);
+    let run = |args: &[&str]| {
+        let mut a = vec!["derive", "-i", g.to_str().unwrap()];
+        a.extend(args);
+        aeromag(&a)
+    };
+    let fvd = d.path().join("fvd.nc");
+    let o = run(&["--vertical-derivative", "--out", fvd.to_str().unwrap()]);
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).contains("vertical derivative") && stdout(&o).contains("nT/m"),
+        "{}",
+        stdout(&o)
+    );
+    let up = d.path().join("up.asc");
+    assert_code(&run(&["--upward", "150", "--out", up.to_str().unwrap()]), 0);
+    let zero = d.path().join("zero.tif");
+    let o = run(&[
+        "--minus",
+        g.to_str().unwrap(),
+        "--out",
+        zero.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).contains("mean 0.0000, std 0.0000"),
+        "{}",
+        stdout(&o)
+    );
+    // Exactly one product; unreadable grids are bad input.
+    assert_code(&run(&["--out", zero.to_str().unwrap()]), 2);
+    assert_code(
+        &run(&[
+            "--upward",
+            "1",
+            "--vertical-derivative",
+            "--out",
+            zero.to_str().unwrap(),
+        ]),
+        2,
+    );
+    std::fs::write(d.path().join("bad.tif"), "not a tiff").unwrap();
+    let o = aeromag(&[
+        "derive",
+        "-i",
+        d.path().join("bad.tif").to_str().unwrap(),
+        "--vertical-derivative",
+        "--out",
+        zero.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("bad.tif"), "{}", stderr(&o));
+
+    let out = d.path().join("micro.csv");
+    let o = aeromag(&[
+        "microlevel",
+        "-i",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(
+        s.contains("mag → mag_mlev") && s.contains("correction mag_mlev_corr: RMS"),
+        "{s}"
+    );
+    let header = std::fs::read_to_string(&out).unwrap();
+    let header = header.lines().find(|l| !l.starts_with('#')).unwrap();
+    assert!(header.ends_with("mag_mlev,mag_mlev_corr"), "{header}");
+    // Running it again on its own output: the column exists already.
+    let again = d.path().join("again.csv");
+    assert_code(
+        &aeromag(&[
+            "microlevel",
+            "-i",
+            out.to_str().unwrap(),
+            "--column",
+            "mag",
+            "--out",
+            again.to_str().unwrap(),
+        ]),
+        2,
+    );
+}

@@ -46,6 +46,15 @@ pub enum GridError {
     /// A grid file format this crate does not write (the extension decides).
     #[error("unknown grid format '{0}': use .tif, .asc, .nc or .grd")]
     UnknownFormat(String),
+    /// A grid file that cannot be read: missing, truncated, or not in the
+    /// format its extension says.
+    #[error("reading '{path}': {reason}")]
+    Read {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// Writing a grid file failed.
     #[error("writing '{path}': {source}")]
     Write {

@@ -6,14 +6,18 @@
 //! - [`gridding`] — [`grid_flight`]: a column of a flight on a grid by
 //!   minimum curvature with tension, blanked away from the lines
 //!   ([`SurveyGrid`]);
+//! - [`derive`](mod@derive) — [`derive()`]: first vertical derivative,
+//!   upward continuation or difference of grid files;
 //! - [`microlevel`](mod@microlevel) — [`microlevel()`]: the corrugation left along the
 //!   lines after levelling, removed by a directional filter of the grid
 //!   and a correction per row ([`Microlevelled`]).
 
+pub mod derive;
 pub mod gridding;
 pub mod microlevel;
 pub mod survey;
 
+pub use derive::{GridProduct, derive};
 pub use gridding::{GridOptions, SurveyGrid, grid_flight};
 pub use microlevel::{MicrolevelOptions, Microlevelled, microlevel};
 pub use survey::{LineGeometry, ProjectedSurvey};

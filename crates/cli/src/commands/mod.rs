@@ -3,6 +3,7 @@
 pub mod calibrate;
 pub mod compensate;
 pub mod demo;
+pub mod derive;
 pub mod dipole;
 pub mod em;
 pub mod grid;

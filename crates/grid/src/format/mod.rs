@@ -207,7 +207,10 @@ pub(crate) fn write_atomic(
 
 /// The error of a file that cannot be read or parsed.
 pub(crate) fn read_error(path: &Path, what: impl std::fmt::Display) -> GridError {
-    GridError::Data(format!("reading '{}': {what}", path.display()))
+    GridError::Read {
+        path: path.display().to_string(),
+        reason: what.to_string(),
+    }
 }
 
 /// Checks the geometry of a grid read from a file (positive cell, node
