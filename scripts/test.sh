@@ -17,6 +17,20 @@ if ! python3 -c "import numpy, h5py" >/dev/null 2>&1; then
     python3 -m pip install --quiet --user numpy h5py || python3 -m pip install --quiet numpy h5py
 fi
 phase() { echo "== $1 (${SECONDS}s since start)" >&2; }
+# GDAL's gdalinfo checks the grid files (GeoTIFF GeoKeys, ESRI ASCII, netCDF)
+# in aeromag-grid's tests: Debian's gdal-bin, installed in the background
+# while the tests build (the test says SKIPPED when it is missing).
+gdal_install=""
+if ! command -v gdalinfo >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
+    echo "gdalinfo not found; installing Debian's gdal-bin for the grid-file tests" >&2
+    (apt-get install -y --no-install-recommends gdal-bin >/dev/null 2>&1 \
+        || { apt-get update >/dev/null 2>&1 && apt-get install -y --no-install-recommends gdal-bin >/dev/null 2>&1; } \
+        || echo "could not install gdal-bin; the gdalinfo test will be skipped" >&2) &
+    gdal_install=$!
+fi
+cargo nextest run --workspace --release --no-fail-fast --no-run "$@"
+[ -n "$gdal_install" ] && wait "$gdal_install"
+phase "tests built"
 cargo nextest run --workspace --release --no-fail-fast "$@"
 phase "Rust tests done"
 # nextest does not run doc tests
