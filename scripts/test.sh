@@ -28,7 +28,7 @@ if ! command -v gdalinfo >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; 
         || echo "could not install gdal-bin; the gdalinfo test will be skipped" >&2) &
     gdal_install=$!
 fi
-cargo nextest run --workspace --release --no-fail-fast --no-run "$@"
+cargo nextest run --workspace --release --no-run "$@"
 [ -n "$gdal_install" ] && wait "$gdal_install"
 phase "tests built"
 cargo nextest run --workspace --release --no-fail-fast "$@"

@@ -10,6 +10,7 @@
 //! | [`flight`] | `Flight`, `read_flight` |
 //! | [`tolles_lawson`] | `calibrate`, `TlModel`, `load_model`, `observability` |
 //! | [`level`] | `level`, `Levelled`, `score` |
+//! | [`map`] | `grid_flight`, `Grid`, `read_grid`, `microlevel`, `Microlevelled` |
 //! | [`rotor_pod`] | `fit_rotor`, `fit_pod`, `Model` |
 //! | [`gradiometry`] | `locate_dipole`, `dipole_crlb`, `simulate_gradiometer` |
 //! | [`em`] | `simulate_em`, `detect_em`, `calibrate_em`, `locate_em` |
@@ -26,6 +27,7 @@ mod fields;
 mod flight;
 mod gradiometry;
 mod level;
+mod map;
 mod online;
 mod progress;
 mod rotor_pod;
@@ -58,6 +60,11 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<level::PyLevelled>()?;
     m.add_function(wrap_pyfunction!(level::level, m)?)?;
     m.add_function(wrap_pyfunction!(level::score, m)?)?;
+    m.add_class::<map::PyGrid>()?;
+    m.add_class::<map::PyMicrolevelled>()?;
+    m.add_function(wrap_pyfunction!(map::grid_flight, m)?)?;
+    m.add_function(wrap_pyfunction!(map::read_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(map::microlevel, m)?)?;
     m.add_function(wrap_pyfunction!(fields::igrf, m)?)?;
     m.add_function(wrap_pyfunction!(fields::decimal_year, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;

@@ -1,0 +1,313 @@
+//! From lines to the map (`aeromag grid`, `aeromag microlevel`,
+//! `aeromag derive`): grids as NumPy arrays with their coordinates and CRS.
+
+use crate::errors::{IntoPy, bad_argument};
+use crate::flight::PyFlight;
+use crate::progress::PyProgress;
+use aeromag::Flight;
+use aeromag::grid::format::{read_grid as lib_read_grid, write_grid};
+use aeromag::grid::gridding::MinCurvature;
+use aeromag::grid::products::{Spectral, apply};
+use aeromag::grid::projection::UtmZone;
+use aeromag::grid::{Grid, GridGeometry};
+use aeromag::map::gridding::GridMethod;
+use aeromag::map::{GridOptions, MicrolevelOptions, Microlevelled, grid_flight as lib_grid, microlevel as lib_microlevel};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
+    utm_zone.map(|z| UtmZone::parse(z).py_err()).transpose()
+}
+
+fn tension(t: f64) -> MinCurvature {
+    MinCurvature {
+        tension: t,
+        ..MinCurvature::default()
+    }
+}
+
+/// A grid (`aeromag grid`): node values with their easting/northing (m)
+/// and coordinate system.
+#[pyclass(name = "Grid", module = "aeromag._aeromag", frozen)]
+pub struct PyGrid {
+    grid: Grid,
+    info: Vec<(&'static str, Py<PyAny>)>,
+}
+
+impl PyGrid {
+    fn plain(grid: Grid) -> Self {
+        Self { grid, info: Vec::new() }
+    }
+}
+
+#[pymethods]
+impl PyGrid {
+    /// Node values, shape (ny, nx), row 0 the southern row; NaN = blank.
+    #[getter]
+    fn values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let g = self.grid.geometry;
+        let rows: Vec<Vec<f64>> = self.grid.values.chunks(g.nx.max(1)).map(<[f64]>::to_vec).collect();
+        PyArray2::from_vec2(py, &rows).map_err(|e| bad_argument(e.to_string()))
+    }
+
+    /// Easting of each column of nodes, m.
+    #[getter]
+    fn x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let g = self.grid.geometry;
+        PyArray1::from_vec(py, (0..g.nx).map(|i| g.x(i)).collect())
+    }
+
+    /// Northing of each row of nodes, m.
+    #[getter]
+    fn y<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let g = self.grid.geometry;
+        PyArray1::from_vec(py, (0..g.ny).map(|j| g.y(j)).collect())
+    }
+
+    /// Node spacing, m.
+    #[getter]
+    fn cell(&self) -> f64 {
+        self.grid.geometry.cell
+    }
+
+    /// EPSG code of the coordinate system (None if unknown).
+    #[getter]
+    fn epsg(&self) -> Option<u16> {
+        self.grid.crs.map(|c| c.epsg())
+    }
+
+    /// Name of the coordinate system, e.g. `WGS 84 / UTM zone 37N`.
+    #[getter]
+    fn crs(&self) -> Option<String> {
+        self.grid.crs.map(|c| c.name())
+    }
+
+    /// What is gridded.
+    #[getter]
+    fn name(&self) -> String {
+        self.grid.name.clone()
+    }
+
+    /// Its unit.
+    #[getter]
+    fn unit(&self) -> String {
+        self.grid.unit.clone()
+    }
+
+    /// How the grid was made (`grid_flight`): column, line spacing and
+    /// direction, blanking, convergence; empty for other grids.
+    #[getter]
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.info {
+            d.set_item(k, v.clone_ref(py))?;
+        }
+        Ok(d)
+    }
+
+    /// Count, mean, std, min and max of the non-blank nodes.
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.grid.stats();
+        let d = PyDict::new(py);
+        d.set_item("count", s.count)?;
+        d.set_item("mean", s.mean)?;
+        d.set_item("std", s.std)?;
+        d.set_item("min", s.min)?;
+        d.set_item("max", s.max)?;
+        Ok(d)
+    }
+
+    /// Bilinear interpolation at an easting and northing (m); NaN outside
+    /// the grid or next to a blank node.
+    fn sample(&self, x: f64, y: f64) -> f64 {
+        self.grid.sample(x, y)
+    }
+
+    /// First vertical derivative (z down), unit per metre (FFT).
+    fn vertical_derivative(&self, py: Python<'_>) -> PyResult<PyGrid> {
+        let g = py.detach(|| apply(&self.grid, Spectral::VerticalDerivative)).py_err()?;
+        Ok(PyGrid::plain(g))
+    }
+
+    /// Upward continuation by `height_m` (FFT).
+    fn upward(&self, py: Python<'_>, height_m: f64) -> PyResult<PyGrid> {
+        let g = py.detach(|| apply(&self.grid, Spectral::UpwardContinuation(height_m))).py_err()?;
+        Ok(PyGrid::plain(g))
+    }
+
+    /// This grid minus `other` (the same nodes).
+    fn minus(&self, other: &PyGrid) -> PyResult<PyGrid> {
+        Ok(PyGrid::plain(self.grid.difference(&other.grid).py_err()?))
+    }
+
+    /// Write the grid; the format follows the extension (`.tif`, `.asc`,
+    /// `.nc`/`.grd`).
+    fn write(&self, path: std::path::PathBuf) -> PyResult<()> {
+        write_grid(&path, &self.grid).py_err()?;
+        Ok(())
+    }
+
+    fn __repr__(&self) -> String {
+        let g = self.grid.geometry;
+        format!(
+            "Grid({} × {} nodes, cell {} m, {}, {})",
+            g.nx,
+            g.ny,
+            g.cell,
+            self.grid.crs.map_or("no CRS".into(), |c| c.name()),
+            self.grid.name
+        )
+    }
+}
+
+/// Grid a column of a survey (the keywords are `aeromag grid`'s flags).
+#[pyfunction]
+#[pyo3(signature = (flight, column=None, cell=None, tension=0.25, method="min-curvature", blanking=None,
+    utm_zone=None, lever_arm=None, extent=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn grid_flight(
+    py: Python<'_>,
+    flight: &PyFlight,
+    column: Option<String>,
+    cell: Option<f64>,
+    tension: f64,
+    method: &str,
+    blanking: Option<f64>,
+    utm_zone: Option<&str>,
+    lever_arm: Option<[f64; 3]>,
+    extent: Option<[f64; 4]>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<PyGrid> {
+    let method = match method {
+        "min-curvature" => GridMethod::MinCurvature,
+        "bidirectional" => GridMethod::Bidirectional,
+        m => return Err(bad_argument(format!("method '{m}': use 'min-curvature' or 'bidirectional'"))),
+    };
+    let geometry = match (extent, cell) {
+        (Some(e), Some(c)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], c).py_err()?),
+        (Some(_), None) => return Err(bad_argument("extent needs cell")),
+        (None, _) => None,
+    };
+    let opts = GridOptions {
+        column,
+        cell_m: cell,
+        blanking_m: blanking,
+        zone: zone(utm_zone)?,
+        lever_arm_m: lever_arm,
+        geometry,
+        method,
+        min_curvature: self::tension(tension),
+    };
+    let mut obs = PyProgress::new(progress);
+    let result = py.detach(|| lib_grid(&flight.inner, &opts, &mut obs));
+    obs.finish()?;
+    let g = result.py_err()?;
+    let mut info: Vec<(&'static str, Py<PyAny>)> = vec![
+        ("column", g.column.clone().into_pyobject(py)?.into_any().unbind()),
+        ("blanking_m", g.blanking_m.into_pyobject(py)?.into_any().unbind()),
+        ("blanked_nodes", g.blanked_nodes.into_pyobject(py)?.into_any().unbind()),
+        ("rows_used", g.rows_used.into_pyobject(py)?.into_any().unbind()),
+        ("converged", pyo3::types::PyBool::new(py, g.report.converged).to_owned().into_any().unbind()),
+        (
+            "notes",
+            g.notes.iter().map(|n| n.to_string()).collect::<Vec<_>>().into_pyobject(py)?.into_any().unbind(),
+        ),
+    ];
+    if let Some(l) = &g.survey.lines {
+        info.push(("line_spacing_m", l.spacing_m.into_pyobject(py)?.into_any().unbind()));
+        info.push(("line_direction_deg", l.direction_deg.into_pyobject(py)?.into_any().unbind()));
+    }
+    Ok(PyGrid { grid: g.grid, info })
+}
+
+/// Read a grid file (GeoTIFF, ESRI ASCII or netCDF).
+#[pyfunction]
+pub fn read_grid(path: std::path::PathBuf) -> PyResult<PyGrid> {
+    Ok(PyGrid::plain(lib_read_grid(&path).py_err()?))
+}
+
+/// A micro-levelled survey (`aeromag microlevel`).
+#[pyclass(name = "Microlevelled", module = "aeromag._aeromag", frozen)]
+pub struct PyMicrolevelled {
+    m: Microlevelled,
+    flight: Flight,
+}
+
+#[pymethods]
+impl PyMicrolevelled {
+    /// The column micro-levelled.
+    #[getter]
+    fn column(&self) -> String {
+        self.m.column.clone()
+    }
+
+    /// `<column>_mlev`.
+    #[getter]
+    fn output_column(&self) -> String {
+        self.m.output_column()
+    }
+
+    /// The micro-levelled values, nT.
+    #[getter]
+    fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.m.values)
+    }
+
+    /// The correction per row, nT (0 off the lines).
+    #[getter]
+    fn correction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.m.correction)
+    }
+
+    /// RMS and largest |correction| on the lines, nT.
+    #[getter]
+    fn correction_nt(&self) -> (f64, f64) {
+        (self.m.correction_rms_nt, self.m.correction_max_nt)
+    }
+
+    /// The flight with `<column>_mlev` and `<column>_mlev_corr` added.
+    fn to_flight(&self) -> PyResult<PyFlight> {
+        let mut t = self.flight.table().clone();
+        self.m.add_to(&mut t).py_err()?;
+        Ok(PyFlight::new(Flight::from_table(t).py_err()?))
+    }
+}
+
+/// Micro-level a levelled survey (the keywords are `aeromag microlevel`'s
+/// flags).
+#[pyfunction]
+#[pyo3(signature = (flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0,
+    tension=0.25, utm_zone=None, lever_arm=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn microlevel(
+    py: Python<'_>,
+    flight: &PyFlight,
+    column: Option<String>,
+    cell: Option<f64>,
+    cutoff: f64,
+    along_line: Option<f64>,
+    cosine_power: f64,
+    tension: f64,
+    utm_zone: Option<&str>,
+    lever_arm: Option<[f64; 3]>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<PyMicrolevelled> {
+    let opts = MicrolevelOptions {
+        column,
+        cell_m: cell,
+        zone: zone(utm_zone)?,
+        lever_arm_m: lever_arm,
+        cutoff_line_spacings: cutoff,
+        along_line_m: along_line,
+        cosine_power,
+        min_curvature: self::tension(tension),
+    };
+    let mut obs = PyProgress::new(progress);
+    let result = py.detach(|| lib_microlevel(&flight.inner, &opts, &mut obs));
+    obs.finish()?;
+    Ok(PyMicrolevelled {
+        m: result.py_err()?,
+        flight: flight.inner.clone(),
+    })
+}
