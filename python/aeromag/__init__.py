@@ -32,6 +32,7 @@ import numpy as np
 
 from . import _aeromag
 from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulate_em
+from ._aeromag import Grid, Microlevelled
 from ._aeromag import Flight, Levelled, Model, OnlineCompensator, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
 from .errors import AeromagError, BadInputError
@@ -43,6 +44,11 @@ __all__ = [
     "Flight",
     "Levelled",
     "Model",
+    "Grid",
+    "Microlevelled",
+    "grid_flight",
+    "microlevel",
+    "read_grid",
     "fit_pod",
     "fit_rotor",
     "dipole_crlb",
@@ -312,6 +318,89 @@ def level(
         ridge_lambda=ridge_lambda,
         reference=reference,
         ties=None if ties is None else [str(t) for t in ties],
+        progress=progress_callback(progress),
+    )
+
+
+def grid_flight(
+    flight: Flight,
+    column: Optional[str] = None,
+    cell: Optional[float] = None,
+    tension: float = 0.25,
+    method: str = "min-curvature",
+    blanking: Optional[float] = None,
+    utm_zone: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    extent: Optional[Tuple[float, float, float, float]] = None,
+    progress: Any = None,
+) -> Grid:
+    """Grid a column of a survey (``aeromag grid``).
+
+    Rows on lines are projected to UTM (``utm_zone`` such as ``"37N"`` or
+    ``"EPSG:32637"``, default the data's zone; at the sensor with
+    ``lever_arm``) and gridded by minimum curvature with ``tension``
+    (``method="bidirectional"``: along the lines, then across them).
+    Defaults follow the lines: ``column`` the most processed magnetic
+    column, ``cell`` a quarter of the line spacing rounded down to 1, 2, 2.5
+    or 5 × 10ᵏ m, ``blanking`` one line spacing; ``extent`` =
+    ``(xmin, xmax, ymin, ymax)`` in m with ``cell``.
+
+    Returns a :class:`Grid`: ``values`` (ny × nx, row 0 south, NaN blank),
+    ``x``, ``y`` (m), ``epsg``, ``info`` (line spacing, blanking,
+    convergence), ``vertical_derivative()``, ``upward(h)``, ``minus(g)``,
+    ``sample(x, y)``, ``write(path)`` (``.tif``, ``.asc``, ``.nc``).
+    """
+    from .tolles_lawson import progress_callback
+
+    return _aeromag.grid_flight(
+        flight,
+        column=column,
+        cell=cell,
+        tension=tension,
+        method=method,
+        blanking=blanking,
+        utm_zone=utm_zone,
+        lever_arm=lever_arm,
+        extent=extent,
+        progress=progress_callback(progress),
+    )
+
+
+def read_grid(path: PathLike) -> Grid:
+    """Read a grid file: GeoTIFF, ESRI ASCII or netCDF (as ``aeromag grid`` writes them)."""
+    return _aeromag.read_grid(os.fspath(path))
+
+
+def microlevel(
+    flight: Flight,
+    column: Optional[str] = None,
+    cell: Optional[float] = None,
+    cutoff: float = 4.0,
+    along_line: Optional[float] = None,
+    cosine_power: float = 2.0,
+    tension: float = 0.25,
+    utm_zone: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    progress: Any = None,
+) -> Microlevelled:
+    """Micro-level a levelled survey (``aeromag microlevel``, Minty 1991).
+
+    Returns a :class:`Microlevelled`: ``values``, ``correction`` (nT per
+    row), ``correction_nt`` (RMS, largest), ``to_flight()`` with
+    ``<column>_mlev`` and ``<column>_mlev_corr``.
+    """
+    from .tolles_lawson import progress_callback
+
+    return _aeromag.microlevel(
+        flight,
+        column=column,
+        cell=cell,
+        cutoff=cutoff,
+        along_line=along_line,
+        cosine_power=cosine_power,
+        tension=tension,
+        utm_zone=utm_zone,
+        lever_arm=lever_arm,
         progress=progress_callback(progress),
     )
 

@@ -3,12 +3,19 @@ m, s; rows are the file's data rows, 0-based."""
 
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union, final
 
+import os
+
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
 __all__ = [
     "__version__",
+    "Grid",
+    "Microlevelled",
+    "grid_flight",
+    "microlevel",
+    "read_grid",
     "Flight",
     "read_flight",
     "TlModel",
@@ -278,6 +285,76 @@ def level(
     ties: Optional[Sequence[str]] = None,
     progress: _Progress = None,
 ) -> Levelled: ...
+@final
+class Grid:
+    """A grid (`aeromag grid`): node values, coordinates, CRS."""
+
+    @property
+    def values(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def x(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def y(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def cell(self) -> float: ...
+    @property
+    def epsg(self) -> Optional[int]: ...
+    @property
+    def crs(self) -> Optional[str]: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def unit(self) -> str: ...
+    @property
+    def info(self) -> Dict[str, Any]: ...
+    def stats(self) -> Dict[str, float]: ...
+    def sample(self, x: float, y: float) -> float: ...
+    def vertical_derivative(self) -> Grid: ...
+    def upward(self, height_m: float) -> Grid: ...
+    def minus(self, other: Grid) -> Grid: ...
+    def write(self, path: Union[str, "os.PathLike[str]"]) -> None: ...
+
+@final
+class Microlevelled:
+    """A micro-levelled survey (`aeromag microlevel`)."""
+
+    @property
+    def column(self) -> str: ...
+    @property
+    def output_column(self) -> str: ...
+    @property
+    def values(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def correction(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def correction_nt(self) -> Tuple[float, float]: ...
+    def to_flight(self) -> Flight: ...
+
+def grid_flight(
+    flight: Flight,
+    column: Optional[str] = None,
+    cell: Optional[float] = None,
+    tension: float = 0.25,
+    method: str = "min-curvature",
+    blanking: Optional[float] = None,
+    utm_zone: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    extent: Optional[Tuple[float, float, float, float]] = None,
+    progress: _Progress = None,
+) -> Grid: ...
+def read_grid(path: Union[str, "os.PathLike[str]"]) -> Grid: ...
+def microlevel(
+    flight: Flight,
+    column: Optional[str] = None,
+    cell: Optional[float] = None,
+    cutoff: float = 4.0,
+    along_line: Optional[float] = None,
+    cosine_power: float = 2.0,
+    tension: float = 0.25,
+    utm_zone: Optional[str] = None,
+    lever_arm: Optional[Tuple[float, float, float]] = None,
+    progress: _Progress = None,
+) -> Microlevelled: ...
 def score(
     flight: Flight,
     reference: Union[None, str, Sequence[str]] = None,

@@ -11,7 +11,10 @@ use aeromag::grid::products::{Spectral, apply};
 use aeromag::grid::projection::UtmZone;
 use aeromag::grid::{Grid, GridGeometry};
 use aeromag::map::gridding::GridMethod;
-use aeromag::map::{GridOptions, MicrolevelOptions, Microlevelled, grid_flight as lib_grid, microlevel as lib_microlevel};
+use aeromag::map::{
+    GridOptions, MicrolevelOptions, Microlevelled, grid_flight as lib_grid,
+    microlevel as lib_microlevel,
+};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -37,7 +40,10 @@ pub struct PyGrid {
 
 impl PyGrid {
     fn plain(grid: Grid) -> Self {
-        Self { grid, info: Vec::new() }
+        Self {
+            grid,
+            info: Vec::new(),
+        }
     }
 }
 
@@ -47,7 +53,12 @@ impl PyGrid {
     #[getter]
     fn values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let g = self.grid.geometry;
-        let rows: Vec<Vec<f64>> = self.grid.values.chunks(g.nx.max(1)).map(<[f64]>::to_vec).collect();
+        let rows: Vec<Vec<f64>> = self
+            .grid
+            .values
+            .chunks(g.nx.max(1))
+            .map(<[f64]>::to_vec)
+            .collect();
         PyArray2::from_vec2(py, &rows).map_err(|e| bad_argument(e.to_string()))
     }
 
@@ -126,13 +137,17 @@ impl PyGrid {
 
     /// First vertical derivative (z down), unit per metre (FFT).
     fn vertical_derivative(&self, py: Python<'_>) -> PyResult<PyGrid> {
-        let g = py.detach(|| apply(&self.grid, Spectral::VerticalDerivative)).py_err()?;
+        let g = py
+            .detach(|| apply(&self.grid, Spectral::VerticalDerivative))
+            .py_err()?;
         Ok(PyGrid::plain(g))
     }
 
     /// Upward continuation by `height_m` (FFT).
     fn upward(&self, py: Python<'_>, height_m: f64) -> PyResult<PyGrid> {
-        let g = py.detach(|| apply(&self.grid, Spectral::UpwardContinuation(height_m))).py_err()?;
+        let g = py
+            .detach(|| apply(&self.grid, Spectral::UpwardContinuation(height_m)))
+            .py_err()?;
         Ok(PyGrid::plain(g))
     }
 
@@ -182,7 +197,11 @@ pub fn grid_flight(
     let method = match method {
         "min-curvature" => GridMethod::MinCurvature,
         "bidirectional" => GridMethod::Bidirectional,
-        m => return Err(bad_argument(format!("method '{m}': use 'min-curvature' or 'bidirectional'"))),
+        m => {
+            return Err(bad_argument(format!(
+                "method '{m}': use 'min-curvature' or 'bidirectional'"
+            )));
+        }
     };
     let geometry = match (extent, cell) {
         (Some(e), Some(c)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], c).py_err()?),
@@ -204,19 +223,49 @@ pub fn grid_flight(
     obs.finish()?;
     let g = result.py_err()?;
     let mut info: Vec<(&'static str, Py<PyAny>)> = vec![
-        ("column", g.column.clone().into_pyobject(py)?.into_any().unbind()),
-        ("blanking_m", g.blanking_m.into_pyobject(py)?.into_any().unbind()),
-        ("blanked_nodes", g.blanked_nodes.into_pyobject(py)?.into_any().unbind()),
-        ("rows_used", g.rows_used.into_pyobject(py)?.into_any().unbind()),
-        ("converged", pyo3::types::PyBool::new(py, g.report.converged).to_owned().into_any().unbind()),
+        (
+            "column",
+            g.column.clone().into_pyobject(py)?.into_any().unbind(),
+        ),
+        (
+            "blanking_m",
+            g.blanking_m.into_pyobject(py)?.into_any().unbind(),
+        ),
+        (
+            "blanked_nodes",
+            g.blanked_nodes.into_pyobject(py)?.into_any().unbind(),
+        ),
+        (
+            "rows_used",
+            g.rows_used.into_pyobject(py)?.into_any().unbind(),
+        ),
+        (
+            "converged",
+            pyo3::types::PyBool::new(py, g.report.converged)
+                .to_owned()
+                .into_any()
+                .unbind(),
+        ),
         (
             "notes",
-            g.notes.iter().map(|n| n.to_string()).collect::<Vec<_>>().into_pyobject(py)?.into_any().unbind(),
+            g.notes
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .into_pyobject(py)?
+                .into_any()
+                .unbind(),
         ),
     ];
     if let Some(l) = &g.survey.lines {
-        info.push(("line_spacing_m", l.spacing_m.into_pyobject(py)?.into_any().unbind()));
-        info.push(("line_direction_deg", l.direction_deg.into_pyobject(py)?.into_any().unbind()));
+        info.push((
+            "line_spacing_m",
+            l.spacing_m.into_pyobject(py)?.into_any().unbind(),
+        ));
+        info.push((
+            "line_direction_deg",
+            l.direction_deg.into_pyobject(py)?.into_any().unbind(),
+        ));
     }
     Ok(PyGrid { grid: g.grid, info })
 }

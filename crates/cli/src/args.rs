@@ -80,6 +80,11 @@ impl fmt::Display for Band {
     }
 }
 
+/// A UTM zone: `37N`, `56S`, `EPSG:32637` or `32737`.
+pub fn utm_zone(s: &str) -> Result<aeromag::grid::projection::UtmZone, String> {
+    aeromag::grid::projection::UtmZone::parse(s).map_err(|e| e.to_string())
+}
+
 /// A value parser from a library type's `FromStr` whose error is
 /// [`aeromag::Error`].
 pub fn parsed<T: FromStr<Err = aeromag::Error>>(s: &str) -> Result<T, String> {

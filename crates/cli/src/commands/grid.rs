@@ -60,7 +60,7 @@ pub struct Args {
     blanking: Option<f64>,
     /// UTM zone, e.g. `37N`, `56S` or `EPSG:32637` (default: the zone of
     /// the data's median longitude).
-    #[arg(long, value_name = "ZONE", value_parser = utm_zone)]
+    #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
     utm_zone: Option<UtmZone>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
     /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
@@ -71,10 +71,6 @@ pub struct Args {
 fn extent(s: &str) -> Result<[f64; 4], String> {
     let v = args::numbers(s, 4)?;
     Ok([v[0], v[1], v[2], v[3]])
-}
-
-fn utm_zone(s: &str) -> Result<UtmZone, String> {
-    UtmZone::parse(s).map_err(|e| e.to_string())
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

@@ -54,16 +54,12 @@ pub struct Args {
     #[arg(long, default_value_t = 0.25)]
     tension: f64,
     /// UTM zone, e.g. `37N` (default: the data's).
-    #[arg(long, value_name = "ZONE", value_parser = utm_zone)]
+    #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
     utm_zone: Option<UtmZone>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
     /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
     lever_arm: Option<[f64; 3]>,
-}
-
-fn utm_zone(s: &str) -> Result<UtmZone, String> {
-    UtmZone::parse(s).map_err(|e| e.to_string())
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {

@@ -1,0 +1,60 @@
+"""Maps from Python (grid_flight, read_grid, microlevel): the same grids as
+the CLI, NumPy arrays with coordinates and CRS."""
+
+import numpy as np
+import pytest
+
+import aeromag
+
+
+def test_grid_equals_the_cli(cli, survey_csv, tmp_path):
+    survey = aeromag.read_flight(survey_csv)
+    g = aeromag.grid_flight(survey, column="true_anomaly", cell=100.0)
+    out = tmp_path / "cli.nc"
+    cli("grid", "-i", survey_csv, "--column", "true_anomaly", "--cell", 100, "--out", out)
+    c = aeromag.read_grid(out)
+    assert g.values.shape == (len(g.y), len(g.x)) == c.values.shape
+    assert g.epsg == c.epsg == 32637 and g.crs == "WGS 84 / UTM zone 37N"
+    np.testing.assert_array_equal(g.x, c.x)
+    np.testing.assert_array_equal(g.y, c.y)
+    # The file holds float32.
+    np.testing.assert_allclose(g.values, c.values, rtol=0, atol=1e-3, equal_nan=True)
+    info = g.info
+    assert info["column"] == "true_anomaly" and abs(info["line_spacing_m"] - 500) < 5
+    assert info["converged"] in (True, False) and info["blanked_nodes"] >= 0
+    # Row 0 is the south row; sample() interpolates the nodes.
+    assert g.y[0] < g.y[-1]
+    j, i = np.argwhere(np.isfinite(g.values))[len(g.x)]
+    assert g.sample(g.x[i], g.y[j]) == pytest.approx(g.values[j, i])
+
+
+def test_products_and_files(survey_csv, tmp_path):
+    survey = aeromag.read_flight(survey_csv)
+    g = aeromag.grid_flight(survey, column="true_anomaly", method="bidirectional")
+    d = g.vertical_derivative()
+    assert d.unit == "nT/m" and d.values.shape == g.values.shape
+    up = g.upward(200.0)
+    assert up.stats()["std"] < g.stats()["std"]
+    assert g.minus(g).stats()["std"] == 0.0
+    for name in ["g.tif", "g.asc", "g.nc"]:
+        g.write(tmp_path / name)
+        back = aeromag.read_grid(tmp_path / name)
+        np.testing.assert_allclose(back.values, g.values, atol=1e-3, equal_nan=True)
+
+
+def test_microlevel_and_bad_arguments(survey_csv):
+    survey = aeromag.read_flight(survey_csv)
+    m = aeromag.microlevel(survey, column="true_anomaly")
+    rms, largest = m.correction_nt
+    assert 0 <= rms <= largest
+    assert m.output_column == "true_anomaly_mlev"
+    f = m.to_flight()
+    np.testing.assert_array_equal(f["true_anomaly_mlev"], m.values)
+    with pytest.raises(aeromag.BadInputError, match="nope"):
+        aeromag.grid_flight(survey, column="nope")
+    with pytest.raises(aeromag.BadInputError, match="bidi"):
+        aeromag.grid_flight(survey, method="bidi")
+    with pytest.raises(aeromag.BadInputError, match="61"):
+        aeromag.grid_flight(survey, utm_zone="61N")
+    with pytest.raises(aeromag.BadInputError):
+        aeromag.read_grid("/nonexistent/grid.tif")
