@@ -93,7 +93,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             tension: a.tension,
             ..MinCurvature::default()
         },
-        ..GridOptions::default()
     };
     let g = grid_flight(&flight, &opts, &mut Bars::new())?;
     let format = g.write(&a.out)?;
