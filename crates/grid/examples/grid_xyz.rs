@@ -1,6 +1,6 @@
 //! Grid an `x y z` text file by minimum curvature and print `x y z` of
 //! every node (for comparisons with GMT `surface` and `grd2xyz`):
-//! `cargo run --release -p aeromag-grid --example grid_xyz -- FILE XMIN XMAX YMIN YMAX CELL TENSION [MAX_SWEEPS]`.
+//! `cargo run --release -p aeromag-grid --example grid_xyz -- FILE XMIN XMAX YMIN YMAX CELL TENSION [MAX_SWEEPS [LIMIT]]`.
 
 use aeromag_grid::GridGeometry;
 use aeromag_grid::gridding::{MinCurvature, Points};
@@ -23,6 +23,7 @@ fn main() {
     let s = MinCurvature {
         tension: num(7),
         max_iterations: a.get(8).map_or(500, |s| s.parse().unwrap()),
+        convergence: a.get(9).map(|s| s.parse().unwrap()),
         ..Default::default()
     };
     let t = std::time::Instant::now();
