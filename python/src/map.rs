@@ -315,6 +315,19 @@ impl PyMicrolevelled {
         (self.m.correction_rms_nt, self.m.correction_max_nt)
     }
 
+    /// RMS of the crossover differences before and after, nT (None
+    /// without crossovers).
+    #[getter]
+    fn crossover_rms_nt(&self) -> Option<(f64, f64)> {
+        self.m.crossover_rms_nt
+    }
+
+    /// Notes and warnings.
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.m.notes.iter().map(|n| n.to_string()).collect()
+    }
+
     /// The flight with `<column>_mlev` and `<column>_mlev_corr` added.
     fn to_flight(&self) -> PyResult<PyFlight> {
         let mut t = self.flight.table().clone();

@@ -48,6 +48,8 @@ def test_microlevel_and_bad_arguments(survey_csv):
     rms, largest = m.correction_nt
     assert 0 <= rms <= largest
     assert m.output_column == "true_anomaly_mlev"
+    before, after = m.crossover_rms_nt
+    assert before >= 0 and after >= 0
     f = m.to_flight()
     np.testing.assert_array_equal(f["true_anomaly_mlev"], m.values)
     with pytest.raises(aeromag.BadInputError, match="nope"):

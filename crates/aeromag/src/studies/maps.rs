@@ -86,6 +86,9 @@ pub struct MapsSummary {
     pub microlevel_correction_rms_nt: f64,
     /// RMS of the micro-levelled grid − the truth grid about its mean, nT.
     pub microlevelled_grid_rms_vs_truth_nt: f64,
+    /// RMS of the levelled survey's crossover differences before and after
+    /// micro-levelling, nT.
+    pub microlevel_crossover_rms_nt: Option<(f64, f64)>,
 }
 
 /// A map for the report: the grid, its colour-bar label and colour map.
@@ -222,6 +225,7 @@ impl Study for MapsStudy {
             stripe_reduction_vs_truth: stripe_reduction,
             microlevel_correction_rms_nt: micro.correction_rms_nt,
             microlevelled_grid_rms_vs_truth_nt: rms_about_mean(err_micro.values.iter().copied()),
+            microlevel_crossover_rms_nt: micro.crossover_rms_nt,
         };
         // Flight lines for the maps, a point every 10 rows.
         let mut tracks: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
@@ -341,7 +345,7 @@ impl StudyOutcome for MapsOutcome {
              longer than 4) falls from {:.3e} to {:.3e} (nT/m)² with compensation ({:.1}× less; the truth's own, the geology in that band, is \
              {:.3e}, a floor under the compensated map's). On the difference from the truth grid, where only the \
              stripes remain, compensation reduces that power {:.0}×. Micro-levelling (Minty's filter, one level per line) corrects by {:.4} nT RMS and leaves {:.4} nT against \
-             the truth grid{}",
+             the truth grid ({}){}",
             s.cell_m,
             s.line_spacing_m,
             s.grid_rms_vs_truth_nt,
@@ -354,6 +358,9 @@ impl StudyOutcome for MapsOutcome {
             s.stripe_reduction_vs_truth,
             s.microlevel_correction_rms_nt,
             s.microlevelled_grid_rms_vs_truth_nt,
+            s.microlevel_crossover_rms_nt.map_or("no crossovers".into(), |(b, a)| format!(
+                "crossover differences {b:.3} → {a:.3} nT RMS"
+            )),
             if s.microlevelled_grid_rms_vs_truth_nt > s.grid_rms_vs_truth_nt {
                 ": here it does harm. The lines undersample the geology (an anomaly crossed by one line \
                  only is a stripe along it on the grid, and the lines' mean anomaly differs from line to line), \

@@ -106,6 +106,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         m.correction_rms_nt,
         m.correction_max_nt
     );
+    match m.crossover_rms_nt {
+        Some((before, after)) => println!(
+            "crossover differences RMS: {before:.4} nT before, {after:.4} nT after micro-levelling"
+        ),
+        None => println!("no crossovers to check the correction against"),
+    }
     println!("wrote {}", a.out.display());
     Ok(())
 }
