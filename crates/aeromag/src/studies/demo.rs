@@ -4,8 +4,8 @@
 use super::{
     EmStudy, EmSummary, FixedWingStudy, FixedWingSummary, GradiometryStudy, GradiometrySummary,
     MapsStudy, MapsSummary, MultiSensorStudy, MultiSensorSummary, PodStudy, PodSummary,
-    PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, StreamStudy, StreamSummary, Study,
-    StudyOutcome, StudySize,
+    PrintedFigure, PrintedSummary, RotorStudyRun, RotorSummary, SitesStudy, SitesSummary,
+    StreamStudy, StreamSummary, Study, StudyOutcome, StudySize,
 };
 use crate::error::Result;
 use crate::observer::Observer;
@@ -45,6 +45,8 @@ pub struct DemoSummary {
     pub stream: StreamSummary,
     /// Maps of the survey.
     pub maps: MapsSummary,
+    /// The interference by part at three sites.
+    pub sites: SitesSummary,
     /// Seed of the fixed-wing flights.
     pub seed: u64,
     /// Version of aeromag.
@@ -70,6 +72,7 @@ impl PrintedSummary for DemoSummary {
         rows.extend(self.multi_sensor.printed());
         rows.extend(self.stream.printed());
         rows.extend(self.maps.printed());
+        rows.extend(self.sites.printed());
         rows
     }
 }
@@ -128,6 +131,7 @@ impl Study for Demo {
         let multi_sensor = MultiSensorStudy { seed: self.seed }.run(size, observer)?;
         let stream = StreamStudy { seed: self.seed }.run(size, observer)?;
         let maps = MapsStudy::of(&fixed_wing, Some(self.out.clone()))?.run(size, observer)?;
+        let sites = SitesStudy { seed: self.seed }.run(size, observer)?;
         let mut sections = fixed_wing.sections()?;
         sections.extend(rotor.sections()?);
         sections.extend(pod.sections()?);
@@ -136,6 +140,7 @@ impl Study for Demo {
         sections.extend(multi_sensor.sections()?);
         sections.extend(stream.sections()?);
         sections.extend(maps.sections()?);
+        sections.extend(sites.sections()?);
         Ok(DemoOutcome {
             summary: DemoSummary {
                 fixed_wing: fixed_wing.summary(),
@@ -146,6 +151,7 @@ impl Study for Demo {
                 multi_sensor: multi_sensor.summary(),
                 stream: stream.summary(),
                 maps: maps.summary(),
+                sites: sites.summary(),
                 seed: self.seed,
                 software_version: env!("CARGO_PKG_VERSION"),
             },

@@ -20,6 +20,7 @@ mod maps;
 mod multi_sensor;
 mod pod;
 mod rotor;
+mod sites;
 mod stream;
 
 pub use demo::{Demo, DemoOutcome, DemoSummary};
@@ -36,6 +37,7 @@ pub use multi_sensor::{
 };
 pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
 pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};
+pub use sites::{SITES, SiteContributions, SitesOutcome, SitesStudy, SitesSummary};
 pub use stream::{
     CREEP_AM2_PER_H, CREEP_CLEARANCE_M, CREEP_LINES, StreamOutcome, StreamStudy, StreamSummary,
     WINDOW_S, creeping_scenario,

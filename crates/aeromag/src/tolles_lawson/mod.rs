@@ -7,6 +7,7 @@
 //! | [`CalibrateSettings`] | the choices as the CLI's flags and Python's keyword options state them → [`CalibrateOptions`] |
 //! | [`calibrate`] | fit a [`TlModel`] on a calibration flight ([`CalibrateOptions`], [`Method`]) → [`Calibration`] |
 //! | [`Compensator`](crate::Compensator) for [`TlModel`] | the modelled interference of every row of a flight, and the compensated reading |
+//! | [`Contributions`] | the interference by part (permanent, induced, eddy, currents) and manoeuvre |
 //! | [`observability`] | rank, weak combinations and estimability of the coefficients on a flight |
 //! | [`calibrate_sensors`] | one model per scalar sensor ([`SensorSet`], reference-sensor mode) → [`SensorsModel`]; [`CompensateSensors`] applies it |
 //!
@@ -18,6 +19,7 @@
 
 mod calibrate;
 mod compensate;
+mod contributions;
 mod kalman;
 mod kalman_section;
 mod lags;
@@ -29,6 +31,7 @@ pub use calibrate::{
     CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, SECOND_ORDER_NOTE_NT, calibrate,
 };
 pub use compensate::{InterferenceParts, TL_OUTPUT, second_order_range_nt};
+pub use contributions::{Contributions, PartsRms};
 pub(crate) use kalman::ground_speed;
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
 pub use observability::{CoefficientVerdict, FlightObservability, Verdict, observability};

@@ -242,6 +242,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         _ => Vec::new(),
     };
     extra.extend(opts.extra.iter().map(|r| r.channel.as_str()));
+    // The simulator's manoeuvre codes, when present, split the table of
+    // contributions by manoeuvre.
+    extra.push("manoeuvre");
     let flight = a.input.load_canonical(&extra)?;
     let cal = calibrate(&flight, &opts, &mut Bars::new())?;
     let model = &cal.model;
@@ -311,6 +314,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     println!("{:<8} {:>14} {:>12}", "term", "coefficient", "std");
     for c in &model.coefficients {
         println!("{:<8} {:>14.6} {:>12.3e}", c.name, c.value, c.std);
+    }
+    let parts = cal.contributions(&flight)?;
+    println!("interference by part on this flight (RMS about each manoeuvre's mean, nT):");
+    println!(
+        "{:<11} {:>6} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "group", "rows", "permanent", "induced", "eddy", "currents", "total"
+    );
+    for g in &parts.groups {
+        println!(
+            "{:<11} {:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3} {:>10.3}",
+            g.group, g.rows, g.permanent_nt, g.induced_nt, g.eddy_nt, g.currents_nt, g.total_nt
+        );
     }
     println!("model written to {}", a.model.display());
     Ok(())
