@@ -19,6 +19,12 @@ fn calibrate_compensate_report_keep_every_row() {
     ]);
     assert_code(&o, 0);
     assert!(!stderr(&o).contains("poorly determined"), "{}", stderr(&o));
+    // The interference by part, per manoeuvre of the simulated box.
+    let out = stdout(&o);
+    assert!(out.contains("interference by part"), "{out}");
+    for group in ["roll ", "pitch ", "yaw ", "manoeuvres ", "between "] {
+        assert!(out.lines().any(|l| l.starts_with(group)), "{group}: {out}");
+    }
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(m["format"], "aeromag-model/2");
