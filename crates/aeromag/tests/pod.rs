@@ -160,3 +160,21 @@ fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_
             .is_bad_input()
     );
 }
+
+/// Issue 23, seed 002 near the magnetic equator: the two-step solve with
+/// the axes reordered (the component of U of largest magnitude
+/// eliminated) works at every inclination, 0° included, where eliminating
+/// U3 divided by zero (measured, seed 1: 0.784, 0.867, 0.891, 0.851, 0.944
+/// at 0°, 5°, 30°, 60°, 85°).
+#[test]
+fn the_two_step_solve_works_from_the_equator_to_the_pole() {
+    use aeromag::studies::{PodStudy, Study, StudyOutcome, StudySize};
+    let out = PodStudy.run(StudySize::Full, &mut aeromag::Silent).unwrap();
+    let s = out.summary();
+    eprintln!("{:?}", s.rate_test_by_inclination);
+    assert_eq!(s.rate_test_by_inclination.len(), 5);
+    for (inclination, rate) in &s.rate_test_by_inclination {
+        assert!(rate.is_finite() && *rate > 0.7, "{inclination}°: {rate}");
+    }
+    assert_eq!(s.rate_test_inclination_0, s.rate_test_by_inclination[0].1);
+}

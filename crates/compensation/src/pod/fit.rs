@@ -30,7 +30,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::model::{
-    N_HEADING, N_JOINT, N_PARAMS, heading_coefficients, heading_design, large_signal_row,
+    N_HEADING, N_JOINT, N_PARAMS, free_axes, heading_coefficients, heading_design, large_signal_row,
 };
 use crate::{CompError, Result};
 
@@ -183,19 +183,21 @@ pub(super) fn lstsq(a: DMatrix<f64>, y: &DVector<f64>) -> Result<DVector<f64>> {
     ))
 }
 
-/// The 7 regressor columns `D` of eq. 19: `v1, v2, v1', v2', x, y, z`
-/// (high-passed when `hp`, else about the heading's mean `U` and pod
-/// position).
+/// The 7 regressor columns `D` of eq. 19: `v_a, v_b, v_a', v_b', x, y, z`
+/// with `(a, b)` the free axes of the heading ([`free_axes`]: `1, 2` unless
+/// `|U3|` is not the largest component) (high-passed when `hp`, else about
+/// the heading's mean `U` and pod position).
 fn small_signal_columns(h: &PodHeading, p: &Prepared, hp: bool) -> Vec<Vec<f64>> {
     let col = |f: &dyn Fn(usize) -> f64| {
         let c: Vec<f64> = (0..h.u.len()).map(f).collect();
         if hp { detrend(&c) } else { c }
     };
+    let (a, b, _) = free_axes(&p.u0);
     vec![
-        col(&|k| h.u[k][0] - p.u0[0]),
-        col(&|k| h.u[k][1] - p.u0[1]),
-        col(&|k| p.du[k][0]),
-        col(&|k| p.du[k][1]),
+        col(&|k| h.u[k][a] - p.u0[a]),
+        col(&|k| h.u[k][b] - p.u0[b]),
+        col(&|k| p.du[k][a]),
+        col(&|k| p.du[k][b]),
         col(&|k| p.dp[k][0]),
         col(&|k| p.dp[k][1]),
         col(&|k| p.dp[k][2]),
@@ -214,8 +216,7 @@ pub fn fit_heading_coefficients(h: &PodHeading) -> Result<[f64; N_HEADING]> {
 }
 
 /// The seed's two-step solve over the learning `headings`: step 1 on each
-/// heading, step 2 `θ` from `W_k = M(U_k) θ`. Errors: bad data, `|U3|`
-/// too small on a heading.
+/// heading, step 2 `θ` from `W_k = M(U_k) θ`. Errors: bad data.
 pub fn fit_two_step(headings: &[PodHeading]) -> Result<TwoStepFit> {
     if headings.is_empty() {
         return Err(CompError::data("two-step pod fit needs headings"));

@@ -122,7 +122,7 @@ pub use fit::{
     predict_small_signal, predict_small_signal_raw,
 };
 pub use model::{
-    N_HEADING, N_JOINT, N_PARAMS, heading_coefficients, heading_design, large_signal_row,
+    N_HEADING, N_JOINT, N_PARAMS, free_axes, heading_coefficients, heading_design, large_signal_row,
 };
 pub use trajectory::{
     Cable, direction_cosines, pod_offset_ned, pod_position_exact, pod_position_seed,

@@ -33,10 +33,17 @@
 //! + Σ_ij ∂b_ij,k u_j u_i')`.
 //!
 //! Small signal on a heading with steady direction cosines `U` (seed eq. 4,
-//! corrected eq. 6): `c = P + 2AU`, `d = bU`,
-//! `W1 = c1 − c3 U1/U3`, `W2 = c2 − c3 U2/U3`, `W3 = d1 − d3 U1/U3`,
-//! `W4 = d2 − d3 U2/U3`, `W5..7 = ∂P_k·U + Uᵀ∂A_k U + g0_k`, and
-//! `s = W1 v1 + W2 v2 + W3 v1' + W4 v2' + W5 x + W6 y + W7 z`.
+//! corrected eq. 6): `c = P + 2AU`, `d = bU`; the perturbation `v ⊥ U`
+//! has one dependent component, eliminated by `U·v = 0`. The seed
+//! eliminates `v3` (`W1 = c1 − c3 U1/U3`, `W2 = c2 − c3 U2/U3`,
+//! `W3 = d1 − d3 U1/U3`, `W4 = d2 − d3 U2/U3`), which fails where `U3 = 0`:
+//! level flight at the magnetic equator. As the seed says for that case,
+//! the axes are reordered: the component `e` with the largest `|U_e|` is
+//! eliminated and `(a, b)` are the other two in order ([`free_axes`]):
+//! `W1 = c_a − c_e U_a/U_e`, `W2 = c_b − c_e U_b/U_e`, `W3 = d_a − d_e U_a/U_e`,
+//! `W4 = d_b − d_e U_b/U_e`, `W5..7 = ∂P_k·U + Uᵀ∂A_k U + g0_k`, and
+//! `s = W1 v_a + W2 v_b + W3 v_a' + W4 v_b' + W5 x + W6 y + W7 z`
+//! (`|U_e| ≥ 1/√3` always; for `|U3|` largest this is the seed's form).
 
 use crate::{CompError, Result};
 
@@ -47,8 +54,19 @@ pub const N_PARAMS: usize = 43;
 pub const N_JOINT: usize = N_PARAMS + 24;
 /// Number of heading coefficients `W1..W7`.
 pub const N_HEADING: usize = 7;
-/// Smallest `|U3|` accepted (axes are not reordered).
-pub const MIN_U3: f64 = 0.05;
+/// The axes of the small-signal model for steady direction cosines `u0`:
+/// `(a, b, e)`, `e` the component of largest `|U_e|` (eliminated), `a < b`
+/// the other two (module docs).
+pub fn free_axes(u0: &[f64; 3]) -> (usize, usize, usize) {
+    let e = (0..3)
+        .max_by(|&i, &j| u0[i].abs().total_cmp(&u0[j].abs()))
+        .unwrap_or(2);
+    match e {
+        0 => (1, 2, 0),
+        1 => (0, 2, 1),
+        _ => (0, 1, 2),
+    }
+}
 
 /// Symmetric `A` from `(a11, a12, a13, a22, a23)`, `a33 = 0`.
 fn sym(a: &[f64]) -> [[f64; 3]; 3] {
@@ -72,8 +90,8 @@ fn gradient_block(g: &[f64], u: &[f64; 3]) -> f64 {
 }
 
 /// Heading coefficients `W1..W7` of parameters `theta` for steady direction
-/// cosines `u0` (corrected seed eq. 6 and eqs. 10–12). Errors: wrong length,
-/// `|U3| <` [`MIN_U3`].
+/// cosines `u0` (corrected seed eq. 6 and eqs. 10–12, the axes of
+/// [`free_axes`]). Errors: wrong length, `u0` not a direction.
 pub fn heading_coefficients(theta: &[f64], u0: &[f64; 3]) -> Result<[f64; N_HEADING]> {
     if theta.len() != N_PARAMS {
         return Err(CompError::data(format!(
@@ -81,12 +99,13 @@ pub fn heading_coefficients(theta: &[f64], u0: &[f64; 3]) -> Result<[f64; N_HEAD
             theta.len()
         )));
     }
-    if u0[2].abs() < MIN_U3 {
+    let norm = (u0[0] * u0[0] + u0[1] * u0[1] + u0[2] * u0[2]).sqrt();
+    if !(norm > 0.5 && norm < 2.0) {
         return Err(CompError::data(format!(
-            "|U3| = {:.3} too small for the small-signal elimination of v3",
-            u0[2].abs()
+            "steady direction cosines {u0:?} are not a unit vector"
         )));
     }
+    let (ia, ib, ie) = free_axes(u0);
     let a = sym(&theta[3..8]);
     let b = eddy(&theta[8..16]);
     let c: Vec<f64> = (0..3)
@@ -95,12 +114,12 @@ pub fn heading_coefficients(theta: &[f64], u0: &[f64; 3]) -> Result<[f64; N_HEAD
     let d: Vec<f64> = (0..3)
         .map(|i| (0..3).map(|j| b[i][j] * u0[j]).sum())
         .collect();
-    let r = [u0[0] / u0[2], u0[1] / u0[2]];
+    let r = [u0[ia] / u0[ie], u0[ib] / u0[ie]];
     Ok([
-        c[0] - c[2] * r[0],
-        c[1] - c[2] * r[1],
-        d[0] - d[2] * r[0],
-        d[1] - d[2] * r[1],
+        c[ia] - c[ie] * r[0],
+        c[ib] - c[ie] * r[1],
+        d[ia] - d[ie] * r[0],
+        d[ib] - d[ie] * r[1],
         gradient_block(&theta[16..25], u0),
         gradient_block(&theta[25..34], u0),
         gradient_block(&theta[34..43], u0),
@@ -177,10 +196,21 @@ mod tests {
     /// position terms are `W5..7`.
     #[test]
     fn small_signal_is_the_derivative_of_the_large_signal_model() {
+        // The seed's case (U3 largest) and level flight at the magnetic
+        // equator heading north-east (U3 = 0: U1 or U2 eliminated).
+        let h = 0.5f64.sqrt();
+        for u0 in [[0.5, -0.5, h], [h, h * 0.999, 0.0], [0.2, -0.97, 0.1397]] {
+            check_derivatives(u0);
+        }
+    }
+
+    fn check_derivatives(u0: [f64; 3]) {
+        let n = (u0[0] * u0[0] + u0[1] * u0[1] + u0[2] * u0[2]).sqrt();
+        let u0 = u0.map(|x| x / n);
+        let (ia, ib, ie) = free_axes(&u0);
         let theta: Vec<f64> = (0..N_PARAMS)
             .map(|k| ((k * 37 % 11) as f64 - 5.0) * 0.1)
             .collect();
-        let u0 = [0.5, -0.5, 0.5f64.sqrt()];
         let w = heading_coefficients(&theta, &u0).unwrap();
         let f = |u: &[f64; 3], du: &[f64; 3], dp: &[f64; 3]| -> f64 {
             large_signal_row(u, du, dp)
@@ -190,9 +220,12 @@ mod tests {
                 .sum()
         };
         let z = [0.0; 3];
-        // v with v3 = −(U1 v1 + U2 v2)/U3.
+        // v with v_e = −(U_a v_a + U_b v_b)/U_e.
         let (v1, v2) = (0.3, -0.2);
-        let v = [v1, v2, -(u0[0] * v1 + u0[1] * v2) / u0[2]];
+        let mut v = [0.0; 3];
+        v[ia] = v1;
+        v[ib] = v2;
+        v[ie] = -(u0[ia] * v1 + u0[ib] * v2) / u0[ie];
         let eps = 1e-6;
         let up = [u0[0] + eps * v[0], u0[1] + eps * v[1], u0[2] + eps * v[2]];
         let num = (f(&up, &z, &z) - f(&u0, &z, &z)) / eps;
@@ -209,9 +242,13 @@ mod tests {
     }
 
     #[test]
-    fn bad_inputs_are_errors() {
+    fn bad_inputs_are_errors_and_the_equator_is_not() {
         assert!(heading_coefficients(&[0.0; 3], &[0.0, 0.0, 1.0]).is_err());
-        assert!(heading_coefficients(&[0.0; N_PARAMS], &[1.0, 0.0, 0.0]).is_err());
+        assert!(heading_coefficients(&[0.0; N_PARAMS], &[0.0, 0.0, 0.0]).is_err());
+        assert!(heading_coefficients(&[0.0; N_PARAMS], &[1.0, 0.0, 0.0]).is_ok());
+        assert_eq!(free_axes(&[1.0, 0.0, 0.0]), (1, 2, 0));
+        assert_eq!(free_axes(&[0.1, -0.9, 0.3]), (0, 2, 1));
+        assert_eq!(free_axes(&[0.6, 0.0, 0.8]), (0, 1, 2));
         assert_eq!(heading_design(&[0.6, 0.0, 0.8]).unwrap().len(), N_PARAMS);
     }
 }
