@@ -23,13 +23,6 @@ fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
     utm_zone.map(|z| UtmZone::parse(z).py_err()).transpose()
 }
 
-fn tension(t: f64) -> MinCurvature {
-    MinCurvature {
-        tension: t,
-        ..MinCurvature::default()
-    }
-}
-
 /// A grid (`aeromag grid`): node values with their easting/northing (m)
 /// and coordinate system.
 #[pyclass(name = "Grid", module = "aeromag._aeromag", frozen)]
@@ -216,7 +209,7 @@ pub fn grid_flight(
         lever_arm_m: lever_arm,
         geometry,
         method,
-        min_curvature: self::tension(tension),
+        min_curvature: MinCurvature::with_tension(tension),
     };
     let mut obs = PyProgress::new(progress);
     let result = py.detach(|| lib_grid(&flight.inner, &opts, &mut obs));
@@ -363,7 +356,7 @@ pub fn microlevel(
         cutoff_line_spacings: cutoff,
         along_line_m: along_line,
         cosine_power,
-        min_curvature: self::tension(tension),
+        min_curvature: MinCurvature::with_tension(tension),
     };
     let mut obs = PyProgress::new(progress);
     let result = py.detach(|| lib_microlevel(&flight.inner, &opts, &mut obs));

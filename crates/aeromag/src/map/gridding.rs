@@ -185,16 +185,13 @@ pub fn grid_flight(
     let (mut grid_values, report) = match (opts.method, &survey.lines) {
         (GridMethod::MinCurvature, _) => opts.min_curvature.grid(points, geometry)?,
         (GridMethod::Bidirectional, Some(l)) => {
-            // Tie lines are left out: their samples go to a line id that
-            // is not a traverse line's.
-            let ids: Vec<i64> = line
-                .iter()
-                .map(|id| if l.traverse_ids.contains(id) { *id } else { -1 })
+            // Tie lines are left out (`traverse_ids` is ascending).
+            let keep: Vec<usize> = (0..line.len())
+                .filter(|&k| l.traverse_ids.binary_search(&line[k]).is_ok())
                 .collect();
-            let keep: Vec<usize> = (0..ids.len()).filter(|&k| ids[k] >= 0).collect();
             let pick = |s: &[f64]| keep.iter().map(|&k| s[k]).collect::<Vec<f64>>();
             let (bx, by, bz) = (pick(&x), pick(&y), pick(&z));
-            let bl: Vec<i64> = keep.iter().map(|&k| ids[k]).collect();
+            let bl: Vec<i64> = keep.iter().map(|&k| line[k]).collect();
             let values = Bidirectional {
                 direction_deg: l.direction_deg,
                 max_gap_cells: 4.0,

@@ -44,7 +44,7 @@ pub struct LineGeometry {
     pub traverse_lines: usize,
     /// Other lines (ties, turns).
     pub other_lines: usize,
-    /// The ids ([`LineLabels`] ids) of the traverse lines.
+    /// The ids ([`LineLabels`] ids) of the traverse lines, ascending.
     #[serde(skip)]
     pub traverse_ids: Vec<i64>,
 }

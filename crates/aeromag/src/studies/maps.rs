@@ -21,6 +21,7 @@
 
 use super::{
     FixedWingOutcome, PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed,
+    rms_about_mean,
 };
 use crate::error::{Error, Result};
 use crate::flight::{Flight, ReferenceChannels, reference_sum};
@@ -116,20 +117,6 @@ fn minus_mean(g: &Grid) -> Grid {
     }
 }
 
-/// RMS about the mean of the finite values.
-fn rms_about_mean(v: impl Iterator<Item = f64> + Clone) -> f64 {
-    let (n, s) = v
-        .clone()
-        .filter(|x| x.is_finite())
-        .fold((0usize, 0.0), |(n, s), x| (n + 1, s + x));
-    let m = s / n.max(1) as f64;
-    (v.filter(|x| x.is_finite())
-        .map(|x| (x - m).powi(2))
-        .sum::<f64>()
-        / n.max(1) as f64)
-        .sqrt()
-}
-
 impl Study for MapsStudy {
     type Outcome = MapsOutcome;
 
@@ -206,12 +193,12 @@ impl Study for MapsStudy {
         let stripe_reduction = stripes(&unc)? / stripes(&comp)?;
         let level = flight.require("mag_comp_level")?;
         let true_anomaly = flight.require("true_anomaly")?;
-        let along = rms_about_mean(
-            (0..level.len())
-                .filter(|&k| truth.survey.on_line(k))
-                .map(|k| level[k] - true_anomaly[k]),
-        );
-        let grid_rms = rms_about_mean(err.values.iter().copied());
+        let along_line: Vec<f64> = (0..level.len())
+            .filter(|&k| truth.survey.on_line(k))
+            .map(|k| level[k] - true_anomaly[k])
+            .collect();
+        let along = rms_about_mean(&along_line);
+        let grid_rms = rms_about_mean(&err.values);
         let summary = MapsSummary {
             cell_m: truth.grid.geometry.cell,
             line_spacing_m: lines.spacing_m,
@@ -224,7 +211,7 @@ impl Study for MapsStudy {
             corrugation_power_truth: p_truth,
             stripe_reduction_vs_truth: stripe_reduction,
             microlevel_correction_rms_nt: micro.correction_rms_nt,
-            microlevelled_grid_rms_vs_truth_nt: rms_about_mean(err_micro.values.iter().copied()),
+            microlevelled_grid_rms_vs_truth_nt: rms_about_mean(&err_micro.values),
             microlevel_crossover_rms_nt: micro.crossover_rms_nt,
         };
         // Flight lines for the maps, a point every 10 rows.

@@ -130,6 +130,16 @@ pub trait PrintedSummary {
     fn printed(&self) -> Vec<PrintedFigure>;
 }
 
+/// RMS about the mean of the finite values of `v` (0 without any), the
+/// scoring of a residual against the truth, whose mean (a datum no
+/// compensation or levelling fixes) does not count.
+pub(crate) fn rms_about_mean(v: &[f64]) -> f64 {
+    let finite = || v.iter().copied().filter(|x| x.is_finite());
+    let n = finite().count().max(1) as f64;
+    let m = finite().sum::<f64>() / n;
+    (finite().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt()
+}
+
 /// A number with `digits` decimals, or `—` when there is none (a figure
 /// that cannot be computed on this flight).
 pub fn fixed(v: Option<f64>, digits: usize) -> String {

@@ -22,7 +22,7 @@
 //!    and magnitude) fitted by least squares on the survey against the true
 //!    external field — the best that family can do there.
 
-use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed};
+use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed, rms_about_mean};
 use crate::error::{Error, Result};
 use crate::flight::{Flight, ReferenceChannels, SensorColumns};
 use crate::observer::Observer;
@@ -151,12 +151,6 @@ fn line_error_rms_against(survey: &Flight, comp: &[f64], truth: &str) -> Result<
     let truth = survey.table().require(truth)?;
     let d: Vec<f64> = comp.iter().zip(truth).map(|(c, t)| c - t).collect();
     Ok(rms_about_mean(&on_lines(survey, &d)?))
-}
-
-fn rms_about_mean(d: &[f64]) -> f64 {
-    let n = d.len().max(1) as f64;
-    let m = d.iter().sum::<f64>() / n;
-    (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n).sqrt()
 }
 
 /// The rows on the survey lines (`line > 0`) where `x` is finite.

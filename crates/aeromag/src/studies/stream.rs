@@ -3,7 +3,7 @@
 //! whose aircraft magnetisation creeps, compensated by the calibration's
 //! model held fixed and by the adaptive compensators.
 
-use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed};
+use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed, rms_about_mean};
 use crate::compensate::Compensator;
 use crate::error::{Error, Result};
 use crate::flight::Flight;
@@ -115,7 +115,7 @@ impl Study for StreamStudy {
         let lines = survey.require("line")?;
         let rms = |interf: &[f64]| {
             let d = on_lines(&survey, interf, truth, lines)?;
-            Ok::<_, Error>(rms_about(&d, mean(&d)))
+            Ok::<_, Error>(rms_about_mean(&d))
         };
         let batch_residual_nt = rms(&model.interference(&survey)?)?;
         let causal_residual_nt = rms(&causal.interference(&survey)?)?;
@@ -203,14 +203,6 @@ fn on_lines(flight: &Flight, interf: &[f64], truth: &[f64], lines: &[f64]) -> Re
         .collect())
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-fn rms_about(v: &[f64], m: f64) -> f64 {
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len().max(1) as f64).sqrt()
-}
-
 /// The residual per [`WINDOW_S`] window of the flight, each about its own
 /// mean; the last entry is the flight's last [`WINDOW_S`].
 fn windows(flight: &Flight, name: &'static str, interf: &[f64]) -> Result<Windows> {
@@ -230,7 +222,7 @@ fn windows(flight: &Flight, name: &'static str, interf: &[f64]) -> Result<Window
             })
             .collect();
         let d = on_lines(flight, interf, truth, &masked)?;
-        Ok(rms_about(&d, mean(&d)))
+        Ok(rms_about_mean(&d))
     };
     let mut rms_nt: Vec<f64> = (0..n)
         .map(|i| {

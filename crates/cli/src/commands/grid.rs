@@ -89,10 +89,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         zone: a.utm_zone,
         lever_arm_m: a.lever_arm,
         method: a.method,
-        min_curvature: MinCurvature {
-            tension: a.tension,
-            ..MinCurvature::default()
-        },
+        min_curvature: MinCurvature::with_tension(a.tension),
     };
     let g = grid_flight(&flight, &opts, &mut Bars::new())?;
     let format = g.write(&a.out)?;

@@ -73,10 +73,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         cutoff_line_spacings: a.cutoff,
         along_line_m: a.along_line,
         cosine_power: a.cosine_power,
-        min_curvature: MinCurvature {
-            tension: a.tension,
-            ..MinCurvature::default()
-        },
+        min_curvature: MinCurvature::with_tension(a.tension),
     };
     let m = microlevel(&flight, &opts, &mut Bars::new())?;
     let mut table = flight.into_table();

@@ -123,6 +123,14 @@ impl MinCurvatureReport {
 }
 
 impl MinCurvature {
+    /// The default settings with tension `tension`.
+    pub fn with_tension(tension: f64) -> Self {
+        Self {
+            tension,
+            ..Self::default()
+        }
+    }
+
     /// Check the settings.
     pub fn validate(&self) -> Result<()> {
         if !(0.0..=1.0).contains(&self.tension) {
