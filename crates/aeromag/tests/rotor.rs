@@ -35,6 +35,31 @@ fn the_rotor_study_meets_the_issue_figures() {
             .any(|m| m.name.contains("synchronous averaging")),
         "the filter baselines"
     );
+    // Issue 23 item 1: the thesis' simplified model beats filtering on a
+    // rotor that satisfies its assumptions, not on the richer default rotor
+    // (measured 4.3 % against 89.7 %, and 113 % against 56 %).
+    assert!(
+        s.simplified_fraction_ideal_rotor <= 0.10
+            && s.simplified_fraction_ideal_rotor < 0.25 * s.best_filter_fraction_ideal_rotor,
+        "{s:?}"
+    );
+    assert!(
+        s.simplified_fraction_default_rotor > s.best_filter_fraction_default_rotor,
+        "{s:?}"
+    );
+    // The tail rotor under the tail boom: unmodelled it is nearly all of
+    // the residual (measured 98.9 %); fitted jointly 2.2 %.
+    assert!(
+        s.tail_residual_fraction <= 0.05
+            && s.tail_unmodelled_residual_fraction >= 10.0 * s.tail_residual_fraction,
+        "{s:?}"
+    );
+    let offset = out.tail.tail_offset_rad.unwrap().to_degrees();
+    assert!(
+        (offset - 37.0).abs() < 1.0,
+        "tail rotor phase offset {offset}°"
+    );
+    assert!(out.tail_rms_nose_nt < 0.05 && out.tail_rms_tail_boom_nt > 5.0);
 }
 
 fn helicopter(seed: u64, config: Option<&str>) -> Flight {

@@ -116,13 +116,9 @@ impl RotorOptions {
             Some(p) => RotorOptions::preset(p),
             None => match (c.hub_m, c.sensor_m, c.blade_span_m, c.blades) {
                 (Some(hub_m), Some(sensor_m), Some([root_m, tip_m]), Some(blades)) => {
-                    RotorOptions::new(RotorGeometry {
-                        hub_m,
-                        sensor_m,
-                        root_m,
-                        tip_m,
-                        blades,
-                    })
+                    RotorOptions::new(RotorGeometry::main_rotor(
+                        hub_m, sensor_m, root_m, tip_m, blades,
+                    ))
                 }
                 _ => {
                     return Err(crate::Error::bad_input(

@@ -222,8 +222,23 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
             pct(m.removed_bumps_01)
         );
     }
+    let sum = out.summary();
+    println!(
+        "simplified model (3 per blade): {:.2} % of the rotor RMS on a rotor that satisfies its assumptions \
+         (best filter {:.2} %), {:.2} % on the default rotor (best filter {:.2} %)",
+        100.0 * sum.simplified_fraction_ideal_rotor,
+        100.0 * sum.best_filter_fraction_ideal_rotor,
+        100.0 * sum.simplified_fraction_default_rotor,
+        100.0 * sum.best_filter_fraction_default_rotor
+    );
+    println!(
+        "tail rotor, sensor under the tail boom: residual {:.2} % of the rotor RMS with the main rotor modelled, \
+         {:.2} % with main and tail rotor",
+        100.0 * sum.tail_unmodelled_residual_fraction,
+        100.0 * sum.tail_residual_fraction
+    );
     std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
-    let summary = serde_json::json!({ "rotor": out.summary() });
+    let summary = serde_json::json!({ "rotor": sum });
     aeromag::io::atomic::write_file(
         &a.out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,

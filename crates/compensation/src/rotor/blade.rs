@@ -44,6 +44,21 @@ pub struct RotorGeometry {
     pub tip_m: f64,
     /// Number of blades.
     pub blades: usize,
+    /// Direction of the rotor's angular velocity, body axes. Default
+    /// (0, 0, 1): a main rotor turning clockwise seen from above.
+    #[serde(default = "main_spin_axis")]
+    pub spin_axis: [f64; 3],
+    /// Body direction of a blade at azimuth 0. Default (1, 0, 0), the nose.
+    #[serde(default = "main_zero_azimuth")]
+    pub zero_azimuth: [f64; 3],
+}
+
+fn main_spin_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+fn main_zero_azimuth() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
 }
 
 /// Flap angles of the rotor cone (rad): coning `β0` and the tip-path-plane
@@ -59,6 +74,51 @@ pub struct FlapAngles {
 }
 
 impl RotorGeometry {
+    /// A main rotor (rotor plane normal to the body z axis, azimuth from
+    /// the nose towards the right) with the hub and the sensor at `hub_m`
+    /// and `sensor_m` (body axes, m), magnetised from `root_m` to `tip_m`
+    /// from the hub, with `blades` blades.
+    pub fn main_rotor(
+        hub_m: [f64; 3],
+        sensor_m: [f64; 3],
+        root_m: f64,
+        tip_m: f64,
+        blades: usize,
+    ) -> Self {
+        Self {
+            hub_m,
+            sensor_m,
+            root_m,
+            tip_m,
+            blades,
+            spin_axis: main_spin_axis(),
+            zero_azimuth: main_zero_azimuth(),
+        }
+    }
+
+    /// The same rotor in another plane: angular velocity along
+    /// `spin_axis`, azimuth 0 towards `zero_azimuth` (body axes; e.g. a
+    /// tail rotor).
+    pub fn with_plane(self, spin_axis: [f64; 3], zero_azimuth: [f64; 3]) -> Self {
+        Self {
+            spin_axis,
+            zero_azimuth,
+            ..self
+        }
+    }
+
+    /// Rotation from the rotor's hub frame (z along the angular velocity,
+    /// x towards azimuth 0) to body axes; errors for a degenerate plane.
+    pub fn body_from_hub(&self) -> Result<Matrix3<f64>> {
+        aeromag_core::frames::blade::body_from_hub(self.spin_axis, self.zero_azimuth).ok_or_else(
+            || {
+                CompError::setting(
+                    "rotor geometry: spin_axis and zero_azimuth must be non-zero and not parallel",
+                )
+            },
+        )
+    }
+
     /// Check the geometry.
     pub fn validate(&self) -> Result<()> {
         let ok = self
@@ -72,7 +132,7 @@ impl RotorGeometry {
             && self.tip_m > self.root_m
             && self.blades >= 2;
         if ok {
-            Ok(())
+            self.body_from_hub().map(|_| ())
         } else {
             Err(CompError::setting(
                 "rotor geometry: finite positions, 0 ≤ root < tip and ≥ 2 blades required",
@@ -80,7 +140,7 @@ impl RotorGeometry {
         }
     }
 
-    /// Sensor relative to the hub, m.
+    /// Sensor relative to the hub, body axes, m.
     pub fn sensor_from_hub(&self) -> Vector3<f64> {
         Vector3::from(self.sensor_m) - Vector3::from(self.hub_m)
     }

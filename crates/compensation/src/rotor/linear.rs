@@ -97,10 +97,13 @@ pub fn regressors(
     let n = input.len()?;
     let nb = geom.blades;
     let pb = terms.per_blade();
-    let a = geom.sensor_from_hub();
+    // Everything in the hub frame (ω along its z axis); the identity for a
+    // main rotor.
+    let hub_from_body = geom.body_from_hub()?.transpose();
+    let a = hub_from_body * geom.sensor_from_hub();
     let mut cols = vec![vec![0.0; n]; nb * pb];
     for k in 0..n {
-        let b = input.b_body_nt[k] * 1e-9;
+        let b = hub_from_body * input.b_body_nt[k] * 1e-9;
         let bn = b.norm();
         if !(bn.is_finite() && bn > 0.0) {
             return Err(CompError::data(format!(

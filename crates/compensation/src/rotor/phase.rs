@@ -60,6 +60,28 @@ pub fn rotor_speed(phase_rad: &[f64], fs_hz: f64, cutoff_hz: f64) -> Result<Vec<
     Ok(sosfiltfilt(&sos, &d)?)
 }
 
+/// A recorded rotor phase (unwrapped, rad) with its white noise filtered
+/// out: the linear trend plus the detrended phase low-passed at
+/// `cutoff_hz` (zero phase, 4th order). The rotor's speed changes over
+/// seconds, so a cutoff of 1–2 Hz keeps its phase and divides white
+/// recording noise by `√(fs / 2 f_c)`. What the tail rotor's phase is
+/// derived from: the gear ratio multiplies the channel's noise.
+pub fn smooth_phase(phase_rad: &[f64], fs_hz: f64, cutoff_hz: f64) -> Result<Vec<f64>> {
+    let n = phase_rad.len();
+    if n < 3 {
+        return Err(CompError::data("rotor phase: fewer than 3 samples"));
+    }
+    let slope = (phase_rad[n - 1] - phase_rad[0]) / (n - 1) as f64;
+    let trend = |k: usize| phase_rad[0] + slope * k as f64;
+    let detrended: Vec<f64> = (0..n).map(|k| phase_rad[k] - trend(k)).collect();
+    let sos = butter(4, Band::Lowpass { cutoff_hz }, fs_hz)?;
+    Ok(sosfiltfilt(&sos, &detrended)?
+        .iter()
+        .enumerate()
+        .map(|(k, d)| trend(k) + d)
+        .collect())
+}
+
 /// A rotor phase estimated from the scalar data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PhaseEstimate {

@@ -53,6 +53,7 @@ fn model_beats_the_filters() {
             true_anomaly_nt: col("true_anomaly"),
             fs_hz: cs.fs,
             edge: cs.edge,
+            tail: None,
         },
     )
     .unwrap();

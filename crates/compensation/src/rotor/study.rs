@@ -18,7 +18,10 @@
 //!   what low-pass filters hurt.
 //!
 //! Methods: full model (7 terms per blade) with nominal cone; the same with
-//! slowly varying cone and tilt ([`fit_slow_angles`]); low-pass at 0.8 of
+//! slowly varying cone and tilt ([`fit_slow_angles`]); the thesis'
+//! simplified model (3 per blade) in both forms; with a tail rotor, the
+//! full model with slowly varying cone fitted jointly with it
+//! ([`fit_with_tail`]; the study's prediction is then this one); low-pass at 0.8 of
 //! the blade-passing and of the rotor frequency; notches at 1…16 `f_r`;
 //! synchronous averaging over 10 s blocks.
 
@@ -28,8 +31,8 @@ use super::lowpass::lowpass;
 use super::notch::{NotchOptions, notch_harmonics};
 use super::synchronous::synchronous_template;
 use super::{
-    BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions, fit,
-    fit_slow_angles, linear, regressors, rotor_speed, unwrap_deg,
+    BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
+    TailRotor, fit, fit_slow_angles, fit_with_tail, linear, regressors, rotor_speed, unwrap_deg,
 };
 use crate::error::{CompError, Result};
 
@@ -37,12 +40,19 @@ use crate::error::{CompError, Result};
 /// hub at (0, 0, −2.6) m, nose-boom sensor at (5, 0, 0.6) m (body axes),
 /// blades from 0.8 to 7.5 m, 4 blades.
 pub fn scenario_geometry() -> RotorGeometry {
-    RotorGeometry {
-        hub_m: [0.0, 0.0, -2.6],
-        sensor_m: [5.0, 0.0, 0.6],
-        root_m: 0.8,
-        tip_m: 7.5,
-        blades: 4,
+    RotorGeometry::main_rotor([0.0, 0.0, -2.6], [5.0, 0.0, 0.6], 0.8, 7.5, 4)
+}
+
+/// The tail rotor of the `helicopter` scenario's `[tail_rotor]` table
+/// (defaults) seen from a sensor at `sensor_m` (body axes, m): hub at
+/// (−12.7, −1.0, −2.4) m, blades from 0.3 to 1.95 m, 3 blades, turning
+/// about −y with azimuth 0 up, geared 4.37 to the main rotor, cone 1°.
+pub fn scenario_tail_rotor(sensor_m: [f64; 3]) -> TailRotor {
+    TailRotor {
+        geometry: RotorGeometry::main_rotor([-12.7, -1.0, -2.4], sensor_m, 0.3, 1.95, 3)
+            .with_plane([0.0, -1.0, 0.0], [0.0, 0.0, -1.0]),
+        gear_ratio: 4.37,
+        coning_rad: 1f64.to_radians(),
     }
 }
 
@@ -107,6 +117,9 @@ pub struct StudyInput<'a> {
     pub fs_hz: f64,
     /// Samples excluded at each end of every metric.
     pub edge: usize,
+    /// A tail rotor to fit jointly with the main rotor (one more method),
+    /// or none.
+    pub tail: Option<&'a TailRotor>,
 }
 
 /// One method's figures.
@@ -139,9 +152,18 @@ pub struct RotorStudy {
     pub residual_model_nt: f64,
     /// Smallest residual of the filter baselines, nT.
     pub residual_best_filter_nt: f64,
+    /// Residual of the thesis' simplified model (3 parameters per blade,
+    /// nominal cone), nT.
+    pub residual_simplified_nt: f64,
+    /// With a tail rotor: the residual of the full model with slowly
+    /// varying cone fitted jointly with the tail rotor, nT.
+    pub residual_with_tail_nt: Option<f64>,
+    /// With a tail rotor: its estimated phase offset, rad.
+    pub tail_offset_rad: Option<f64>,
     /// Every method, models first.
     pub methods: Vec<MethodResult>,
-    /// Prediction of the full model with slowly varying cone, nT per sample.
+    /// Prediction of the full model with slowly varying cone (and the tail
+    /// rotor, when given), nT per sample.
     pub prediction_nt: Vec<f64>,
     /// Estimated coning angle per sample, rad.
     pub coning_rad: Vec<f64>,
@@ -186,44 +208,79 @@ pub fn evaluate(geom: &RotorGeometry, input: &StudyInput) -> Result<RotorStudy> 
     let r_rms = std_mid(rot, edge);
     let mut methods = Vec::new();
 
-    let f = fit(geom, BladeTerms::Full, &rin, mag, fs, &opts)?;
-    let p = f.predict(geom, &rin)?;
-    methods.push(MethodResult {
-        name: "model (7 per blade), nominal cone".into(),
-        residual_nt: std_mid(&diff(rot, &p), edge),
-        removed_anomaly: f64::NAN,
-        removed_bumps_05: f64::NAN,
-        removed_bumps_01: f64::NAN,
-        is_filter: false,
-    });
-    let slow = fit_slow_angles(
-        geom,
-        BladeTerms::Full,
-        &rin,
-        mag,
-        fs,
-        &opts,
-        &SlowAngleOptions::default(),
-    )?;
-    let inp_s = RotorInput {
-        angles: &slow.angles,
-        ..rin
-    };
-    let cols = regressors(geom, BladeTerms::Full, &inp_s)?;
-    let pred = slow.fit.predict_columns(&cols)?;
-    let model_res = std_mid(&diff(rot, &pred), edge);
-    let removed = |sig: &[f64]| -> Result<f64> {
-        let f = linear::fit_columns(&cols, BladeTerms::Full, sig, fs, &opts)?;
-        Ok(std_mid(&f.predict_columns(&cols)?, edge) / std_mid(sig, edge))
-    };
-    methods.push(MethodResult {
-        name: "model (7 per blade) + slowly varying cone".into(),
-        residual_nt: model_res,
-        removed_anomaly: removed(anom)?,
-        removed_bumps_05: removed(&bump)?,
-        removed_bumps_01: removed(&sharp)?,
-        is_filter: false,
-    });
+    // Both blade models, each with the nominal cone and with the slowly
+    // varying cone; the full model's slow-cone fit is the study's model.
+    let mut slow_fits = Vec::new();
+    for terms in [BladeTerms::Full, BladeTerms::Simplified] {
+        let label = match terms {
+            BladeTerms::Full => "model (7 per blade)",
+            BladeTerms::Simplified => "simplified model (3 per blade)",
+        };
+        let f = fit(geom, terms, &rin, mag, fs, &opts)?;
+        let p = f.predict(geom, &rin)?;
+        methods.push(MethodResult {
+            name: format!("{label}, nominal cone"),
+            residual_nt: std_mid(&diff(rot, &p), edge),
+            removed_anomaly: f64::NAN,
+            removed_bumps_05: f64::NAN,
+            removed_bumps_01: f64::NAN,
+            is_filter: false,
+        });
+        let slow = fit_slow_angles(
+            geom,
+            terms,
+            &rin,
+            mag,
+            fs,
+            &opts,
+            &SlowAngleOptions::default(),
+        )?;
+        let inp_s = RotorInput {
+            angles: &slow.angles,
+            ..rin
+        };
+        let cols = regressors(geom, terms, &inp_s)?;
+        let pred = slow.fit.predict_columns(&cols)?;
+        let removed = |sig: &[f64]| -> Result<f64> {
+            let f = linear::fit_columns(&cols, terms, sig, fs, &opts)?;
+            Ok(std_mid(&f.predict_columns(&cols)?, edge) / std_mid(sig, edge))
+        };
+        methods.push(MethodResult {
+            name: format!("{label} + slowly varying cone"),
+            residual_nt: std_mid(&diff(rot, &pred), edge),
+            removed_anomaly: removed(anom)?,
+            removed_bumps_05: removed(&bump)?,
+            removed_bumps_01: removed(&sharp)?,
+            is_filter: false,
+        });
+        slow_fits.push((slow, pred));
+    }
+    let (slow, mut pred) = slow_fits.swap_remove(0);
+    let model_res = methods[1].residual_nt;
+    let simplified_res = methods[2].residual_nt;
+    let mut tail_fit = None;
+    if let Some(tail) = input.tail {
+        let t = fit_with_tail(
+            geom,
+            tail,
+            BladeTerms::Full,
+            &rin,
+            mag,
+            fs,
+            &opts,
+            Some(&SlowAngleOptions::default()),
+        )?;
+        methods.push(MethodResult {
+            name: "model (7 per blade) + slowly varying cone + tail rotor".into(),
+            residual_nt: std_mid(&diff(rot, &t.prediction_nt), edge),
+            removed_anomaly: f64::NAN,
+            removed_bumps_05: f64::NAN,
+            removed_bumps_01: f64::NAN,
+            is_filter: false,
+        });
+        pred = t.prediction_nt.clone();
+        tail_fit = Some((methods.last().map_or(f64::NAN, |m| m.residual_nt), t));
+    }
 
     // Linear baselines: residual = what they let through of the rotor part.
     let lin = |name: String, f: &dyn Fn(&[f64]) -> Result<Vec<f64>>| -> Result<MethodResult> {
@@ -268,6 +325,9 @@ pub fn evaluate(geom: &RotorGeometry, input: &StudyInput) -> Result<RotorStudy> 
         rotor_hz: f_r,
         residual_model_nt: model_res,
         residual_best_filter_nt: best_filter,
+        residual_simplified_nt: simplified_res,
+        residual_with_tail_nt: tail_fit.as_ref().map(|t| t.0),
+        tail_offset_rad: tail_fit.as_ref().map(|t| t.1.offset_rad),
         methods,
         prediction_nt: pred,
         coning_rad: slow.angles.iter().map(|a| a.coning_rad).collect(),

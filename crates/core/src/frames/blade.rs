@@ -21,6 +21,31 @@ pub fn blade_axes(psi_rad: f64, beta_rad: f64) -> Matrix3<f64> {
     Matrix3::from_columns(&[r, l, u])
 }
 
+/// The rotation from a rotor's hub frame to body axes, as columns
+/// `[x_h y_h z_h]`: `z_h` along `spin_axis` (the direction of the rotor's
+/// angular velocity, so `ω = (0, 0, Ω)` in the hub frame), `x_h` the part of
+/// `zero_azimuth` (the body direction of a blade at azimuth 0) orthogonal
+/// to it, `y_h = z_h × x_h`. The main rotor of the body frame (x forward,
+/// z down, turning clockwise seen from above) has `spin_axis = (0, 0, 1)`,
+/// `zero_azimuth = (1, 0, 0)` and the identity. `None` when either vector
+/// is zero or not finite, or they are parallel.
+pub fn body_from_hub(spin_axis: [f64; 3], zero_azimuth: [f64; 3]) -> Option<Matrix3<f64>> {
+    let z = Vector3::from(spin_axis);
+    let x = Vector3::from(zero_azimuth);
+    let (nz, nx) = (z.norm(), x.norm());
+    if !(nz.is_finite() && nx.is_finite() && nz > 0.0 && nx > 0.0) {
+        return None;
+    }
+    let z = z / nz;
+    let x = x / nx - z * z.dot(&(x / nx));
+    let n = x.norm();
+    if n.is_nan() || n <= 1e-6 {
+        return None;
+    }
+    let x = x / n;
+    Some(Matrix3::from_columns(&[x, z.cross(&x), z]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -35,5 +60,20 @@ mod tests {
             "e_u is up (−z) for a level blade"
         );
         assert!(a[(2, 0)] < 0.0, "a positive flap points the blade up (−z)");
+    }
+
+    #[test]
+    fn hub_frame_is_a_rotation_and_the_main_rotor_is_the_identity() {
+        assert_eq!(
+            body_from_hub([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+            Some(Matrix3::identity())
+        );
+        let c = body_from_hub([0.0, 2.0, 0.0], [0.3, 0.1, -1.0]).unwrap();
+        assert!((c * c.transpose() - Matrix3::identity()).norm() < 1e-14);
+        assert!((c.determinant() - 1.0).abs() < 1e-14);
+        assert!((c.column(2) - Vector3::new(0.0, 1.0, 0.0)).norm() < 1e-15);
+        assert!(body_from_hub([0.0, 1.0, 0.0], [0.0, -3.0, 0.0]).is_none());
+        assert!(body_from_hub([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]).is_none());
+        assert!(body_from_hub([f64::NAN, 0.0, 1.0], [1.0, 0.0, 0.0]).is_none());
     }
 }

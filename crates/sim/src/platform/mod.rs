@@ -9,9 +9,12 @@
 //! * [`rotor`] — a helicopter's main rotor: magnetised, conducting thin
 //!   blades with coning and tip-path-plane tilt, dipole integral along each
 //!   blade (the fuselage of the `helicopter` scenario is an [`aircraft`]).
+//! * [`tail_rotor`] — its tail rotor: the same blades in their own plane,
+//!   geared to the main rotor.
 //!
 //! Later platforms (towed pod) belong here, one model per file.
 
 pub mod aircraft;
 pub mod currents;
 pub mod rotor;
+pub mod tail_rotor;

@@ -75,6 +75,19 @@ pub struct BladeConfig {
     pub eddy_tau_s: f64,
 }
 
+impl BladeConfig {
+    /// Check the values (`f` names the blade in messages).
+    pub fn validate(&self, f: &str) -> Result<()> {
+        for (k, x) in self.hard_am.iter().enumerate() {
+            require_finite(&format!("{f}.hard_am[{k}]"), *x)?;
+        }
+        require_finite(&format!("{f}.soft_along_m2"), self.soft_along_m2)?;
+        require_finite(&format!("{f}.soft_across_m2"), self.soft_across_m2)?;
+        require_finite(&format!("{f}.eddy_am_per_t_s"), self.eddy_am_per_t_s)?;
+        require_positive(&format!("{f}.eddy_tau_s"), self.eddy_tau_s)
+    }
+}
+
 /// The main rotor.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -198,16 +211,39 @@ impl RotorConfig {
             return Err(invalid(format!("{p}.blades"), "at least two blades"));
         }
         for (i, b) in self.blades.iter().enumerate() {
-            let f = format!("{p}.blades[{i}]");
-            for (k, x) in b.hard_am.iter().enumerate() {
-                require_finite(&format!("{f}.hard_am[{k}]"), *x)?;
-            }
-            require_finite(&format!("{f}.soft_along_m2"), b.soft_along_m2)?;
-            require_finite(&format!("{f}.soft_across_m2"), b.soft_across_m2)?;
-            require_finite(&format!("{f}.eddy_am_per_t_s"), b.eddy_am_per_t_s)?;
-            require_positive(&format!("{f}.eddy_tau_s"), b.eddy_tau_s)?;
+            b.validate(&format!("{p}.blades[{i}]"))?;
         }
         Ok(())
+    }
+
+    /// A rotor that satisfies the assumptions of the thesis' simplified
+    /// model (seed `000_…` §16; spec `helicopter.md`, "Simplified, linear
+    /// model"): the blades turn uniformly (no speed variation, no droop) in
+    /// one plane fixed in the body (constant cone and tilt), the hard
+    /// magnetisation lies along the blade, the soft magnetisation along the
+    /// blade only, and the eddy currents follow the field without lag
+    /// (`τ` = 0.1 ms, `ω τ` = 0.003 rad). Otherwise the default rotor, with
+    /// the default blades' along-spar values.
+    pub fn simplified() -> Self {
+        let d = Self::default();
+        Self {
+            speed_rms_frac: 0.0,
+            droop_per_g: 0.0,
+            coning_per_g_deg: 0.0,
+            tilt_per_pitch_rate_s: 0.0,
+            tilt_per_roll_rate_s: 0.0,
+            blades: d
+                .blades
+                .iter()
+                .map(|b| BladeConfig {
+                    hard_am: [b.hard_am[0], 0.0, 0.0],
+                    soft_across_m2: 0.0,
+                    eddy_tau_s: 1e-4,
+                    ..b.clone()
+                })
+                .collect(),
+            ..d
+        }
     }
 
     /// Nominal rotor frequency, Hz.
@@ -351,29 +387,126 @@ pub fn rotor_field_nt(
 ) -> Vec<Vector3<f64>> {
     let n = b_nt.len().min(state.phase_rad.len());
     let nb = cfg.blades.len();
+    let span = BladeSpan {
+        hub_m: cfg.hub_m,
+        root_m: cfg.root_m,
+        radius_m: cfg.radius_m,
+    };
+    blades_field_nt(
+        &span,
+        &cfg.blades,
+        &|k, j| state.blade_axes(k, j, nb),
+        &EddyInput::Sampled,
+        sensor_m,
+        &b_nt[..n],
+        dt_s,
+    )
+}
+
+/// How the eddy-current state `y_j` of a blade (`τ dy_j/dt + y_j =
+/// d(R_jᵀ B)/dt`, T/s, blade axes) is computed.
+pub enum EddyInput<'a> {
+    /// From the sampled blade-frame field: forward differences, lagged with
+    /// a zero-order hold (the main rotor: 0.3 rad of rotation per sample at
+    /// 100 Hz).
+    Sampled,
+    /// Integrated between samples in `substeps` zero-order-hold steps, with
+    /// the rate given at any time: `rate(k, f, j)` is `d(R_jᵀ B)/dt` (T/s)
+    /// of blade `j` at time `(k + f)·dt`, `0 ≤ f < 1`. For rotors that turn
+    /// through a large angle within a sample (a tail rotor: 1.3 rad at
+    /// 100 Hz), where differences of samples do not resolve the rotation.
+    Substepped {
+        /// Steps per sample interval.
+        substeps: usize,
+        /// The rate.
+        rate: &'a dyn Fn(usize, f64, usize) -> Vector3<f64>,
+    },
+}
+
+impl EddyInput<'_> {
+    /// `y_j` at every sample for the blade-frame field `bb` (T) of blade
+    /// `j` with time constant `tau_s`.
+    fn state(&self, j: usize, bb: &[Vector3<f64>], tau_s: f64, dt_s: f64) -> Vec<Vector3<f64>> {
+        let n = bb.len();
+        match self {
+            EddyInput::Sampled => {
+                let lagged: [Vec<f64>; 3] = std::array::from_fn(|c| {
+                    let u: Vec<f64> = (0..n)
+                        .map(|k| {
+                            if k + 1 < n {
+                                (bb[k + 1][c] - bb[k][c]) / dt_s
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect();
+                    let y0 = u.first().copied().unwrap_or(0.0);
+                    lag_zoh(&u, dt_s, tau_s, y0)
+                });
+                (0..n)
+                    .map(|k| Vector3::new(lagged[0][k], lagged[1][k], lagged[2][k]))
+                    .collect()
+            }
+            EddyInput::Substepped { substeps, rate } => {
+                let m = (*substeps).max(1);
+                let a = (-dt_s / (m as f64 * tau_s)).exp();
+                let mut out = Vec::with_capacity(n);
+                if n == 0 {
+                    return out;
+                }
+                let mut y = rate(0, 0.0, j);
+                out.push(y);
+                for k in 0..n - 1 {
+                    for s in 0..m {
+                        let u = rate(k, (s as f64 + 0.5) / m as f64, j);
+                        y = y * a + u * (1.0 - a);
+                    }
+                    out.push(y);
+                }
+                out
+            }
+        }
+    }
+}
+
+/// Where a rotor's magnetised blades are: the hub (body axes, m) and the
+/// magnetised span from `root_m` to `radius_m` along each blade.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BladeSpan {
+    /// Hub position, body axes, m.
+    pub hub_m: [f64; 3],
+    /// Start of the magnetised span, m.
+    pub root_m: f64,
+    /// Blade tip, m.
+    pub radius_m: f64,
+}
+
+/// The field (nT, body axes) at `sensor_m` of rotating blades with the
+/// magnetisation of the module docs, for the external body field `b_nt`
+/// (nT): `axes(k, j)` gives blade `j`'s axes `[r_p e_l e_u]` in body axes
+/// at sample `k`, `eddy` how the eddy currents follow the rotation. Shared
+/// by the main and the tail rotor.
+pub fn blades_field_nt(
+    span: &BladeSpan,
+    blades: &[BladeConfig],
+    axes: &dyn Fn(usize, usize) -> Matrix3<f64>,
+    eddy: &EddyInput,
+    sensor_m: [f64; 3],
+    b_nt: &[Vector3<f64>],
+    dt_s: f64,
+) -> Vec<Vector3<f64>> {
+    let n = b_nt.len();
     let gl = gauss_legendre(24);
-    let (r0, r1) = (cfg.root_m, cfg.radius_m);
-    let a = Vector3::from(sensor_m) - Vector3::from(cfg.hub_m);
+    let (r0, r1) = (span.root_m, span.radius_m);
+    let a = Vector3::from(sensor_m) - Vector3::from(span.hub_m);
     let mut out = vec![Vector3::zeros(); n];
-    for (j, bl) in cfg.blades.iter().enumerate() {
+    for (j, bl) in blades.iter().enumerate() {
         // Blade-frame field rate, lagged: y_j.
-        let axes: Vec<Matrix3<f64>> = (0..n).map(|k| state.blade_axes(k, j, nb)).collect();
+        let axes: Vec<Matrix3<f64>> = (0..n).map(|k| axes(k, j)).collect();
         let bb: Vec<Vector3<f64>> = (0..n)
             .map(|k| axes[k].transpose() * b_nt[k] / NT_PER_T)
             .collect();
-        let lagged: [Vec<f64>; 3] = std::array::from_fn(|c| {
-            let u: Vec<f64> = (0..n)
-                .map(|k| {
-                    if k + 1 < n {
-                        (bb[k + 1][c] - bb[k][c]) / dt_s
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            let y0 = u.first().copied().unwrap_or(0.0);
-            lag_zoh(&u, dt_s, bl.eddy_tau_s, y0)
-        });
+        let lagged = eddy.state(j, &bb, bl.eddy_tau_s, dt_s);
         let hard = Vector3::from(bl.hard_am);
         for k in 0..n {
             let rj = &axes[k];
@@ -385,7 +518,7 @@ pub fn rotor_field_nt(
             }
             let bt = b_nt[k] / NT_PER_T;
             let along = rp * rp.dot(&bt);
-            let y = Vector3::new(lagged[0][k], lagged[1][k], lagged[2][k]);
+            let y = lagged[k];
             let m = rj * hard
                 + along * (bl.soft_along_m2 / MU0)
                 + (bt - along) * (bl.soft_across_m2 / MU0)

@@ -22,7 +22,10 @@
 //! the default lag of this scenario is 0 s.
 //!
 //! The scenario file is the fixed-wing file plus a `[rotor]` table
-//! ([`RotorConfig`]).
+//! ([`RotorConfig`]) and, optionally, a `[tail_rotor]` table
+//! ([`TailRotorConfig`]; an empty table takes its defaults): its field
+//! `ΔB_t` is added with the main rotor's, `ΔB_r` below standing for both
+//! in the `flux` and `true_rotor_x/y/z` columns.
 //!
 //! ## Extra columns
 //!
@@ -32,7 +35,8 @@
 //! | `true_rotor_phase` | deg | true phase of blade 0, unwrapped |
 //! | `true_rotor_hz` | Hz | true rotor frequency `Ω/2π` |
 //! | `true_coning`, `true_tilt_lon`, `true_tilt_lat` | deg | true flap angles |
-//! | `true_rotor` | nT | rotor part of the scalar reading (exact, see above) |
+//! | `true_rotor` | nT | rotor part of the scalar reading (exact, see above; main and tail rotor) |
+//! | `true_tail_rotor` | nT | the tail rotor's share of it, `|B + ΔB_f + ΔB_r + ΔB_t| − |B + ΔB_f + ΔB_r|` (with a tail rotor) |
 //! | `true_fuselage` | nT | fuselage part `|B + ΔB_f| − |B|` |
 //! | `true_rotor_x/y/z` | nT | rotor field at the scalar sensor, body axes |
 //!
@@ -50,6 +54,7 @@ use crate::environment::anomaly::{AnomalyArea, AnomalyConfig};
 use crate::error::{Result, SimError};
 use crate::output::{Column, Simulation};
 use crate::platform::rotor::{RotorConfig, RotorState, rotor_field_nt};
+use crate::platform::tail_rotor::{TailRotorConfig, tail_rotor_field_nt};
 use crate::random::{Stream, normal, rng_for};
 use crate::sensor::fluxgate::FluxgateConfig;
 use crate::sensor::scalar::ScalarSensorConfig;
@@ -63,12 +68,17 @@ pub struct HelicopterConfig {
     pub base: FixedWingConfig<CalibrationPattern>,
     /// The main rotor.
     pub rotor: RotorConfig,
+    /// The tail rotor, if modelled (a `[tail_rotor]` table; an empty table
+    /// takes the defaults of [`TailRotorConfig`]). Default none.
+    pub tail_rotor: Option<TailRotorConfig>,
 }
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RotorTable {
     rotor: RotorConfig,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tail_rotor: Option<TailRotorConfig>,
 }
 
 /// The default helicopter scenario: 100 Hz, 40 m/s, box at 300 m (150 m
@@ -112,6 +122,7 @@ pub fn helicopter_defaults() -> HelicopterConfig {
             ..FixedWingConfig::default()
         },
         rotor: RotorConfig::default(),
+        tail_rotor: None,
     }
 }
 
@@ -126,12 +137,9 @@ impl HelicopterConfig {
     pub fn parse_over(defaults: Self, text: Option<&str>, seed: Option<u64>) -> Result<Self> {
         let kind = ScenarioKind::Helicopter;
         let Some(text) = text else {
+            defaults.validate()?;
             let base = FixedWingConfig::parse_over(defaults.base, kind, None, seed)?;
-            defaults.rotor.validate("rotor")?;
-            return Ok(Self {
-                base,
-                rotor: defaults.rotor,
-            });
+            return Ok(Self { base, ..defaults });
         };
         let mut user: toml::Table =
             toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
@@ -141,13 +149,34 @@ impl HelicopterConfig {
                 .try_into::<RotorConfig>()
                 .map_err(|e| SimError::ConfigParse(format!("[rotor]: {e}")))?,
         };
-        rotor.validate("rotor")?;
+        let tail_rotor = match user.remove("tail_rotor") {
+            None => defaults.tail_rotor,
+            Some(v) => Some(
+                v.try_into::<TailRotorConfig>()
+                    .map_err(|e| SimError::ConfigParse(format!("[tail_rotor]: {e}")))?,
+            ),
+        };
         let rest = toml::to_string(&user).map_err(|e| SimError::Serialize {
             what: "scenario",
             reason: e.to_string(),
         })?;
         let base = FixedWingConfig::parse_over(defaults.base, kind, Some(&rest), seed)?;
-        Ok(Self { base, rotor })
+        let cfg = Self {
+            base,
+            rotor,
+            tail_rotor,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Check the rotor tables.
+    pub fn validate(&self) -> Result<()> {
+        self.rotor.validate("rotor")?;
+        match &self.tail_rotor {
+            Some(t) => t.validate("tail_rotor"),
+            None => Ok(()),
+        }
     }
 
     /// The configuration as TOML, every default filled in.
@@ -155,6 +184,7 @@ impl HelicopterConfig {
         let base = self.base.to_toml(ScenarioKind::Helicopter)?;
         let rotor = toml::to_string(&RotorTable {
             rotor: self.rotor.clone(),
+            tail_rotor: self.tail_rotor.clone(),
         })
         .map_err(|e| SimError::Serialize {
             what: "rotor",
@@ -190,7 +220,7 @@ fn set(cols: &mut [Column], name: &str, f: impl Fn(usize, f64) -> f64) {
 
 /// Run the helicopter scenario (module docs).
 pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
-    cfg.rotor.validate("rotor")?;
+    cfg.validate()?;
     if !cfg.base.installation.is_stinger() {
         return Err(crate::error::invalid(
             "installation",
@@ -224,12 +254,31 @@ pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
     let d_fus = vectors(cols, "true_interf")?;
     let mut rng = rng_for(cfg.base.seed, Stream::HelicopterRotor);
     let state = RotorState::generate(&cfg.rotor, &roll, &pitch, &speed, dt, &mut rng);
-    let r_s = rotor_field_nt(&cfg.rotor, &state, cfg.base.scalar.position_m, &b_ext, dt);
-    let r_f = rotor_field_nt(&cfg.rotor, &state, cfg.base.fluxgate.position_m, &b_ext, dt);
+    let mut r_s = rotor_field_nt(&cfg.rotor, &state, cfg.base.scalar.position_m, &b_ext, dt);
+    let mut r_f = rotor_field_nt(&cfg.rotor, &state, cfg.base.fluxgate.position_m, &b_ext, dt);
     let n = b_ext.len();
     let fus: Vec<f64> = (0..n)
         .map(|k| (b_ext[k] + d_fus[k]).norm() - b_ext[k].norm())
         .collect();
+    // The tail rotor's part of the scalar reading, on top of the main rotor.
+    let tail = match &cfg.tail_rotor {
+        None => None,
+        Some(t) => {
+            let t_s = tail_rotor_field_nt(t, &state, cfg.base.scalar.position_m, &b_ext, dt);
+            let t_f = tail_rotor_field_nt(t, &state, cfg.base.fluxgate.position_m, &b_ext, dt);
+            let part: Vec<f64> = (0..n)
+                .map(|k| {
+                    let main = b_ext[k] + d_fus[k] + r_s[k];
+                    (main + t_s[k]).norm() - main.norm()
+                })
+                .collect();
+            for k in 0..n {
+                r_s[k] += t_s[k];
+                r_f[k] += t_f[k];
+            }
+            Some(part)
+        }
+    };
     let rot: Vec<f64> = (0..n)
         .map(|k| (b_ext[k] + d_fus[k] + r_s[k]).norm() - (b_ext[k] + d_fus[k]).norm())
         .collect();
@@ -308,6 +357,14 @@ pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
         "rotor part of the scalar reading |B+ΔB_f+ΔB_r| − |B+ΔB_f|",
         rot.clone(),
     );
+    if let Some(part) = tail {
+        add(
+            "true_tail_rotor",
+            "nT",
+            "tail rotor part of the scalar reading |B+ΔB_f+ΔB_r+ΔB_t| − |B+ΔB_f+ΔB_r| (included in true_rotor)",
+            part,
+        );
+    }
     add(
         "true_fuselage",
         "nT",
@@ -335,6 +392,7 @@ pub fn run(cfg: &HelicopterConfig) -> Result<Simulation> {
             "rotor".into(),
             serde_json::json!({
                 "config": &cfg.rotor,
+                "tail_rotor": &cfg.tail_rotor,
                 "true_rotor_mean_nt": mean,
                 "true_rotor_std_nt": rms,
                 "blade_passing_hz": cfg.rotor.nominal_hz() * cfg.rotor.blades.len() as f64,
@@ -394,6 +452,45 @@ mod tests {
             HelicopterConfig::parse_over(helicopter_defaults(), Some(&sim.scenario_toml), None)
                 .unwrap();
         assert_eq!(again, cfg);
+    }
+
+    #[test]
+    fn the_tail_rotor_adds_its_part_and_round_trips() {
+        let text = format!("{SHORT}[tail_rotor]\n");
+        let cfg =
+            HelicopterConfig::parse_over(helicopter_defaults(), Some(&text), Some(3)).unwrap();
+        assert_eq!(cfg.tail_rotor, Some(TailRotorConfig::default()));
+        let sim = run(&cfg).unwrap();
+        let c = |n: &str| sim.column(n).unwrap();
+        let plain = run(
+            &HelicopterConfig::parse_over(helicopter_defaults(), Some(SHORT), Some(3)).unwrap(),
+        )
+        .unwrap();
+        let (rot, tail, rot0) = (
+            c("true_rotor"),
+            c("true_tail_rotor"),
+            plain.column("true_rotor").unwrap(),
+        );
+        for k in 0..rot.len() {
+            // The tail's part is what it adds to the main rotor's (same seed).
+            assert!((rot[k] - rot0[k] - tail[k]).abs() < 1e-9, "k={k}");
+        }
+        let m = tail.iter().sum::<f64>() / tail.len() as f64;
+        let rms = (tail.iter().map(|x| (x - m).powi(2)).sum::<f64>() / tail.len() as f64).sqrt();
+        // 18 m from the nose-boom sensor: a small part.
+        assert!(rms > 1e-3 && rms < 0.1, "tail rotor rms {rms}");
+        let again =
+            HelicopterConfig::parse_over(helicopter_defaults(), Some(&sim.scenario_toml), None)
+                .unwrap();
+        assert_eq!(again, cfg);
+        assert!(
+            HelicopterConfig::parse_over(
+                helicopter_defaults(),
+                Some("[tail_rotor]\nspin_axis = [0.0, 0.0, 0.0]\n"),
+                None
+            )
+            .is_err()
+        );
     }
 
     #[test]
