@@ -124,7 +124,23 @@ fn the_study_meets_the_issue_figures() {
         .iter()
         .filter(|b| matches!(b, aeromag::report::Block::Figure { .. }))
         .count();
-    assert_eq!(figures, 3 + 4, "pass figures and map slices");
+    assert_eq!(
+        figures,
+        3 + 4 + 1,
+        "pass figures, map slices, approximation against range"
+    );
+    // the gradient-tensor approximation at range/baseline 1.5: its bias
+    // alone is ~1170 CRLB σ (measured 1165.9)
+    assert!(
+        (1000.0..1400.0).contains(&s.tensor_approx_efficiency_worst),
+        "{s:?}"
+    );
+    let tables = sec
+        .blocks
+        .iter()
+        .filter(|b| matches!(b, aeromag::report::Block::Table(_)))
+        .count();
+    assert_eq!(tables, 2, "efficiency table and approximation table");
 }
 
 #[test]

@@ -18,7 +18,8 @@
 //! [environment]  # variation_nt, lat_deg, lon_deg, alt_m, decimal_year (IGRF field and gradient)
 //! [object]       # permanent_moment_am2, induced_am2_per_nt, yaw_rad, yaw_rate_rad_s
 //! [trajectory]   # dt_s, epochs, speed_m_s, offset_east_m, offset_down_m
-//! [estimator]    # quiet epochs, motion-model noise, detection, initialisation, passes
+//! [estimator]    # quiet epochs, motion-model noise, detection, initialisation, passes,
+//!                # difference_model = "exact" | "gradient_tensor"
 //! ```
 
 use crate::error::{GradiometryError, Result};
@@ -27,6 +28,7 @@ use crate::locate::LocateConfig;
 use crate::motion::MotionNoise;
 use crate::sim::{Gradiometer, Processing, Scenario, SensorSpec, SystemMotion};
 use crate::sr_iekf::IekfConfig;
+use crate::tensor_approx::DifferenceModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
 use nalgebra::Vector3;
@@ -221,6 +223,10 @@ pub struct EstimatorConfig {
     pub max_iterations: usize,
     /// `k` of the residual threshold `k σ √Z`. Default 1.5.
     pub residual_factor: f64,
+    /// Forward model of the tensor differences: `"exact"` (default, the
+    /// seed's) or `"gradient_tensor"` (the linear approximation of
+    /// [`crate::tensor_approx`], for comparison).
+    pub difference_model: DifferenceModel,
 }
 
 impl Default for EstimatorConfig {
@@ -242,6 +248,7 @@ impl Default for EstimatorConfig {
             first_pass_extra_moment_am2: 30.0,
             max_iterations: 30,
             residual_factor: 1.5,
+            difference_model: DifferenceModel::Exact,
         }
     }
 }
@@ -424,6 +431,7 @@ impl GradiometerConfig {
             passes: e.passes,
             first_pass_extra_position_m: e.first_pass_extra_position_m,
             first_pass_extra_moment_am2: e.first_pass_extra_moment_am2,
+            difference_model: e.difference_model,
         };
         c.validate()?;
         Ok(c)
@@ -467,6 +475,17 @@ mod tests {
         assert_eq!(c.sensors.vector, SensorsConfig::default().vector);
         let text = c.to_toml().unwrap();
         assert_eq!(GradiometerConfig::from_toml(&text).unwrap(), c);
+        assert_eq!(
+            c.locate_config(None).unwrap().difference_model,
+            DifferenceModel::Exact
+        );
+        let approx =
+            GradiometerConfig::from_toml("[estimator]\ndifference_model = \"gradient_tensor\"\n")
+                .unwrap();
+        assert_eq!(
+            approx.locate_config(None).unwrap().difference_model,
+            DifferenceModel::GradientTensor
+        );
     }
 
     #[test]

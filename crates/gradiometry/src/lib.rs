@@ -7,6 +7,7 @@
 //! - [`geometry`] — four-sensor layouts (tetrahedron, cross, planar);
 //! - [`decorrelate`] — the orthonormal contrasts that whiten the differences;
 //! - [`forward`] — `ForwardMT` / `ForwardMV` with analytic Jacobians;
+//! - [`tensor_approx`] — the gradient-tensor (linear) approximation of the differences, for comparison;
 //! - [`sr_iekf`] — square-root IEKF (`PrognosisFK`, `ProcessingFK`, per-epoch iteration) on
 //!   the triangular toolkit of `aeromag_estimation::kalman`;
 //! - [`pass`] — the filter over the epochs of a pass, re-linearised passes;
@@ -40,3 +41,4 @@ pub mod parallel;
 pub mod pass;
 pub mod sim;
 pub mod sr_iekf;
+pub mod tensor_approx;

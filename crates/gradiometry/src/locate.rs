@@ -28,12 +28,19 @@
 //! zero moment with σ `prior_sigma_moment_am2`.
 //!
 //! Each epoch's output carries the residual `‖z − h(x⁺)‖` (nT).
+//!
+//! The tensor system's forward model is the exact one
+//! ([`DifferenceModel::Exact`], default) or, for comparison, the
+//! gradient-tensor approximation ([`DifferenceModel::GradientTensor`],
+//! [`crate::tensor_approx`]), chosen in [`LocateConfig::difference_model`].
 
 use crate::convergence::candidate_starts;
 use crate::error::{GradiometryError, Result, positive};
 use crate::forward::{Forward, ScalarForward, TensorForward};
 use crate::pass::{PassEpoch, PassStep, run_pass, run_pass_relinearised};
 use crate::sr_iekf::{IekfConfig, SrState, iterate_epoch};
+pub use crate::tensor_approx::DifferenceModel;
+use crate::tensor_approx::TensorApproxForward;
 use nalgebra::{SMatrix, SVector, Vector3};
 
 /// Settings of the pass estimator (module docs).
@@ -59,6 +66,9 @@ pub struct LocateConfig {
     pub first_pass_extra_position_m: f64,
     /// Extra moment noise root per step of the first of several passes, A·m².
     pub first_pass_extra_moment_am2: f64,
+    /// Forward model of the tensor differences in the estimator (default
+    /// [`DifferenceModel::Exact`]; the scalar system is always exact).
+    pub difference_model: DifferenceModel,
 }
 
 impl LocateConfig {
@@ -125,8 +135,8 @@ pub const WINDOW_ITERATIONS: usize = 5;
 /// transitions, `x̄_{j−1} = F_j⁻¹ (x̄_j − u_j)`, and scored by the whole
 /// window's residual `Σ_j ‖z_j − h_j(x̄_j)‖²` (nT²). Returns `x̄_0` of the
 /// best candidate (first on ties). The first epoch's transition is ignored.
-pub fn window_multistart(
-    window: &[PassEpoch<6, 9, TensorForward>],
+pub fn window_multistart<F: Forward<6, 9>>(
+    window: &[PassEpoch<6, 9, F>],
     iekf: &IekfConfig,
     sigma: &SVector<f64, 6>,
 ) -> Result<SVector<f64, 6>> {
@@ -193,9 +203,29 @@ pub fn window_multistart(
 }
 
 /// Tensor system over a pass (module docs): `None` before detection (or
-/// everywhere when the object is never detected).
+/// everywhere when the object is never detected). The estimator's forward
+/// model is the exact one of the epochs or, with
+/// [`DifferenceModel::GradientTensor`], the approximation of
+/// [`crate::tensor_approx`] for the same geometry and background.
 pub fn locate_tensor(
     epochs: &[PassEpoch<6, 9, TensorForward>],
+    cfg: &LocateConfig,
+) -> Result<Vec<Option<Located<6>>>> {
+    match cfg.difference_model {
+        DifferenceModel::Exact => locate_tensor_with(epochs, cfg),
+        DifferenceModel::GradientTensor => {
+            let approx: Vec<_> = epochs
+                .iter()
+                .map(|e| e.with_model(TensorApproxForward::from(e.model)))
+                .collect();
+            locate_tensor_with(&approx, cfg)
+        }
+    }
+}
+
+/// [`locate_tensor`] with the epochs' own forward model `F`.
+fn locate_tensor_with<F: Forward<6, 9> + Clone>(
+    epochs: &[PassEpoch<6, 9, F>],
     cfg: &LocateConfig,
 ) -> Result<Vec<Option<Located<6>>>> {
     cfg.validate()?;
@@ -293,6 +323,7 @@ mod tests {
             passes: 1,
             first_pass_extra_position_m: 0.3,
             first_pass_extra_moment_am2: 30.0,
+            difference_model: DifferenceModel::Exact,
         };
         let out = locate_tensor(&epochs, &cfg).unwrap();
         let j0 = out.iter().position(Option::is_some).unwrap();

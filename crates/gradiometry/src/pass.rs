@@ -40,6 +40,19 @@ pub struct PassEpoch<const N: usize, const Z: usize, F> {
     pub z: SVector<f64, Z>,
 }
 
+impl<const N: usize, const Z: usize, F> PassEpoch<N, Z, F> {
+    /// The same epoch with another forward model.
+    pub fn with_model<G>(&self, model: G) -> PassEpoch<N, Z, G> {
+        PassEpoch {
+            transition: self.transition,
+            offset: self.offset,
+            s_q: self.s_q,
+            model,
+            z: self.z,
+        }
+    }
+}
+
 /// One epoch of output.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PassStep<const N: usize> {
