@@ -258,6 +258,13 @@ def fit_rotor(
     estimate_phase: bool = False,
     rotor_hz: Optional[Tuple[float, float]] = None,
     window_s: Optional[float] = None,
+    tail_rotor: bool = False,
+    tail_hub_m: Optional[Tuple[float, float, float]] = None,
+    tail_spin_axis: Optional[Tuple[float, float, float]] = None,
+    tail_zero_azimuth: Optional[Tuple[float, float, float]] = None,
+    tail_blade_span_m: Optional[Tuple[float, float]] = None,
+    tail_blades: Optional[int] = None,
+    gear_ratio: Optional[float] = None,
     progress: _Progress = None,
 ) -> Model: ...
 def fit_pod(

@@ -137,7 +137,8 @@ impl PyModel {
 #[pyfunction]
 #[pyo3(signature = (flight, preset=None, hub_m=None, sensor_m=None, blade_span_m=None, blades=None,
     coning_deg=None, tilt_lon_deg=None, phase_column=None, estimate_phase=false, rotor_hz=None,
-    window_s=None, progress=None))]
+    window_s=None, tail_rotor=false, tail_hub_m=None, tail_spin_axis=None, tail_zero_azimuth=None,
+    tail_blade_span_m=None, tail_blades=None, gear_ratio=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_rotor(
     py: Python<'_>,
@@ -153,6 +154,13 @@ pub fn fit_rotor(
     estimate_phase: bool,
     rotor_hz: Option<[f64; 2]>,
     window_s: Option<f64>,
+    tail_rotor: bool,
+    tail_hub_m: Option<[f64; 3]>,
+    tail_spin_axis: Option<[f64; 3]>,
+    tail_zero_azimuth: Option<[f64; 3]>,
+    tail_blade_span_m: Option<[f64; 2]>,
+    tail_blades: Option<usize>,
+    gear_ratio: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyModel> {
     let preset = preset
@@ -181,6 +189,13 @@ pub fn fit_rotor(
         estimate_phase,
         rotor_hz,
         window_s,
+        tail_rotor,
+        tail_hub_m,
+        tail_spin_axis,
+        tail_zero_azimuth,
+        tail_blade_span_m,
+        tail_blades,
+        gear_ratio,
     })
     .py_err()?;
     let mut obs = PyProgress::new(progress);

@@ -25,6 +25,11 @@ def test_rotor_model_equals_the_cli(cli, tmp_path):
     np.testing.assert_array_equal(loaded.apply(flight)["mag_comp"], written["mag_comp"])
     with pytest.raises(aeromag.BadInputError, match="preset"):
         aeromag.fit_rotor(flight, hub_m=(0, 0, -2.6))
+    with pytest.raises(aeromag.BadInputError, match="tail rotor"):
+        aeromag.fit_rotor(flight, preset="aeromag-sim-helicopter", gear_ratio=4.0)
+    with pytest.raises(aeromag.BadInputError, match="phase channel"):
+        aeromag.fit_rotor(flight, preset="aeromag-sim-helicopter", tail_rotor=True,
+                          estimate_phase=True)
 
 
 def test_pod_model_equals_the_cli(cli, tmp_path):

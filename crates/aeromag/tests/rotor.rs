@@ -4,7 +4,7 @@
 //! dropouts bridged and time gaps refined over.
 
 use aeromag::prelude::*;
-use aeromag::rotor::{PhaseChoice, RotorOptions, RotorPreset, fit_rotor};
+use aeromag::rotor::{PhaseChoice, RotorChoices, RotorOptions, RotorPreset, fit_rotor};
 use aeromag::simulate::{ScenarioKind, simulate_flight};
 use aeromag::studies::{RotorStudyRun, Study, StudyOutcome, StudySize};
 use aeromag::{FlightTable, Note};
@@ -185,4 +185,77 @@ fn without_a_phase_channel_the_phase_is_estimated() {
         100.0 * share
     );
     assert!(share <= 0.10, "{share}");
+}
+
+/// A sensor under the tail boom with the simulator's tail rotor.
+const TAIL_BOOM: &str = "[tail_rotor]\n[scalar]\nposition_m = [-10.0, 0.0, 0.3]\n[fluxgate]\nposition_m = [-9.5, 0.0, 0.3]\n";
+
+#[test]
+fn a_tail_rotor_fitted_jointly_carries_over_to_an_independent_flight() {
+    let learn = helicopter(11, Some(TAIL_BOOM));
+    let other = helicopter(12, Some(TAIL_BOOM));
+    let choices = |tail_rotor| RotorChoices {
+        preset: Some(RotorPreset::AeromagSimHelicopter),
+        sensor_m: Some([-10.0, 0.0, 0.3]),
+        tail_rotor,
+        ..RotorChoices::default()
+    };
+    let main_only = RotorOptions::from_choices(&choices(false)).unwrap();
+    let with_tail = RotorOptions::from_choices(&choices(true)).unwrap();
+    assert_eq!(
+        with_tail.tail.as_ref().unwrap().geometry.sensor_m,
+        [-10.0, 0.0, 0.3]
+    );
+    let fit0 = fit_rotor(&learn, &main_only, &mut Silent).unwrap();
+    let fit1 = fit_rotor(&learn, &with_tail, &mut Silent).unwrap();
+    let tail = fit1.model.tail.as_ref().unwrap();
+    assert!((tail.offset_rad.to_degrees() - 37.0).abs() < 1.0);
+    let s0 = residual_share(&other, &fit0.model.interference(&other).unwrap());
+    let s1 = residual_share(&other, &fit1.model.interference(&other).unwrap());
+    eprintln!(
+        "tail-boom sensor, independent flight: main rotor only {:.2} %, main and tail {:.2} %",
+        100.0 * s0,
+        100.0 * s1
+    );
+    assert!(s1 <= 0.05 && s0 >= 10.0 * s1, "{s0} {s1}");
+    // The model file round-trips with its tail rotor.
+    let text = serde_json::to_string(&fit1.model).unwrap();
+    assert_eq!(
+        aeromag::rotor::RotorModelFile::from_json(&text, "m.json").unwrap(),
+        fit1.model
+    );
+    // No phase channel: the tail rotor cannot be geared; bad input.
+    let estimated = RotorOptions::from_choices(&RotorChoices {
+        estimate_phase: true,
+        ..choices(true)
+    })
+    .unwrap();
+    let e = fit_rotor(&learn, &estimated, &mut Silent).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("phase channel"),
+        "{e}"
+    );
+    // Tail values without the tail rotor, or an incomplete tail geometry
+    // without a preset: bad input.
+    assert!(
+        RotorOptions::from_choices(&RotorChoices {
+            gear_ratio: Some(4.0),
+            ..choices(false)
+        })
+        .unwrap_err()
+        .is_bad_input()
+    );
+    assert!(
+        RotorOptions::from_choices(&RotorChoices {
+            hub_m: Some([0.0, 0.0, -2.6]),
+            sensor_m: Some([5.0, 0.0, 0.6]),
+            blade_span_m: Some([0.8, 7.5]),
+            blades: Some(4),
+            tail_rotor: true,
+            gear_ratio: Some(4.0),
+            ..RotorChoices::default()
+        })
+        .unwrap_err()
+        .is_bad_input()
+    );
 }

@@ -105,6 +105,7 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
     let o = fit(&["--preset", "aeromag-sim-helicopter"]);
     assert_code(&o, 0);
     assert!(stdout(&o).contains("from `rotor_phase`"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("tail rotor"), "{}", stdout(&o));
     assert_eq!(std::fs::read_to_string(&model).unwrap(), by_numbers);
     let m: serde_json::Value = serde_json::from_str(&by_numbers).unwrap();
     assert_eq!(m["format"], "aeromag-model/2");
@@ -119,6 +120,23 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
         ]),
         2,
     );
+    // A tail rotor: its values need --tail-rotor (usage error), and without a
+    // phase channel it cannot be geared (bad input, exit 2, says why).
+    assert_code(
+        &fit(&["--preset", "aeromag-sim-helicopter", "--gear-ratio", "4"]),
+        2,
+    );
+    let o = fit(&[
+        "--preset",
+        "aeromag-sim-helicopter",
+        "--tail-rotor",
+        "--estimate-phase",
+    ]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("phase channel"), "{}", stderr(&o));
+    let o = fit(&["--preset", "aeromag-sim-helicopter", "--tail-rotor"]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("tail rotor 21 parameters"), "{}", stdout(&o));
     // Apply: one row per input row, a missing `mag` kept and flagged.
     let text = std::fs::read_to_string(&heli).unwrap();
     let lines: Vec<&str> = text.lines().collect();

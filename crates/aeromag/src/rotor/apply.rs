@@ -10,8 +10,8 @@ use crate::flight::{Flight, SegmentRule, finite_segments};
 use crate::observer::{Note, Observer};
 use aeromag_compensation::rotor::model_file::RotorModelFile;
 use aeromag_compensation::rotor::{
-    FlapAngles, RotorInput, SlowAngleOptions, align_phase_offset, estimate_phase, rotor_speed,
-    track_slow_angles, unwrap_deg,
+    FlapAngles, RotorInput, SlowAngleOptions, TailRotor, align_phase_offset, estimate_phase,
+    regressors, rotor_speed, track_slow_angles, unwrap_deg,
 };
 use nalgebra::Vector3;
 use std::ops::Range;
@@ -103,9 +103,47 @@ pub(super) struct TrackedSegment {
     omega: Vec<f64>,
     phase: Vec<f64>,
     angles: Vec<FlapAngles>,
+    /// The recorded main phase (rad, unwrapped), which the tail rotor's is
+    /// geared from.
+    recorded_phase: Vec<f64>,
 }
 
 impl TrackedSegment {
+    /// The regressor columns of `model` on this stretch: the main rotor's,
+    /// then the tail rotor's when modelled.
+    pub fn columns(&self, model: &RotorModelFile, fs: f64) -> Result<Vec<Vec<f64>>> {
+        let mut cols = regressors(&model.geometry, model.model.terms, &self.input())?;
+        if let Some(t) = &model.tail {
+            let phase = TailRotor::smoothed_main_phase(&self.recorded_phase, fs)?;
+            cols.extend(t.rotor.regressors(
+                t.model.terms,
+                &self.b,
+                &phase,
+                &self.omega,
+                t.offset_rad,
+            )?);
+        }
+        Ok(cols)
+    }
+
+    /// The modelled interference of this stretch (main and tail rotor),
+    /// nT.
+    pub fn predict(&self, model: &RotorModelFile, fs: f64) -> Result<Vec<f64>> {
+        let mut p = model.model.predict(&model.geometry, &self.input())?;
+        if let Some(t) = &model.tail {
+            let tp = t.rotor.predict(
+                &t.model,
+                t.offset_rad,
+                &self.b,
+                &self.recorded_phase,
+                &self.omega,
+                fs,
+            )?;
+            p.iter_mut().zip(tp).for_each(|(a, b)| *a += b);
+        }
+        Ok(p)
+    }
+
     pub fn input(&self) -> RotorInput<'_> {
         RotorInput {
             b_body_nt: &self.b,
@@ -129,8 +167,24 @@ pub(super) fn track_segment(
     let g = &model.geometry;
     let nominal = [model.nominal_angles];
     let b = cols.field(r);
-    let mag = &cols.mag[r.clone()];
     let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
+    let recorded_phase = phase.clone();
+    // The slow angles are tracked on the reading minus the tail rotor's part.
+    let rest;
+    let mag = match &model.tail {
+        None => &cols.mag[r.clone()],
+        Some(t) => {
+            let tp = t
+                .rotor
+                .predict(&t.model, t.offset_rad, &b, &phase, &omega, fs)?;
+            rest = cols.mag[r.clone()]
+                .iter()
+                .zip(tp)
+                .map(|(m, p)| m - p)
+                .collect::<Vec<f64>>();
+            &rest
+        }
+    };
     let estimated = model.phase.column.is_none();
     if estimated {
         let inp = RotorInput {
@@ -159,6 +213,7 @@ pub(super) fn track_segment(
         omega,
         phase: slow.phase_rad,
         angles: slow.angles,
+        recorded_phase,
     })
 }
 
@@ -187,7 +242,7 @@ impl Compensator for RotorModelFile {
         let mut out = vec![f64::NAN; flight.n_rows()];
         for r in cols.stretches(fs) {
             let t = track_segment(self, &cols, &r, fs).in_file(&flight.label())?;
-            let p = self.model.predict(&self.geometry, &t.input())?;
+            let p = t.predict(self, fs)?;
             out[r].copy_from_slice(&p);
         }
         Ok(out)

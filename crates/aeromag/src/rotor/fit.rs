@@ -6,10 +6,11 @@ use crate::error::{Error, Result};
 use crate::flight::{Flight, GAP_FACTOR};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::model_file::MODEL_FORMAT;
-use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile};
+use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile, TailModel};
+use aeromag_compensation::rotor::tail::split;
 use aeromag_compensation::rotor::{
-    BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleOptions,
-    fit_records, fit_slow_angles, refine_phase_offset, regressors,
+    BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleFit,
+    SlowAngleOptions, TailRotor, fit_records, fit_slow_angles, fit_with_tail, refine_phase_offset,
 };
 use aeromag_compensation::tolles_lawson::segments::median_step;
 
@@ -63,6 +64,21 @@ pub struct RotorChoices {
     pub rotor_hz: Option<[f64; 2]>,
     /// Window of constant cone angles, s.
     pub window_s: Option<f64>,
+    /// Model a tail rotor: the preset's, with any of the `tail_…` values
+    /// given overriding it; without a preset all of them are needed.
+    pub tail_rotor: bool,
+    /// Tail rotor hub (body frame, m).
+    pub tail_hub_m: Option<[f64; 3]>,
+    /// Direction of the tail rotor's angular velocity (body frame).
+    pub tail_spin_axis: Option<[f64; 3]>,
+    /// Body direction of a tail blade at azimuth 0.
+    pub tail_zero_azimuth: Option<[f64; 3]>,
+    /// Tail blade root and tip radius, m.
+    pub tail_blade_span_m: Option<[f64; 2]>,
+    /// Number of tail blades.
+    pub tail_blades: Option<usize>,
+    /// Tail rotor speed over main rotor speed.
+    pub gear_ratio: Option<f64>,
 }
 
 /// What the rotor fit is told: the installation (geometry, required) and
@@ -82,6 +98,9 @@ pub struct RotorOptions {
     /// Window over which the cone angles are taken as constant, s
     /// (default 1).
     pub window_s: f64,
+    /// A tail rotor fitted jointly with the main rotor (needs a phase
+    /// channel), or none.
+    pub tail: Option<TailRotor>,
 }
 
 impl RotorOptions {
@@ -94,6 +113,7 @@ impl RotorOptions {
             phase: PhaseChoice::Auto,
             rotor_hz_range: [4.0, 6.0],
             window_s: 1.0,
+            tail: None,
         }
     }
 
@@ -147,7 +167,67 @@ impl RotorOptions {
         };
         o.rotor_hz_range = c.rotor_hz.unwrap_or(o.rotor_hz_range);
         o.window_s = c.window_s.unwrap_or(o.window_s);
+        o.tail = Self::tail_from_choices(c, &o.geometry)?;
         Ok(o)
+    }
+
+    /// The tail rotor of [`RotorChoices`]: the preset's or the values given
+    /// (all needed without a preset), seen from the main geometry's sensor.
+    fn tail_from_choices(c: &RotorChoices, main: &RotorGeometry) -> Result<Option<TailRotor>> {
+        let any_value = c.tail_hub_m.is_some()
+            || c.tail_spin_axis.is_some()
+            || c.tail_zero_azimuth.is_some()
+            || c.tail_blade_span_m.is_some()
+            || c.tail_blades.is_some()
+            || c.gear_ratio.is_some();
+        if !c.tail_rotor {
+            return if any_value {
+                Err(crate::Error::bad_input(
+                    "tail rotor values given without the tail rotor (--tail-rotor)",
+                ))
+            } else {
+                Ok(None)
+            };
+        }
+        let base = match c.preset {
+            Some(p) => p.tail_rotor(),
+            None => match (
+                c.tail_hub_m,
+                c.tail_spin_axis,
+                c.tail_zero_azimuth,
+                c.tail_blade_span_m,
+                c.tail_blades,
+                c.gear_ratio,
+            ) {
+                (Some(hub), Some(axis), Some(zero), Some([root, tip]), Some(blades), Some(k)) => {
+                    TailRotor {
+                        geometry: RotorGeometry::main_rotor(hub, main.sensor_m, root, tip, blades)
+                            .with_plane(axis, zero),
+                        gear_ratio: k,
+                        coning_rad: 0.0,
+                    }
+                }
+                _ => {
+                    return Err(crate::Error::bad_input(
+                        "the tail rotor needs a preset, or all of tail_hub_m, tail_spin_axis, tail_zero_azimuth, \
+                         tail_blade_span_m, tail_blades and gear_ratio (--tail-hub-m, --tail-spin-axis, \
+                         --tail-zero-azimuth, --tail-blade-span-m, --tail-blades, --gear-ratio)",
+                    ));
+                }
+            },
+        };
+        let mut t = base;
+        let g = &mut t.geometry;
+        g.sensor_m = main.sensor_m;
+        g.hub_m = c.tail_hub_m.unwrap_or(g.hub_m);
+        g.spin_axis = c.tail_spin_axis.unwrap_or(g.spin_axis);
+        g.zero_azimuth = c.tail_zero_azimuth.unwrap_or(g.zero_azimuth);
+        if let Some([root, tip]) = c.tail_blade_span_m {
+            (g.root_m, g.tip_m) = (root, tip);
+        }
+        g.blades = c.tail_blades.unwrap_or(g.blades);
+        t.gear_ratio = c.gear_ratio.unwrap_or(t.gear_ratio);
+        Ok(Some(t))
     }
 
     /// The options of a named installation.
@@ -173,6 +253,10 @@ impl RotorOptions {
                 "window {} s must be positive",
                 self.window_s
             )));
+        }
+        if let Some(t) = &self.tail {
+            t.validate()
+                .map_err(|e| Error::bad_input(format!("tail rotor: {e}")))?;
         }
         Ok(())
     }
@@ -238,7 +322,8 @@ fn phase_refinement(window_s: f64) -> SlowAngleOptions {
     }
 }
 
-/// Fit the physical main-rotor model on a helicopter flight.
+/// Fit the physical main-rotor model (and a tail rotor geared to it, when
+/// [`RotorOptions::tail`] names one) on a helicopter flight.
 ///
 /// Reads `time` (s, uniform sampling ≥ 2.5 × the blade-passing frequency),
 /// `mag` (nT), `flux_x/y/z` (nT, body axes: the field direction) and the
@@ -249,7 +334,9 @@ fn phase_refinement(window_s: f64) -> SlowAngleOptions {
 /// are estimated from the data (blade-passing peak, complex demodulation,
 /// offset by the fit residual, a slowly varying correction). Dropouts of up
 /// to 0.1 s are bridged by linear interpolation; with several stretches of
-/// at least 10 s the parameters are refined on all of them.
+/// at least 10 s the parameters are refined on all of them. A tail rotor
+/// needs the phase channel; it is fitted jointly with the main rotor
+/// ([`fit_with_tail`]).
 ///
 /// ```
 /// use aeromag::prelude::*;
@@ -282,6 +369,13 @@ pub fn fit_rotor(
         return Err(Error::bad_file(
             file,
             format!("`{c}` is a simulation truth column; the rotor model never reads truth"),
+        ));
+    }
+    if opts.tail.is_some() && phase_col.is_none() {
+        return Err(Error::bad_file(
+            file,
+            "a tail rotor is modelled with a rotor phase channel only (its phase is geared from the main rotor's); \
+             the flight has none or the phase is to be estimated",
         ));
     }
     let raw = RotorColumns::of(flight, phase_col.as_deref())?;
@@ -373,7 +467,36 @@ pub fn fit_rotor(
         omega_rad_s: &omega,
         angles: &nominal,
     };
-    let slow = fit_slow_angles(geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &slow_opts)?;
+    let (slow, tail) = match &opts.tail {
+        None => (
+            fit_slow_angles(geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &slow_opts)?,
+            None,
+        ),
+        Some(t) => {
+            let j = fit_with_tail(
+                geom,
+                t,
+                BladeTerms::Full,
+                &inp,
+                mag,
+                fs,
+                &fit_opts,
+                Some(&slow_opts),
+            )?;
+            let angles = j.angles.unwrap_or_else(|| vec![opts.nominal_angles]);
+            let slow = SlowAngleFit {
+                fit: j.main,
+                angles,
+                phase_rad: phase.clone(),
+            };
+            let tail = TailModel {
+                rotor: t.clone(),
+                offset_rad: j.offset_rad,
+                model: j.tail,
+            };
+            (slow, Some(tail))
+        }
+    };
     let rotor_hz = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
     let coning_mean_deg =
         slow.angles.iter().map(|x| x.coning_rad).sum::<f64>() / slow.angles.len() as f64 * 180.0
@@ -386,6 +509,7 @@ pub fn fit_rotor(
         format: MODEL_FORMAT.into(),
         kind: ROTOR_KIND.into(),
         geometry: geom.clone(),
+        tail,
         nominal_angles: opts.nominal_angles,
         model: slow.fit,
         fit_options: fit_opts,
@@ -412,14 +536,20 @@ pub fn fit_rotor(
                 .collect::<Result<Vec<_>>>()?;
             let regs: Vec<Vec<Vec<f64>>> = tracked
                 .iter()
-                .map(|t| regressors(&model.geometry, model.model.terms, &t.input()))
-                .collect::<std::result::Result<_, _>>()?;
+                .map(|t| t.columns(&model, fs))
+                .collect::<Result<_>>()?;
             let records: Vec<(&[Vec<f64>], &[f64])> = regs
                 .iter()
                 .zip(&segs)
                 .map(|(c, s)| (c.as_slice(), &cols.mag[s.clone()]))
                 .collect();
-            model.model = fit_records(&records, model.model.terms, fs, &fit_opts)?;
+            let joint = fit_records(&records, model.model.terms, fs, &fit_opts)?;
+            let p_main = model.model.params.len();
+            let (main, tail) = split(&joint, p_main);
+            model.model = main;
+            if let Some(t) = &mut model.tail {
+                t.model = tail;
+            }
         }
         model.rows = used;
         notes.note(format!(

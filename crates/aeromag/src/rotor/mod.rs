@@ -10,6 +10,8 @@
 //!   from its channel, or estimated and aligned with the model; the slow
 //!   angles tracked with the parameters fixed; output `rotor_interf`,
 //!   `mag_comp`, `rotor_flag`;
+//! - a tail rotor geared to the main rotor ([`TailRotor`], with a phase
+//!   channel) is fitted jointly with it when the options name one;
 //! - the rotor geometry is the user's ([`RotorGeometry`]) or a named
 //!   [`RotorPreset`]: nothing defaults silently to the simulator's
 //!   helicopter.
@@ -17,8 +19,10 @@
 mod apply;
 mod fit;
 
-pub use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile};
-pub use aeromag_compensation::rotor::{FlapAngles, RotorGeometry};
+pub use aeromag_compensation::rotor::model_file::{
+    PhaseSource, ROTOR_KIND, RotorModelFile, TailModel,
+};
+pub use aeromag_compensation::rotor::{FlapAngles, RotorGeometry, TailRotor};
 pub use apply::ROTOR_OUTPUT;
 pub use fit::{PhaseChoice, RotorChoices, RotorFitResult, RotorOptions, fit_rotor};
 
@@ -57,6 +61,18 @@ impl RotorPreset {
         match self {
             RotorPreset::AeromagSimHelicopter => {
                 aeromag_compensation::rotor::study::scenario_geometry()
+            }
+        }
+    }
+
+    /// Its tail rotor seen from the sensor of [`Self::geometry`]: the
+    /// defaults of the simulator's `[tail_rotor]` table (hub (−12.7, −1.0,
+    /// −2.4) m, blades 0.3–1.95 m, 3 blades, turning about −y with azimuth 0
+    /// up, geared 4.37:1, cone 1°).
+    pub fn tail_rotor(self) -> TailRotor {
+        match self {
+            RotorPreset::AeromagSimHelicopter => {
+                aeromag_compensation::rotor::study::scenario_tail_rotor(self.geometry().sensor_m)
             }
         }
     }
@@ -101,6 +117,7 @@ mod tests {
         for p in RotorPreset::ALL {
             assert_eq!(p.name().parse::<RotorPreset>().unwrap(), p);
             p.geometry().validate().unwrap();
+            p.tail_rotor().validate().unwrap();
         }
         assert!("nosuch".parse::<RotorPreset>().unwrap_err().is_bad_input());
     }

@@ -65,8 +65,15 @@ struct StudyArgs {
 /// 4 blades, nominal coning 4°, tilt −1.5°), whose values the flags below
 /// override, or all of --hub-m, --sensor-m, --blade-span-m and --blades.
 ///
+/// --tail-rotor adds a tail rotor geared to the main rotor (its phase is the
+/// main rotor's phase channel times the gear ratio plus an offset found in
+/// the fit), fitted jointly with it: where the sensor is near the tail
+/// (a tail-boom installation); at a nose boom its field is negligible.
+///
 /// Example:
 ///   aeromag rotor fit --input heli.csv --model rotor.json --preset aeromag-sim-helicopter
+///   aeromag rotor fit --input tailboom.csv --model rotor.json --preset aeromag-sim-helicopter \
+///       --sensor-m -10,0,0.3 --tail-rotor
 ///   aeromag rotor fit --input heli.csv --model rotor.json --hub-m 0,0,-2.6 --sensor-m 5,0,0.6 \
 ///       --blade-span-m 0.8,7.5 --blades 4 --estimate-phase --rotor-hz 4.5,5.2
 #[derive(Debug, clap::Args)]
@@ -116,6 +123,32 @@ struct FitArgs {
     /// Window over which the cone angles are taken as constant, s (default 1).
     #[arg(long)]
     window_s: Option<f64>,
+    /// Also model a tail rotor, geared to the main rotor and fitted jointly
+    /// with it (needs the phase channel): the preset's, or all of the
+    /// --tail-… flags and --gear-ratio.
+    #[arg(long)]
+    tail_rotor: bool,
+    /// Tail rotor hub position, body axes, m.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
+          requires = "tail_rotor")]
+    tail_hub_m: Option<[f64; 3]>,
+    /// Direction of the tail rotor's angular velocity, body axes.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
+          requires = "tail_rotor")]
+    tail_spin_axis: Option<[f64; 3]>,
+    /// Body direction of a tail blade at azimuth 0.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
+          requires = "tail_rotor")]
+    tail_zero_azimuth: Option<[f64; 3]>,
+    /// Magnetised span of a tail blade from its hub, m.
+    #[arg(long, value_name = "ROOT,TIP", value_parser = args::pair, requires = "tail_rotor")]
+    tail_blade_span_m: Option<[f64; 2]>,
+    /// Number of tail blades.
+    #[arg(long, requires = "tail_rotor")]
+    tail_blades: Option<usize>,
+    /// Tail rotor speed over main rotor speed.
+    #[arg(long, requires = "tail_rotor")]
+    gear_ratio: Option<f64>,
 }
 
 /// Apply a rotor model (from `aeromag rotor fit`) to a flight file.
@@ -163,6 +196,13 @@ fn options(a: &FitArgs) -> anyhow::Result<RotorOptions> {
         estimate_phase: a.estimate_phase,
         rotor_hz: a.rotor_hz,
         window_s: a.window_s,
+        tail_rotor: a.tail_rotor,
+        tail_hub_m: a.tail_hub_m,
+        tail_spin_axis: a.tail_spin_axis,
+        tail_zero_azimuth: a.tail_zero_azimuth,
+        tail_blade_span_m: a.tail_blade_span_m,
+        tail_blades: a.tail_blades,
+        gear_ratio: a.gear_ratio,
     })?)
 }
 
@@ -175,7 +215,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
     model.write(&a.model)?;
     println!(
         "fitted the rotor model on {} rows of {} ({:.3} Hz, f_r {:.4} Hz, phase {}): {} parameters, \
-         high-passed residual {:.4} nT, mean coning {:.2}°; written to {}",
+         high-passed residual {:.4} nT, mean coning {:.2}°{}; written to {}",
         model.rows,
         flight.file_label(),
         model.sample_rate_hz,
@@ -190,6 +230,11 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
         model.model.params.len(),
         model.model.residual_rms_nt,
         model.coning_mean_deg,
+        model.tail.as_ref().map_or(String::new(), |t| format!(
+            ", tail rotor {} parameters, phase offset {:.2}°",
+            t.model.params.len(),
+            t.offset_rad.to_degrees()
+        )),
         a.model.display()
     );
     Ok(())

@@ -5,6 +5,7 @@
 use super::blade::{FlapAngles, RotorGeometry};
 use super::coning::SlowAngleOptions;
 use super::linear::{RotorFit, RotorFitOptions};
+use super::tail::TailRotor;
 use crate::error::{CompError, Result};
 #[cfg(test)]
 use crate::model_file::MODEL_FORMAT;
@@ -25,6 +26,20 @@ pub struct PhaseSource {
     pub rotor_hz_range: [f64; 2],
 }
 
+/// A tail rotor in a model file: its geometry and gear, the phase offset
+/// found on the fitted record and its parameters (fitted jointly with the
+/// main rotor's; [`super::tail`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TailModel {
+    /// Geometry, gear ratio and cone.
+    pub rotor: TailRotor,
+    /// Phase offset `φ_0` of `ψ_t = k ψ + φ_0`, rad (fixed by the gearbox
+    /// for a given phase channel).
+    pub offset_rad: f64,
+    /// Its parameters.
+    pub model: RotorFit,
+}
+
 /// The rotor model file (versioned JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RotorModelFile {
@@ -34,6 +49,9 @@ pub struct RotorModelFile {
     pub kind: String,
     /// Rotor and sensor geometry.
     pub geometry: RotorGeometry,
+    /// The tail rotor, when modelled (absent in files without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tail: Option<TailModel>,
     /// Nominal cone angles (start of the slowly varying estimate), rad.
     pub nominal_angles: FlapAngles,
     /// Blade terms, parameters (regressor order of
@@ -85,6 +103,24 @@ impl RotorModelFile {
                 self.model.params.len()
             )));
         }
+        if let Some(t) = &self.tail {
+            t.rotor.validate()?;
+            let expect = t.rotor.geometry.blades * t.model.terms.per_blade();
+            if t.model.params.len() != expect
+                || t.model.params.iter().any(|p| !p.is_finite())
+                || !t.offset_rad.is_finite()
+            {
+                return Err(CompError::data(format!(
+                    "expected {expect} finite tail rotor parameters and a finite offset, got {}",
+                    t.model.params.len()
+                )));
+            }
+            if self.phase.column.is_none() {
+                return Err(CompError::data(
+                    "a tail rotor is modelled with a phase channel only",
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -102,6 +138,7 @@ mod tests {
             format: MODEL_FORMAT.into(),
             kind: ROTOR_KIND.into(),
             geometry,
+            tail: None,
             nominal_angles: nominal_angles(),
             model: RotorFit {
                 terms: BladeTerms::Full,
@@ -148,8 +185,30 @@ mod tests {
                 .to_string()
                 .contains("finite rotor parameters")
         );
-        let mut nan = m;
+        let mut nan = m.clone();
         nan.model.params[0] = f64::NAN;
         assert!(nan.validate().is_err());
+        // With a tail rotor: round trip, its parameter count, and it needs
+        // a phase channel.
+        let mut tail = m;
+        let rotor = crate::rotor::study::scenario_tail_rotor([5.0, 0.0, 0.6]);
+        tail.tail = Some(TailModel {
+            model: RotorFit {
+                params: vec![0.1; rotor.geometry.blades * 7],
+                ..tail.model.clone()
+            },
+            rotor,
+            offset_rad: 0.6,
+        });
+        tail.phase.column = Some("rotor_phase".into());
+        tail.validate().unwrap();
+        let text = serde_json::to_string(&tail).unwrap();
+        assert_eq!(RotorModelFile::from_json(&text, "t.json").unwrap(), tail);
+        let mut no_channel = tail.clone();
+        no_channel.phase.column = None;
+        assert!(no_channel.validate().is_err());
+        let mut short = tail;
+        short.tail.as_mut().unwrap().model.params.pop();
+        assert!(short.validate().is_err());
     }
 }

@@ -59,9 +59,38 @@ impl TailRotor {
         Ok(())
     }
 
+    /// The main rotor's recorded phase (rad, unwrapped) smoothed for
+    /// gearing to the tail rotor ([`TAIL_PHASE_CUTOFF_HZ`]).
+    pub fn smoothed_main_phase(main_phase_rad: &[f64], fs_hz: f64) -> Result<Vec<f64>> {
+        smooth_phase(main_phase_rad, fs_hz, TAIL_PHASE_CUTOFF_HZ)
+    }
+
+    /// The tail rotor's interference (nT) with the parameters of `fit` and
+    /// phase offset `offset_rad`, from the main rotor's recorded phase
+    /// (rad, unwrapped) and speed (rad/s) sampled at `fs_hz`.
+    pub fn predict(
+        &self,
+        fit: &RotorFit,
+        offset_rad: f64,
+        b_body_nt: &[Vector3<f64>],
+        main_phase_rad: &[f64],
+        main_omega_rad_s: &[f64],
+        fs_hz: f64,
+    ) -> Result<Vec<f64>> {
+        let phase = Self::smoothed_main_phase(main_phase_rad, fs_hz)?;
+        fit.predict_columns(&self.regressors(
+            fit.terms,
+            b_body_nt,
+            &phase,
+            main_omega_rad_s,
+            offset_rad,
+        )?)
+    }
+
     /// The tail rotor's regressor columns (units as [`linear::regressors`])
-    /// for the main rotor's phase (rad) and speed (rad/s), with phase
-    /// offset `offset_rad`.
+    /// for the main rotor's phase (rad, smoothed:
+    /// [`Self::smoothed_main_phase`]) and speed (rad/s), with phase offset
+    /// `offset_rad`.
     pub fn regressors(
         &self,
         terms: BladeTerms,
@@ -104,8 +133,11 @@ pub const TAIL_PHASE_CUTOFF_HZ: f64 = 2.0;
 pub struct TailFit {
     /// The tail rotor's phase offset `φ_0`, rad, in `[0, 2π/N_t)`.
     pub offset_rad: f64,
-    /// Main and tail parameters together (the main rotor's first).
-    pub fit: RotorFit,
+    /// The main rotor's parameters (fitted jointly).
+    pub main: RotorFit,
+    /// The tail rotor's parameters (fitted jointly; the residual is the
+    /// joint fit's).
+    pub tail: RotorFit,
     /// The joint prediction, nT per sample.
     pub prediction_nt: Vec<f64>,
     /// The tail rotor's part of it, nT per sample.
@@ -132,7 +164,7 @@ pub fn fit_with_tail(
     opts: &RotorFitOptions,
     slow: Option<&SlowAngleOptions>,
 ) -> Result<TailFit> {
-    let phase = smooth_phase(input.phase_rad, fs_hz, TAIL_PHASE_CUTOFF_HZ)?;
+    let phase = TailRotor::smoothed_main_phase(input.phase_rad, fs_hz)?;
     let tail_cols = |c: f64| tail.regressors(terms, input.b_body_nt, &phase, input.omega_rad_s, c);
     let main_cols = regressors(geom, terms, input)?;
     let first = joint(&main_cols, &tail_cols, None, terms, mag_nt, fs_hz, opts)?;
@@ -206,16 +238,24 @@ fn joint(
     cols.extend(tail);
     let fit = linear::fit_columns(&cols, terms, mag_nt, fs_hz, opts)?;
     let prediction_nt = fit.predict_columns(&cols)?;
-    let tail_only = RotorFit {
-        params: fit.params[p_main..].to_vec(),
-        ..fit.clone()
-    };
-    let tail_prediction_nt = tail_only.predict_columns(&cols[p_main..])?;
+    let (main, tail) = split(&fit, p_main);
+    let tail_prediction_nt = tail.predict_columns(&cols[p_main..])?;
     Ok(TailFit {
         offset_rad: offset,
-        fit,
+        main,
+        tail,
         prediction_nt,
         tail_prediction_nt,
         angles: None,
     })
+}
+
+/// A joint fit's parameters split after the first `p_main` (main rotor,
+/// tail rotor), each with the joint residual.
+pub fn split(joint: &RotorFit, p_main: usize) -> (RotorFit, RotorFit) {
+    let part = |params: &[f64]| RotorFit {
+        params: params.to_vec(),
+        ..joint.clone()
+    };
+    (part(&joint.params[..p_main]), part(&joint.params[p_main..]))
 }
