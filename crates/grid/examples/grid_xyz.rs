@@ -1,6 +1,7 @@
 //! Grid an `x y z` text file by minimum curvature and print `x y z` of
 //! every node (for comparisons with GMT `surface` and `grd2xyz`):
-//! `cargo run --release -p aeromag-grid --example grid_xyz -- FILE XMIN XMAX YMIN YMAX CELL TENSION [MAX_SWEEPS [LIMIT]]`.
+//! `cargo run --release -p aeromag-grid --example grid_xyz -- FILE XMIN XMAX YMIN YMAX CELL TENSION [MAX_SWEEPS [LIMIT [as-is]]]`
+//! (`as-is`: solve on exactly the requested region, GMT's `-Qr`).
 
 use aeromag_grid::GridGeometry;
 use aeromag_grid::gridding::{MinCurvature, Points};
@@ -24,6 +25,7 @@ fn main() {
         tension: num(7),
         max_iterations: a.get(8).map_or(500, |s| s.parse().unwrap()),
         convergence: a.get(9).map(|s| s.parse().unwrap()),
+        enlarge: a.get(10).is_none_or(|s| s != "as-is"),
         ..Default::default()
     };
     let t = std::time::Instant::now();

@@ -35,14 +35,14 @@
 //! bilinear interpolation of the coarser one, until the largest change of
 //! a sweep is below the convergence limit (default 10⁻⁴ of the data's RMS
 //! about the plane, GMT's default; divided by the spacing on the coarser
-//! grids, which are cheap) or the sweep limit is reached. The
-//! boundary conditions hold at the requested grid's edges (GMT `surface`
-//! may solve on a slightly larger region it factors better and crop it:
-//! near the edges the two then differ; on the same region, both converged
-//! tightly, one test survey with 26 nT mis-ties at its crossings agreed to
-//! 0.34 % of the grid's standard deviation). The sweeps run in a fixed order on one thread: the result is bit-identical
+//! grids, which are cheap) or the sweep limit is reached. As GMT `surface`
+//! does by default, the solve runs on the slightly larger grid whose
+//! dimensions have more common factors ([`super::good_size`]) and is
+//! cropped: the edge conditions hold at its edges, so this is also what
+//! keeps the two agreeing near the requested edges. The sweeps run in a fixed order on one thread: the result is bit-identical
 //! from run to run.
 
+use super::good_size::{Enlargement, enlargement};
 use super::points::{BlockMeans, Points};
 use crate::error::{GridError, Result};
 use crate::grid::GridGeometry;
@@ -59,6 +59,10 @@ pub struct MinCurvature {
     pub convergence: Option<f64>,
     /// Over-relaxation factor, 1–2 (default 1.4, as GMT).
     pub relaxation: f64,
+    /// Solve on the slightly larger grid GMT `surface` would use and crop
+    /// ([`super::good_size`]; default true, GMT's default; false is GMT's
+    /// `-Qr`).
+    pub enlarge: bool,
 }
 
 impl Default for MinCurvature {
@@ -68,6 +72,7 @@ impl Default for MinCurvature {
             max_iterations: 500,
             convergence: None,
             relaxation: 1.4,
+            enlarge: true,
         }
     }
 }
@@ -102,8 +107,10 @@ pub struct MinCurvatureReport {
     pub points_used: usize,
     /// Points skipped for a non-finite value or coordinate.
     pub points_non_finite: usize,
-    /// Points more than half a cell outside the grid.
+    /// Points more than half a cell outside the grid that was solved.
     pub points_outside: usize,
+    /// Intervals added on each side for the solve, when enlarged.
+    pub enlarged: Option<Enlargement>,
 }
 
 impl MinCurvatureReport {
@@ -118,6 +125,7 @@ impl MinCurvatureReport {
             points_used: means.used,
             points_non_finite: means.non_finite,
             points_outside: means.outside,
+            enlarged: None,
         }
     }
 }
@@ -175,6 +183,37 @@ impl MinCurvature {
                 geometry.nx, geometry.ny
             )));
         }
+        let grown = self
+            .enlarge
+            .then(|| enlargement(geometry.nx - 1, geometry.ny - 1))
+            .flatten();
+        let Some(e) = grown else {
+            return self.solve(points, geometry);
+        };
+        let big = GridGeometry {
+            x0: geometry.x0 - e.west as f64 * geometry.cell,
+            y0: geometry.y0 - e.south as f64 * geometry.cell,
+            cell: geometry.cell,
+            nx: geometry.nx + e.west + e.east,
+            ny: geometry.ny + e.south + e.north,
+        };
+        let (all, mut report) = self.solve(points, big)?;
+        report.enlarged = Some(e);
+        let mut values = vec![0.0; geometry.len()];
+        for j in 0..geometry.ny {
+            for i in 0..geometry.nx {
+                values[geometry.index(i, j)] = all[big.index(i + e.west, j + e.south)];
+            }
+        }
+        Ok((values, report))
+    }
+
+    /// [`Self::grid`] on exactly `geometry`.
+    fn solve(
+        &self,
+        points: Points,
+        geometry: GridGeometry,
+    ) -> Result<(Vec<f64>, MinCurvatureReport)> {
         let means = BlockMeans::of(points, &geometry);
         if means.blocks.len() < 3 {
             return Err(GridError::Data(format!(
@@ -200,6 +239,7 @@ impl MinCurvature {
             points_used: means.used,
             points_non_finite: means.non_finite,
             points_outside: means.outside,
+            enlarged: None,
         };
         let mut values = vec![0.0; geometry.len()];
         if rms > 0.0 {
