@@ -134,7 +134,10 @@ pub struct RotorConfig {
     pub blades: Vec<BladeConfig>,
 }
 
-fn blade(hard: [f64; 3], along: f64, across: f64, eddy: f64, tau: f64) -> BladeConfig {
+/// A blade from its hard magnetisation (A·m, blade axes), χA along and
+/// across the spar in 10⁻³ m², eddy gain (A·m per T/s) and time constant
+/// (s): the defaults' shorthand.
+pub(crate) fn blade(hard: [f64; 3], along: f64, across: f64, eddy: f64, tau: f64) -> BladeConfig {
     BladeConfig {
         hard_am: hard,
         soft_along_m2: along / 1e3,

@@ -23,7 +23,7 @@ use aeromag_core::frames::blade::{blade_axes, body_from_hub};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::rotor::{BladeConfig, BladeSpan, EddyInput, RotorState, blades_field_nt};
+use super::rotor::{BladeConfig, BladeSpan, EddyInput, RotorState, blade, blades_field_nt};
 use crate::error::{Result, invalid, require_finite, require_non_negative, require_positive};
 use aeromag_core::NT_PER_T;
 
@@ -56,16 +56,6 @@ pub struct TailRotorConfig {
     /// 2.4–3.3 A·m along the spar (±10 % across), χA ≈ 1.2·10⁻² m² along
     /// and 2·10⁻³ m² across, eddy gain ≈ 60 A·m per T/s with τ ≈ 4 ms.
     pub blades: Vec<BladeConfig>,
-}
-
-fn blade(hard: [f64; 3], along: f64, across: f64, eddy: f64, tau: f64) -> BladeConfig {
-    BladeConfig {
-        hard_am: hard,
-        soft_along_m2: along / 1e3,
-        soft_across_m2: across / 1e3,
-        eddy_am_per_t_s: eddy,
-        eddy_tau_s: tau,
-    }
 }
 
 impl Default for TailRotorConfig {
