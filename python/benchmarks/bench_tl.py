@@ -17,6 +17,7 @@ runs); peak memory is the growth of the peak RSS of a fresh process during
 the aeromag call, against the size of the input arrays it fits on.
 """
 
+import os
 import resource
 import sys
 import time
@@ -25,7 +26,7 @@ import numpy as np
 
 import aeromag
 
-REPEAT = 3
+REPEAT = int(os.environ.get("BENCH_REPEAT", "3"))
 FS = 10.0
 
 
