@@ -30,8 +30,11 @@ enum Sub {
 /// model (magnetic masses and eddy currents of each blade, slowly varying
 /// cone) and the filter baselines (low-pass, notches, synchronous averaging),
 /// and compares the residual rotor interference and the share of anomaly
-/// signal each removes. Prints the table; writes DIR/summary.json and
-/// DIR/index.html.
+/// signal each removes. Also runs the thesis' simplified model (3 parameters
+/// per blade) on the default rotor and on one that satisfies its
+/// assumptions, and the same flight with a tail rotor seen from a sensor
+/// under the tail boom, fitted with and without it. Prints the table and
+/// those figures; writes DIR/summary.json and DIR/index.html.
 ///
 /// Example: `aeromag rotor study --out rotor-study`
 #[derive(Debug, clap::Args)]

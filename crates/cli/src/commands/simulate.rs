@@ -9,7 +9,8 @@ use std::path::PathBuf;
 /// Scenarios: `calibration` (four-heading box at 3000 m with roll, pitch and
 /// yaw manoeuvres), `calibration-truncated` (the thesis' shorter pattern),
 /// `survey` (lines and tie lines at 100 m above ground), `helicopter` (the box
-/// at 40 m/s with a main rotor, 100 Hz, rotor phase channel), `pod` (a towed
+/// at 40 m/s with a main rotor, 100 Hz, rotor phase channel; a `[tail_rotor]`
+/// table in the --config file adds a tail rotor), `pod` (a towed
 /// magnetometer pod under a helicopter, seed 002's parameters, 20 Hz, cable
 /// inclination and azimuth channels), `gradiometer` (a dipole passing a
 /// gradiometer: see `aeromag dipole simulate`), `em` (ADC-level EM
