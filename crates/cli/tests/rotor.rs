@@ -136,7 +136,11 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
     assert!(stderr(&o).contains("phase channel"), "{}", stderr(&o));
     let o = fit(&["--preset", "aeromag-sim-helicopter", "--tail-rotor"]);
     assert_code(&o, 0);
-    assert!(stdout(&o).contains("tail rotor 21 parameters"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("tail rotor 21 parameters"),
+        "{}",
+        stdout(&o)
+    );
     // Apply: one row per input row, a missing `mag` kept and flagged.
     let text = std::fs::read_to_string(&heli).unwrap();
     let lines: Vec<&str> = text.lines().collect();

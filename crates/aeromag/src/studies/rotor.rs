@@ -271,52 +271,33 @@ fn simplified_and_tail_blocks(o: &RotorOutcome) -> Vec<Block> {
             pct(m.residual_nt / s.rotor_rms_nt),
         ]
     };
-    let mut rows = Vec::new();
-    for (case, s) in [("default rotor", &o.study), ("ideal rotor", &o.ideal)] {
-        for m in s.methods.iter().filter(|m| !m.is_filter) {
-            rows.push(row(case, s, m));
-        }
-        if let Some(m) = s
-            .methods
+    // Every model, then the best filter, of one case.
+    let case_rows = |case: &str, s: &RotorStudy| -> Vec<Vec<String>> {
+        s.methods
             .iter()
-            .filter(|m| m.is_filter)
-            .min_by(|a, b| a.residual_nt.total_cmp(&b.residual_nt))
-        {
-            rows.push(row(case, s, m));
-        }
-    }
+            .filter(|m| !m.is_filter)
+            .chain(s.best_filter())
+            .map(|m| row(case, s, m))
+            .collect()
+    };
+    let mut rows = case_rows("default rotor", &o.study);
+    rows.extend(case_rows("ideal rotor", &o.ideal));
     let verdict = |s: &RotorStudy| {
-        if s.residual_simplified_nt < s.residual_best_filter_nt {
-            format!(
-                "beats the best filter ({:.1} % against {:.1} %)",
-                100.0 * s.residual_simplified_nt / s.rotor_rms_nt,
-                100.0 * s.residual_best_filter_nt / s.rotor_rms_nt
-            )
-        } else {
-            format!(
-                "does not beat the best filter ({:.1} % against {:.1} %)",
-                100.0 * s.residual_simplified_nt / s.rotor_rms_nt,
-                100.0 * s.residual_best_filter_nt / s.rotor_rms_nt
-            )
-        }
+        format!(
+            "{} the best filter ({:.1} % against {:.1} %)",
+            if s.residual_simplified_nt < s.residual_best_filter_nt {
+                "beats"
+            } else {
+                "does not beat"
+            },
+            100.0 * s.residual_simplified_nt / s.rotor_rms_nt,
+            100.0 * s.residual_best_filter_nt / s.rotor_rms_nt
+        )
     };
     let t = &o.tail;
     let tail_cfg = TailRotorConfig::default();
     let with = t.residual_with_tail_nt.unwrap_or(f64::NAN);
-    let mut tail_rows: Vec<Vec<String>> = t
-        .methods
-        .iter()
-        .filter(|m| !m.is_filter)
-        .map(|m| row("tail-boom sensor", t, m))
-        .collect();
-    if let Some(m) = t
-        .methods
-        .iter()
-        .filter(|m| m.is_filter)
-        .min_by(|a, b| a.residual_nt.total_cmp(&b.residual_nt))
-    {
-        tail_rows.push(row("tail-boom sensor", t, m));
-    }
+    let tail_rows = case_rows("tail-boom sensor", t);
     let header = [
         "case",
         "method",

@@ -169,6 +169,21 @@ pub struct RotorStudy {
     pub coning_rad: Vec<f64>,
 }
 
+/// The filter baseline with the smallest residual, if any.
+fn best_filter(methods: &[MethodResult]) -> Option<&MethodResult> {
+    methods
+        .iter()
+        .filter(|m| m.is_filter)
+        .min_by(|a, b| a.residual_nt.total_cmp(&b.residual_nt))
+}
+
+impl RotorStudy {
+    /// The filter baseline with the smallest residual.
+    pub fn best_filter(&self) -> Option<&MethodResult> {
+        best_filter(&self.methods)
+    }
+}
+
 /// Run the comparison (module docs) on `input` with the rotor geometry
 /// `geom`.
 ///
@@ -314,11 +329,7 @@ pub fn evaluate(geom: &RotorGeometry, input: &StudyInput) -> Result<RotorStudy> 
             &synchronous_template(x, &phase, fs, 64, 10.0, 2.0)?,
         ))
     })?);
-    let best_filter = methods
-        .iter()
-        .filter(|m| m.is_filter)
-        .map(|m| m.residual_nt)
-        .fold(f64::INFINITY, f64::min);
+    let best_filter = best_filter(&methods).map_or(f64::INFINITY, |m| m.residual_nt);
     Ok(RotorStudy {
         rotor_rms_nt: r_rms,
         anomaly_rms_nt: std_mid(anom, edge),

@@ -390,13 +390,8 @@ pub fn rotor_field_nt(
 ) -> Vec<Vector3<f64>> {
     let n = b_nt.len().min(state.phase_rad.len());
     let nb = cfg.blades.len();
-    let span = BladeSpan {
-        hub_m: cfg.hub_m,
-        root_m: cfg.root_m,
-        radius_m: cfg.radius_m,
-    };
     blades_field_nt(
-        &span,
+        &BladeSpan::new(cfg.hub_m, cfg.root_m, cfg.radius_m),
         &cfg.blades,
         &|k, j| state.blade_axes(k, j, nb),
         &EddyInput::Sampled,
@@ -482,6 +477,17 @@ pub struct BladeSpan {
     pub root_m: f64,
     /// Blade tip, m.
     pub radius_m: f64,
+}
+
+impl BladeSpan {
+    /// The span of blades from `root_m` to `radius_m` of a hub at `hub_m`.
+    pub fn new(hub_m: [f64; 3], root_m: f64, radius_m: f64) -> Self {
+        Self {
+            hub_m,
+            root_m,
+            radius_m,
+        }
+    }
 }
 
 /// The field (nT, body axes) at `sensor_m` of rotating blades with the

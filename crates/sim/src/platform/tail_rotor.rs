@@ -180,13 +180,8 @@ fn tail_field_with_step(
         let omega = spin * (dpsi / dt_s);
         blade(psi[k] + f * dpsi, j).transpose() * (db / dt_s - omega.cross(&b))
     };
-    let span = BladeSpan {
-        hub_m: cfg.hub_m,
-        root_m: cfg.root_m,
-        radius_m: cfg.radius_m,
-    };
     blades_field_nt(
-        &span,
+        &BladeSpan::new(cfg.hub_m, cfg.root_m, cfg.radius_m),
         &cfg.blades,
         &|k, j| blade(psi[k], j),
         &EddyInput::Substepped {
