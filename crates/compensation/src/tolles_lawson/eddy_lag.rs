@@ -24,12 +24,20 @@ pub struct FirstOrderLag {
     tau_s: f64,
     /// Previous `(t, u, g)`.
     prev: Option<(f64, f64, f64)>,
+    /// The coefficients `(Δt, a, 1 − τ(1 − a)/Δt)` of the last step, kept
+    /// while the step stays the same (an `exp` per sample costs more than
+    /// the recursion; the values are those a fresh computation gives).
+    coef: (f64, f64, f64),
 }
 
 impl FirstOrderLag {
     /// A lag of time constant `tau_s` (s, > 0) at rest.
     pub fn new(tau_s: f64) -> Self {
-        Self { tau_s, prev: None }
+        Self {
+            tau_s,
+            prev: None,
+            coef: (f64::NAN, f64::NAN, f64::NAN),
+        }
     }
 
     /// The output at time `t_s` (s) for input `u` (any unit; the output has
@@ -38,8 +46,12 @@ impl FirstOrderLag {
         let g = match self.prev {
             Some((t0, u0, g0)) if u0.is_finite() && g0.is_finite() && t_s > t0 => {
                 let dt = t_s - t0;
-                let a = (-dt / self.tau_s).exp();
-                a * g0 + (1.0 - a) * u0 + (u - u0) * (1.0 - self.tau_s * (1.0 - a) / dt)
+                if dt != self.coef.0 {
+                    let a = (-dt / self.tau_s).exp();
+                    self.coef = (dt, a, 1.0 - self.tau_s * (1.0 - a) / dt);
+                }
+                let (_, a, h) = self.coef;
+                a * g0 + (1.0 - a) * u0 + (u - u0) * h
             }
             _ => u,
         };
@@ -78,6 +90,10 @@ impl LagBank {
         for (lag, o) in self.lags.iter_mut().zip(self.out.iter_mut()) {
             for c in 0..3 {
                 o[c] = lag[c].step(t_s, db[c]);
+                // The axes share τ and the time step: one `exp` for three.
+                if c < 2 {
+                    lag[c + 1].coef = lag[c].coef;
+                }
             }
         }
         &self.out

@@ -287,6 +287,17 @@ fn segment_filter(
     Ok(Ok((dt, sos)))
 }
 
+/// Which of `segments` a fit under `cfg` uses (the others are too short to
+/// filter and trim with its number of columns, or have no time step).
+pub(crate) fn usable_segments(segments: &[Segment], cfg: &LsConfig) -> Result<Vec<bool>> {
+    validate(cfg)?;
+    segments
+        .iter()
+        .enumerate()
+        .map(|(k, seg)| Ok(segment_filter(k, seg, cfg)?.is_ok()))
+        .collect()
+}
+
 /// The band-passed residual `y − A c` of every segment that
 /// [`fit_band_pass_ls`] uses (trimmed like the fit), with its sampling
 /// rate (Hz); segments that are skipped are left out.
@@ -470,16 +481,31 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
 
 /// The first-order (linear) band-pass least-squares fit.
 fn fit_first_order(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit> {
-    let Accumulated {
-        ne,
-        used,
-        effective_dof,
-        mut warnings,
-    } = accumulate(segments, cfg)?;
+    let acc = accumulate(segments, cfg)?;
+    solve_accumulated(&acc.ne, &acc, cfg)
+}
+
+/// The fit of `cfg`'s design from its accumulated normal equations `ne`
+/// (those of `acc`, or a [`NormalEquations::subset`] of them that holds
+/// exactly `cfg`'s columns in its order); `acc` gives the rows' bookkeeping.
+pub(crate) fn solve_accumulated(
+    ne: &NormalEquations,
+    acc: &Accumulated,
+    cfg: &LsConfig,
+) -> Result<LsFit> {
+    let (used, effective_dof) = (acc.used, acc.effective_dof);
+    let mut warnings = acc.warnings.clone();
     let sol = ne
         .solve_with_dof(cfg.lambda, effective_dof)
         .map_err(CompError::estimation("least-squares fit failed"))?;
     let names = cfg.design.column_names();
+    if names.len() != sol.coef.len() {
+        return Err(CompError::data(format!(
+            "{} accumulated columns for a design of {}",
+            sol.coef.len(),
+            names.len()
+        )));
+    }
     warnings.extend(diagnose(&sol, &names, cfg.max_vif));
     Ok(LsFit {
         coef: sol.coef.iter().copied().collect(),
