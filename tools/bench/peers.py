@@ -4,6 +4,9 @@
     python peers.py magnav IN.csv OUT.csv    end to end: read, fit + apply (MagNav port), write
     python peers.py deinterf IN.csv OUT.csv [plain]   the same with deinterf (RidgeCV, or plain LS)
     python peers.py table DIR               the ratio table of the hyperfine exports in DIR
+    python peers.py read FILE.csv READ_TIME  reading alone: aeromag (the read_time example of
+                                            aeromag-io) against pandas.read_csv, best of 5, on
+                                            the CSV and on the same rows whitespace-separated
 
 The flights are simulated calibration boxes (aeromag.simulate, seeds 1–8)
 joined end to end and repeated up to N samples with the time running on.
@@ -96,6 +99,38 @@ def table(folder):
         print(f"{n:9d}  {tool:40s} {s:8.2f} {ratio:10.1f}")
 
 
+def read_alone(csv_path, read_time):
+    import subprocess
+    import time
+
+    import pandas
+
+    txt = csv_path[: -len(".csv")] + ".txt"
+    if not os.path.exists(txt):
+        with open(csv_path) as f, open(txt + ".part", "w") as g:
+            for line in f:
+                g.write(line.replace(",", " "))
+        os.replace(txt + ".part", txt)
+
+    def best(f):
+        times = []
+        for _ in range(5):
+            t = time.perf_counter()
+            f()
+            times.append(time.perf_counter() - t)
+        return min(times)
+
+    size = os.path.getsize(csv_path) / 1e6
+    print(f"| file ({size:.0f} MB) | aeromag, s | pandas.read_csv, s | pandas / aeromag |")
+    print("|---|---|---|---|")
+    for path, kw in [(csv_path, {}), (txt, {"sep": r"\s+"})]:
+        out = subprocess.run([read_time, path, "5"], check=True, capture_output=True, text=True)
+        ours = float(out.stdout.split()[0])
+        theirs = best(lambda: pandas.read_csv(path, **kw))
+        name = "CSV" if path == csv_path else "whitespace-separated"
+        print(f"| {name} | {ours:.3f} | {theirs:.3f} | {theirs / ours:.2f}x |")
+
+
 if __name__ == "__main__":
     cmd = sys.argv[1]
     if cmd == "gen":
@@ -106,5 +141,7 @@ if __name__ == "__main__":
         deinterf(sys.argv[2], sys.argv[3], len(sys.argv) > 4 and sys.argv[4] == "plain")
     elif cmd == "table":
         table(sys.argv[2])
+    elif cmd == "read":
+        read_alone(sys.argv[2], sys.argv[3])
     else:
         sys.exit(f"unknown command {cmd}")

@@ -21,6 +21,7 @@ sizes=("$@")
 mkdir -p "$dir"
 command -v hyperfine >/dev/null || { apt-get install -y hyperfine >/dev/null 2>&1 || cargo install --locked hyperfine; }
 cargo build --release -p aeromag-cli
+cargo build --release -p aeromag-io --example read_time
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
 py=$PWD/$venv/bin/python
 "$py" -m pip install --quiet --upgrade pip
@@ -42,6 +43,8 @@ for n in "${sizes[@]}"; do
         -n "deinterf, default RidgeCV" "$py tools/bench/peers.py deinterf $f $dir/d-out.csv"
     echo "== $n samples, compute alone (fit + apply on arrays)"
     BENCH_REPEAT=$runs "$py" python/benchmarks/bench_tl.py "$n" | tee "$dir/compute-$n.txt"
+    echo "== $n samples, reading alone"
+    "$py" tools/bench/peers.py read "$f" "$PWD/target/release/examples/read_time" | tee "$dir/read-$n.txt"
 done
 echo "== end to end, all sizes"
 "$py" tools/bench/peers.py table "$dir"

@@ -73,9 +73,13 @@ pub(crate) fn line_too_long(file: &str, line: u64) -> IoError {
 }
 
 /// A stream of data rows whose field count already matches the header.
-pub(crate) trait RowSource {
+pub(crate) trait RowSource: RowFields {
     /// Advances to the next data row; `false` at the end of the input.
     fn next_row(&mut self) -> Result<bool>;
+}
+
+/// The current row of a [`RowSource`] (or of rows read ahead).
+pub(crate) trait RowFields {
     /// 1-based file line of the current row.
     fn line(&self) -> u64;
     /// Field `i` of the current row (`i` < number of header columns).
@@ -223,7 +227,7 @@ impl TableBuilder {
     }
 
     /// Appends the current row of `src`.
-    pub(crate) fn push_row<S: RowSource>(&mut self, src: &S) -> Result<()> {
+    pub(crate) fn push_row<S: RowFields>(&mut self, src: &S) -> Result<()> {
         let row = self.n_rows;
         let line = src.line();
         if row == RESERVE_AFTER_ROWS {

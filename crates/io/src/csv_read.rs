@@ -33,18 +33,20 @@
 //! per-column vectors of the [`TableBuilder`](crate::builder); see there for
 //! the memory bound.
 
-use std::cell::Cell;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-use std::rc::Rc;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::ReadOptions;
 use crate::builder::{
-    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowSource, TableBuilder, line_too_long, too_many_columns,
+    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowFields, RowSource, TableBuilder, line_too_long,
+    too_many_columns,
 };
 use crate::cell::check_text;
 use crate::error::{IoError, Result};
+use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, first_content_line, read_prefix};
 use crate::table::FlightTable;
 use crate::xyz;
@@ -85,9 +87,7 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     src.n_fields = builder.names().len();
-    while src.next_row()? {
-        builder.push_row(&src)?;
-    }
+    push_rows(&mut builder, src)?;
     builder.finish(|| {
         let mut s = open()?;
         s.n_fields = s.header()?.len();
@@ -179,18 +179,18 @@ const OVER_BUDGET: &str = "record longer than the line limit";
 /// spanning lines) never grows beyond the limit in memory.
 struct Budget<R> {
     inner: R,
-    left: Rc<Cell<u64>>,
+    left: Arc<AtomicU64>,
 }
 
 impl<R: Read> Read for Budget<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let left = self.left.get();
+        let left = self.left.load(Ordering::Relaxed);
         if left == 0 {
             return Err(std::io::Error::other(OVER_BUDGET));
         }
         let n = buf.len().min(usize::try_from(left).unwrap_or(usize::MAX));
         let got = self.inner.read(&mut buf[..n])?;
-        self.left.set(left - got as u64);
+        self.left.store(left - got as u64, Ordering::Relaxed);
         Ok(got)
     }
 }
@@ -203,7 +203,7 @@ impl<R: Read> Read for Budget<R> {
 /// ending in `\r` in the last column of a CRLF file loses that `\r`).
 struct CsvSource {
     rdr: csv::Reader<Budget<BufReader<File>>>,
-    budget: Rc<Cell<u64>>,
+    budget: Arc<AtomicU64>,
     rec: csv::ByteRecord,
     file: String,
     delimiter: u8,
@@ -234,10 +234,10 @@ impl CsvSource {
         let bom = if head.starts_with(BOM) { BOM.len() } else { 0 };
         reader.consume(bom);
         let ends_with_newline = last_byte(&file, path, file_size)? == Some(b'\n');
-        let budget = Rc::new(Cell::new(MAX_LINE_BYTES + READ_AHEAD));
+        let budget = Arc::new(AtomicU64::new(MAX_LINE_BYTES + READ_AHEAD));
         let reader = Budget {
             inner: reader,
-            left: Rc::clone(&budget),
+            left: Arc::clone(&budget),
         };
         let rdr = csv::ReaderBuilder::new()
             .has_headers(false)
@@ -292,7 +292,8 @@ impl CsvSource {
                     });
                 }
             }
-            self.budget.set(MAX_LINE_BYTES + READ_AHEAD);
+            self.budget
+                .store(MAX_LINE_BYTES + READ_AHEAD, Ordering::Relaxed);
             // The budget allows up to READ_AHEAD more; the limit itself is
             // on the record's text (fields and delimiters, quotes excluded).
             let cr = self.rec.as_slice().ends_with(b"\r");
@@ -363,7 +364,9 @@ impl RowSource for CsvSource {
         self.row += 1;
         Ok(true)
     }
+}
 
+impl RowFields for CsvSource {
     fn line(&self) -> u64 {
         self.line
     }

@@ -41,6 +41,7 @@ pub mod derive;
 mod error;
 mod fields;
 mod hdf5;
+mod read_ahead;
 pub mod select;
 mod sniff;
 mod summary;

@@ -50,9 +50,11 @@ use std::path::{Path, PathBuf};
 
 use crate::ReadOptions;
 use crate::builder::{
-    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowSource, TableBuilder, line_too_long, too_many_columns,
+    Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowFields, RowSource, TableBuilder, line_too_long,
+    too_many_columns,
 };
 use crate::error::{IoError, Result};
+use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, read_prefix};
 use crate::table::FlightTable;
 
@@ -69,7 +71,7 @@ pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightT
 
 fn read_tokens(path: &Path, opts: &ReadOptions, dialect: Dialect) -> Result<FlightTable> {
     let prefix = read_prefix(path)?;
-    let (mut src, names) = TokenSource::open(path, dialect)?;
+    let (src, names) = TokenSource::open(path, dialect)?;
     let layout = Layout {
         path: path.to_path_buf(),
         names,
@@ -80,9 +82,7 @@ fn read_tokens(path: &Path, opts: &ReadOptions, dialect: Dialect) -> Result<Flig
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     let header = builder.names().to_vec();
-    while src.next_row()? {
-        builder.push_row(&src)?;
-    }
+    let mut src = push_rows(&mut builder, src)?;
     let mut table = builder.finish(|| TokenSource::open(path, dialect).map(|(s, _)| s))?;
     if src.any_record {
         let free = |name: &str| {
@@ -426,7 +426,9 @@ impl RowSource for TokenSource {
             }
         }
     }
+}
 
+impl RowFields for TokenSource {
     fn line(&self) -> u64 {
         self.line
     }
