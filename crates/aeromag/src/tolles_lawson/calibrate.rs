@@ -12,7 +12,9 @@ use aeromag_compensation::model_file::{
 };
 use aeromag_compensation::tolles_lawson::extra_select::ChannelSelection;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment, fit_band_pass_ls};
-use aeromag_compensation::tolles_lawson::lag_select::LagSelection;
+use aeromag_compensation::tolles_lawson::lag_select::{
+    DEFAULT_SELECTION_BLOCK, LagSelection, within_budget,
+};
 use aeromag_compensation::tolles_lawson::{Convention, ExtraRequest, ExtraTerm};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -346,10 +348,18 @@ pub(super) fn calibrate_with(
 /// exact magnitude, nT (peak to peak over the flight).
 pub const SECOND_ORDER_NOTE_NT: f64 = 0.1;
 
+/// Rows [`second_order_note`] evaluates at most: a longer flight is
+/// sampled in blocks spread evenly over every segment (`within_budget`,
+/// as the lag search), since the remainder needs the interference vector
+/// (three evaluations of the design) and follows the attitude and heading,
+/// which a tenth of a long flight samples fully. On a 10⁷-row flight the
+/// note cost as much as the fit.
+pub const SECOND_ORDER_NOTE_ROWS: usize = 200_000;
+
 /// Say when the first-order projection is not enough: the peak-to-peak of
-/// its second-order remainder over the flight's rows, under the fitted
-/// coefficients (the vector model they imply), when it exceeds
-/// [`SECOND_ORDER_NOTE_NT`].
+/// its second-order remainder over the flight's rows (at most
+/// [`SECOND_ORDER_NOTE_ROWS`] of them), under the fitted coefficients (the
+/// vector model they imply), when it exceeds [`SECOND_ORDER_NOTE_NT`].
 pub(super) fn second_order_note(
     design: &aeromag_compensation::tolles_lawson::Design,
     coef: &[f64],
@@ -361,12 +371,19 @@ pub(super) fn second_order_note(
         return;
     }
     let mut span = super::compensate::Span::default();
-    for s in segments {
+    let sample = within_budget(segments, SECOND_ORDER_NOTE_ROWS, DEFAULT_SELECTION_BLOCK);
+    for s in &sample {
         span.add(design, coef, s);
     }
     if span.range() > SECOND_ORDER_NOTE_NT {
+        let rows: usize = segments.iter().map(|s| s.time.len()).sum();
+        let over = if rows > SECOND_ORDER_NOTE_ROWS {
+            format!("over {SECOND_ORDER_NOTE_ROWS} rows sampled from this flight")
+        } else {
+            "over this flight".to_string()
+        };
         notes.note(format!(
-            "the second-order term of the projection varies by {:.2} nT over this flight (interference ≳ 1 % of the field): --magnitude exact fits |B + ΔB| − |B|",
+            "the second-order term of the projection varies by {:.2} nT {over} (interference ≳ 1 % of the field): --magnitude exact fits |B + ΔB| − |B|",
             span.range()
         ));
     }
