@@ -310,7 +310,11 @@ impl Design {
             .collect()
     }
 
-    /// `A c` with the direction cosines of `dir` (default: of `flux`).
+    /// `A c` with the direction cosines of `dir` (default: of `flux`), in
+    /// blocks of [`PROJECTION_BLOCK`] rows. Without lagged columns the
+    /// blocks are independent and are shared out over the available cores
+    /// (each row's sum is the same bits whatever the thread count); lagged
+    /// columns carry their state from block to block, one thread.
     fn projected(
         &self,
         coef: &[f64],
@@ -319,35 +323,52 @@ impl Design {
         channels: Channels,
         dir: Option<[&[f64]; 3]>,
     ) -> Vec<f64> {
-        const BLOCK: usize = 4096;
         let n = time.len();
         let mut db = Default::default();
         self.derivatives_into(time, flux, &mut db);
-        let mut lags = Lags::new(&self.terms);
-        let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
-        let mut out = Vec::with_capacity(n);
-        for start in (0..n).step_by(BLOCK) {
-            let r = start..(start + BLOCK).min(n);
-            self.block_columns(
-                r.clone(),
-                time,
-                flux,
-                dir,
-                channels,
-                &db,
-                &mut lags,
-                &mut scratch,
-                &mut cols,
-            );
-            // −0.0 is the identity of f64 addition (what `Iterator::sum`
-            // starts from), so this is the bits of `row · c`.
-            let mut acc = vec![-0.0; r.len()];
-            for (col, c) in cols.iter().zip(coef) {
-                for (a, v) in acc.iter_mut().zip(col) {
-                    *a += v * c;
+        let lagged =
+            !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some();
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .clamp(1, 8);
+        let mut out = vec![0.0; n];
+        let project = |start: usize, part: &mut [f64]| {
+            let mut lags = Lags::new(&self.terms);
+            let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
+            for (k, acc) in part.chunks_mut(PROJECTION_BLOCK).enumerate() {
+                let a = start + k * PROJECTION_BLOCK;
+                let r = a..a + acc.len();
+                self.block_columns(
+                    r,
+                    time,
+                    flux,
+                    dir,
+                    channels,
+                    &db,
+                    &mut lags,
+                    &mut scratch,
+                    &mut cols,
+                );
+                // −0.0 is the identity of f64 addition (what `Iterator::sum`
+                // starts from), so this is the bits of `row · c`.
+                acc.fill(-0.0);
+                for (col, c) in cols.iter().zip(coef) {
+                    for (a, v) in acc.iter_mut().zip(col) {
+                        *a += v * c;
+                    }
                 }
             }
-            out.extend(acc);
+        };
+        if lagged || threads == 1 || n < 4 * PROJECTION_BLOCK {
+            project(0, &mut out);
+        } else {
+            let per = n.div_ceil(threads).div_ceil(PROJECTION_BLOCK) * PROJECTION_BLOCK;
+            std::thread::scope(|scope| {
+                for (t, part) in out.chunks_mut(per).enumerate() {
+                    let project = &project;
+                    scope.spawn(move || project(t * per, part));
+                }
+            });
         }
         out
     }
@@ -427,6 +448,9 @@ impl Design {
         }
     }
 }
+
+/// Rows per block of [`Design::projected`].
+const PROJECTION_BLOCK: usize = 4096;
 
 fn norm(v: [f64; 3]) -> f64 {
     dot(v, v).sqrt()

@@ -36,7 +36,7 @@ use super::segments::median_step;
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
 use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_with};
-use aeromag_estimation::least_squares::{LsSolution, NormalEquations};
+use aeromag_estimation::least_squares::{BlockProducts, LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
 /// Settings of the band-pass least-squares fit.
@@ -172,14 +172,73 @@ const BLOCK_TOLERANCE: f64 = 1e-15;
 /// filtering to that tolerance (the transients of the block's artificial
 /// ends have decayed), so memory is `O(block_len × columns)` whatever the
 /// segment's length.
-fn for_each_filtered_block(
+///
+/// The blocks are independent, so they are designed, filtered and passed
+/// through `map` on the available cores, one block per thread (a single
+/// block spreads its columns over the threads instead); `reduce` receives
+/// the mapped blocks in order on the calling thread. Each block is the same
+/// bits whatever the thread count.
+fn for_each_filtered_block<T: Send>(
     seg: &Segment,
     dt_s: f64,
     cfg: &LsConfig,
     sos: Option<&Sos>,
-    mut sink: impl FnMut(&[&[f64]], &[f64]) -> Result<()>,
+    map: impl Fn(&[&[f64]], &[f64]) -> Result<T> + Sync,
+    mut reduce: impl FnMut(T) -> Result<()>,
 ) -> Result<()> {
-    let n = seg.time.len();
+    let plan = block_plan(seg.time.len(), dt_s, cfg, sos)?;
+    let threads = worker_threads();
+    if plan.len() == 1 || threads == 1 {
+        let mut work = BlockWork::default();
+        for blk in &plan {
+            work.compute(seg, cfg, sos, blk, threads)?;
+            reduce(work.map(blk, &map)?)?;
+        }
+        return Ok(());
+    }
+    let mut works: Vec<BlockWork> = (0..threads).map(|_| BlockWork::default()).collect();
+    for chunk in plan.chunks(threads) {
+        let mapped: Vec<T> = std::thread::scope(|scope| {
+            let map = &map;
+            let handles: Vec<_> = works
+                .iter_mut()
+                .zip(chunk)
+                .map(|(w, blk)| {
+                    scope.spawn(move || {
+                        w.compute(seg, cfg, sos, blk, 1)?;
+                        w.map(blk, map)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                .collect::<Result<Vec<T>>>()
+        })?;
+        for m in mapped {
+            reduce(m)?;
+        }
+    }
+    Ok(())
+}
+
+/// Threads the fit uses (the available cores, at most 8).
+fn worker_threads() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 8)
+}
+
+/// One block of [`for_each_filtered_block`]: rows `a..b` of the segment are
+/// designed and filtered, rows `core` (within `a..b`) are kept.
+struct BlockPlan {
+    a: usize,
+    b: usize,
+    core: std::ops::Range<usize>,
+}
+
+/// The blocks of a segment of `n` rows (see [`for_each_filtered_block`]).
+fn block_plan(n: usize, dt_s: f64, cfg: &LsConfig, sos: Option<&Sos>) -> Result<Vec<BlockPlan>> {
     let (keep_lo, keep_hi) = if sos.is_some() {
         (cfg.trim, n - cfg.trim)
     } else {
@@ -206,8 +265,8 @@ fn for_each_filtered_block(
         .unwrap_or(0);
     let overlap = filter_overlap + lag_overlap;
     let block = cfg.block_len.max(1);
+    let mut plan = Vec::new();
     let mut start = keep_lo;
-    let (mut design, mut y, mut scratch) = (DesignBlock::default(), Vec::new(), Vec::new());
     while start < keep_hi {
         let end = (start + block).min(keep_hi);
         let (a, b) = if keep_lo == 0 && keep_hi == n && block >= n {
@@ -215,6 +274,35 @@ fn for_each_filtered_block(
         } else {
             (start.saturating_sub(overlap), (end + overlap).min(n))
         };
+        plan.push(BlockPlan {
+            a,
+            b,
+            core: start..end,
+        });
+        start = end;
+    }
+    Ok(plan)
+}
+
+/// The buffers of one block, kept for the next.
+#[derive(Default)]
+struct BlockWork {
+    design: DesignBlock,
+    y: Vec<f64>,
+    scratch: Vec<Vec<[f64; FILTER_LANES]>>,
+}
+
+impl BlockWork {
+    /// Design and filter the rows of `blk` (the columns over `threads`).
+    fn compute(
+        &mut self,
+        seg: &Segment,
+        cfg: &LsConfig,
+        sos: Option<&Sos>,
+        blk: &BlockPlan,
+        threads: usize,
+    ) -> Result<()> {
+        let (a, b) = (blk.a, blk.b);
         let time = &seg.time[a..b];
         let flux = [&seg.flux[0][a..b], &seg.flux[1][a..b], &seg.flux[2][a..b]];
         let channels = seg.channels.slice(a..b);
@@ -222,18 +310,27 @@ fn for_each_filtered_block(
             .direction
             .map(|d| [&d[0][a..b], &d[1][a..b], &d[2][a..b]]);
         cfg.design
-            .columns_along_into(time, flux, channels, dir, &mut design);
-        y.clear();
-        y.extend_from_slice(&seg.mag[a..b]);
+            .columns_along_into(time, flux, channels, dir, &mut self.design);
+        self.y.clear();
+        self.y.extend_from_slice(&seg.mag[a..b]);
         if let Some(sos) = sos {
-            filter_columns(sos, &mut design.columns, &mut y, &mut scratch)?;
+            filter_columns(
+                sos,
+                &mut self.design.columns,
+                &mut self.y,
+                &mut self.scratch,
+                threads,
+            )?;
         }
-        let (ca, cb) = (start - a, end - a);
-        let refs: Vec<&[f64]> = design.columns.iter().map(|c| &c[ca..cb]).collect();
-        sink(&refs, &y[ca..cb])?;
-        start = end;
+        Ok(())
     }
-    Ok(())
+
+    /// `map` of the kept rows of the block.
+    fn map<T>(&self, blk: &BlockPlan, map: &impl Fn(&[&[f64]], &[f64]) -> Result<T>) -> Result<T> {
+        let (ca, cb) = (blk.core.start - blk.a, blk.core.end - blk.a);
+        let refs: Vec<&[f64]> = self.design.columns.iter().map(|c| &c[ca..cb]).collect();
+        map(&refs, &self.y[ca..cb])
+    }
 }
 
 /// Segment `k`'s sampling interval (s) and band-pass filter, or the warning
@@ -320,12 +417,21 @@ pub(crate) fn band_passed_residuals(
             continue;
         };
         let mut r = Vec::with_capacity(seg.time.len());
-        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
-            for (i, &yi) in y.iter().enumerate() {
-                r.push(yi - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>());
-            }
-            Ok(())
-        })?;
+        for_each_filtered_block(
+            seg,
+            dt,
+            cfg,
+            sos.as_ref(),
+            |cols, y| {
+                Ok((0..y.len())
+                    .map(|i| y[i] - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>())
+                    .collect::<Vec<f64>>())
+            },
+            |block| {
+                r.extend(block);
+                Ok(())
+            },
+        )?;
         out.push((r, 1.0 / dt));
     }
     Ok(out)
@@ -451,10 +557,18 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
                 continue;
             }
         };
-        for_each_filtered_block(seg, dt, cfg, sos.as_ref(), |cols, y| {
-            ne.add_columns(cols, y)
-                .map_err(CompError::estimation(format!("segment {k}")))
-        })?;
+        let context = || format!("segment {k}");
+        for_each_filtered_block(
+            seg,
+            dt,
+            cfg,
+            sos.as_ref(),
+            |cols, y| BlockProducts::of(cols, y).map_err(CompError::estimation(context())),
+            |p| {
+                ne.add_products(&p)
+                    .map_err(CompError::estimation(context()))
+            },
+        )?;
         used += 1;
         fs_used.push(1.0 / dt);
     }
@@ -585,6 +699,7 @@ fn filter_columns(
     cols: &mut [Vec<f64>],
     y: &mut [f64],
     scratch: &mut Vec<Vec<[f64; FILTER_LANES]>>,
+    threads: usize,
 ) -> Result<()> {
     // Constant columns (the permanent terms on a straight leg) stay as
     // they are; the others go through the filter FILTER_LANES at a time,
@@ -597,9 +712,12 @@ fn filter_columns(
         .chain(std::iter::once(y))
         .filter(|c| std_dev(c) > f64::EPSILON)
         .collect();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .clamp(1, 8);
+    let threads = threads.max(1);
+    if threads == 1 {
+        scratch.resize_with(1, Vec::new);
+        return sosfiltfilt_columns_with(sos, &mut varying, &mut scratch[0])
+            .map_err(CompError::from);
+    }
     let groups = varying.len().div_ceil(FILTER_LANES);
     let per = groups.div_ceil(threads).max(1) * FILTER_LANES;
     scratch.resize_with(threads, Vec::new);

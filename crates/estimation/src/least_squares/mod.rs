@@ -2,4 +2,4 @@
 
 pub mod normal_equations;
 
-pub use normal_equations::{LsSolution, NormalEquations};
+pub use normal_equations::{BlockProducts, LsSolution, NormalEquations};

@@ -121,6 +121,7 @@ impl NormalEquations {
 
     /// Add a block of rows stored column-major: `columns[j][k]` is row `k`,
     /// column `j`; `y[k]` the observations. Faster than row by row.
+    /// Equivalent to [`Self::add_products`] of [`BlockProducts::of`].
     pub fn add_columns(&mut self, columns: &[&[f64]], y: &[f64]) -> Result<()> {
         let n = self.n();
         if columns.len() != n {
@@ -129,44 +130,35 @@ impl NormalEquations {
                 columns.len()
             )));
         }
-        let m = y.len();
-        if columns.iter().any(|c| c.len() != m) {
-            return Err(EstError::Dimension("columns of unequal length".into()));
+        self.add_products(&BlockProducts::of(columns, y)?)
+    }
+
+    /// Add the products of a block formed elsewhere (for example on
+    /// another thread): the same bits as [`Self::add_columns`] of that
+    /// block, since each sum of a run of rows is added in the same order.
+    pub fn add_products(&mut self, p: &BlockProducts) -> Result<()> {
+        let n = self.n();
+        if p.n != n {
+            return Err(EstError::Dimension(format!(
+                "products of {} columns for {n} unknowns",
+                p.n
+            )));
         }
-        if !all_finite(y) || !columns.iter().all(|c| all_finite(c)) {
-            return Err(EstError::NonFinite {
-                what: "least-squares block",
-            });
-        }
-        // Rows in blocks that stay in cache while all n(n+1)/2 products
-        // are formed (instead of streaming every pair of columns from
-        // memory), four columns at a time against each column.
-        let mut start = 0;
-        while start < m {
-            let end = (start + ROW_BLOCK).min(m);
-            let block: Vec<&[f64]> = columns.iter().map(|c| &c[start..end]).collect();
-            let yb = &y[start..end];
+        for run in p.sums.chunks_exact(BlockProducts::per_run(n)) {
+            let (aty, rest) = run.split_at(n);
+            for (a, v) in self.aty.iter_mut().zip(aty) {
+                *a += v;
+            }
+            let mut k = 0;
             for i in 0..n {
-                self.aty[i] += dot(block[i], yb);
-                let mut j = i;
-                while j + 4 <= n {
-                    let d = aeromag_core::simd::run(Dot4 {
-                        a: block[i],
-                        b: [block[j], block[j + 1], block[j + 2], block[j + 3]],
-                    });
-                    for (t, v) in d.into_iter().enumerate() {
-                        self.ata[(i, j + t)] += v;
-                    }
-                    j += 4;
-                }
-                for j in j..n {
-                    self.ata[(i, j)] += dot(block[i], block[j]);
+                for j in i..n {
+                    self.ata[(i, j)] += rest[k];
+                    k += 1;
                 }
             }
-            self.yty += dot(yb, yb);
-            start = end;
+            self.yty += rest[k];
         }
-        self.rows += m;
+        self.rows += p.rows;
         Ok(())
     }
 
@@ -333,6 +325,72 @@ fn symmetric_inverse(m: &DMatrix<f64>) -> Option<DMatrix<f64>> {
         Some(inv)
     } else {
         None
+    }
+}
+
+/// The products `aᵢ·y`, `aᵢ·aⱼ` (i ≤ j) and `y·y` of a block of rows,
+/// summed per run of [`ROW_BLOCK`] rows and not yet added to an
+/// accumulator ([`NormalEquations::add_products`]): forming them is the
+/// `O(rows × n²)` work, which can then run on several threads while the
+/// accumulation keeps its order.
+#[derive(Debug, Clone)]
+pub struct BlockProducts {
+    n: usize,
+    rows: usize,
+    /// Per run: `n` values of `aᵢ·y`, the upper triangle row by row, `y·y`.
+    sums: Vec<f64>,
+}
+
+impl BlockProducts {
+    fn per_run(n: usize) -> usize {
+        n + n * (n + 1) / 2 + 1
+    }
+
+    /// The products of the block `columns` (column-major: `columns[j][k]`
+    /// is row `k`, column `j`) with observations `y`. Errors: columns of
+    /// unequal length, non-finite values.
+    pub fn of(columns: &[&[f64]], y: &[f64]) -> Result<BlockProducts> {
+        let n = columns.len();
+        let m = y.len();
+        if columns.iter().any(|c| c.len() != m) {
+            return Err(EstError::Dimension("columns of unequal length".into()));
+        }
+        if !all_finite(y) || !columns.iter().all(|c| all_finite(c)) {
+            return Err(EstError::NonFinite {
+                what: "least-squares block",
+            });
+        }
+        // Rows in runs that stay in cache while all n(n+1)/2 products
+        // are formed (instead of streaming every pair of columns from
+        // memory), four columns at a time against each column.
+        let per = Self::per_run(n);
+        let mut sums = Vec::with_capacity(m.div_ceil(ROW_BLOCK) * per);
+        let mut start = 0;
+        while start < m {
+            let end = (start + ROW_BLOCK).min(m);
+            let block: Vec<&[f64]> = columns.iter().map(|c| &c[start..end]).collect();
+            let yb = &y[start..end];
+            sums.extend(block.iter().map(|c| dot(c, yb)));
+            for i in 0..n {
+                let mut j = i;
+                while j + 4 <= n {
+                    sums.extend(aeromag_core::simd::run(Dot4 {
+                        a: block[i],
+                        b: [block[j], block[j + 1], block[j + 2], block[j + 3]],
+                    }));
+                    j += 4;
+                }
+                sums.extend((j..n).map(|j| dot(block[i], block[j])));
+            }
+            sums.push(dot(yb, yb));
+            start = end;
+        }
+        Ok(BlockProducts { n, rows: m, sums })
+    }
+
+    /// Rows in the block.
+    pub fn rows(&self) -> usize {
+        self.rows
     }
 }
 
