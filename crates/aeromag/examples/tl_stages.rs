@@ -24,7 +24,9 @@ impl Observer for Clock {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args().nth(1).ok_or("usage: tl_stages FLIGHT.csv")?;
+    let path = std::env::args()
+        .nth(1)
+        .ok_or("usage: tl_stages FLIGHT.csv")?;
     let mut clock = Clock(Instant::now(), "reading".into());
     let flight = aeromag::Flight::read(&path)?;
     let settings = CalibrateSettings {
