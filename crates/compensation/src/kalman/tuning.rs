@@ -358,7 +358,7 @@ fn grid_starts(
     free: &[usize],
     theta0: &[f64],
     n: usize,
-    objective: &impl Fn(&[f64]) -> f64,
+    objective: &(impl Fn(&[f64]) -> f64 + Sync),
 ) -> Starts {
     let q_axes: Vec<usize> = (0..free.len()).filter(|&j| free[j] < 2).collect();
     if n == 0 || q_axes.is_empty() {
@@ -370,7 +370,7 @@ fn grid_starts(
     let step = GRID_STEP_DECADES * std::f64::consts::LN_10;
     let half = (GRID_SPAN_DECADES / GRID_STEP_DECADES).round() as usize;
     let per_axis = 2 * half + 1;
-    let mut nodes: Vec<(f64, Vec<f64>)> = vec![(objective(theta0), theta0.to_vec())];
+    let mut points: Vec<Vec<f64>> = vec![theta0.to_vec()];
     // Node `flat` has the digits of `flat` in base `per_axis` as its grid
     // indices along the free field axes, the first axis fastest; the centre
     // (every index `half`) is the start, already in.
@@ -384,9 +384,13 @@ fn grid_starts(
             t[j] += (i as f64 - half as f64) * step;
         }
         if !centre {
-            nodes.push((objective(&t), t));
+            points.push(t);
         }
     }
+    // The nodes are independent filter runs: shared out over the cores,
+    // each value the same whatever the thread count.
+    let values = evaluate_all(&points, objective);
+    let mut nodes: Vec<(f64, Vec<f64>)> = values.into_iter().zip(points).collect();
     let evaluations = nodes.len();
     // The start is the first node; the stable sort keeps it ahead of
     // equally good ones.
@@ -395,6 +399,26 @@ fn grid_starts(
         points: nodes.into_iter().take(n).map(|(_, t)| t).collect(),
         evaluations,
     }
+}
+
+/// `objective` at every point, in order, the points shared out over the
+/// available cores in contiguous runs.
+fn evaluate_all(points: &[Vec<f64>], objective: &(impl Fn(&[f64]) -> f64 + Sync)) -> Vec<f64> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .clamp(1, 8);
+    let mut values = vec![0.0; points.len()];
+    let per = points.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for (vs, ps) in values.chunks_mut(per).zip(points.chunks(per)) {
+            scope.spawn(move || {
+                for (v, p) in vs.iter_mut().zip(ps) {
+                    *v = objective(p);
+                }
+            });
+        }
+    });
+    values
 }
 
 /// Spacing of the coarse grid of [`grid_starts`], decades.
