@@ -42,7 +42,11 @@
 //! two (`Λ` ≈ 53 against 24.5; threshold 27.6 for nine candidates, 26.9 for
 //! the seven of [`DEFAULT_LAG_GRID_S`]).
 //!
-//! Cost: `grid × max_lags` least-squares fits (each O(N·n²)); pass
+//! Cost: for the eddy lags of the first-order model, one filtering pass
+//! over the design with every grid lag (`O(N·(n + 9m)²)`), each candidate
+//! then a subset of its normal equations (`EddyLagUnion`), and one residual
+//! pass per greedy step for the flatness; otherwise (an extra regressor's
+//! lag, the exact magnitude) `grid × max_lags` least-squares fits. Pass
 //! [`within_budget`] segments to bound `N` on long records.
 
 use super::design::Magnitude;
