@@ -104,7 +104,15 @@ pub(super) fn next_chunk(
     let n = r
         .read_frames(frames, out)
         .map_err(|e| Error::bad_file(&file, e.to_string()))?;
-    if let Some(k) = out.iter().position(|v| !v.is_finite()) {
+    // Runs without an early exit vectorise; the position is looked for
+    // only when a run has a bad value.
+    let all_finite = out
+        .chunks(4096)
+        .all(|c| c.iter().fold(true, |ok, v| ok & v.is_finite()));
+    if let Some(k) = (!all_finite)
+        .then(|| out.iter().position(|v| !v.is_finite()))
+        .flatten()
+    {
         let frame = first + (k / 3) as u64;
         return Err(Error::bad_file(
             &file,

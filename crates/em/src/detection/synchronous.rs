@@ -401,6 +401,10 @@ impl SyncDetector {
     /// (`data[i * channels + c]`), the first sample having absolute index
     /// `start_index`. A trailing partial block is ignored.
     ///
+    /// The blocks are independent: they are shared out over the available
+    /// cores in contiguous runs, and the epochs come back in order, each
+    /// the same bits whatever the thread count.
+    ///
     /// Errors for `channels == 0`.
     pub fn detect_interleaved(
         &self,
@@ -413,6 +417,39 @@ impl SyncDetector {
                 reason: "zero channels".into(),
             });
         }
+        let block = self.config.window_len * channels;
+        let blocks = data.len() / block;
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .clamp(1, 8)
+            .min(blocks);
+        if threads <= 1 {
+            return self.detect_run(data, channels, start_index);
+        }
+        let per = blocks.div_ceil(threads);
+        let runs: Vec<Result<Vec<Epoch>>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = data[..blocks * block]
+                .chunks(per * block)
+                .enumerate()
+                .map(|(t, part)| {
+                    let first = start_index + (t * per * self.config.window_len) as u64;
+                    scope.spawn(move || self.detect_run(part, channels, first))
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                .collect()
+        });
+        let mut out = Vec::with_capacity(blocks);
+        for run in runs {
+            out.extend(run?);
+        }
+        Ok(out)
+    }
+
+    /// [`Self::detect_interleaved`] on one thread.
+    fn detect_run(&self, data: &[f32], channels: usize, start_index: u64) -> Result<Vec<Epoch>> {
         let n = self.config.window_len;
         let nf = self.config.frequencies_hz.len();
         let fs = self.config.sample_rate_hz;
