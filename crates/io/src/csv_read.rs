@@ -208,6 +208,8 @@ struct CsvSource {
     file: String,
     delimiter: u8,
     header_line: u64,
+    /// Line on which the previous record ended (0 before the first).
+    last_line_end: u64,
     n_fields: usize,
     row: usize,
     line: u64,
@@ -258,6 +260,7 @@ impl CsvSource {
             file,
             delimiter,
             header_line: 0,
+            last_line_end: 0,
             n_fields: 0,
             row: 0,
             line: 0,
@@ -305,7 +308,14 @@ impl CsvSource {
             let pos = self.rdr.position();
             let at_end = pos.byte() + self.bom >= self.file_size;
             let last_line = pos.line() - u64::from(!at_end || self.ends_with_newline);
-            let embedded = self.rec.as_slice().iter().filter(|&&b| b == b'\n').count() as u64;
+            // A record ending on the line after the previous one holds no
+            // line end of its own (the common case: no scan of its bytes).
+            let embedded = if last_line == self.last_line_end + 1 {
+                0
+            } else {
+                self.rec.as_slice().iter().filter(|&&b| b == b'\n').count() as u64
+            };
+            self.last_line_end = last_line;
             self.line = last_line.saturating_sub(embedded).max(1);
             if record_bytes as u64 > MAX_LINE_BYTES {
                 return Err(line_too_long(&self.file, self.line));
