@@ -255,7 +255,7 @@ impl Ctx<'_> {
     fn total_field(
         &self,
         name: &str,
-        abs: impl Iterator<Item = f64>,
+        abs: impl ExactSizeIterator<Item = f64>,
         w: &mut Vec<Warning>,
     ) -> Result<()> {
         let Some(m) = median(abs) else { return Ok(()) };
@@ -441,11 +441,10 @@ fn max_abs(v: &[f64]) -> Option<f64> {
 
 /// Median of the finite values among at most [`MEDIAN_SAMPLES`] evenly
 /// strided samples of `values`; `None` when there is none.
-pub(crate) fn median(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let all: Vec<f64> = values.collect();
-    let stride = all.len().div_ceil(MEDIAN_SAMPLES).max(1);
-    let mut v: Vec<f64> = all
-        .into_iter()
+pub(crate) fn median(values: impl ExactSizeIterator<Item = f64>) -> Option<f64> {
+    // Only the samples are kept (a 10⁷-row column is not copied whole).
+    let stride = values.len().div_ceil(MEDIAN_SAMPLES).max(1);
+    let mut v: Vec<f64> = values
         .step_by(stride)
         .filter(|x| x.is_finite())
         .collect();
