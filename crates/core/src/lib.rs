@@ -32,6 +32,7 @@ pub mod estimability;
 pub mod field;
 pub mod filter;
 pub mod frames;
+pub mod parallel;
 pub mod quadrature;
 pub mod random;
 pub mod simd;

@@ -24,14 +24,14 @@
 //! (ties broken by order). The candidates do not depend on the start, so
 //! they are run once per data set and shared by every start of the map.
 //!
-//! Parallel over threads ([`crate::parallel::parallel_map`]); each start is
+//! Parallel over threads ([`aeromag_core::parallel::parallel_map`]); each start is
 //! independent, so the map is identical for any thread count.
 
 use crate::error::{GradiometryError, Result, positive};
 use crate::forward::{Background, Forward, TensorForward};
 use crate::geometry::{Geometry, Layout};
-use crate::parallel::parallel_map;
 use crate::sr_iekf::{EpochResult, IekfConfig, SrState, iterate_epoch};
+use aeromag_core::parallel::parallel_map;
 use aeromag_core::random::{normal, stream};
 use nalgebra::{SVector, Vector3};
 

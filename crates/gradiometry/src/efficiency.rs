@@ -35,7 +35,6 @@ use crate::forward::Forward;
 use crate::geometry::{Geometry, Layout};
 use crate::locate::{DifferenceModel, LocateConfig, locate_scalar, locate_tensor};
 use crate::motion::MotionNoise;
-use crate::parallel::parallel_map;
 use crate::pass::PassEpoch;
 use crate::sim::{
     Gradiometer, Processing, Scenario, SimEpoch, SystemMotion, scalar_epochs, simulate,
@@ -43,6 +42,7 @@ use crate::sim::{
 };
 use crate::sr_iekf::IekfConfig;
 use aeromag_core::frames::Attitude;
+use aeromag_core::parallel::parallel_map;
 use nalgebra::{SMatrix, SVector, Vector3};
 
 /// Result of a Monte-Carlo run.

@@ -19,7 +19,7 @@
 //! - [`config`] — the `gradiometer` scenario file (TOML);
 //! - [`convergence`] — the seed's fig. 2 convergence map and a multi-start initialisation;
 //! - [`sim`] — the simulator scenario `gradiometer`;
-//! - [`parallel`] — index-parallel map over scoped threads (results independent of the thread count);
+//! - [`parallel`] — index-parallel map over scoped threads (results independent of the thread count; from `aeromag-core`);
 //! - [`error`] — [`GradiometryError`], with `is_bad_input()`.
 
 #![warn(missing_docs)]
@@ -37,7 +37,7 @@ pub mod efficiency;
 pub mod estimability;
 pub mod locate;
 pub mod motion;
-pub mod parallel;
+pub use aeromag_core::parallel;
 pub mod pass;
 pub mod sim;
 pub mod sr_iekf;

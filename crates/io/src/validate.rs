@@ -444,10 +444,7 @@ fn max_abs(v: &[f64]) -> Option<f64> {
 pub(crate) fn median(values: impl ExactSizeIterator<Item = f64>) -> Option<f64> {
     // Only the samples are kept (a 10⁷-row column is not copied whole).
     let stride = values.len().div_ceil(MEDIAN_SAMPLES).max(1);
-    let mut v: Vec<f64> = values
-        .step_by(stride)
-        .filter(|x| x.is_finite())
-        .collect();
+    let mut v: Vec<f64> = values.step_by(stride).filter(|x| x.is_finite()).collect();
     median_in_place(&mut v)
 }
 

@@ -127,6 +127,7 @@
 use super::anomaly_model::{NoiseModel, X2Prior};
 use super::joint_filter::JointFilter;
 use crate::error::{CompError, Result};
+use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead};
 use serde::{Deserialize, Serialize};
 
@@ -389,7 +390,7 @@ fn grid_starts(
     }
     // The nodes are independent filter runs: shared out over the cores,
     // each value the same whatever the thread count.
-    let values = evaluate_all(&points, objective);
+    let values = parallel_map(points.len(), threads(), |i| objective(&points[i]));
     let mut nodes: Vec<(f64, Vec<f64>)> = values.into_iter().zip(points).collect();
     let evaluations = nodes.len();
     // The start is the first node; the stable sort keeps it ahead of
@@ -399,26 +400,6 @@ fn grid_starts(
         points: nodes.into_iter().take(n).map(|(_, t)| t).collect(),
         evaluations,
     }
-}
-
-/// `objective` at every point, in order, the points shared out over the
-/// available cores in contiguous runs.
-fn evaluate_all(points: &[Vec<f64>], objective: &(impl Fn(&[f64]) -> f64 + Sync)) -> Vec<f64> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .clamp(1, 8);
-    let mut values = vec![0.0; points.len()];
-    let per = points.len().div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        for (vs, ps) in values.chunks_mut(per).zip(points.chunks(per)) {
-            scope.spawn(move || {
-                for (v, p) in vs.iter_mut().zip(ps) {
-                    *v = objective(p);
-                }
-            });
-        }
-    });
-    values
 }
 
 /// Spacing of the coarse grid of [`grid_starts`], decades.

@@ -328,9 +328,7 @@ impl Design {
         self.derivatives_into(time, flux, &mut db);
         let lagged =
             !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some();
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .clamp(1, 8);
+        let threads = aeromag_core::parallel::threads();
         let mut out = vec![0.0; n];
         let project = |start: usize, part: &mut [f64]| {
             let mut lags = Lags::new(&self.terms);

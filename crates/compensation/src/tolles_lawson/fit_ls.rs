@@ -187,7 +187,7 @@ fn for_each_filtered_block<T: Send>(
     mut reduce: impl FnMut(T) -> Result<()>,
 ) -> Result<()> {
     let plan = block_plan(seg.time.len(), dt_s, cfg, sos)?;
-    let threads = worker_threads();
+    let threads = aeromag_core::parallel::threads();
     if plan.len() == 1 || threads == 1 {
         let mut work = BlockWork::default();
         for blk in &plan {
@@ -220,13 +220,6 @@ fn for_each_filtered_block<T: Send>(
         }
     }
     Ok(())
-}
-
-/// Threads the fit uses (the available cores, at most 8).
-fn worker_threads() -> usize {
-    std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .clamp(1, 8)
 }
 
 /// One block of [`for_each_filtered_block`]: rows `a..b` of the segment are

@@ -419,27 +419,15 @@ impl SyncDetector {
         }
         let block = self.config.window_len * channels;
         let blocks = data.len() / block;
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .clamp(1, 8)
-            .min(blocks);
+        let threads = aeromag_core::parallel::threads().min(blocks);
         if threads <= 1 {
             return self.detect_run(data, channels, start_index);
         }
         let per = blocks.div_ceil(threads);
-        let runs: Vec<Result<Vec<Epoch>>> = std::thread::scope(|scope| {
-            let handles: Vec<_> = data[..blocks * block]
-                .chunks(per * block)
-                .enumerate()
-                .map(|(t, part)| {
-                    let first = start_index + (t * per * self.config.window_len) as u64;
-                    scope.spawn(move || self.detect_run(part, channels, first))
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-                .collect()
+        let runs = aeromag_core::parallel::parallel_map(blocks.div_ceil(per), threads, |t| {
+            let part = &data[t * per * block..((t + 1) * per).min(blocks) * block];
+            let first = start_index + (t * per * self.config.window_len) as u64;
+            self.detect_run(part, channels, first)
         });
         let mut out = Vec::with_capacity(blocks);
         for run in runs {

@@ -1,9 +1,17 @@
-//! Index-parallel map over scoped threads, for the convergence map and the
-//! Monte-Carlo efficiency.
+//! Index-parallel map over scoped threads (the gradiometry convergence map
+//! and Monte-Carlo efficiency, the Kalman tuning grid, EM detection), and
+//! the number of threads the workspace's parallel loops use.
 //!
 //! Item `i` is always computed by `f(i)` and stored at position `i`, so the
 //! result does not depend on the number of threads (the chunks only decide
 //! which thread computes what).
+
+/// Threads for a parallel loop: the available cores, at most 8.
+pub fn threads() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 8)
+}
 
 /// `[f(0), f(1), …, f(n − 1)]`, computed on up to `threads` threads (≥ 1) in
 /// contiguous chunks.
