@@ -119,6 +119,28 @@ fn gcd(a: usize, b: usize) -> usize {
     if b == 0 { a } else { gcd(b, a % b) }
 }
 
+/// The grids a solve on `nx × ny` intervals runs through, as node spacings
+/// in final cells, coarsest first and ending at 1: GMT's sequence, which
+/// starts at the greatest common divisor of the two and divides by its
+/// prime factors, largest first, the coarsest keeping at least 4 nodes a
+/// side.
+pub(super) fn strides(nx: usize, ny: usize) -> Vec<usize> {
+    let mut stride = gcd(nx, ny).max(1);
+    let mut factors = prime_factors(stride);
+    while nx / stride < 3 || ny / stride < 3 {
+        match factors.pop() {
+            Some(p) => stride /= p,
+            None => break,
+        }
+    }
+    let mut out = vec![stride];
+    while let Some(p) = factors.pop() {
+        stride /= p;
+        out.push(stride);
+    }
+    out
+}
+
 /// Estimated work of a solve on `nx × ny` intervals (module docs).
 fn solve_work(nx: usize, ny: usize) -> f64 {
     let g = gcd(nx, ny);

@@ -96,9 +96,13 @@ pub struct Block {
 
 impl BlockMeans {
     /// Assign each finite point to its nearest node of `g` and average per
-    /// node. Blocks come out in node order (south row first), so the
-    /// result does not depend on the points' order beyond round-off of the
-    /// sums (which are taken in the points' order: deterministic).
+    /// node. A point exactly halfway between two nodes goes to the one with
+    /// the even index (counted from the west and the south), as GMT
+    /// `blockmean` does, so both see the same block means on data laid out
+    /// on round coordinates. Blocks come out in node order (south row
+    /// first), so the result does not depend on the points' order beyond
+    /// round-off of the sums (which are taken in the points' order:
+    /// deterministic).
     pub fn of(points: Points, g: &GridGeometry) -> Self {
         let mut sums: Vec<(f64, f64, f64, usize)> = vec![(0.0, 0.0, 0.0, 0); g.len()];
         let (mut used, mut non_finite, mut outside) = (0, 0, 0);
@@ -109,7 +113,7 @@ impl BlockMeans {
                 continue;
             }
             let (u, v) = g.to_node(x, y);
-            let (iu, iv) = (u.round(), v.round());
+            let (iu, iv) = (u.round_ties_even(), v.round_ties_even());
             if iu < 0.0 || iv < 0.0 || iu >= g.nx as f64 || iv >= g.ny as f64 {
                 outside += 1;
                 continue;
@@ -143,5 +147,34 @@ impl BlockMeans {
             non_finite,
             outside,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points halfway between nodes go where GMT 6.4 `blockmean` puts them:
+    /// `printf "8 12 1\n" | gmt blockmean -R3/43/7/37 -I10 -C` gives the
+    /// node (3, 7); 18 22 → (23, 27); 28 32 → (23, 27); 38 12 → (43, 7).
+    #[test]
+    fn halfway_points_go_to_the_even_node_as_in_gmt_blockmean() {
+        let g = GridGeometry {
+            x0: 3.0,
+            y0: 7.0,
+            cell: 10.0,
+            nx: 5,
+            ny: 4,
+        };
+        let (x, y) = ([8.0, 18.0, 28.0, 38.0], [12.0, 22.0, 32.0, 12.0]);
+        let z = [1.0, 2.0, 4.0, 8.0];
+        let m = BlockMeans::of(Points::new(&x, &y, &z).unwrap(), &g);
+        let nodes: Vec<(f64, f64, f64)> =
+            m.blocks.iter().map(|b| (g.x(b.i), g.y(b.j), b.z)).collect();
+        assert_eq!(
+            nodes,
+            [(3.0, 7.0, 1.0), (43.0, 7.0, 8.0), (23.0, 27.0, 3.0)],
+            "{m:?}"
+        );
     }
 }
