@@ -643,10 +643,10 @@ fn several_sensors_and_the_reference_sensor_mode() {
 /// today's stinger installation; each cabin sensor more than 10× below its
 /// 16-term model and within 1.5× of its oracle; in reference-sensor mode
 /// the worst cabin sensor within 1.2× of its oracle. Measured (seed 1):
-/// stinger 0.1645 nT (16 terms 0.204; today's
-/// installation, which has no currents, 0.1640); cabin 0.725 / 0.104 /
-/// 0.229 / 0.184 nT against oracles 0.716 / 0.099 / 0.213 / 0.168 (worst
-/// ratio 1.09), 16 terms up to 277 nT; reference mode worst 0.730 nT
+/// stinger 0.1638 nT (16 terms 0.204; today's
+/// installation, which has no currents, 0.1640); cabin 0.724 / 0.102 /
+/// 0.226 / 0.186 nT against oracles 0.716 / 0.099 / 0.213 / 0.168 (worst
+/// ratio 1.11), 16 terms up to 277 nT; reference mode worst 0.730 nT
 /// (1.02×). The figures are printed (`--no-capture`).
 #[test]
 fn sgl_installation_several_sensors_and_currents() {
