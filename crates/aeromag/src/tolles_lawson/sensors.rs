@@ -124,11 +124,11 @@ pub fn calibrate_sensors(
         notes.stage(&format!("calibrating the reference sensor {}", s.mag));
         // Filtered through the turns, as the other sensors are fitted
         // against it (module docs).
-        let of = |s: &SensorColumns| CalibrateOptions {
+        let through = CalibrateOptions {
             split_lines: false,
             ..of(s)
         };
-        let cal = calibrate_with(flight, &of(s), None, &mut notes)?;
+        let cal = calibrate_with(flight, &through, None, &mut notes)?;
         // The other sensors' reference is the reference sensor compensated
         // by band-pass LS, whatever the method of its own model (module
         // docs).
@@ -138,7 +138,7 @@ pub fn calibrate_sensors(
             notes.stage(&format!("least-squares reference fit of {}", s.mag));
             let ls = CalibrateOptions {
                 method: Method::Ls,
-                ..of(s)
+                ..through.clone()
             };
             Some(calibrate_with(flight, &ls, None, &mut notes)?.model)
         };
