@@ -138,12 +138,13 @@ pub struct MultiSensorOutcome {
 }
 
 /// RMS about the mean of `comp − true_external_<k>` over the survey lines
-/// (`line > 0`; turns left out), rows where both are finite. One mean for
-/// all lines, not one per line as in
+/// (`line > 0`; turns left out), rows where both are finite, nT: the
+/// study's score of sensor `k` of a simulated survey. One mean for all
+/// lines, not one per line as in
 /// [`aeromag_compensation::metrics::residual::residual_by_line`]: a cabin
 /// sensor's heading-dependent error shows as line-to-line offsets, which
 /// belong to the compensation here.
-fn line_error_rms(survey: &Flight, comp: &[f64], k: usize) -> Result<f64> {
+pub fn line_error_rms(survey: &Flight, comp: &[f64], k: usize) -> Result<f64> {
     line_error_rms_against(survey, comp, &format!("true_external_{k}"))
 }
 
@@ -323,10 +324,12 @@ fn noise_floor_nt(fs_hz: f64) -> f64 {
     c.noise_density_nt_per_rthz * (fs_hz / 2.0).sqrt()
 }
 
-/// The oracle of module docs for the cabin sensor `idx`: `m`'s terms (lags
-/// fixed, extras as kept, magnitude), a bias, every survey row unfiltered,
-/// against the true external field.
-fn oracle(
+/// The oracle of module docs for the cabin sensor `idx` of a simulated
+/// survey, scored by [`line_error_rms`], nT: `m`'s terms (lags fixed,
+/// extras as kept, magnitude), a bias, every survey row unfiltered, fitted
+/// against the true external field (the best that model family can do
+/// there).
+pub fn oracle(
     survey: &Flight,
     s: &SensorColumns,
     m: &aeromag_compensation::model_file::TlModel,
