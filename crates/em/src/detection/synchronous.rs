@@ -271,14 +271,33 @@ impl SyncDetector {
         }
         let mut kernels_re = Vec::with_capacity(config.frequencies_hz.len());
         let mut kernels_im = Vec::with_capacity(config.frequencies_hz.len());
+        // On the bin grid (f = k f_s/N, the frequency plan's rule) the
+        // phase 2π f n/f_s is 2π ((k n) mod N)/N: one table of N phasors
+        // serves every frequency (N sines and cosines instead of N per
+        // frequency; the phase is also exact, without the integer part
+        // that f n/f_s carries).
+        let len = config.window_len;
+        let mut unit: Vec<(f64, f64)> = Vec::new();
         for &f in &config.frequencies_hz {
+            let bins = f * len as f64 / fs;
+            let on_grid = (bins - bins.round()).abs() <= 1e-9 * bins.max(1.0);
+            if on_grid && unit.is_empty() {
+                unit = (0..len)
+                    .map(|m| (TAU * (m as f64 / len as f64)).sin_cos())
+                    .collect();
+            }
+            let k = bins.round() as usize % len;
             let (re, im): (Vec<f32>, Vec<f32>) = weights
                 .iter()
                 .enumerate()
                 .map(|(n, w)| {
-                    let ph = TAU * (f * n as f64 / fs).fract();
+                    let (sin, cos) = if on_grid {
+                        unit[((k as u64 * n as u64) % len as u64) as usize]
+                    } else {
+                        (TAU * (f * n as f64 / fs).fract()).sin_cos()
+                    };
                     let s = 2.0 * w / sum;
-                    ((s * ph.cos()) as f32, (s * ph.sin()) as f32)
+                    ((s * cos) as f32, (s * sin) as f32)
                 })
                 .unzip();
             kernels_re.push(re);
@@ -445,9 +464,16 @@ impl SyncDetector {
         let mut sums = vec![(0.0f64, 0.0f64); nf * channels];
         let mut out = Vec::with_capacity(data.len() / (n * channels));
         for (b, block) in data.chunks_exact(n * channels).enumerate() {
-            for (i, frame) in block.chunks_exact(channels).enumerate() {
-                for (c, &v) in frame.iter().enumerate() {
-                    buf[c][i] = v;
+            if let [b0, b1, b2] = &mut buf[..] {
+                // The usual three components, without an index per value.
+                for (((frame, x), y), z) in block.chunks_exact(3).zip(b0).zip(b1).zip(b2) {
+                    (*x, *y, *z) = (frame[0], frame[1], frame[2]);
+                }
+            } else {
+                for (i, frame) in block.chunks_exact(channels).enumerate() {
+                    for (c, &v) in frame.iter().enumerate() {
+                        buf[c][i] = v;
+                    }
                 }
             }
             sums.iter_mut().for_each(|s| *s = (0.0, 0.0));
