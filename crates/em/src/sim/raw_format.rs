@@ -96,7 +96,6 @@ pub struct RawReader<R: Read> {
     header: RawHeader,
     body_offset: u64,
     frames_read: u64,
-    bytes: Vec<u8>,
 }
 
 fn bad(m: String) -> EmError {
@@ -170,7 +169,6 @@ impl<R: Read> RawReader<R> {
             header,
             body_offset,
             frames_read: 0,
-            bytes: Vec::new(),
         })
     }
 
@@ -210,27 +208,32 @@ impl<R: Read> RawReader<R> {
             }
             return Ok(0);
         }
-        // Read what is there rather than allocate the requested size first:
-        // a header claiming 10^12 frames meets a short body.
-        let len = (frames as u64).saturating_mul(ch as u64 * 4);
-        self.bytes.clear();
-        let got = (&mut self.inner)
-            .take(len)
-            .read_to_end(&mut self.bytes)
-            .map_err(|e| bad(format!("read error: {e}")))?;
-        if (got as u64) < len {
-            let at = self.frames_read + (got / (4 * ch)) as u64;
-            return Err(bad(format!(
-                "truncated body: the header says {} frames × {ch} channels, the file ends in frame {at} (byte {})",
-                self.header.frames,
-                self.body_offset + self.frames_read * ch as u64 * 4 + got as u64
-            )));
+        // Straight into the samples' memory, in steps of at most 1 MiB
+        // beyond what was read: a header claiming 10^12 frames meets a short
+        // body without a huge allocation first.
+        let samples = frames.saturating_mul(ch);
+        let mut got = 0;
+        while got < samples {
+            let end = samples.min(got + (1 << 18));
+            out.resize(end, 0.0);
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut out[got..end]);
+            let n = read_full(&mut self.inner, bytes)?;
+            got += n / 4;
+            if n < bytes.len() {
+                let read = 4 * got as u64 + (n % 4) as u64;
+                let at = self.frames_read + (read / (4 * ch as u64));
+                return Err(bad(format!(
+                    "truncated body: the header says {} frames × {ch} channels, the file ends in frame {at} (byte {})",
+                    self.header.frames,
+                    self.body_offset + self.frames_read * ch as u64 * 4 + read
+                )));
+            }
         }
-        out.extend(
-            self.bytes
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-        );
+        if cfg!(target_endian = "big") {
+            for v in out.iter_mut() {
+                *v = f32::from_bits(u32::from_le(v.to_bits()));
+            }
+        }
         self.frames_read += frames as u64;
         Ok(frames)
     }
