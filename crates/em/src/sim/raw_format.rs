@@ -187,18 +187,18 @@ impl<R: Read> RawReader<R> {
         self.frames_read
     }
 
-    /// Read up to `max_frames` frames into `out` (replacing its contents);
-    /// returns the number read, 0 at the end. After the last frame the
-    /// stream must end.
+    /// Read up to `max_frames` frames into `out` (replacing its contents;
+    /// unspecified after an error); returns the number read, 0 at the end.
+    /// After the last frame the stream must end.
     ///
     /// Errors ([`EmError::InvalidData`]): the body ends before the header's
     /// frame count (truncated file) or continues after it (trailing bytes).
     pub fn read_frames(&mut self, max_frames: usize, out: &mut Vec<f32>) -> Result<usize> {
-        out.clear();
         let left = self.header.frames - self.frames_read;
         let frames = (max_frames as u64).min(left) as usize;
         let ch = self.header.channels;
         if frames == 0 {
+            out.clear();
             if read_full(&mut self.inner, &mut [0u8; 1])? != 0 {
                 return Err(bad(format!(
                     "trailing bytes after the header's {} frames (from byte {})",
@@ -210,12 +210,16 @@ impl<R: Read> RawReader<R> {
         }
         // Straight into the samples' memory, in steps of at most 1 MiB
         // beyond what was read: a header claiming 10^12 frames meets a short
-        // body without a huge allocation first.
+        // body without a huge allocation first. A buffer passed back in is
+        // overwritten as it is (not zeroed first).
         let samples = frames.saturating_mul(ch);
+        out.truncate(samples);
         let mut got = 0;
         while got < samples {
             let end = samples.min(got + (1 << 18));
-            out.resize(end, 0.0);
+            if out.len() < end {
+                out.resize(end, 0.0);
+            }
             let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut out[got..end]);
             let n = read_full(&mut self.inner, bytes)?;
             got += n / 4;
