@@ -766,7 +766,7 @@ fn exact_magnitude_searches_see_currents_beside_the_second_order_term() {
 #[test]
 fn a_perturbed_cabin_meets_its_oracle_with_the_stinger_fitted_through_the_turns() {
     use aeromag::compensation::tolles_lawson::{ExtraRequest, Magnitude};
-    use aeromag::studies::{line_error_rms, oracle};
+    use aeromag::studies::{compensated, line_error_rms, oracle};
     let cal = simulate_flight(
         ScenarioKind::Calibration,
         Some(include_str!("data/cabin_b_calibration.toml")),
@@ -814,15 +814,8 @@ fn a_perturbed_cabin_meets_its_oracle_with_the_stinger_fitted_through_the_turns(
         &mut Silent,
     )
     .unwrap();
-    let one = SensorsModel::new(vec![aeromag::compensation::model_file::SensorModel {
-        name: "mag_1".into(),
-        mag: "mag_1_uc".into(),
-        flux: set.sensors[0].flux.clone(),
-        reference_sensor: None,
-        model: by_legs.model,
-    }]);
-    let stinger_by_legs =
-        line_error_rms(&survey, &one.compensate(&survey).unwrap().sensors[0].2, 1).unwrap();
+    let by_legs = compensated(&survey, &set.sensors[0], by_legs.model).unwrap();
+    let stinger_by_legs = line_error_rms(&survey, &by_legs, 1).unwrap();
     println!(
         "stinger {stinger:.4} nT (leg by leg {stinger_by_legs:.4}); mag_5_uc {mag_5:.4} nT, oracle {mag_5_oracle:.4} ({:.2}×)",
         mag_5 / mag_5_oracle

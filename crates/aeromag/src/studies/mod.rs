@@ -33,7 +33,7 @@ pub use gradiometry::{GradiometryOutcome, GradiometryStudy, GradiometrySummary};
 pub use maps::{MapsOutcome, MapsStudy, MapsSummary};
 pub use multi_sensor::{
     CALIBRATION_CYCLES, MultiSensorOutcome, MultiSensorStudy, MultiSensorSummary, SGL_CURRENTS,
-    SensorFigures, line_error_rms, oracle,
+    SensorFigures, compensated, line_error_rms, oracle,
 };
 pub use pod::{MethodRates, PodOutcome, PodStudy, PodSummary};
 pub use rotor::{RotorOutcome, RotorStudyRun, RotorSummary, pct};

@@ -365,8 +365,8 @@ pub fn oracle(
     line_error_rms(survey, &compensated(survey, s, fit)?, idx)
 }
 
-/// The compensated reading of the sensor `s` of `flight` under `model`.
-fn compensated(
+/// The compensated reading of the sensor `s` of `flight` under `model`, nT.
+pub fn compensated(
     flight: &Flight,
     s: &SensorColumns,
     model: aeromag_compensation::model_file::TlModel,

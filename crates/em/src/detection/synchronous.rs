@@ -464,16 +464,9 @@ impl SyncDetector {
         let mut sums = vec![(0.0f64, 0.0f64); nf * channels];
         let mut out = Vec::with_capacity(data.len() / (n * channels));
         for (b, block) in data.chunks_exact(n * channels).enumerate() {
-            if let [b0, b1, b2] = &mut buf[..] {
-                // The usual three components, without an index per value.
-                for (((frame, x), y), z) in block.chunks_exact(3).zip(b0).zip(b1).zip(b2) {
-                    (*x, *y, *z) = (frame[0], frame[1], frame[2]);
-                }
-            } else {
-                for (i, frame) in block.chunks_exact(channels).enumerate() {
-                    for (c, &v) in frame.iter().enumerate() {
-                        buf[c][i] = v;
-                    }
+            for (i, frame) in block.chunks_exact(channels).enumerate() {
+                for (c, &v) in frame.iter().enumerate() {
+                    buf[c][i] = v;
                 }
             }
             sums.iter_mut().for_each(|s| *s = (0.0, 0.0));
