@@ -5,7 +5,7 @@
 //! line ends, a final line end.
 //!
 //! - Numbers are written with the shortest text that reads back to the same
-//!   `f64` (Ryū: `0.1`, `53210.4`, `1e-7`, `-0.0`, `inf`), so a write → read
+//!   `f64` ([`NumberText`], Ryū's layout: `0.1`, `53210.4`, `1e-7`, `-0.0`, `inf`), so a write → read
 //!   round trip preserves every finite value and infinity bit for bit.
 //! - Missing values (`NaN`) are written as **empty cells** (the reader reads
 //!   them back as missing, `Missing::blank`); the NaN payload and sign are not
@@ -25,6 +25,7 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::error::{IoError, Result};
+use crate::number_text::NumberText;
 use crate::table::{Column, ColumnData, FlightTable};
 
 /// Writes `table` as CSV to the file `path` (created or replaced).
@@ -96,6 +97,26 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
 /// Rows per chunk formatted by one thread of [`write_csv_to`].
 const WRITE_CHUNK_ROWS: usize = 16 * 1024;
 
+/// One column as [`format_rows`] writes it.
+enum Cells<'a> {
+    /// Shortest round-trip text (Ryū).
+    Float(&'a [f64]),
+    /// Read as integers (`1003`): whole values written without `.0`.
+    Integer(&'a [f64]),
+    /// Text, quoted when needed.
+    Text(&'a [String]),
+}
+
+impl<'a> Cells<'a> {
+    fn of(c: &'a Column) -> Self {
+        match c.data() {
+            ColumnData::Numeric { values, .. } if c.integer_text() => Cells::Integer(values),
+            ColumnData::Numeric { values, .. } => Cells::Float(values),
+            ColumnData::Text(t) => Cells::Text(t),
+        }
+    }
+}
+
 /// The text of `rows` of `columns` (each row ending in `\n`) into `out`
 /// (cleared first); missing values as `missing`.
 fn format_rows(
@@ -105,26 +126,27 @@ fn format_rows(
     out: &mut Vec<u8>,
 ) {
     out.clear();
-    let mut ryu = ryu::Buffer::new();
+    let cells: Vec<Cells> = columns.iter().map(|c| Cells::of(c)).collect();
+    let mut int = itoa::Buffer::new();
+    let mut float = NumberText::new();
     for row in rows {
-        for (i, c) in columns.iter().enumerate() {
+        for (i, c) in cells.iter().enumerate() {
             if i > 0 {
                 out.push(b',');
             }
-            match c.data() {
-                ColumnData::Numeric { values, .. } => {
-                    let v = values[row];
-                    if v.is_nan() {
-                        out.extend_from_slice(missing);
-                    } else if c.integer_text() && v.fract() == 0.0 {
-                        // Read as `1003`: written back as `1003`, not `1003.0`
-                        // (at most 15 digits, so exact).
-                        let _ = write!(out, "{}", v as i64); // into a Vec: cannot fail
-                    } else {
-                        out.extend_from_slice(ryu.format(v).as_bytes());
-                    }
+            match c {
+                Cells::Float(values) | Cells::Integer(values) if values[row].is_nan() => {
+                    out.extend_from_slice(missing)
                 }
-                ColumnData::Text(t) => push_text(out, &t[row]),
+                // Read as `1003`: written back as `1003`, not `1003.0`
+                // (at most 15 digits, so exact).
+                Cells::Integer(values) if values[row].fract() == 0.0 => {
+                    out.extend_from_slice(int.format(values[row] as i64).as_bytes())
+                }
+                Cells::Float(values) | Cells::Integer(values) => {
+                    out.extend_from_slice(float.format(values[row]).as_bytes())
+                }
+                Cells::Text(t) => push_text(out, &t[row]),
             }
         }
         out.push(b'\n');

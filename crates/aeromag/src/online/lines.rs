@@ -277,11 +277,11 @@ impl LineCompensator {
         };
         self.counts.add(flag);
         out.push_str(line);
-        let mut ryu = ryu::Buffer::new();
+        let mut text = aeromag_io::NumberText::new();
         for v in [interf, comp] {
             out.push(',');
             if v.is_finite() {
-                out.push_str(ryu.format(v));
+                out.push_str(text.format(v));
             }
         }
         out.push(',');
