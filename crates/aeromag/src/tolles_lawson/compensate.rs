@@ -44,10 +44,9 @@ pub(super) fn tl_interference(
     let mut out = vec![f64::NAN; flight.n_rows()];
     let coef = model.coef();
     for_model_segments(model, flight, sensor, |r, s| {
-        let v = model
+        model
             .design
-            .interference_with(&coef, s.time, s.flux, s.channels);
-        out[r].copy_from_slice(&v);
+            .interference_with_into(&coef, s.time, s.flux, s.channels, &mut out[r]);
     })?;
     Ok(out)
 }

@@ -3,17 +3,16 @@
 //!
 //! Row `i` is the design row of the vector field and its derivative under
 //! the design's convention, exactly as [`Design::columns`]
-//! builds it over the same run: the derivatives come from
-//! [`crate::tolles_lawson::terms::derivative`] applied to each chunk extended
-//! by one neighbour on each side (at least three samples), so interior
-//! samples get the central difference and the run's two ends the one-sided
-//! one. The lagged derivatives of the `l9` group run through the whole
+//! builds it over the same run: the derivatives of each chunk's rows are
+//! those of the whole run ([`crate::tolles_lawson::terms::derivative_rows_into`]),
+//! so interior samples get the central difference and the run's two ends
+//! the one-sided one. The lagged derivatives of the `l9` group run through the whole
 //! run sample by sample, as over one segment.
 
 use crate::tolles_lawson::Design;
 use crate::tolles_lawson::design::Lags;
 use crate::tolles_lawson::fit_ls::Segment;
-use crate::tolles_lawson::terms::derivative_into;
+use crate::tolles_lawson::terms::derivative_rows_into;
 use std::ops::Range;
 
 /// Samples per chunk.
@@ -41,29 +40,24 @@ pub fn for_each_design_row(
     let mut a = s;
     while a < e {
         let b = (a + CHUNK).min(e);
-        // Slice with one neighbour each side, at least three samples.
-        let mut lo = if a > s { a - 1 } else { s };
-        let hi = (b + 1).min(e);
-        if hi - lo < 3 {
-            lo = hi.saturating_sub(3).max(s);
-        }
-        let db: [Vec<f64>; 3] = if eddy {
-            [0, 1, 2].map(|c| {
-                let mut d = Vec::new();
-                derivative_into(
-                    &flux[c][lo..hi],
-                    &time[lo..hi],
+        let db: [Vec<f64>; 3] = [0, 1, 2].map(|c| {
+            let mut d = Vec::new();
+            if eddy {
+                derivative_rows_into(
+                    &flux[c][s..e],
+                    &time[s..e],
                     spec.convention,
                     spec.differencing,
+                    a - s..b - s,
                     &mut d,
                 );
-                d
-            })
-        } else {
-            [vec![0.0; hi - lo], vec![0.0; hi - lo], vec![0.0; hi - lo]]
-        };
+            } else {
+                d.resize(b - a, 0.0);
+            }
+            d
+        });
         for i in a..b {
-            let j = i - lo;
+            let j = i - a;
             let d = [db[0][j], db[1][j], db[2][j]];
             for ((x, c), lag) in extra.iter_mut().zip(&channels).zip(&mut lags.extra) {
                 let v = c.map_or(f64::NAN, |c| c[i]);

@@ -7,7 +7,7 @@
 
 use super::eddy_lag::{FirstOrderLag, LagBank};
 use super::terms::{
-    Convention, DEFAULT_BT_SCALE_NT, Differencing, ExtraSeries, TermSet, derivative_into,
+    Convention, DEFAULT_BT_SCALE_NT, Differencing, ExtraSeries, TermSet, derivative_rows_into,
 };
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
@@ -215,7 +215,7 @@ impl Design {
         dir: Option<[&[f64]; 3]>,
         block: &mut DesignBlock,
     ) {
-        self.derivatives_into(time, flux, &mut block.db);
+        self.derivatives_into(time, flux, 0..time.len(), &mut block.db);
         let mut lags = Lags::new(&self.terms);
         let DesignBlock {
             columns,
@@ -228,7 +228,7 @@ impl Design {
             flux,
             dir,
             channels,
-            db,
+            [&db[0][..], &db[1][..], &db[2][..]],
             &mut lags,
             scratch,
             columns,
@@ -255,13 +255,28 @@ impl Design {
         flux: [&[f64]; 3],
         channels: Channels,
     ) -> Vec<f64> {
+        let mut out = vec![0.0; time.len()];
+        self.interference_with_into(coef, time, flux, channels, &mut out);
+        out
+    }
+
+    /// [`Design::interference_with`] into `out` (of the segment's length),
+    /// without a buffer of its own under the first-order magnitude.
+    pub fn interference_with_into(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        out: &mut [f64],
+    ) {
         match self.magnitude {
-            Magnitude::FirstOrder => self.projected(coef, time, flux, channels, None),
+            Magnitude::FirstOrder => self.projected_into(coef, time, flux, channels, None, out),
             Magnitude::Exact => {
                 let (d, bias) = self.field_vector(coef, time, flux, channels);
-                (0..time.len())
-                    .map(|k| TotalField::at(flux, &d, k).change() + bias)
-                    .collect()
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = TotalField::at(flux, &d, k).change() + bias;
+                }
             }
         }
     }
@@ -323,26 +338,43 @@ impl Design {
         channels: Channels,
         dir: Option<[&[f64]; 3]>,
     ) -> Vec<f64> {
+        let mut out = vec![0.0; time.len()];
+        self.projected_into(coef, time, flux, channels, dir, &mut out);
+        out
+    }
+
+    /// [`Design::projected`] into `out` (of the segment's length). The
+    /// derivatives are formed block by block too, so the memory beyond
+    /// `out` is a few blocks whatever the segment's length.
+    fn projected_into(
+        &self,
+        coef: &[f64],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        dir: Option<[&[f64]; 3]>,
+        out: &mut [f64],
+    ) {
         let n = time.len();
-        let mut db = Default::default();
-        self.derivatives_into(time, flux, &mut db);
+        debug_assert_eq!(out.len(), n);
         let lagged =
             !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some();
         let threads = aeromag_core::parallel::threads();
-        let mut out = vec![0.0; n];
         let project = |start: usize, part: &mut [f64]| {
             let mut lags = Lags::new(&self.terms);
             let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
+            let mut db: [Vec<f64>; 3] = Default::default();
             for (k, acc) in part.chunks_mut(PROJECTION_BLOCK).enumerate() {
                 let a = start + k * PROJECTION_BLOCK;
                 let r = a..a + acc.len();
+                self.derivatives_into(time, flux, r.clone(), &mut db);
                 self.block_columns(
                     r,
                     time,
                     flux,
                     dir,
                     channels,
-                    &db,
+                    [&db[0][..], &db[1][..], &db[2][..]],
                     &mut lags,
                     &mut scratch,
                     &mut cols,
@@ -358,7 +390,7 @@ impl Design {
             }
         };
         if lagged || threads == 1 || n < 4 * PROJECTION_BLOCK {
-            project(0, &mut out);
+            project(0, out);
         } else {
             let per = n.div_ceil(threads).div_ceil(PROJECTION_BLOCK) * PROJECTION_BLOCK;
             std::thread::scope(|scope| {
@@ -368,11 +400,10 @@ impl Design {
                 }
             });
         }
-        out
     }
 
-    /// The columns of rows `r` of a segment into `out` (derivatives `db`
-    /// over the whole segment; `lags` stepped through every earlier row,
+    /// The columns of rows `r` of a segment into `out` (`db`: the
+    /// derivatives of those rows; `lags` stepped through every earlier row,
     /// so that the lagged derivatives and channels start at the segment's
     /// first sample; the direction cosines of `dir`, default `flux`).
     #[allow(clippy::too_many_arguments)]
@@ -383,7 +414,7 @@ impl Design {
         flux: [&[f64]; 3],
         dir: Option<[&[f64]; 3]>,
         channels: Channels,
-        db: &[Vec<f64>; 3],
+        db: [&[f64]; 3],
         lags: &mut Lags,
         scratch: &mut Scratch,
         out: &mut Vec<Vec<f64>>,
@@ -396,7 +427,8 @@ impl Design {
         }
         if n_lags > 0 {
             for i in r.clone() {
-                let d = [db[0][i], db[1][i], db[2][i]];
+                let j = i - r.start;
+                let d = [db[0][j], db[1][j], db[2][j]];
                 for (l, g) in lagged.iter_mut().zip(lags.eddy.step(time[i], d)) {
                     for (axis, v) in l.iter_mut().zip(g) {
                         axis.push(*v);
@@ -424,7 +456,7 @@ impl Design {
         self.terms.columns_into(
             dir.unwrap_or(flux).map(|f| &f[r.clone()]),
             flux.map(|f| &f[r.clone()]),
-            [&db[0][r.clone()], &db[1][r.clone()], &db[2][r.clone()]],
+            db,
             &lagged,
             &series,
             self.bt_scale_nt,
@@ -433,15 +465,28 @@ impl Design {
         )
     }
 
-    /// Field derivatives for the eddy columns into `db` (zeros when no
-    /// eddy group is used).
-    fn derivatives_into(&self, time: &[f64], flux: [&[f64]; 3], db: &mut [Vec<f64>; 3]) {
+    /// Field derivatives for the eddy columns of rows `r` of the segment
+    /// into `db` (zeros when no eddy group is used).
+    fn derivatives_into(
+        &self,
+        time: &[f64],
+        flux: [&[f64]; 3],
+        r: std::ops::Range<usize>,
+        db: &mut [Vec<f64>; 3],
+    ) {
         for (k, d) in db.iter_mut().enumerate() {
             if self.terms.has_eddy() {
-                derivative_into(flux[k], time, self.convention, self.differencing, d);
+                derivative_rows_into(
+                    flux[k],
+                    time,
+                    self.convention,
+                    self.differencing,
+                    r.clone(),
+                    d,
+                );
             } else {
                 d.clear();
-                d.resize(time.len(), 0.0);
+                d.resize(r.len(), 0.0);
             }
         }
     }

@@ -853,32 +853,57 @@ pub fn derivative_into(
     differencing: Differencing,
     d: &mut Vec<f64>,
 ) {
+    derivative_rows_into(x, t, convention, differencing, 0..x.len(), d);
+}
+
+/// Rows `rows` of [`derivative_into`] of the whole series `x` into `d`
+/// (resized to `rows.len()`): the same values, computed from the
+/// neighbours of those rows only, so that a long series can be
+/// differentiated block by block without a full-length buffer.
+pub fn derivative_rows_into(
+    x: &[f64],
+    t: &[f64],
+    convention: Convention,
+    differencing: Differencing,
+    rows: std::ops::Range<usize>,
+    d: &mut Vec<f64>,
+) {
     let n = x.len();
     d.clear();
-    d.resize(n, 0.0);
+    d.resize(rows.len(), 0.0);
+    let first = rows.start;
     if differencing == Differencing::Backward {
-        for i in 1..n {
-            d[i] = backward_difference(convention, x[i - 1], x[i], t[i - 1], t[i]);
+        for i in rows.start.max(1)..rows.end {
+            d[i - first] = backward_difference(convention, x[i - 1], x[i], t[i - 1], t[i]);
         }
         return;
     }
     if n < 3 {
         return;
     }
+    let interior = rows.start.max(1)..rows.end.min(n - 1);
     match convention {
         Convention::MagNav => {
-            d[0] = x[1] - x[0];
-            for i in 1..n - 1 {
-                d[i] = (x[i + 1] - x[i - 1]) / 2.0;
+            for i in interior {
+                d[i - first] = (x[i + 1] - x[i - 1]) / 2.0;
             }
-            d[n - 1] = x[n - 1] - x[n - 2];
+            if rows.contains(&0) {
+                d[0] = x[1] - x[0];
+            }
+            if rows.contains(&(n - 1)) {
+                d[n - 1 - first] = x[n - 1] - x[n - 2];
+            }
         }
         Convention::Physical => {
-            d[0] = (x[1] - x[0]) / (t[1] - t[0]);
-            for i in 1..n - 1 {
-                d[i] = (x[i + 1] - x[i - 1]) / (t[i + 1] - t[i - 1]);
+            for i in interior {
+                d[i - first] = (x[i + 1] - x[i - 1]) / (t[i + 1] - t[i - 1]);
             }
-            d[n - 1] = (x[n - 1] - x[n - 2]) / (t[n - 1] - t[n - 2]);
+            if rows.contains(&0) {
+                d[0] = (x[1] - x[0]) / (t[1] - t[0]);
+            }
+            if rows.contains(&(n - 1)) {
+                d[n - 1 - first] = (x[n - 1] - x[n - 2]) / (t[n - 1] - t[n - 2]);
+            }
         }
     }
 }
@@ -1063,5 +1088,30 @@ mod tests {
                 && (p[0] - 10.0).abs() < 1e-12
                 && (p[3] - 50.0).abs() < 1e-9
         );
+    }
+
+    proptest::proptest! {
+        /// Any block of rows is the same bits as those rows of the whole
+        /// series, under every convention and differencing, ends included.
+        #[test]
+        fn rows_of_a_derivative_are_the_whole_series_rows(
+            x in proptest::collection::vec(-1e4f64..1e4, 0..40),
+            cut in (0usize..40, 0usize..40),
+        ) {
+            let n = x.len();
+            let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1 + (i % 3) as f64 * 1e-3).collect();
+            let (a, b) = (cut.0.min(n), cut.1.min(n));
+            let rows = a.min(b)..a.max(b);
+            for convention in [Convention::MagNav, Convention::Physical] {
+                for differencing in [Differencing::Centred, Differencing::Backward] {
+                    let mut whole = Vec::new();
+                    derivative_into(&x, &t, convention, differencing, &mut whole);
+                    let mut part = vec![7.0; 5];
+                    derivative_rows_into(&x, &t, convention, differencing, rows.clone(), &mut part);
+                    let bits = |v: &[f64]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+                    proptest::prop_assert_eq!(bits(&part), bits(&whole[rows.clone()]));
+                }
+            }
+        }
     }
 }
