@@ -177,15 +177,24 @@ impl<'a> TlInputs<'a> {
     /// extra channels finite, and the flux not exactly zero (a dropped-out
     /// fluxgate).
     pub fn usable(&self) -> Vec<bool> {
-        (0..self.time.len())
+        // Column by column with `&` (no early exit), so each pass vectorises.
+        let [x, y, z] = self.flux;
+        let mut ok: Vec<bool> = (0..self.time.len())
             .map(|i| {
-                self.time[i].is_finite()
-                    && self.mag[i].is_finite()
-                    && self.flux.iter().all(|f| f[i].is_finite())
-                    && self.channels.iter().all(|c| c[i].is_finite())
-                    && (self.flux[0][i] != 0.0 || self.flux[1][i] != 0.0 || self.flux[2][i] != 0.0)
+                let finite = self.time[i].is_finite()
+                    & self.mag[i].is_finite()
+                    & x[i].is_finite()
+                    & y[i].is_finite()
+                    & z[i].is_finite();
+                finite & ((x[i] != 0.0) | (y[i] != 0.0) | (z[i] != 0.0))
             })
-            .collect()
+            .collect();
+        for c in &self.channels {
+            for (o, v) in ok.iter_mut().zip(c.iter()) {
+                *o &= v.is_finite();
+            }
+        }
+        ok
     }
 
     /// The segments of usable rows under `rule`.

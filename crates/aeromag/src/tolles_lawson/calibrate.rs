@@ -455,8 +455,9 @@ fn with_ls_segments<T>(
         TlInputs::of_sensor(flight, &opts.sensor)?.with_extras(flight, ls.design.terms.extras())?;
     let (ref_cols, y) = reduced_mag(flight, &cols, opts, reference_nt)?;
     let cols = cols.with_mag(&y);
-    let segs = cols.segments(&fit_rule(opts));
-    let left_out = cols.usable().iter().filter(|u| !**u).count();
+    let usable = cols.usable();
+    let segs = fit_rule(opts).split(cols.time, cols.line, &usable);
+    let left_out = usable.iter().filter(|u| !**u).count();
     if left_out > 0 {
         notes.warn(format!(
             "{} of {} rows have missing values and are not used by the fit",
