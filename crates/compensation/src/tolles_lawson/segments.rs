@@ -67,7 +67,7 @@ pub fn split_at_steps(
 /// Median of the positive finite time steps, s (0 if there are none): the
 /// step of rank `⌊N/2⌋` (from 0) among the `N` such steps.
 ///
-/// A long record is not copied whole: the quantiles 0.45 and 0.55 of every
+/// A long record is not copied whole: the quantiles 0.48 and 0.52 of every
 /// `k`-th step bracket the median, one pass counts the steps below the
 /// bracket and on its ends and keeps those strictly inside it, and the
 /// median is selected among those (exact: when the bracket misses it, every
@@ -80,7 +80,7 @@ pub fn median_step(time: &[f64]) -> f64 {
             .filter(|v| *v > 0.0 && v.is_finite())
     };
     let nth = |mut d: Vec<f64>, m: usize| *d.select_nth_unstable_by(m, f64::total_cmp).1;
-    const SAMPLE: usize = 4096;
+    const SAMPLE: usize = 16_384;
     if time.len() > 16 * SAMPLE {
         // Every `every`-th step by index (a filtered iterator's `step_by`
         // would still test every step).
@@ -92,7 +92,7 @@ pub fn median_step(time: &[f64]) -> f64 {
             .collect();
         if sample.len() >= 16 {
             let q = |p: f64| nth(sample.clone(), (p * (sample.len() - 1) as f64) as usize);
-            let (lo, hi) = (q(0.45), q(0.55));
+            let (lo, hi) = (q(0.48), q(0.52));
             // Steps below the bracket are counted, steps on its ends too
             // (time stamps on a fixed clock give few distinct steps, often
             // the ends themselves), and only those strictly inside are kept.
@@ -150,7 +150,7 @@ mod tests {
             let m = d.len() / 2;
             *d.select_nth_unstable_by(m, f64::total_cmp).1
         };
-        let n = 200_000;
+        let n = 400_000; // above the sampled path's threshold
         let decimal: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
         let mut state = 7u64;
         let mut jittered = Vec::with_capacity(n);
