@@ -104,11 +104,23 @@ impl Compensated {
     /// `mag − interference` of `flight`.
     pub fn new(flight: &Flight, output: OutputColumns, interference_nt: Vec<f64>) -> Result<Self> {
         let mag = flight.require("mag")?;
-        let compensated_nt = mag
-            .iter()
-            .zip(&interference_nt)
-            .map(|(m, i)| m - i)
-            .collect();
+        let mut compensated_nt = vec![0.0; mag.len().min(interference_nt.len())];
+        let threads = aeromag_core::parallel::threads();
+        aeromag_core::parallel::for_each_part_mut(
+            &mut compensated_nt,
+            threads,
+            1 << 16,
+            |a, part| {
+                let n = part.len();
+                for ((c, m), i) in part
+                    .iter_mut()
+                    .zip(&mag[a..a + n])
+                    .zip(&interference_nt[a..a + n])
+                {
+                    *c = m - i;
+                }
+            },
+        );
         let missing = interference_nt.iter().filter(|v| !v.is_finite()).count();
         Ok(Self {
             output,

@@ -34,6 +34,33 @@ pub fn parallel_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + 
     })
 }
 
+/// `f(start, part)` for contiguous parts of `out`, one per thread on up to
+/// `threads` threads (≥ 1): `part` is `out[start..start + part.len()]`,
+/// and every part but the last is a multiple of `align` items long (so
+/// that fixed-size blocks inside the parts fall where they would in one
+/// pass). One part on the calling thread when `out` is shorter than two
+/// `align`s or `threads` is 1.
+pub fn for_each_part_mut<T: Send>(
+    out: &mut [T],
+    threads: usize,
+    align: usize,
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    let align = align.max(1);
+    let n = out.len();
+    if threads <= 1 || n < 2 * align {
+        f(0, out);
+        return;
+    }
+    let per = n.div_ceil(threads).div_ceil(align) * align;
+    let f = &f;
+    std::thread::scope(|scope| {
+        for (t, part) in out.chunks_mut(per).enumerate() {
+            scope.spawn(move || f(t * per, part));
+        }
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -48,5 +75,28 @@ mod tests {
         }
         assert!(parallel_map(0, 4, f).is_empty());
         assert_eq!(parallel_map(1, 0, f), vec![0.0]);
+    }
+
+    #[test]
+    fn parts_cover_every_item_once_at_aligned_starts() {
+        for (n, threads, align) in [
+            (1000, 3, 64),
+            (10, 4, 64),
+            (4096, 2, 1),
+            (0, 2, 8),
+            (130, 8, 16),
+        ] {
+            let mut out = vec![usize::MAX; n];
+            for_each_part_mut(&mut out, threads, align, |start, part| {
+                assert!(start % align == 0);
+                for (k, v) in part.iter_mut().enumerate() {
+                    *v = start + k;
+                }
+            });
+            assert!(
+                out.iter().enumerate().all(|(i, v)| *v == i),
+                "{n} {threads} {align}"
+            );
+        }
     }
 }

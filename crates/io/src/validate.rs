@@ -154,7 +154,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     let ctx = Ctx { table };
     for name in ["mag", "igrf"] {
         if let Some(v) = table.column(name) {
-            ctx.total_field(name, v.iter().map(|x| x.abs()), &mut warnings)?;
+            ctx.total_field(name, median(v.len(), |i| v[i].abs()), &mut warnings)?;
         }
     }
     let flux: Vec<&[f64]> = ["flux_x", "flux_y", "flux_z"]
@@ -170,11 +170,11 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
         let norm = |i: usize| (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt();
         ctx.total_field(
             "flux_x/flux_y/flux_z",
-            (0..table.n_rows()).map(norm),
+            median(table.n_rows(), norm),
             &mut warnings,
         )?;
         if let Some(mag) = table.column("mag")
-            && let Some(d) = median((0..table.n_rows()).map(|i| (norm(i) - mag[i]) / mag[i]))
+            && let Some(d) = median(table.n_rows(), |i| (norm(i) - mag[i]) / mag[i])
             && d.abs() > VECTOR_SCALAR_TOLERANCE
         {
             let names = |c: &str| table.resolve(c).unwrap_or(c).to_string();
@@ -197,7 +197,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     ctx.position(&mut warnings)?;
     ctx.attitude(&mut warnings)?;
     if let Some(alt) = table.column("alt")
-        && let Some(m) = median(alt.iter().copied())
+        && let Some(m) = median(alt.len(), |i| alt[i])
         && m > 20_000.0
     {
         warnings.push(ctx.warn(
@@ -252,13 +252,8 @@ impl Ctx<'_> {
     }
 
     /// A total-field magnitude (nT): errors for tesla/gauss/pT-like medians, warning outside Earth's range.
-    fn total_field(
-        &self,
-        name: &str,
-        abs: impl ExactSizeIterator<Item = f64>,
-        w: &mut Vec<Warning>,
-    ) -> Result<()> {
-        let Some(m) = median(abs) else { return Ok(()) };
+    fn total_field(&self, name: &str, median_abs: Option<f64>, w: &mut Vec<Warning>) -> Result<()> {
+        let Some(m) = median_abs else { return Ok(()) };
         let fix = "expected nT";
         if m < 1.0 {
             let guess = if (1e-6..1e-3).contains(&m) {
@@ -292,20 +287,16 @@ impl Ctx<'_> {
 
     /// One field component (nT), which may be small: tested by its maximum.
     fn component(&self, name: &str, v: &[f64]) -> Result<()> {
-        let max = v
-            .iter()
-            .filter(|x| x.is_finite())
-            .fold(None, |m: Option<f64>, x| {
-                Some(m.map_or(x.abs(), |m| m.max(x.abs())))
-            });
-        let Some(max) = max else { return Ok(()) };
+        let Some(max) = max_abs(v) else {
+            return Ok(());
+        };
         if max > 0.0 && max < 1e-3 {
             return Err(self.units(
                 name,
                 format!("all values are below 1e-3 in magnitude (max |value| = {max:e}): looks like tesla, expected nT (multiply by 1e9)"),
             ));
         }
-        if let Some(m) = median(v.iter().map(|x| x.abs()))
+        if let Some(m) = median(v.len(), |i| v[i].abs())
             && m > 1e6
         {
             return Err(self.units(
@@ -433,18 +424,27 @@ fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {
 }
 
 fn max_abs(v: &[f64]) -> Option<f64> {
-    v.iter()
-        .filter(|x| x.is_finite())
-        .map(|x| x.abs())
-        .fold(None, |m, x| Some(m.map_or(x, |m: f64| m.max(x))))
+    // Branch-free in blocks, so the pass over a long column vectorises.
+    let (max, any) = v.chunks(256).fold((0.0f64, false), |(m, any), c| {
+        c.iter().fold((m, any), |(m, any), x| {
+            let finite = x.is_finite();
+            (if finite { m.max(x.abs()) } else { m }, any | finite)
+        })
+    });
+    any.then_some(max)
 }
 
 /// Median of the finite values among at most [`MEDIAN_SAMPLES`] evenly
-/// strided samples of `values`; `None` when there is none.
-pub(crate) fn median(values: impl ExactSizeIterator<Item = f64>) -> Option<f64> {
-    // Only the samples are kept (a 10⁷-row column is not copied whole).
-    let stride = values.len().div_ceil(MEDIAN_SAMPLES).max(1);
-    let mut v: Vec<f64> = values.step_by(stride).filter(|x| x.is_finite()).collect();
+/// strided samples `value(0), value(s), value(2s), …` of `n` rows; `None`
+/// when there is none. Only the sampled rows are evaluated (a 10⁷-row
+/// column is neither copied nor passed over whole).
+pub(crate) fn median(n: usize, value: impl Fn(usize) -> f64) -> Option<f64> {
+    let stride = n.div_ceil(MEDIAN_SAMPLES).max(1);
+    let mut v: Vec<f64> = (0..n)
+        .step_by(stride)
+        .map(value)
+        .filter(|x| x.is_finite())
+        .collect();
     median_in_place(&mut v)
 }
 
@@ -471,10 +471,7 @@ mod tests {
         assert_eq!(median_in_place(&mut [3.0, 1.0, 2.0]), Some(2.0));
         assert_eq!(median_in_place(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.5));
         assert_eq!(median_in_place(&mut []), None);
-        assert_eq!(
-            median([f64::NAN, 5.0, f64::INFINITY].into_iter()),
-            Some(5.0)
-        );
+        assert_eq!(median(3, |i| [f64::NAN, 5.0, f64::INFINITY][i]), Some(5.0));
     }
 
     #[test]

@@ -41,13 +41,19 @@ pub(super) fn tl_interference(
     flight: &Flight,
     sensor: &SensorColumns,
 ) -> Result<Vec<f64>> {
-    let mut out = vec![f64::NAN; flight.n_rows()];
+    // Zeroed (fresh pages, written first by the projection's threads),
+    // NaN between the segments.
+    let mut out = vec![0.0; flight.n_rows()];
     let coef = model.coef();
+    let mut next = 0;
     for_model_segments(model, flight, sensor, |r, s| {
+        out[next..r.start].fill(f64::NAN);
+        next = r.end;
         model
             .design
             .interference_with_into(&coef, s.time, s.flux, s.channels, &mut out[r]);
     })?;
+    out[next..].fill(f64::NAN);
     Ok(out)
 }
 

@@ -389,16 +389,10 @@ impl Design {
                 }
             }
         };
-        if lagged || threads == 1 || n < 4 * PROJECTION_BLOCK {
+        if lagged || n < 4 * PROJECTION_BLOCK {
             project(0, out);
         } else {
-            let per = n.div_ceil(threads).div_ceil(PROJECTION_BLOCK) * PROJECTION_BLOCK;
-            std::thread::scope(|scope| {
-                for (t, part) in out.chunks_mut(per).enumerate() {
-                    let project = &project;
-                    scope.spawn(move || project(t * per, part));
-                }
-            });
+            aeromag_core::parallel::for_each_part_mut(out, threads, PROJECTION_BLOCK, project);
         }
     }
 
