@@ -362,28 +362,58 @@ impl BlockProducts {
         }
         // Rows in runs that stay in cache while all n(n+1)/2 products
         // are formed (instead of streaming every pair of columns from
-        // memory), four columns at a time against each column.
+        // memory), four columns at a time against each column; the
+        // products left over (against `y`, the last < 4 of each row of the
+        // triangle, `y·y`) go four at a time through the same kernel.
         let per = Self::per_run(n);
-        let mut sums = Vec::with_capacity(m.div_ceil(ROW_BLOCK) * per);
-        let mut start = 0;
-        while start < m {
-            let end = (start + ROW_BLOCK).min(m);
-            let block: Vec<&[f64]> = columns.iter().map(|c| &c[start..end]).collect();
-            let yb = &y[start..end];
-            sums.extend(block.iter().map(|c| dot(c, yb)));
-            for i in 0..n {
-                let mut j = i;
-                while j + 4 <= n {
-                    sums.extend(aeromag_core::simd::run(Dot4 {
-                        a: block[i],
-                        b: [block[j], block[j + 1], block[j + 2], block[j + 3]],
-                    }));
-                    j += 4;
-                }
-                sums.extend((j..n).map(|j| dot(block[i], block[j])));
+        let mut grouped = Vec::new();
+        let mut leftover = Vec::new();
+        for i in 0..n {
+            leftover.push((i, i, n));
+        }
+        let mut pos = n;
+        for i in 0..n {
+            let mut j = i;
+            while j + 4 <= n {
+                grouped.push((pos, i, j));
+                pos += 4;
+                j += 4;
             }
-            sums.push(dot(yb, yb));
-            start = end;
+            for j in j..n {
+                leftover.push((pos, i, j));
+                pos += 1;
+            }
+        }
+        leftover.push((pos, n, n));
+        let mut sums = vec![0.0; m.div_ceil(ROW_BLOCK) * per];
+        for (run, out) in sums.chunks_exact_mut(per).enumerate() {
+            let (start, end) = (run * ROW_BLOCK, ((run + 1) * ROW_BLOCK).min(m));
+            // Column `n` is `y`.
+            let block: Vec<&[f64]> = columns
+                .iter()
+                .map(|c| &c[start..end])
+                .chain(std::iter::once(&y[start..end]))
+                .collect();
+            for &(pos, i, j) in &grouped {
+                let b = [block[j], block[j + 1], block[j + 2], block[j + 3]];
+                out[pos..pos + 4].copy_from_slice(&aeromag_core::simd::run(Dot4::<true> {
+                    a: [block[i]; 4],
+                    b,
+                }));
+            }
+            let mut quads = leftover.chunks_exact(4);
+            for q in quads.by_ref() {
+                let v = aeromag_core::simd::run(Dot4::<false> {
+                    a: std::array::from_fn(|t| block[q[t].1]),
+                    b: std::array::from_fn(|t| block[q[t].2]),
+                });
+                for (t, &(pos, _, _)) in q.iter().enumerate() {
+                    out[pos] = v[t];
+                }
+            }
+            for &(pos, i, j) in quads.remainder() {
+                out[pos] = dot(block[i], block[j]);
+            }
         }
         Ok(BlockProducts { n, rows: m, sums })
     }
@@ -398,34 +428,39 @@ impl BlockProducts {
 /// 512 rows take 80 kB, which stays in a core's L2 cache.
 const ROW_BLOCK: usize = 512;
 
-/// Four dot products `a·b[t]` at once, each summed exactly as [`dot`] sums
-/// (four accumulators, pairwise at the end, then the tail), so the result
-/// does not depend on how the columns are grouped.
-struct Dot4<'a> {
-    a: &'a [f64],
+/// Four dot products `a[t]·b[t]` at once, each summed exactly as [`dot`]
+/// sums (four accumulators, pairwise at the end, then the tail), so the
+/// result does not depend on how the products are grouped. `SHARED`: one
+/// `a` for all four (`a[0]`), loaded once per row.
+struct Dot4<'a, const SHARED: bool> {
+    a: [&'a [f64]; 4],
     b: [&'a [f64]; 4],
 }
 
-impl aeromag_core::simd::Kernel for Dot4<'_> {
+impl<const SHARED: bool> aeromag_core::simd::Kernel for Dot4<'_, SHARED> {
     type Output = [f64; 4];
     #[inline(always)]
     fn run(self) -> [f64; 4] {
-        let m = self.a.len();
+        let m = self.a[0].len();
+        let a = if SHARED { [self.a[0]; 4] } else { self.a };
+        let a = a.map(|a| &a[..m]);
         let b = self.b.map(|b| &b[..m]);
         let (mut s0, mut s1, mut s2, mut s3) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
-        let rows = self
-            .a
+        let rows = a[0]
             .chunks_exact(4)
+            .zip(a[1].chunks_exact(4))
+            .zip(a[2].chunks_exact(4))
+            .zip(a[3].chunks_exact(4))
             .zip(b[0].chunks_exact(4))
             .zip(b[1].chunks_exact(4))
             .zip(b[2].chunks_exact(4))
             .zip(b[3].chunks_exact(4));
-        for ((((a, b0), b1), b2), b3) in rows {
+        for (((((((a0, a1), a2), a3), b0), b1), b2), b3) in rows {
             for l in 0..4 {
-                s0[l] += a[l] * b0[l];
-                s1[l] += a[l] * b1[l];
-                s2[l] += a[l] * b2[l];
-                s3[l] += a[l] * b3[l];
+                s0[l] += a0[l] * b0[l];
+                s1[l] += a1[l] * b1[l];
+                s2[l] += a2[l] * b2[l];
+                s3[l] += a3[l] * b3[l];
             }
         }
         let tail = 4 * (m / 4);
@@ -433,7 +468,7 @@ impl aeromag_core::simd::Kernel for Dot4<'_> {
         std::array::from_fn(|t| {
             let s = sums[t];
             let mut v = (s[0] + s[1]) + (s[2] + s[3]);
-            for (x, y) in self.a[tail..].iter().zip(&b[t][tail..]) {
+            for (x, y) in a[t][tail..].iter().zip(&b[t][tail..]) {
                 v += x * y;
             }
             v
