@@ -95,3 +95,44 @@ fn the_file_chain_locates_the_bird_within_the_issue_figures() {
         }
     }
 }
+
+/// A record whose samples start at a multiple of 4 bytes is read in place
+/// from a memory map, any other through the streaming reader: the same
+/// epochs, and the same error naming frame, channel and byte offset for a
+/// bad sample, whatever the header's length.
+#[test]
+fn records_are_detected_alike_in_place_and_streamed() {
+    let d = tempfile::tempdir().unwrap();
+    let files = simulate_to_dir(&command_default(), 8, d.path()).unwrap();
+    let bytes = std::fs::read(&files.raw).unwrap();
+    let len = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    assert_eq!((12 + len) % 4, 0, "the writer aligns the samples");
+    let mut seen: Option<String> = None;
+    for pad in 0..4 {
+        // The same record with `pad` more spaces after the JSON header.
+        let mut b = bytes[..8].to_vec();
+        b.extend(((len + pad) as u32).to_le_bytes());
+        b.extend(&bytes[12..12 + len]);
+        b.extend(std::iter::repeat_n(b' ', pad));
+        let body = b.len();
+        b.extend(&bytes[12 + len..]);
+        let p = d.path().join(format!("pad{pad}.raw"));
+        std::fs::write(&p, &b).unwrap();
+        let det = detect(&p, &DetectOptions::default(), &mut Silent).unwrap();
+        let text = format!("{:?}", det.epochs);
+        match &seen {
+            None => seen = Some(text),
+            Some(first) => assert!(*first == text, "pad {pad}: other epochs"),
+        }
+        let k = body + 4 * (3 * 500 + 2);
+        b[k..k + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+        std::fs::write(&p, &b).unwrap();
+        let e = detect(&p, &DetectOptions::default(), &mut Silent).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("frame 500 channel 2 (byte offset {k}) is NaN")),
+            "pad {pad}: {msg}"
+        );
+    }
+}

@@ -1,6 +1,6 @@
 //! Synchronous detection of a raw EM record, streamed in chunks.
 
-use super::files::{next_chunk, open_raw};
+use super::files::RawSource;
 use crate::error::{Error, InFile, Result};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_core::filter::Window;
@@ -79,8 +79,8 @@ pub struct Detection {
 pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) -> Result<Detection> {
     let mut notes = Notes::new(observer);
     let file = path.display().to_string();
-    let mut reader = open_raw(path)?;
-    let header = reader.header().clone();
+    let source = RawSource::open(path)?;
+    let header = source.header().clone();
     let system = opts.system.clone().unwrap_or(header.system.clone());
     let fs = header.sample_rate_hz;
     let n = opts.window_len;
@@ -109,18 +109,14 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         .chain(fs, n, opts.window, opts.pilot)
         .in_file(&file)?;
     notes.stage("detecting");
-    // Whole detector blocks of about 2¹⁸ frames (3 MB) per chunk: the
-    // default 10.24 s record is read in four.
+    // Streamed: whole detector blocks of about 2¹⁸ frames (3 MB) per
+    // chunk, the default 10.24 s record in four. Mapped: in one piece.
     let chunk = n * (1usize << 18).div_ceil(n);
-    let mut samples = Vec::new();
     let mut epochs = Vec::new();
-    loop {
-        let (first, got) = next_chunk(&mut reader, path, chunk, &mut samples)?;
-        if got == 0 {
-            break;
-        }
-        epochs.extend(chain.process(&samples, first)?);
-    }
+    source.for_each_chunk(path, chunk, |first, samples| {
+        epochs.extend(chain.process(samples, first)?);
+        Ok(())
+    })?;
     let ratios: Vec<f64> = epochs
         .iter()
         .flat_map(|e| e.h.iter().map(|h| major_axis(h).ratio))

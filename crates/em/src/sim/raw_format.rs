@@ -7,6 +7,10 @@
 //! bytes 12..12+L JSON RawHeader (UTF-8)
 //! then           frames × channels f32 LE, interleaved: sample n, channel c at index n·channels + c
 //! ```
+//!
+//! [`write_raw`] pads the JSON with spaces so that the samples start at a
+//! multiple of 4 bytes (readers accept any `L`; an aligned body can be read
+//! in place from a memory map).
 
 use crate::detection::EmSystem;
 use crate::{EmError, Result};
@@ -69,9 +73,12 @@ pub fn write_raw<W: Write>(mut w: W, header: &RawHeader, samples: &[f32]) -> Res
             reason: format!("{} samples, header says {expected}", samples.len()),
         });
     }
-    let json = serde_json::to_vec(header).map_err(|e| EmError::InvalidData {
+    let mut json = serde_json::to_vec(header).map_err(|e| EmError::InvalidData {
         reason: e.to_string(),
     })?;
+    // Spaces after the JSON (valid JSON whitespace) so that the samples
+    // start at a multiple of 4 bytes and can be read in place.
+    json.resize(json.len() + (4 - (12 + json.len()) % 4) % 4, b' ');
     let len = u32::try_from(json.len()).map_err(|_| EmError::InvalidData {
         reason: "header too long".into(),
     })?;

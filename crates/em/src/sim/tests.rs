@@ -46,10 +46,16 @@ fn raw_format_round_trip_and_determinism() {
     );
     let mut bytes = Vec::new();
     write_raw(&mut bytes, &a.header, &a.samples).unwrap();
+    // The JSON header, padded with at most 3 spaces so that the samples
+    // start at a multiple of 4 bytes.
+    let json = serde_json::to_vec(&a.header).unwrap().len();
+    let body = (12 + json).next_multiple_of(4);
+    assert_eq!(bytes.len(), body + a.samples.len() * 4);
     assert_eq!(
-        bytes.len(),
-        12 + serde_json::to_vec(&a.header).unwrap().len() + a.samples.len() * 4
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,
+        body - 12
     );
+    assert!(bytes[12 + json..body].iter().all(|&b| b == b' '));
     let (h, s) = read_raw(&bytes).unwrap();
     // serde_json's default float parsing may differ in the last ulp of the
     // drawn matrices; the short-decimal constants are exact.
