@@ -305,7 +305,11 @@ impl Design {
         let axis = |a: usize| -> [&[f64]; 3] {
             std::array::from_fn(|i| if i == a { &one[..] } else { &zero[..] })
         };
-        let d = [0, 1, 2].map(|a| self.projected(&c, time, flux, channels, Some(axis(a))));
+        let d = [0, 1, 2].map(|a| {
+            let mut v = vec![0.0; n];
+            self.projected_into(&c, time, flux, channels, Some(axis(a)), &mut v);
+            v
+        });
         (d, b)
     }
 
@@ -325,27 +329,14 @@ impl Design {
             .collect()
     }
 
-    /// `A c` with the direction cosines of `dir` (default: of `flux`), in
-    /// blocks of [`PROJECTION_BLOCK`] rows. Without lagged columns the
-    /// blocks are independent and are shared out over the available cores
-    /// (each row's sum is the same bits whatever the thread count); lagged
-    /// columns carry their state from block to block, one thread.
-    fn projected(
-        &self,
-        coef: &[f64],
-        time: &[f64],
-        flux: [&[f64]; 3],
-        channels: Channels,
-        dir: Option<[&[f64]; 3]>,
-    ) -> Vec<f64> {
-        let mut out = vec![0.0; time.len()];
-        self.projected_into(coef, time, flux, channels, dir, &mut out);
-        out
-    }
-
-    /// [`Design::projected`] into `out` (of the segment's length). The
-    /// derivatives are formed block by block too, so the memory beyond
-    /// `out` is a few blocks whatever the segment's length.
+    /// `A c` with the direction cosines of `dir` (default: of `flux`) into
+    /// `out` (of the segment's length), in blocks of [`PROJECTION_BLOCK`]
+    /// rows; the derivatives are formed block by block too, so the memory
+    /// beyond `out` is a few blocks whatever the segment's length. Without
+    /// lagged columns the blocks are independent and are shared out over
+    /// the available cores (each row's sum is the same bits whatever the
+    /// thread count); lagged columns carry their state from block to block,
+    /// one thread.
     fn projected_into(
         &self,
         coef: &[f64],
@@ -486,7 +477,7 @@ impl Design {
     }
 }
 
-/// Rows per block of [`Design::projected`].
+/// Rows per block of [`Design::projected_into`].
 const PROJECTION_BLOCK: usize = 4096;
 
 fn norm(v: [f64; 3]) -> f64 {

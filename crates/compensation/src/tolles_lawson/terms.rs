@@ -787,22 +787,12 @@ impl aeromag_core::simd::Kernel for DesignColumns<'_, '_> {
 
     #[inline(always)]
     fn run(self) {
-        let Self {
-            kinds,
-            dir,
-            b,
-            db,
-            lagged,
-            extra,
-            bt_scale,
-            e,
-            out,
-        } = self;
+        let (b, bt_scale) = (self.b, self.bt_scale);
         let n = b[0].len();
         // e[0] holds |B| until e[1] and e[2] are divided by it, then
         // becomes B_x/|B| in place (no fourth buffer).
-        let [e0, e1, e2] = e;
-        let (dx, dy, dz) = (&dir[0][..n], &dir[1][..n], &dir[2][..n]);
+        let [e0, e1, e2] = self.e;
+        let (dx, dy, dz) = (&self.dir[0][..n], &self.dir[1][..n], &self.dir[2][..n]);
         e0.resize(n, 0.0);
         for (k, t) in e0.iter_mut().enumerate() {
             *t = magnitude([dx[k], dy[k], dz[k]]);
@@ -817,15 +807,15 @@ impl aeromag_core::simd::Kernel for DesignColumns<'_, '_> {
             *v = x / *v;
         }
         let e = [&e0[..n], &e1[..n], &e2[..n]];
-        for (col, &c) in out.iter_mut().zip(kinds) {
+        for (col, &c) in self.out.iter_mut().zip(self.kinds) {
             col.resize(n, 0.0);
             match c {
                 Column::Direction(i) => col.copy_from_slice(e[i]),
                 Column::Product { i, source, j } => {
                     let s = match source {
                         Source::Field => b[j],
-                        Source::Derivative => db[j],
-                        Source::Lagged(l) => match lagged.get(l) {
+                        Source::Derivative => self.db[j],
+                        Source::Lagged(l) => match self.lagged.get(l) {
                             Some(g) => g[j],
                             None => {
                                 col.fill(f64::NAN);
@@ -839,7 +829,8 @@ impl aeromag_core::simd::Kernel for DesignColumns<'_, '_> {
                 }
                 Column::Bias => col.fill(1.0),
                 Column::Extra { i, k, lagged } => {
-                    let x = extra
+                    let x = self
+                        .extra
                         .get(k)
                         .map(|x| if lagged { x.lagged } else { x.values });
                     match x {
