@@ -46,17 +46,38 @@ pub fn for_each_part_mut<T: Send>(
     align: usize,
     f: impl Fn(usize, &mut [T]) + Sync,
 ) {
+    for_each_rows_mut(&mut [out], threads, align, |start, parts| {
+        f(start, &mut *parts[0])
+    });
+}
+
+/// [`for_each_part_mut`] over several slices of equal length at once:
+/// `f(start, parts)` gets rows `start..start + len` of every slice of
+/// `outs`, in order.
+pub fn for_each_rows_mut<T: Send>(
+    outs: &mut [&mut [T]],
+    threads: usize,
+    align: usize,
+    f: impl Fn(usize, &mut [&mut [T]]) + Sync,
+) {
     let align = align.max(1);
-    let n = out.len();
+    let n = outs.first().map_or(0, |o| o.len());
+    debug_assert!(outs.iter().all(|o| o.len() == n));
     if threads <= 1 || n < 2 * align {
-        f(0, out);
+        f(0, outs);
         return;
     }
     let per = n.div_ceil(threads).div_ceil(align) * align;
+    let mut split: Vec<Vec<&mut [T]>> = (0..n.div_ceil(per)).map(|_| Vec::new()).collect();
+    for out in outs.iter_mut() {
+        for (t, part) in out.chunks_mut(per).enumerate() {
+            split[t].push(part);
+        }
+    }
     let f = &f;
     std::thread::scope(|scope| {
-        for (t, part) in out.chunks_mut(per).enumerate() {
-            scope.spawn(move || f(t * per, part));
+        for (t, mut parts) in split.into_iter().enumerate() {
+            scope.spawn(move || f(t * per, &mut parts));
         }
     });
 }

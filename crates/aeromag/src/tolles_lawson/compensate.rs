@@ -41,20 +41,40 @@ pub(super) fn tl_interference(
     flight: &Flight,
     sensor: &SensorColumns,
 ) -> Result<Vec<f64>> {
+    let [out] = tl_interferences(model, [&model.coef()[..]], flight, sensor)?;
+    Ok(out)
+}
+
+/// [`tl_interference`] of `model`'s design under each coefficient vector
+/// of `coefs` at once (the design built once per block under the
+/// first-order magnitude); each the bits of its own call.
+fn tl_interferences<const K: usize>(
+    model: &TlModel,
+    coefs: [&[f64]; K],
+    flight: &Flight,
+    sensor: &SensorColumns,
+) -> Result<[Vec<f64>; K]> {
     // Zeroed (fresh pages, written first by the projection's threads),
     // NaN between the segments.
-    let mut out = vec![0.0; flight.n_rows()];
-    let coef = model.coef();
+    let mut outs: [Vec<f64>; K] = std::array::from_fn(|_| vec![0.0; flight.n_rows()]);
     let mut next = 0;
     for_model_segments(model, flight, sensor, |r, s| {
-        out[next..r.start].fill(f64::NAN);
+        let mut parts: Vec<&mut [f64]> = outs
+            .iter_mut()
+            .map(|o| {
+                o[next..r.start].fill(f64::NAN);
+                &mut o[r.clone()]
+            })
+            .collect();
         next = r.end;
         model
             .design
-            .interference_with_into(&coef, s.time, s.flux, s.channels, &mut out[r]);
+            .interferences_into(&coefs, s.time, s.flux, s.channels, &mut parts);
     })?;
-    out[next..].fill(f64::NAN);
-    Ok(out)
+    for o in &mut outs {
+        o[next..].fill(f64::NAN);
+    }
+    Ok(outs)
 }
 
 /// Call `f` with every stretch of `flight` that `model` applies to at the
@@ -149,20 +169,27 @@ pub struct InterferenceParts {
 impl InterferenceParts {
     /// The parts of `model` at the sensor `sensor` of `flight`.
     pub fn of(model: &TlModel, flight: &Flight, sensor: &SensorColumns) -> Result<Self> {
-        let part = |keep: &dyn Fn(&str) -> bool| {
-            let mut m = model.clone();
-            for c in &mut m.coefficients {
-                if !keep(&c.name) {
-                    c.value = 0.0;
-                }
-            }
-            tl_interference(&m, flight, sensor)
+        // The coefficients of one part, the others' set to zero.
+        let part = |keep: &dyn Fn(&str) -> bool| -> Vec<f64> {
+            model
+                .coefficients
+                .iter()
+                .map(|c| if keep(&c.name) { c.value } else { 0.0 })
+                .collect()
         };
+        let coefs = [
+            part(&|n| n.starts_with("p_")),
+            part(&|n| n.starts_with("i_")),
+            part(&|n| n.starts_with("e_") || n.starts_with('l')),
+            part(&|n| n.contains(':')),
+        ];
+        let [permanent, induced, eddy, currents] =
+            tl_interferences(model, coefs.each_ref().map(|c| &c[..]), flight, sensor)?;
         Ok(Self {
-            permanent: part(&|n| n.starts_with("p_"))?,
-            induced: part(&|n| n.starts_with("i_"))?,
-            eddy: part(&|n| n.starts_with("e_") || n.starts_with('l'))?,
-            currents: part(&|n| n.contains(':'))?,
+            permanent,
+            induced,
+            eddy,
+            currents,
         })
     }
 }

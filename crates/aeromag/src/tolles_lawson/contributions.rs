@@ -104,13 +104,15 @@ impl Contributions {
         let rms = |f: &dyn Fn(usize) -> f64| {
             let (mut ss, mut n) = (0.0, 0usize);
             for r in runs {
-                let v: Vec<f64> = r.clone().map(f).filter(|x| x.is_finite()).collect();
-                if v.is_empty() {
+                // Two passes over the run's finite values (no copy).
+                let v = || r.clone().map(f).filter(|x| x.is_finite());
+                let count = v().count();
+                if count == 0 {
                     continue;
                 }
-                let m = v.iter().sum::<f64>() / v.len() as f64;
-                ss += v.iter().map(|x| (x - m).powi(2)).sum::<f64>();
-                n += v.len();
+                let m = v().sum::<f64>() / count as f64;
+                ss += v().map(|x| (x - m).powi(2)).sum::<f64>();
+                n += count;
             }
             if n == 0 {
                 f64::NAN

@@ -260,6 +260,28 @@ impl Design {
         out
     }
 
+    /// [`Design::interference_with_into`] for several coefficient vectors
+    /// at once: `outs[k]` is the interference under `coefs[k]`, the bits of
+    /// its own call. Under the first-order magnitude the design is built
+    /// once for all of them.
+    pub fn interferences_into(
+        &self,
+        coefs: &[&[f64]],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        outs: &mut [&mut [f64]],
+    ) {
+        match self.magnitude {
+            Magnitude::FirstOrder => self.projections_into(coefs, time, flux, channels, None, outs),
+            Magnitude::Exact => {
+                for (coef, out) in coefs.iter().zip(outs.iter_mut()) {
+                    self.interference_with_into(coef, time, flux, channels, out);
+                }
+            }
+        }
+    }
+
     /// [`Design::interference_with`] into `out` (of the segment's length),
     /// without a buffer of its own under the first-order magnitude.
     pub fn interference_with_into(
@@ -330,13 +352,8 @@ impl Design {
     }
 
     /// `A c` with the direction cosines of `dir` (default: of `flux`) into
-    /// `out` (of the segment's length), in blocks of [`PROJECTION_BLOCK`]
-    /// rows; the derivatives are formed block by block too, so the memory
-    /// beyond `out` is a few blocks whatever the segment's length. Without
-    /// lagged columns the blocks are independent and are shared out over
-    /// the available cores (each row's sum is the same bits whatever the
-    /// thread count); lagged columns carry their state from block to block,
-    /// one thread.
+    /// `out` (of the segment's length): [`Design::projections_into`] with
+    /// one coefficient vector.
     fn projected_into(
         &self,
         coef: &[f64],
@@ -346,18 +363,42 @@ impl Design {
         dir: Option<[&[f64]; 3]>,
         out: &mut [f64],
     ) {
+        self.projections_into(&[coef], time, flux, channels, dir, &mut [out]);
+    }
+
+    /// `A c_k` for each coefficient vector `coefs[k]` into `outs[k]` (each
+    /// of the segment's length), with the direction cosines of `dir`
+    /// (default: of `flux`): the design is built once per block of
+    /// [`PROJECTION_BLOCK`] rows for all of them, the derivatives block by
+    /// block too, so the memory beyond the outputs is a few blocks whatever
+    /// the segment's length. Each output is the bits of its own single
+    /// projection. Without lagged columns the blocks are independent and
+    /// are shared out over the available cores (each row's sum is the same
+    /// bits whatever the thread count); lagged columns carry their state
+    /// from block to block, one thread.
+    fn projections_into(
+        &self,
+        coefs: &[&[f64]],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        dir: Option<[&[f64]; 3]>,
+        outs: &mut [&mut [f64]],
+    ) {
         let n = time.len();
-        debug_assert_eq!(out.len(), n);
+        debug_assert!(outs.iter().all(|o| o.len() == n) && outs.len() == coefs.len());
         let lagged =
             !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some();
         let threads = aeromag_core::parallel::threads();
-        let project = |start: usize, part: &mut [f64]| {
+        // Rows `start..start + len` into `parts` (the outputs' rows there).
+        let project = |start: usize, parts: &mut [&mut [f64]]| {
+            let len = parts.first().map_or(0, |p| p.len());
             let mut lags = Lags::new(&self.terms);
             let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
             let mut db: [Vec<f64>; 3] = Default::default();
-            for (k, acc) in part.chunks_mut(PROJECTION_BLOCK).enumerate() {
-                let a = start + k * PROJECTION_BLOCK;
-                let r = a..a + acc.len();
+            for a in (0..len).step_by(PROJECTION_BLOCK) {
+                let local = a..(a + PROJECTION_BLOCK).min(len);
+                let r = start + local.start..start + local.end;
                 self.derivatives_into(time, flux, r.clone(), &mut db);
                 self.block_columns(
                     r,
@@ -370,20 +411,24 @@ impl Design {
                     &mut scratch,
                     &mut cols,
                 );
-                // −0.0 is the identity of f64 addition (what `Iterator::sum`
-                // starts from), so this is the bits of `row · c`.
-                acc.fill(-0.0);
-                for (col, c) in cols.iter().zip(coef) {
-                    for (a, v) in acc.iter_mut().zip(col) {
-                        *a += v * c;
+                for (part, coef) in parts.iter_mut().zip(coefs) {
+                    let acc = &mut part[local.clone()];
+                    // −0.0 is the identity of f64 addition (what
+                    // `Iterator::sum` starts from), so this is the bits of
+                    // `row · c`.
+                    acc.fill(-0.0);
+                    for (col, c) in cols.iter().zip(*coef) {
+                        for (a, v) in acc.iter_mut().zip(col) {
+                            *a += v * c;
+                        }
                     }
                 }
             }
         };
         if lagged || n < 4 * PROJECTION_BLOCK {
-            project(0, out);
+            project(0, outs);
         } else {
-            aeromag_core::parallel::for_each_part_mut(out, threads, PROJECTION_BLOCK, project);
+            aeromag_core::parallel::for_each_rows_mut(outs, threads, PROJECTION_BLOCK, project);
         }
     }
 
