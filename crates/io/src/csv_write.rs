@@ -5,8 +5,9 @@
 //! line ends, a final line end.
 //!
 //! - Numbers are written with the shortest text that reads back to the same
-//!   `f64` ([`NumberText`], Ryū's layout: `0.1`, `53210.4`, `1e-7`, `-0.0`, `inf`), so a write → read
-//!   round trip preserves every finite value and infinity bit for bit.
+//!   `f64` ([`NumberText`], in Ryū's layout: `0.1`, `53210.4`, `1e-7`,
+//!   `-0.0`, `inf`), so a write → read round trip preserves every finite
+//!   value and infinity bit for bit.
 //! - Missing values (`NaN`) are written as **empty cells** (the reader reads
 //!   them back as missing, `Missing::blank`); the NaN payload and sign are not
 //!   kept. Exception: in a one-column table they are written as `NaN`, because
@@ -99,7 +100,7 @@ const WRITE_CHUNK_ROWS: usize = 16 * 1024;
 
 /// One column as [`format_rows`] writes it.
 enum Cells<'a> {
-    /// Shortest round-trip text (Ryū).
+    /// Shortest round-trip text ([`NumberText`]).
     Float(&'a [f64]),
     /// Read as integers (`1003`): whole values written without `.0`.
     Integer(&'a [f64]),

@@ -1,4 +1,5 @@
-//! Synchronous detection of a raw EM record, streamed in chunks.
+//! Synchronous detection of a raw EM record, read in place or streamed in
+//! chunks.
 
 use super::files::RawSource;
 use crate::error::{Error, InFile, Result};

@@ -1,6 +1,8 @@
 //! Reading the files of the EM chain with file, line, row and column in
 //! every error: detected-vector CSV, KNOWN CSV (through aeromag-io's
-//! reader), the system JSON and the raw record (streamed in chunks).
+//! reader), the system JSON and the raw record (read in place from a
+//! memory map when its samples are aligned and complete, else streamed in
+//! chunks).
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
