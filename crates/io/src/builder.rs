@@ -226,6 +226,11 @@ impl TableBuilder {
         &self.names
     }
 
+    /// Data rows so far.
+    pub(crate) fn rows(&self) -> usize {
+        self.n_rows
+    }
+
     /// Appends the current row of `src`.
     pub(crate) fn push_row<S: RowFields>(&mut self, src: &S) -> Result<()> {
         let row = self.n_rows;
@@ -296,6 +301,52 @@ impl TableBuilder {
         self.last_line = line;
         self.n_rows += 1;
         Ok(())
+    }
+
+    /// Appends the clean rows of a piece of the file whose first line is
+    /// `first_line` ([`crate::csv_clean`]); `bytes_read` is the file offset
+    /// after the piece. The same columns, counts and line breakpoints as
+    /// [`Self::push_row`] on each of its rows. `false` (nothing appended)
+    /// when a column has turned to text: such rows are the general reader's.
+    pub(crate) fn append_clean(
+        &mut self,
+        part: &crate::csv_clean::CleanRows,
+        first_line: u64,
+        bytes_read: u64,
+    ) -> bool {
+        if self.cols.iter().any(|c| matches!(c, ColState::Text { .. })) {
+            return false;
+        }
+        if part.rows == 0 {
+            return true;
+        }
+        for (i, col) in self.cols.iter_mut().enumerate() {
+            if let ColState::Numeric {
+                values,
+                missing,
+                integers,
+            } = col
+            {
+                values.extend_from_slice(&part.values[i]);
+                missing.blank += part.missing[i].blank;
+                missing.nan += part.missing[i].nan;
+                missing.dummy += part.missing[i].dummy;
+                *integers &= part.integers[i];
+            }
+        }
+        for &(r, l) in &part.breaks {
+            let (row, line) = (self.n_rows + r, first_line + l);
+            if r > 0 || row == 0 || line != self.last_line + 1 {
+                self.row_lines.push((row, line));
+            }
+        }
+        let before = self.n_rows;
+        self.n_rows += part.rows;
+        self.last_line = first_line + part.last_row_line;
+        if before <= RESERVE_AFTER_ROWS && self.n_rows > RESERVE_AFTER_ROWS {
+            self.reserve(bytes_read);
+        }
+        true
     }
 
     /// Reserves every column for the estimated total number of rows.
@@ -463,7 +514,7 @@ pub(crate) fn cell_error(
 
 /// True for a cell written as an integer: optional sign and decimal digits
 /// (surrounding spaces allowed), e.g. `1003`, `-7`; not `1003.0`, `1e3`.
-fn is_integer_text(bytes: &[u8]) -> bool {
+pub(crate) fn is_integer_text(bytes: &[u8]) -> bool {
     let b = bytes.trim_ascii();
     let digits = b
         .strip_prefix(b"-")

@@ -29,9 +29,21 @@
 //! column 'a;b;c'"). With a semicolon or tab delimiter, a number with a
 //! decimal comma gets a hint in its parse error.
 //!
-//! The file is streamed with `csv::ByteRecord` (one reused buffer) into the
-//! per-column vectors of the [`TableBuilder`](crate::builder); see there for
-//! the memory bound.
+//! # Two readers, one table
+//!
+//! After the header, the rows go into the per-column vectors of one
+//! [`TableBuilder`](crate::builder) (see there for the memory bound):
+//!
+//! - first through the fast path ([`crate::csv_clean`]): clean rows (no
+//!   quote, numbers and missing markers only, as many fields as names)
+//!   parsed on all cores, piece by piece, in file order;
+//! - from the first line that is not clean, through the general reader:
+//!   `csv::ByteRecord` (one reused buffer) with quotes, text columns and
+//!   every error message, its tokenizer one thread ahead of the cell parser
+//!   ([`crate::read_ahead`]).
+//!
+//! The table, the warnings and the errors are the general reader's own
+//! either way (a property test reads generated files both ways).
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -45,6 +57,7 @@ use crate::builder::{
     too_many_columns,
 };
 use crate::cell::check_text;
+use crate::csv_clean::{self, PIECE_BYTES, Resume, Shape, push_clean_rows};
 use crate::error::{IoError, Result};
 use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, first_content_line, read_prefix};
@@ -53,6 +66,17 @@ use crate::xyz;
 
 /// Reads a CSV (or whitespace-separated) flight-data file. See the module docs.
 pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
+    read_csv_with(path, opts, Some((csv_clean::threads(), PIECE_BYTES)))
+}
+
+/// [`read_csv`], with the clean rows read by [`csv_clean`] on `threads`
+/// threads in pieces of `piece_bytes` when `clean` is given, by the general
+/// reader alone otherwise (tests compare the two).
+fn read_csv_with(
+    path: &Path,
+    opts: &ReadOptions,
+    clean: Option<(usize, usize)>,
+) -> Result<FlightTable> {
     let file = path.display().to_string();
     let prefix = read_prefix(path)?;
     let Some((header_line, header, _)) = first_content_line(&prefix.bytes, |l| l.starts_with(b"#"))
@@ -87,7 +111,34 @@ pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     src.n_fields = builder.names().len();
-    push_rows(&mut builder, src)?;
+    let shape = Shape {
+        delimiter,
+        n_fields: src.n_fields,
+        crlf: src.crlf,
+    };
+    // Clean rows on all cores first; the general reader from the first
+    // line that is not clean (module docs of csv_clean).
+    if let Some((threads, piece_bytes)) = clean {
+        let (after_header, header_line) = (src.resume(), src.header_line);
+        drop(src);
+        if let Some(at) = push_clean_rows(
+            &mut builder,
+            path,
+            after_header,
+            shape,
+            threads,
+            piece_bytes,
+        )? {
+            let src = CsvSource::open_at(path, delimiter, prefix.file_size, at)?.after_header(
+                header_line,
+                shape,
+                builder.rows(),
+            );
+            push_rows(&mut builder, src)?;
+        }
+    } else {
+        push_rows(&mut builder, src)?;
+    }
     builder.finish(|| {
         let mut s = open()?;
         s.n_fields = s.header()?.len();
@@ -213,7 +264,10 @@ struct CsvSource {
     n_fields: usize,
     row: usize,
     line: u64,
-    bom: u64,
+    /// File offset of the reader's first byte (after a byte-order mark, or
+    /// where the reader was opened) and the number of lines before it.
+    base: u64,
+    line_base: u64,
     file_size: u64,
     ends_with_newline: bool,
     last: usize,
@@ -222,18 +276,33 @@ struct CsvSource {
 
 impl CsvSource {
     fn open(path: &Path, delimiter: u8, file_size: u64) -> Result<Self> {
+        Self::open_at(path, delimiter, file_size, Resume { offset: 0, line: 1 })
+    }
+
+    /// A reader from the start of a line `at` (the file's start: after its
+    /// byte-order mark, if any).
+    fn open_at(path: &Path, delimiter: u8, file_size: u64, at: Resume) -> Result<Self> {
+        use std::io::{Seek, SeekFrom};
         let file = path.display().to_string();
-        let f = File::open(path).map_err(|source| IoError::Open {
+        let read_err = |source| IoError::Read {
+            file: file.clone(),
+            line: at.line,
+            source,
+        };
+        let mut f = File::open(path).map_err(|source| IoError::Open {
             file: file.clone(),
             source,
         })?;
+        if at.offset > 0 {
+            f.seek(SeekFrom::Start(at.offset)).map_err(read_err)?;
+        }
         let mut reader = BufReader::with_capacity(256 * 1024, f);
-        let head = reader.fill_buf().map_err(|source| IoError::Read {
-            file: file.clone(),
-            line: 1,
-            source,
-        })?;
-        let bom = if head.starts_with(BOM) { BOM.len() } else { 0 };
+        let head = reader.fill_buf().map_err(read_err)?;
+        let bom = if at.offset == 0 && head.starts_with(BOM) {
+            BOM.len()
+        } else {
+            0
+        };
         reader.consume(bom);
         let ends_with_newline = last_byte(&file, path, file_size)? == Some(b'\n');
         let budget = Arc::new(AtomicU64::new(MAX_LINE_BYTES + READ_AHEAD));
@@ -260,11 +329,12 @@ impl CsvSource {
             file,
             delimiter,
             header_line: 0,
-            last_line_end: 0,
+            last_line_end: at.line - 1,
             n_fields: 0,
             row: 0,
-            line: 0,
-            bom: bom as u64,
+            line: at.line - 1,
+            base: at.offset + bom as u64,
+            line_base: at.line - 1,
             file_size,
             ends_with_newline,
             last: 0,
@@ -279,7 +349,9 @@ impl CsvSource {
                 Ok(false) => return Ok(false),
                 Ok(true) => {}
                 Err(e) => {
-                    let line = e.position().map_or(self.line + 1, |p| p.line());
+                    let line = e
+                        .position()
+                        .map_or(self.line + 1, |p| p.line() + self.line_base);
                     let source = match e.into_kind() {
                         csv::ErrorKind::Io(io) if io.to_string() == OVER_BUDGET => {
                             // csv-core has not counted the record's lines yet.
@@ -306,8 +378,9 @@ impl CsvSource {
             // record's own '\n' has been consumed unless it is the unterminated
             // last line; quoted fields may contain more line ends.
             let pos = self.rdr.position();
-            let at_end = pos.byte() + self.bom >= self.file_size;
-            let last_line = pos.line() - u64::from(!at_end || self.ends_with_newline);
+            let at_end = pos.byte() + self.base >= self.file_size;
+            let last_line =
+                pos.line() + self.line_base - u64::from(!at_end || self.ends_with_newline);
             // A record ending on the line after the previous one holds no
             // line end of its own (the common case: no scan of its bytes).
             let embedded = if last_line == self.last_line_end + 1 {
@@ -325,6 +398,25 @@ impl CsvSource {
             }
             return Ok(true);
         }
+    }
+
+    /// Where the next record starts (after the last one read).
+    fn resume(&self) -> Resume {
+        Resume {
+            offset: self.bytes_read(),
+            line: self.last_line_end + 1,
+        }
+    }
+
+    /// A reader opened after the header ([`Self::open_at`]) for rows of
+    /// `shape`, `rows` data rows already read.
+    fn after_header(mut self, header_line: u64, shape: Shape, rows: usize) -> Self {
+        self.header_line = header_line;
+        self.n_fields = shape.n_fields;
+        self.last = shape.n_fields.saturating_sub(1);
+        self.crlf = shape.crlf;
+        self.row = rows;
+        self
     }
 
     /// Reads the header record and returns its names (trimmed).
@@ -393,13 +485,126 @@ impl RowFields for CsvSource {
     }
 
     fn bytes_read(&self) -> u64 {
-        self.rdr.position().byte() + self.bom
+        self.rdr.position().byte() + self.base
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// One line of a generated file (`{d}` stands for the delimiter):
+    /// mostly clean rows, some lines the fast path leaves to the general
+    /// reader (comments, blank lines, quotes, text in the free column `note`),
+    /// rarely one that makes the read fail.
+    fn line() -> impl Strategy<Value = String> {
+        let cell = prop_oneof![
+            8 => (-99_999_999i64..99_999_999, 0u32..9).prop_map(|(m, k)| {
+                let s = format!("{}", m.abs());
+                let s = if k == 0 || (k as usize) >= s.len() {
+                    s
+                } else {
+                    format!("{}.{}", &s[..s.len() - k as usize], &s[s.len() - k as usize..])
+                };
+                if m < 0 { format!("-{s}") } else { s }
+            }),
+            1 => prop::sample::select(vec![
+                "", " ", "*", "NaN", "-nan", "inf", "1e-3", " 12 ", "+5", "5.", ".5", "-0",
+                "12345678901234567890", "0.12345678901234567", "1234567.1234567", "007",
+                "9007199254740993", "123456789", "-12345678.9", "1\r",
+            ])
+            .prop_map(str::to_string),
+        ];
+        prop_oneof![
+            // `note` mostly integers (its integer flag is then at stake).
+            60 => (proptest::collection::vec(cell.clone(), 2), prop_oneof![
+                9 => (-9999i64..9999).prop_map(|i| i.to_string()),
+                1 => cell,
+            ])
+                .prop_map(|(c, n)| format!("{}{{d}}{}{{d}}{n}", c[0], c[1])),
+            2 => Just("# a comment, with \"quotes\"".to_string()),
+            2 => prop::sample::select(vec!["", "   ", "\r"]).prop_map(str::to_string),
+            1 => Just("\"1.5\"{d}2{d}\"3\"".to_string()),
+            1 => Just("1{d}2{d}\"multi\nline\"".to_string()),
+            1 => Just("1{d}2{d}text".to_string()),
+            // Fatal: text in a numeric column, short and long rows, a NUL.
+            1 => prop::sample::select(vec![
+                "1{d}text{d}3", "1{d}2", "1{d}2{d}3{d}4", "1{d}2{d}\u{0}", "1.2.3{d}2{d}3",
+            ])
+            .prop_map(str::to_string),
+        ]
+    }
+
+    /// A whole file: header `time,mag,note` (`mag` must be numeric, `note`
+    /// may turn to text), lines mostly clean, a delimiter, CRLF or LF, a
+    /// byte-order mark or none, a final line end or none.
+    fn file() -> impl Strategy<Value = Vec<u8>> {
+        (
+            proptest::collection::vec(
+                prop_oneof![8 => line().prop_map(Some), 1 => Just(None)],
+                0..60,
+            ),
+            prop::sample::select(vec![",", ";", "\t"]),
+            any::<bool>(),
+            any::<bool>(),
+            any::<bool>(),
+        )
+            .prop_map(|(lines, d, crlf, bom, last_newline)| {
+                let end = if crlf { "\r\n" } else { "\n" };
+                let mut text = String::new();
+                if bom {
+                    text.push('\u{feff}');
+                }
+                text.push_str(&format!("# head{end}time{d}mag{d}note{end}"));
+                // `None`: a run of 40 clean rows, so that pieces hold many.
+                for (k, l) in lines.iter().enumerate() {
+                    match l {
+                        Some(l) => text.push_str(&l.replace("{d}", d)),
+                        None => text.push_str(
+                            &(0..40)
+                                .map(|i| format!("{k}.{i}{d}-5300{i}.25{d}{i}"))
+                                .collect::<Vec<_>>()
+                                .join(end),
+                        ),
+                    }
+                    text.push_str(end);
+                }
+                if !last_newline && text.ends_with(end) {
+                    text.truncate(text.len() - end.len());
+                }
+                text.into_bytes()
+            })
+    }
+
+    fn outcome(r: Result<FlightTable>) -> std::result::Result<String, String> {
+        r.map(|t| format!("{t:?}")).map_err(|e| e.to_string())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// The fast path changes nothing: the same table (values, missing
+        /// counts, integer flags, text columns, line numbers) or the same
+        /// error as the general reader alone, for any thread count and
+        /// piece size (small pieces: rounds end inside long lines).
+        #[test]
+        fn clean_rows_read_as_the_general_reader_reads_them(
+            text in file(),
+            threads in 1usize..4,
+            piece in 8usize..300,
+        ) {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("f.csv");
+            std::fs::write(&path, &text).unwrap();
+            let opts = ReadOptions::default();
+            let general = outcome(read_csv_with(&path, &opts, None));
+            let clean = outcome(read_csv_with(&path, &opts, Some((threads, piece))));
+            prop_assert_eq!(&clean, &general, "{}", String::from_utf8_lossy(&text));
+            let big = outcome(read_csv_with(&path, &opts, Some((threads, PIECE_BYTES))));
+            prop_assert_eq!(&big, &general);
+        }
+    }
 
     #[test]
     fn delimiter_detection() {

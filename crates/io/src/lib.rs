@@ -35,6 +35,7 @@ pub mod atomic;
 mod builder;
 mod cell;
 pub mod columns;
+mod csv_clean;
 mod csv_read;
 mod csv_write;
 pub mod derive;
