@@ -255,6 +255,61 @@ mod tests {
         }
     }
 
+    /// Every size (four columns at a time, the remainder, the specialised
+    /// 5, 6, 8): the covariance form to round-off, and `α = r + Σ f_j²` with
+    /// each `f_j` summed one column at a time, bit for bit.
+    #[test]
+    fn any_size_matches_the_covariance_form_and_sums_f_in_row_order() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for n in [1, 3, 4, 5, 6, 7, 8, 9, 11, 13, 42] {
+            let mut s = vec![0.0; n * n];
+            for j in 0..n {
+                for i in 0..=j {
+                    s[i + j * n] = {
+                        let v: f64 = StandardNormal.sample(&mut rng);
+                        v
+                    } + if i == j { 2.0 } else { 0.0 };
+                }
+            }
+            let h: Vec<f64> = (0..n)
+                .map(|_| {
+                    let v: f64 = StandardNormal.sample(&mut rng);
+                    v
+                })
+                .collect();
+            let (y, r) = (0.7, 0.05);
+            let mut alpha_ref = r;
+            for j in 0..n {
+                let mut fj = 0.0;
+                for i in 0..=j {
+                    fj += s[i + j * n] * h[i];
+                }
+                alpha_ref += fj * fj;
+            }
+            let sm = DMatrix::from_column_slice(n, n, &s);
+            let p = &sm * sm.transpose();
+            let hv = DVector::from_column_slice(&h);
+            let k = &p * &hv / alpha_ref;
+            let p_ref = &p - &k * hv.transpose() * &p;
+            let mut x = vec![0.0; n];
+            let mut gain = vec![0.0; n];
+            let mut work = vec![0.0; 3 * n];
+            let inn = carlson_update(&mut s, &mut x, &h, y, r, &mut gain, &mut work).unwrap();
+            assert_eq!(inn.variance.to_bits(), alpha_ref.to_bits(), "n {n}");
+            let s2 = DMatrix::from_column_slice(n, n, &s);
+            assert!(
+                (s2.clone() * s2.transpose() - p_ref).abs().max() < 1e-12,
+                "n {n}"
+            );
+            assert!(
+                (DVector::from_column_slice(&gain) - k).abs().max() < 1e-12,
+                "n {n}"
+            );
+        }
+    }
+
     #[test]
     fn bad_input_leaves_the_state_alone() {
         let mut s = vec![1.0, 0.0, 0.0, 1.0];
