@@ -128,7 +128,7 @@ use super::anomaly_model::{NoiseModel, X2Prior};
 use super::joint_filter::JointFilter;
 use crate::error::{CompError, Result};
 use aeromag_core::parallel::{parallel_map, threads};
-use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead};
+use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead_parallel};
 use serde::{Deserialize, Serialize};
 
 /// Settings of the maximum-likelihood tuning.
@@ -327,8 +327,10 @@ pub fn tune(
     let mut evaluations = starts.evaluations;
     let mut best: Option<NelderMeadResult> = None;
     for x0 in &starts.points {
-        let r =
-            nelder_mead(&objective, x0, &opts).map_err(CompError::estimation("noise tuning"))?;
+        // Filter runs side by side where the search can use them; the
+        // same path, values and count as one at a time.
+        let r = nelder_mead_parallel(&objective, x0, &opts, threads())
+            .map_err(CompError::estimation("noise tuning"))?;
         evaluations += r.evaluations;
         if best.as_ref().is_none_or(|b| r.f < b.f) {
             best = Some(r);
@@ -410,6 +412,7 @@ const GRID_SPAN_DECADES: f64 = 6.0;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use aeromag_estimation::optimize::nelder_mead;
 
     /// Two basins in `(ln q₁, ln q₂)`: a wide shallow one at the start and
     /// a narrow deeper one 4 decades up in `q₁` and 4 down in `q₂`.
