@@ -81,37 +81,49 @@ pub(crate) const EXACT_POWERS_OF_TEN: [f64; 23] = [
 /// general algorithm, which were a third of reading a flight file.
 #[inline]
 fn plain_decimal(b: &[u8]) -> Option<f64> {
-    let (negative, digits) = match b {
-        [b'-', rest @ ..] => (true, rest),
-        [b'+', rest @ ..] => (false, rest),
-        _ => (false, b),
+    plain_decimal_prefix(b)
+        .filter(|&(_, _, len)| len == b.len())
+        .map(|(v, _, _)| v)
+}
+
+/// The plain decimal at the start of `b` (it ends at the first byte that
+/// cannot continue it): its value as [`plain_decimal`] gives it, whether it
+/// is written as an integer (no point, at most 15 digits: the
+/// [`crate::builder`]'s integer flag), and its length in bytes. `None` when
+/// it has no digit, more than 19 digits, `m ≥ 2⁵³` or `k > 22`.
+#[inline]
+pub(crate) fn plain_decimal_prefix(b: &[u8]) -> Option<(f64, bool, usize)> {
+    let (negative, mut i) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
     };
+    // Wrapping: a run of more than 19 digits is rejected below.
     let mut m: u64 = 0;
-    let mut n_digits = 0usize;
-    let mut frac: Option<usize> = None;
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                // 19 digits cannot overflow u64; longer ones go to the general parser.
-                if n_digits == 19 {
-                    return None;
-                }
-                m = m * 10 + u64::from(c - b'0');
-                n_digits += 1;
-                if let Some(k) = frac.as_mut() {
-                    *k += 1;
-                }
-            }
-            b'.' if frac.is_none() => frac = Some(0),
-            _ => return None,
-        }
+    let int_start = i;
+    while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
+        m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
     }
-    let k = frac.unwrap_or(0);
-    if n_digits == 0 || m >= 1 << 53 || k >= EXACT_POWERS_OF_TEN.len() {
+    let int_digits = i - int_start;
+    let mut k = 0;
+    let point = b.get(i) == Some(&b'.');
+    if point {
+        i += 1;
+        let frac_start = i;
+        while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        k = i - frac_start;
+    }
+    let digits = int_digits + k;
+    if digits == 0 || digits > 19 || m >= 1 << 53 || k >= EXACT_POWERS_OF_TEN.len() {
         return None;
     }
     let v = m as f64 / EXACT_POWERS_OF_TEN[k];
-    Some(if negative { -v } else { v })
+    let integer = !point && digits <= 15;
+    Some((if negative { -v } else { v }, integer, i))
 }
 
 /// Classifies a cell that is not a number: binary or plain text.

@@ -27,7 +27,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use crate::builder::{TableBuilder, is_integer_text};
-use crate::cell::{Cell, EXACT_POWERS_OF_TEN, MissingKind, parse_cell};
+use crate::cell::{Cell, EXACT_POWERS_OF_TEN, MissingKind, parse_cell, plain_decimal_prefix};
 use crate::error::{IoError, Result};
 use crate::table::Missing;
 
@@ -296,13 +296,13 @@ fn plain_decimal_field(text: &[u8], p: usize, end: usize) -> Option<(f64, bool, 
     let negative = first == b'-';
     let i = p + usize::from(negative | (first == b'+'));
     let Some((int, int_len)) = digit_run(text, i) else {
-        return plain_decimal_scalar(&text[p..end]);
+        return plain_decimal_prefix(&text[p..end]);
     };
     let mut q = i + int_len;
     let (mut m, mut k, mut point) = (int, 0, false);
     if q < end && text[q] == b'.' {
         let Some((frac, frac_len)) = digit_run(text, q + 1) else {
-            return plain_decimal_scalar(&text[p..end]);
+            return plain_decimal_prefix(&text[p..end]);
         };
         m = int * POWERS_OF_TEN_U64[frac_len] + frac;
         k = frac_len;
@@ -352,42 +352,6 @@ fn digit_run(text: &[u8], p: usize) -> Option<(u64, usize)> {
     let v = (v.wrapping_mul(100) + (v >> 16)) & 0x0000_ffff_0000_ffff;
     let v = (v.wrapping_mul(10_000) + (v >> 32)) & 0xffff_ffff;
     Some((v, len))
-}
-
-/// [`plain_decimal_field`] byte by byte, for the cells `digit_run` does not
-/// take (runs of 8 digits or more, the last bytes of a piece); the number
-/// ends at the first byte that cannot continue it.
-fn plain_decimal_scalar(b: &[u8]) -> Option<(f64, bool, usize)> {
-    let (negative, mut i) = match b.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let mut m: u64 = 0;
-    let int_start = i;
-    while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
-        m = m.wrapping_mul(10).wrapping_add(u64::from(d));
-        i += 1;
-    }
-    let int_digits = i - int_start;
-    let mut k = 0;
-    let point = b.get(i) == Some(&b'.');
-    if point {
-        i += 1;
-        let frac_start = i;
-        while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
-            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
-            i += 1;
-        }
-        k = i - frac_start;
-    }
-    let digits = int_digits + k;
-    if digits == 0 || digits > 19 || m >= 1 << 53 || k >= EXACT_POWERS_OF_TEN.len() {
-        return None;
-    }
-    let v = m as f64 / EXACT_POWERS_OF_TEN[k];
-    let integer = !point && digits <= 15;
-    Some((if negative { -v } else { v }, integer, i))
 }
 
 /// Threads of the fast path: the available cores, at most 8.
