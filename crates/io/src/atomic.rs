@@ -149,6 +149,16 @@ pub fn check_writable_folder(dir: &Path) -> std::io::Result<()> {
     check_writable(&dir.join(".aeromag-probe"))
 }
 
+/// For the crate's tests that write files atomically: they run one at a
+/// time, since one of them sets the process-wide interruption flag, which
+/// fails any other write meanwhile (`cargo test` runs a crate's tests as
+/// threads of one process).
+#[cfg(test)]
+pub(crate) fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static SERIAL: Mutex<()> = Mutex::new(());
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,6 +181,7 @@ mod tests {
 
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let _serial = serial();
         let d = dir("fail");
         let p = d.join("out.csv");
         write_file(&p, "old").unwrap();
@@ -186,6 +197,7 @@ mod tests {
 
     #[test]
     fn temporaries_in_progress_are_removed_on_request() {
+        let _serial = serial();
         let d = dir("signal");
         let p = d.join("big.csv");
         write_atomically(&p, |w| {
@@ -206,6 +218,7 @@ mod tests {
 
     #[test]
     fn check_writable_creates_folders_and_rejects_folders_and_files_as_folders() {
+        let _serial = serial();
         let d = dir("check");
         check_writable(&d.join("a/b/out.json")).unwrap();
         assert!(d.join("a/b").is_dir());

@@ -227,6 +227,7 @@ mod tests {
 
     #[test]
     fn a_file_is_replaced_whole_and_no_temporary_is_left() {
+        let _serial = crate::atomic::serial();
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("out.csv");
         let mut t = FlightTable::new();
