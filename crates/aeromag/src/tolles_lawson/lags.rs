@@ -16,6 +16,7 @@ use aeromag_compensation::tolles_lawson::lag_select::{
     lag_threshold, select_eddy_lags, select_extra_lag, within_budget,
 };
 use aeromag_compensation::tolles_lawson::{Design, ExtraRequest, Magnitude, TermSet};
+use aeromag_core::parallel::{parallel_map, threads};
 
 /// Passes of the extra regressors' lag searches at most ([`choose_terms`]).
 pub const MAX_EXTRA_LAG_PASSES: usize = 3;
@@ -316,12 +317,21 @@ pub(super) fn add_lags_by_kalman_likelihood(
     while terms.eddy_lags_s().len() < 2 {
         let lags = terms.eddy_lags_s().to_vec();
         let mut best: Option<(f64, usize, TermSet, f64)> = None;
-        for &tau in DEFAULT_LAG_GRID_S.iter().filter(|t| !lags.contains(t)) {
-            let mut with: Vec<f64> = lags.clone();
-            with.push(tau);
-            with.sort_by(f64::total_cmp);
-            let cand = terms.with_eddy_lags(&with).in_file(file)?;
-            let (ll, mc) = profile(&cand)?;
+        let candidates = DEFAULT_LAG_GRID_S
+            .iter()
+            .filter(|t| !lags.contains(t))
+            .map(|&tau| {
+                let mut with: Vec<f64> = lags.clone();
+                with.push(tau);
+                with.sort_by(f64::total_cmp);
+                Ok((tau, terms.with_eddy_lags(&with).in_file(file)?))
+            })
+            .collect::<Result<Vec<(f64, TermSet)>>>()?;
+        // Independent filter runs over the whole flight: shared out over
+        // the cores, then taken in grid order as one at a time.
+        let profiles = parallel_map(candidates.len(), threads(), |i| profile(&candidates[i].1));
+        for ((tau, cand), p) in candidates.into_iter().zip(profiles) {
+            let (ll, mc) = p?;
             if ll.is_finite() && best.as_ref().is_none_or(|b| ll > b.0) {
                 best = Some((ll, mc, cand, tau));
             }
