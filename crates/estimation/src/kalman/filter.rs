@@ -226,9 +226,9 @@ impl SqrtKalmanFilter {
                 dense[i * k + l] = p;
             }
             match k {
-                5 => upper_times_columns(5, dense, s, n),
-                6 => upper_times_columns(6, dense, s, n),
-                8 => upper_times_columns(8, dense, s, n),
+                5 => aeromag_core::simd::run(UpperTimesColumns::<5> { phi: dense, s, n }),
+                6 => aeromag_core::simd::run(UpperTimesColumns::<6> { phi: dense, s, n }),
+                8 => aeromag_core::simd::run(UpperTimesColumns::<8> { phi: dense, s, n }),
                 _ => upper_times_columns(k, dense, s, n),
             }
         } else {
@@ -371,6 +371,45 @@ fn upper_times_columns(k: usize, phi: &[f64], s: &mut [f64], n: usize) {
                 t += phi[i * k + l] * col[l];
             }
             col[i] = t;
+        }
+    }
+}
+
+/// [`upper_times_columns`] for `K` leading states, as a
+/// [`aeromag_core::simd::Kernel`]: each column's new entries are formed
+/// together, `out[..=l] += Φ[..=l, l] c_l` for `l` ascending (runs of rows
+/// in SIMD lanes), so each entry is still `Σ_{l ≥ i} Φ_il c_l` summed from
+/// 0 in ascending `l`: the same bits.
+struct UpperTimesColumns<'a, const K: usize> {
+    phi: &'a [f64],
+    s: &'a mut [f64],
+    n: usize,
+}
+
+impl<const K: usize> aeromag_core::simd::Kernel for UpperTimesColumns<'_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        let n = self.n;
+        // Φ by columns: by_col[l][i] = Φ_il (i ≤ l).
+        let mut by_col = [[0.0f64; K]; K];
+        for (i, row) in self.phi[..K * K].chunks_exact(K).enumerate() {
+            for l in i..K {
+                by_col[l][i] = row[l];
+            }
+        }
+        for j in K..n {
+            let col = &mut self.s[j * n..j * n + K];
+            let mut c = [0.0f64; K];
+            c.copy_from_slice(col);
+            let mut out = [0.0f64; K];
+            for l in 0..K {
+                let cl = c[l];
+                for i in 0..=l {
+                    out[i] += by_col[l][i] * cl;
+                }
+            }
+            col.copy_from_slice(&out);
         }
     }
 }
