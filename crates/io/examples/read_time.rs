@@ -1,6 +1,6 @@
 //! Times `read_table` on a file: best of `N` reads (default 5).
 //! Run: `cargo run --release -p aeromag-io --example read_time -- FILE [N]`.
-//! tools/bench/read_peers.sh runs it against pandas' `read_csv` on the same file.
+//! `python tools/bench/peers.py read FILE.csv READ_TIME` runs it against pandas' `read_csv` on the same file.
 
 use std::time::Instant;
 
