@@ -32,7 +32,7 @@
 use std::path::PathBuf;
 
 use crate::ReadOptions;
-use crate::cell::{Cell, CellError, MissingKind, check_text, parse_cell};
+use crate::cell::{Cell, CellError, check_text, parse_cell};
 use crate::columns::{MappedColumn, must_be_numeric, resolve};
 use crate::error::{IoError, Result};
 use crate::table::{ColumnData, FlightTable, Missing};
@@ -252,11 +252,7 @@ impl TableBuilder {
                     }
                     Ok(Cell::Missing(kind)) => {
                         values.push(f64::NAN);
-                        match kind {
-                            MissingKind::Blank => missing.blank += 1,
-                            MissingKind::Nan => missing.nan += 1,
-                            MissingKind::Dummy => missing.dummy += 1,
-                        }
+                        missing.count(kind);
                     }
                     Err(CellError::NotNumber) if !self.numeric_only[i] => {
                         // First text cell of a free column: it becomes a text column.
@@ -328,9 +324,7 @@ impl TableBuilder {
             } = col
             {
                 values.extend_from_slice(&part.values[i]);
-                missing.blank += part.missing[i].blank;
-                missing.nan += part.missing[i].nan;
-                missing.dummy += part.missing[i].dummy;
+                missing.add(&part.missing[i]);
                 *integers &= part.integers[i];
             }
         }

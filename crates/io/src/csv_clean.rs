@@ -148,11 +148,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
                 break;
             }
             for &(i, kind) in &missing {
-                match kind {
-                    MissingKind::Blank => out.missing[i].blank += 1,
-                    MissingKind::Nan => out.missing[i].nan += 1,
-                    MissingKind::Dummy => out.missing[i].dummy += 1,
-                }
+                out.missing[i].count(kind);
             }
             out.row_on(line);
         }
@@ -355,7 +351,8 @@ fn digit_run(text: &[u8], p: usize) -> Option<(u64, usize)> {
     Some((v, len))
 }
 
-/// Threads of the fast path: the available cores, at most 8.
+/// Threads of the fast path: the available cores, at most 8 (as
+/// `aeromag_core::parallel::threads`; this crate does not depend on core).
 pub(crate) fn threads() -> usize {
     std::thread::available_parallelism()
         .map_or(1, |n| n.get())

@@ -35,6 +35,23 @@ impl Missing {
     pub fn total(&self) -> usize {
         self.blank + self.nan + self.dummy
     }
+
+    /// Counts one missing cell of kind `kind`.
+    pub(crate) fn count(&mut self, kind: crate::cell::MissingKind) {
+        use crate::cell::MissingKind;
+        match kind {
+            MissingKind::Blank => self.blank += 1,
+            MissingKind::Nan => self.nan += 1,
+            MissingKind::Dummy => self.dummy += 1,
+        }
+    }
+
+    /// Adds the counts of `other` (rows appended).
+    pub(crate) fn add(&mut self, other: &Missing) {
+        self.blank += other.blank;
+        self.nan += other.nan;
+        self.dummy += other.dummy;
+    }
 }
 
 /// The values of one column.

@@ -229,7 +229,15 @@ impl SqrtKalmanFilter {
                 5 => aeromag_core::simd::run(UpperTimesColumns::<5> { phi: dense, s, n }),
                 6 => aeromag_core::simd::run(UpperTimesColumns::<6> { phi: dense, s, n }),
                 8 => aeromag_core::simd::run(UpperTimesColumns::<8> { phi: dense, s, n }),
-                _ => upper_times_columns(k, dense, s, n),
+                _ => {
+                    // Workspace in `wide`, which propagate_block refills next.
+                    if self.wide.len() < k * k + 2 * k {
+                        self.wide.resize(k * k + 2 * k, 0.0);
+                    }
+                    let (by_col, rest) = self.wide.split_at_mut(k * k);
+                    let (c, out) = rest.split_at_mut(k);
+                    upper_times_columns(k, dense, s, n, by_col, c, out);
+                }
             }
         } else {
             let tmp = &mut self.tmp[..k];
@@ -360,26 +368,44 @@ impl SqrtKalmanFilter {
 
 /// `U_b ← Φ U_b` for an upper-triangular `Φ` (`k × k`, row-major in
 /// `phi`) on the columns `k..n` of the column-major `n × n` factor `s`.
+/// Each column's new entries are formed together, `out[..=l] += Φ[..=l, l]
+/// c_l` for `l` ascending (runs of rows in SIMD lanes), each entry summed
+/// as `Σ_{l ≥ i} Φ_il c_l` from 0 in ascending `l`. `by_col` (`k²`), `c`
+/// and `out` (`k` each) are workspace.
 #[inline(always)]
-fn upper_times_columns(k: usize, phi: &[f64], s: &mut [f64], n: usize) {
-    let phi = &phi[..k * k];
+fn upper_times_columns(
+    k: usize,
+    phi: &[f64],
+    s: &mut [f64],
+    n: usize,
+    by_col: &mut [f64],
+    c: &mut [f64],
+    out: &mut [f64],
+) {
+    // Φ by columns: by_col[l k + i] = Φ_il (i ≤ l; the rest is not read).
+    for (i, row) in phi[..k * k].chunks_exact(k).enumerate() {
+        for l in i..k {
+            by_col[l * k + i] = row[l];
+        }
+    }
+    let (c, out) = (&mut c[..k], &mut out[..k]);
     for j in k..n {
         let col = &mut s[j * n..j * n + k];
-        for i in 0..k {
-            let mut t = 0.0;
-            for l in i..k {
-                t += phi[i * k + l] * col[l];
+        c.copy_from_slice(col);
+        out.fill(0.0);
+        for l in 0..k {
+            let cl = c[l];
+            for (o, p) in out[..=l].iter_mut().zip(&by_col[l * k..=l * k + l]) {
+                *o += p * cl;
             }
-            col[i] = t;
         }
+        col.copy_from_slice(out);
     }
 }
 
-/// [`upper_times_columns`] for `K` leading states, as a
-/// [`aeromag_core::simd::Kernel`]: each column's new entries are formed
-/// together, `out[..=l] += Φ[..=l, l] c_l` for `l` ascending (runs of rows
-/// in SIMD lanes), so each entry is still `Σ_{l ≥ i} Φ_il c_l` summed from
-/// 0 in ascending `l`: the same bits.
+/// [`upper_times_columns`] for `K` leading states (the field models of
+/// orders 3, 4 and 6), its workspace on the stack, as a
+/// [`aeromag_core::simd::Kernel`] (AVX where the processor has it).
 struct UpperTimesColumns<'a, const K: usize> {
     phi: &'a [f64],
     s: &'a mut [f64],
@@ -390,27 +416,17 @@ impl<const K: usize> aeromag_core::simd::Kernel for UpperTimesColumns<'_, K> {
     type Output = ();
     #[inline(always)]
     fn run(self) {
-        let n = self.n;
-        // Φ by columns: by_col[l][i] = Φ_il (i ≤ l).
         let mut by_col = [[0.0f64; K]; K];
-        for (i, row) in self.phi[..K * K].chunks_exact(K).enumerate() {
-            for l in i..K {
-                by_col[l][i] = row[l];
-            }
-        }
-        for j in K..n {
-            let col = &mut self.s[j * n..j * n + K];
-            let mut c = [0.0f64; K];
-            c.copy_from_slice(col);
-            let mut out = [0.0f64; K];
-            for l in 0..K {
-                let cl = c[l];
-                for i in 0..=l {
-                    out[i] += by_col[l][i] * cl;
-                }
-            }
-            col.copy_from_slice(&out);
-        }
+        let (mut c, mut out) = ([0.0f64; K], [0.0f64; K]);
+        upper_times_columns(
+            K,
+            self.phi,
+            self.s,
+            self.n,
+            by_col.as_flattened_mut(),
+            &mut c,
+            &mut out,
+        );
     }
 }
 
