@@ -14,6 +14,7 @@ use crate::model_file::{
 use crate::tolles_lawson::Design;
 use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
+use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::kalman::{Checkpoint, LeadingConditional, default_block_len};
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::DMatrix;
@@ -495,7 +496,9 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     })
 }
 
-/// Every `dec`-th sample of every run, for the likelihood.
+/// Every `dec`-th sample of every run, for the likelihood. The runs'
+/// design rows (every sample's, for the lag filters) are formed on all
+/// cores and joined in run order.
 fn decimated_subset(
     segments: &[KalmanSegment],
     runs: &[Run],
@@ -505,12 +508,13 @@ fn decimated_subset(
     y_ref: f64,
 ) -> Subset {
     let m = spec.n_columns();
-    let mut sub = Subset {
-        m,
-        ..Subset::default()
-    };
-    for run in runs {
+    let parts = parallel_map(runs.len(), threads(), |r| {
+        let run = &runs[r];
         let s = &segments[run.seg];
+        let mut sub = Subset {
+            m,
+            ..Subset::default()
+        };
         let mut dist = 0.0;
         for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
             if i > run.range.start {
@@ -525,6 +529,18 @@ fn decimated_subset(
                 dist = 0.0;
             }
         });
+        sub
+    });
+    let mut sub = Subset {
+        m,
+        ..Subset::default()
+    };
+    for p in parts {
+        sub.rows.extend_from_slice(&p.rows);
+        sub.y.extend_from_slice(&p.y);
+        sub.dz.extend_from_slice(&p.dz);
+        sub.d.extend_from_slice(&p.d);
+        sub.start.extend_from_slice(&p.start);
     }
     sub
 }

@@ -621,3 +621,39 @@ fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
         );
     }
 }
+
+/// The tuning's likelihood (field filter with the coefficients integrated
+/// out, `AugmentedFilter`) is the pass-1 joint filter's, over three runs,
+/// for the thesis' order and the default: with nothing free the tuning
+/// reports the likelihood at the start, on the whole record (decimation 1).
+#[test]
+fn the_tuning_likelihood_is_the_pass_1_filters() {
+    let terms = TermSet::observable16();
+    let mut b = flight(NOISE, &terms, &coef16(), 21);
+    b.mag[1234] = f64::NAN;
+    b.alt[2000] = f64::NAN;
+    for prior in [X2Prior::thesis(), X2Prior::default()] {
+        let cfg = KalmanConfig {
+            field_prior: prior,
+            tuning: TuningConfig {
+                enabled: true,
+                tune_q1: false,
+                tune_q2: false,
+                tune_r: false,
+                max_rows: 1_000_000,
+                ..TuningConfig::default()
+            },
+            compute_series: false,
+            ..no_tuning(terms.clone(), NOISE)
+        };
+        let fit = fit_kalman(&[b.segment()], &cfg).unwrap();
+        let rep = fit.tuning.as_ref().unwrap();
+        assert_eq!((fit.runs, rep.decimation, rep.rows), (3, 1, fit.rows));
+        let (a, j) = (rep.log_likelihood_initial, fit.log_likelihood);
+        eprintln!("order {}: augmented {a}, joint {j}", prior.order);
+        assert!(
+            (a - j).abs() <= 1e-10 * j.abs(),
+            "augmented {a} vs joint {j}"
+        );
+    }
+}

@@ -39,6 +39,7 @@
 //! | [`mbf`] | the modified Bryson–Frazier smoother: smoothed means by an adjoint recursion, no gain |
 //! | [`fixed_interval`] | forward filter + backward smoother over a record, with checkpointing (`O(√N n²)` memory) |
 //! | [`innovation`] | innovations and their Gaussian log-likelihood |
+//! | [`augmented`] | the likelihood with constant regression coefficients integrated out, from a filter of the dynamic states alone ([`AugmentedFilter`]) |
 //! | [`conventional`] | the Joseph-form filter and textbook RTS smoother: the test reference |
 //!
 //! References: G. J. Bierman, *Factorization Methods for Discrete Sequential
@@ -46,6 +47,7 @@
 //! Filtering: Theory and Practice* (4th ed., Wiley 2015); C. L. Thornton,
 //! *Triangular Covariance Factorizations for Kalman Filtering* (UCLA 1976).
 
+pub mod augmented;
 pub mod carlson;
 pub mod conventional;
 pub mod filter;
@@ -55,6 +57,7 @@ pub mod mbf;
 pub mod rts;
 pub mod triangularize;
 
+pub use augmented::AugmentedFilter;
 pub use conventional::{ConventionalKalmanFilter, rts_step_conventional};
 pub use filter::{LeadingConditional, SqrtKalmanFilter, upper_cholesky};
 pub use fixed_interval::{

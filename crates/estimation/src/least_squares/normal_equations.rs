@@ -212,6 +212,11 @@ impl NormalEquations {
         &self.aty
     }
 
+    /// `yᵀy`.
+    pub fn yty(&self) -> f64 {
+        self.yty
+    }
+
     /// Solve with ridge parameter `lambda ≥ 0`, taking every row as independent.
     pub fn solve(&self, lambda: f64) -> Result<LsSolution> {
         self.solve_with_dof(lambda, self.rows as f64)

@@ -1,0 +1,565 @@
+//! The likelihood of a state-space model with constant regression
+//! coefficients, from a filter of the dynamic states alone (de Jong's
+//! augmented Kalman filter).
+//!
+//! ```text
+//! x_k = Φ_k x_{k−1} + G_k w_k                   (n dynamic states)
+//! y_k = h_kᵀ x_k + z_kᵀ β + v_k,   v_k ~ N(0, r_k)
+//! β ~ N(β₀, diag(σ_β²))                         (m constant coefficients)
+//! ```
+//!
+//! The joint filter of `(x, β)` carries `n + m` states. But with `β`
+//! constant the gains of the dynamic part do not depend on `β` or on the
+//! data: the filter of `x` alone, applied to the reading `y − z·β₀` and to
+//! each regressor column `z_j` as further right-hand sides, gives
+//! innovations `e_k` and `E_k` (a row of `m`) with one variance `S_k`, and
+//! the joint filter's innovation at `β` is `e_k − E_k (β − β₀)`.
+//! Integrating `β` out of the prediction-error decomposition (P. de Jong,
+//! "The likelihood for a state space model", *Biometrika* 75 (1988)
+//! 165–169; "The diffuse Kalman filter", *Ann. Statist.* 19 (1991)
+//! 1073–1083) gives the joint filter's log-likelihood exactly:
+//!
+//! ```text
+//! M = Σ_k E_kᵀE_k / S_k + diag(σ_β⁻²),   c = Σ_k E_kᵀ e_k / S_k,   q = Σ_k e_k² / S_k
+//! ℓ = −½ [ Σ_k ln(2π S_k) + Σ_j ln σ_βj² + ln det M + q − cᵀM⁻¹c ]
+//! ```
+//!
+//! `ln det M` and `q − cᵀM⁻¹c` are read off one Cholesky factor of the
+//! bordered matrix `[[M, c], [cᵀ, q]]` (the last pivot squared is the
+//! Schur complement, computed without forming `M⁻¹`).
+//!
+//! **Cost and parallelism.** A step costs the `n`-state filter plus
+//! `O(n m)` for the `m + 1` right-hand sides (one pass over them, four at a
+//! time in SIMD lanes) and `m²/2` products for the cross-products (formed
+//! in blocks of 256 samples by [`NormalEquations::add_columns`]), against
+//! `O((n + m)²)` for the joint Carlson update. Measured with 8 field
+//! states and 34 coefficients: 0.97 µs per step, half of it the 8-state
+//! covariance update, against 1.15 µs for the joint filter. The larger gain
+//! is that `β` no longer links the runs of a record: runs filtered apart
+//! and their sums added ([`AugmentedFilter::merge`]) give the same
+//! likelihood, so one evaluation can use every core. It gives no running
+//! estimate of `β`; the joint filter ([`super::SqrtKalmanFilter`] with the
+//! constants ordered last) does.
+//!
+//! **Accuracy.** The cross-products are normal equations, not a square
+//! root: on the tests' models (regressors spanning three decades, prior
+//! standard deviations 0.1–100) the likelihood agrees with the joint
+//! square-root filter's to 1·10⁻¹⁰ relative or better, on the Kalman
+//! compensation's flights to 5·10⁻¹³.
+
+use super::filter::SqrtKalmanFilter;
+use crate::error::{EstError, Result};
+use crate::least_squares::NormalEquations;
+use nalgebra::DMatrix;
+
+/// Lanes of the column loops.
+const LANES: usize = 4;
+/// Samples whose scaled innovations are buffered before their
+/// cross-products are formed in one block ([`NormalEquations::add_columns`]).
+const BLOCK: usize = 256;
+
+/// The dynamic-state filter applied to the reading and to every regressor
+/// column, and the cross-products of their innovations (module docs).
+#[derive(Debug, Clone)]
+pub struct AugmentedFilter {
+    filter: SqrtKalmanFilter,
+    /// `x` at the start of each run: zero mean, this upper factor.
+    prior_factor: DMatrix<f64>,
+    zeros: Vec<f64>,
+    prior_mean: Vec<f64>,
+    prior_var: Vec<f64>,
+    /// `m + 1` right-hand sides (the columns, then the reading) rounded up to
+    /// a multiple of [`LANES`]; the padding stays zero.
+    width: usize,
+    /// `n × width`, row-major: each right-hand side's state.
+    x: Vec<f64>,
+    next: Vec<f64>,
+    nu: Vec<f64>,
+    /// The time update of the right-hand sides waiting for the next
+    /// measurement update (done in the same pass over `x`): `Φ`, row-major.
+    pending: bool,
+    phi: Vec<f64>,
+    phi_upper: bool,
+    phi_nz: Vec<(usize, usize, f64)>,
+    /// Innovations scaled by `1/√S` of the last `filled` samples: `m`
+    /// columns of [`BLOCK`], then the reading's.
+    columns: Vec<f64>,
+    reading: Vec<f64>,
+    filled: usize,
+    /// `Σ E_kᵀE_k/S_k`, `Σ E_kᵀe_k/S_k`, `Σ e_k²/S_k` of the flushed blocks.
+    moments: NormalEquations,
+    sum_log_2pi_var: f64,
+}
+
+impl AugmentedFilter {
+    /// A filter of `n = s0.nrows()` dynamic states, each run starting from
+    /// zero mean and the upper-triangular factor `s0`, and `m =
+    /// prior_mean.len()` coefficients with prior means `prior_mean` and
+    /// standard deviations `prior_std` (finite, > 0).
+    pub fn new(s0: &DMatrix<f64>, prior_mean: &[f64], prior_std: &[f64]) -> Result<Self> {
+        let n = s0.nrows();
+        let m = prior_mean.len();
+        if prior_std.len() != m {
+            return Err(EstError::Dimension(format!(
+                "augmented filter: {m} prior means, {} standard deviations",
+                prior_std.len()
+            )));
+        }
+        if prior_mean.iter().any(|v| !v.is_finite())
+            || prior_std.iter().any(|s| !(*s > 0.0 && s.is_finite()))
+        {
+            return Err(EstError::NonFinite {
+                what: "coefficient prior (finite means, finite standard deviations > 0)",
+            });
+        }
+        let zeros = vec![0.0; n];
+        let filter = SqrtKalmanFilter::new(&zeros, s0)?;
+        let width = (m + 1).div_ceil(LANES) * LANES;
+        Ok(Self {
+            filter,
+            prior_factor: s0.clone(),
+            zeros,
+            prior_mean: prior_mean.to_vec(),
+            prior_var: prior_std.iter().map(|s| s * s).collect(),
+            width,
+            x: vec![0.0; n * width],
+            next: vec![0.0; n * width],
+            nu: vec![0.0; width],
+            pending: false,
+            phi: vec![0.0; n * n],
+            phi_upper: true,
+            phi_nz: Vec::with_capacity(n * n),
+            columns: vec![0.0; m * BLOCK],
+            reading: vec![0.0; BLOCK],
+            filled: 0,
+            moments: NormalEquations::new(m),
+            sum_log_2pi_var: 0.0,
+        })
+    }
+
+    /// Start a contiguous run: the dynamic states of every right-hand side
+    /// get their prior again; the coefficients carry over.
+    pub fn start_run(&mut self) -> Result<()> {
+        self.filter.set(&self.zeros, &self.prior_factor)?;
+        self.x.fill(0.0);
+        self.pending = false;
+        Ok(())
+    }
+
+    /// Time update with `Φ` (`n × n`) and noise factor `G` (`n × q`).
+    pub fn predict(&mut self, phi: &DMatrix<f64>, g: &DMatrix<f64>) -> Result<()> {
+        self.filter.predict(phi, g)?;
+        if self.pending {
+            self.propagate_now();
+        }
+        let n = self.zeros.len();
+        let mut upper = true;
+        for (j, col) in phi.as_slice().chunks_exact(n).enumerate() {
+            for (i, &p) in col.iter().enumerate() {
+                self.phi[i * n + j] = p;
+                upper &= i <= j || p == 0.0;
+            }
+        }
+        self.phi_upper = upper;
+        self.pending = true;
+        Ok(())
+    }
+
+    /// The waiting time update of the right-hand sides, on its own.
+    fn propagate_now(&mut self) {
+        let n = self.zeros.len();
+        self.phi_nz.clear();
+        for j in 0..n {
+            for i in 0..n {
+                let v = self.phi[i * n + j];
+                if v != 0.0 {
+                    self.phi_nz.push((i, j, v));
+                }
+            }
+        }
+        aeromag_core::simd::run(Propagate {
+            x: &self.x,
+            next: &mut self.next,
+            phi_nz: &self.phi_nz,
+            width: self.width,
+        });
+        std::mem::swap(&mut self.x, &mut self.next);
+        self.pending = false;
+    }
+
+    /// Measurement update with the dynamic row `h` (length `n`), the
+    /// regressor row `z` (length `m`), the reading `y` and its noise
+    /// variance `r > 0`. Returns the innovation variance `S_k`.
+    pub fn update(&mut self, h: &[f64], z: &[f64], y: f64, r: f64) -> Result<f64> {
+        let m = self.prior_mean.len();
+        if z.len() != m {
+            return Err(EstError::Dimension(format!(
+                "augmented filter: regressor row of length {} for {m} coefficients",
+                z.len()
+            )));
+        }
+        if !y.is_finite() || z.iter().any(|v| !v.is_finite()) {
+            return Err(EstError::NonFinite {
+                what: "reading or regressor row",
+            });
+        }
+        let s = self.filter.update(h, 0.0, r)?.variance;
+        let y0: f64 = z.iter().zip(&self.prior_mean).map(|(a, b)| a * b).sum();
+        self.nu[..m].copy_from_slice(z);
+        self.nu[m] = y - y0;
+        let phi = self.pending.then_some(self.phi.as_slice());
+        macro_rules! fixed {
+            ($k:literal) => {
+                aeromag_core::simd::run(Step::<$k> {
+                    x: &mut self.x,
+                    nu: &mut self.nu,
+                    phi,
+                    h,
+                    gain: self.filter.last_gain(),
+                    width: self.width,
+                })
+            };
+        }
+        match (h.len(), self.phi_upper || phi.is_none()) {
+            // The field models of orders 3, 4 and 6 (upper-triangular Φ).
+            (5, true) => fixed!(5),
+            (6, true) => fixed!(6),
+            (8, true) => fixed!(8),
+            _ => {
+                if self.pending {
+                    self.propagate_now();
+                }
+                aeromag_core::simd::run(Innovate {
+                    x: &mut self.x,
+                    nu: &mut self.nu,
+                    h,
+                    gain: self.filter.last_gain(),
+                    width: self.width,
+                })
+            }
+        }
+        self.pending = false;
+        self.sum_log_2pi_var += (2.0 * std::f64::consts::PI * s).ln();
+        let scale = 1.0 / s.sqrt();
+        let k = self.filled;
+        for (j, v) in self.nu[..m].iter().enumerate() {
+            self.columns[j * BLOCK + k] = v * scale;
+        }
+        self.reading[k] = self.nu[m] * scale;
+        self.filled += 1;
+        if self.filled == BLOCK {
+            self.flush()?;
+        }
+        Ok(s)
+    }
+
+    /// Form the cross-products of the buffered innovations.
+    fn flush(&mut self) -> Result<()> {
+        let k = self.filled;
+        if k > 0 {
+            let cols: Vec<&[f64]> = self.columns.chunks_exact(BLOCK).map(|c| &c[..k]).collect();
+            self.moments.add_columns(&cols, &self.reading[..k])?;
+            self.filled = 0;
+        }
+        Ok(())
+    }
+
+    /// Add the readings of `other` (the same model and prior over other
+    /// runs, for example on another thread) to these.
+    pub fn merge(&mut self, other: &mut AugmentedFilter) -> Result<()> {
+        if other.prior_mean != self.prior_mean || other.prior_var != self.prior_var {
+            return Err(EstError::Dimension(
+                "augmented filter: merging filters of other priors".into(),
+            ));
+        }
+        self.flush()?;
+        other.flush()?;
+        self.moments.merge(&other.moments)?;
+        self.sum_log_2pi_var += other.sum_log_2pi_var;
+        Ok(())
+    }
+
+    /// The log-likelihood of every reading so far, with `β` integrated out
+    /// (module docs). [`EstError::Singular`] if the bordered matrix is not
+    /// positive definite in floating point.
+    pub fn log_likelihood(&mut self) -> Result<f64> {
+        self.flush()?;
+        let m = self.prior_mean.len();
+        let mut b = DMatrix::<f64>::zeros(m + 1, m + 1);
+        b.view_mut((0, 0), (m, m)).copy_from(&self.moments.ata());
+        for (j, v) in self.moments.aty().iter().enumerate() {
+            b[(j, m)] = *v;
+            b[(m, j)] = *v;
+        }
+        b[(m, m)] = self.moments.yty();
+        for (j, v) in self.prior_var.iter().enumerate() {
+            b[(j, j)] += 1.0 / v;
+        }
+        let l = nalgebra::Cholesky::new(b)
+            .ok_or_else(|| {
+                EstError::Singular(
+                    "augmented likelihood: cross-products not positive definite".into(),
+                )
+            })?
+            .unpack();
+        let log_det_m: f64 = (0..m).map(|j| 2.0 * l[(j, j)].ln()).sum();
+        let log_det_prior: f64 = self.prior_var.iter().map(|v| v.ln()).sum();
+        let schur = l[(m, m)] * l[(m, m)];
+        Ok(-0.5 * (self.sum_log_2pi_var + log_det_prior + log_det_m + schur))
+    }
+}
+
+/// `next ← Φ x` for every right-hand side (any `Φ`).
+struct Propagate<'a> {
+    x: &'a [f64],
+    next: &'a mut [f64],
+    phi_nz: &'a [(usize, usize, f64)],
+    width: usize,
+}
+
+impl aeromag_core::simd::Kernel for Propagate<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        let w = self.width;
+        self.next.fill(0.0);
+        for &(i, j, p) in self.phi_nz {
+            let (src, dst) = (
+                &self.x[j * w..(j + 1) * w],
+                &mut self.next[i * w..(i + 1) * w],
+            );
+            for (d, s) in dst.chunks_exact_mut(LANES).zip(src.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    d[l] += p * s[l];
+                }
+            }
+        }
+    }
+}
+
+/// Innovations `ν = rhs − hᵀx` (in `nu` on entry: the right-hand sides) and
+/// states `x += K ν`, for any number of states.
+struct Innovate<'a> {
+    x: &'a mut [f64],
+    nu: &'a mut [f64],
+    h: &'a [f64],
+    gain: &'a [f64],
+    width: usize,
+}
+
+impl aeromag_core::simd::Kernel for Innovate<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        let w = self.width;
+        for (i, &hi) in self.h.iter().enumerate() {
+            let xi = &self.x[i * w..(i + 1) * w];
+            for (v, s) in self.nu.chunks_exact_mut(LANES).zip(xi.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    v[l] -= hi * s[l];
+                }
+            }
+        }
+        for (i, &k) in self.gain.iter().enumerate() {
+            let xi = &mut self.x[i * w..(i + 1) * w];
+            for (s, v) in xi.chunks_exact_mut(LANES).zip(self.nu.chunks_exact(LANES)) {
+                for l in 0..LANES {
+                    s[l] += k * v[l];
+                }
+            }
+        }
+    }
+}
+
+/// [`Propagate`] with an upper-triangular `Φ` (when given) and
+/// [`Innovate`] in one pass over `x`, four right-hand sides at a time held
+/// in registers, for `N` states: the same operations in the same order.
+struct Step<'a, const N: usize> {
+    x: &'a mut [f64],
+    nu: &'a mut [f64],
+    phi: Option<&'a [f64]>,
+    h: &'a [f64],
+    gain: &'a [f64],
+    width: usize,
+}
+
+impl<const N: usize> aeromag_core::simd::Kernel for Step<'_, N> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        let w = self.width;
+        let h: [f64; N] = std::array::from_fn(|i| self.h[i]);
+        let k: [f64; N] = std::array::from_fn(|i| self.gain[i]);
+        let phi: Option<[[f64; N]; N]> = self
+            .phi
+            .map(|p| std::array::from_fn(|i| std::array::from_fn(|j| p[i * N + j])));
+        for b in (0..w).step_by(LANES) {
+            let mut xs = [[0.0; LANES]; N];
+            for (i, v) in xs.iter_mut().enumerate() {
+                v.copy_from_slice(&self.x[i * w + b..i * w + b + LANES]);
+            }
+            if let Some(p) = &phi {
+                // Row i reads the states j ≥ i, not yet overwritten.
+                for i in 0..N {
+                    let mut a = [0.0; LANES];
+                    for j in i..N {
+                        for l in 0..LANES {
+                            a[l] += p[i][j] * xs[j][l];
+                        }
+                    }
+                    xs[i] = a;
+                }
+            }
+            let mut v = [0.0; LANES];
+            v.copy_from_slice(&self.nu[b..b + LANES]);
+            for i in 0..N {
+                for l in 0..LANES {
+                    v[l] -= h[i] * xs[i][l];
+                }
+            }
+            for i in 0..N {
+                for l in 0..LANES {
+                    xs[i][l] += k[i] * v[l];
+                }
+            }
+            for (i, xi) in xs.iter().enumerate() {
+                self.x[i * w + b..i * w + b + LANES].copy_from_slice(xi);
+            }
+            self.nu[b..b + LANES].copy_from_slice(&v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small linear model `(n, upper)` with `m` regressors: the augmented
+    /// likelihood equals the joint filter's sum of innovation terms, over
+    /// two runs (the second started after two time updates in a row) and
+    /// with a non-zero prior mean; `n` of 5, 6 and 8 with an upper Φ take
+    /// the fused kernel, the others the general one.
+    fn equals_the_joint_filters_likelihood_for(n: usize, m: usize, upper: bool) {
+        let mut seed = 7u64 + n as u64;
+        let mut rnd = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let s0 = DMatrix::from_fn(n, n, |i, j| match (i, j) {
+            _ if i == j => 3.0 / (1 + i) as f64,
+            _ if i < j => 0.3 * rnd(),
+            _ => 0.0,
+        });
+        let phi = DMatrix::from_fn(n, n, |i, j| match (i, j) {
+            _ if i == j => 0.97,
+            _ if i < j || !upper => 0.2 * rnd(),
+            _ => 0.0,
+        });
+        let g = DMatrix::from_fn(n, n, |i, j| if i <= j { 0.1 * rnd() } else { 0.0 });
+        let prior_mean: Vec<f64> = (0..m).map(|j| j as f64 - 1.0).collect();
+        let prior_std: Vec<f64> = (0..m).map(|j| 10f64.powi(j as i32 % 4 - 1)).collect();
+        let mut aug = AugmentedFilter::new(&s0, &prior_mean, &prior_std).unwrap();
+        let mut s_joint = DMatrix::zeros(n + m, n + m);
+        s_joint.view_mut((0, 0), (n, n)).copy_from(&s0);
+        let mut x0 = vec![0.0; n + m];
+        for j in 0..m {
+            s_joint[(n + j, n + j)] = prior_std[j];
+            x0[n + j] = prior_mean[j];
+        }
+        let mut joint = SqrtKalmanFilter::new(&x0, &s_joint).unwrap();
+        let mut ll_joint = 0.0;
+        for k in 0..700 {
+            if k == 0 || k == 450 {
+                aug.start_run().unwrap();
+                joint.reset_leading(&vec![0.0; n], &s0).unwrap();
+            } else {
+                let twice = k == 300;
+                for _ in 0..1 + twice as usize {
+                    aug.predict(&phi, &g).unwrap();
+                    joint.predict_leading(&phi, &g).unwrap();
+                }
+            }
+            let mut h = vec![0.0; n];
+            h[0] = 1.0;
+            h[n - 1] = (0.1 * k as f64) % 3.0;
+            let z: Vec<f64> = (0..m).map(|j| rnd() * 10f64.powi(j as i32 % 3)).collect();
+            let y = 5.0 * rnd()
+                + z.iter()
+                    .enumerate()
+                    .map(|(j, v)| v * (j as f64 * 0.3 - 0.5))
+                    .sum::<f64>();
+            let r = 0.04;
+            aug.update(&h, &z, y, r).unwrap();
+            let mut hj = h.clone();
+            hj.extend_from_slice(&z);
+            ll_joint += joint.update(&hj, y, r).unwrap().log_likelihood();
+        }
+        let ll = aug.log_likelihood().unwrap();
+        assert!(
+            (ll - ll_joint).abs() <= 1e-10 * ll_joint.abs(),
+            "n {n}, m {m}, upper {upper}: augmented {ll} vs joint {ll_joint}"
+        );
+    }
+
+    #[test]
+    fn equals_the_joint_filters_likelihood() {
+        for (n, m, upper) in [
+            (2, 3, true),
+            (2, 3, false),
+            (5, 7, true),
+            (6, 1, true),
+            (8, 34, true),
+            (8, 5, false),
+        ] {
+            equals_the_joint_filters_likelihood_for(n, m, upper);
+        }
+    }
+
+    /// Splitting the runs between two filters and merging gives the
+    /// likelihood of one filter over all of them.
+    #[test]
+    fn merged_runs_give_the_whole_likelihood() {
+        let s0 = DMatrix::from_row_slice(2, 2, &[2.0, 0.1, 0.0, 1.0]);
+        let phi = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 0.9]);
+        let g = DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.0, 0.2]);
+        let new = || AugmentedFilter::new(&s0, &[0.0, 1.0], &[5.0, 5.0]).unwrap();
+        let (mut all, mut a, mut b) = (new(), new(), new());
+        for run in 0..4 {
+            all.start_run().unwrap();
+            let part = if run < 2 { &mut a } else { &mut b };
+            part.start_run().unwrap();
+            for k in 0..300 {
+                if k > 0 {
+                    all.predict(&phi, &g).unwrap();
+                    part.predict(&phi, &g).unwrap();
+                }
+                let t = (run * 300 + k) as f64;
+                let (z, y) = ([t.sin(), (0.3 * t).cos()], 0.1 * (0.01 * t).sin() + t.sin());
+                all.update(&[1.0, 0.0], &z, y, 0.01).unwrap();
+                part.update(&[1.0, 0.0], &z, y, 0.01).unwrap();
+            }
+        }
+        a.merge(&mut b).unwrap();
+        let (whole, merged) = (all.log_likelihood().unwrap(), a.log_likelihood().unwrap());
+        assert!(
+            (whole - merged).abs() <= 1e-12 * whole.abs(),
+            "{whole} vs {merged}"
+        );
+        let mut other = AugmentedFilter::new(&s0, &[0.0, 2.0], &[5.0, 5.0]).unwrap();
+        assert!(a.merge(&mut other).is_err());
+    }
+
+    #[test]
+    fn bad_prior_and_rows_are_errors() {
+        let s0 = DMatrix::identity(2, 2);
+        assert!(AugmentedFilter::new(&s0, &[0.0], &[0.0]).is_err());
+        assert!(AugmentedFilter::new(&s0, &[0.0], &[1.0, 2.0]).is_err());
+        let mut a = AugmentedFilter::new(&s0, &[0.0], &[1.0]).unwrap();
+        a.start_run().unwrap();
+        assert!(a.update(&[1.0, 0.0], &[1.0, 2.0], 0.0, 1.0).is_err());
+        assert!(a.update(&[1.0, 0.0], &[f64::NAN], 0.0, 1.0).is_err());
+        assert!(a.update(&[1.0, 0.0], &[1.0], 0.0, 1.0).is_ok());
+    }
+}
