@@ -417,10 +417,13 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     let mut residual_rms_nt = f64::NAN;
     if cfg.compute_series {
         let transition = AnomalyTransition::new(&noise, cfg.field_prior.order);
-        let mut res2 = 0.0;
-        for (run, cps) in runs.iter().zip(&conditionals) {
+        // The runs are independent given X̂1: each run's compensated reading
+        // and smoothed field on the cores (run-local slices, the same
+        // arithmetic), written back in run order.
+        let per_run = parallel_map(runs.len(), threads(), |r| -> Result<(Vec<f64>, Vec<f64>)> {
+            let (run, cps) = (&runs[r], &conditionals[r]);
             let s = &segments[run.seg];
-            let out = &mut series[run.seg];
+            let range = run.range.clone();
             let checkpoints: Vec<Checkpoint> = cps
                 .iter()
                 .map(|(step, c)| Checkpoint {
@@ -429,30 +432,38 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
                     factor: c.factor.clone(),
                 })
                 .collect();
-            for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+            let mut compensated = vec![0.0; range.len()];
+            for_each_design_row(spec, &s.data, range.clone(), |i, row| {
                 let a: f64 = row.iter().zip(&coef).map(|(a, c)| a * c).sum();
-                out.compensated_nt[i] = s.data.mag[i] - a;
+                compensated[i - range.start] = s.data.mag[i] - a;
             });
             let model = FieldModel {
-                time: s.data.time,
-                speed_m_s: s.speed_m_s,
-                alt_m: s.alt_m,
-                compensated_nt: &out.compensated_nt,
-                offset: run.range.start,
-                len: run.range.len(),
+                time: &s.data.time[range.clone()],
+                speed_m_s: &s.speed_m_s[range.clone()],
+                alt_m: &s.alt_m[range.clone()],
+                compensated_nt: &compensated,
+                offset: 0,
+                len: range.len(),
                 y_ref_nt: y_ref,
                 z0_m: z0,
                 noise,
                 prior: cfg.field_prior,
                 transition: transition.clone(),
             };
-            let mut external = std::mem::take(&mut out.external_nt);
+            let mut external = vec![0.0; range.len()];
             smooth_field(&model, &checkpoints, &mut external)?;
-            for i in run.range.clone() {
-                let e = out.compensated_nt[i] - external[i];
+            Ok((compensated, external))
+        });
+        let mut res2 = 0.0;
+        for (run, done) in runs.iter().zip(per_run) {
+            let (compensated, external) = done?;
+            let out = &mut series[run.seg];
+            out.compensated_nt[run.range.clone()].copy_from_slice(&compensated);
+            out.external_nt[run.range.clone()].copy_from_slice(&external);
+            for (c, e) in compensated.iter().zip(&external) {
+                let e = c - e;
                 res2 += e * e;
             }
-            out.external_nt = external;
         }
         residual_rms_nt = (res2 / rows as f64).sqrt();
     }
