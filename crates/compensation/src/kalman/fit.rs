@@ -4,7 +4,7 @@
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::JointFilter;
-use super::rows::for_each_design_row;
+use super::rows::{for_each_design_row, for_each_design_row_ahead};
 use super::track::step_length;
 use super::tuning::{Subset, TuningConfig, TuningReport, tune};
 use crate::error::{CompError, Result};
@@ -346,59 +346,66 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     let mut jf = JointFilter::new(&coef_mean, &coef_std, &cfg.field_prior, noise)?;
     let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
     // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
-    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = Vec::with_capacity(runs.len());
-    for run in &runs {
+    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = vec![Vec::new(); runs.len()];
+    // The design rows are formed on a second thread while the filter runs.
+    let run_list: Vec<(&Segment, Range<usize>)> = runs
+        .iter()
+        .map(|r| (&segments[r.seg].data, r.range.clone()))
+        .collect();
+    let (mut err, mut every, mut current) = (None, 0, usize::MAX);
+    for_each_design_row_ahead(spec, &run_list, |r, i, row| {
+        let run = &runs[r];
         let s = &segments[run.seg];
-        jf.start_run()?;
-        let mut err = None;
         let len = run.range.len();
-        let every = if cfg.smoother_block_len > 0 {
-            cfg.smoother_block_len
-        } else {
-            default_block_len(len)
-        };
-        let mut cps = Vec::new();
-        let out = series.get_mut(run.seg);
-        let (mut inn_out, mut std_out) = match out {
-            Some(o) => (Some(&mut o.innovation_nt), Some(&mut o.innovation_std_nt)),
-            None => (None, None),
-        };
-        for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
-            if err.is_some() {
-                return;
+        if r != current {
+            current = r;
+            if let Err(e) = jf.start_run() {
+                err = Some(e);
+                return false;
             }
-            let d = if i == run.range.start {
-                0.0
+            every = if cfg.smoother_block_len > 0 {
+                cfg.smoother_block_len
             } else {
-                step_length(s.data.time, s.speed_m_s, i)
+                default_block_len(len)
             };
-            match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
-                Ok(inn) => {
-                    log_lik += inn.log_likelihood();
-                    if i - run.range.start >= cfg.field_prior.dim() {
-                        chi2 += inn.value * inn.value / inn.variance;
-                        ss += inn.value * inn.value;
-                        n_stat += 1;
-                    }
-                    if let (Some(a), Some(b)) = (inn_out.as_deref_mut(), std_out.as_deref_mut()) {
-                        a[i] = inn.value;
-                        b[i] = inn.std();
-                    }
-                    let local = i - run.range.start;
-                    if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
-                        match jf.field_conditional() {
-                            Ok(c) => cps.push((local, c)),
-                            Err(e) => err = Some(e),
+        }
+        let d = if i == run.range.start {
+            0.0
+        } else {
+            step_length(s.data.time, s.speed_m_s, i)
+        };
+        match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
+            Ok(inn) => {
+                log_lik += inn.log_likelihood();
+                if i - run.range.start >= cfg.field_prior.dim() {
+                    chi2 += inn.value * inn.value / inn.variance;
+                    ss += inn.value * inn.value;
+                    n_stat += 1;
+                }
+                if let Some(o) = series.get_mut(run.seg) {
+                    o.innovation_nt[i] = inn.value;
+                    o.innovation_std_nt[i] = inn.std();
+                }
+                let local = i - run.range.start;
+                if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                    match jf.field_conditional() {
+                        Ok(c) => conditionals[r].push((local, c)),
+                        Err(e) => {
+                            err = Some(e);
+                            return false;
                         }
                     }
                 }
-                Err(e) => err = Some(e.at(format!("segment {}, row {i}", run.seg))),
+                true
             }
-        });
-        if let Some(e) = err {
-            return Err(e);
+            Err(e) => {
+                err = Some(e.at(format!("segment {}, row {i}", run.seg)));
+                false
+            }
         }
-        conditionals.push(cps);
+    });
+    if let Some(e) = err {
+        return Err(e);
     }
     let coef = jf.coefficients().to_vec();
     let posterior_covariance = jf.coefficient_covariance();

@@ -74,6 +74,86 @@ pub fn for_each_design_row(
     }
 }
 
+/// Rows per block handed from the producing thread
+/// ([`for_each_design_row_ahead`]).
+const AHEAD_BLOCK: usize = 512;
+
+/// A block of consecutive rows of one run.
+struct RowBlock {
+    run: usize,
+    first: usize,
+    rows: Vec<f64>,
+}
+
+/// [`for_each_design_row`] over the runs `runs` (a segment and a range of
+/// it each), calling `f(run, i, row)` for every sample in order, with the
+/// rows formed on a second thread a few blocks ahead of `f` (a sequential
+/// filter consuming them overlaps with the lag filters and products that
+/// form them). The same rows in the same order as one thread. `f` returns
+/// `false` to stop.
+pub fn for_each_design_row_ahead(
+    spec: &Design,
+    runs: &[(&Segment, Range<usize>)],
+    mut f: impl FnMut(usize, usize, &[f64]) -> bool,
+) {
+    let ncol = spec.terms.n_columns();
+    if aeromag_core::parallel::threads() < 2 || ncol == 0 {
+        for (r, (seg, range)) in runs.iter().enumerate() {
+            let mut go = true;
+            for_each_design_row(spec, seg, range.clone(), |i, row| {
+                go = go && f(r, i, row);
+            });
+            if !go {
+                return;
+            }
+        }
+        return;
+    }
+    let (full_tx, full_rx) = std::sync::mpsc::sync_channel::<RowBlock>(4);
+    let (empty_tx, empty_rx) = std::sync::mpsc::channel::<Vec<f64>>();
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            for (r, (seg, range)) in runs.iter().enumerate() {
+                let fresh = || empty_rx.try_recv().unwrap_or_default();
+                let mut block = RowBlock {
+                    run: r,
+                    first: range.start,
+                    rows: fresh(),
+                };
+                block.rows.clear();
+                let mut stopped = false;
+                for_each_design_row(spec, seg, range.clone(), |i, row| {
+                    if stopped {
+                        return;
+                    }
+                    block.rows.extend_from_slice(row);
+                    if block.rows.len() == AHEAD_BLOCK * ncol {
+                        let mut next = RowBlock {
+                            run: r,
+                            first: i + 1,
+                            rows: fresh(),
+                        };
+                        next.rows.clear();
+                        stopped = full_tx.send(std::mem::replace(&mut block, next)).is_err();
+                    }
+                });
+                if stopped || (!block.rows.is_empty() && full_tx.send(block).is_err()) {
+                    return;
+                }
+            }
+        });
+        for block in full_rx.iter() {
+            for (j, row) in block.rows.chunks_exact(ncol).enumerate() {
+                if !f(block.run, block.first + j, row) {
+                    // Dropping the receiver stops the producer.
+                    return;
+                }
+            }
+            let _ = empty_tx.send(block.rows);
+        }
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,5 +216,57 @@ mod tests {
                 assert_eq!(count, run.len());
             }
         }
+    }
+
+    /// The rows handed over from the second thread are those of one thread,
+    /// in order, across runs of several segments and block boundaries, and
+    /// stopping early stops.
+    #[test]
+    fn rows_ahead_equal_the_rows_in_turn() {
+        let n = 3 * AHEAD_BLOCK + 17;
+        let time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1).collect();
+        let f: [Vec<f64>; 3] = [0.05, 0.031, 0.07].map(|w| {
+            (0..n)
+                .map(|k| 20_000.0 + 300.0 * (k as f64 * w).sin())
+                .collect()
+        });
+        let seg = Segment {
+            time: &time,
+            flux: [&f[0], &f[1], &f[2]],
+            mag: &f[0],
+            channels: Default::default(),
+            direction: None,
+        };
+        let spec = Design {
+            terms: TermSet::parse("p3,i6,e9")
+                .unwrap()
+                .with_eddy_lags(&[0.3])
+                .unwrap(),
+            ..Design::default()
+        };
+        let runs = [
+            (&seg, 0..AHEAD_BLOCK),
+            (&seg, AHEAD_BLOCK..AHEAD_BLOCK + 1),
+            (&seg, 700..n),
+            (&seg, 3..40),
+        ];
+        let mut want = Vec::new();
+        for (r, (s, range)) in runs.iter().enumerate() {
+            for_each_design_row(&spec, s, range.clone(), |i, row| {
+                want.push((r, i, row.to_vec()))
+            });
+        }
+        let mut got = Vec::new();
+        for_each_design_row_ahead(&spec, &runs, |r, i, row| {
+            got.push((r, i, row.to_vec()));
+            true
+        });
+        assert_eq!(got, want);
+        let mut seen = 0;
+        for_each_design_row_ahead(&spec, &runs, |_, _, _| {
+            seen += 1;
+            seen < 1000
+        });
+        assert_eq!(seen, 1000);
     }
 }
