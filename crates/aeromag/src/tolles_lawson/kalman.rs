@@ -11,9 +11,9 @@ use aeromag_compensation::kalman::altitude::{
     AltitudeSmoothing, AltitudeSource, NavRun, check_down_velocity, smooth_altitude,
 };
 use aeromag_compensation::kalman::{
-    DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, NoiseModel, ORDERS,
-    X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions, ground_speed_from_velocity,
-    q1_unit,
+    CoefficientPass, DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries,
+    NoiseModel, ORDERS, X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions,
+    ground_speed_from_velocity, q1_unit,
 };
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
@@ -236,6 +236,9 @@ pub(super) fn fit_kalman_flight(
                         .in_file(&file)?,
                 ),
                 compute_series: true,
+                // Only its coefficients, field and intensities are used:
+                // no innovations, the runs on all cores.
+                coefficient_pass: CoefficientPass::Augmented,
                 ..cfg.clone()
             };
             let first = fit_kalman(&segments, &pass1).in_file(&file)?;

@@ -5,7 +5,9 @@
 use super::calibrate::EddyLag;
 use crate::error::{Error, InFile, Result};
 use crate::observer::Notes;
-use aeromag_compensation::kalman::{KalmanConfig, KalmanFit, KalmanSegment, fit_kalman};
+use aeromag_compensation::kalman::{
+    CoefficientPass, KalmanConfig, KalmanFit, KalmanSegment, fit_kalman,
+};
 use aeromag_compensation::tolles_lawson::extra_select::{ChannelSelection, select_extra_channels};
 use aeromag_compensation::tolles_lawson::fit_ls::{
     LsConfig, Segment, fit_exact_magnitude, linearised,
@@ -301,6 +303,8 @@ pub(super) fn add_lags_by_kalman_likelihood(
     let mut fixed = KalmanConfig {
         noise: first.noise,
         compute_series: false,
+        // Only the likelihood and the covariances are used.
+        coefficient_pass: CoefficientPass::Augmented,
         ..cfg.clone()
     };
     fixed.tuning.enabled = false;

@@ -2,8 +2,9 @@
 //! smoothed external field), outputs and diagnostics.
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
+use super::field_filter::{FieldFilter, check_field_model, groups_of_runs};
 use super::field_smoother::{FieldModel, smooth_field};
-use super::joint_filter::JointFilter;
+use super::joint_filter::{JointFilter, est};
 use super::rows::{for_each_design_row, for_each_design_row_ahead};
 use super::track::step_length;
 use super::tuning::{Subset, TuningConfig, TuningReport, tune};
@@ -15,7 +16,9 @@ use crate::tolles_lawson::Design;
 use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
 use aeromag_core::parallel::{parallel_map, threads};
-use aeromag_estimation::kalman::{Checkpoint, LeadingConditional, default_block_len};
+use aeromag_estimation::kalman::{
+    AugmentedFilter, Checkpoint, LeadingConditional, default_block_len, upper_cholesky,
+};
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -65,6 +68,28 @@ pub struct KalmanConfig {
     /// Variance inflation factor above which a term is reported as poorly
     /// determined (default 1e4).
     pub max_vif: f64,
+    /// How pass 1 estimates the coefficients (default: the joint filter).
+    #[serde(default)]
+    pub coefficient_pass: CoefficientPass,
+}
+
+/// How pass 1 estimates the coefficients.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CoefficientPass {
+    /// The joint square-root filter of field and coefficients over the
+    /// runs in turn (the thesis): also gives the sequential innovations,
+    /// each with the coefficients estimated from the samples before it
+    /// (their statistics and the innovation series).
+    #[default]
+    Joint,
+    /// The field filter with the coefficients integrated out
+    /// ([`super::field_filter`]), groups of runs on all cores: the same
+    /// coefficients, covariance, likelihood and smoothed field to
+    /// round-off, without innovations (their statistics NaN, their series
+    /// NaN). For fits whose innovations nobody reads: the Kalman method's
+    /// field removal and its likelihood-ratio tests of further lags.
+    Augmented,
 }
 
 impl Default for KalmanConfig {
@@ -79,6 +104,7 @@ impl Default for KalmanConfig {
             compute_series: true,
             smoother_block_len: 0,
             max_vif: 1e4,
+            coefficient_pass: CoefficientPass::Joint,
         }
     }
 }
@@ -326,7 +352,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         tuning = Some(rep);
     }
 
-    // ---- pass 1: the joint filter over every run.
+    // ---- pass 1: the coefficients and the smoother's restart points.
     let mut series: Vec<KalmanSeries> = if cfg.compute_series {
         segments
             .iter()
@@ -343,77 +369,34 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     } else {
         Vec::new()
     };
-    let mut jf = JointFilter::new(&coef_mean, &coef_std, &cfg.field_prior, noise)?;
-    let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
-    // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
-    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = vec![Vec::new(); runs.len()];
-    // The design rows are formed on a second thread while the filter runs.
-    let run_list: Vec<(&Segment, Range<usize>)> = runs
-        .iter()
-        .map(|r| (&segments[r.seg].data, r.range.clone()))
-        .collect();
-    let (mut err, mut every, mut current) = (None, 0, usize::MAX);
-    for_each_design_row_ahead(spec, &run_list, |r, i, row| {
-        let run = &runs[r];
-        let s = &segments[run.seg];
-        let len = run.range.len();
-        if r != current {
-            current = r;
-            if let Err(e) = jf.start_run() {
-                err = Some(e);
-                return false;
-            }
-            every = if cfg.smoother_block_len > 0 {
-                cfg.smoother_block_len
-            } else {
-                default_block_len(len)
-            };
-        }
-        let d = if i == run.range.start {
-            0.0
-        } else {
-            step_length(s.data.time, s.speed_m_s, i)
-        };
-        match jf.step(d, row, s.alt_m[i] - z0, s.data.mag[i] - y_ref) {
-            Ok(inn) => {
-                log_lik += inn.log_likelihood();
-                if i - run.range.start >= cfg.field_prior.dim() {
-                    chi2 += inn.value * inn.value / inn.variance;
-                    ss += inn.value * inn.value;
-                    n_stat += 1;
-                }
-                if let Some(o) = series.get_mut(run.seg) {
-                    o.innovation_nt[i] = inn.value;
-                    o.innovation_std_nt[i] = inn.std();
-                }
-                let local = i - run.range.start;
-                if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
-                    match jf.field_conditional() {
-                        Ok(c) => conditionals[r].push((local, c)),
-                        Err(e) => {
-                            err = Some(e);
-                            return false;
-                        }
-                    }
-                }
-                true
-            }
-            Err(e) => {
-                err = Some(e.at(format!("segment {}, row {i}", run.seg)));
-                false
-            }
-        }
-    });
-    if let Some(e) = err {
-        return Err(e);
-    }
-    let coef = jf.coefficients().to_vec();
-    let posterior_covariance = jf.coefficient_covariance();
+    let inputs = PassInputs {
+        segments,
+        runs: &runs,
+        cfg,
+        noise,
+        z0,
+        y_ref,
+        coef_mean: &coef_mean,
+        coef_std: &coef_std,
+    };
+    let Pass1 {
+        coef,
+        posterior_covariance,
+        factor,
+        log_lik,
+        chi2,
+        ss,
+        n_stat,
+        conditionals,
+    } = match cfg.coefficient_pass {
+        CoefficientPass::Joint => joint_pass(&inputs, &mut series)?,
+        CoefficientPass::Augmented => augmented_pass(&inputs)?,
+    };
     let std: Vec<f64> = (0..m)
         .map(|j| posterior_covariance[(j, j)].max(0.0).sqrt())
         .collect();
     let (vif, condition, diag_warnings) = information_diagnostics(
-        &jf.coefficient_factor(),
+        &factor,
         cfg.coef_prior_std * cfg.coef_prior_std,
         &names,
         cfg.max_vif,
@@ -474,6 +457,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         }
         residual_rms_nt = (res2 / rows as f64).sqrt();
     }
+    let innovations = cfg.coefficient_pass == CoefficientPass::Joint;
     let n_stat_f = n_stat.max(1) as f64;
     let niv = chi2 / n_stat_f;
     if n_stat > 0 && !(0.25..=4.0).contains(&niv) {
@@ -489,7 +473,10 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         names,
         coef,
         std,
-        prior_covariance: jf.coefficient_prior_covariance().clone(),
+        prior_covariance: DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(
+            m,
+            coef_std.iter().map(|s| s * s),
+        )),
         posterior_covariance,
         vif,
         condition,
@@ -499,8 +486,12 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         z0_m: z0,
         y_ref_nt: y_ref,
         log_likelihood: log_lik,
-        normalized_innovation_variance: niv,
-        innovation_rms_nt: (ss / n_stat_f).sqrt(),
+        normalized_innovation_variance: if innovations { niv } else { f64::NAN },
+        innovation_rms_nt: if innovations {
+            (ss / n_stat_f).sqrt()
+        } else {
+            f64::NAN
+        },
         residual_rms_nt,
         rows,
         runs: runs.len(),
@@ -511,6 +502,192 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         },
         warnings,
         series,
+    })
+}
+
+/// What pass 1 needs besides the configuration.
+struct PassInputs<'a> {
+    segments: &'a [KalmanSegment<'a>],
+    runs: &'a [Run],
+    cfg: &'a KalmanConfig,
+    noise: NoiseModel,
+    z0: f64,
+    y_ref: f64,
+    coef_mean: &'a [f64],
+    coef_std: &'a [f64],
+}
+
+/// Pass 1's results: the coefficients' posterior (mean, covariance and its
+/// upper factor), the log-likelihood, the innovation statistics (zero
+/// without innovations) and per run the smoother's restart points
+/// (run-local step, `X2 | X1`).
+struct Pass1 {
+    coef: Vec<f64>,
+    posterior_covariance: DMatrix<f64>,
+    factor: DMatrix<f64>,
+    log_lik: f64,
+    chi2: f64,
+    ss: f64,
+    n_stat: usize,
+    conditionals: Vec<Vec<(usize, LeadingConditional)>>,
+}
+
+/// Pass 1 by the joint filter over the runs in turn; the innovations go
+/// into `series` (when computed).
+fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
+    let mut jf = JointFilter::new(p.coef_mean, p.coef_std, &p.cfg.field_prior, p.noise)?;
+    let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
+    // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
+    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = vec![Vec::new(); p.runs.len()];
+    // The design rows are formed on a second thread while the filter runs.
+    let run_list: Vec<(&Segment, Range<usize>)> = p
+        .runs
+        .iter()
+        .map(|r| (&p.segments[r.seg].data, r.range.clone()))
+        .collect();
+    let (mut err, mut every, mut current) = (None, 0, usize::MAX);
+    for_each_design_row_ahead(&p.cfg.design, &run_list, |r, i, row| {
+        let run = &p.runs[r];
+        let s = &p.segments[run.seg];
+        let len = run.range.len();
+        if r != current {
+            current = r;
+            if let Err(e) = jf.start_run() {
+                err = Some(e);
+                return false;
+            }
+            every = if p.cfg.smoother_block_len > 0 {
+                p.cfg.smoother_block_len
+            } else {
+                default_block_len(len)
+            };
+        }
+        let d = if i == run.range.start {
+            0.0
+        } else {
+            step_length(s.data.time, s.speed_m_s, i)
+        };
+        match jf.step(d, row, s.alt_m[i] - p.z0, s.data.mag[i] - p.y_ref) {
+            Ok(inn) => {
+                log_lik += inn.log_likelihood();
+                if i - run.range.start >= p.cfg.field_prior.dim() {
+                    chi2 += inn.value * inn.value / inn.variance;
+                    ss += inn.value * inn.value;
+                    n_stat += 1;
+                }
+                if let Some(o) = series.get_mut(run.seg) {
+                    o.innovation_nt[i] = inn.value;
+                    o.innovation_std_nt[i] = inn.std();
+                }
+                let local = i - run.range.start;
+                if p.cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                    match jf.field_conditional() {
+                        Ok(c) => conditionals[r].push((local, c)),
+                        Err(e) => {
+                            err = Some(e);
+                            return false;
+                        }
+                    }
+                }
+                true
+            }
+            Err(e) => {
+                err = Some(e.at(format!("segment {}, row {i}", run.seg)));
+                false
+            }
+        }
+    });
+    if let Some(e) = err {
+        return Err(e);
+    }
+    Ok(Pass1 {
+        coef: jf.coefficients().to_vec(),
+        posterior_covariance: jf.coefficient_covariance(),
+        factor: jf.coefficient_factor(),
+        log_lik,
+        chi2,
+        ss,
+        n_stat,
+        conditionals,
+    })
+}
+
+/// Pass 1 by the field filter with the coefficients integrated out
+/// ([`super::field_filter`]): groups of runs on the cores, their sums
+/// added in run order.
+fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
+    let (spec, cfg) = (&p.cfg.design, p.cfg);
+    check_field_model(&p.noise, &cfg.field_prior)?;
+    let groups = groups_of_runs(p.runs.iter().map(|r| r.range.len()));
+    let transition = AnomalyTransition::new(&p.noise, cfg.field_prior.order);
+    type Part = (AugmentedFilter, Vec<Vec<(usize, LeadingConditional)>>);
+    let parts = parallel_map(groups.len(), threads(), |gi| -> Result<Part> {
+        let mut f = FieldFilter::new(
+            &cfg.field_prior,
+            &transition,
+            p.noise.r_nt2,
+            p.coef_mean,
+            p.coef_std,
+        )?;
+        let mut restarts = Vec::new();
+        for run in &p.runs[groups[gi].clone()] {
+            let s = &p.segments[run.seg];
+            let len = run.range.len();
+            let every = if cfg.smoother_block_len > 0 {
+                cfg.smoother_block_len
+            } else {
+                default_block_len(len)
+            };
+            let (mut cps, mut err) = (Vec::new(), None);
+            for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+                if err.is_some() {
+                    return;
+                }
+                let first = i == run.range.start;
+                let d = if first {
+                    0.0
+                } else {
+                    step_length(s.data.time, s.speed_m_s, i)
+                };
+                if let Err(e) = f.step(first, d, row, s.alt_m[i] - p.z0, s.data.mag[i] - p.y_ref) {
+                    err = Some(e.at(format!("segment {}, row {i}", run.seg)));
+                    return;
+                }
+                let local = i - run.range.start;
+                if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                    cps.push((local, f.filter().conditional()));
+                }
+            });
+            if let Some(e) = err {
+                return Err(e);
+            }
+            restarts.push(cps);
+        }
+        Ok((f.into_filter(), restarts))
+    });
+    let mut total: Option<AugmentedFilter> = None;
+    let mut conditionals = Vec::with_capacity(p.runs.len());
+    for part in parts {
+        let (mut f, restarts) = part?;
+        conditionals.extend(restarts);
+        match total.as_mut() {
+            None => total = Some(f),
+            Some(t) => t.merge(&mut f).map_err(est)?,
+        }
+    }
+    let sol = total
+        .ok_or_else(|| CompError::data("no usable samples".to_string()))?
+        .solve()
+        .map_err(est)?;
+    Ok(Pass1 {
+        factor: upper_cholesky(&sol.covariance).map_err(est)?,
+        coef: sol.coef,
+        posterior_covariance: sol.covariance,
+        log_lik: sol.log_likelihood,
+        chi2: 0.0,
+        ss: 0.0,
+        n_stat: 0,
+        conditionals,
     })
 }
 

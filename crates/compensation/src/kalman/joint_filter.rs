@@ -23,6 +23,7 @@
 //! filtered estimate at the end is also its smoothed estimate).
 
 use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
+use super::field_filter::check_field_model;
 use crate::error::{CompError, Result};
 use aeromag_estimation::kalman::{Innovation, LeadingConditional, SqrtKalmanFilter};
 use nalgebra::{DMatrix, DVector};
@@ -72,16 +73,7 @@ impl JointFilter {
                 "coefficient prior: one finite positive standard deviation per coefficient",
             ));
         }
-        if !noise.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)"
-            )));
-        }
-        if !x2_prior.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid field prior {x2_prior:?} (positive, finite)"
-            )));
-        }
+        check_field_model(&noise, x2_prior)?;
         let x2_dim = x2_prior.dim();
         let n = x2_dim + m;
         let mut x0 = vec![0.0; n];

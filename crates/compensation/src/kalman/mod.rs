@@ -81,6 +81,7 @@
 //! | [`track`] | ground speed, along-track steps |
 //! | [`rows`] | streaming design rows in chunks |
 //! | [`joint_filter`] | pass 1: the joint square-root filter |
+//! | [`field_filter`] | pass 1 and the tuning's likelihood without the coefficients in the state (the runs on all cores) |
 //! | [`field_smoother`] | pass 2: the 5-state smoother given `X̂1` |
 //! | [`tuning`] | maximum-likelihood tuning of `q₁, q₂, r` (Nelder–Mead) |
 //! | [`fit`] | the whole method, outputs, diagnostics |
@@ -90,6 +91,7 @@
 
 pub mod altitude;
 pub mod anomaly_model;
+pub mod field_filter;
 pub mod field_smoother;
 pub mod fit;
 pub mod joint_filter;
@@ -99,7 +101,10 @@ pub mod track;
 pub mod tuning;
 
 pub use anomaly_model::{DEFAULT_ORDER, NoiseModel, ORDERS, THESIS_ORDER, X2Prior, q1_unit};
-pub use fit::{KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman, fit_kalman_exact};
+pub use fit::{
+    CoefficientPass, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman,
+    fit_kalman_exact,
+};
 pub use joint_filter::JointFilter;
 pub use track::{ground_speed_from_positions, ground_speed_from_velocity};
 pub use tuning::{TuningConfig, TuningReport};

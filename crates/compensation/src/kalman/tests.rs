@@ -3,6 +3,7 @@
 //! use the physically richer truth).
 
 use super::anomaly_model::{AnomalyTransition, B_H, DEFAULT_ORDER, THESIS_ORDER};
+use super::fit::CoefficientPass;
 use super::*;
 use crate::model_file::TlModel;
 use crate::tolles_lawson::Design;
@@ -655,5 +656,63 @@ fn the_tuning_likelihood_is_the_pass_1_filters() {
             (a - j).abs() <= 1e-10 * j.abs(),
             "augmented {a} vs joint {j}"
         );
+    }
+}
+
+/// Pass 1 by the field filter with the coefficients integrated out gives
+/// the joint filter's coefficients, covariance, likelihoods, diagnostics
+/// and smoothed field to round-off, over three runs, for the thesis' order
+/// and the default; it has no innovations.
+#[test]
+fn the_augmented_pass_gives_the_joint_fit() {
+    let terms = TermSet::observable16();
+    let mut b = flight(NOISE, &terms, &coef16(), 21);
+    b.mag[1234] = f64::NAN;
+    b.alt[2000] = f64::NAN;
+    for prior in [X2Prior::thesis(), X2Prior::default()] {
+        let joint_cfg = KalmanConfig {
+            field_prior: prior,
+            smoother_block_len: 100,
+            ..no_tuning(terms.clone(), NOISE)
+        };
+        let aug_cfg = KalmanConfig {
+            coefficient_pass: CoefficientPass::Augmented,
+            ..joint_cfg.clone()
+        };
+        let j = fit_kalman(&[b.segment()], &joint_cfg).unwrap();
+        let a = fit_kalman(&[b.segment()], &aug_cfg).unwrap();
+        assert_eq!((a.runs, a.rows), (3, j.rows));
+        let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+        let mut worst = [0.0f64; 5];
+        for k in 0..j.coef.len() {
+            worst[0] = worst[0].max((a.coef[k] - j.coef[k]).abs() / j.std[k]);
+            worst[1] = worst[1].max(rel(a.std[k], j.std[k]));
+            worst[2] = worst[2].max(rel(a.vif[k], j.vif[k]));
+        }
+        let (sa, sj) = (&a.series[0], &j.series[0]);
+        for k in 0..sj.external_nt.len() {
+            if sj.external_nt[k].is_nan() {
+                assert!(sa.external_nt[k].is_nan() && sa.compensated_nt[k].is_nan());
+                continue;
+            }
+            worst[3] = worst[3].max((sa.external_nt[k] - sj.external_nt[k]).abs());
+            worst[4] = worst[4].max((sa.compensated_nt[k] - sj.compensated_nt[k]).abs());
+        }
+        eprintln!(
+            "order {}: coefficients {:.1e} σ, std {:.1e}, VIF {:.1e}, field {:.1e} nT, compensated {:.1e} nT",
+            prior.order, worst[0], worst[1], worst[2], worst[3], worst[4]
+        );
+        assert!(
+            worst[0] < 1e-7 && worst[1] < 1e-7 && worst[2] < 1e-6,
+            "{worst:?}"
+        );
+        assert!(worst[3] < 1e-6 && worst[4] < 1e-6, "{worst:?}");
+        assert!(rel(a.log_likelihood, j.log_likelihood) < 1e-10);
+        assert!(rel(a.profile_log_likelihood(), j.profile_log_likelihood()) < 1e-10);
+        assert!(rel(a.condition, j.condition) < 1e-6);
+        assert!(rel(a.residual_rms_nt, j.residual_rms_nt) < 1e-8);
+        assert!(j.normalized_innovation_variance.is_finite());
+        assert!(a.normalized_innovation_variance.is_nan() && a.innovation_rms_nt.is_nan());
+        assert!(sa.innovation_nt.iter().all(|v| v.is_nan()));
     }
 }

@@ -138,13 +138,13 @@
 //! refinement): 1.8 s against 2.8 s with the joint filter and speculative
 //! Nelder–Mead steps on the second core (2 cores).
 
-use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
+use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
+use super::field_filter::{FieldFilter, check_field_model, groups_of_runs};
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
 use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::kalman::AugmentedFilter;
 use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead};
-use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the maximum-likelihood tuning.
@@ -241,7 +241,7 @@ impl Subset {
     /// integrated out of a filter of the field states alone
     /// ([`AugmentedFilter`]; equal to round-off). The runs are then
     /// independent: they are filtered in groups of about
-    /// [`SAMPLES_PER_GROUP`] samples on up to `threads` threads, and the
+    /// [`super::field_filter::SAMPLES_PER_GROUP`] samples on up to `threads` threads, and the
     /// groups' sums added in run order (the same bits with any number of
     /// threads).
     pub fn log_likelihood(
@@ -252,34 +252,32 @@ impl Subset {
         noise: NoiseModel,
         threads: usize,
     ) -> Result<f64> {
-        if !noise.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)"
-            )));
-        }
-        if !x2_prior.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid field prior {x2_prior:?} (positive, finite)"
-            )));
-        }
-        let mut groups = Vec::new();
-        let mut from = 0;
-        for k in 1..=self.len() {
-            if k == self.len() || (self.start[k] && k - from >= SAMPLES_PER_GROUP) {
-                groups.push(from..k);
-                from = k;
-            }
-        }
+        check_field_model(&noise, x2_prior)?;
+        // Runs as (start, length) in the subset.
+        let starts: Vec<usize> = (0..self.len())
+            .filter(|&k| k == 0 || self.start[k])
+            .collect();
+        let lengths = starts
+            .iter()
+            .enumerate()
+            .map(|(r, &k)| starts.get(r + 1).copied().unwrap_or(self.len()) - k);
+        let groups = groups_of_runs(lengths);
         let transition = AnomalyTransition::new(&noise, x2_prior.order);
-        let filtered = parallel_map(groups.len(), threads, |i| {
-            self.filter_samples(
-                groups[i].clone(),
-                coef_mean,
-                coef_std,
-                x2_prior,
-                &transition,
-                noise.r_nt2,
-            )
+        let filtered = parallel_map(groups.len(), threads, |i| -> Result<AugmentedFilter> {
+            let g = &groups[i];
+            let to = starts.get(g.end).copied().unwrap_or(self.len());
+            let mut f = FieldFilter::new(x2_prior, &transition, noise.r_nt2, coef_mean, coef_std)?;
+            for k in starts[g.start]..to {
+                let first = k == starts[g.start] || self.start[k];
+                f.step(
+                    first,
+                    self.d[k],
+                    &self.rows[k * self.m..(k + 1) * self.m],
+                    self.dz[k],
+                    self.y[k],
+                )?;
+            }
+            Ok(f.into_filter())
         });
         let mut total: Option<AugmentedFilter> = None;
         for f in filtered {
@@ -294,59 +292,7 @@ impl Subset {
             None => Ok(0.0),
         }
     }
-
-    /// The field filter over the samples `range` (whole runs).
-    fn filter_samples(
-        &self,
-        range: std::ops::Range<usize>,
-        coef_mean: &[f64],
-        coef_std: &[f64],
-        x2_prior: &X2Prior,
-        transition: &AnomalyTransition,
-        r_nt2: f64,
-    ) -> Result<AugmentedFilter> {
-        let mut f = AugmentedFilter::new(&x2_prior.factor(), coef_mean, coef_std).map_err(est)?;
-        let dim = x2_prior.dim();
-        let (mut phi, mut g) = (DMatrix::zeros(dim, dim), DMatrix::zeros(dim, dim));
-        let mut h = vec![0.0; dim];
-        h[B_H] = 1.0;
-        let mut last_d = f64::NAN;
-        let mut fresh = true;
-        for k in range {
-            if self.start[k] {
-                f.start_run().map_err(est)?;
-                fresh = true;
-            }
-            if !fresh {
-                let d = self.d[k];
-                if !(d >= 0.0 && d.is_finite()) {
-                    return Err(CompError::setting(format!(
-                        "along-track step {d} m must be finite and ≥ 0"
-                    )));
-                }
-                if d != last_d {
-                    transition.fill(d, &mut phi, &mut g);
-                    last_d = d;
-                }
-                f.predict(&phi, &g).map_err(est)?;
-            }
-            fresh = false;
-            h[x2_prior.b_z()] = self.dz[k];
-            f.update(
-                &h,
-                &self.rows[k * self.m..(k + 1) * self.m],
-                self.y[k],
-                r_nt2,
-            )
-            .map_err(est)?;
-        }
-        Ok(f)
-    }
 }
-
-/// Samples per group of runs filtered on one thread
-/// ([`Subset::log_likelihood`]).
-pub const SAMPLES_PER_GROUP: usize = 2048;
 
 /// Maximise the likelihood of `subset` over the selected `ln q₁, ln q₂,
 /// ln r` from `start` (the others stay at their start values).
@@ -514,7 +460,6 @@ const GRID_SPAN_DECADES: f64 = 6.0;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use aeromag_estimation::kalman::AugmentedFilter;
     use aeromag_estimation::optimize::nelder_mead;
 
     /// Two basins in `(ln q₁, ln q₂)`: a wide shallow one at the start and

@@ -47,7 +47,7 @@
 //! square-root filter's to 1·10⁻¹⁰ relative or better, on the Kalman
 //! compensation's flights to 5·10⁻¹³.
 
-use super::filter::SqrtKalmanFilter;
+use super::filter::{LeadingConditional, SqrtKalmanFilter};
 use crate::error::{EstError, Result};
 use crate::least_squares::NormalEquations;
 use nalgebra::DMatrix;
@@ -279,10 +279,58 @@ impl AugmentedFilter {
         Ok(())
     }
 
+    /// The dynamic states given `β` after the last [`Self::update`], as the
+    /// joint filter's [`LeadingConditional`]: `E[x | β] = x̂(β₀) + W (β −
+    /// β₀)` with `W = −(states of the regressor columns)`, covariance from
+    /// the `n`-state factor (which does not depend on `β`).
+    pub fn conditional(&self) -> LeadingConditional {
+        let (n, m, w) = (self.zeros.len(), self.prior_mean.len(), self.width);
+        LeadingConditional {
+            mean: (0..n).map(|i| self.x[i * w + m]).collect(),
+            factor: self.filter.factor().clone(),
+            weight: DMatrix::from_fn(n, m, |i, j| -self.x[i * w + j]),
+            trailing_mean: self.prior_mean.clone(),
+        }
+    }
+
+    /// The posterior of `β` from every reading so far: mean `β₀ + M⁻¹c`,
+    /// covariance `M⁻¹`, and the log-likelihood ([`Self::log_likelihood`]),
+    /// from one Cholesky factor of the bordered matrix.
+    pub fn solve(&mut self) -> Result<AugmentedSolution> {
+        let (l, log_likelihood) = self.factor()?;
+        let m = self.prior_mean.len();
+        let l11 = l.view((0, 0), (m, m)).into_owned();
+        // c = L11 l21 (the bordered factor's last row), so M⁻¹c = L11⁻ᵀ l21.
+        let l21 = l.view((m, 0), (1, m)).transpose();
+        let singular = || EstError::Singular("augmented solution: triangular solve".into());
+        let beta = l11
+            .transpose()
+            .solve_upper_triangular(&l21)
+            .ok_or_else(singular)?;
+        let inv_l = l11
+            .solve_lower_triangular(&DMatrix::identity(m, m))
+            .ok_or_else(singular)?;
+        Ok(AugmentedSolution {
+            coef: beta
+                .iter()
+                .zip(&self.prior_mean)
+                .map(|(d, b)| b + d)
+                .collect(),
+            covariance: inv_l.transpose() * &inv_l,
+            log_likelihood,
+        })
+    }
+
     /// The log-likelihood of every reading so far, with `β` integrated out
     /// (module docs). [`EstError::Singular`] if the bordered matrix is not
     /// positive definite in floating point.
     pub fn log_likelihood(&mut self) -> Result<f64> {
+        Ok(self.factor()?.1)
+    }
+
+    /// The lower Cholesky factor of the bordered matrix and the
+    /// log-likelihood.
+    fn factor(&mut self) -> Result<(DMatrix<f64>, f64)> {
         self.flush()?;
         let m = self.prior_mean.len();
         let mut b = DMatrix::<f64>::zeros(m + 1, m + 1);
@@ -305,8 +353,20 @@ impl AugmentedFilter {
         let log_det_m: f64 = (0..m).map(|j| 2.0 * l[(j, j)].ln()).sum();
         let log_det_prior: f64 = self.prior_var.iter().map(|v| v.ln()).sum();
         let schur = l[(m, m)] * l[(m, m)];
-        Ok(-0.5 * (self.sum_log_2pi_var + log_det_prior + log_det_m + schur))
+        let ll = -0.5 * (self.sum_log_2pi_var + log_det_prior + log_det_m + schur);
+        Ok((l, ll))
     }
+}
+
+/// The posterior of the coefficients ([`AugmentedFilter::solve`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AugmentedSolution {
+    /// The posterior mean of `β`.
+    pub coef: Vec<f64>,
+    /// Its covariance `M⁻¹` (`m × m`).
+    pub covariance: DMatrix<f64>,
+    /// The log-likelihood of the readings with `β` integrated out.
+    pub log_likelihood: f64,
 }
 
 /// `next ← Φ x` for every right-hand side (any `Φ`).
@@ -500,6 +560,43 @@ mod tests {
         assert!(
             (ll - ll_joint).abs() <= 1e-10 * ll_joint.abs(),
             "n {n}, m {m}, upper {upper}: augmented {ll} vs joint {ll_joint}"
+        );
+        // The posterior of β and the field given β: the joint filter's.
+        let sol = aug.solve().unwrap();
+        assert_eq!(sol.log_likelihood, ll);
+        let p_joint = joint.trailing_covariance(n);
+        let mut worst = (0.0f64, 0.0f64, 0.0f64);
+        for j in 0..m {
+            let sd = p_joint[(j, j)].sqrt();
+            worst.0 = worst.0.max((sol.coef[j] - joint.state()[n + j]).abs() / sd);
+            for i in 0..m {
+                let scale = (p_joint[(i, i)] * p_joint[(j, j)]).sqrt();
+                worst.1 = worst
+                    .1
+                    .max((sol.covariance[(i, j)] - p_joint[(i, j)]).abs() / scale);
+            }
+        }
+        let (ca, cj) = (aug.conditional(), joint.leading_conditional(n).unwrap());
+        let (ma, mj) = (ca.mean_given(&sol.coef), cj.mean_given(&sol.coef));
+        let (pa, pj) = (
+            &ca.factor * ca.factor.transpose(),
+            &cj.factor * cj.factor.transpose(),
+        );
+        for i in 0..n {
+            worst.2 = worst.2.max((ma[i] - mj[i]).abs() / pj[(i, i)].sqrt());
+            for k in 0..n {
+                worst.2 = worst
+                    .2
+                    .max((pa[(i, k)] - pj[(i, k)]).abs() / (pj[(i, i)] * pj[(k, k)]).sqrt());
+            }
+        }
+        eprintln!(
+            "n {n}, m {m}: worst coefficient {:.1e} σ, covariance {:.1e}, field {:.1e}",
+            worst.0, worst.1, worst.2
+        );
+        assert!(
+            worst.0 < 1e-9 && worst.1 < 1e-9 && worst.2 < 1e-9,
+            "n {n}, m {m}: {worst:?}"
         );
     }
 

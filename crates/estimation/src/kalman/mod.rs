@@ -57,7 +57,7 @@ pub mod mbf;
 pub mod rts;
 pub mod triangularize;
 
-pub use augmented::AugmentedFilter;
+pub use augmented::{AugmentedFilter, AugmentedSolution};
 pub use conventional::{ConventionalKalmanFilter, rts_step_conventional};
 pub use filter::{LeadingConditional, SqrtKalmanFilter, upper_cholesky};
 pub use fixed_interval::{
