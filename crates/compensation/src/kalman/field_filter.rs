@@ -43,6 +43,20 @@ pub fn groups_of_runs(lengths: impl IntoIterator<Item = usize>) -> Vec<std::ops:
     groups
 }
 
+/// One filter over the groups of runs that `parts` were filtered over, in
+/// order (their sums added in that order: the same bits however the groups
+/// were shared out). [`CompError::Data`] if there are none.
+pub fn merge_in_order(parts: impl IntoIterator<Item = AugmentedFilter>) -> Result<AugmentedFilter> {
+    let mut total: Option<AugmentedFilter> = None;
+    for mut f in parts {
+        match total.as_mut() {
+            None => total = Some(f),
+            Some(t) => t.merge(&mut f).map_err(est)?,
+        }
+    }
+    total.ok_or_else(|| CompError::data("no usable samples".to_string()))
+}
+
 /// The noise intensities and the field prior are usable: a
 /// [`CompError::Setting`] naming the bad one otherwise.
 pub fn check_field_model(noise: &NoiseModel, x2_prior: &X2Prior) -> Result<()> {

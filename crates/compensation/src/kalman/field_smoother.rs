@@ -7,8 +7,10 @@
 //! samples. They come from pass 1 at no extra filtering cost: the joint
 //! filter's conditional distribution of `X2` given `X1`
 //! (`E[X2 | X1] = x̂2 + U_b U_c⁻¹ (X1 − x̂1)`, factor `U_a`,
-//! [`super::JointFilter::field_conditional`]) evaluated at the final `X̂1`
-//! *is* the filtered estimate of pass 2 at that sample. So pass 2 re-runs
+//! [`super::JointFilter::field_conditional`]; from the field filter's
+//! right-hand sides with [`super::CoefficientPass::Augmented`],
+//! [`aeromag_estimation::kalman::AugmentedFilter::conditional`]) evaluated
+//! at the final `X̂1` *is* the filtered estimate of pass 2 at that sample. So pass 2 re-runs
 //! the 5-state filter once, block by block, and smooths backward.
 //!
 //! Why this equals the joint smoother (module docs of [`super`]): the field

@@ -1,8 +1,17 @@
 //! Method 2 end to end: runs, tuning, pass 1 (coefficients), pass 2 (the
 //! smoothed external field), outputs and diagnostics.
+//!
+//! Pass 1 is the joint filter over the runs in turn
+//! ([`CoefficientPass::Joint`], the default: it also gives the sequential
+//! innovations) or the field filter with the coefficients integrated out
+//! over groups of runs on all cores ([`CoefficientPass::Augmented`]: the
+//! same coefficients, covariance, likelihood and field to round-off, test
+//! `the_augmented_pass_gives_the_joint_fit`). Pass 2 smooths each run on
+//! its own, the runs on all cores, while pass 1's design rows are formed a
+//! few blocks ahead on a second thread.
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
-use super::field_filter::{FieldFilter, check_field_model, groups_of_runs};
+use super::field_filter::{FieldFilter, check_field_model, groups_of_runs, merge_in_order};
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::{JointFilter, est};
 use super::rows::{for_each_design_row, for_each_design_row_ahead};
@@ -665,20 +674,14 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
         }
         Ok((f.into_filter(), restarts))
     });
-    let mut total: Option<AugmentedFilter> = None;
+    let mut filters = Vec::with_capacity(parts.len());
     let mut conditionals = Vec::with_capacity(p.runs.len());
     for part in parts {
-        let (mut f, restarts) = part?;
+        let (f, restarts) = part?;
+        filters.push(f);
         conditionals.extend(restarts);
-        match total.as_mut() {
-            None => total = Some(f),
-            Some(t) => t.merge(&mut f).map_err(est)?,
-        }
     }
-    let sol = total
-        .ok_or_else(|| CompError::data("no usable samples".to_string()))?
-        .solve()
-        .map_err(est)?;
+    let sol = merge_in_order(filters)?.solve().map_err(est)?;
     Ok(Pass1 {
         factor: upper_cholesky(&sol.covariance).map_err(est)?,
         coef: sol.coef,

@@ -139,7 +139,7 @@
 //! Nelder–Mead steps on the second core (2 cores).
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
-use super::field_filter::{FieldFilter, check_field_model, groups_of_runs};
+use super::field_filter::{FieldFilter, check_field_model, groups_of_runs, merge_in_order};
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
 use aeromag_core::parallel::{parallel_map, threads};
@@ -279,18 +279,9 @@ impl Subset {
             }
             Ok(f.into_filter())
         });
-        let mut total: Option<AugmentedFilter> = None;
-        for f in filtered {
-            let mut f = f?;
-            match total.as_mut() {
-                None => total = Some(f),
-                Some(t) => t.merge(&mut f).map_err(est)?,
-            }
-        }
-        match total {
-            Some(mut t) => t.log_likelihood().map_err(est),
-            None => Ok(0.0),
-        }
+        merge_in_order(filtered.into_iter().collect::<Result<Vec<_>>>()?)?
+            .log_likelihood()
+            .map_err(est)
     }
 }
 
