@@ -103,6 +103,7 @@
 //! what the Tolles-Lawson model leaves). [`super::tuning`] adjusts them by
 //! maximum likelihood (the default of `aeromag calibrate --method kalman`).
 
+use crate::error::{CompError, Result};
 use aeromag_estimation::kalman::upper_cholesky;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -417,6 +418,44 @@ impl AnomalyTransition {
         g.as_mut_slice().fill(0.0);
         self.horizontal.fill(d, 0, phi, g);
         self.vertical.fill(d, b_z_index(self.order), phi, g);
+    }
+}
+
+/// [`AnomalyTransition`] for the steps of a run in turn: `Φ` and `G`
+/// recomputed only when the step length changes.
+#[derive(Debug, Clone)]
+pub struct StepTransition {
+    transition: AnomalyTransition,
+    phi: DMatrix<f64>,
+    g: DMatrix<f64>,
+    last_d: f64,
+}
+
+impl StepTransition {
+    /// The cache of `transition` (empty: the first step fills it).
+    pub fn new(transition: AnomalyTransition) -> Self {
+        let dim = transition.dim();
+        Self {
+            transition,
+            phi: DMatrix::zeros(dim, dim),
+            g: DMatrix::zeros(dim, dim),
+            last_d: f64::NAN,
+        }
+    }
+
+    /// `Φ` and `G` of a step of `d_m` metres (finite and ≥ 0, otherwise
+    /// [`CompError::Setting`]).
+    pub fn step(&mut self, d_m: f64) -> Result<(&DMatrix<f64>, &DMatrix<f64>)> {
+        if !(d_m >= 0.0 && d_m.is_finite()) {
+            return Err(CompError::setting(format!(
+                "along-track step {d_m} m must be finite and ≥ 0"
+            )));
+        }
+        if d_m != self.last_d {
+            self.transition.fill(d_m, &mut self.phi, &mut self.g);
+            self.last_d = d_m;
+        }
+        Ok((&self.phi, &self.g))
     }
 }
 

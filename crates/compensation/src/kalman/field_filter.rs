@@ -13,11 +13,10 @@
 //! way; what it cannot give is the joint filter's sequential innovations
 //! (each made with the coefficients estimated from the samples before).
 
-use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
+use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, StepTransition, X2Prior};
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
 use aeromag_estimation::kalman::AugmentedFilter;
-use nalgebra::DMatrix;
 
 /// Samples per group of runs filtered on one thread (a fixed partition:
 /// the same sums, the same bits, with any number of threads).
@@ -78,12 +77,9 @@ pub fn check_field_model(noise: &NoiseModel, x2_prior: &X2Prior) -> Result<()> {
 /// `h = e_{B^h} + Δz e_{B_z}`.
 pub struct FieldFilter {
     filter: AugmentedFilter,
-    transition: AnomalyTransition,
-    phi: DMatrix<f64>,
-    g: DMatrix<f64>,
+    transition: StepTransition,
     h: Vec<f64>,
     b_z: usize,
-    last_d: f64,
     r_nt2: f64,
 }
 
@@ -113,12 +109,9 @@ impl FieldFilter {
         h[B_H] = 1.0;
         Ok(Self {
             filter: AugmentedFilter::new(&x2_prior.factor(), coef_mean, coef_std).map_err(est)?,
-            transition: transition.clone(),
-            phi: DMatrix::zeros(dim, dim),
-            g: DMatrix::zeros(dim, dim),
+            transition: StepTransition::new(transition.clone()),
             h,
             b_z: x2_prior.b_z(),
-            last_d: f64::NAN,
             r_nt2,
         })
     }
@@ -130,16 +123,8 @@ impl FieldFilter {
         if first {
             self.filter.start_run().map_err(est)?;
         } else {
-            if !(d_m >= 0.0 && d_m.is_finite()) {
-                return Err(CompError::setting(format!(
-                    "along-track step {d_m} m must be finite and ≥ 0"
-                )));
-            }
-            if d_m != self.last_d {
-                self.transition.fill(d_m, &mut self.phi, &mut self.g);
-                self.last_d = d_m;
-            }
-            self.filter.predict(&self.phi, &self.g).map_err(est)?;
+            let (phi, g) = self.transition.step(d_m)?;
+            self.filter.predict(phi, g).map_err(est)?;
         }
         self.h[self.b_z] = dz_m;
         self.filter

@@ -22,7 +22,7 @@
 //! `P1 = U_c U_cᵀ` are the estimate from the whole flight (a constant's
 //! filtered estimate at the end is also its smoothed estimate).
 
-use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, X2Prior};
+use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, StepTransition, X2Prior};
 use super::field_filter::check_field_model;
 use crate::error::{CompError, Result};
 use aeromag_estimation::kalman::{Innovation, LeadingConditional, SqrtKalmanFilter};
@@ -39,13 +39,9 @@ pub struct JointFilter {
     b_z: usize,
     x2_factor: DMatrix<f64>,
     x1_prior_cov: DMatrix<f64>,
-    transition: AnomalyTransition,
-    phi: DMatrix<f64>,
-    g: DMatrix<f64>,
+    transition: StepTransition,
     h: Vec<f64>,
     fresh: bool,
-    /// The step length `phi`, `g` currently hold (NaN: none).
-    last_d: f64,
     /// Random-walk intensities of the first coefficients (online
     /// adaptation, [`Self::with_drift`]), coefficient units per √s; empty:
     /// every coefficient constant (the thesis).
@@ -96,12 +92,9 @@ impl JointFilter {
                 m,
                 coef_prior_std.iter().map(|s| s * s),
             )),
-            transition: AnomalyTransition::new(&noise, x2_prior.order),
-            phi: DMatrix::zeros(x2_dim, x2_dim),
-            g: DMatrix::zeros(x2_dim, x2_dim),
+            transition: StepTransition::new(AnomalyTransition::new(&noise, x2_prior.order)),
             h: vec![0.0; n],
             fresh: true,
-            last_d: f64::NAN,
             drift_per_sqrt_s: Vec::new(),
             phi_drift: DMatrix::zeros(0, 0),
             g_drift: DMatrix::zeros(0, 0),
@@ -176,19 +169,9 @@ impl JointFilter {
             )));
         }
         if !self.fresh {
-            if !(d_m >= 0.0 && d_m.is_finite()) {
-                return Err(CompError::setting(format!(
-                    "along-track step {d_m} m must be finite and ≥ 0"
-                )));
-            }
-            if d_m != self.last_d {
-                self.transition.fill(d_m, &mut self.phi, &mut self.g);
-                self.last_d = d_m;
-            }
+            let (phi, g) = self.transition.step(d_m)?;
             if self.drift_per_sqrt_s.is_empty() {
-                self.filter
-                    .predict_leading(&self.phi, &self.g)
-                    .map_err(est)?;
+                self.filter.predict_leading(phi, g).map_err(est)?;
             } else {
                 if !(dt_s >= 0.0 && dt_s.is_finite()) {
                     return Err(CompError::setting(format!(
@@ -196,8 +179,8 @@ impl JointFilter {
                     )));
                 }
                 let f = self.x2_dim;
-                self.phi_drift.view_mut((0, 0), (f, f)).copy_from(&self.phi);
-                self.g_drift.view_mut((0, 0), (f, f)).copy_from(&self.g);
+                self.phi_drift.view_mut((0, 0), (f, f)).copy_from(phi);
+                self.g_drift.view_mut((0, 0), (f, f)).copy_from(g);
                 for (j, s) in self.drift_per_sqrt_s.iter().enumerate() {
                     self.g_drift[(f + j, f + j)] = s * dt_s.sqrt();
                 }

@@ -623,16 +623,22 @@ fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
     }
 }
 
+/// The box of `observable16` with two missing samples: three runs.
+fn three_runs() -> (TermSet, Box) {
+    let terms = TermSet::observable16();
+    let mut b = flight(NOISE, &terms, &coef16(), 21);
+    b.mag[1234] = f64::NAN;
+    b.alt[2000] = f64::NAN;
+    (terms, b)
+}
+
 /// The tuning's likelihood (field filter with the coefficients integrated
 /// out, `AugmentedFilter`) is the pass-1 joint filter's, over three runs,
 /// for the thesis' order and the default: with nothing free the tuning
 /// reports the likelihood at the start, on the whole record (decimation 1).
 #[test]
 fn the_tuning_likelihood_is_the_pass_1_filters() {
-    let terms = TermSet::observable16();
-    let mut b = flight(NOISE, &terms, &coef16(), 21);
-    b.mag[1234] = f64::NAN;
-    b.alt[2000] = f64::NAN;
+    let (terms, b) = three_runs();
     for prior in [X2Prior::thesis(), X2Prior::default()] {
         let cfg = KalmanConfig {
             field_prior: prior,
@@ -665,10 +671,7 @@ fn the_tuning_likelihood_is_the_pass_1_filters() {
 /// and the default; it has no innovations.
 #[test]
 fn the_augmented_pass_gives_the_joint_fit() {
-    let terms = TermSet::observable16();
-    let mut b = flight(NOISE, &terms, &coef16(), 21);
-    b.mag[1234] = f64::NAN;
-    b.alt[2000] = f64::NAN;
+    let (terms, b) = three_runs();
     for prior in [X2Prior::thesis(), X2Prior::default()] {
         let joint_cfg = KalmanConfig {
             field_prior: prior,

@@ -369,6 +369,17 @@ pub struct AugmentedSolution {
     pub log_likelihood: f64,
 }
 
+/// `y ← y + a x`, [`LANES`] at a time (lengths multiples of it; `y − b x`
+/// as `a = −b` is the same in floating point).
+#[inline(always)]
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (v, s) in y.chunks_exact_mut(LANES).zip(x.chunks_exact(LANES)) {
+        for l in 0..LANES {
+            v[l] += a * s[l];
+        }
+    }
+}
+
 /// `next ← Φ x` for every right-hand side (any `Φ`).
 struct Propagate<'a> {
     x: &'a [f64],
@@ -388,11 +399,7 @@ impl aeromag_core::simd::Kernel for Propagate<'_> {
                 &self.x[j * w..(j + 1) * w],
                 &mut self.next[i * w..(i + 1) * w],
             );
-            for (d, s) in dst.chunks_exact_mut(LANES).zip(src.chunks_exact(LANES)) {
-                for l in 0..LANES {
-                    d[l] += p * s[l];
-                }
-            }
+            axpy(dst, p, src);
         }
     }
 }
@@ -413,20 +420,10 @@ impl aeromag_core::simd::Kernel for Innovate<'_> {
     fn run(self) {
         let w = self.width;
         for (i, &hi) in self.h.iter().enumerate() {
-            let xi = &self.x[i * w..(i + 1) * w];
-            for (v, s) in self.nu.chunks_exact_mut(LANES).zip(xi.chunks_exact(LANES)) {
-                for l in 0..LANES {
-                    v[l] -= hi * s[l];
-                }
-            }
+            axpy(self.nu, -hi, &self.x[i * w..(i + 1) * w]);
         }
         for (i, &k) in self.gain.iter().enumerate() {
-            let xi = &mut self.x[i * w..(i + 1) * w];
-            for (s, v) in xi.chunks_exact_mut(LANES).zip(self.nu.chunks_exact(LANES)) {
-                for l in 0..LANES {
-                    s[l] += k * v[l];
-                }
-            }
+            axpy(&mut self.x[i * w..(i + 1) * w], k, self.nu);
         }
     }
 }
