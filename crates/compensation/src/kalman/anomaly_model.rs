@@ -444,7 +444,7 @@ impl StepTransition {
     }
 
     /// `Φ` and `G` of a step of `d_m` metres (finite and ≥ 0, otherwise
-    /// [`CompError::Setting`]).
+    /// [`CompError::InvalidSetting`]).
     pub fn step(&mut self, d_m: f64) -> Result<(&DMatrix<f64>, &DMatrix<f64>)> {
         if !(d_m >= 0.0 && d_m.is_finite()) {
             return Err(CompError::setting(format!(

@@ -44,7 +44,7 @@ pub fn groups_of_runs(lengths: impl IntoIterator<Item = usize>) -> Vec<std::ops:
 
 /// One filter over the groups of runs that `parts` were filtered over, in
 /// order (their sums added in that order: the same bits however the groups
-/// were shared out). [`CompError::Data`] if there are none.
+/// were shared out). [`CompError::UnusableData`] if there are none.
 pub fn merge_in_order(parts: impl IntoIterator<Item = AugmentedFilter>) -> Result<AugmentedFilter> {
     let mut total: Option<AugmentedFilter> = None;
     for mut f in parts {
@@ -57,7 +57,7 @@ pub fn merge_in_order(parts: impl IntoIterator<Item = AugmentedFilter>) -> Resul
 }
 
 /// The noise intensities and the field prior are usable: a
-/// [`CompError::Setting`] naming the bad one otherwise.
+/// [`CompError::InvalidSetting`] naming the bad one otherwise.
 pub fn check_field_model(noise: &NoiseModel, x2_prior: &X2Prior) -> Result<()> {
     if !noise.is_valid() {
         return Err(CompError::setting(format!(

@@ -108,7 +108,7 @@ impl JointFilter {
     /// thesis' coefficients are constant; an online filter over hours lets
     /// the permanent terms follow a creeping magnetisation
     /// ([`super::online`]). A negative or non-finite intensity, or more than
-    /// `m`, is [`CompError::Setting`].
+    /// `m`, is [`CompError::InvalidSetting`].
     pub fn with_drift(mut self, drift_per_sqrt_s: &[f64]) -> Result<Self> {
         if drift_per_sqrt_s.len() > self.m
             || drift_per_sqrt_s

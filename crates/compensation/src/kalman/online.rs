@@ -138,7 +138,7 @@ pub struct OnlineKalman {
 impl OnlineKalman {
     /// The filter for `design`, starting at the model's coefficients `coef`
     /// with standard deviations `coef_std` (column order; NaN: unknown).
-    /// Bad settings are [`CompError::Setting`].
+    /// Bad settings are [`CompError::InvalidSetting`].
     pub fn new(
         design: &Design,
         coef: &[f64],

@@ -131,7 +131,7 @@ pub struct OnlineRows {
 impl OnlineRows {
     /// Rows of `design` under the causal convention, runs broken at time
     /// steps over `max_step_s` (s; the batch rule is 1.5 × the sample
-    /// interval). A step not positive is [`CompError::Setting`].
+    /// interval). A step not positive is [`CompError::InvalidSetting`].
     pub fn new(design: &Design, max_step_s: f64) -> Result<Self> {
         design.validate()?;
         if !(max_step_s > 0.0 && max_step_s.is_finite()) {
@@ -283,7 +283,7 @@ impl OnlineTl {
     /// The model `design` with coefficients `coef`, runs broken at time
     /// steps over `max_step_s` (s; the batch rule is 1.5 × the sample
     /// interval). Bad settings (coefficients not matching the design, a
-    /// step not positive) are [`CompError::Setting`].
+    /// step not positive) are [`CompError::InvalidSetting`].
     pub fn new(design: &Design, coef: &[f64], max_step_s: f64) -> Result<Self> {
         let rows = OnlineRows::new(design, max_step_s)?;
         let n = design.n_columns();

@@ -70,7 +70,7 @@ pub struct Rls {
 impl Rls {
     /// Start at the coefficients `coef` with standard deviations `coef_std`
     /// (NaN: unknown, the floor is used). Bad settings are
-    /// [`CompError::Setting`].
+    /// [`CompError::InvalidSetting`].
     pub fn new(coef: &[f64], coef_std: &[f64], settings: RlsSettings) -> Result<Self> {
         let ok = |v: f64| v > 0.0 && v.is_finite();
         if !(ok(settings.memory_s)
