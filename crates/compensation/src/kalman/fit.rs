@@ -393,9 +393,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         posterior_covariance,
         factor,
         log_lik,
-        chi2,
-        ss,
-        n_stat,
+        innovations,
         conditionals,
     } = match cfg.coefficient_pass {
         CoefficientPass::Joint => joint_pass(&inputs, &mut series)?,
@@ -466,10 +464,15 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         }
         residual_rms_nt = (res2 / rows as f64).sqrt();
     }
-    let innovations = cfg.coefficient_pass == CoefficientPass::Joint;
-    let n_stat_f = n_stat.max(1) as f64;
-    let niv = chi2 / n_stat_f;
-    if n_stat > 0 && !(0.25..=4.0).contains(&niv) {
+    // The innovation statistics (NaN without innovations).
+    let (niv, innovation_rms_nt) = match &innovations {
+        Some(sums) => {
+            let n = sums.count.max(1) as f64;
+            (sums.chi2 / n, (sums.ss / n).sqrt())
+        }
+        None => (f64::NAN, f64::NAN),
+    };
+    if innovations.as_ref().is_some_and(|sums| sums.count > 0) && !(0.25..=4.0).contains(&niv) {
         warnings.push(format!(
             "the innovations are {:.1}× {} than the noise model predicts (mean ν²/σ² = {niv:.2}): the noise \
              intensities do not fit this flight; subtract a base-station diurnal record, or tune them \
@@ -495,12 +498,8 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         z0_m: z0,
         y_ref_nt: y_ref,
         log_likelihood: log_lik,
-        normalized_innovation_variance: if innovations { niv } else { f64::NAN },
-        innovation_rms_nt: if innovations {
-            (ss / n_stat_f).sqrt()
-        } else {
-            f64::NAN
-        },
+        normalized_innovation_variance: niv,
+        innovation_rms_nt,
         residual_rms_nt,
         rows,
         runs: runs.len(),
@@ -527,18 +526,37 @@ struct PassInputs<'a> {
 }
 
 /// Pass 1's results: the coefficients' posterior (mean, covariance and its
-/// upper factor), the log-likelihood, the innovation statistics (zero
-/// without innovations) and per run the smoother's restart points
-/// (run-local step, `X2 | X1`).
+/// upper factor), the log-likelihood, the innovation statistics (the joint
+/// filter's only) and per run the smoother's restart points (run-local
+/// step, `X2 | X1`).
 struct Pass1 {
     coef: Vec<f64>,
     posterior_covariance: DMatrix<f64>,
     factor: DMatrix<f64>,
     log_lik: f64,
+    innovations: Option<InnovationSums>,
+    conditionals: Vec<Vec<(usize, LeadingConditional)>>,
+}
+
+/// Sums over the innovations past each run's first `n_f` samples: `Σ ν²/σ²`,
+/// `Σ ν²` and their number.
+struct InnovationSums {
     chi2: f64,
     ss: f64,
-    n_stat: usize,
-    conditionals: Vec<Vec<(usize, LeadingConditional)>>,
+    count: usize,
+}
+
+/// Whether pass 1 keeps a restart point of the smoother after the
+/// run-local sample `local` of a run of `len` samples: every smoother block
+/// ([`KalmanConfig::smoother_block_len`]) but the last, when the series are
+/// computed.
+fn restart_point(cfg: &KalmanConfig, local: usize, len: usize) -> bool {
+    let every = if cfg.smoother_block_len > 0 {
+        cfg.smoother_block_len
+    } else {
+        default_block_len(len)
+    };
+    cfg.compute_series && (local + 1).is_multiple_of(every) && local + 1 < len
 }
 
 /// Pass 1 by the joint filter over the runs in turn; the innovations go
@@ -554,7 +572,7 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         .iter()
         .map(|r| (&p.segments[r.seg].data, r.range.clone()))
         .collect();
-    let (mut err, mut every, mut current) = (None, 0, usize::MAX);
+    let (mut err, mut current) = (None, usize::MAX);
     for_each_design_row_ahead(&p.cfg.design, &run_list, |r, i, row| {
         let run = &p.runs[r];
         let s = &p.segments[run.seg];
@@ -565,11 +583,6 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
                 err = Some(e);
                 return false;
             }
-            every = if p.cfg.smoother_block_len > 0 {
-                p.cfg.smoother_block_len
-            } else {
-                default_block_len(len)
-            };
         }
         let d = if i == run.range.start {
             0.0
@@ -589,7 +602,7 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
                     o.innovation_std_nt[i] = inn.std();
                 }
                 let local = i - run.range.start;
-                if p.cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                if restart_point(p.cfg, local, len) {
                     match jf.field_conditional() {
                         Ok(c) => conditionals[r].push((local, c)),
                         Err(e) => {
@@ -614,9 +627,11 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         posterior_covariance: jf.coefficient_covariance(),
         factor: jf.coefficient_factor(),
         log_lik,
-        chi2,
-        ss,
-        n_stat,
+        innovations: Some(InnovationSums {
+            chi2,
+            ss,
+            count: n_stat,
+        }),
         conditionals,
     })
 }
@@ -642,11 +657,6 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
         for run in &p.runs[groups[gi].clone()] {
             let s = &p.segments[run.seg];
             let len = run.range.len();
-            let every = if cfg.smoother_block_len > 0 {
-                cfg.smoother_block_len
-            } else {
-                default_block_len(len)
-            };
             let (mut cps, mut err) = (Vec::new(), None);
             for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
                 if err.is_some() {
@@ -663,7 +673,7 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
                     return;
                 }
                 let local = i - run.range.start;
-                if cfg.compute_series && (local + 1) % every == 0 && local + 1 < len {
+                if restart_point(cfg, local, len) {
                     cps.push((local, f.filter().conditional()));
                 }
             });
@@ -687,9 +697,7 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
         coef: sol.coef,
         posterior_covariance: sol.covariance,
         log_lik: sol.log_likelihood,
-        chi2: 0.0,
-        ss: 0.0,
-        n_stat: 0,
+        innovations: None,
         conditionals,
     })
 }

@@ -135,8 +135,9 @@
 //! of the demo's calibrations and of 10⁵- and 10⁶-row flights were
 //! byte-identical. Tuning cost of `calibrate --method kalman` on a 10⁵-row
 //! flight (20 000 samples; the pass-1 search with its grid, then the final
-//! refinement): 1.8 s against 2.8 s with the joint filter and speculative
-//! Nelder–Mead steps on the second core (2 cores).
+//! refinement): 1.8 s against 2.8 s when the joint filter ran each
+//! evaluation and the second core evaluated Nelder–Mead's likely next
+//! point beside it (2 cores).
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
 use super::field_filter::{FieldFilter, check_field_model, groups_of_runs, merge_in_order};
@@ -366,8 +367,7 @@ pub fn tune(
     let mut evaluations = starts.evaluations;
     let mut best: Option<NelderMeadResult> = None;
     for x0 in &starts.points {
-        // Each evaluation on all cores (its runs shared out): no
-        // speculative evaluation is wasted, unlike nelder_mead_parallel.
+        // Each evaluation on all cores (its runs shared out).
         let r = nelder_mead(|t| objective(t, threads()), x0, &opts)
             .map_err(CompError::estimation("noise tuning"))?;
         evaluations += r.evaluations;

@@ -6,4 +6,4 @@
 
 pub mod nelder_mead;
 
-pub use nelder_mead::{NelderMeadOptions, NelderMeadResult, nelder_mead, nelder_mead_parallel};
+pub use nelder_mead::{NelderMeadOptions, NelderMeadResult, nelder_mead};

@@ -54,105 +54,7 @@ pub struct NelderMeadResult {
 
 /// Minimise `f` from `x0` (module docs).
 pub fn nelder_mead(
-    f: impl FnMut(&[f64]) -> f64,
-    x0: &[f64],
-    opts: &NelderMeadOptions,
-) -> Result<NelderMeadResult> {
-    search(&mut OneAtATime(f), x0, opts)
-}
-
-/// [`nelder_mead`] with the evaluations spread over up to `threads`
-/// threads: the points of the first simplex and of a shrink together, and
-/// with each reflected point the candidates the step may need next
-/// (inside contraction, outside contraction, expansion, as many as there
-/// are threads beside the one for the reflected point). The search takes the same path: for a function
-/// that depends only on its argument, the result (point, value, number of
-/// evaluations counted as [`nelder_mead`] counts them) is bit for bit that
-/// of [`nelder_mead`]; evaluations the path did not need are not counted.
-/// With expensive evaluations (a Kalman filter run over a flight) on two
-/// cores, a search takes about two thirds of the time.
-pub fn nelder_mead_parallel(
-    f: impl Fn(&[f64]) -> f64 + Sync,
-    x0: &[f64],
-    opts: &NelderMeadOptions,
-    threads: usize,
-) -> Result<NelderMeadResult> {
-    if threads <= 1 {
-        return nelder_mead(f, x0, opts);
-    }
-    search(&mut Speculative { f, threads }, x0, opts)
-}
-
-/// How [`search`] evaluates the function (values non-finite as `+∞`).
-trait Evaluator {
-    /// `f(needed)`, and `f` at those of `maybe` (best guesses first) that
-    /// can be evaluated meanwhile, `None` at the others.
-    fn with_candidates(&mut self, needed: &[f64], maybe: &[&[f64]]) -> (f64, Vec<Option<f64>>);
-    /// `f` at every point.
-    fn all(&mut self, xs: &[Vec<f64>]) -> Vec<f64>;
-}
-
-/// Non-finite values as `+∞` (the point is rejected).
-fn finite_or_inf(v: f64) -> f64 {
-    if v.is_finite() { v } else { f64::INFINITY }
-}
-
-/// One evaluation after the other.
-struct OneAtATime<F>(F);
-
-impl<F: FnMut(&[f64]) -> f64> Evaluator for OneAtATime<F> {
-    fn with_candidates(&mut self, needed: &[f64], maybe: &[&[f64]]) -> (f64, Vec<Option<f64>>) {
-        (finite_or_inf((self.0)(needed)), vec![None; maybe.len()])
-    }
-
-    fn all(&mut self, xs: &[Vec<f64>]) -> Vec<f64> {
-        xs.iter().map(|x| finite_or_inf((self.0)(x))).collect()
-    }
-}
-
-/// Evaluations side by side on scoped threads.
-struct Speculative<F> {
-    f: F,
-    threads: usize,
-}
-
-impl<F: Fn(&[f64]) -> f64 + Sync> Evaluator for Speculative<F> {
-    fn with_candidates(&mut self, needed: &[f64], maybe: &[&[f64]]) -> (f64, Vec<Option<f64>>) {
-        let extra = maybe.len().min(self.threads - 1);
-        let f = &self.f;
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = maybe[..extra]
-                .iter()
-                .map(|x| scope.spawn(move || finite_or_inf(f(x))))
-                .collect();
-            let v = finite_or_inf(f(needed));
-            let mut out: Vec<Option<f64>> = handles
-                .into_iter()
-                // A worker only panics if `f` does; pass that panic on.
-                .map(|h| Some(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p))))
-                .collect();
-            out.resize(maybe.len(), None);
-            (v, out)
-        })
-    }
-
-    fn all(&mut self, xs: &[Vec<f64>]) -> Vec<f64> {
-        let f = &self.f;
-        aeromag_core::parallel::parallel_map(xs.len(), self.threads, |i| finite_or_inf(f(&xs[i])))
-    }
-}
-
-/// The candidates after a reflection, in the order they are evaluated
-/// beside it: near a maximum of a likelihood most steps contract inside
-/// (74 % of the second evaluations over the Kalman tuning's searches on
-/// four flights, against 57 % for "the kind the previous step needed").
-const INSIDE: usize = 0;
-const OUTSIDE: usize = 1;
-const EXPAND: usize = 2;
-
-/// The search of [`nelder_mead`] (module docs), its evaluations through `ev`.
-fn search(
-    ev: &mut impl Evaluator,
+    mut f: impl FnMut(&[f64]) -> f64,
     x0: &[f64],
     opts: &NelderMeadOptions,
 ) -> Result<NelderMeadResult> {
@@ -170,21 +72,27 @@ fn search(
             what: "Nelder–Mead start point or step (steps must be non-zero)",
         });
     }
+    let mut evals = 0usize;
+    let mut eval = |x: &[f64], evals: &mut usize| {
+        *evals += 1;
+        let v = f(x);
+        if v.is_finite() { v } else { f64::INFINITY }
+    };
     let mut pts: Vec<Vec<f64>> = Vec::with_capacity(d + 1);
+    let mut fs: Vec<f64> = Vec::with_capacity(d + 1);
     pts.push(x0.to_vec());
+    fs.push(eval(x0, &mut evals));
     for i in 0..d {
         let mut p = x0.to_vec();
         p[i] += opts.initial_step[i];
+        fs.push(eval(&p, &mut evals));
         pts.push(p);
     }
-    let mut fs = ev.all(&pts);
-    let mut evals = d + 1;
     let mut order: Vec<usize> = (0..=d).collect();
     let mut converged = false;
     let mut c = vec![0.0; d];
     let mut xr = vec![0.0; d];
-    // Candidates after the reflection: inside and outside contraction, expansion.
-    let mut cand = [vec![0.0; d], vec![0.0; d], vec![0.0; d]];
+    let mut xe = vec![0.0; d];
     loop {
         // Stable sort: ties keep their previous order.
         order.sort_by(|&a, &b| fs[a].total_cmp(&fs[b]));
@@ -222,21 +130,15 @@ fn search(
         let f_worst = fs[worst];
         for j in 0..d {
             xr[j] = 2.0 * c[j] - pts[worst][j];
-            cand[INSIDE][j] = c[j] + 0.5 * (pts[worst][j] - c[j]);
-            cand[OUTSIDE][j] = c[j] + 0.5 * (xr[j] - c[j]);
-            cand[EXPAND][j] = c[j] + 2.0 * (xr[j] - c[j]);
         }
-        let maybe = [&cand[INSIDE][..], &cand[OUTSIDE][..], &cand[EXPAND][..]];
-        let (fr, known) = ev.with_candidates(&xr, &maybe);
-        evals += 1;
-        // The value at a candidate: evaluated meanwhile, or now.
-        let mut value_at =
-            |k: usize| known[k].unwrap_or_else(|| ev.with_candidates(&cand[k], &[]).0);
+        let fr = eval(&xr, &mut evals);
         if fr < f_best {
-            let fe = value_at(EXPAND);
-            evals += 1;
+            for j in 0..d {
+                xe[j] = c[j] + 2.0 * (xr[j] - c[j]);
+            }
+            let fe = eval(&xe, &mut evals);
             if fe < fr {
-                pts[worst].copy_from_slice(&cand[EXPAND]);
+                pts[worst].copy_from_slice(&xe);
                 fs[worst] = fe;
             } else {
                 pts[worst].copy_from_slice(&xr);
@@ -251,25 +153,26 @@ fn search(
         }
         // Contraction: outside if the reflection improved on the worst point.
         let outside = fr < f_worst;
-        let kind = if outside { OUTSIDE } else { INSIDE };
-        let fc = value_at(kind);
-        evals += 1;
+        for j in 0..d {
+            xe[j] = if outside {
+                c[j] + 0.5 * (xr[j] - c[j])
+            } else {
+                c[j] + 0.5 * (pts[worst][j] - c[j])
+            };
+        }
+        let fc = eval(&xe, &mut evals);
         if (outside && fc <= fr) || (!outside && fc < f_worst) {
-            pts[worst].copy_from_slice(&cand[kind]);
+            pts[worst].copy_from_slice(&xe);
             fs[worst] = fc;
             continue;
         }
         // Shrink towards the best point.
         let xb = pts[best].clone();
-        let shrunk: Vec<Vec<f64>> = order[1..]
-            .iter()
-            .map(|&i| (0..d).map(|j| xb[j] + 0.5 * (pts[i][j] - xb[j])).collect())
-            .collect();
-        let values = ev.all(&shrunk);
-        evals += d;
-        for ((&i, p), v) in order[1..].iter().zip(shrunk).zip(values) {
-            pts[i] = p;
-            fs[i] = v;
+        for &i in &order[1..] {
+            for j in 0..d {
+                pts[i][j] = xb[j] + 0.5 * (pts[i][j] - xb[j]);
+            }
+            fs[i] = eval(&pts[i].clone(), &mut evals);
         }
     }
     let best = order
@@ -331,52 +234,6 @@ mod tests {
             "{:?}",
             r.x
         );
-    }
-
-    /// The parallel search takes the sequential path: the same point, value
-    /// and count, bit for bit, on 2–4 threads, through expansions,
-    /// contractions, shrinks, rejected NaN and a budget that runs out.
-    #[test]
-    fn the_parallel_search_is_the_sequential_one() {
-        let rosen = |x: &[f64]| 100.0 * (x[1] - x[0] * x[0]).powi(2) + (1.0 - x[0]).powi(2);
-        // A non-smooth valley, NaN beyond x₂ = 4.
-        let kinked = |x: &[f64]| {
-            if x[2] > 4.0 {
-                return f64::NAN;
-            }
-            (x[0] - 0.3).abs() + 2.0 * (x[1] + x[0]).abs() + (x[2] - 1.0).powi(2)
-        };
-        // Steps: a contraction fails and the simplex shrinks.
-        let stairs =
-            |x: &[f64]| (x[0] * 3.0).floor().abs() + (x[1] * 3.0).floor().abs() + x[2].abs();
-        let cases: [(&(dyn Fn(&[f64]) -> f64 + Sync), Vec<f64>, NelderMeadOptions); 4] = [
-            (&stairs, vec![2.0, -1.0, 3.5], opts(3)),
-            (&rosen, vec![-1.2, 1.0], opts(2)),
-            (&kinked, vec![2.0, -1.0, 3.5], opts(3)),
-            (
-                &rosen,
-                vec![-1.2, 1.0],
-                NelderMeadOptions {
-                    max_evaluations: 37,
-                    ..opts(2)
-                },
-            ),
-        ];
-        for (f, x0, o) in &cases {
-            let seq = nelder_mead(f, x0, o).unwrap();
-            for threads in 2..=4 {
-                let par = nelder_mead_parallel(f, x0, o, threads).unwrap();
-                assert_eq!(
-                    par.x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-                    seq.x.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
-                );
-                assert_eq!(
-                    (par.f.to_bits(), par.evaluations, par.converged),
-                    (seq.f.to_bits(), seq.evaluations, seq.converged),
-                    "{threads} threads"
-                );
-            }
-        }
     }
 
     #[test]
