@@ -262,8 +262,12 @@ pub(super) fn fit_kalman_flight(
         }
     };
     let selection = choice.eddy;
+    // The final fit's sequential innovations by the joint filter split in
+    // two: the field filter on the cores, the coefficients' least squares
+    // alongside (the joint filter's results to round-off).
     let mut cfg = KalmanConfig {
         design: cfg.design.with_terms(choice.terms),
+        coefficient_pass: CoefficientPass::Split,
         ..cfg
     };
     // Pass 1 searched the likelihood globally (kalman::tuning, several

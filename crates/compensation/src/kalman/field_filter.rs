@@ -10,13 +10,23 @@
 //! on all cores and their sums added in run order. The noise tuning
 //! ([`super::tuning`]) evaluates its likelihood this way, and
 //! [`super::fit::CoefficientPass::Augmented`] fits the coefficients this
-//! way; what it cannot give is the joint filter's sequential innovations
-//! (each made with the coefficients estimated from the samples before).
+//! way; what it cannot give on its own is the joint filter's sequential
+//! innovations (each made with the coefficients estimated from the samples
+//! before): [`super::fit::CoefficientPass::Split`] records its whitened
+//! innovations for the coefficients' recursive least squares, which does.
+//!
+//! [`filter_groups`] filters the groups four at a time in SIMD lanes
+//! ([`AugmentedLanes`]: the small square-root factor's updates are chains
+//! of square roots and divisions, which four filters fill side by side),
+//! every group bit for bit what [`FieldFilter`] gives over it alone.
 
 use super::anomaly_model::{AnomalyTransition, B_H, NoiseModel, StepTransition, X2Prior};
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
-use aeromag_estimation::kalman::AugmentedFilter;
+use aeromag_estimation::kalman::{
+    AugmentedFilter, AugmentedLanes, FILTER_LANES, LaneStep, LeadingConditional, Reading,
+};
+use std::borrow::Cow;
 
 /// Samples per group of runs filtered on one thread (a fixed partition:
 /// the same sums, the same bits, with any number of threads).
@@ -142,4 +152,299 @@ impl FieldFilter {
     pub fn into_filter(self) -> AugmentedFilter {
         self.filter
     }
+}
+
+/// The samples of one group of runs for [`filter_groups`]: sample `k`
+/// starts a run (`first[k]`; sample 0 always does) or moves the field on
+/// by `d_m[k]` metres, then has the design row `rows[k m..(k + 1) m]`, the
+/// altitude offset `dz_m[k]` and the centred reading `y_nt[k]` (the
+/// arguments of [`FieldFilter::step`]); the field given the coefficients
+/// is kept after the samples where `keep[k]` (empty: none).
+#[derive(Debug, Clone, Default)]
+pub struct GroupSamples<'a> {
+    /// A run starts at the sample.
+    pub first: Cow<'a, [bool]>,
+    /// Along-track step from the sample before, m.
+    pub d_m: Cow<'a, [f64]>,
+    /// The design rows, row after row.
+    pub rows: Cow<'a, [f64]>,
+    /// Altitude offset from the reference, m.
+    pub dz_m: Cow<'a, [f64]>,
+    /// The centred reading, nT.
+    pub y_nt: Cow<'a, [f64]>,
+    /// Keep the field given the coefficients after the sample.
+    pub keep: Cow<'a, [bool]>,
+}
+
+impl GroupSamples<'_> {
+    fn len(&self) -> usize {
+        self.y_nt.len()
+    }
+
+    /// Sample `k`'s arguments of [`FieldFilter::step`].
+    fn at(&self, k: usize, m: usize) -> StepArgs<'_> {
+        (
+            k == 0 || self.first[k],
+            self.d_m[k],
+            &self.rows[k * m..(k + 1) * m],
+            self.dz_m[k],
+            self.y_nt[k],
+        )
+    }
+
+    fn keeps(&self, k: usize) -> bool {
+        self.keep.get(k).copied().unwrap_or(false)
+    }
+}
+
+/// [`GroupSamples`] built sample by sample.
+pub struct OwnedSamples {
+    first: Vec<bool>,
+    d_m: Vec<f64>,
+    rows: Vec<f64>,
+    dz_m: Vec<f64>,
+    y_nt: Vec<f64>,
+    keep: Vec<bool>,
+}
+
+impl OwnedSamples {
+    /// Room for `len` samples of `m` regressors.
+    pub fn with_capacity(len: usize, m: usize) -> Self {
+        Self {
+            first: Vec::with_capacity(len),
+            d_m: Vec::with_capacity(len),
+            rows: Vec::with_capacity(len * m),
+            dz_m: Vec::with_capacity(len),
+            y_nt: Vec::with_capacity(len),
+            keep: Vec::with_capacity(len),
+        }
+    }
+
+    /// One more sample (the fields of [`GroupSamples`]).
+    pub fn push(&mut self, first: bool, d_m: f64, row: &[f64], dz_m: f64, y_nt: f64, keep: bool) {
+        self.first.push(first);
+        self.d_m.push(d_m);
+        self.rows.extend_from_slice(row);
+        self.dz_m.push(dz_m);
+        self.y_nt.push(y_nt);
+        self.keep.push(keep);
+    }
+
+    /// The samples.
+    pub fn into_samples(self) -> GroupSamples<'static> {
+        GroupSamples {
+            first: Cow::Owned(self.first),
+            d_m: Cow::Owned(self.d_m),
+            rows: Cow::Owned(self.rows),
+            dz_m: Cow::Owned(self.dz_m),
+            y_nt: Cow::Owned(self.y_nt),
+            keep: Cow::Owned(self.keep),
+        }
+    }
+}
+
+/// The arguments of [`FieldFilter::step`]: `(first, d_m, row, dz_m, y_nt)`.
+type StepArgs<'s> = (bool, f64, &'s [f64], f64, f64);
+
+/// A group filtered by [`filter_groups`]: its filter (sums, last state) and
+/// the field given the coefficients after each kept sample (index in the
+/// group, conditional).
+pub struct FilteredGroup {
+    /// The filter after the group's last sample.
+    pub filter: AugmentedFilter,
+    /// `(k, X2 | X1)` after each sample `k` with `keep[k]`.
+    pub kept: Vec<(usize, LeadingConditional)>,
+    /// With [`FieldModelSpec::record_innovations`], each sample's whitened
+    /// innovations ([`AugmentedFilter::take_innovations`]), otherwise empty.
+    pub innovations: Vec<f64>,
+}
+
+impl FilteredGroup {
+    fn of(mut filter: AugmentedFilter, kept: Vec<(usize, LeadingConditional)>) -> Result<Self> {
+        let innovations = filter.take_innovations().map_err(est)?;
+        Ok(Self {
+            filter,
+            kept,
+            innovations,
+        })
+    }
+}
+
+/// What [`FieldFilter::new`] takes: the field prior, the transition for the
+/// noise intensities in use, the white-noise variance and the
+/// coefficients' prior.
+pub struct FieldModelSpec<'a> {
+    /// The field states' prior.
+    pub x2_prior: &'a X2Prior,
+    /// The transition for the noise intensities.
+    pub transition: &'a AnomalyTransition,
+    /// White-noise variance, nT².
+    pub r_nt2: f64,
+    /// The coefficients' prior means.
+    pub coef_mean: &'a [f64],
+    /// The coefficients' prior standard deviations.
+    pub coef_std: &'a [f64],
+    /// Record the innovations ([`FilteredGroup::innovations`]).
+    pub record_innovations: bool,
+}
+
+/// The field filter ([`FieldFilter`]) over each of `groups` groups of runs
+/// (`load(g)`: group `g`'s samples), the groups shared over `threads`
+/// threads and, for the field models of orders 3, 4 and 6, filtered four at
+/// a time in SIMD lanes ([`AugmentedLanes`]): every group's filter bit for
+/// bit [`FieldFilter`]'s over it alone, returned in group order.
+pub fn filter_groups<'a>(
+    groups: usize,
+    threads: usize,
+    model: &FieldModelSpec<'_>,
+    load: impl Fn(usize) -> Result<GroupSamples<'a>> + Sync,
+) -> Result<Vec<FilteredGroup>> {
+    if !(model.r_nt2 > 0.0 && model.r_nt2.is_finite()) {
+        return Err(CompError::setting(format!(
+            "white-noise variance {} nT² must be finite and > 0",
+            model.r_nt2
+        )));
+    }
+    let threads = threads.clamp(1, groups.max(1));
+    let per_thread = aeromag_core::parallel::parallel_map(threads, threads, |t| {
+        let mine: Vec<usize> = (t..groups).step_by(threads).collect();
+        let filtered = match model.x2_prior.dim() {
+            5 => lanes_over::<5>(&mine, model, &load),
+            6 => lanes_over::<6>(&mine, model, &load),
+            8 => lanes_over::<8>(&mine, model, &load),
+            _ => mine.iter().map(|&g| one_group(&load(g)?, model)).collect(),
+        };
+        filtered.map(|f| mine.into_iter().zip(f).collect::<Vec<_>>())
+    });
+    let mut out: Vec<Option<FilteredGroup>> = (0..groups).map(|_| None).collect();
+    for part in per_thread {
+        for (g, f) in part? {
+            out[g] = Some(f);
+        }
+    }
+    Ok(out
+        .into_iter()
+        .map(|f| f.expect("every group filtered"))
+        .collect())
+}
+
+/// One group with [`FieldFilter`].
+fn one_group(samples: &GroupSamples<'_>, model: &FieldModelSpec<'_>) -> Result<FilteredGroup> {
+    let mut f = FieldFilter::new(
+        model.x2_prior,
+        model.transition,
+        model.r_nt2,
+        model.coef_mean,
+        model.coef_std,
+    )?;
+    f.filter.record_innovations(model.record_innovations);
+    let m = model.coef_mean.len();
+    let mut kept = Vec::new();
+    for k in 0..samples.len() {
+        let (first, d, row, dz, y) = samples.at(k, m);
+        f.step(first, d, row, dz, y)?;
+        if samples.keeps(k) {
+            kept.push((k, f.filter().conditional()));
+        }
+    }
+    FilteredGroup::of(f.into_filter(), kept)
+}
+
+/// The groups `mine` in four lanes of `N` field states, a lane whose group
+/// is done taking the next one.
+fn lanes_over<'a, const N: usize>(
+    mine: &[usize],
+    model: &FieldModelSpec<'_>,
+    load: &(impl Fn(usize) -> Result<GroupSamples<'a>> + Sync),
+) -> Result<Vec<FilteredGroup>> {
+    let m = model.coef_mean.len();
+    let mut lanes =
+        AugmentedLanes::<N>::new(&model.x2_prior.factor(), model.coef_mean, model.coef_std)
+            .map_err(est)?;
+    lanes.record_innovations(model.record_innovations);
+    let mut transitions: Vec<StepTransition> = (0..FILTER_LANES)
+        .map(|_| StepTransition::new(model.transition.clone()))
+        .collect();
+    let b_z = model.x2_prior.b_z();
+    let mut h = [[0.0; N]; FILTER_LANES];
+    for hl in &mut h {
+        hl[B_H] = 1.0;
+    }
+    // Per lane: the group's position in `mine`, its samples, the next
+    // sample and the kept conditionals.
+    type Lane<'a> = (
+        usize,
+        GroupSamples<'a>,
+        usize,
+        Vec<(usize, LeadingConditional)>,
+    );
+    let mut at: [Option<Lane<'a>>; FILTER_LANES] = std::array::from_fn(|_| None);
+    let mut next_group = 0;
+    let mut done: Vec<Option<FilteredGroup>> = (0..mine.len()).map(|_| None).collect();
+    loop {
+        for (l, slot) in at.iter_mut().enumerate() {
+            while slot.is_none() && next_group < mine.len() {
+                let samples = load(mine[next_group])?;
+                if samples.len() == 0 {
+                    done[next_group] =
+                        Some(FilteredGroup::of(lanes.take(l).map_err(est)?, Vec::new())?);
+                } else {
+                    *slot = Some((next_group, samples, 0, Vec::new()));
+                }
+                next_group += 1;
+            }
+        }
+        if at.iter().all(Option::is_none) {
+            break;
+        }
+        let samples: [Option<StepArgs<'_>>; FILTER_LANES] =
+            std::array::from_fn(|l| at[l].as_ref().map(|(_, s, k, _)| s.at(*k, m)));
+        for (hl, s) in h.iter_mut().zip(&samples) {
+            if let Some((_, _, _, dz, _)) = s {
+                hl[b_z] = *dz;
+            }
+        }
+        let mut mats = Vec::with_capacity(FILTER_LANES);
+        for (t, s) in transitions.iter_mut().zip(&samples) {
+            mats.push(match s {
+                Some((false, d, ..)) => Some(t.step(*d)?),
+                _ => None,
+            });
+        }
+        let steps: [LaneStep; FILTER_LANES] = std::array::from_fn(|l| match &samples[l] {
+            None => LaneStep::Idle,
+            Some((_, _, row, _, y)) => {
+                let reading = Reading {
+                    h: &h[l],
+                    z: row,
+                    y: *y,
+                };
+                match mats[l] {
+                    Some((phi, g)) => LaneStep::Next { phi, g, reading },
+                    None => LaneStep::Start(reading),
+                }
+            }
+        });
+        lanes.step(steps, model.r_nt2).map_err(est)?;
+        for (l, slot) in at.iter_mut().enumerate() {
+            let finished = match slot {
+                None => continue,
+                Some((_, samples, k, kept)) => {
+                    if samples.keeps(*k) {
+                        kept.push((*k, lanes.conditional(l)));
+                    }
+                    *k += 1;
+                    *k == samples.len()
+                }
+            };
+            if finished {
+                let (i, _, _, kept) = slot.take().expect("an active lane");
+                done[i] = Some(FilteredGroup::of(lanes.take(l).map_err(est)?, kept)?);
+            }
+        }
+    }
+    Ok(done
+        .into_iter()
+        .map(|f| f.expect("every group filtered"))
+        .collect())
 }

@@ -11,7 +11,10 @@
 //! few blocks ahead on a second thread.
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
-use super::field_filter::{FieldFilter, check_field_model, groups_of_runs, merge_in_order};
+use super::field_filter::{
+    FieldModelSpec, FilteredGroup, GroupSamples, OwnedSamples, check_field_model, filter_groups,
+    groups_of_runs, merge_in_order,
+};
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::{JointFilter, est};
 use super::rows::{for_each_design_row, for_each_design_row_ahead};
@@ -26,7 +29,8 @@ use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
 use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::kalman::{
-    AugmentedFilter, Checkpoint, LeadingConditional, default_block_len, upper_cholesky,
+    Checkpoint, FILTER_LANES, Innovation, LeadingConditional, SqrtKalmanFilter, default_block_len,
+    upper_cholesky,
 };
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::DMatrix;
@@ -99,6 +103,16 @@ pub enum CoefficientPass {
     /// NaN). For fits whose innovations nobody reads: the Kalman method's
     /// field removal and its likelihood-ratio tests of further lags.
     Augmented,
+    /// The joint filter split in two (de Jong 1991): the field filter with
+    /// the coefficients integrated out, groups of runs on the cores, hands
+    /// each sample's whitened innovations (`E_k/√S_k`, `e_k/√S_k`) to the
+    /// recursive least squares of the coefficients over the runs in turn
+    /// (Carlson's square-root update of `m` states), which gives the joint
+    /// filter's sequential innovations `ν_k = e_k − E_k (β̂_{k−1} − β₀)`,
+    /// `σ_k² = S_k (1 + Ẽ_k P_{k−1} Ẽ_kᵀ)`, its coefficients, covariance and
+    /// likelihood — the same to round-off, with the field filter's work on
+    /// every core and overlapping the least squares.
+    Split,
 }
 
 impl Default for KalmanConfig {
@@ -398,6 +412,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     } = match cfg.coefficient_pass {
         CoefficientPass::Joint => joint_pass(&inputs, &mut series)?,
         CoefficientPass::Augmented => augmented_pass(&inputs)?,
+        CoefficientPass::Split => split_pass(&inputs, &mut series)?,
     };
     let std: Vec<f64> = (0..m)
         .map(|j| posterior_covariance[(j, j)].max(0.0).sqrt())
@@ -636,60 +651,94 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
     })
 }
 
+/// The samples of `runs` (a group of runs) for the field filter
+/// ([`filter_groups`]): design rows formed run by run, checked here so that
+/// an error names the segment and row.
+fn group_samples(p: &PassInputs, runs: &[Run]) -> Result<GroupSamples<'static>> {
+    let spec = &p.cfg.design;
+    let len: usize = runs.iter().map(|r| r.range.len()).sum();
+    let mut g = OwnedSamples::with_capacity(len, spec.n_columns());
+    for run in runs {
+        let s = &p.segments[run.seg];
+        let mut err = None;
+        for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+            if err.is_some() {
+                return;
+            }
+            let first = i == run.range.start;
+            let d = if first {
+                0.0
+            } else {
+                step_length(s.data.time, s.speed_m_s, i)
+            };
+            let (dz, y) = (s.alt_m[i] - p.z0, s.data.mag[i] - p.y_ref);
+            let usable = d >= 0.0
+                && d.is_finite()
+                && dz.is_finite()
+                && y.is_finite()
+                && aeromag_core::simd::all_finite(row);
+            if !usable {
+                err = Some(
+                    CompError::data(format!(
+                        "non-finite design row, reading or altitude, or an along-track step {d} m \
+                         (must be finite and ≥ 0)"
+                    ))
+                    .at(format!("segment {}, row {i}", run.seg)),
+                );
+                return;
+            }
+            let local = i - run.range.start;
+            g.push(
+                first,
+                d,
+                row,
+                dz,
+                y,
+                restart_point(p.cfg, local, run.range.len()),
+            );
+        });
+        if let Some(e) = err {
+            return Err(e);
+        }
+    }
+    Ok(g.into_samples())
+}
+
 /// Pass 1 by the field filter with the coefficients integrated out
 /// ([`super::field_filter`]): groups of runs on the cores, their sums
 /// added in run order.
 fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
-    let (spec, cfg) = (&p.cfg.design, p.cfg);
+    let cfg = p.cfg;
     check_field_model(&p.noise, &cfg.field_prior)?;
     let groups = groups_of_runs(p.runs.iter().map(|r| r.range.len()));
     let transition = AnomalyTransition::new(&p.noise, cfg.field_prior.order);
-    type Part = (AugmentedFilter, Vec<Vec<(usize, LeadingConditional)>>);
-    let parts = parallel_map(groups.len(), threads(), |gi| -> Result<Part> {
-        let mut f = FieldFilter::new(
-            &cfg.field_prior,
-            &transition,
-            p.noise.r_nt2,
-            p.coef_mean,
-            p.coef_std,
-        )?;
-        let mut restarts = Vec::new();
-        for run in &p.runs[groups[gi].clone()] {
-            let s = &p.segments[run.seg];
-            let len = run.range.len();
-            let (mut cps, mut err) = (Vec::new(), None);
-            for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
-                if err.is_some() {
-                    return;
-                }
-                let first = i == run.range.start;
-                let d = if first {
-                    0.0
-                } else {
-                    step_length(s.data.time, s.speed_m_s, i)
-                };
-                if let Err(e) = f.step(first, d, row, s.alt_m[i] - p.z0, s.data.mag[i] - p.y_ref) {
-                    err = Some(e.at(format!("segment {}, row {i}", run.seg)));
-                    return;
-                }
-                let local = i - run.range.start;
-                if restart_point(cfg, local, len) {
-                    cps.push((local, f.filter().conditional()));
-                }
-            });
-            if let Some(e) = err {
-                return Err(e);
-            }
-            restarts.push(cps);
-        }
-        Ok((f.into_filter(), restarts))
-    });
-    let mut filters = Vec::with_capacity(parts.len());
+    let model = FieldModelSpec {
+        x2_prior: &cfg.field_prior,
+        transition: &transition,
+        r_nt2: p.noise.r_nt2,
+        coef_mean: p.coef_mean,
+        coef_std: p.coef_std,
+        record_innovations: false,
+    };
+    let filtered = filter_groups(groups.len(), threads(), &model, |gi| {
+        group_samples(p, &p.runs[groups[gi].clone()])
+    })?;
+    let mut filters = Vec::with_capacity(filtered.len());
     let mut conditionals = Vec::with_capacity(p.runs.len());
-    for part in parts {
-        let (f, restarts) = part?;
-        filters.push(f);
-        conditionals.extend(restarts);
+    for (group, done) in groups.iter().zip(filtered) {
+        // The kept conditionals back to their runs (run-local steps).
+        let mut kept = done.kept.into_iter().peekable();
+        let mut offset = 0;
+        for run in &p.runs[group.clone()] {
+            let len = run.range.len();
+            let mut cps = Vec::new();
+            while let Some((k, c)) = kept.next_if(|(k, _)| *k < offset + len) {
+                cps.push((k - offset, c));
+            }
+            conditionals.push(cps);
+            offset += len;
+        }
+        filters.push(done.filter);
     }
     let sol = merge_in_order(filters)?.solve().map_err(est)?;
     Ok(Pass1 {
@@ -698,6 +747,119 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
         posterior_covariance: sol.covariance,
         log_lik: sol.log_likelihood,
         innovations: None,
+        conditionals,
+    })
+}
+
+/// Pass 1 as [`CoefficientPass::Split`]: rounds of groups of runs through
+/// the field filter on the cores, each round's whitened innovations fed to
+/// the coefficients' recursive least squares while the next round is
+/// filtered; the innovations go into `series` (when computed).
+fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
+    let cfg = p.cfg;
+    check_field_model(&p.noise, &cfg.field_prior)?;
+    let groups = groups_of_runs(p.runs.iter().map(|r| r.range.len()));
+    let transition = AnomalyTransition::new(&p.noise, cfg.field_prior.order);
+    let model = FieldModelSpec {
+        x2_prior: &cfg.field_prior,
+        transition: &transition,
+        r_nt2: p.noise.r_nt2,
+        coef_mean: p.coef_mean,
+        coef_std: p.coef_std,
+        record_innovations: true,
+    };
+    let m = p.coef_mean.len();
+    let mut rls = SqrtKalmanFilter::new(
+        &vec![0.0; m],
+        &DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(p.coef_std)),
+    )
+    .map_err(est)?;
+    let mut sums = InnovationSums {
+        chi2: 0.0,
+        ss: 0.0,
+        count: 0,
+    };
+    let mut log_lik = 0.0;
+    let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = Vec::with_capacity(p.runs.len());
+    // The least squares of one round's groups, in run order.
+    let mut absorb = |first_group: usize,
+                      done: Vec<FilteredGroup>,
+                      series: &mut [KalmanSeries],
+                      conditionals: &mut Vec<Vec<(usize, LeadingConditional)>>|
+     -> Result<()> {
+        for (gi, group) in done.into_iter().enumerate() {
+            let runs = &p.runs[groups[first_group + gi].clone()];
+            let mut rows = group.innovations.chunks_exact(m + 2);
+            let mut kept = group.kept.into_iter().peekable();
+            let mut offset = 0;
+            for run in runs {
+                let len = run.range.len();
+                let mut cps = Vec::new();
+                while let Some((k, c)) = kept.next_if(|(k, _)| *k < offset + len) {
+                    cps.push((k - offset, c));
+                }
+                conditionals.push(cps);
+                offset += len;
+                for i in run.range.clone() {
+                    let w = rows.next().ok_or_else(|| {
+                        CompError::data("split pass: fewer innovations than samples".to_string())
+                    })?;
+                    let (z, e, s_k) = (&w[..m], w[m], w[m + 1]);
+                    let white = rls.update(z, e, 1.0).map_err(est)?;
+                    let inn = Innovation {
+                        value: white.value * s_k.sqrt(),
+                        variance: white.variance * s_k,
+                    };
+                    log_lik += inn.log_likelihood();
+                    if i - run.range.start >= cfg.field_prior.dim() {
+                        sums.chi2 += inn.value * inn.value / inn.variance;
+                        sums.ss += inn.value * inn.value;
+                        sums.count += 1;
+                    }
+                    if let Some(o) = series.get_mut(run.seg) {
+                        o.innovation_nt[i] = inn.value;
+                        o.innovation_std_nt[i] = inn.std();
+                    }
+                }
+            }
+        }
+        Ok(())
+    };
+    // Rounds of a few groups per core and lane: memory O(round), the least
+    // squares of a round overlapping the filtering of the next ones.
+    let round = threads() * FILTER_LANES;
+    // The least squares on a thread of its own, taking the rounds in order
+    // from a channel of two: the filter runs at most two rounds ahead.
+    let (to_ls, from_filter) = std::sync::mpsc::sync_channel::<(usize, Vec<FilteredGroup>)>(2);
+    std::thread::scope(|scope| -> Result<()> {
+        let ls = scope.spawn(|| -> Result<()> {
+            for (first, done) in from_filter {
+                absorb(first, done, series, &mut conditionals)?;
+            }
+            Ok(())
+        });
+        let filtered = (0..groups.len()).step_by(round).try_for_each(|start| {
+            let end = (start + round).min(groups.len());
+            let done = filter_groups(end - start, threads(), &model, |gi| {
+                group_samples(p, &p.runs[groups[start + gi].clone()])
+            })?;
+            // A closed channel: the least squares failed (its error below).
+            let _ = to_ls.send((start, done));
+            Ok(())
+        });
+        drop(to_ls);
+        let ls = ls
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        filtered.and(ls)
+    })?;
+    let delta = rls.state().as_slice();
+    Ok(Pass1 {
+        coef: p.coef_mean.iter().zip(delta).map(|(b, d)| b + d).collect(),
+        posterior_covariance: rls.covariance(),
+        factor: rls.factor().clone(),
+        log_lik,
+        innovations: Some(sums),
         conditionals,
     })
 }

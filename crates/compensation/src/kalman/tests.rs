@@ -719,3 +719,71 @@ fn the_augmented_pass_gives_the_joint_fit() {
         assert!(sa.innovation_nt.iter().all(|v| v.is_nan()));
     }
 }
+
+/// The joint filter split in two (the field filter on the cores, the
+/// coefficients' recursive least squares in run order) gives the joint
+/// filter's coefficients, covariance, likelihood, diagnostics, smoothed
+/// field and every sequential innovation with its standard deviation, to
+/// round-off.
+#[test]
+fn the_split_pass_gives_the_joint_fit() {
+    let (terms, b) = three_runs();
+    for prior in [X2Prior::thesis(), X2Prior::default()] {
+        let joint_cfg = KalmanConfig {
+            field_prior: prior,
+            smoother_block_len: 100,
+            ..no_tuning(terms.clone(), NOISE)
+        };
+        let split_cfg = KalmanConfig {
+            coefficient_pass: CoefficientPass::Split,
+            ..joint_cfg.clone()
+        };
+        let j = fit_kalman(&[b.segment()], &joint_cfg).unwrap();
+        let s = fit_kalman(&[b.segment()], &split_cfg).unwrap();
+        assert_eq!((s.runs, s.rows), (3, j.rows));
+        let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+        let mut worst = [0.0f64; 7];
+        for k in 0..j.coef.len() {
+            worst[0] = worst[0].max((s.coef[k] - j.coef[k]).abs() / j.std[k]);
+            worst[1] = worst[1].max(rel(s.std[k], j.std[k]));
+            worst[2] = worst[2].max(rel(s.vif[k], j.vif[k]));
+        }
+        let (ss, sj) = (&s.series[0], &j.series[0]);
+        let mut innovations = 0;
+        for k in 0..sj.external_nt.len() {
+            if sj.external_nt[k].is_nan() {
+                assert!(ss.external_nt[k].is_nan() && ss.innovation_nt[k].is_nan());
+                continue;
+            }
+            worst[3] = worst[3].max((ss.external_nt[k] - sj.external_nt[k]).abs());
+            worst[4] = worst[4].max((ss.compensated_nt[k] - sj.compensated_nt[k]).abs());
+            let sd = sj.innovation_std_nt[k];
+            worst[5] = worst[5].max((ss.innovation_nt[k] - sj.innovation_nt[k]).abs() / sd);
+            worst[6] = worst[6].max(rel(ss.innovation_std_nt[k], sd));
+            innovations += 1;
+        }
+        eprintln!(
+            "order {}: coefficients {:.1e} σ, std {:.1e}, VIF {:.1e}, field {:.1e} nT, compensated {:.1e} nT, \
+             innovations {:.1e} σ, their σ {:.1e} ({innovations} samples)",
+            prior.order, worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6]
+        );
+        assert!(innovations > 1000);
+        assert!(
+            worst[0] < 1e-7 && worst[1] < 1e-7 && worst[2] < 1e-6,
+            "{worst:?}"
+        );
+        assert!(worst[3] < 1e-6 && worst[4] < 1e-6, "{worst:?}");
+        assert!(worst[5] < 1e-7 && worst[6] < 1e-7, "{worst:?}");
+        assert!(rel(s.log_likelihood, j.log_likelihood) < 1e-10);
+        assert!(rel(s.profile_log_likelihood(), j.profile_log_likelihood()) < 1e-10);
+        assert!(
+            rel(
+                s.normalized_innovation_variance,
+                j.normalized_innovation_variance
+            ) < 1e-9
+        );
+        assert!(rel(s.innovation_rms_nt, j.innovation_rms_nt) < 1e-9);
+        assert!(rel(s.condition, j.condition) < 1e-6);
+        assert!(rel(s.residual_rms_nt, j.residual_rms_nt) < 1e-8);
+    }
+}

@@ -140,13 +140,15 @@
 //! point beside it (2 cores).
 
 use super::anomaly_model::{AnomalyTransition, NoiseModel, X2Prior};
-use super::field_filter::{FieldFilter, check_field_model, groups_of_runs, merge_in_order};
+use super::field_filter::{
+    FieldModelSpec, GroupSamples, check_field_model, filter_groups, groups_of_runs, merge_in_order,
+};
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
 use aeromag_core::parallel::{parallel_map, threads};
-use aeromag_estimation::kalman::AugmentedFilter;
 use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// Settings of the maximum-likelihood tuning.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -240,11 +242,12 @@ impl Subset {
     /// Log-likelihood of the subset under `noise`: the pass-1 filter's
     /// (the sum of its innovation terms), computed with the coefficients
     /// integrated out of a filter of the field states alone
-    /// ([`AugmentedFilter`]; equal to round-off). The runs are then
-    /// independent: they are filtered in groups of about
-    /// [`super::field_filter::SAMPLES_PER_GROUP`] samples on up to `threads` threads, and the
-    /// groups' sums added in run order (the same bits with any number of
-    /// threads).
+    /// ([`aeromag_estimation::kalman::AugmentedFilter`]; equal to round-off).
+    /// The runs are then independent: they are filtered in groups of about
+    /// [`super::field_filter::SAMPLES_PER_GROUP`] samples on up to `threads`
+    /// threads, four groups at a time in SIMD lanes
+    /// ([`super::field_filter::filter_groups`]), and the groups' sums added
+    /// in run order (the same bits with any number of threads).
     pub fn log_likelihood(
         &self,
         coef_mean: &[f64],
@@ -262,25 +265,31 @@ impl Subset {
             .iter()
             .enumerate()
             .map(|(r, &k)| starts.get(r + 1).copied().unwrap_or(self.len()) - k);
-        let groups = groups_of_runs(lengths);
+        let groups: Vec<std::ops::Range<usize>> = groups_of_runs(lengths)
+            .into_iter()
+            .map(|g| starts[g.start]..starts.get(g.end).copied().unwrap_or(self.len()))
+            .collect();
         let transition = AnomalyTransition::new(&noise, x2_prior.order);
-        let filtered = parallel_map(groups.len(), threads, |i| -> Result<AugmentedFilter> {
-            let g = &groups[i];
-            let to = starts.get(g.end).copied().unwrap_or(self.len());
-            let mut f = FieldFilter::new(x2_prior, &transition, noise.r_nt2, coef_mean, coef_std)?;
-            for k in starts[g.start]..to {
-                let first = k == starts[g.start] || self.start[k];
-                f.step(
-                    first,
-                    self.d[k],
-                    &self.rows[k * self.m..(k + 1) * self.m],
-                    self.dz[k],
-                    self.y[k],
-                )?;
-            }
-            Ok(f.into_filter())
-        });
-        merge_in_order(filtered.into_iter().collect::<Result<Vec<_>>>()?)?
+        let model = FieldModelSpec {
+            x2_prior,
+            transition: &transition,
+            r_nt2: noise.r_nt2,
+            coef_mean,
+            coef_std,
+            record_innovations: false,
+        };
+        let filtered = filter_groups(groups.len(), threads, &model, |g| {
+            let r = groups[g].clone();
+            Ok(GroupSamples {
+                first: Cow::Borrowed(&self.start[r.clone()]),
+                d_m: Cow::Borrowed(&self.d[r.clone()]),
+                rows: Cow::Borrowed(&self.rows[r.start * self.m..r.end * self.m]),
+                dz_m: Cow::Borrowed(&self.dz[r.clone()]),
+                y_nt: Cow::Borrowed(&self.y[r]),
+                keep: Cow::Borrowed(&[]),
+            })
+        })?;
+        merge_in_order(filtered.into_iter().map(|g| g.filter))?
             .log_likelihood()
             .map_err(est)
     }

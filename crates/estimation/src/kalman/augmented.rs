@@ -37,9 +37,12 @@
 //! covariance update, against 1.15 µs for the joint filter. The larger gain
 //! is that `β` no longer links the runs of a record: runs filtered apart
 //! and their sums added ([`AugmentedFilter::merge`]) give the same
-//! likelihood, so one evaluation can use every core. It gives no running
-//! estimate of `β`; the joint filter ([`super::SqrtKalmanFilter`] with the
-//! constants ordered last) does.
+//! likelihood, so one evaluation can use every core, and four filters can
+//! share the lanes of a SIMD register ([`super::AugmentedLanes`]). It gives
+//! no running estimate of `β`; the joint filter ([`super::SqrtKalmanFilter`]
+//! with the constants ordered last) does, and so does the recursive least
+//! squares of `β` on the innovations this filter records
+//! ([`AugmentedFilter::record_innovations`]).
 //!
 //! **Accuracy.** The cross-products are normal equations, not a square
 //! root: on the tests' models (regressors spanning three decades, prior
@@ -94,6 +97,16 @@ pub struct AugmentedFilter {
     /// `x` at the start of each run: zero mean, this upper factor.
     prior_factor: DMatrix<f64>,
     zeros: Vec<f64>,
+    rhs: RightHandSides,
+}
+
+/// The right-hand sides' states and the cross-products of their
+/// innovations: everything of [`AugmentedFilter`] but the `n`-state
+/// factor, whose gains it is given ([`AugmentedLanes`] steps four of them
+/// with the factors in SIMD lanes).
+#[derive(Debug, Clone)]
+pub(super) struct RightHandSides {
+    n: usize,
     prior_mean: Vec<f64>,
     prior_var: Vec<f64>,
     /// `m + 1` right-hand sides (the columns, then the reading) rounded up to
@@ -104,7 +117,7 @@ pub struct AugmentedFilter {
     next: Vec<f64>,
     nu: Vec<f64>,
     /// The time update of the right-hand sides waiting for the next
-    /// measurement update (done in the same pass over `x`): `Φ`, row-major.
+    /// measurement update (done in the same pass over `x`): `Φ`, column-major.
     pending: bool,
     phi: Vec<f64>,
     phi_upper: bool,
@@ -117,6 +130,12 @@ pub struct AugmentedFilter {
     /// `Σ E_kᵀE_k/S_k`, `Σ E_kᵀe_k/S_k`, `Σ e_k²/S_k` of the flushed blocks.
     moments: NormalEquations,
     sum_log_2pi_var: f64,
+    /// With [`AugmentedFilter::record_innovations`]: `S_k` of the buffered
+    /// samples, and every flushed sample's `(E_k/√S_k, e_k/√S_k, S_k)`.
+    variance: Vec<f64>,
+    recorded: Option<Vec<f64>>,
+    /// Samples were recorded and not summed: no likelihood or solution.
+    unsummed: bool,
 }
 
 impl AugmentedFilter {
@@ -147,21 +166,27 @@ impl AugmentedFilter {
             filter,
             prior_factor: s0.clone(),
             zeros,
-            prior_mean: prior_mean.to_vec(),
-            prior_var: prior_std.iter().map(|s| s * s).collect(),
-            width,
-            x: vec![0.0; n * width],
-            next: vec![0.0; n * width],
-            nu: vec![0.0; width],
-            pending: false,
-            phi: vec![0.0; n * n],
-            phi_upper: true,
-            phi_nz: Vec::with_capacity(n * n),
-            columns: vec![0.0; m * BLOCK],
-            reading: vec![0.0; BLOCK],
-            filled: 0,
-            moments: NormalEquations::new(m),
-            sum_log_2pi_var: 0.0,
+            rhs: RightHandSides {
+                n,
+                prior_mean: prior_mean.to_vec(),
+                prior_var: prior_std.iter().map(|s| s * s).collect(),
+                width,
+                x: vec![0.0; n * width],
+                next: vec![0.0; n * width],
+                nu: vec![0.0; width],
+                pending: false,
+                phi: vec![0.0; n * n],
+                phi_upper: true,
+                phi_nz: Vec::with_capacity(n * n),
+                columns: vec![0.0; m * BLOCK],
+                reading: vec![0.0; BLOCK],
+                filled: 0,
+                moments: NormalEquations::new(m),
+                sum_log_2pi_var: 0.0,
+                variance: vec![0.0; BLOCK],
+                recorded: None,
+                unsummed: false,
+            },
         })
     }
 
@@ -169,141 +194,79 @@ impl AugmentedFilter {
     /// get their prior again; the coefficients carry over.
     pub fn start_run(&mut self) -> Result<()> {
         self.filter.set(&self.zeros, &self.prior_factor)?;
-        self.x.fill(0.0);
-        self.pending = false;
+        self.rhs.start_run();
         Ok(())
     }
 
     /// Time update with `Φ` (`n × n`) and noise factor `G` (`n × q`).
     pub fn predict(&mut self, phi: &DMatrix<f64>, g: &DMatrix<f64>) -> Result<()> {
         self.filter.predict(phi, g)?;
-        if self.pending {
-            self.propagate_now();
-        }
-        let n = self.zeros.len();
-        let mut upper = true;
-        for (j, col) in phi.as_slice().chunks_exact(n).enumerate() {
-            for (i, &p) in col.iter().enumerate() {
-                self.phi[i * n + j] = p;
-                upper &= i <= j || p == 0.0;
-            }
-        }
-        self.phi_upper = upper;
-        self.pending = true;
+        self.rhs.predict(phi);
         Ok(())
-    }
-
-    /// The waiting time update of the right-hand sides, on its own.
-    fn propagate_now(&mut self) {
-        let n = self.zeros.len();
-        self.phi_nz.clear();
-        for j in 0..n {
-            for i in 0..n {
-                let v = self.phi[i * n + j];
-                if v != 0.0 {
-                    self.phi_nz.push((i, j, v));
-                }
-            }
-        }
-        aeromag_core::simd::run(Propagate {
-            x: &self.x,
-            next: &mut self.next,
-            phi_nz: &self.phi_nz,
-            width: self.width,
-        });
-        std::mem::swap(&mut self.x, &mut self.next);
-        self.pending = false;
     }
 
     /// Measurement update with the dynamic row `h` (length `n`), the
     /// regressor row `z` (length `m`), the reading `y` and its noise
     /// variance `r > 0`. Returns the innovation variance `S_k`.
     pub fn update(&mut self, h: &[f64], z: &[f64], y: f64, r: f64) -> Result<f64> {
-        let m = self.prior_mean.len();
-        if z.len() != m {
-            return Err(EstError::Dimension(format!(
-                "augmented filter: regressor row of length {} for {m} coefficients",
-                z.len()
-            )));
-        }
-        if !y.is_finite() || z.iter().any(|v| !v.is_finite()) {
-            return Err(EstError::NonFinite {
-                what: "reading or regressor row",
-            });
-        }
+        self.rhs.check(z, y)?;
         let s = self.filter.update(h, 0.0, r)?.variance;
-        let y0: f64 = z.iter().zip(&self.prior_mean).map(|(a, b)| a * b).sum();
-        self.nu[..m].copy_from_slice(z);
-        self.nu[m] = y - y0;
-        let phi = self.pending.then_some(self.phi.as_slice());
-        macro_rules! fixed {
-            ($k:literal) => {
-                aeromag_core::simd::run(Step::<$k> {
-                    x: &mut self.x,
-                    nu: &mut self.nu,
-                    phi,
-                    h,
-                    gain: self.filter.last_gain(),
-                    width: self.width,
-                })
-            };
-        }
-        match (h.len(), self.phi_upper || phi.is_none()) {
-            // The field models of orders 3, 4 and 6 (upper-triangular Φ).
-            (5, true) => fixed!(5),
-            (6, true) => fixed!(6),
-            (8, true) => fixed!(8),
-            _ => {
-                if self.pending {
-                    self.propagate_now();
-                }
-                aeromag_core::simd::run(Innovate {
-                    x: &mut self.x,
-                    nu: &mut self.nu,
-                    h,
-                    gain: self.filter.last_gain(),
-                    width: self.width,
-                })
-            }
-        }
-        self.pending = false;
-        self.sum_log_2pi_var += (2.0 * std::f64::consts::PI * s).ln();
-        let scale = 1.0 / s.sqrt();
-        let k = self.filled;
-        for (j, v) in self.nu[..m].iter().enumerate() {
-            self.columns[j * BLOCK + k] = v * scale;
-        }
-        self.reading[k] = self.nu[m] * scale;
-        self.filled += 1;
-        if self.filled == BLOCK {
-            self.flush()?;
-        }
+        self.rhs.absorb(h, z, y, s, self.filter.last_gain())?;
         Ok(s)
     }
 
-    /// Form the cross-products of the buffered innovations.
-    fn flush(&mut self) -> Result<()> {
-        let k = self.filled;
-        if k > 0 {
-            let cols: Vec<&[f64]> = self.columns.chunks_exact(BLOCK).map(|c| &c[..k]).collect();
-            self.moments.add_columns(&cols, &self.reading[..k])?;
-            self.filled = 0;
-        }
+    /// Keep every innovation from now on (or stop): for each sample in
+    /// turn, the regressor columns' `E_k/√S_k` (`m` values), the reading's
+    /// `e_k/√S_k` and `S_k` — the whitened regression of the coefficients
+    /// whose recursive least squares gives the joint filter's sequential
+    /// innovations (de Jong 1991). [`Self::take_innovations`] hands them over.
+    /// Recorded samples are not added to the cross-products (the record's
+    /// user does the least squares): after them [`Self::solve`],
+    /// [`Self::log_likelihood`] and [`Self::merge`] are errors.
+    pub fn record_innovations(&mut self, on: bool) {
+        self.rhs.record(on);
+    }
+
+    /// The innovations recorded so far ([`Self::record_innovations`]),
+    /// `m + 2` values per sample; the record starts again empty.
+    pub fn take_innovations(&mut self) -> Result<Vec<f64>> {
+        self.rhs.flush()?;
+        Ok(self
+            .rhs
+            .recorded
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default())
+    }
+
+    /// The `n`-state factor, with the right-hand sides and sums of `rhs`
+    /// (the lane of an [`AugmentedLanes`] handed back as a filter).
+    pub(super) fn with_factor(&mut self, factor: &DMatrix<f64>, rhs: RightHandSides) -> Result<()> {
+        self.filter.set(&self.zeros, factor)?;
+        self.rhs = rhs;
         Ok(())
+    }
+
+    /// The right-hand sides and sums (to step them with [`AugmentedLanes`]).
+    pub(super) fn right_hand_sides(&self) -> &RightHandSides {
+        &self.rhs
     }
 
     /// Add the readings of `other` (the same model and prior over other
     /// runs, for example on another thread) to these.
     pub fn merge(&mut self, other: &mut AugmentedFilter) -> Result<()> {
-        if other.prior_mean != self.prior_mean || other.prior_var != self.prior_var {
+        let (mine, theirs) = (&mut self.rhs, &mut other.rhs);
+        mine.summed()?;
+        theirs.summed()?;
+        if theirs.prior_mean != mine.prior_mean || theirs.prior_var != mine.prior_var {
             return Err(EstError::Dimension(
                 "augmented filter: merging filters of other priors".into(),
             ));
         }
-        self.flush()?;
-        other.flush()?;
-        self.moments.merge(&other.moments)?;
-        self.sum_log_2pi_var += other.sum_log_2pi_var;
+        mine.flush()?;
+        theirs.flush()?;
+        mine.moments.merge(&theirs.moments)?;
+        mine.sum_log_2pi_var += theirs.sum_log_2pi_var;
         Ok(())
     }
 
@@ -312,13 +275,7 @@ impl AugmentedFilter {
     /// β₀)` with `W = −(states of the regressor columns)`, covariance from
     /// the `n`-state factor (which does not depend on `β`).
     pub fn conditional(&self) -> LeadingConditional {
-        let (n, m, w) = (self.zeros.len(), self.prior_mean.len(), self.width);
-        LeadingConditional {
-            mean: (0..n).map(|i| self.x[i * w + m]).collect(),
-            factor: self.filter.factor().clone(),
-            weight: DMatrix::from_fn(n, m, |i, j| -self.x[i * w + j]),
-            trailing_mean: self.prior_mean.clone(),
-        }
+        self.rhs.conditional(self.filter.factor().clone())
     }
 
     /// The posterior of `β` from every reading so far: mean `β₀ + M⁻¹c`,
@@ -326,7 +283,7 @@ impl AugmentedFilter {
     /// from one Cholesky factor of the bordered matrix.
     pub fn solve(&mut self) -> Result<AugmentedSolution> {
         let (l, log_likelihood) = self.factor()?;
-        let m = self.prior_mean.len();
+        let m = self.rhs.prior_mean.len();
         let l11 = l.view((0, 0), (m, m)).into_owned();
         // c = L11 l21 (the bordered factor's last row), so M⁻¹c = L11⁻ᵀ l21.
         let l21 = l.view((m, 0), (1, m)).transpose();
@@ -341,7 +298,7 @@ impl AugmentedFilter {
         Ok(AugmentedSolution {
             coef: beta
                 .iter()
-                .zip(&self.prior_mean)
+                .zip(&self.rhs.prior_mean)
                 .map(|(d, b)| b + d)
                 .collect(),
             covariance: inv_l.transpose() * &inv_l,
@@ -359,16 +316,18 @@ impl AugmentedFilter {
     /// The lower Cholesky factor of the bordered matrix and the
     /// log-likelihood.
     fn factor(&mut self) -> Result<(DMatrix<f64>, f64)> {
-        self.flush()?;
-        let m = self.prior_mean.len();
+        let rhs = &mut self.rhs;
+        rhs.flush()?;
+        rhs.summed()?;
+        let m = rhs.prior_mean.len();
         let mut b = DMatrix::<f64>::zeros(m + 1, m + 1);
-        b.view_mut((0, 0), (m, m)).copy_from(&self.moments.ata());
-        for (j, v) in self.moments.aty().iter().enumerate() {
+        b.view_mut((0, 0), (m, m)).copy_from(&rhs.moments.ata());
+        for (j, v) in rhs.moments.aty().iter().enumerate() {
             b[(j, m)] = *v;
             b[(m, j)] = *v;
         }
-        b[(m, m)] = self.moments.yty();
-        for (j, v) in self.prior_var.iter().enumerate() {
+        b[(m, m)] = rhs.moments.yty();
+        for (j, v) in rhs.prior_var.iter().enumerate() {
             b[(j, j)] += 1.0 / v;
         }
         let l = nalgebra::Cholesky::new(b)
@@ -379,10 +338,187 @@ impl AugmentedFilter {
             })?
             .unpack();
         let log_det_m: f64 = (0..m).map(|j| 2.0 * l[(j, j)].ln()).sum();
-        let log_det_prior: f64 = self.prior_var.iter().map(|v| v.ln()).sum();
+        let log_det_prior: f64 = rhs.prior_var.iter().map(|v| v.ln()).sum();
         let schur = l[(m, m)] * l[(m, m)];
-        let ll = -0.5 * (self.sum_log_2pi_var + log_det_prior + log_det_m + schur);
+        let ll = -0.5 * (rhs.sum_log_2pi_var + log_det_prior + log_det_m + schur);
         Ok((l, ll))
+    }
+}
+
+impl RightHandSides {
+    /// Record the innovations ([`AugmentedFilter::record_innovations`]).
+    pub(super) fn record(&mut self, on: bool) {
+        self.recorded = on.then(Vec::new);
+    }
+
+    /// [`AugmentedFilter::conditional`] with the `n`-state factor `factor`.
+    pub(super) fn conditional(&self, factor: DMatrix<f64>) -> LeadingConditional {
+        let (n, m, w) = (self.n, self.prior_mean.len(), self.width);
+        LeadingConditional {
+            mean: (0..n).map(|i| self.x[i * w + m]).collect(),
+            factor,
+            weight: DMatrix::from_fn(n, m, |i, j| -self.x[i * w + j]),
+            trailing_mean: self.prior_mean.clone(),
+        }
+    }
+
+    /// A run starts: every right-hand side's state back to zero.
+    pub(super) fn start_run(&mut self) {
+        self.x.fill(0.0);
+        self.pending = false;
+    }
+
+    /// The time update with `Φ` (`n × n`), applied with the next
+    /// measurement update.
+    pub(super) fn predict(&mut self, phi: &DMatrix<f64>) {
+        if self.pending {
+            self.propagate_now();
+        }
+        let n = self.n;
+        self.phi.copy_from_slice(phi.as_slice());
+        self.phi_upper = (0..n).all(|j| {
+            self.phi[j * n + j + 1..(j + 1) * n]
+                .iter()
+                .all(|p| *p == 0.0)
+        });
+        self.pending = true;
+    }
+
+    /// The waiting time update of the right-hand sides, on its own.
+    fn propagate_now(&mut self) {
+        let n = self.n;
+        self.phi_nz.clear();
+        for j in 0..n {
+            for i in 0..n {
+                let v = self.phi[i + j * n];
+                if v != 0.0 {
+                    self.phi_nz.push((i, j, v));
+                }
+            }
+        }
+        aeromag_core::simd::run(Propagate {
+            x: &self.x,
+            next: &mut self.next,
+            phi_nz: &self.phi_nz,
+            width: self.width,
+        });
+        std::mem::swap(&mut self.x, &mut self.next);
+        self.pending = false;
+    }
+
+    /// A regressor row of the right length, a finite reading and row.
+    pub(super) fn check(&self, z: &[f64], y: f64) -> Result<()> {
+        let m = self.prior_mean.len();
+        if z.len() != m {
+            return Err(EstError::Dimension(format!(
+                "augmented filter: regressor row of length {} for {m} coefficients",
+                z.len()
+            )));
+        }
+        if !y.is_finite() || z.iter().any(|v| !v.is_finite()) {
+            return Err(EstError::NonFinite {
+                what: "reading or regressor row",
+            });
+        }
+        Ok(())
+    }
+
+    /// The measurement update of every right-hand side with the factor's
+    /// innovation variance `s` and gain (the row checked by
+    /// [`Self::check`]), and the scaled innovations into the sums.
+    pub(super) fn absorb(
+        &mut self,
+        h: &[f64],
+        z: &[f64],
+        y: f64,
+        s: f64,
+        gain: &[f64],
+    ) -> Result<()> {
+        let m = self.prior_mean.len();
+        let y0: f64 = z.iter().zip(&self.prior_mean).map(|(a, b)| a * b).sum();
+        self.nu[..m].copy_from_slice(z);
+        self.nu[m] = y - y0;
+        let phi = self.pending.then_some(self.phi.as_slice());
+        macro_rules! fixed {
+            ($k:literal) => {
+                aeromag_core::simd::run(Step::<$k> {
+                    x: &mut self.x,
+                    nu: &mut self.nu,
+                    phi,
+                    h,
+                    gain,
+                    width: self.width,
+                })
+            };
+        }
+        match (h.len(), self.phi_upper || phi.is_none()) {
+            // The field models of orders 3, 4 and 6 (upper-triangular Φ).
+            (5, true) => fixed!(5),
+            (6, true) => fixed!(6),
+            (8, true) => fixed!(8),
+            _ => {
+                if self.pending {
+                    self.propagate_now();
+                }
+                aeromag_core::simd::run(Innovate {
+                    x: &mut self.x,
+                    nu: &mut self.nu,
+                    h,
+                    gain,
+                    width: self.width,
+                })
+            }
+        }
+        self.pending = false;
+        self.sum_log_2pi_var += (2.0 * std::f64::consts::PI * s).ln();
+        let scale = 1.0 / s.sqrt();
+        let k = self.filled;
+        self.variance[k] = s;
+        for (j, v) in self.nu[..m].iter().enumerate() {
+            self.columns[j * BLOCK + k] = v * scale;
+        }
+        self.reading[k] = self.nu[m] * scale;
+        self.filled += 1;
+        if self.filled == BLOCK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Every sample is in the cross-products (none only recorded).
+    fn summed(&mut self) -> Result<()> {
+        self.flush()?;
+        if self.unsummed {
+            return Err(EstError::Dimension(
+                "augmented filter: recorded innovations are not summed (no likelihood or solution)"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Form the cross-products of the buffered innovations (or record them).
+    fn flush(&mut self) -> Result<()> {
+        let k = self.filled;
+        if let Some(out) = &mut self.recorded {
+            let m = self.prior_mean.len();
+            for i in 0..k {
+                out.extend((0..m).map(|j| self.columns[j * BLOCK + i]));
+                out.push(self.reading[i]);
+                out.push(self.variance[i]);
+            }
+        }
+        if k > 0 && self.recorded.is_some() {
+            // Recorded instead of summed (record_innovations).
+            self.unsummed = true;
+            self.filled = 0;
+        }
+        if k > 0 && self.recorded.is_none() {
+            let cols: Vec<&[f64]> = self.columns.chunks_exact(BLOCK).map(|c| &c[..k]).collect();
+            self.moments.add_columns(&cols, &self.reading[..k])?;
+            self.filled = 0;
+        }
+        Ok(())
     }
 }
 
@@ -477,7 +613,7 @@ impl<const N: usize> aeromag_core::simd::Kernel for Step<'_, N> {
         let k: [f64; N] = std::array::from_fn(|i| self.gain[i]);
         let phi: Option<[[f64; N]; N]> = self
             .phi
-            .map(|p| std::array::from_fn(|i| std::array::from_fn(|j| p[i * N + j])));
+            .map(|p| std::array::from_fn(|i| std::array::from_fn(|j| p[i + j * N])));
         for b in (0..w).step_by(LANES) {
             let mut xs = [[0.0; LANES]; N];
             for (i, v) in xs.iter_mut().enumerate() {
@@ -671,6 +807,50 @@ mod tests {
         );
         let mut other = AugmentedFilter::new(&s0, &[0.0, 2.0], &[5.0, 5.0]).unwrap();
         assert!(a.merge(&mut other).is_err());
+    }
+
+    /// The record holds each sample's whitened innovations, which are then
+    /// not summed: their cross-products are the filter's without the record.
+    #[test]
+    fn recorded_innovations_are_the_whitened_rows() {
+        let s0 = DMatrix::from_row_slice(2, 2, &[2.0, 0.1, 0.0, 1.0]);
+        let phi = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 0.9]);
+        let g = DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.0, 0.2]);
+        let new = || AugmentedFilter::new(&s0, &[0.5, 1.0], &[5.0, 5.0]).unwrap();
+        let (mut summed, mut recorded) = (new(), new());
+        recorded.record_innovations(true);
+        let n = 600; // more than two blocks
+        for f in [&mut summed, &mut recorded] {
+            f.start_run().unwrap();
+            for k in 0..n {
+                if k > 0 {
+                    f.predict(&phi, &g).unwrap();
+                }
+                let t = k as f64;
+                f.update(&[1.0, 0.0], &[t.sin(), (0.3 * t).cos()], t.sin(), 0.01)
+                    .unwrap();
+            }
+        }
+        let rows = recorded.take_innovations().unwrap();
+        assert_eq!(rows.len(), n * 4);
+        let mut ne = NormalEquations::new(2);
+        let (mut ln_s, mut yy) = (0.0, 0.0);
+        for w in rows.chunks_exact(4) {
+            ne.add_columns(&[&w[0..1], &w[1..2]], &w[2..3]).unwrap();
+            ln_s += (2.0 * std::f64::consts::PI * w[3]).ln();
+            yy += w[2] * w[2];
+        }
+        summed.rhs.flush().unwrap();
+        let m = &summed.rhs.moments;
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        assert!(close(ne.yty(), m.yty()) && close(yy, m.yty()));
+        for (a, b) in ne.ata().iter().zip(m.ata().iter()) {
+            assert!(close(*a, *b), "{a} vs {b}");
+        }
+        assert!(close(ln_s, summed.rhs.sum_log_2pi_var));
+        assert!(recorded.log_likelihood().is_err() && recorded.solve().is_err());
+        assert!(summed.merge(&mut recorded).is_err());
+        assert!(recorded.take_innovations().unwrap().is_empty());
     }
 
     #[test]

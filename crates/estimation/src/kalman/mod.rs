@@ -53,6 +53,7 @@ pub mod conventional;
 pub mod filter;
 pub mod fixed_interval;
 pub mod innovation;
+pub mod lanes;
 pub mod mbf;
 pub mod rts;
 pub mod triangularize;
@@ -65,6 +66,7 @@ pub use fixed_interval::{
     fixed_interval_smooth, smooth_from_checkpoints,
 };
 pub use innovation::Innovation;
+pub use lanes::{AugmentedLanes, FILTER_LANES, LaneStep, Reading};
 pub use mbf::{MbfAdjoint, MbfUpdate};
 pub use rts::SqrtRts;
 

@@ -1,0 +1,579 @@
+//! Four augmented filters of the same model stepped together: their
+//! `n`-state square-root factors in SIMD lanes.
+//!
+//! The time update `U ← tri([G, Φ U])` (Householder, both halves upper
+//! triangular: [`super::triangularize::triangularize_upper_pair`]) and
+//! Carlson's measurement update ([`super::carlson::carlson_update`]) of a
+//! small factor are chains of dependent operations — a square root and a
+//! division per row or column — so one filter waits on their latency. Four
+//! independent filters (four groups of runs of one likelihood evaluation)
+//! fill the four lanes of an AVX register instead: each lane does the
+//! operations of [`super::SqrtKalmanFilter::predict`] and
+//! [`super::SqrtKalmanFilter::update`] in their order, so every lane's factor,
+//! gain and innovation variance are **bit for bit** those of its filter
+//! stepped alone (the tests compare the bits). Entries of `Φ` that are zero
+//! in one lane and not in another are added as `0 · u` in the first, which
+//! leaves a sum that started from `+0` unchanged; a lane whose `Φ` or `G` is
+//! not upper triangular is an error, not a different algorithm.
+//!
+//! The right-hand sides and the sums of each lane are its own
+//! [`AugmentedFilter`]'s, given the lane's gain; [`AugmentedLanes::take`]
+//! hands a lane back as that filter.
+
+// The kernels index several arrays by the same state and lane, as the
+// scalar code they mirror does.
+#![allow(clippy::needless_range_loop)]
+
+use super::augmented::{AugmentedFilter, RightHandSides};
+use super::filter::LeadingConditional;
+use crate::error::{EstError, Result};
+use nalgebra::DMatrix;
+
+/// Filters stepped together.
+pub const FILTER_LANES: usize = 4;
+const L: usize = FILTER_LANES;
+
+/// What one lane does in a step of [`AugmentedLanes::step`].
+#[derive(Debug, Clone, Copy)]
+pub enum LaneStep<'a> {
+    /// Nothing (its filter has no more samples).
+    Idle,
+    /// A run starts: the prior, then the reading.
+    Start(Reading<'a>),
+    /// The time update with `Φ` and `G` (`n × n`, upper triangular), then
+    /// the reading.
+    Next {
+        /// The transition.
+        phi: &'a DMatrix<f64>,
+        /// The noise factor, `Q = G Gᵀ`.
+        g: &'a DMatrix<f64>,
+        /// The measurement.
+        reading: Reading<'a>,
+    },
+}
+
+/// One measurement of [`AugmentedFilter::update`]: the dynamic row `h`
+/// (length `n`), the regressor row `z` (length `m`) and the reading `y`.
+#[derive(Debug, Clone, Copy)]
+pub struct Reading<'a> {
+    /// The dynamic row.
+    pub h: &'a [f64],
+    /// The regressor row.
+    pub z: &'a [f64],
+    /// The reading.
+    pub y: f64,
+}
+
+/// Four [`AugmentedFilter`]s of `N` dynamic states and one prior, stepped
+/// together (module docs).
+pub struct AugmentedLanes<const N: usize> {
+    /// `u[j][i][l]`: entry `(i, j)` of lane `l`'s upper factor.
+    u: [[[f64; L]; N]; N],
+    gain: [[f64; L]; N],
+    /// The lanes' last `Φ` and `G`, `phi[i][j][l]` (upper parts).
+    phi: [[[f64; L]; N]; N],
+    g: [[[f64; L]; N]; N],
+    prior: [[f64; N]; N],
+    /// A fresh filter (prior and right-hand sides), for each lane's start.
+    fresh: AugmentedFilter,
+    rhs: Vec<RightHandSides>,
+}
+
+impl<const N: usize> AugmentedLanes<N> {
+    /// Four fresh filters of [`AugmentedFilter::new`]`(s0, prior_mean,
+    /// prior_std)` (`s0` is `N × N`).
+    pub fn new(s0: &DMatrix<f64>, prior_mean: &[f64], prior_std: &[f64]) -> Result<Self> {
+        if s0.nrows() != N || s0.ncols() != N {
+            return Err(EstError::Dimension(format!(
+                "filter lanes of {N} states for a {}×{} prior factor",
+                s0.nrows(),
+                s0.ncols()
+            )));
+        }
+        let fresh = AugmentedFilter::new(s0, prior_mean, prior_std)?;
+        let mut prior = [[0.0; N]; N];
+        for (j, col) in prior.iter_mut().enumerate() {
+            for (i, v) in col.iter_mut().enumerate().take(j + 1) {
+                *v = s0[(i, j)];
+            }
+        }
+        let mut lanes = Self {
+            u: [[[0.0; L]; N]; N],
+            gain: [[0.0; L]; N],
+            phi: [[[0.0; L]; N]; N],
+            g: [[[0.0; L]; N]; N],
+            prior,
+            rhs: vec![fresh.right_hand_sides().clone(); L],
+            fresh,
+        };
+        for l in 0..L {
+            lanes.reset_factor(l);
+        }
+        Ok(lanes)
+    }
+
+    /// One step of every lane. The rows are checked first (the errors of
+    /// [`AugmentedFilter::update`]); on error nothing has changed.
+    pub fn step(&mut self, lanes: [LaneStep<'_>; L], r: f64) -> Result<()> {
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(EstError::NonFinite {
+                what: "measurement noise variance (must be finite and > 0)",
+            });
+        }
+        let mut h = [[0.0; L]; N];
+        let mut moving = [false; L];
+        for (l, step) in lanes.iter().enumerate() {
+            let reading = match step {
+                LaneStep::Idle => continue,
+                LaneStep::Start(reading) => reading,
+                LaneStep::Next { phi, g, reading } => {
+                    if phi.shape() != (N, N) || g.shape() != (N, N) {
+                        return Err(EstError::Dimension(format!(
+                            "filter lanes: Φ {:?}, G {:?} for {N} states",
+                            phi.shape(),
+                            g.shape()
+                        )));
+                    }
+                    // Column-major: the upper part of column j is its rows
+                    // 0..=j; the rest must be zero.
+                    let (p, q) = (phi.as_slice(), g.as_slice());
+                    for j in 0..N {
+                        let (pc, qc) = (&p[j * N..(j + 1) * N], &q[j * N..(j + 1) * N]);
+                        if pc[j + 1..].iter().chain(&qc[j + 1..]).any(|v| *v != 0.0) {
+                            return Err(EstError::Dimension(
+                                "filter lanes: Φ and G must be upper triangular".into(),
+                            ));
+                        }
+                        for i in 0..=j {
+                            self.phi[i][j][l] = pc[i];
+                            self.g[i][j][l] = qc[i];
+                        }
+                    }
+                    moving[l] = true;
+                    reading
+                }
+            };
+            if reading.h.len() != N || reading.h.iter().any(|v| !v.is_finite()) {
+                return Err(EstError::NonFinite {
+                    what: "scalar measurement or its row",
+                });
+            }
+            self.rhs[l].check(reading.z, reading.y)?;
+            for i in 0..N {
+                h[i][l] = reading.h[i];
+            }
+        }
+        for (l, step) in lanes.iter().enumerate() {
+            if let LaneStep::Start(_) = step {
+                self.reset_factor(l);
+                self.rhs[l].start_run();
+            }
+        }
+        // Lanes not moving compute with whatever Φ and G they last had (the
+        // lower parts are never written: zero); their results are not kept.
+        aeromag_core::simd::run(Predict {
+            u: &mut self.u,
+            phi: &self.phi,
+            g: &self.g,
+            moving,
+        });
+        // Idle lanes: h = 0, so every f_j is 0 and the factor is unchanged.
+        let mut rr = [1.0; L];
+        for (l, step) in lanes.iter().enumerate() {
+            if !matches!(step, LaneStep::Idle) {
+                rr[l] = r;
+            }
+        }
+        let variance = aeromag_core::simd::run(Update {
+            u: &mut self.u,
+            gain: &mut self.gain,
+            h: &h,
+            r: rr,
+        });
+        for (l, step) in lanes.iter().enumerate() {
+            let reading = match step {
+                LaneStep::Idle => continue,
+                LaneStep::Start(reading) => reading,
+                LaneStep::Next { phi, reading, .. } => {
+                    self.rhs[l].predict(phi);
+                    reading
+                }
+            };
+            let gain: [f64; N] = std::array::from_fn(|i| self.gain[i][l]);
+            self.rhs[l].absorb(reading.h, reading.z, reading.y, variance[l], &gain)?;
+        }
+        Ok(())
+    }
+
+    /// Every lane records its innovations from its next fresh start
+    /// ([`AugmentedFilter::record_innovations`]; [`Self::take`] hands them
+    /// over with the filter).
+    pub fn record_innovations(&mut self, on: bool) {
+        self.fresh.record_innovations(on);
+        for r in &mut self.rhs {
+            r.record(on);
+        }
+    }
+
+    /// Lane `l`'s [`AugmentedFilter::conditional`]: its dynamic states
+    /// given the coefficients after its last step.
+    pub fn conditional(&self, l: usize) -> LeadingConditional {
+        self.rhs[l].conditional(self.factor(l))
+    }
+
+    /// Lane `l`'s upper factor.
+    fn factor(&self, l: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(N, N, |i, j| if i <= j { self.u[j][i][l] } else { 0.0 })
+    }
+
+    /// Lane `l`'s filter (factor, right-hand sides and sums), the lane
+    /// fresh again.
+    pub fn take(&mut self, l: usize) -> Result<AugmentedFilter> {
+        let factor = self.factor(l);
+        let mut f = self.fresh.clone();
+        let rhs = std::mem::replace(&mut self.rhs[l], self.fresh.right_hand_sides().clone());
+        f.with_factor(&factor, rhs)?;
+        self.reset_factor(l);
+        Ok(f)
+    }
+
+    /// Lane `l`'s factor back to the prior.
+    fn reset_factor(&mut self, l: usize) {
+        for j in 0..N {
+            for i in 0..N {
+                self.u[j][i][l] = if i <= j { self.prior[j][i] } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// `U ← tri([G, Φ U])` in every moving lane: [`super::SqrtKalmanFilter::predict`]'s
+/// arithmetic (`propagate_impl` with the pair triangularisation), lane by
+/// lane.
+struct Predict<'a, const N: usize> {
+    u: &'a mut [[[f64; L]; N]; N],
+    phi: &'a [[[f64; L]; N]; N],
+    g: &'a [[[f64; L]; N]; N],
+    moving: [bool; L],
+}
+
+impl<const N: usize> aeromag_core::simd::Kernel for Predict<'_, N> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        // [B, A] = [G, Φ U], row-major: b[i][j], a[i][j].
+        let mut b = *self.g;
+        let mut a = [[[0.0; L]; N]; N];
+        // A = Φ U: each entry summed over l ascending from +0 (the sparse
+        // sum's order; the zeros of Φ add nothing).
+        for k in 0..N {
+            for i in 0..=k {
+                let p = self.phi[i][k];
+                for j in k..N {
+                    let ukj = self.u[j][k];
+                    for l in 0..L {
+                        a[i][j][l] += p[l] * ukj[l];
+                    }
+                }
+            }
+        }
+        // Rows from the last: the reflection of row i acts on B[:, i..N]
+        // and the pivot column A[:, i].
+        for i in (0..N).rev() {
+            let pivot = a[i][i];
+            let mut off2 = [0.0; L];
+            for j in i..N {
+                for l in 0..L {
+                    off2[l] += b[i][j][l] * b[i][j][l];
+                }
+            }
+            let mut reflect = [false; L];
+            let mut alpha = [0.0; L];
+            let mut vp = [0.0; L];
+            let mut beta = [0.0; L];
+            for l in 0..L {
+                reflect[l] = off2[l] > 0.0;
+                let norm = (off2[l] + pivot[l] * pivot[l]).sqrt();
+                alpha[l] = if pivot[l] >= 0.0 { -norm } else { norm };
+                vp[l] = pivot[l] - alpha[l];
+                beta[l] = 2.0 / (off2[l] + vp[l] * vp[l]);
+            }
+            let vb = b[i];
+            for r in 0..i {
+                let mut t = [0.0; L];
+                for l in 0..L {
+                    t[l] = a[r][i][l] * vp[l];
+                }
+                for j in i..N {
+                    for l in 0..L {
+                        t[l] += b[r][j][l] * vb[j][l];
+                    }
+                }
+                let mut bt = [0.0; L];
+                for l in 0..L {
+                    bt[l] = beta[l] * t[l];
+                }
+                for j in i..N {
+                    for l in 0..L {
+                        let v = b[r][j][l] - bt[l] * vb[j][l];
+                        b[r][j][l] = if reflect[l] { v } else { b[r][j][l] };
+                    }
+                }
+                for l in 0..L {
+                    let v = a[r][i][l] - bt[l] * vp[l];
+                    a[r][i][l] = if reflect[l] { v } else { a[r][i][l] };
+                }
+            }
+            for l in 0..L {
+                if reflect[l] {
+                    a[i][i][l] = alpha[l];
+                }
+                // A non-negative diagonal (a sign flip of the column).
+                if a[i][i][l] < 0.0 {
+                    a[i][i][l] = -a[i][i][l];
+                    for row in a.iter_mut().take(i) {
+                        row[i][l] = -row[i][l];
+                    }
+                }
+            }
+        }
+        for j in 0..N {
+            for i in 0..=j {
+                for l in 0..L {
+                    if self.moving[l] {
+                        self.u[j][i][l] = a[i][j][l];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Carlson's update of every lane ([`super::carlson::carlson_update`]'s
+/// arithmetic, the state mean left out: it is zero in an augmented filter);
+/// returns the innovation variances.
+struct Update<'a, const N: usize> {
+    u: &'a mut [[[f64; L]; N]; N],
+    gain: &'a mut [[f64; L]; N],
+    h: &'a [[f64; L]; N],
+    r: [f64; L],
+}
+
+impl<const N: usize> aeromag_core::simd::Kernel for Update<'_, N> {
+    type Output = [f64; L];
+    #[inline(always)]
+    fn run(self) -> [f64; L] {
+        // f = Uᵀh, each summed over its rows in order.
+        let mut f = [[0.0; L]; N];
+        for (j, fj) in f.iter_mut().enumerate() {
+            for i in 0..=j {
+                for l in 0..L {
+                    fj[l] += self.u[j][i][l] * self.h[i][l];
+                }
+            }
+        }
+        let mut alpha = self.r;
+        let mut eta = [[0.0; L]; N];
+        let mut zeta = [[0.0; L]; N];
+        for j in 0..N {
+            for l in 0..L {
+                let beta = alpha[l];
+                alpha[l] += f[j][l] * f[j][l];
+                let inv_gamma = 1.0 / (alpha[l] * beta).sqrt();
+                eta[j][l] = beta * inv_gamma;
+                zeta[j][l] = f[j][l] * inv_gamma;
+            }
+        }
+        let mut k = [[0.0; L]; N];
+        for j in 0..N {
+            for i in 0..=j {
+                for l in 0..L {
+                    let a = self.u[j][i][l];
+                    let moves = f[j][l] != 0.0;
+                    let s = eta[j][l] * a - zeta[j][l] * k[i][l];
+                    let ki = k[i][l] + f[j][l] * a;
+                    self.u[j][i][l] = if moves { s } else { a };
+                    k[i][l] = if moves { ki } else { k[i][l] };
+                }
+            }
+        }
+        for i in 0..N {
+            for l in 0..L {
+                self.gain[i][l] = k[i][l] * (1.0 / alpha[l]);
+            }
+        }
+        alpha
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rnd(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    }
+
+    /// Four lanes with their own transitions, rows, run starts and idle
+    /// steps: each lane's filter is bit for bit the filter stepped alone.
+    fn lanes_equal_filters_alone<const N: usize>() {
+        let mut seed = 11 + N as u64;
+        let s0 = DMatrix::from_fn(N, N, |i, j| match (i, j) {
+            _ if i == j => 2.0 / (1 + i) as f64,
+            _ if i < j => 0.2,
+            _ => 0.0,
+        });
+        let m = 7;
+        let prior_mean: Vec<f64> = (0..m).map(|j| 0.1 * j as f64).collect();
+        let prior_std = vec![30.0; m];
+        let template = AugmentedFilter::new(&s0, &prior_mean, &prior_std).unwrap();
+        let mut lanes = AugmentedLanes::<N>::new(&s0, &prior_mean, &prior_std).unwrap();
+        let mut alone: Vec<AugmentedFilter> = (0..L).map(|_| template.clone()).collect();
+        // Per lane and step: a step length (Φ, G from it; 0 for some steps:
+        // Φ = I and G = 0, no reflection), a run start or idle.
+        let transition = |d: f64| {
+            let phi = DMatrix::from_fn(N, N, |i, j| {
+                if i == j {
+                    1.0
+                } else if i < j {
+                    d.powi((j - i) as i32) / (1 + j - i) as f64
+                } else {
+                    0.0
+                }
+            });
+            let g = DMatrix::from_fn(N, N, |i, j| {
+                if i <= j {
+                    0.05 * d * (1.0 + 0.1 * (i + 2 * j) as f64)
+                } else {
+                    0.0
+                }
+            });
+            (phi, g)
+        };
+        let r = 0.03;
+        for k in 0..900 {
+            let mut mats = Vec::new();
+            let mut plan = Vec::new();
+            for l in 0..L {
+                let d = if (k + l) % 37 == 5 {
+                    0.0
+                } else {
+                    0.5 + rnd(&mut seed)
+                };
+                mats.push(transition(d));
+                let what = if k == 0 || (k + 3 * l) % 250 == 0 {
+                    1
+                } else if l == 3 && k > 700 {
+                    0 // idle at the end
+                } else {
+                    2
+                };
+                let mut h = vec![0.0; N];
+                h[0] = 1.0;
+                h[N - 1] = if (k + l) % 11 == 0 {
+                    0.0
+                } else {
+                    rnd(&mut seed)
+                };
+                let z: Vec<f64> = (0..m).map(|_| 10.0 * rnd(&mut seed)).collect();
+                let y = 3.0 * rnd(&mut seed) + z[0] - 0.5 * z[3];
+                plan.push((what, h, z, y));
+            }
+            let steps: [LaneStep; L] = std::array::from_fn(|l| {
+                let (what, h, z, y) = &plan[l];
+                let reading = Reading { h, z, y: *y };
+                match what {
+                    0 => LaneStep::Idle,
+                    1 => LaneStep::Start(reading),
+                    _ => LaneStep::Next {
+                        phi: &mats[l].0,
+                        g: &mats[l].1,
+                        reading,
+                    },
+                }
+            });
+            lanes.step(steps, r).unwrap();
+            for (l, f) in alone.iter_mut().enumerate() {
+                let (what, h, z, y) = &plan[l];
+                match what {
+                    0 => continue,
+                    1 => f.start_run().unwrap(),
+                    _ => f.predict(&mats[l].0, &mats[l].1).unwrap(),
+                }
+                f.update(h, z, *y, r).unwrap();
+                if k % 97 == 0 {
+                    assert_eq!(
+                        lanes.conditional(l),
+                        f.conditional(),
+                        "N {N}, lane {l}, step {k}"
+                    );
+                }
+            }
+        }
+        for (l, f) in alone.iter_mut().enumerate() {
+            let mut lane = lanes.take(l).unwrap();
+            let (a, b) = (lane.conditional(), f.conditional());
+            let bits = |m: &DMatrix<f64>| m.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&a.factor), bits(&b.factor), "N {N}, lane {l}: factor");
+            assert_eq!(bits(&a.weight), bits(&b.weight), "N {N}, lane {l}: states");
+            assert_eq!(
+                lane.log_likelihood().unwrap().to_bits(),
+                f.log_likelihood().unwrap().to_bits(),
+                "N {N}, lane {l}: likelihood"
+            );
+        }
+        // A lane taken is fresh again.
+        let again = lanes.take(0).unwrap().conditional();
+        let fresh = template.conditional();
+        assert_eq!(again, fresh);
+        assert!(again.weight.iter().all(|v| *v == 0.0));
+    }
+
+    #[test]
+    fn each_lane_is_its_filter_alone_bit_for_bit() {
+        lanes_equal_filters_alone::<5>();
+        lanes_equal_filters_alone::<6>();
+        lanes_equal_filters_alone::<8>();
+    }
+
+    #[test]
+    fn bad_rows_and_lower_transitions_are_errors() {
+        let s0 = DMatrix::identity(2, 2);
+        let mut lanes = AugmentedLanes::<2>::new(&s0, &[0.0], &[1.0]).unwrap();
+        assert!(AugmentedLanes::<3>::new(&s0, &[0.0], &[1.0]).is_err());
+        let h = [1.0, 0.0];
+        let ok = Reading {
+            h: &h,
+            z: &[1.0],
+            y: 0.5,
+        };
+        let nan = Reading { y: f64::NAN, ..ok };
+        let idle = LaneStep::Idle;
+        assert!(
+            lanes
+                .step([LaneStep::Start(ok), idle, idle, idle], 1.0)
+                .is_ok()
+        );
+        assert!(
+            lanes
+                .step([LaneStep::Start(nan), idle, idle, idle], 1.0)
+                .is_err()
+        );
+        assert!(
+            lanes
+                .step([LaneStep::Start(ok), idle, idle, idle], 0.0)
+                .is_err()
+        );
+        let lower = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.5, 1.0]);
+        let g = DMatrix::zeros(2, 2);
+        let next = LaneStep::Next {
+            phi: &lower,
+            g: &g,
+            reading: ok,
+        };
+        assert!(lanes.step([next, idle, idle, idle], 1.0).is_err());
+    }
+}
