@@ -249,6 +249,7 @@ type StepArgs<'s> = (bool, f64, &'s [f64], f64, f64);
 /// A group filtered by [`filter_groups`]: its filter (sums, last state) and
 /// the field given the coefficients after each kept sample (index in the
 /// group, conditional).
+#[derive(Debug, Clone)]
 pub struct FilteredGroup {
     /// The filter after the group's last sample.
     pub filter: AugmentedFilter,
@@ -447,4 +448,98 @@ fn lanes_over<'a, const N: usize>(
         .into_iter()
         .map(|f| f.expect("every group filtered"))
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kalman::anomaly_model::NoiseModel;
+
+    /// Groups of unequal lengths (a lane whose group ends takes the next,
+    /// the last one goes on alone) on one and two threads, with kept
+    /// conditionals and recorded innovations: every group bit for bit the
+    /// field filter over it alone.
+    #[test]
+    fn groups_in_lanes_are_each_group_alone() {
+        for (order, m) in [(3, 5), (6, 9)] {
+            let prior = X2Prior {
+                order,
+                ..X2Prior::default()
+            };
+            let noise = NoiseModel::calibration_default();
+            let transition = AnomalyTransition::new(&noise, order);
+            let (coef_mean, coef_std) = (vec![0.0; m], vec![100.0; m]);
+            let lengths = [300usize, 40, 517, 129, 260, 3, 411];
+            let mut seed = 5u64;
+            let mut rnd = move || {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            };
+            let groups: Vec<OwnedSamples> = lengths
+                .iter()
+                .map(|&len| {
+                    let mut g = OwnedSamples::with_capacity(len, m);
+                    for k in 0..len {
+                        let row: Vec<f64> = (0..m).map(|_| rnd()).collect();
+                        let first = k == 0 || k % 97 == 0;
+                        let d = if k % 13 == 0 { 0.0 } else { 9.0 + rnd() };
+                        g.push(
+                            first,
+                            d,
+                            &row,
+                            5.0 * rnd(),
+                            3.0 * rnd() + row[0],
+                            k % 50 == 49,
+                        );
+                    }
+                    g
+                })
+                .collect();
+            let samples: Vec<GroupSamples<'static>> =
+                groups.into_iter().map(OwnedSamples::into_samples).collect();
+            for record in [false, true] {
+                let model = FieldModelSpec {
+                    x2_prior: &prior,
+                    transition: &transition,
+                    r_nt2: noise.r_nt2,
+                    coef_mean: &coef_mean,
+                    coef_std: &coef_std,
+                    record_innovations: record,
+                };
+                let alone: Vec<FilteredGroup> = samples
+                    .iter()
+                    .map(|s| one_group(s, &model).unwrap())
+                    .collect();
+                for threads in [1, 2] {
+                    let lanes =
+                        filter_groups(samples.len(), threads, &model, |g| Ok(samples[g].clone()))
+                            .unwrap();
+                    for (g, (mut a, mut b)) in
+                        lanes.into_iter().zip(alone.iter().cloned()).enumerate()
+                    {
+                        let what =
+                            format!("order {order}, group {g}, threads {threads}, record {record}");
+                        assert_eq!(a.filter.conditional(), b.filter.conditional(), "{what}");
+                        assert_eq!(a.kept.len(), b.kept.len(), "{what}");
+                        for ((ka, ca), (kb, cb)) in a.kept.iter().zip(&b.kept) {
+                            assert_eq!((ka, ca), (kb, cb), "{what}");
+                        }
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&a.innovations), bits(&b.innovations), "{what}");
+                        if !record {
+                            assert_eq!(
+                                a.filter.log_likelihood().unwrap().to_bits(),
+                                b.filter.log_likelihood().unwrap().to_bits(),
+                                "{what}"
+                            );
+                        } else {
+                            assert!(!a.innovations.is_empty());
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
