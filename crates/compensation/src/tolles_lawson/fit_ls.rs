@@ -174,7 +174,7 @@ const BLOCK_TOLERANCE: f64 = 1e-15;
 /// segment's length.
 ///
 /// The blocks are independent, so they are designed, filtered and passed
-/// through `map` on the available cores, one block per thread (a single
+/// through `map` on `threads` threads, one block per thread (a single
 /// block spreads its columns over the threads instead); `reduce` receives
 /// the mapped blocks in order on the calling thread. Each block is the same
 /// bits whatever the thread count.
@@ -183,11 +183,12 @@ fn for_each_filtered_block<T: Send>(
     dt_s: f64,
     cfg: &LsConfig,
     sos: Option<&Sos>,
+    threads: usize,
     map: impl Fn(&[&[f64]], &[f64]) -> Result<T> + Sync,
     mut reduce: impl FnMut(T) -> Result<()>,
 ) -> Result<()> {
     let plan = block_plan(seg.time.len(), dt_s, cfg, sos)?;
-    let threads = aeromag_core::parallel::threads();
+    let threads = threads.max(1);
     if plan.len() == 1 || threads == 1 {
         let mut work = BlockWork::default();
         for blk in &plan {
@@ -415,6 +416,7 @@ pub(crate) fn band_passed_residuals(
             dt,
             cfg,
             sos.as_ref(),
+            aeromag_core::parallel::threads(),
             |cols, y| {
                 Ok((0..y.len())
                     .map(|i| y[i] - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>())
@@ -542,28 +544,59 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
     let mut warnings = Vec::new();
     let mut used = 0;
     let mut fs_used = Vec::new();
-    for (k, seg) in segments.iter().enumerate() {
+    // One segment's block products (`Ok(Err(w))`: skipped, why), its blocks
+    // or columns on `threads` threads.
+    let products = |k: usize,
+                    threads: usize|
+     -> Result<std::result::Result<(f64, Vec<BlockProducts>), String>> {
+        let seg = &segments[k];
         let (dt, sos) = match segment_filter(k, seg, cfg)? {
             Ok(f) => f,
-            Err(w) => {
-                warnings.push(w);
-                continue;
-            }
+            Err(w) => return Ok(Err(w)),
         };
         let context = || format!("segment {k}");
+        let mut blocks = Vec::new();
         for_each_filtered_block(
             seg,
             dt,
             cfg,
             sos.as_ref(),
+            threads,
             |cols, y| BlockProducts::of(cols, y).map_err(CompError::estimation(context())),
             |p| {
-                ne.add_products(&p)
-                    .map_err(CompError::estimation(context()))
+                blocks.push(p);
+                Ok(())
             },
         )?;
-        used += 1;
-        fs_used.push(1.0 / dt);
+        Ok(Ok((dt, blocks)))
+    };
+    // Many segments (lines, or the lag search's sampled blocks): several
+    // segments at once, one per core; few: one at a time, its blocks or
+    // columns on the cores. Each segment's products are the same bits
+    // either way and are added in segment order.
+    let threads = aeromag_core::parallel::threads();
+    let per_core = threads > 1 && segments.len() >= 2 * threads;
+    let chunk = if per_core { 4 * threads } else { 1 };
+    for first in (0..segments.len()).step_by(chunk) {
+        let ks: Vec<usize> = (first..(first + chunk).min(segments.len())).collect();
+        let done = if per_core {
+            aeromag_core::parallel::parallel_map(ks.len(), threads, |i| products(ks[i], 1))
+        } else {
+            vec![products(ks[0], threads)]
+        };
+        for (k, d) in ks.into_iter().zip(done) {
+            match d? {
+                Err(w) => warnings.push(w),
+                Ok((dt, blocks)) => {
+                    for p in &blocks {
+                        ne.add_products(p)
+                            .map_err(CompError::estimation(format!("segment {k}")))?;
+                    }
+                    used += 1;
+                    fs_used.push(1.0 / dt);
+                }
+            }
+        }
     }
     if used == 0 {
         return Err(CompError::data(
