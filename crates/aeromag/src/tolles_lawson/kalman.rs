@@ -368,8 +368,12 @@ fn sensor_altitude(
     }
     let mut clean = alt.to_vec();
     let mut how = AltitudeSource::AsRecorded;
-    for (r, run) in segs.iter().zip(&runs) {
-        let (s, h) = smooth_altitude(run, use_vd, &cfg);
+    // Each run on its own (on the cores), written back in order.
+    let smoothed =
+        aeromag_core::parallel::parallel_map(runs.len(), aeromag_core::parallel::threads(), |i| {
+            smooth_altitude(&runs[i], use_vd, &cfg)
+        });
+    for (r, (s, h)) in segs.iter().zip(smoothed) {
         clean[r.clone()].copy_from_slice(&s);
         if how == AltitudeSource::AsRecorded {
             how = h;

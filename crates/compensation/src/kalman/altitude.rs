@@ -127,35 +127,43 @@ fn usable_runs(time: &[f64], n: usize, ok: impl Fn(usize) -> bool) -> Vec<std::o
 /// that record one (module docs). `None` when no run has a velocity channel
 /// long enough to band-pass.
 pub fn check_down_velocity(runs: &[NavRun<'_>], cfg: &AltitudeSmoothing) -> Option<VelocityCheck> {
+    // Each run's band-passed climb and altitude (on the cores), then the
+    // sums over every sample in run order.
+    let filtered =
+        aeromag_core::parallel::parallel_map(runs.len(), aeromag_core::parallel::threads(), |i| {
+            let run = &runs[i];
+            let mut out = Vec::new();
+            let Some(vd) = run.down_velocity_m_s else {
+                return out;
+            };
+            let n = run.time.len().min(run.alt_m.len()).min(vd.len());
+            let ok =
+                |k: usize| run.time[k].is_finite() && run.alt_m[k].is_finite() && vd[k].is_finite();
+            for r in usable_runs(run.time, n, ok) {
+                let t = &run.time[r.clone()];
+                let dt = median_step(t);
+                if dt <= 0.0 || cfg.check_band_hz.1 >= 0.45 / dt {
+                    continue;
+                }
+                let Ok(bp) = BandPass::new(2, cfg.check_band_hz.0, cfg.check_band_hz.1, 1.0 / dt)
+                else {
+                    continue;
+                };
+                let z = climb(t, &vd[r.clone()]);
+                if let (Ok(x), Ok(y)) = (bp.filter(&z), bp.filter(&run.alt_m[r.clone()])) {
+                    out.push((x, y));
+                }
+            }
+            out
+        });
     let (mut sxy, mut sxx, mut syy, mut samples) = (0.0, 0.0, 0.0, 0usize);
-    for run in runs {
-        let Some(vd) = run.down_velocity_m_s else {
-            continue;
-        };
-        let n = run.time.len().min(run.alt_m.len()).min(vd.len());
-        let ok =
-            |k: usize| run.time[k].is_finite() && run.alt_m[k].is_finite() && vd[k].is_finite();
-        for r in usable_runs(run.time, n, ok) {
-            let t = &run.time[r.clone()];
-            let dt = median_step(t);
-            if dt <= 0.0 || cfg.check_band_hz.1 >= 0.45 / dt {
-                continue;
-            }
-            let Ok(bp) = BandPass::new(2, cfg.check_band_hz.0, cfg.check_band_hz.1, 1.0 / dt)
-            else {
-                continue;
-            };
-            let z = climb(t, &vd[r.clone()]);
-            let (Ok(x), Ok(y)) = (bp.filter(&z), bp.filter(&run.alt_m[r.clone()])) else {
-                continue;
-            };
-            for (a, b) in x.iter().zip(&y) {
-                sxy += a * b;
-                sxx += a * a;
-                syy += b * b;
-            }
-            samples += x.len();
+    for (x, y) in filtered.iter().flatten() {
+        for (a, b) in x.iter().zip(y) {
+            sxy += a * b;
+            sxx += a * a;
+            syy += b * b;
         }
+        samples += x.len();
     }
     if samples == 0 || sxx <= 0.0 || syy <= 0.0 {
         return None;
