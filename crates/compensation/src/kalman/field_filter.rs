@@ -144,9 +144,8 @@ impl FieldFilter {
         Ok(())
     }
 
-    /// [`Self::new`] going on from `filter` (a filter of this model: a lane
-    /// of [`AugmentedLanes`] taken mid-group).
-    fn resume(filter: AugmentedFilter, model: &FieldModelSpec<'_>) -> Result<Self> {
+    /// [`Self::new`] of `model`, recording its innovations if it says so.
+    fn of(model: &FieldModelSpec<'_>) -> Result<Self> {
         let mut f = Self::new(
             model.x2_prior,
             model.transition,
@@ -154,6 +153,14 @@ impl FieldFilter {
             model.coef_mean,
             model.coef_std,
         )?;
+        f.filter.record_innovations(model.record_innovations);
+        Ok(f)
+    }
+
+    /// [`Self::of`] going on from `filter` (a filter of this model: a lane
+    /// of [`AugmentedLanes`] taken mid-group).
+    fn resume(filter: AugmentedFilter, model: &FieldModelSpec<'_>) -> Result<Self> {
+        let mut f = Self::of(model)?;
         f.filter = filter;
         Ok(f)
     }
@@ -276,6 +283,25 @@ pub struct FilteredGroup {
 }
 
 impl FilteredGroup {
+    /// The kept conditionals of a group of runs of `lengths` samples each,
+    /// run by run (run-local steps), appended to `out`.
+    pub fn kept_by_run(
+        kept: Vec<(usize, LeadingConditional)>,
+        lengths: impl IntoIterator<Item = usize>,
+        out: &mut Vec<Vec<(usize, LeadingConditional)>>,
+    ) {
+        let mut kept = kept.into_iter().peekable();
+        let mut offset = 0;
+        for len in lengths {
+            let mut cps = Vec::new();
+            while let Some((k, c)) = kept.next_if(|(k, _)| *k < offset + len) {
+                cps.push((k - offset, c));
+            }
+            out.push(cps);
+            offset += len;
+        }
+    }
+
     fn of(mut filter: AugmentedFilter, kept: Vec<(usize, LeadingConditional)>) -> Result<Self> {
         let innovations = filter.take_innovations().map_err(est)?;
         Ok(Self {
@@ -355,15 +381,13 @@ const MIN_GROUPS_FOR_LANES: usize = 3;
 
 /// One group with [`FieldFilter`].
 fn one_group(samples: &GroupSamples<'_>, model: &FieldModelSpec<'_>) -> Result<FilteredGroup> {
-    let mut f = FieldFilter::new(
-        model.x2_prior,
-        model.transition,
-        model.r_nt2,
-        model.coef_mean,
-        model.coef_std,
-    )?;
-    f.filter.record_innovations(model.record_innovations);
-    go_on(f, samples, 0, Vec::new(), model.coef_mean.len())
+    go_on(
+        FieldFilter::of(model)?,
+        samples,
+        0,
+        Vec::new(),
+        model.coef_mean.len(),
+    )
 }
 
 /// The samples `from..` of a group through `f`, the conditionals kept.

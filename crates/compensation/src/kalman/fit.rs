@@ -651,6 +651,34 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
     })
 }
 
+/// The groups of runs of the field filter's passes and the transition of
+/// their noise intensities, the model checked.
+fn pass_groups(p: &PassInputs) -> Result<(Vec<Range<usize>>, AnomalyTransition)> {
+    check_field_model(&p.noise, &p.cfg.field_prior)?;
+    Ok((
+        groups_of_runs(p.runs.iter().map(|r| r.range.len())),
+        AnomalyTransition::new(&p.noise, p.cfg.field_prior.order),
+    ))
+}
+
+impl PassInputs<'_> {
+    /// The field filter's model of these inputs under `transition`.
+    fn field_model<'t>(
+        &'t self,
+        transition: &'t AnomalyTransition,
+        record: bool,
+    ) -> FieldModelSpec<'t> {
+        FieldModelSpec {
+            x2_prior: &self.cfg.field_prior,
+            transition,
+            r_nt2: self.noise.r_nt2,
+            coef_mean: self.coef_mean,
+            coef_std: self.coef_std,
+            record_innovations: record,
+        }
+    }
+}
+
 /// The samples of `runs` (a group of runs) for the field filter
 /// ([`filter_groups`]): design rows formed run by run, checked here so that
 /// an error names the segment and row.
@@ -708,36 +736,16 @@ fn group_samples(p: &PassInputs, runs: &[Run]) -> Result<GroupSamples<'static>> 
 /// ([`super::field_filter`]): groups of runs on the cores, their sums
 /// added in run order.
 fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
-    let cfg = p.cfg;
-    check_field_model(&p.noise, &cfg.field_prior)?;
-    let groups = groups_of_runs(p.runs.iter().map(|r| r.range.len()));
-    let transition = AnomalyTransition::new(&p.noise, cfg.field_prior.order);
-    let model = FieldModelSpec {
-        x2_prior: &cfg.field_prior,
-        transition: &transition,
-        r_nt2: p.noise.r_nt2,
-        coef_mean: p.coef_mean,
-        coef_std: p.coef_std,
-        record_innovations: false,
-    };
+    let (groups, transition) = pass_groups(p)?;
+    let model = p.field_model(&transition, false);
     let filtered = filter_groups(groups.len(), threads(), &model, |gi| {
         group_samples(p, &p.runs[groups[gi].clone()])
     })?;
     let mut filters = Vec::with_capacity(filtered.len());
     let mut conditionals = Vec::with_capacity(p.runs.len());
     for (group, done) in groups.iter().zip(filtered) {
-        // The kept conditionals back to their runs (run-local steps).
-        let mut kept = done.kept.into_iter().peekable();
-        let mut offset = 0;
-        for run in &p.runs[group.clone()] {
-            let len = run.range.len();
-            let mut cps = Vec::new();
-            while let Some((k, c)) = kept.next_if(|(k, _)| *k < offset + len) {
-                cps.push((k - offset, c));
-            }
-            conditionals.push(cps);
-            offset += len;
-        }
+        let lengths = p.runs[group.clone()].iter().map(|r| r.range.len());
+        FilteredGroup::kept_by_run(done.kept, lengths, &mut conditionals);
         filters.push(done.filter);
     }
     let sol = merge_in_order(filters)?.solve().map_err(est)?;
@@ -757,17 +765,8 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
 /// filtered; the innovations go into `series` (when computed).
 fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
     let cfg = p.cfg;
-    check_field_model(&p.noise, &cfg.field_prior)?;
-    let groups = groups_of_runs(p.runs.iter().map(|r| r.range.len()));
-    let transition = AnomalyTransition::new(&p.noise, cfg.field_prior.order);
-    let model = FieldModelSpec {
-        x2_prior: &cfg.field_prior,
-        transition: &transition,
-        r_nt2: p.noise.r_nt2,
-        coef_mean: p.coef_mean,
-        coef_std: p.coef_std,
-        record_innovations: true,
-    };
+    let (groups, transition) = pass_groups(p)?;
+    let model = p.field_model(&transition, true);
     let m = p.coef_mean.len();
     let mut rls = SqrtKalmanFilter::new(
         &vec![0.0; m],
@@ -790,16 +789,9 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         for (gi, group) in done.into_iter().enumerate() {
             let runs = &p.runs[groups[first_group + gi].clone()];
             let mut rows = group.innovations.chunks_exact(m + 2);
-            let mut kept = group.kept.into_iter().peekable();
-            let mut offset = 0;
+            let lengths = runs.iter().map(|r| r.range.len());
+            FilteredGroup::kept_by_run(group.kept, lengths, conditionals);
             for run in runs {
-                let len = run.range.len();
-                let mut cps = Vec::new();
-                while let Some((k, c)) = kept.next_if(|(k, _)| *k < offset + len) {
-                    cps.push((k - offset, c));
-                }
-                conditionals.push(cps);
-                offset += len;
                 for i in run.range.clone() {
                     let w = rows.next().ok_or_else(|| {
                         CompError::data("split pass: fewer innovations than samples".to_string())

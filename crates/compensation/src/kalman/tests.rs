@@ -665,12 +665,12 @@ fn the_tuning_likelihood_is_the_pass_1_filters() {
     }
 }
 
-/// Pass 1 by the field filter with the coefficients integrated out gives
-/// the joint filter's coefficients, covariance, likelihoods, diagnostics
-/// and smoothed field to round-off, over three runs, for the thesis' order
-/// and the default; it has no innovations.
-#[test]
-fn the_augmented_pass_gives_the_joint_fit() {
+/// The joint fit and the fit by `pass` over three runs, for the thesis'
+/// order and the default: the same coefficients, standard deviations, VIF,
+/// smoothed field and compensated reading (worst differences printed and
+/// bounded), likelihoods, condition and residual to round-off; then
+/// `more(fit by pass, joint fit)`.
+fn against_the_joint_fit(pass: CoefficientPass, more: impl Fn(&KalmanFit, &KalmanFit)) {
     let (terms, b) = three_runs();
     for prior in [X2Prior::thesis(), X2Prior::default()] {
         let joint_cfg = KalmanConfig {
@@ -678,12 +678,12 @@ fn the_augmented_pass_gives_the_joint_fit() {
             smoother_block_len: 100,
             ..no_tuning(terms.clone(), NOISE)
         };
-        let aug_cfg = KalmanConfig {
-            coefficient_pass: CoefficientPass::Augmented,
+        let cfg = KalmanConfig {
+            coefficient_pass: pass,
             ..joint_cfg.clone()
         };
         let j = fit_kalman(&[b.segment()], &joint_cfg).unwrap();
-        let a = fit_kalman(&[b.segment()], &aug_cfg).unwrap();
+        let a = fit_kalman(&[b.segment()], &cfg).unwrap();
         assert_eq!((a.runs, a.rows), (3, j.rows));
         let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
         let mut worst = [0.0f64; 5];
@@ -702,7 +702,7 @@ fn the_augmented_pass_gives_the_joint_fit() {
             worst[4] = worst[4].max((sa.compensated_nt[k] - sj.compensated_nt[k]).abs());
         }
         eprintln!(
-            "order {}: coefficients {:.1e} σ, std {:.1e}, VIF {:.1e}, field {:.1e} nT, compensated {:.1e} nT",
+            "{pass:?}, order {}: coefficients {:.1e} σ, std {:.1e}, VIF {:.1e}, field {:.1e} nT, compensated {:.1e} nT",
             prior.order, worst[0], worst[1], worst[2], worst[3], worst[4]
         );
         assert!(
@@ -715,67 +715,47 @@ fn the_augmented_pass_gives_the_joint_fit() {
         assert!(rel(a.condition, j.condition) < 1e-6);
         assert!(rel(a.residual_rms_nt, j.residual_rms_nt) < 1e-8);
         assert!(j.normalized_innovation_variance.is_finite());
-        assert!(a.normalized_innovation_variance.is_nan() && a.innovation_rms_nt.is_nan());
-        assert!(sa.innovation_nt.iter().all(|v| v.is_nan()));
+        more(&a, &j);
     }
+}
+
+/// Pass 1 by the field filter with the coefficients integrated out gives
+/// the joint filter's coefficients, covariance, likelihoods, diagnostics
+/// and smoothed field to round-off; it has no innovations.
+#[test]
+fn the_augmented_pass_gives_the_joint_fit() {
+    against_the_joint_fit(CoefficientPass::Augmented, |a, _| {
+        assert!(a.normalized_innovation_variance.is_nan() && a.innovation_rms_nt.is_nan());
+        assert!(a.series[0].innovation_nt.iter().all(|v| v.is_nan()));
+    });
 }
 
 /// The joint filter split in two (the field filter on the cores, the
 /// coefficients' recursive least squares in run order) gives the joint
-/// filter's coefficients, covariance, likelihood, diagnostics, smoothed
-/// field and every sequential innovation with its standard deviation, to
-/// round-off.
+/// filter's fit and also every sequential innovation with its standard
+/// deviation, and their statistics, to round-off.
 #[test]
 fn the_split_pass_gives_the_joint_fit() {
-    let (terms, b) = three_runs();
-    for prior in [X2Prior::thesis(), X2Prior::default()] {
-        let joint_cfg = KalmanConfig {
-            field_prior: prior,
-            smoother_block_len: 100,
-            ..no_tuning(terms.clone(), NOISE)
-        };
-        let split_cfg = KalmanConfig {
-            coefficient_pass: CoefficientPass::Split,
-            ..joint_cfg.clone()
-        };
-        let j = fit_kalman(&[b.segment()], &joint_cfg).unwrap();
-        let s = fit_kalman(&[b.segment()], &split_cfg).unwrap();
-        assert_eq!((s.runs, s.rows), (3, j.rows));
+    against_the_joint_fit(CoefficientPass::Split, |s, j| {
         let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
-        let mut worst = [0.0f64; 7];
-        for k in 0..j.coef.len() {
-            worst[0] = worst[0].max((s.coef[k] - j.coef[k]).abs() / j.std[k]);
-            worst[1] = worst[1].max(rel(s.std[k], j.std[k]));
-            worst[2] = worst[2].max(rel(s.vif[k], j.vif[k]));
-        }
         let (ss, sj) = (&s.series[0], &j.series[0]);
-        let mut innovations = 0;
-        for k in 0..sj.external_nt.len() {
-            if sj.external_nt[k].is_nan() {
-                assert!(ss.external_nt[k].is_nan() && ss.innovation_nt[k].is_nan());
+        let (mut worst, mut innovations) = ([0.0f64; 2], 0);
+        for k in 0..sj.innovation_nt.len() {
+            if sj.innovation_nt[k].is_nan() {
+                assert!(ss.innovation_nt[k].is_nan());
                 continue;
             }
-            worst[3] = worst[3].max((ss.external_nt[k] - sj.external_nt[k]).abs());
-            worst[4] = worst[4].max((ss.compensated_nt[k] - sj.compensated_nt[k]).abs());
             let sd = sj.innovation_std_nt[k];
-            worst[5] = worst[5].max((ss.innovation_nt[k] - sj.innovation_nt[k]).abs() / sd);
-            worst[6] = worst[6].max(rel(ss.innovation_std_nt[k], sd));
+            worst[0] = worst[0].max((ss.innovation_nt[k] - sj.innovation_nt[k]).abs() / sd);
+            worst[1] = worst[1].max(rel(ss.innovation_std_nt[k], sd));
             innovations += 1;
         }
         eprintln!(
-            "order {}: coefficients {:.1e} σ, std {:.1e}, VIF {:.1e}, field {:.1e} nT, compensated {:.1e} nT, \
-             innovations {:.1e} σ, their σ {:.1e} ({innovations} samples)",
-            prior.order, worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], worst[6]
+            "innovations {:.1e} σ, their σ {:.1e} ({innovations} samples)",
+            worst[0], worst[1]
         );
         assert!(innovations > 1000);
-        assert!(
-            worst[0] < 1e-7 && worst[1] < 1e-7 && worst[2] < 1e-6,
-            "{worst:?}"
-        );
-        assert!(worst[3] < 1e-6 && worst[4] < 1e-6, "{worst:?}");
-        assert!(worst[5] < 1e-7 && worst[6] < 1e-7, "{worst:?}");
-        assert!(rel(s.log_likelihood, j.log_likelihood) < 1e-10);
-        assert!(rel(s.profile_log_likelihood(), j.profile_log_likelihood()) < 1e-10);
+        assert!(worst[0] < 1e-7 && worst[1] < 1e-7, "{worst:?}");
         assert!(
             rel(
                 s.normalized_innovation_variance,
@@ -783,7 +763,5 @@ fn the_split_pass_gives_the_joint_fit() {
             ) < 1e-9
         );
         assert!(rel(s.innovation_rms_nt, j.innovation_rms_nt) < 1e-9);
-        assert!(rel(s.condition, j.condition) < 1e-6);
-        assert!(rel(s.residual_rms_nt, j.residual_rms_nt) < 1e-8);
-    }
+    });
 }
