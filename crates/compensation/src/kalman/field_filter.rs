@@ -95,35 +95,21 @@ pub struct FieldFilter {
 }
 
 impl FieldFilter {
-    /// A filter with the field prior `x2_prior`, the transition for the
-    /// noise intensities in use, white-noise variance `r_nt2` and the
-    /// coefficients' prior means and standard deviations.
-    pub fn new(
-        x2_prior: &X2Prior,
-        transition: &AnomalyTransition,
-        r_nt2: f64,
-        coef_mean: &[f64],
-        coef_std: &[f64],
-    ) -> Result<Self> {
-        if !x2_prior.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid field prior {x2_prior:?} (positive, finite)"
-            )));
-        }
-        if !(r_nt2 > 0.0 && r_nt2.is_finite()) {
-            return Err(CompError::setting(format!(
-                "white-noise variance {r_nt2} nT² must be finite and > 0"
-            )));
-        }
-        let dim = x2_prior.dim();
-        let mut h = vec![0.0; dim];
+    /// A filter of `model` (recording its innovations if it says so).
+    pub fn new(model: &FieldModelSpec<'_>) -> Result<Self> {
+        model.check()?;
+        let mut h = vec![0.0; model.x2_prior.dim()];
         h[B_H] = 1.0;
+        let mut filter =
+            AugmentedFilter::new(&model.x2_prior.factor(), model.coef_mean, model.coef_std)
+                .map_err(est)?;
+        filter.record_innovations(model.record_innovations);
         Ok(Self {
-            filter: AugmentedFilter::new(&x2_prior.factor(), coef_mean, coef_std).map_err(est)?,
-            transition: StepTransition::new(transition.clone()),
+            filter,
+            transition: StepTransition::new(model.transition.clone()),
             h,
-            b_z: x2_prior.b_z(),
-            r_nt2,
+            b_z: model.x2_prior.b_z(),
+            r_nt2: model.r_nt2,
         })
     }
 
@@ -144,23 +130,10 @@ impl FieldFilter {
         Ok(())
     }
 
-    /// [`Self::new`] of `model`, recording its innovations if it says so.
-    fn of(model: &FieldModelSpec<'_>) -> Result<Self> {
-        let mut f = Self::new(
-            model.x2_prior,
-            model.transition,
-            model.r_nt2,
-            model.coef_mean,
-            model.coef_std,
-        )?;
-        f.filter.record_innovations(model.record_innovations);
-        Ok(f)
-    }
-
-    /// [`Self::of`] going on from `filter` (a filter of this model: a lane
+    /// [`Self::new`] going on from `filter` (a filter of this model: a lane
     /// of [`AugmentedLanes`] taken mid-group).
     fn resume(filter: AugmentedFilter, model: &FieldModelSpec<'_>) -> Result<Self> {
-        let mut f = Self::of(model)?;
+        let mut f = Self::new(model)?;
         f.filter = filter;
         Ok(f)
     }
@@ -312,9 +285,9 @@ impl FilteredGroup {
     }
 }
 
-/// What [`FieldFilter::new`] takes: the field prior, the transition for the
-/// noise intensities in use, the white-noise variance and the
-/// coefficients' prior.
+/// The field filter's model ([`FieldFilter::new`]): the field prior, the
+/// transition for the noise intensities in use, the white-noise variance
+/// and the coefficients' prior.
 pub struct FieldModelSpec<'a> {
     /// The field states' prior.
     pub x2_prior: &'a X2Prior,
@@ -330,6 +303,26 @@ pub struct FieldModelSpec<'a> {
     pub record_innovations: bool,
 }
 
+impl FieldModelSpec<'_> {
+    /// A usable field prior and white-noise variance: a
+    /// [`CompError::InvalidSetting`] naming the bad one otherwise.
+    fn check(&self) -> Result<()> {
+        if !self.x2_prior.is_valid() {
+            return Err(CompError::setting(format!(
+                "invalid field prior {:?} (positive, finite)",
+                self.x2_prior
+            )));
+        }
+        if !(self.r_nt2 > 0.0 && self.r_nt2.is_finite()) {
+            return Err(CompError::setting(format!(
+                "white-noise variance {} nT² must be finite and > 0",
+                self.r_nt2
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// The field filter ([`FieldFilter`]) over each of `groups` groups of runs
 /// (`load(g)`: group `g`'s samples), the groups shared over `threads`
 /// threads and, for the field models of orders 3, 4 and 6, filtered four at
@@ -341,25 +334,18 @@ pub fn filter_groups<'a>(
     model: &FieldModelSpec<'_>,
     load: impl Fn(usize) -> Result<GroupSamples<'a>> + Sync,
 ) -> Result<Vec<FilteredGroup>> {
-    if !(model.r_nt2 > 0.0 && model.r_nt2.is_finite()) {
-        return Err(CompError::setting(format!(
-            "white-noise variance {} nT² must be finite and > 0",
-            model.r_nt2
-        )));
-    }
+    model.check()?;
     let threads = threads.clamp(1, groups.max(1));
     let per_thread = aeromag_core::parallel::parallel_map(threads, threads, |t| {
         let mine: Vec<usize> = (t..groups).step_by(threads).collect();
         // Lanes pay for four factors' updates whatever the number of groups
         // in them: worth it from three groups on (measured on one simulated
         // calibration box, 3 groups: one at a time is faster for 1 or 2).
+        let lanes = mine.len() >= MIN_GROUPS_FOR_LANES;
         let filtered = match model.x2_prior.dim() {
-            _ if mine.len() < MIN_GROUPS_FOR_LANES => {
-                mine.iter().map(|&g| one_group(&load(g)?, model)).collect()
-            }
-            5 => lanes_over::<5>(&mine, model, &load),
-            6 => lanes_over::<6>(&mine, model, &load),
-            8 => lanes_over::<8>(&mine, model, &load),
+            5 if lanes => lanes_over::<5>(&mine, model, &load),
+            6 if lanes => lanes_over::<6>(&mine, model, &load),
+            8 if lanes => lanes_over::<8>(&mine, model, &load),
             _ => mine.iter().map(|&g| one_group(&load(g)?, model)).collect(),
         };
         filtered.map(|f| mine.into_iter().zip(f).collect::<Vec<_>>())
@@ -382,7 +368,7 @@ const MIN_GROUPS_FOR_LANES: usize = 3;
 /// One group with [`FieldFilter`].
 fn one_group(samples: &GroupSamples<'_>, model: &FieldModelSpec<'_>) -> Result<FilteredGroup> {
     go_on(
-        FieldFilter::of(model)?,
+        FieldFilter::new(model)?,
         samples,
         0,
         Vec::new(),
@@ -452,15 +438,16 @@ fn lanes_over<'a, const N: usize>(
                 next_group += 1;
             }
         }
-        let active: Vec<usize> = (0..FILTER_LANES).filter(|&l| at[l].is_some()).collect();
-        if let ([l], true) = (&active[..], next_group == mine.len()) {
-            // The last group alone: on without the lanes.
-            let (i, samples, k, kept) = at[*l].take().expect("an active lane");
-            let f = FieldFilter::resume(lanes.take(*l).map_err(est)?, model)?;
-            done[i] = Some(go_on(f, &samples, k, kept, m)?);
+        let active = at.iter().filter(|a| a.is_some()).count();
+        if active == 0 {
             break;
         }
-        if active.is_empty() {
+        if active == 1 && next_group == mine.len() {
+            // The last group alone: on without the lanes.
+            let l = at.iter().position(Option::is_some).expect("an active lane");
+            let (i, samples, k, kept) = at[l].take().expect("an active lane");
+            let f = FieldFilter::resume(lanes.take(l).map_err(est)?, model)?;
+            done[i] = Some(go_on(f, &samples, k, kept, m)?);
             break;
         }
         let samples: [Option<StepArgs<'_>>; FILTER_LANES] =

@@ -561,6 +561,51 @@ struct InnovationSums {
     count: usize,
 }
 
+/// A pass's sequential innovations as they come (the joint filter's, or
+/// the split pass's least squares'): the log-likelihood of all of them,
+/// [`InnovationSums`] past each run's first `n_f` samples, and the series.
+struct InnovationTally {
+    log_lik: f64,
+    sums: InnovationSums,
+    n_f: usize,
+}
+
+impl InnovationTally {
+    fn new(n_f: usize) -> Self {
+        Self {
+            log_lik: 0.0,
+            sums: InnovationSums {
+                chi2: 0.0,
+                ss: 0.0,
+                count: 0,
+            },
+            n_f,
+        }
+    }
+
+    /// The innovation of row `i` of segment `seg` (`local`: its index in
+    /// its run), into the sums and into `series` (when computed).
+    fn add(
+        &mut self,
+        inn: &Innovation,
+        local: usize,
+        seg: usize,
+        i: usize,
+        series: &mut [KalmanSeries],
+    ) {
+        self.log_lik += inn.log_likelihood();
+        if local >= self.n_f {
+            self.sums.chi2 += inn.value * inn.value / inn.variance;
+            self.sums.ss += inn.value * inn.value;
+            self.sums.count += 1;
+        }
+        if let Some(o) = series.get_mut(seg) {
+            o.innovation_nt[i] = inn.value;
+            o.innovation_std_nt[i] = inn.std();
+        }
+    }
+}
+
 /// Whether pass 1 keeps a restart point of the smoother after the
 /// run-local sample `local` of a run of `len` samples: every smoother block
 /// ([`KalmanConfig::smoother_block_len`]) but the last, when the series are
@@ -578,7 +623,7 @@ fn restart_point(cfg: &KalmanConfig, local: usize, len: usize) -> bool {
 /// into `series` (when computed).
 fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
     let mut jf = JointFilter::new(p.coef_mean, p.coef_std, &p.cfg.field_prior, p.noise)?;
-    let (mut log_lik, mut chi2, mut ss, mut n_stat) = (0.0, 0.0, 0.0, 0usize);
+    let mut tally = InnovationTally::new(p.cfg.field_prior.dim());
     // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
     let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = vec![Vec::new(); p.runs.len()];
     // The design rows are formed on a second thread while the filter runs.
@@ -606,17 +651,8 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         };
         match jf.step(d, row, s.alt_m[i] - p.z0, s.data.mag[i] - p.y_ref) {
             Ok(inn) => {
-                log_lik += inn.log_likelihood();
-                if i - run.range.start >= p.cfg.field_prior.dim() {
-                    chi2 += inn.value * inn.value / inn.variance;
-                    ss += inn.value * inn.value;
-                    n_stat += 1;
-                }
-                if let Some(o) = series.get_mut(run.seg) {
-                    o.innovation_nt[i] = inn.value;
-                    o.innovation_std_nt[i] = inn.std();
-                }
                 let local = i - run.range.start;
+                tally.add(&inn, local, run.seg, i, series);
                 if restart_point(p.cfg, local, len) {
                     match jf.field_conditional() {
                         Ok(c) => conditionals[r].push((local, c)),
@@ -641,12 +677,8 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         coef: jf.coefficients().to_vec(),
         posterior_covariance: jf.coefficient_covariance(),
         factor: jf.coefficient_factor(),
-        log_lik,
-        innovations: Some(InnovationSums {
-            chi2,
-            ss,
-            count: n_stat,
-        }),
+        log_lik: tally.log_lik,
+        innovations: Some(tally.sums),
         conditionals,
     })
 }
@@ -773,12 +805,7 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         &DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(p.coef_std)),
     )
     .map_err(est)?;
-    let mut sums = InnovationSums {
-        chi2: 0.0,
-        ss: 0.0,
-        count: 0,
-    };
-    let mut log_lik = 0.0;
+    let mut tally = InnovationTally::new(cfg.field_prior.dim());
     let mut conditionals: Vec<Vec<(usize, LeadingConditional)>> = Vec::with_capacity(p.runs.len());
     // The least squares of one round's groups, in run order.
     let mut absorb = |first_group: usize,
@@ -802,16 +829,7 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
                         value: white.value * s_k.sqrt(),
                         variance: white.variance * s_k,
                     };
-                    log_lik += inn.log_likelihood();
-                    if i - run.range.start >= cfg.field_prior.dim() {
-                        sums.chi2 += inn.value * inn.value / inn.variance;
-                        sums.ss += inn.value * inn.value;
-                        sums.count += 1;
-                    }
-                    if let Some(o) = series.get_mut(run.seg) {
-                        o.innovation_nt[i] = inn.value;
-                        o.innovation_std_nt[i] = inn.std();
-                    }
+                    tally.add(&inn, i - run.range.start, run.seg, i, series);
                 }
             }
         }
@@ -850,8 +868,8 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         coef: p.coef_mean.iter().zip(delta).map(|(b, d)| b + d).collect(),
         posterior_covariance: rls.covariance(),
         factor: rls.factor().clone(),
-        log_lik,
-        innovations: Some(sums),
+        log_lik: tally.log_lik,
+        innovations: Some(tally.sums),
         conditionals,
     })
 }

@@ -775,13 +775,20 @@ mod tests {
         }
     }
 
+    /// A two-state model: prior factor, Φ and G.
+    fn two_states() -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+        (
+            DMatrix::from_row_slice(2, 2, &[2.0, 0.1, 0.0, 1.0]),
+            DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 0.9]),
+            DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.0, 0.2]),
+        )
+    }
+
     /// Splitting the runs between two filters and merging gives the
     /// likelihood of one filter over all of them.
     #[test]
     fn merged_runs_give_the_whole_likelihood() {
-        let s0 = DMatrix::from_row_slice(2, 2, &[2.0, 0.1, 0.0, 1.0]);
-        let phi = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 0.9]);
-        let g = DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.0, 0.2]);
+        let (s0, phi, g) = two_states();
         let new = || AugmentedFilter::new(&s0, &[0.0, 1.0], &[5.0, 5.0]).unwrap();
         let (mut all, mut a, mut b) = (new(), new(), new());
         for run in 0..4 {
@@ -813,9 +820,7 @@ mod tests {
     /// not summed: their cross-products are the filter's without the record.
     #[test]
     fn recorded_innovations_are_the_whitened_rows() {
-        let s0 = DMatrix::from_row_slice(2, 2, &[2.0, 0.1, 0.0, 1.0]);
-        let phi = DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.0, 0.9]);
-        let g = DMatrix::from_row_slice(2, 2, &[0.1, 0.0, 0.0, 0.2]);
+        let (s0, phi, g) = two_states();
         let new = || AugmentedFilter::new(&s0, &[0.5, 1.0], &[5.0, 5.0]).unwrap();
         let (mut summed, mut recorded) = (new(), new());
         recorded.record_innovations(true);

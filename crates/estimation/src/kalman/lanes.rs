@@ -205,9 +205,9 @@ impl<const N: usize> AugmentedLanes<N> {
         Ok(())
     }
 
-    /// Every lane records its innovations from its next fresh start
-    /// ([`AugmentedFilter::record_innovations`]; [`Self::take`] hands them
-    /// over with the filter).
+    /// Every lane records its innovations from now on, and so does every
+    /// lane made fresh again ([`AugmentedFilter::record_innovations`];
+    /// [`Self::take`] hands them over with the filter).
     pub fn record_innovations(&mut self, on: bool) {
         self.fresh.record_innovations(on);
         for r in &mut self.rhs {
