@@ -365,59 +365,47 @@ impl BlockProducts {
                 what: "least-squares block",
             });
         }
-        // Rows in runs that stay in cache while all n(n+1)/2 products
-        // are formed (instead of streaming every pair of columns from
-        // memory), four columns at a time against each column; the
-        // products left over (against `y`, the last < 4 of each row of the
-        // triangle, `y·y`) go four at a time through the same kernel.
+        // Rows in runs that stay in cache while all the products are
+        // formed (instead of streaming every pair of columns from memory).
+        // Column `n` is `y`; the products are those (i, j) with i ≤ j ≤ n,
+        // formed in tiles of two columns against four, the rest four pairs
+        // at a time. Each product is summed as [`dot`] sums, whatever the
+        // grouping.
         let per = Self::per_run(n);
-        let mut grouped = Vec::new();
-        let mut leftover = Vec::new();
-        for i in 0..n {
-            leftover.push((i, i, n));
-        }
-        let mut pos = n;
-        for i in 0..n {
-            let mut j = i;
-            while j + 4 <= n {
-                grouped.push((pos, i, j));
-                pos += 4;
-                j += 4;
-            }
-            for j in j..n {
-                leftover.push((pos, i, j));
-                pos += 1;
-            }
-        }
-        leftover.push((pos, n, n));
+        let plan = ProductPlan::new(n);
         let mut sums = vec![0.0; m.div_ceil(ROW_BLOCK) * per];
         for (run, out) in sums.chunks_exact_mut(per).enumerate() {
             let (start, end) = (run * ROW_BLOCK, ((run + 1) * ROW_BLOCK).min(m));
-            // Column `n` is `y`.
             let block: Vec<&[f64]> = columns
                 .iter()
                 .map(|c| &c[start..end])
                 .chain(std::iter::once(&y[start..end]))
                 .collect();
-            for &(pos, i, j) in &grouped {
-                let b = [block[j], block[j + 1], block[j + 2], block[j + 3]];
-                out[pos..pos + 4].copy_from_slice(&aeromag_core::simd::run(Dot4::<true> {
-                    a: [block[i]; 4],
-                    b,
-                }));
-            }
-            let mut quads = leftover.chunks_exact(4);
-            for q in quads.by_ref() {
-                let v = aeromag_core::simd::run(Dot4::<false> {
-                    a: std::array::from_fn(|t| block[q[t].1]),
-                    b: std::array::from_fn(|t| block[q[t].2]),
-                });
-                for (t, &(pos, _, _)) in q.iter().enumerate() {
-                    out[pos] = v[t];
+            let len = end - start;
+            for &(i, j) in &plan.tiles {
+                let lanes = aeromag_core::simd::lane_dots(
+                    [block[i], block[i + 1]],
+                    [block[j], block[j + 1], block[j + 2], block[j + 3]],
+                );
+                for (r, row) in lanes.iter().enumerate() {
+                    for (c, s) in row.iter().enumerate() {
+                        out[plan.pos(i + r, j + c)] =
+                            finish_dot(s, block[i + r], block[j + c], len);
+                    }
                 }
             }
-            for &(pos, i, j) in quads.remainder() {
-                out[pos] = dot(block[i], block[j]);
+            let mut quads = plan.pairs.chunks_exact(4);
+            for q in quads.by_ref() {
+                let lanes = aeromag_core::simd::lane_dots_pairs(
+                    std::array::from_fn(|t| block[q[t].0]),
+                    std::array::from_fn(|t| block[q[t].1]),
+                );
+                for (&(i, j), s) in q.iter().zip(&lanes) {
+                    out[plan.pos(i, j)] = finish_dot(s, block[i], block[j], len);
+                }
+            }
+            for &(i, j) in quads.remainder() {
+                out[plan.pos(i, j)] = dot(block[i], block[j]);
             }
         }
         Ok(BlockProducts { n, rows: m, sums })
@@ -433,52 +421,68 @@ impl BlockProducts {
 /// 512 rows take 80 kB, which stays in a core's L2 cache.
 const ROW_BLOCK: usize = 512;
 
-/// Four dot products `a[t]·b[t]` at once, each summed exactly as [`dot`]
-/// sums (four accumulators, pairwise at the end, then the tail), so the
-/// result does not depend on how the products are grouped. `SHARED`: one
-/// `a` for all four (`a[0]`), loaded once per row.
-struct Dot4<'a, const SHARED: bool> {
-    a: [&'a [f64]; 4],
-    b: [&'a [f64]; 4],
+/// Which products [`BlockProducts::of`] forms in tiles and which in
+/// pairs, for `n` columns and `y` (column `n`).
+struct ProductPlan {
+    n: usize,
+    /// Tiles: columns `i, i + 1` against `j .. j + 4` (all `≥ i + 1`).
+    tiles: Vec<(usize, usize)>,
+    /// The products `(i, j)`, `i ≤ j`, that are in no tile.
+    pairs: Vec<(usize, usize)>,
 }
 
-impl<const SHARED: bool> aeromag_core::simd::Kernel for Dot4<'_, SHARED> {
-    type Output = [f64; 4];
-    #[inline(always)]
-    fn run(self) -> [f64; 4] {
-        let m = self.a[0].len();
-        let a = if SHARED { [self.a[0]; 4] } else { self.a };
-        let a = a.map(|a| &a[..m]);
-        let b = self.b.map(|b| &b[..m]);
-        let (mut s0, mut s1, mut s2, mut s3) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
-        let rows = a[0]
-            .chunks_exact(4)
-            .zip(a[1].chunks_exact(4))
-            .zip(a[2].chunks_exact(4))
-            .zip(a[3].chunks_exact(4))
-            .zip(b[0].chunks_exact(4))
-            .zip(b[1].chunks_exact(4))
-            .zip(b[2].chunks_exact(4))
-            .zip(b[3].chunks_exact(4));
-        for (((((((a0, a1), a2), a3), b0), b1), b2), b3) in rows {
-            for l in 0..4 {
-                s0[l] += a0[l] * b0[l];
-                s1[l] += a1[l] * b1[l];
-                s2[l] += a2[l] * b2[l];
-                s3[l] += a3[l] * b3[l];
+impl ProductPlan {
+    fn new(n: usize) -> Self {
+        let (mut tiles, mut pairs) = (Vec::new(), Vec::new());
+        let mut i = 0;
+        while i + 1 < n {
+            // Columns i and i + 1 share j = i + 1 ..= n.
+            pairs.push((i, i));
+            let mut j = i + 1;
+            while j + 3 <= n {
+                tiles.push((i, j));
+                j += 4;
             }
+            for j in j..=n {
+                pairs.push((i, j));
+                pairs.push((i + 1, j));
+            }
+            i += 2;
         }
-        let tail = 4 * (m / 4);
-        let sums = [s0, s1, s2, s3];
-        std::array::from_fn(|t| {
-            let s = sums[t];
-            let mut v = (s[0] + s[1]) + (s[2] + s[3]);
-            for (x, y) in a[t][tail..].iter().zip(&b[t][tail..]) {
-                v += x * y;
-            }
-            v
-        })
+        // The last column when n is odd, and y·y.
+        for j in i..=n {
+            pairs.push((i, j));
+        }
+        if i < n {
+            pairs.push((n, n));
+        }
+        Self { n, tiles, pairs }
     }
+
+    /// Where the product of columns `i ≤ j` goes in a run of
+    /// [`BlockProducts::sums`]: `aᵢ·y` first, the triangle row by row,
+    /// `y·y` last.
+    fn pos(&self, i: usize, j: usize) -> usize {
+        let n = self.n;
+        if i == n {
+            n + n * (n + 1) / 2
+        } else if j == n {
+            i
+        } else {
+            n + i * n - i * i.saturating_sub(1) / 2 + (j - i)
+        }
+    }
+}
+
+/// A dot product from its four lane sums (`s`, over the whole groups of
+/// four of `len` rows) as [`dot`] finishes it: pairwise, then the rows left.
+fn finish_dot(s: &[f64; 4], a: &[f64], b: &[f64], len: usize) -> f64 {
+    let tail = 4 * (len / 4);
+    let mut v = (s[0] + s[1]) + (s[2] + s[3]);
+    for (x, y) in a[tail..len].iter().zip(&b[tail..len]) {
+        v += x * y;
+    }
+    v
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -595,6 +599,49 @@ mod tests {
         let sb = b.solve(0.5).unwrap();
         for j in 0..4 {
             assert!((sa.coef[j] - sb.coef[j]).abs() <= 1e-10 * sa.coef[j].abs().max(1e-12));
+        }
+    }
+
+    /// Every product of a block, whatever tile or pair forms it, is the
+    /// bits of `dot` on each run of rows, the runs added in order; for odd
+    /// and even column counts and lengths that leave rows over.
+    #[test]
+    fn block_products_are_each_products_dot() {
+        for n in 1..=10 {
+            for len in [1, 3, 4, 7, 64, ROW_BLOCK + 3, 2 * ROW_BLOCK + 5] {
+                let cols: Vec<Vec<f64>> = (0..=n)
+                    .map(|j| {
+                        (0..len)
+                            .map(|k| ((k * (j + 2) + j) as f64 * 0.37).sin() * (1.0 + j as f64))
+                            .collect()
+                    })
+                    .collect();
+                let refs: Vec<&[f64]> = cols[..n].iter().map(|c| c.as_slice()).collect();
+                let p = BlockProducts::of(&refs, &cols[n]).unwrap();
+                let mut ne = NormalEquations::new(n);
+                ne.add_products(&p).unwrap();
+                let sum = |i: usize, j: usize| {
+                    (0..len).step_by(ROW_BLOCK).fold(0.0, |acc, s| {
+                        let e = (s + ROW_BLOCK).min(len);
+                        acc + dot(&cols[i][s..e], &cols[j][s..e])
+                    })
+                };
+                for i in 0..n {
+                    assert_eq!(
+                        ne.aty[i].to_bits(),
+                        sum(i, n).to_bits(),
+                        "n {n} len {len} a{i}·y"
+                    );
+                    for j in i..n {
+                        assert_eq!(
+                            ne.ata[(i, j)].to_bits(),
+                            sum(i, j).to_bits(),
+                            "n {n} len {len} a{i}·a{j}"
+                        );
+                    }
+                }
+                assert_eq!(ne.yty.to_bits(), sum(n, n).to_bits(), "n {n} len {len} y·y");
+            }
         }
     }
 
