@@ -72,8 +72,10 @@ impl Contributions {
     pub fn from_series(parts: [&[f64]; 4], manoeuvre: Option<&[f64]>) -> Self {
         let n = parts[0].len();
         let Some(codes) = manoeuvre else {
+            let runs = [(0.0, 0..n)];
+            let moments = run_moments(&runs, parts);
             return Self {
-                groups: vec![Self::group("all", std::slice::from_ref(&(0..n)), parts)],
+                groups: vec![Self::group("all", &[0], &runs, &moments)],
             };
         };
         // Runs of one code.
@@ -85,34 +87,38 @@ impl Contributions {
                 start = k;
             }
         }
+        // Each run's moments once (a group pools those of its runs, and
+        // `manoeuvres` reuses those of roll, pitch and yaw), the runs and
+        // parts on the cores.
+        let moments = run_moments(&runs, parts);
         let groups = GROUPS
             .iter()
             .filter_map(|(name, of)| {
-                let rs: Vec<std::ops::Range<usize>> = runs
-                    .iter()
-                    .filter(|(c, _)| of.contains(c))
-                    .map(|(_, r)| r.clone())
+                let rs: Vec<usize> = (0..runs.len())
+                    .filter(|&r| of.contains(&runs[r].0))
                     .collect();
-                (!rs.is_empty()).then(|| Self::group(name, &rs, parts))
+                (!rs.is_empty()).then(|| Self::group(name, &rs, &runs, &moments))
             })
             .collect();
         Self { groups }
     }
 
-    /// The RMS of each part's deviation from its mean over each run, pooled.
-    fn group(name: &str, runs: &[std::ops::Range<usize>], parts: [&[f64]; 4]) -> PartsRms {
-        let rms = |f: &dyn Fn(usize) -> f64| {
+    /// The RMS of each part's deviation from its mean over each of the
+    /// runs `rs`, pooled (`moments`: those of every run).
+    fn group(
+        name: &str,
+        rs: &[usize],
+        runs: &[(f64, std::ops::Range<usize>)],
+        moments: &[[Moments; PARTS]],
+    ) -> PartsRms {
+        let rms = |p: usize| {
             let (mut ss, mut n) = (0.0, 0usize);
-            for r in runs {
-                // Two passes over the run's finite values (no copy).
-                let v = || r.clone().map(f).filter(|x| x.is_finite());
-                let count = v().count();
-                if count == 0 {
-                    continue;
+            for &r in rs {
+                let m = moments[r][p];
+                if m.count > 0 {
+                    ss += m.ss;
+                    n += m.count;
                 }
-                let m = v().sum::<f64>() / count as f64;
-                ss += v().map(|x| (x - m).powi(2)).sum::<f64>();
-                n += count;
             }
             if n == 0 {
                 f64::NAN
@@ -120,18 +126,74 @@ impl Contributions {
                 (ss / n as f64).sqrt()
             }
         };
-        let rows = runs.iter().map(|r| r.len()).sum();
-        let zero_if_nan = |x: f64| if x.is_nan() { 0.0 } else { x };
         PartsRms {
             group: name.to_string(),
-            rows,
-            permanent_nt: rms(&|k| parts[0][k]),
-            induced_nt: rms(&|k| parts[1][k]),
-            eddy_nt: rms(&|k| parts[2][k]),
-            currents_nt: rms(&|k| zero_if_nan(parts[3][k])),
-            total_nt: rms(&|k| parts[0][k] + parts[1][k] + parts[2][k] + zero_if_nan(parts[3][k])),
+            rows: rs.iter().map(|&r| runs[r].1.len()).sum(),
+            permanent_nt: rms(0),
+            induced_nt: rms(1),
+            eddy_nt: rms(2),
+            currents_nt: rms(3),
+            total_nt: rms(4),
         }
     }
+}
+
+/// The parts measured: permanent, induced, eddy, currents, their sum.
+const PARTS: usize = 5;
+
+/// The finite values of one part over one run: how many, and the sum of
+/// their squared deviations from their mean.
+#[derive(Debug, Clone, Copy)]
+struct Moments {
+    count: usize,
+    ss: f64,
+}
+
+impl Moments {
+    /// Two passes over the run's finite values of `f` (no copy).
+    fn of(r: &std::ops::Range<usize>, f: impl Fn(usize) -> f64) -> Self {
+        let v = || r.clone().map(&f).filter(|x| x.is_finite());
+        let count = v().count();
+        if count == 0 {
+            return Self { count, ss: 0.0 };
+        }
+        let m = v().sum::<f64>() / count as f64;
+        Self {
+            count,
+            ss: v().map(|x| (x - m).powi(2)).sum::<f64>(),
+        }
+    }
+}
+
+/// [`Moments`] of every part over every run, each on its own (the same
+/// bits on any number of cores).
+fn run_moments(
+    runs: &[(f64, std::ops::Range<usize>)],
+    parts: [&[f64]; 4],
+) -> Vec<[Moments; PARTS]> {
+    let zero_if_nan = |x: f64| if x.is_nan() { 0.0 } else { x };
+    let one = |i: usize| {
+        let r = &runs[i / PARTS].1;
+        match i % PARTS {
+            0 => Moments::of(r, |k| parts[0][k]),
+            1 => Moments::of(r, |k| parts[1][k]),
+            2 => Moments::of(r, |k| parts[2][k]),
+            3 => Moments::of(r, |k| zero_if_nan(parts[3][k])),
+            _ => Moments::of(r, |k| {
+                parts[0][k] + parts[1][k] + parts[2][k] + zero_if_nan(parts[3][k])
+            }),
+        }
+    };
+    let rows = parts[0].len();
+    let threads = if rows >= 1 << 16 {
+        aeromag_core::parallel::threads()
+    } else {
+        1
+    };
+    let flat = aeromag_core::parallel::parallel_map(runs.len() * PARTS, threads, one);
+    flat.chunks_exact(PARTS)
+        .map(|c| std::array::from_fn(|p| c[p]))
+        .collect()
 }
 
 impl super::Calibration {
