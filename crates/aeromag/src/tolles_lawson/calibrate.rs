@@ -391,20 +391,25 @@ pub(super) fn second_order_note(
 
 /// The reference channels of `opts` and `mag` reduced by their sum and by
 /// `reference_nt` when given.
-pub(super) fn reduced_mag(
+pub(super) fn reduced_mag<'a>(
     flight: &Flight,
-    inputs: &TlInputs,
+    inputs: &TlInputs<'a>,
     opts: &CalibrateOptions,
     reference_nt: Option<&[f64]>,
-) -> Result<(Vec<String>, Vec<f64>)> {
+) -> Result<(Vec<String>, std::borrow::Cow<'a, [f64]>)> {
     let ref_cols = opts.reference.resolve(flight)?;
+    if ref_cols.is_empty() && reference_nt.is_none() {
+        // Nothing to subtract: the reading itself (`mag − 0` is `mag`, bit
+        // for bit), without two copies of the flight's length.
+        return Ok((ref_cols, std::borrow::Cow::Borrowed(inputs.mag)));
+    }
     let mut sum = reference_sum(flight, &ref_cols, opts.lever_arm.as_ref())?;
     if let Some(r) = reference_nt {
         for (s, v) in sum.iter_mut().zip(r) {
             *s += v;
         }
     }
-    Ok((ref_cols.clone(), reduced(inputs.mag, &sum)))
+    Ok((ref_cols, std::borrow::Cow::Owned(reduced(inputs.mag, &sum))))
 }
 
 /// The segment rule of a fit: split at lines unless told not to.
