@@ -113,9 +113,23 @@ pub fn sosfiltfilt_columns_with(
             *s = end.map(|v| z * v);
         }
         sos.run_lanes(ext, &mut state, true);
-        for (l, x) in group.iter_mut().enumerate() {
-            for (v, e) in x.iter_mut().zip(&ext[pad..pad + n]) {
-                *v = e[l];
+        let filtered = &ext[pad..pad + n];
+        if let [a, b, c, d] = group {
+            // A full group in one pass over the lanes.
+            for ((((e, a), b), c), d) in filtered
+                .iter()
+                .zip(a.iter_mut())
+                .zip(b.iter_mut())
+                .zip(c.iter_mut())
+                .zip(d.iter_mut())
+            {
+                [*a, *b, *c, *d] = *e;
+            }
+        } else {
+            for (l, x) in group.iter_mut().enumerate() {
+                for (v, e) in x.iter_mut().zip(filtered) {
+                    *v = e[l];
+                }
             }
         }
     }
