@@ -7,6 +7,13 @@
 //! additions in the same order (Rust never fuses them into FMA), so the
 //! results are bit-identical on every machine; only the speed differs.
 //!
+//! Where the compiler's own vectorisation of such a loop goes wrong (it may
+//! pack the loop across independent sums instead of along the lanes, and
+//! then spends its instructions on shuffles), the kernel is written with
+//! explicit AVX instructions beside the plain loop it must equal:
+//! [`lane_dots`] and [`lane_dots_pairs`], the dot products of the normal
+//! equations (multiply, then add, lane by lane: the same bits).
+//!
 //! ```
 //! use aeromag_core::simd::{Kernel, run};
 //! struct SumOfSquares<'a>(&'a [f64]);
@@ -70,27 +77,47 @@ pub fn lane_dots<const R: usize, const C: usize>(
     a: [&[f64]; R],
     b: [&[f64]; C],
 ) -> [[[f64; 4]; C]; R] {
+    lane_dots_of::<R, C, false>(a, b)
+}
+
+/// Four dot products `a[t] · b[t]` in lanes, summed as [`lane_dots`]
+/// sums them (`out[t][l]`): the products that do not fill a tile.
+pub fn lane_dots_pairs(a: [&[f64]; 4], b: [&[f64]; 4]) -> [[f64; 4]; 4] {
+    let s = lane_dots_of::<4, 4, true>(a, b);
+    std::array::from_fn(|t| s[t][t])
+}
+
+/// The products `a[r] · b[c]` of a tile (`DIAGONAL`: those with `r = c`
+/// alone; the others are left at zero), with AVX where the processor has
+/// it.
+fn lane_dots_of<const R: usize, const C: usize, const DIAGONAL: bool>(
+    a: [&[f64]; R],
+    b: [&[f64]; C],
+) -> [[[f64; 4]; C]; R] {
     let m = a.iter().chain(&b).map(|x| x.len()).min().unwrap_or(0);
     let (a, b) = (a.map(|x| &x[..m]), b.map(|x| &x[..m]));
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the processor supports AVX (checked just above), and
         // every slice holds `m` values.
-        return unsafe { lane_dots_avx(a, b, m / 4) };
+        return unsafe { lane_dots_avx::<R, C, DIAGONAL>(a, b, m / 4) };
     }
-    lane_dots_portable(a, b, m / 4)
+    lane_dots_portable::<R, C, DIAGONAL>(a, b, m / 4)
 }
 
-/// [`lane_dots`] as plain loops (any processor).
-fn lane_dots_portable<const R: usize, const C: usize>(
+/// [`lane_dots_of`] as plain loops (any processor).
+fn lane_dots_portable<const R: usize, const C: usize, const DIAGONAL: bool>(
     a: [&[f64]; R],
     b: [&[f64]; C],
     groups: usize,
 ) -> [[[f64; 4]; C]; R] {
     let mut s = [[[0.0f64; 4]; C]; R];
     for k in 0..groups {
-        for (sr, ar) in s.iter_mut().zip(&a) {
-            for (src, bc) in sr.iter_mut().zip(&b) {
+        for (r, (sr, ar)) in s.iter_mut().zip(&a).enumerate() {
+            for (c, (src, bc)) in sr.iter_mut().zip(&b).enumerate() {
+                if DIAGONAL && r != c {
+                    continue;
+                }
                 for l in 0..4 {
                     src[l] += ar[4 * k + l] * bc[4 * k + l];
                 }
@@ -100,58 +127,14 @@ fn lane_dots_portable<const R: usize, const C: usize>(
     s
 }
 
-/// Four dot products `a[t] · b[t]` in lanes, summed as [`lane_dots`]
-/// sums them (`out[t][l]`): the products that do not fill a tile.
-pub fn lane_dots_pairs(a: [&[f64]; 4], b: [&[f64]; 4]) -> [[f64; 4]; 4] {
-    let m = a.iter().chain(&b).map(|x| x.len()).min().unwrap_or(0);
-    let (a, b) = (a.map(|x| &x[..m]), b.map(|x| &x[..m]));
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: as in `lane_dots`.
-        return unsafe { lane_dots_pairs_avx(a, b, m / 4) };
-    }
-    std::array::from_fn(|t| lane_dots_portable([a[t]], [b[t]], m / 4)[0][0])
-}
-
-/// [`lane_dots_pairs`] over `groups` groups of four rows, with AVX.
-///
-/// # Safety
-/// As [`lane_dots_avx`].
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-unsafe fn lane_dots_pairs_avx(a: [&[f64]; 4], b: [&[f64]; 4], groups: usize) -> [[f64; 4]; 4] {
-    use std::arch::x86_64::{
-        __m256d, _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-    };
-    let mut s: [__m256d; 4] = [_mm256_setzero_pd(); 4];
-    for k in 0..groups {
-        for t in 0..4 {
-            // SAFETY: row 4k + 3 < 4 · groups ≤ every slice's length.
-            let (av, bv) = unsafe {
-                (
-                    _mm256_loadu_pd(a[t].as_ptr().add(4 * k)),
-                    _mm256_loadu_pd(b[t].as_ptr().add(4 * k)),
-                )
-            };
-            s[t] = _mm256_add_pd(s[t], _mm256_mul_pd(av, bv));
-        }
-    }
-    let mut out = [[0.0f64; 4]; 4];
-    for (o, v) in out.iter_mut().zip(s) {
-        // SAFETY: `o` holds four values.
-        unsafe { _mm256_storeu_pd(o.as_mut_ptr(), v) };
-    }
-    out
-}
-
-/// [`lane_dots`] over `groups` groups of four rows, with AVX.
+/// [`lane_dots_of`] over `groups` groups of four rows, with AVX.
 ///
 /// # Safety
 /// The processor must support AVX and every slice must hold at least
 /// `4 · groups` values.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-unsafe fn lane_dots_avx<const R: usize, const C: usize>(
+unsafe fn lane_dots_avx<const R: usize, const C: usize, const DIAGONAL: bool>(
     a: [&[f64]; R],
     b: [&[f64]; C],
     groups: usize,
@@ -170,7 +153,9 @@ unsafe fn lane_dots_avx<const R: usize, const C: usize>(
         };
         for r in 0..R {
             for c in 0..C {
-                s[r][c] = _mm256_add_pd(s[r][c], _mm256_mul_pd(av[r], bv[c]));
+                if !DIAGONAL || r == c {
+                    s[r][c] = _mm256_add_pd(s[r][c], _mm256_mul_pd(av[r], bv[c]));
+                }
             }
         }
     }
@@ -211,7 +196,7 @@ mod tests {
             let tile = lane_dots([&c[0], &c[1]], [&c[2], &c[3], &c[4], &c[5]]);
             assert_eq!(
                 tile,
-                lane_dots_portable(
+                lane_dots_portable::<2, 4, false>(
                     [&c[0][..m], &c[1][..m]],
                     [&c[2][..m], &c[3][..m], &c[4][..m], &c[5][..m]],
                     groups
@@ -219,7 +204,8 @@ mod tests {
             );
             let pairs = lane_dots_pairs([&c[0], &c[1], &c[6], &c[7]], [&c[7], &c[2], &c[6], &c[3]]);
             for (t, (i, j)) in [(0, 7), (1, 2), (6, 6), (7, 3)].into_iter().enumerate() {
-                let one = lane_dots_portable([&c[i][..m]], [&c[j][..m]], groups)[0][0];
+                let one =
+                    lane_dots_portable::<1, 1, false>([&c[i][..m]], [&c[j][..m]], groups)[0][0];
                 assert_eq!(
                     pairs[t].map(f64::to_bits),
                     one.map(f64::to_bits),
