@@ -54,44 +54,89 @@ fn tl_interferences<const K: usize>(
     flight: &Flight,
     sensor: &SensorColumns,
 ) -> Result<[Vec<f64>; K]> {
+    let (cols, segs) = model_segments(model, flight, sensor)?;
+    let whole = cols.whole();
+    let n = flight.n_rows();
     // Zeroed (fresh pages, written first by the projection's threads),
-    // NaN between the segments.
-    let mut outs: [Vec<f64>; K] = std::array::from_fn(|_| vec![0.0; flight.n_rows()]);
-    let mut next = 0;
-    for_model_segments(model, flight, sensor, |r, s| {
-        let mut parts: Vec<&mut [f64]> = outs
-            .iter_mut()
-            .map(|o| {
-                o[next..r.start].fill(f64::NAN);
-                &mut o[r.clone()]
-            })
-            .collect();
-        next = r.end;
+    // NaN between the segments; each segment's K output rows.
+    let mut outs: [Vec<f64>; K] = std::array::from_fn(|_| vec![0.0; n]);
+    let mut parts: Vec<Vec<&mut [f64]>> = segs.iter().map(|_| Vec::with_capacity(K)).collect();
+    for o in outs.iter_mut() {
+        let (mut rest, mut at) = (o.as_mut_slice(), 0);
+        for (r, p) in segs.iter().zip(parts.iter_mut()) {
+            let (gap, tail) = std::mem::take(&mut rest).split_at_mut(r.start - at);
+            gap.fill(f64::NAN);
+            let (seg, tail) = tail.split_at_mut(r.len());
+            p.push(seg);
+            (rest, at) = (tail, r.end);
+        }
+        rest.fill(f64::NAN);
+    }
+    let apply = |r: &std::ops::Range<usize>, out: &mut Vec<&mut [f64]>| {
+        let s = whole.slice(r.clone());
         model
             .design
-            .interferences_into(&coefs, s.time, s.flux, s.channels, &mut parts);
-    })?;
-    for o in &mut outs {
-        o[next..].fill(f64::NAN);
+            .interferences_into(&coefs, s.time, s.flux, s.channels, out);
+    };
+    let mut jobs: Vec<_> = segs.iter().zip(parts.iter_mut()).collect();
+    let threads = aeromag_core::parallel::threads();
+    if threads < 2 || jobs.len() < 2 || n < 1 << 16 {
+        for (r, out) in jobs {
+            apply(r, out);
+        }
+        return Ok(outs);
     }
+    // Several segments (a model with lags runs its lag filters through
+    // each one sample by sample): consecutive segments of about n/threads
+    // rows per thread, each segment computed as alone (the same bits).
+    let per_thread = n.div_ceil(threads);
+    std::thread::scope(|scope| {
+        let mut rest = &mut jobs[..];
+        while !rest.is_empty() {
+            let (mut k, mut rows) = (0, 0);
+            while k < rest.len() && (k == 0 || rows < per_thread) {
+                rows += rest[k].0.len();
+                k += 1;
+            }
+            let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            rest = tail;
+            let apply = &apply;
+            scope.spawn(move || {
+                for (r, out) in mine.iter_mut() {
+                    apply(r, out);
+                }
+            });
+        }
+    });
     Ok(outs)
 }
 
+/// The stretches of `flight` that `model` applies to at the sensor
+/// `sensor` (no gaps or missing values; line changes do not matter), and
+/// the inputs they are read from.
+fn model_segments<'a>(
+    model: &TlModel,
+    flight: &'a Flight,
+    sensor: &SensorColumns,
+) -> Result<(TlInputs<'a>, Vec<std::ops::Range<usize>>)> {
+    let cols =
+        TlInputs::of_sensor(flight, sensor)?.with_extras(flight, model.design.terms.extras())?;
+    let segs = cols.segments(&SegmentRule::ignoring_lines());
+    debug_assert!(segs.short.is_empty());
+    Ok((cols, segs.kept))
+}
+
 /// Call `f` with every stretch of `flight` that `model` applies to at the
-/// sensor `sensor` (no gaps or missing values; line changes do not matter):
-/// its rows and its inputs.
+/// sensor `sensor` ([`model_segments`]): its rows and its inputs.
 fn for_model_segments(
     model: &TlModel,
     flight: &Flight,
     sensor: &SensorColumns,
     mut f: impl FnMut(std::ops::Range<usize>, &Segment),
 ) -> Result<()> {
-    let cols =
-        TlInputs::of_sensor(flight, sensor)?.with_extras(flight, model.design.terms.extras())?;
+    let (cols, segs) = model_segments(model, flight, sensor)?;
     let whole = cols.whole();
-    let segs = cols.segments(&SegmentRule::ignoring_lines());
-    debug_assert!(segs.short.is_empty());
-    for r in segs.kept {
+    for r in segs {
         f(r.clone(), &whole.slice(r));
     }
     Ok(())
