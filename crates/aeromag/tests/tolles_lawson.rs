@@ -124,6 +124,76 @@ fn every_row_is_kept_and_rows_with_missing_inputs_are_flagged() {
     }
 }
 
+/// The rows `rows` of every column of `f`, as a flight.
+fn rows_of(f: &FlightTable, rows: std::ops::Range<usize>) -> Flight {
+    let mut t = FlightTable::new();
+    for c in f.columns() {
+        t.add_column(c.name(), c.values().unwrap()[rows.clone()].to_vec())
+            .unwrap();
+    }
+    Flight::from_table(t).unwrap()
+}
+
+/// A long flight cut by missing values into several stretches is
+/// compensated with the stretches shared out over the cores, each as if
+/// alone: the interference on each stretch is, bit for bit, that of the
+/// stretch's rows compensated as a flight of their own (a model with eddy
+/// lags, whose lag filters restart at every stretch).
+#[test]
+fn stretches_of_a_long_flight_are_each_compensated_as_alone() {
+    let cal = calibration(5);
+    let model = calibrate(&cal, &CalibrateOptions::default(), &mut Silent)
+        .unwrap()
+        .model;
+    assert!(!model.design.terms.eddy_lags_s().is_empty());
+    // Twelve boxes end to end (more than 2¹⁶ rows), time going on.
+    let (n, copies) = (cal.n_rows(), 12);
+    let time = cal.require("time").unwrap();
+    let span = time[n - 1] - time[0] + (time[1] - time[0]);
+    let mut long = FlightTable::new();
+    for c in cal.columns() {
+        let v = c.values().unwrap();
+        let col: Vec<f64> = (0..copies)
+            .flat_map(|k| {
+                v.iter().map(move |x| {
+                    if c.name() == "time" {
+                        x + k as f64 * span
+                    } else {
+                        *x
+                    }
+                })
+            })
+            .collect();
+        long.add_column(c.name(), col).unwrap();
+    }
+    let holes = [9_000, 30_001, 51_234];
+    let mut fx = long.require("flux_x").unwrap().to_vec();
+    for h in holes {
+        fx[h] = f64::NAN;
+    }
+    long.set_column("flux_x", fx).unwrap();
+    let rows = n * copies;
+    assert!(rows > 1 << 16);
+    let whole = model
+        .interference(&Flight::from_table(long.clone()).unwrap())
+        .unwrap();
+    let mut start = 0;
+    for end in holes.into_iter().chain(std::iter::once(rows)) {
+        let alone = model.interference(&rows_of(&long, start..end)).unwrap();
+        assert!(
+            alone
+                .iter()
+                .zip(&whole[start..end])
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "stretch {start}..{end}"
+        );
+        if end < rows {
+            assert!(whole[end].is_nan());
+        }
+        start = end + 1;
+    }
+}
+
 #[test]
 fn a_single_heading_without_manoeuvres_does_not_determine_the_model() {
     let one = single_heading(&calibration(6));
