@@ -82,6 +82,37 @@ pub fn for_each_rows_mut<T: Send>(
     });
 }
 
+/// `f(item)` for every item of `items`, on up to `threads` threads (≥ 1),
+/// each thread taking consecutive items of about the same total
+/// `weight` (for example the rows of a segment). On the calling thread
+/// when `threads` is 1 or there is one item.
+pub fn for_each_weighted_mut<T: Send>(
+    items: &mut [T],
+    threads: usize,
+    weight: impl Fn(&T) -> usize,
+    f: impl Fn(&mut T) + Sync,
+) {
+    if threads <= 1 || items.len() < 2 {
+        items.iter_mut().for_each(f);
+        return;
+    }
+    let per = items.iter().map(&weight).sum::<usize>().div_ceil(threads);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let mut rest = items;
+        while !rest.is_empty() {
+            let (mut k, mut w) = (0, 0);
+            while k < rest.len() && (k == 0 || w < per) {
+                w += weight(&rest[k]);
+                k += 1;
+            }
+            let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            rest = tail;
+            scope.spawn(move || mine.iter_mut().for_each(f));
+        }
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,6 +149,15 @@ mod tests {
                 out.iter().enumerate().all(|(i, v)| *v == i),
                 "{n} {threads} {align}"
             );
+        }
+    }
+
+    #[test]
+    fn weighted_items_are_each_done_once() {
+        for (n, threads) in [(0, 2), (1, 4), (7, 2), (50, 3), (9, 64)] {
+            let mut items: Vec<(usize, usize)> = (0..n).map(|i| (1 + (i * 7) % 5, 0)).collect();
+            for_each_weighted_mut(&mut items, threads, |it| it.0, |it| it.1 += 10 * it.0);
+            assert!(items.iter().all(|(w, v)| *v == 10 * w), "{n} {threads}");
         }
     }
 }

@@ -78,36 +78,21 @@ fn tl_interferences<const K: usize>(
             .design
             .interferences_into(&coefs, s.time, s.flux, s.channels, out);
     };
-    let mut jobs: Vec<_> = segs.iter().zip(parts.iter_mut()).collect();
-    let threads = aeromag_core::parallel::threads();
-    if threads < 2 || jobs.len() < 2 || n < 1 << 16 {
-        for (r, out) in jobs {
-            apply(r, out);
-        }
-        return Ok(outs);
-    }
     // Several segments (a model with lags runs its lag filters through
-    // each one sample by sample): consecutive segments of about n/threads
-    // rows per thread, each segment computed as alone (the same bits).
-    let per_thread = n.div_ceil(threads);
-    std::thread::scope(|scope| {
-        let mut rest = &mut jobs[..];
-        while !rest.is_empty() {
-            let (mut k, mut rows) = (0, 0);
-            while k < rest.len() && (k == 0 || rows < per_thread) {
-                rows += rest[k].0.len();
-                k += 1;
-            }
-            let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
-            rest = tail;
-            let apply = &apply;
-            scope.spawn(move || {
-                for (r, out) in mine.iter_mut() {
-                    apply(r, out);
-                }
-            });
-        }
-    });
+    // each one sample by sample) on the cores by rows, each computed as
+    // alone (the same bits); a single one spreads its blocks instead.
+    let mut jobs: Vec<_> = segs.iter().zip(parts.iter_mut()).collect();
+    let threads = if n < 1 << 16 {
+        1
+    } else {
+        aeromag_core::parallel::threads()
+    };
+    aeromag_core::parallel::for_each_weighted_mut(
+        &mut jobs,
+        threads,
+        |(r, _)| r.len(),
+        |(r, out)| apply(r, out),
+    );
     Ok(outs)
 }
 

@@ -75,6 +75,11 @@ pub fn check_field_model(noise: &NoiseModel, x2_prior: &X2Prior) -> Result<()> {
             "invalid noise intensities {noise:?} (q ≥ 0, r > 0, finite)"
         )));
     }
+    check_prior(x2_prior)
+}
+
+/// A usable field prior: a [`CompError::InvalidSetting`] otherwise.
+fn check_prior(x2_prior: &X2Prior) -> Result<()> {
     if !x2_prior.is_valid() {
         return Err(CompError::setting(format!(
             "invalid field prior {x2_prior:?} (positive, finite)"
@@ -307,12 +312,7 @@ impl FieldModelSpec<'_> {
     /// A usable field prior and white-noise variance: a
     /// [`CompError::InvalidSetting`] naming the bad one otherwise.
     fn check(&self) -> Result<()> {
-        if !self.x2_prior.is_valid() {
-            return Err(CompError::setting(format!(
-                "invalid field prior {:?} (positive, finite)",
-                self.x2_prior
-            )));
-        }
+        check_prior(self.x2_prior)?;
         if !(self.r_nt2 > 0.0 && self.r_nt2.is_finite()) {
             return Err(CompError::setting(format!(
                 "white-noise variance {} nT² must be finite and > 0",

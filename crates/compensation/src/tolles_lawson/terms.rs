@@ -643,65 +643,55 @@ impl TermSet {
     ) {
         let bt = magnitude(dir);
         let e = [dir[0] / bt, dir[1] / bt, dir[2] / bt];
-        // Group by group in the order of [`Self::for_each_column`] (a test
-        // compares the two): fixed-length loops, which the compiler
-        // unrolls and vectorises, instead of one call per column.
+        // Block by block ([`Self::for_each_block`]; a test compares the
+        // row with [`Self::for_each_column`]): fixed-length loops, which the
+        // compiler unrolls and vectorises, instead of one call per column.
         let nine = |s: [f64; 3], out: &mut [f64]| {
             for (m, o) in out.iter_mut().enumerate() {
                 *o = product(e[m / 3], s[m % 3], bt_scale);
             }
         };
         let mut k = 0;
-        for g in &self.groups {
-            match g {
-                TermGroup::P3 => {
-                    out[k..k + 3].copy_from_slice(&e);
-                    k += 3;
+        self.for_each_block(|block| match block {
+            Block::Directions => {
+                out[k..k + 3].copy_from_slice(&e);
+                k += 3;
+            }
+            Block::Field(n) => {
+                for (o, &(i, j)) in out[k..k + n].iter_mut().zip(&PAIRS6) {
+                    *o = product(e[i], b[j], bt_scale);
                 }
-                TermGroup::I6 | TermGroup::I5 => {
-                    let n = if *g == TermGroup::I6 { 6 } else { 5 };
-                    for (o, &(i, j)) in out[k..k + n].iter_mut().zip(&PAIRS6) {
-                        *o = product(e[i], b[j], bt_scale);
-                    }
-                    k += n;
-                }
-                TermGroup::E9 => {
-                    nine(db, &mut out[k..k + 9]);
-                    k += 9;
-                }
-                TermGroup::E8 => {
-                    let mut all = [0.0; 9];
-                    nine(db, &mut all);
-                    out[k..k + 8].copy_from_slice(&all[..8]);
-                    k += 8;
-                }
-                TermGroup::L9 => {
-                    for lag in 0..self.eddy_lags_s.len() {
-                        nine(
-                            lagged.get(lag).copied().unwrap_or([f64::NAN; 3]),
-                            &mut out[k..k + 9],
-                        );
-                        k += 9;
-                    }
-                }
-                TermGroup::Bias => {
-                    out[k] = 1.0;
+                k += n;
+            }
+            Block::Derivative(9) => {
+                nine(db, &mut out[k..k + 9]);
+                k += 9;
+            }
+            Block::Derivative(n) => {
+                let mut all = [0.0; 9];
+                nine(db, &mut all);
+                out[k..k + n].copy_from_slice(&all[..n]);
+                k += n;
+            }
+            Block::Lagged(lag) => {
+                nine(
+                    lagged.get(lag).copied().unwrap_or([f64::NAN; 3]),
+                    &mut out[k..k + 9],
+                );
+                k += 9;
+            }
+            Block::Bias => {
+                out[k] = 1.0;
+                k += 1;
+            }
+            Block::Extra { k: x, lagged } => {
+                let v = extra.get(x).map_or(f64::NAN, |v| v[usize::from(lagged)]);
+                for ei in e {
+                    out[k] = ei * v;
                     k += 1;
                 }
             }
-        }
-        for (x, term) in self.extras.iter().enumerate() {
-            let v = extra.get(x).copied().unwrap_or([f64::NAN; 2]);
-            for lagged in [false, true] {
-                if lagged && term.lag_s.is_none() {
-                    continue;
-                }
-                for i in 0..3 {
-                    out[k] = e[i] * v[usize::from(lagged)];
-                    k += 1;
-                }
-            }
-        }
+        });
     }
 
     /// The design matrix column by column (`out[k][n]`, the same values as
@@ -770,40 +760,67 @@ impl TermSet {
     /// Every column in order, as a [`Column`] (the module's table).
     pub fn for_each_column(&self, mut f: impl FnMut(Column)) {
         let products = |i: usize, source: Source, j: usize| Column::Product { i, source, j };
+        self.for_each_block(|b| match b {
+            Block::Directions => (0..3).for_each(|i| f(Column::Direction(i))),
+            Block::Field(n) => {
+                for &(i, j) in &PAIRS6[..n] {
+                    f(products(i, Source::Field, j));
+                }
+            }
+            Block::Derivative(n) => {
+                for m in 0..n {
+                    f(products(m / 3, Source::Derivative, m % 3));
+                }
+            }
+            Block::Lagged(lag) => {
+                for m in 0..9 {
+                    f(products(m / 3, Source::Lagged(lag), m % 3));
+                }
+            }
+            Block::Bias => f(Column::Bias),
+            Block::Extra { k, lagged } => (0..3).for_each(|i| f(Column::Extra { i, k, lagged })),
+        });
+    }
+
+    /// The blocks of columns in order: the one place that orders the
+    /// columns ([`Self::for_each_column`] and [`Self::row_along`] follow it).
+    #[inline(always)]
+    fn for_each_block(&self, mut f: impl FnMut(Block)) {
         for g in &self.groups {
             match g {
-                TermGroup::P3 => (0..3).for_each(|i| f(Column::Direction(i))),
-                TermGroup::I6 | TermGroup::I5 => {
-                    let n = if *g == TermGroup::I6 { 6 } else { 5 };
-                    for &(i, j) in &PAIRS6[..n] {
-                        f(products(i, Source::Field, j));
-                    }
-                }
-                TermGroup::E9 | TermGroup::E8 => {
-                    let n = if *g == TermGroup::E9 { 9 } else { 8 };
-                    for m in 0..n {
-                        f(products(m / 3, Source::Derivative, m % 3));
-                    }
-                }
-                TermGroup::L9 => {
-                    for lag in 0..self.eddy_lags_s.len() {
-                        for m in 0..9 {
-                            f(products(m / 3, Source::Lagged(lag), m % 3));
-                        }
-                    }
-                }
-                TermGroup::Bias => f(Column::Bias),
+                TermGroup::P3 => f(Block::Directions),
+                TermGroup::I6 => f(Block::Field(6)),
+                TermGroup::I5 => f(Block::Field(5)),
+                TermGroup::E9 => f(Block::Derivative(9)),
+                TermGroup::E8 => f(Block::Derivative(8)),
+                TermGroup::L9 => (0..self.eddy_lags_s.len()).for_each(|lag| f(Block::Lagged(lag))),
+                TermGroup::Bias => f(Block::Bias),
             }
         }
         for (k, x) in self.extras.iter().enumerate() {
-            for lagged in [false, true] {
-                if lagged && x.lag_s.is_none() {
-                    continue;
-                }
-                (0..3).for_each(|i| f(Column::Extra { i, k, lagged }));
+            f(Block::Extra { k, lagged: false });
+            if x.lag_s.is_some() {
+                f(Block::Extra { k, lagged: true });
             }
         }
     }
+}
+
+/// A block of consecutive columns ([`TermSet::for_each_block`]).
+#[derive(Debug, Clone, Copy)]
+enum Block {
+    /// `e_x, e_y, e_z`.
+    Directions,
+    /// The first `n` products `e_i B_j` of [`PAIRS6`].
+    Field(usize),
+    /// The first `n` products `e_i dB_j` (`i` major).
+    Derivative(usize),
+    /// The nine products `e_i L_τ[dB_j]` of lag `τ` number `lag`.
+    Lagged(usize),
+    /// The constant.
+    Bias,
+    /// `e_i x_k` (or `e_i L[x_k]`) of extra regressor `k`.
+    Extra { k: usize, lagged: bool },
 }
 
 /// The arguments of [`TermSet::columns_into`] as a kernel compiled with

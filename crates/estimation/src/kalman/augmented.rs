@@ -263,8 +263,6 @@ impl AugmentedFilter {
                 "augmented filter: merging filters of other priors".into(),
             ));
         }
-        mine.flush()?;
-        theirs.flush()?;
         mine.moments.merge(&theirs.moments)?;
         mine.sum_log_2pi_var += theirs.sum_log_2pi_var;
         Ok(())
@@ -317,7 +315,6 @@ impl AugmentedFilter {
     /// log-likelihood.
     fn factor(&mut self) -> Result<(DMatrix<f64>, f64)> {
         let rhs = &mut self.rhs;
-        rhs.flush()?;
         rhs.summed()?;
         let m = rhs.prior_mean.len();
         let mut b = DMatrix::<f64>::zeros(m + 1, m + 1);
