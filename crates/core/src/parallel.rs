@@ -1,6 +1,8 @@
 //! Index-parallel map over scoped threads (the gradiometry convergence map
-//! and Monte-Carlo efficiency, the Kalman tuning grid, EM detection), and
-//! the number of threads the workspace's parallel loops use.
+//! and Monte-Carlo efficiency, the Kalman tuning grid, EM detection), parts
+//! of slices and items shared out by weight (a model's interference over
+//! the segments of a flight), and the number of threads the workspace's
+//! parallel loops use.
 //!
 //! Item `i` is always computed by `f(i)` and stored at position `i`, so the
 //! result does not depend on the number of threads (the chunks only decide
