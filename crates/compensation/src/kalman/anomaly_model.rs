@@ -315,6 +315,8 @@ impl X2Prior {
 /// The longest chain of integrators ([`ORDERS`] and the `B_z` chain).
 const MAX_CHAIN: usize = 8;
 const _: () = assert!(*ORDERS.end() <= MAX_CHAIN && Z_ORDER <= MAX_CHAIN);
+// Chain::fill's specialised lengths cover the orders and the B_z chain.
+const _: () = assert!(*ORDERS.start() >= 2 && *ORDERS.end() <= 6 && Z_ORDER == 2);
 
 /// `n!` as a float.
 fn factorial(n: usize) -> f64 {
@@ -326,7 +328,8 @@ fn factorial(n: usize) -> f64 {
 #[derive(Debug, Clone)]
 struct Chain {
     n: usize,
-    u: DMatrix<f64>,
+    /// `U_M` by columns: `u[j][i]` for `i ≤ j < n` (the rest zero).
+    u: [[f64; MAX_CHAIN]; MAX_CHAIN],
     sqrt_q: f64,
 }
 
@@ -338,7 +341,13 @@ impl Chain {
             let (a, b) = (n - 1 - i, n - 1 - j);
             1.0 / (factorial(a) * factorial(b) * (a + b + 1) as f64)
         });
-        let u = upper_cholesky(&m).expect("the Gram matrix of the monomials is positive definite");
+        let f = upper_cholesky(&m).expect("the Gram matrix of the monomials is positive definite");
+        let mut u = [[0.0; MAX_CHAIN]; MAX_CHAIN];
+        for (j, col) in u.iter_mut().enumerate().take(n) {
+            for (i, v) in col.iter_mut().enumerate().take(j + 1) {
+                *v = f[(i, j)];
+            }
+        }
         Self {
             n,
             u,
@@ -349,25 +358,47 @@ impl Chain {
     /// Write `Φ` (`d^{j−i}/(j−i)!`) and `G = √q T U_M` of a step `d`
     /// into the diagonal block starting at `at` (the rest is untouched).
     fn fill(&self, d: f64, at: usize, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
-        let n = self.n;
+        // The same code with the chain's length known to the compiler
+        // (ORDERS and the B_z chain), called once per sample by the filters.
+        match self.n {
+            2 => self.fill_n::<2>(d, at, phi, g),
+            3 => self.fill_n::<3>(d, at, phi, g),
+            4 => self.fill_n::<4>(d, at, phi, g),
+            5 => self.fill_n::<5>(d, at, phi, g),
+            6 => self.fill_n::<6>(d, at, phi, g),
+            n => unreachable!("chain of {n} integrators (ORDERS)"),
+        }
+    }
+
+    #[inline(always)]
+    fn fill_n<const N: usize>(
+        &self,
+        d: f64,
+        at: usize,
+        phi: &mut DMatrix<f64>,
+        g: &mut DMatrix<f64>,
+    ) {
         let rows = phi.nrows();
-        // d^m/m! and d^m for m < n (MAX_CHAIN bounds n: ORDERS).
-        let mut taylor = [0.0; MAX_CHAIN];
-        let mut power = [0.0; MAX_CHAIN];
+        // d^m/m! and d^m for m < N.
+        let mut taylor = [0.0; N];
+        let mut power = [0.0; N];
         let (mut t, mut p) = (1.0, 1.0);
-        for m in 0..n {
+        for m in 0..N {
             taylor[m] = t;
             power[m] = p;
             t *= d / (m + 1) as f64;
             p *= d;
         }
-        let (phi, g) = (phi.as_mut_slice(), g.as_mut_slice());
+        // Row i of G is (√q √d) d^{N−1−i} times row i of U_M.
         let scale = self.sqrt_q * d.sqrt();
-        for j in 0..n {
+        let row_scale: [f64; N] = std::array::from_fn(|i| scale * power[N - 1 - i]);
+        let (phi, g) = (phi.as_mut_slice(), g.as_mut_slice());
+        for j in 0..N {
             let col = (at + j) * rows + at;
+            let (phi_col, g_col) = (&mut phi[col..col + j + 1], &mut g[col..col + j + 1]);
             for i in 0..=j {
-                phi[col + i] = taylor[j - i];
-                g[col + i] = scale * power[n - 1 - i] * self.u[(i, j)];
+                phi_col[i] = taylor[j - i];
+                g_col[i] = row_scale[i] * self.u[j][i];
             }
         }
     }
