@@ -24,8 +24,8 @@ pub fn compensate<'py>(
     model: &(dyn Compensator + Sync),
     flight: &PyFlight,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let c = py.detach(|| model.compensate(&flight.inner)).py_err()?;
-    Ok(PyArray1::from_vec(py, c.compensated_nt))
+    let c = py.detach(|| model.compensated(&flight.inner)).py_err()?;
+    Ok(PyArray1::from_vec(py, c))
 }
 
 /// The flight with the model's output columns added.

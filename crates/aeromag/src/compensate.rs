@@ -83,6 +83,29 @@ pub trait Compensator {
     fn compensate(&self, flight: &Flight) -> Result<Compensated> {
         self.compensate_observed(flight, &mut Silent)
     }
+
+    /// The compensated reading alone (nT, NaN where not compensated):
+    /// [`Compensated::compensated_nt`], computed in the place of the
+    /// interference instead of beside it (one flight-long buffer, not two).
+    fn compensated(&self, flight: &Flight) -> Result<Vec<f64>> {
+        let mut out = self.interference(flight)?;
+        minus_from_mag(flight, &mut out)?;
+        Ok(out)
+    }
+}
+
+/// `values ← mag − values` on the rows both have (`values` cut to them),
+/// on the cores by parts.
+fn minus_from_mag(flight: &Flight, values: &mut Vec<f64>) -> Result<()> {
+    let mag = flight.require("mag")?;
+    values.truncate(mag.len());
+    let threads = aeromag_core::parallel::threads();
+    aeromag_core::parallel::for_each_part_mut(values, threads, 1 << 16, |a, part| {
+        for (v, m) in part.iter_mut().zip(&mag[a..]) {
+            *v = m - *v;
+        }
+    });
+    Ok(())
 }
 
 /// A flight's reading with a model's interference removed, row by row.
@@ -103,24 +126,8 @@ pub struct Compensated {
 impl Compensated {
     /// `mag − interference` of `flight`.
     pub fn new(flight: &Flight, output: OutputColumns, interference_nt: Vec<f64>) -> Result<Self> {
-        let mag = flight.require("mag")?;
-        let mut compensated_nt = vec![0.0; mag.len().min(interference_nt.len())];
-        let threads = aeromag_core::parallel::threads();
-        aeromag_core::parallel::for_each_part_mut(
-            &mut compensated_nt,
-            threads,
-            1 << 16,
-            |a, part| {
-                let n = part.len();
-                for ((c, m), i) in part
-                    .iter_mut()
-                    .zip(&mag[a..a + n])
-                    .zip(&interference_nt[a..a + n])
-                {
-                    *c = m - i;
-                }
-            },
-        );
+        let mut compensated_nt = interference_nt.clone();
+        minus_from_mag(flight, &mut compensated_nt)?;
         let missing = interference_nt.iter().filter(|v| !v.is_finite()).count();
         Ok(Self {
             output,

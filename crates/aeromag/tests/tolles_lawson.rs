@@ -118,6 +118,11 @@ fn every_row_is_kept_and_rows_with_missing_inputs_are_flagged() {
         interf.iter().filter(|v| v.is_finite()).count(),
         holed.n_rows() - 3
     );
+    // The compensated reading alone (computed in the interference's place)
+    // is the full compensation's, bit for bit, NaN on the same rows.
+    let alone = model.compensated(&holed).unwrap();
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&alone), bits(&out.compensated_nt));
     let table = out.into_table(holed).unwrap();
     for c in ["mag_interf", "mag_comp", "comp_flag"] {
         assert!(table.column(c).is_some(), "{c}");
