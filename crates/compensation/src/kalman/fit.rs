@@ -17,7 +17,7 @@ use super::field_filter::{
 };
 use super::field_smoother::{FieldModel, smooth_field};
 use super::joint_filter::{JointFilter, est};
-use super::rows::{for_each_design_row, for_each_design_row_ahead};
+use super::rows::{for_each_design_row, for_each_design_row_ahead, for_every_nth_design_row};
 use super::track::step_length;
 use super::tuning::{Subset, TuningConfig, TuningReport, tune};
 use crate::error::{CompError, Result};
@@ -874,9 +874,9 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
     })
 }
 
-/// Every `dec`-th sample of every run, for the likelihood. The runs'
-/// design rows (every sample's, for the lag filters) are formed on all
-/// cores and joined in run order.
+/// Every `dec`-th sample of every run, for the likelihood: the lag filters
+/// step through every sample, the design rows are formed at the kept ones
+/// alone; the runs on all cores, joined in run order.
 fn decimated_subset(
     segments: &[KalmanSegment],
     runs: &[Run],
@@ -893,19 +893,22 @@ fn decimated_subset(
             m,
             ..Subset::default()
         };
+        // The path since the kept sample before, summed step by step.
         let mut dist = 0.0;
-        for_each_design_row(spec, &s.data, run.range.clone(), |i, row| {
+        for i in run.range.clone() {
             if i > run.range.start {
                 dist += step_length(s.data.time, s.speed_m_s, i);
             }
             if (i - run.range.start) % dec == 0 {
-                sub.rows.extend_from_slice(row);
-                sub.y.push(s.data.mag[i] - y_ref);
-                sub.dz.push(s.alt_m[i] - z0);
                 sub.d.push(dist);
-                sub.start.push(i == run.range.start);
                 dist = 0.0;
             }
+        }
+        for_every_nth_design_row(spec, &s.data, run.range.clone(), dec, |i, row| {
+            sub.rows.extend_from_slice(row);
+            sub.y.push(s.data.mag[i] - y_ref);
+            sub.dz.push(s.alt_m[i] - z0);
+            sub.start.push(i == run.range.start);
         });
         sub
     });

@@ -25,8 +25,22 @@ pub fn for_each_design_row(
     spec: &Design,
     seg: &Segment,
     run: Range<usize>,
+    f: impl FnMut(usize, &[f64]),
+) {
+    for_every_nth_design_row(spec, seg, run, 1, f)
+}
+
+/// [`for_each_design_row`] for the samples `run.start + k·every` alone:
+/// the lag filters still step through every sample (the same rows, bit
+/// for bit), the other samples' rows are not formed.
+pub fn for_every_nth_design_row(
+    spec: &Design,
+    seg: &Segment,
+    run: Range<usize>,
+    every: usize,
     mut f: impl FnMut(usize, &[f64]),
 ) {
+    let every = every.max(1);
     let (time, flux) = (seg.time, seg.flux);
     let ncol = spec.terms.n_columns();
     let mut row = vec![0.0; ncol];
@@ -64,6 +78,9 @@ pub fn for_each_design_row(
                 *x = [v, lag.as_mut().map_or(f64::NAN, |l| l.step(time[i], v))];
             }
             let lagged = lags.eddy.step(time[i], d);
+            if !(i - s).is_multiple_of(every) {
+                continue;
+            }
             let b = [flux[0][i], flux[1][i], flux[2][i]];
             let dir = seg.direction.map_or(b, |v| [v[0][i], v[1][i], v[2][i]]);
             spec.terms
@@ -214,6 +231,19 @@ mod tests {
                     count += 1;
                 });
                 assert_eq!(count, run.len());
+                // Every n-th row alone: the same rows (the lags stepped
+                // through the samples between), at the same samples.
+                for every in [3, 1000] {
+                    let mut kept = Vec::new();
+                    for_every_nth_design_row(&spec, &seg, run.clone(), every, |i, row| {
+                        for (c, v) in row.iter().enumerate() {
+                            let want = cols[c][i - run.start];
+                            assert_eq!(v.to_bits(), want.to_bits(), "every {every} row {i} col {c}");
+                        }
+                        kept.push(i);
+                    });
+                    assert_eq!(kept, run.clone().step_by(every).collect::<Vec<_>>());
+                }
             }
         }
     }
