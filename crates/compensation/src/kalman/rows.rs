@@ -238,7 +238,11 @@ mod tests {
                     for_every_nth_design_row(&spec, &seg, run.clone(), every, |i, row| {
                         for (c, v) in row.iter().enumerate() {
                             let want = cols[c][i - run.start];
-                            assert_eq!(v.to_bits(), want.to_bits(), "every {every} row {i} col {c}");
+                            assert_eq!(
+                                v.to_bits(),
+                                want.to_bits(),
+                                "every {every} row {i} col {c}"
+                            );
                         }
                         kept.push(i);
                     });

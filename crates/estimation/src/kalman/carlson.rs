@@ -456,8 +456,16 @@ mod tests {
                 let got =
                     carlson_update(&mut s, &mut x, &h, 0.4, 0.05, &mut gain, &mut work).unwrap();
                 let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
-                assert_eq!(got.value.to_bits(), want.value.to_bits(), "n {n} case {case}");
-                assert_eq!(got.variance.to_bits(), want.variance.to_bits(), "n {n} case {case}");
+                assert_eq!(
+                    got.value.to_bits(),
+                    want.value.to_bits(),
+                    "n {n} case {case}"
+                );
+                assert_eq!(
+                    got.variance.to_bits(),
+                    want.variance.to_bits(),
+                    "n {n} case {case}"
+                );
                 assert_eq!(bits(&s), bits(&s_ref), "factor, n {n} case {case}");
                 assert_eq!(bits(&gain), bits(&g_ref), "gain, n {n} case {case}");
                 assert_eq!(bits(&x), bits(&x_ref), "state, n {n} case {case}");
