@@ -899,7 +899,7 @@ fn decimated_subset(
             if i > run.range.start {
                 dist += step_length(s.data.time, s.speed_m_s, i);
             }
-            if (i - run.range.start) % dec == 0 {
+            if (i - run.range.start).is_multiple_of(dec) {
                 sub.d.push(dist);
                 dist = 0.0;
             }
