@@ -34,6 +34,7 @@ use super::design::{Channels, Design, DesignBlock, Magnitude, TotalField};
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use crate::error::{CompError, Result};
+use aeromag_core::parallel::for_each_weighted_mut;
 use aeromag_core::filter::sos::Sos;
 use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_with};
 use aeromag_estimation::least_squares::{BlockProducts, LsSolution, NormalEquations};
@@ -199,25 +200,18 @@ fn for_each_filtered_block<T: Send>(
     }
     let mut works: Vec<BlockWork> = (0..threads).map(|_| BlockWork::default()).collect();
     for chunk in plan.chunks(threads) {
-        let mapped: Vec<T> = std::thread::scope(|scope| {
-            let map = &map;
-            let handles: Vec<_> = works
-                .iter_mut()
-                .zip(chunk)
-                .map(|(w, blk)| {
-                    scope.spawn(move || {
-                        w.compute(seg, cfg, sos, blk, 1)?;
-                        w.map(blk, map)
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-                .collect::<Result<Vec<T>>>()
-        })?;
-        for m in mapped {
-            reduce(m)?;
+        // One block per thread (the first on the calling thread), each
+        // with its work buffers, kept for the next chunk.
+        let mut jobs: Vec<(&mut BlockWork, &BlockPlan, Option<Result<T>>)> = works
+            .iter_mut()
+            .zip(chunk)
+            .map(|(w, blk)| (w, blk, None))
+            .collect();
+        for_each_weighted_mut(&mut jobs, threads, |_| 1, |(w, blk, out)| {
+            *out = Some(w.compute(seg, cfg, sos, blk, 1).and_then(|()| w.map(blk, &map)));
+        });
+        for (_, _, m) in jobs {
+            reduce(m.expect("every block is mapped")?)?;
         }
     }
     Ok(())
@@ -747,23 +741,17 @@ fn filter_columns(
     let groups = varying.len().div_ceil(FILTER_LANES);
     let per = groups.div_ceil(threads).max(1) * FILTER_LANES;
     scratch.resize_with(threads, Vec::new);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = varying
-            .chunks_mut(per)
-            .zip(scratch.iter_mut())
-            .map(|(chunk, ext)| scope.spawn(move || sosfiltfilt_columns_with(sos, chunk, ext)))
-            .collect();
-        handles.into_iter().try_for_each(|h| {
-            h.join().map_or_else(
-                |_| {
-                    Err(CompError::Failed {
-                        reason: "filter thread failed".into(),
-                    })
-                },
-                |r| r.map_err(CompError::from),
-            )
-        })
-    })
+    // One share of the columns per thread (the first on the calling thread).
+    let mut jobs: Vec<_> = varying
+        .chunks_mut(per)
+        .zip(scratch.iter_mut())
+        .map(|(chunk, ext)| (chunk, ext, Ok(())))
+        .collect();
+    for_each_weighted_mut(&mut jobs, threads, |_| 1, |(chunk, ext, out)| {
+        *out = sosfiltfilt_columns_with(sos, chunk, ext);
+    });
+    jobs.into_iter()
+        .try_for_each(|(_, _, out)| out.map_err(CompError::from))
 }
 
 fn std_dev(x: &[f64]) -> f64 {
