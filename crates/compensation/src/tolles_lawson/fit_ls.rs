@@ -399,10 +399,12 @@ pub(crate) fn band_passed_residuals(
             coef.len()
         )));
     }
-    let mut out = Vec::new();
-    for (k, seg) in segments.iter().enumerate() {
+    // One segment's residual (`None`: skipped), its blocks or columns on
+    // `threads` threads.
+    let residual = |k: usize, threads: usize| -> Result<Option<(Vec<f64>, f64)>> {
+        let seg = &segments[k];
         let Ok((dt, sos)) = segment_filter(k, seg, cfg)? else {
-            continue;
+            return Ok(None);
         };
         let mut r = Vec::with_capacity(seg.time.len());
         for_each_filtered_block(
@@ -410,7 +412,7 @@ pub(crate) fn band_passed_residuals(
             dt,
             cfg,
             sos.as_ref(),
-            aeromag_core::parallel::threads(),
+            threads,
             |cols, y| {
                 Ok((0..y.len())
                     .map(|i| y[i] - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>())
@@ -421,9 +423,41 @@ pub(crate) fn band_passed_residuals(
                 Ok(())
             },
         )?;
-        out.push((r, 1.0 / dt));
-    }
+        Ok(Some((r, 1.0 / dt)))
+    };
+    let mut out = Vec::new();
+    for_each_segment_on_cores(segments.len(), residual, |_, r| {
+        out.extend(r?);
+        Ok(())
+    })?;
     Ok(out)
+}
+
+/// `take(k, f(k, threads))` for every segment `k < n` in order, `f` run on
+/// the cores: many segments (lines, or the lag search's sampled blocks)
+/// several at once, one per core (`threads` 1); few one at a time, its
+/// blocks or columns on the cores. Each segment's result is the same bits
+/// either way.
+fn for_each_segment_on_cores<T: Send>(
+    n: usize,
+    f: impl Fn(usize, usize) -> T + Sync,
+    mut take: impl FnMut(usize, T) -> Result<()>,
+) -> Result<()> {
+    let threads = aeromag_core::parallel::threads();
+    let per_core = threads > 1 && n >= 2 * threads;
+    let chunk = if per_core { 4 * threads } else { 1 };
+    for first in (0..n).step_by(chunk) {
+        let ks: Vec<usize> = (first..(first + chunk).min(n)).collect();
+        let done = if per_core {
+            aeromag_core::parallel::parallel_map(ks.len(), threads, |i| f(ks[i], 1))
+        } else {
+            vec![f(ks[0], threads)]
+        };
+        for (k, d) in ks.into_iter().zip(done) {
+            take(k, d)?;
+        }
+    }
+    Ok(())
 }
 
 /// Fit the Tolles-Lawson coefficients to calibration segments, under the
@@ -564,34 +598,21 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
         )?;
         Ok(Ok((dt, blocks)))
     };
-    // Many segments (lines, or the lag search's sampled blocks): several
-    // segments at once, one per core; few: one at a time, its blocks or
-    // columns on the cores. Each segment's products are the same bits
-    // either way and are added in segment order.
-    let threads = aeromag_core::parallel::threads();
-    let per_core = threads > 1 && segments.len() >= 2 * threads;
-    let chunk = if per_core { 4 * threads } else { 1 };
-    for first in (0..segments.len()).step_by(chunk) {
-        let ks: Vec<usize> = (first..(first + chunk).min(segments.len())).collect();
-        let done = if per_core {
-            aeromag_core::parallel::parallel_map(ks.len(), threads, |i| products(ks[i], 1))
-        } else {
-            vec![products(ks[0], threads)]
-        };
-        for (k, d) in ks.into_iter().zip(done) {
-            match d? {
-                Err(w) => warnings.push(w),
-                Ok((dt, blocks)) => {
-                    for p in &blocks {
-                        ne.add_products(p)
-                            .map_err(CompError::estimation(format!("segment {k}")))?;
-                    }
-                    used += 1;
-                    fs_used.push(1.0 / dt);
+    // The segments' products added in segment order.
+    for_each_segment_on_cores(segments.len(), products, |k, d| {
+        match d? {
+            Err(w) => warnings.push(w),
+            Ok((dt, blocks)) => {
+                for p in &blocks {
+                    ne.add_products(p)
+                        .map_err(CompError::estimation(format!("segment {k}")))?;
                 }
+                used += 1;
+                fs_used.push(1.0 / dt);
             }
         }
-    }
+        Ok(())
+    })?;
     if used == 0 {
         return Err(CompError::data(
             "no segment is long enough to fit (see the warnings)",
