@@ -426,36 +426,48 @@ pub(crate) fn band_passed_residuals(
         Ok(Some((r, 1.0 / dt)))
     };
     let mut out = Vec::new();
-    for_each_segment_on_cores(segments.len(), residual, |_, r| {
+    for_each_segment_on_cores(segments, residual, |_, r| {
         out.extend(r?);
         Ok(())
     })?;
     Ok(out)
 }
 
-/// `take(k, f(k, threads))` for every segment `k < n` in order, `f` run on
-/// the cores: many segments (lines, or the lag search's sampled blocks)
-/// several at once, one per core (`threads` 1); few one at a time, its
+/// Rows per thread in one round of [`for_each_segment_on_cores`].
+const ROUND_ROWS_PER_THREAD: usize = 1 << 16;
+
+/// `take(k, f(k, threads))` for every segment `k` of `segments` in order,
+/// `f` run on the cores: many segments (lines, or the lag search's sampled
+/// blocks) several at once, one per core (`threads` 1), in rounds of about
+/// [`ROUND_ROWS_PER_THREAD`] rows per thread (the results of a round held
+/// until taken; a spawn per round, not per leg); few one at a time, its
 /// blocks or columns on the cores. Each segment's result is the same bits
 /// either way.
 fn for_each_segment_on_cores<T: Send>(
-    n: usize,
+    segments: &[Segment],
     f: impl Fn(usize, usize) -> T + Sync,
     mut take: impl FnMut(usize, T) -> Result<()>,
 ) -> Result<()> {
+    let n = segments.len();
     let threads = aeromag_core::parallel::threads();
-    let per_core = threads > 1 && n >= 2 * threads;
-    let chunk = if per_core { 4 * threads } else { 1 };
-    for first in (0..n).step_by(chunk) {
-        let ks: Vec<usize> = (first..(first + chunk).min(n)).collect();
-        let done = if per_core {
-            aeromag_core::parallel::parallel_map(ks.len(), threads, |i| f(ks[i], 1))
-        } else {
-            vec![f(ks[0], threads)]
-        };
-        for (k, d) in ks.into_iter().zip(done) {
+    if !(threads > 1 && n >= 2 * threads) {
+        for k in 0..n {
+            take(k, f(k, threads))?;
+        }
+        return Ok(());
+    }
+    let mut first = 0;
+    while first < n {
+        let (mut end, mut rows) = (first, 0);
+        while end < n && (end - first < 2 * threads || rows < threads * ROUND_ROWS_PER_THREAD) {
+            rows += segments[end].time.len();
+            end += 1;
+        }
+        let done = aeromag_core::parallel::parallel_map(end - first, threads, |i| f(first + i, 1));
+        for (k, d) in (first..end).zip(done) {
             take(k, d)?;
         }
+        first = end;
     }
     Ok(())
 }
@@ -599,7 +611,7 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
         Ok(Ok((dt, blocks)))
     };
     // The segments' products added in segment order.
-    for_each_segment_on_cores(segments.len(), products, |k, d| {
+    for_each_segment_on_cores(segments, products, |k, d| {
         match d? {
             Err(w) => warnings.push(w),
             Ok((dt, blocks)) => {
