@@ -24,26 +24,23 @@ pub fn threads() -> usize {
 }
 
 /// `[f(0), f(1), …, f(n − 1)]`, computed on up to `threads` threads (≥ 1) in
-/// contiguous chunks, the first on the calling thread (every helper here
-/// spawns one thread fewer than it uses: a spawn and its stack cost tens of
-/// microseconds, and some loops call these for every short leg).
+/// contiguous chunks.
 pub fn parallel_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let threads = threads.clamp(1, n.max(1));
     let chunk = n.div_ceil(threads).max(1);
     let f = &f;
-    let part = move |start: usize| (start..(start + chunk).min(n)).map(f).collect::<Vec<T>>();
     std::thread::scope(|scope| {
-        // The first chunk on the calling thread, the others spawned first.
-        let handles: Vec<_> = (chunk..n)
+        let handles: Vec<_> = (0..n)
             .step_by(chunk)
-            .map(|start| scope.spawn(move || part(start)))
+            .map(|start| {
+                scope.spawn(move || (start..(start + chunk).min(n)).map(f).collect::<Vec<T>>())
+            })
             .collect();
-        let mut out = part(0);
-        for h in handles {
-            // A worker only panics if `f` does; pass that panic on.
-            out.extend(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
-        }
-        out
+        // A worker only panics if `f` does; pass that panic on.
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
     })
 }
 
@@ -89,14 +86,8 @@ pub fn for_each_rows_mut<T: Send>(
     }
     let f = &f;
     std::thread::scope(|scope| {
-        let mut split = split.into_iter();
-        let first = split.next();
-        for (t, mut parts) in split.enumerate() {
-            scope.spawn(move || f((t + 1) * per, &mut parts));
-        }
-        // The first part on the calling thread.
-        if let Some(mut parts) = first {
-            f(0, &mut parts);
+        for (t, mut parts) in split.into_iter().enumerate() {
+            scope.spawn(move || f(t * per, &mut parts));
         }
     });
 }
@@ -117,27 +108,17 @@ pub fn for_each_weighted_mut<T: Send>(
     }
     let per = items.iter().map(&weight).sum::<usize>().div_ceil(threads);
     let f = &f;
-    let mut shares = Vec::new();
-    let mut rest = items;
-    while !rest.is_empty() {
-        let (mut k, mut w) = (0, 0);
-        while k < rest.len() && (k == 0 || w < per) {
-            w += weight(&rest[k]);
-            k += 1;
-        }
-        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
-        rest = tail;
-        shares.push(mine);
-    }
     std::thread::scope(|scope| {
-        let mut shares = shares.into_iter();
-        let first = shares.next();
-        for mine in shares {
+        let mut rest = items;
+        while !rest.is_empty() {
+            let (mut k, mut w) = (0, 0);
+            while k < rest.len() && (k == 0 || w < per) {
+                w += weight(&rest[k]);
+                k += 1;
+            }
+            let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            rest = tail;
             scope.spawn(move || mine.iter_mut().for_each(f));
-        }
-        // The first share on the calling thread.
-        if let Some(mine) = first {
-            mine.iter_mut().for_each(f);
         }
     });
 }
@@ -188,29 +169,5 @@ mod tests {
             for_each_weighted_mut(&mut items, threads, |it| it.0, |it| it.1 += 10 * it.0);
             assert!(items.iter().all(|(w, v)| *v == 10 * w), "{n} {threads}");
         }
-    }
-
-    /// The first share of every helper runs on the calling thread (one
-    /// thread spawned fewer per call), the others each on a thread of its
-    /// own; with one thread nothing is spawned.
-    #[test]
-    fn the_first_share_runs_on_the_calling_thread() {
-        let me = std::thread::current().id();
-        let on = |_: usize| std::thread::current().id();
-        let ids = parallel_map(10, 2, on);
-        assert!(ids[..5].iter().all(|t| *t == me) && ids[5..].iter().all(|t| *t != me));
-        assert!(parallel_map(10, 1, on).iter().all(|t| *t == me));
-        let mut rows = vec![None; 64];
-        for_each_part_mut(&mut rows, 2, 8, |_, part| {
-            part.fill(Some(std::thread::current().id()));
-        });
-        assert!(rows[..32].iter().all(|t| *t == Some(me)));
-        assert!(rows[32..].iter().all(|t| t.is_some() && *t != Some(me)));
-        let mut items = vec![(1, None); 4];
-        for_each_weighted_mut(&mut items, 2, |it| it.0, |it| {
-            it.1 = Some(std::thread::current().id());
-        });
-        assert!(items[..2].iter().all(|it| it.1 == Some(me)));
-        assert!(items[2..].iter().all(|it| it.1.is_some() && it.1 != Some(me)));
     }
 }
