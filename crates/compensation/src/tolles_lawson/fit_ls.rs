@@ -34,9 +34,9 @@ use super::design::{Channels, Design, DesignBlock, Magnitude, TotalField};
 use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use crate::error::{CompError, Result};
-use aeromag_core::parallel::for_each_weighted_mut;
 use aeromag_core::filter::sos::Sos;
 use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_with};
+use aeromag_core::parallel::for_each_weighted_mut;
 use aeromag_estimation::least_squares::{BlockProducts, LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
@@ -200,16 +200,24 @@ fn for_each_filtered_block<T: Send>(
     }
     let mut works: Vec<BlockWork> = (0..threads).map(|_| BlockWork::default()).collect();
     for chunk in plan.chunks(threads) {
-        // One block per thread (the first on the calling thread), each
-        // with its work buffers, kept for the next chunk.
+        // One block per thread, each with its work buffers, kept for the
+        // next chunk.
         let mut jobs: Vec<(&mut BlockWork, &BlockPlan, Option<Result<T>>)> = works
             .iter_mut()
             .zip(chunk)
             .map(|(w, blk)| (w, blk, None))
             .collect();
-        for_each_weighted_mut(&mut jobs, threads, |_| 1, |(w, blk, out)| {
-            *out = Some(w.compute(seg, cfg, sos, blk, 1).and_then(|()| w.map(blk, &map)));
-        });
+        for_each_weighted_mut(
+            &mut jobs,
+            threads,
+            |_| 1,
+            |(w, blk, out)| {
+                *out = Some(
+                    w.compute(seg, cfg, sos, blk, 1)
+                        .and_then(|()| w.map(blk, &map)),
+                );
+            },
+        );
         for (_, _, m) in jobs {
             reduce(m.expect("every block is mapped")?)?;
         }
@@ -774,15 +782,20 @@ fn filter_columns(
     let groups = varying.len().div_ceil(FILTER_LANES);
     let per = groups.div_ceil(threads).max(1) * FILTER_LANES;
     scratch.resize_with(threads, Vec::new);
-    // One share of the columns per thread (the first on the calling thread).
+    // One share of the columns per thread.
     let mut jobs: Vec<_> = varying
         .chunks_mut(per)
         .zip(scratch.iter_mut())
         .map(|(chunk, ext)| (chunk, ext, Ok(())))
         .collect();
-    for_each_weighted_mut(&mut jobs, threads, |_| 1, |(chunk, ext, out)| {
-        *out = sosfiltfilt_columns_with(sos, chunk, ext);
-    });
+    for_each_weighted_mut(
+        &mut jobs,
+        threads,
+        |_| 1,
+        |(chunk, ext, out)| {
+            *out = sosfiltfilt_columns_with(sos, chunk, ext);
+        },
+    );
     jobs.into_iter()
         .try_for_each(|(_, _, out)| out.map_err(CompError::from))
 }
