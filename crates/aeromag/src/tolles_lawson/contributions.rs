@@ -150,39 +150,53 @@ struct Moments {
 }
 
 impl Moments {
-    /// Two passes over the run's finite values of `f` (no copy).
-    fn of(r: &std::ops::Range<usize>, f: impl Fn(usize) -> f64) -> Self {
-        let v = || r.clone().map(&f).filter(|x| x.is_finite());
-        let count = v().count();
-        if count == 0 {
-            return Self { count, ss: 0.0 };
+    /// The moments of each of the `PARTS` values `f(k)` over the rows `r`,
+    /// all parts in each pass (two passes, no copy). Each part's sums are
+    /// those of its own values in row order, as `Iterator::sum` adds them.
+    fn of_parts(r: &std::ops::Range<usize>, f: impl Fn(usize) -> [f64; PARTS]) -> [Self; PARTS] {
+        let (mut count, mut sum) = ([0usize; PARTS], [-0.0; PARTS]);
+        for k in r.clone() {
+            for (p, x) in f(k).into_iter().enumerate() {
+                if x.is_finite() {
+                    count[p] += 1;
+                    sum[p] += x;
+                }
+            }
         }
-        let m = v().sum::<f64>() / count as f64;
-        Self {
-            count,
-            ss: v().map(|x| (x - m).powi(2)).sum::<f64>(),
+        let mean: [f64; PARTS] = std::array::from_fn(|p| sum[p] / count[p] as f64);
+        let mut ss = [-0.0; PARTS];
+        if count.iter().any(|&c| c > 0) {
+            for k in r.clone() {
+                for (p, x) in f(k).into_iter().enumerate() {
+                    if x.is_finite() {
+                        ss[p] += (x - mean[p]).powi(2);
+                    }
+                }
+            }
         }
+        std::array::from_fn(|p| Self {
+            count: count[p],
+            ss: if count[p] == 0 { 0.0 } else { ss[p] },
+        })
     }
 }
 
-/// [`Moments`] of every part over every run, each on its own (the same
-/// bits on any number of cores).
+/// [`Moments`] of every part over every run, each run on its own (the
+/// same bits on any number of cores).
 fn run_moments(
     runs: &[(f64, std::ops::Range<usize>)],
     parts: [&[f64]; 4],
 ) -> Vec<[Moments; PARTS]> {
     let zero_if_nan = |x: f64| if x.is_nan() { 0.0 } else { x };
-    let one = |i: usize| {
-        let r = &runs[i / PARTS].1;
-        match i % PARTS {
-            0 => Moments::of(r, |k| parts[0][k]),
-            1 => Moments::of(r, |k| parts[1][k]),
-            2 => Moments::of(r, |k| parts[2][k]),
-            3 => Moments::of(r, |k| zero_if_nan(parts[3][k])),
-            _ => Moments::of(r, |k| {
-                parts[0][k] + parts[1][k] + parts[2][k] + zero_if_nan(parts[3][k])
-            }),
-        }
+    let values = |k: usize| {
+        let currents = zero_if_nan(parts[3][k]);
+        [
+            parts[0][k],
+            parts[1][k],
+            parts[2][k],
+            currents,
+            parts[0][k] + parts[1][k] + parts[2][k] + currents,
+        ]
     };
     let rows = parts[0].len();
     let threads = if rows >= 1 << 16 {
@@ -190,10 +204,9 @@ fn run_moments(
     } else {
         1
     };
-    let flat = aeromag_core::parallel::parallel_map(runs.len() * PARTS, threads, one);
-    flat.chunks_exact(PARTS)
-        .map(|c| std::array::from_fn(|p| c[p]))
-        .collect()
+    aeromag_core::parallel::parallel_map(runs.len(), threads, |i| {
+        Moments::of_parts(&runs[i].1, values)
+    })
 }
 
 impl super::Calibration {
@@ -207,6 +220,52 @@ impl super::Calibration {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// All parts in one pass give each part's moments as a pass over that
+    /// part alone gives them, bit for bit, with missing values and a run
+    /// where a part has none.
+    #[test]
+    fn moments_of_all_parts_at_once_are_each_parts_own() {
+        let n = 3000;
+        let wave = |f: f64, every: usize| -> Vec<f64> {
+            (0..n)
+                .map(|k| {
+                    if every > 0 && k % every == 3 {
+                        f64::NAN
+                    } else {
+                        (k as f64 * f).sin() * 17.0 + f
+                    }
+                })
+                .collect()
+        };
+        let (p0, p1, p2) = (wave(0.1, 0), wave(0.37, 11), wave(1.3, 0));
+        let mut p3 = wave(0.05, 7);
+        p3[2000..].fill(f64::NAN);
+        let runs = [(1.0, 0..1200), (2.0, 1200..2000), (0.0, 2000..n)];
+        let moments = run_moments(&runs, [&p0, &p1, &p2, &p3]);
+        let zero_if_nan = |x: f64| if x.is_nan() { 0.0 } else { x };
+        for (run, (_, r)) in moments.iter().zip(&runs) {
+            let series: [Vec<f64>; PARTS] = [
+                p0[r.clone()].to_vec(),
+                p1[r.clone()].to_vec(),
+                p2[r.clone()].to_vec(),
+                p3[r.clone()].iter().map(|&x| zero_if_nan(x)).collect(),
+                r.clone()
+                    .map(|k| p0[k] + p1[k] + p2[k] + zero_if_nan(p3[k]))
+                    .collect(),
+            ];
+            for (m, v) in run.iter().zip(&series) {
+                let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+                let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+                let ss: f64 = finite.iter().map(|x| (x - mean).powi(2)).sum();
+                assert_eq!(m.count, finite.len());
+                assert_eq!(m.ss.to_bits(), ss.to_bits());
+            }
+        }
+        // The last run's currents are all missing: counted as zero.
+        assert_eq!(moments[2][3].count, n - 2000);
+        assert_eq!(moments[2][3].ss, 0.0);
+    }
 
     #[test]
     fn each_manoeuvre_is_measured_about_its_own_mean() {
