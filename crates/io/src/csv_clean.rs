@@ -48,6 +48,10 @@ pub(crate) struct Shape {
     pub n_fields: usize,
     /// The header ended with `\r\n`: the last field of each row loses a final `\r`.
     pub crlf: bool,
+    /// Fields separated by runs of spaces and tabs, with any before the
+    /// first and after the last (a whitespace table, [`crate::xyz`]):
+    /// `delimiter` and `crlf` are not used.
+    pub whitespace: bool,
 }
 
 /// The clean rows at the start of one piece, column by column.
@@ -116,7 +120,18 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
     let mut line = 0u64;
     while pos < piece.len() {
         // Most lines: plain decimals and the line end, in one pass.
-        if let Some(end) = plain_row(piece, pos, shape, &mut out.values, &mut out.integers) {
+        let row = if shape.whitespace {
+            whitespace_row(
+                piece,
+                pos,
+                shape.n_fields,
+                &mut out.values,
+                &mut out.integers,
+            )
+        } else {
+            plain_row(piece, pos, shape, &mut out.values, &mut out.integers)
+        };
+        if let Some(end) = row {
             out.row_on(line);
             line += 1;
             pos = (end + 1).min(piece.len());
@@ -128,10 +143,19 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
         let end = memchr::memchr(b'\n', &piece[pos..]).map_or(piece.len(), |i| pos + i);
         let body = &piece[pos..end];
         let next = (end + 1).min(piece.len());
-        let skip = body.first() == Some(&b'#')
-            || (body.trim_ascii().is_empty() && !body.contains(&shape.delimiter));
+        let skip = if shape.whitespace {
+            // Blank and `#` lines, as the whitespace reader classifies them.
+            let t = body.trim_ascii_start();
+            t.trim_ascii_end().is_empty() || t.starts_with(b"#")
+        } else {
+            body.first() == Some(&b'#')
+                || (body.trim_ascii().is_empty() && !body.contains(&shape.delimiter))
+        };
         if !skip {
-            if (quotes && body.contains(&b'"'))
+            // A whitespace row that is not plain decimals goes to the
+            // general reader.
+            if shape.whitespace
+                || (quotes && body.contains(&b'"'))
                 || !clean_row(
                     piece,
                     pos..end,
@@ -197,6 +221,49 @@ fn plain_row(
         }
     }
     None
+}
+
+/// [`plain_row`] for a whitespace table: the line starting at
+/// `piece[start]` when it is `n_fields` plain decimals separated by runs of
+/// spaces and tabs, with any before the first and after the last and an
+/// optional `\r` before the line end (the whitespace reader drops line-end
+/// `\r`s), at most [`MAX_LINE_BYTES`] long; the position of its line end.
+/// Any other line (a dummy `*`, an exponent, another separator, a field
+/// count that is not the header's) is `None`, for the general reader.
+#[inline]
+fn whitespace_row(
+    piece: &[u8],
+    start: usize,
+    n_fields: usize,
+    values: &mut [Vec<f64>],
+    integers: &mut [bool],
+) -> Option<usize> {
+    let blank = |p: usize| matches!(piece.get(p), Some(b' ' | b'\t'));
+    let mut p = start;
+    while blank(p) {
+        p += 1;
+    }
+    for (column, integer) in values.iter_mut().zip(integers.iter_mut()).take(n_fields) {
+        let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
+        column.push(v);
+        *integer &= is_integer;
+        p += len;
+        // A field ends at a blank or the line's end.
+        if !blank(p) && !matches!(piece.get(p), None | Some(b'\n' | b'\r')) {
+            return None;
+        }
+        while blank(p) {
+            p += 1;
+        }
+    }
+    while piece.get(p) == Some(&b'\r') {
+        p += 1;
+    }
+    let end = match piece.get(p) {
+        None | Some(b'\n') => p,
+        _ => return None,
+    };
+    (end - start <= crate::builder::MAX_LINE_BYTES as usize).then_some(end)
 }
 
 /// Splits and parses the line `piece[line]`, pushing one value onto each
@@ -490,6 +557,7 @@ mod tests {
         delimiter: b',',
         n_fields: 2,
         crlf: false,
+        whitespace: false,
     };
 
     fn parsed(piece: &[u8], shape: Shape) -> CleanRows {

@@ -115,6 +115,7 @@ fn read_csv_with(
         delimiter,
         n_fields: src.n_fields,
         crlf: src.crlf,
+        whitespace: false,
     };
     // Clean rows on all cores first; the general reader from the first
     // line that is not clean (module docs of csv_clean).

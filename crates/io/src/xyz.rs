@@ -45,7 +45,7 @@
 //! [`read_csv`](crate::read_csv) hands over when it detects them.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use crate::ReadOptions;
@@ -53,6 +53,7 @@ use crate::builder::{
     Layout, MAX_COLUMNS, MAX_LINE_BYTES, RowFields, RowSource, TableBuilder, line_too_long,
     too_many_columns,
 };
+use crate::csv_clean::{self, Resume, Shape, push_clean_rows};
 use crate::error::{IoError, Result};
 use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, read_prefix};
@@ -61,15 +62,40 @@ use crate::table::FlightTable;
 /// Reads a Geosoft XYZ file. See the module docs for the header rule and the
 /// `line`/`line_type` columns.
 pub fn read_xyz(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_tokens(path, opts, Dialect::Geosoft)
+    read_tokens(path, opts, Dialect::Geosoft, None)
 }
 
 /// Reads a whitespace-separated table with a plain header line and `#` comments.
+///
+/// Its rows of plain decimals are read on all cores by the CSV reader's
+/// fast path ([`crate::csv_clean`], whitespace shape), the general reader
+/// going on from the first row that is not (a dummy, an exponent, a wrong
+/// field count), so every warning and error is the general reader's.
 pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_tokens(path, opts, Dialect::Whitespace)
+    read_whitespace_with(
+        path,
+        opts,
+        Some((csv_clean::threads(), csv_clean::PIECE_BYTES)),
+    )
 }
 
-fn read_tokens(path: &Path, opts: &ReadOptions, dialect: Dialect) -> Result<FlightTable> {
+/// [`read_whitespace`], with the clean rows read on `threads` threads in
+/// pieces of `piece_bytes` when `clean` is given, by the general reader
+/// alone otherwise (tests compare the two).
+fn read_whitespace_with(
+    path: &Path,
+    opts: &ReadOptions,
+    clean: Option<(usize, usize)>,
+) -> Result<FlightTable> {
+    read_tokens(path, opts, Dialect::Whitespace, clean)
+}
+
+fn read_tokens(
+    path: &Path,
+    opts: &ReadOptions,
+    dialect: Dialect,
+    clean: Option<(usize, usize)>,
+) -> Result<FlightTable> {
     let prefix = read_prefix(path)?;
     let (src, names) = TokenSource::open(path, dialect)?;
     let layout = Layout {
@@ -82,7 +108,36 @@ fn read_tokens(path: &Path, opts: &ReadOptions, dialect: Dialect) -> Result<Flig
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     let header = builder.names().to_vec();
-    let mut src = push_rows(&mut builder, src)?;
+    let mut src = match clean {
+        // A plain table's rows start right after its header line.
+        Some((threads, piece_bytes)) if dialect == Dialect::Whitespace => {
+            let after_header = Resume {
+                offset: src.bytes,
+                line: src.line + 1,
+            };
+            let shape = Shape {
+                delimiter: b' ',
+                n_fields: src.n_fields,
+                crlf: false,
+                whitespace: true,
+            };
+            match push_clean_rows(
+                &mut builder,
+                path,
+                after_header,
+                shape,
+                threads,
+                piece_bytes,
+            )? {
+                Some(at) => {
+                    let rows = builder.rows();
+                    push_rows(&mut builder, src.resumed_at(at, rows)?)?
+                }
+                None => src,
+            }
+        }
+        _ => push_rows(&mut builder, src)?,
+    };
     let mut table = builder.finish(|| TokenSource::open(path, dialect).map(|(s, _)| s))?;
     if src.any_record {
         let free = |name: &str| {
@@ -175,6 +230,23 @@ impl TokenSource {
             line_values: Vec::new(),
             line_types: Vec::new(),
         })
+    }
+
+    /// This source (its header read) moved to the line start `at`, with
+    /// `rows` data rows already read before it.
+    fn resumed_at(mut self, at: Resume, rows: usize) -> Result<Self> {
+        self.reader
+            .seek(SeekFrom::Start(at.offset))
+            .map_err(|source| IoError::Read {
+                file: self.file.clone(),
+                line: at.line,
+                source,
+            })?;
+        self.bytes = at.offset;
+        self.line = at.line - 1;
+        self.row = rows;
+        self.replay = false;
+        Ok(self)
     }
 
     /// Scans comments and records up to the first data line and applies the header rule.
@@ -469,5 +541,136 @@ mod tests {
         assert_eq!(record_number(b"10:2"), Some(10.0));
         assert_eq!(record_number(b"abc"), None);
         assert_eq!(record_number(b""), None);
+    }
+
+    mod whitespace_fast_path {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// One line of a whitespace table of three columns: mostly plain
+        /// decimals with runs of spaces and tabs around them, and what the
+        /// fast path leaves to the general reader.
+        fn line() -> impl Strategy<Value = String> {
+            let blank = prop::sample::select(vec![" ", "  ", "\t", " \t ", "   "]);
+            let num = prop_oneof![
+                6 => (-99999i32..99999, 0u32..4).prop_map(|(m, k)| {
+                    let v = m as f64 / 10f64.powi(k as i32);
+                    if k == 0 { format!("{m}") } else { format!("{v:.*}", k as usize) }
+                }),
+                1 => prop::sample::select(vec!["*", "NaN", "1e3", "+2.5", "-0", ".5", "7.", "abc", "1\u{0c}"])
+                    .prop_map(str::to_string),
+            ];
+            prop_oneof![
+                12 => (blank.clone(), num.clone(), blank.clone(), num.clone(), blank.clone(), num, prop::sample::select(vec!["", " ", "\t", "\r"]))
+                    .prop_map(|(a, x, b, y, c, z, end)| {
+                        let lead = if a.len() > 1 { a } else { "" };
+                        format!("{lead}{x}{b}{y}{c}{z}{end}")
+                    }),
+                1 => Just("# a comment".to_string()),
+                1 => Just("   # indented comment".to_string()),
+                1 => Just("".to_string()),
+                1 => Just(" \t ".to_string()),
+                1 => Just("1 2".to_string()),
+                1 => Just("1 2 3 4".to_string()),
+                // Fields not parted by a blank.
+                1 => Just("1-2-3".to_string()),
+                1 => Just("4.5.6 1".to_string()),
+            ]
+        }
+
+        /// A table: a header, lines (runs of 40 clean rows among them, so
+        /// that pieces hold many), LF or CRLF, a final line end or none.
+        fn file() -> impl Strategy<Value = Vec<u8>> {
+            (
+                proptest::collection::vec(
+                    prop_oneof![8 => line().prop_map(Some), 1 => Just(None)],
+                    0..60,
+                ),
+                any::<bool>(),
+                any::<bool>(),
+            )
+                .prop_map(|(lines, crlf, last_newline)| {
+                    let end = if crlf { "\r\n" } else { "\n" };
+                    let mut text = format!("# head{end}time  mag\tnote{end}");
+                    for (k, l) in lines.iter().enumerate() {
+                        match l {
+                            Some(l) => text.push_str(l),
+                            None => text.push_str(
+                                &(0..40)
+                                    .map(|i| format!(" {k}.{i}   -5300{i}.25\t{i}"))
+                                    .collect::<Vec<_>>()
+                                    .join(end),
+                            ),
+                        }
+                        text.push_str(end);
+                    }
+                    if !last_newline && text.ends_with(end) {
+                        text.truncate(text.len() - end.len());
+                    }
+                    text.into_bytes()
+                })
+        }
+
+        fn outcome(r: Result<FlightTable>) -> std::result::Result<String, String> {
+            r.map(|t| format!("{t:?}")).map_err(|e| e.to_string())
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+
+            /// The fast path changes nothing: the same table (values,
+            /// missing counts, integer flags, text columns, line numbers)
+            /// or the same error as the general reader alone, for any
+            /// thread count and piece size.
+            #[test]
+            fn clean_rows_read_as_the_general_reader_reads_them(
+                text in file(),
+                threads in 1usize..4,
+                piece in 8usize..300,
+            ) {
+                let dir = tempfile::tempdir().unwrap();
+                let path = dir.path().join("f.txt");
+                std::fs::write(&path, &text).unwrap();
+                let opts = ReadOptions::default();
+                let general = outcome(read_whitespace_with(&path, &opts, None));
+                let clean = outcome(read_whitespace_with(&path, &opts, Some((threads, piece))));
+                prop_assert_eq!(&clean, &general, "{}", String::from_utf8_lossy(&text));
+                let big = outcome(read_whitespace_with(
+                    &path,
+                    &opts,
+                    Some((threads, csv_clean::PIECE_BYTES)),
+                ));
+                prop_assert_eq!(&big, &general);
+            }
+        }
+
+        /// A table of plain decimals is read whole by the fast path; the
+        /// same table with a dummy half way is read by both, the same.
+        #[test]
+        fn a_plain_table_and_one_with_a_dummy() {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("t.txt");
+            let mut text = String::from("time mag\n");
+            for i in 0..5000 {
+                text.push_str(&format!("  {}.{}\t{}.5 \n", i / 10, i % 10, 53000 + i));
+            }
+            std::fs::write(&path, &text).unwrap();
+            let opts = ReadOptions::default();
+            let fast = read_whitespace_with(&path, &opts, Some((2, 4096))).unwrap();
+            assert_eq!(fast.n_rows(), 5000);
+            assert_eq!(fast.column("mag").unwrap()[4999], 57999.5);
+            assert_eq!(
+                format!("{fast:?}"),
+                format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
+            );
+            let dummy = text.replacen("53100.5", "*", 1);
+            std::fs::write(&path, &dummy).unwrap();
+            let fast = read_whitespace_with(&path, &opts, Some((2, 4096))).unwrap();
+            assert!(fast.column("mag").unwrap()[100].is_nan());
+            assert_eq!(
+                format!("{fast:?}"),
+                format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
+            );
+        }
     }
 }
