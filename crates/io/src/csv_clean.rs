@@ -549,6 +549,65 @@ fn fill(f: &mut File, buf: &mut Vec<u8>, target: usize) -> std::io::Result<bool>
     Ok(got < want)
 }
 
+/// What the tests of the fast path's readers ([`crate::csv_read`],
+/// [`crate::xyz`]) share: a file of lines among runs of clean rows, and the
+/// check that the fast path reads it as the general reader alone does.
+#[cfg(test)]
+pub(crate) mod check {
+    use crate::error::Result;
+    use crate::table::FlightTable;
+    use proptest::test_runner::TestCaseError;
+    use std::path::Path;
+
+    /// `head`, then each of `lines` (`None`: a run of 40 clean rows,
+    /// `clean(k, i)` the `i`-th of the `k`-th run, so that pieces hold
+    /// many), each ended by `end`; the last line end cut without
+    /// `last_newline`.
+    pub(crate) fn text(
+        head: &str,
+        lines: &[Option<String>],
+        clean: impl Fn(usize, usize) -> String,
+        end: &str,
+        last_newline: bool,
+    ) -> Vec<u8> {
+        let mut text = head.to_string();
+        for (k, l) in lines.iter().enumerate() {
+            match l {
+                Some(l) => text.push_str(l),
+                None => text.push_str(&(0..40).map(|i| clean(k, i)).collect::<Vec<_>>().join(end)),
+            }
+            text.push_str(end);
+        }
+        if !last_newline && text.ends_with(end) {
+            text.truncate(text.len() - end.len());
+        }
+        text.into_bytes()
+    }
+
+    /// `text` written to a file and read by `read` with the fast path on
+    /// `threads` threads in pieces of `piece` bytes (and of the default
+    /// size) gives the same table (values, missing counts, integer flags,
+    /// text columns, line numbers) or the same error as `read` without it.
+    pub(crate) fn reads_as_the_general_reader(
+        text: &[u8],
+        read: impl Fn(&Path, Option<(usize, usize)>) -> Result<FlightTable>,
+        threads: usize,
+        piece: usize,
+    ) -> std::result::Result<(), TestCaseError> {
+        let outcome =
+            |r: Result<FlightTable>| r.map(|t| format!("{t:?}")).map_err(|e| e.to_string());
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.txt");
+        std::fs::write(&path, text).unwrap();
+        let general = outcome(read(&path, None));
+        let clean = outcome(read(&path, Some((threads, piece))));
+        proptest::prop_assert_eq!(&clean, &general, "{}", String::from_utf8_lossy(text));
+        let big = outcome(read(&path, Some((threads, super::PIECE_BYTES))));
+        proptest::prop_assert_eq!(&big, &general);
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

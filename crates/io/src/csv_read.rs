@@ -553,33 +553,19 @@ mod tests {
         )
             .prop_map(|(lines, d, crlf, bom, last_newline)| {
                 let end = if crlf { "\r\n" } else { "\n" };
-                let mut text = String::new();
-                if bom {
-                    text.push('\u{feff}');
-                }
-                text.push_str(&format!("# head{end}time{d}mag{d}note{end}"));
-                // `None`: a run of 40 clean rows, so that pieces hold many.
-                for (k, l) in lines.iter().enumerate() {
-                    match l {
-                        Some(l) => text.push_str(&l.replace("{d}", d)),
-                        None => text.push_str(
-                            &(0..40)
-                                .map(|i| format!("{k}.{i}{d}-5300{i}.25{d}{i}"))
-                                .collect::<Vec<_>>()
-                                .join(end),
-                        ),
-                    }
-                    text.push_str(end);
-                }
-                if !last_newline && text.ends_with(end) {
-                    text.truncate(text.len() - end.len());
-                }
-                text.into_bytes()
+                let bom = if bom { "\u{feff}" } else { "" };
+                let lines: Vec<Option<String>> = lines
+                    .iter()
+                    .map(|l| l.as_ref().map(|l| l.replace("{d}", d)))
+                    .collect();
+                csv_clean::check::text(
+                    &format!("{bom}# head{end}time{d}mag{d}note{end}"),
+                    &lines,
+                    |k, i| format!("{k}.{i}{d}-5300{i}.25{d}{i}"),
+                    end,
+                    last_newline,
+                )
             })
-    }
-
-    fn outcome(r: Result<FlightTable>) -> std::result::Result<String, String> {
-        r.map(|t| format!("{t:?}")).map_err(|e| e.to_string())
     }
 
     proptest! {
@@ -595,15 +581,13 @@ mod tests {
             threads in 1usize..4,
             piece in 8usize..300,
         ) {
-            let dir = tempfile::tempdir().unwrap();
-            let path = dir.path().join("f.csv");
-            std::fs::write(&path, &text).unwrap();
             let opts = ReadOptions::default();
-            let general = outcome(read_csv_with(&path, &opts, None));
-            let clean = outcome(read_csv_with(&path, &opts, Some((threads, piece))));
-            prop_assert_eq!(&clean, &general, "{}", String::from_utf8_lossy(&text));
-            let big = outcome(read_csv_with(&path, &opts, Some((threads, PIECE_BYTES))));
-            prop_assert_eq!(&big, &general);
+            csv_clean::check::reads_as_the_general_reader(
+                &text,
+                |path, clean| read_csv_with(path, &opts, clean),
+                threads,
+                piece,
+            )?;
         }
     }
 

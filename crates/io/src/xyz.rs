@@ -591,28 +591,14 @@ mod tests {
             )
                 .prop_map(|(lines, crlf, last_newline)| {
                     let end = if crlf { "\r\n" } else { "\n" };
-                    let mut text = format!("# head{end}time  mag\tnote{end}");
-                    for (k, l) in lines.iter().enumerate() {
-                        match l {
-                            Some(l) => text.push_str(l),
-                            None => text.push_str(
-                                &(0..40)
-                                    .map(|i| format!(" {k}.{i}   -5300{i}.25\t{i}"))
-                                    .collect::<Vec<_>>()
-                                    .join(end),
-                            ),
-                        }
-                        text.push_str(end);
-                    }
-                    if !last_newline && text.ends_with(end) {
-                        text.truncate(text.len() - end.len());
-                    }
-                    text.into_bytes()
+                    csv_clean::check::text(
+                        &format!("# head{end}time  mag\tnote{end}"),
+                        &lines,
+                        |k, i| format!(" {k}.{i}   -5300{i}.25\t{i}"),
+                        end,
+                        last_newline,
+                    )
                 })
-        }
-
-        fn outcome(r: Result<FlightTable>) -> std::result::Result<String, String> {
-            r.map(|t| format!("{t:?}")).map_err(|e| e.to_string())
         }
 
         proptest! {
@@ -628,19 +614,13 @@ mod tests {
                 threads in 1usize..4,
                 piece in 8usize..300,
             ) {
-                let dir = tempfile::tempdir().unwrap();
-                let path = dir.path().join("f.txt");
-                std::fs::write(&path, &text).unwrap();
                 let opts = ReadOptions::default();
-                let general = outcome(read_whitespace_with(&path, &opts, None));
-                let clean = outcome(read_whitespace_with(&path, &opts, Some((threads, piece))));
-                prop_assert_eq!(&clean, &general, "{}", String::from_utf8_lossy(&text));
-                let big = outcome(read_whitespace_with(
-                    &path,
-                    &opts,
-                    Some((threads, csv_clean::PIECE_BYTES)),
-                ));
-                prop_assert_eq!(&big, &general);
+                csv_clean::check::reads_as_the_general_reader(
+                    &text,
+                    |path, clean| read_whitespace_with(path, &opts, clean),
+                    threads,
+                    piece,
+                )?;
             }
         }
 
