@@ -152,19 +152,26 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
                 || (body.trim_ascii().is_empty() && !body.contains(&shape.delimiter))
         };
         if !skip {
-            // A whitespace row that is not plain decimals goes to the
-            // general reader.
-            if shape.whitespace
-                || (quotes && body.contains(&b'"'))
-                || !clean_row(
-                    piece,
-                    pos..end,
-                    shape,
+            let clean = if shape.whitespace {
+                whitespace_clean_row(
+                    body,
+                    shape.n_fields,
                     &mut out.values,
                     &mut out.integers,
                     &mut missing,
                 )
-            {
+            } else {
+                !(quotes && body.contains(&b'"'))
+                    && clean_row(
+                        piece,
+                        pos..end,
+                        shape,
+                        &mut out.values,
+                        &mut out.integers,
+                        &mut missing,
+                    )
+            };
+            if !clean {
                 for v in &mut out.values {
                     v.truncate(out.rows);
                 }
@@ -227,9 +234,9 @@ fn plain_row(
 /// `piece[start]` when it is `n_fields` plain decimals separated by runs of
 /// spaces and tabs, with any before the first and after the last and an
 /// optional `\r` before the line end (the whitespace reader drops line-end
-/// `\r`s), at most [`MAX_LINE_BYTES`] long; the position of its line end.
-/// Any other line (a dummy `*`, an exponent, another separator, a field
-/// count that is not the header's) is `None`, for the general reader.
+/// `\r`s); the position of its line end. Any other line (a dummy `*`, an
+/// exponent, a field count that is not the header's) is `None`, for
+/// [`whitespace_clean_row`].
 #[inline]
 fn whitespace_row(
     piece: &[u8],
@@ -259,11 +266,54 @@ fn whitespace_row(
     while piece.get(p) == Some(&b'\r') {
         p += 1;
     }
-    let end = match piece.get(p) {
-        None | Some(b'\n') => p,
-        _ => return None,
-    };
-    (end - start <= crate::builder::MAX_LINE_BYTES as usize).then_some(end)
+    match piece.get(p) {
+        None | Some(b'\n') => Some(p),
+        _ => None,
+    }
+}
+
+/// [`clean_row`] for a whitespace table: the fields of `line` (without its
+/// line end), split on runs of spaces and tabs after dropping line-end
+/// `\r`s, each read by [`parse_cell`] (a dummy `*`, `NaN`, an exponent);
+/// `false` for a line that is not clean (a field count that is not the
+/// header's, a cell that is not a number or a missing marker, or another
+/// ASCII blank, which the whitespace reader would also split on).
+#[inline]
+fn whitespace_clean_row(
+    line: &[u8],
+    n_fields: usize,
+    values: &mut [Vec<f64>],
+    integers: &mut [bool],
+    missing: &mut Vec<(usize, MissingKind)>,
+) -> bool {
+    missing.clear();
+    let mut line = line;
+    while let [rest @ .., b'\r'] = line {
+        line = rest;
+    }
+    let mut fields = line
+        .split(|b| matches!(b, b' ' | b'\t'))
+        .filter(|f| !f.is_empty());
+    for (i, column) in values.iter_mut().enumerate().take(n_fields) {
+        let Some(f) = fields.next() else {
+            return false; // short row
+        };
+        if f.iter().any(u8::is_ascii_whitespace) {
+            return false;
+        }
+        match parse_cell(f) {
+            Ok(Cell::Value(v)) => {
+                column.push(v);
+                integers[i] &= is_integer_text(f);
+            }
+            Ok(Cell::Missing(kind)) => {
+                column.push(f64::NAN);
+                missing.push((i, kind));
+            }
+            Err(_) => return false,
+        }
+    }
+    fields.next().is_none() // else a long row
 }
 
 /// Splits and parses the line `piece[line]`, pushing one value onto each

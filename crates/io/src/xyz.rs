@@ -67,10 +67,11 @@ pub fn read_xyz(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
 
 /// Reads a whitespace-separated table with a plain header line and `#` comments.
 ///
-/// Its rows of plain decimals are read on all cores by the CSV reader's
-/// fast path ([`crate::csv_clean`], whitespace shape), the general reader
-/// going on from the first row that is not (a dummy, an exponent, a wrong
-/// field count), so every warning and error is the general reader's.
+/// Its rows of numbers and missing markers are read on all cores by the
+/// CSV reader's fast path ([`crate::csv_clean`], whitespace shape), the
+/// general reader going on from the first row that is not (a text cell, a
+/// wrong field count, another ASCII blank than spaces and tabs), so every
+/// warning and error is the general reader's.
 pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     read_whitespace_with(
         path,
