@@ -52,6 +52,9 @@ pub(crate) struct Shape {
     /// first and after the last (a whitespace table, [`crate::xyz`]):
     /// `delimiter` and `crlf` are not used.
     pub whitespace: bool,
+    /// With `whitespace`: the lines of a Geosoft XYZ file (`/` comments,
+    /// `Line`/`Tie` records, [`crate::xyz`]) rather than `#` comments.
+    pub geosoft: bool,
 }
 
 /// The clean rows at the start of one piece, column by column.
@@ -76,6 +79,9 @@ pub(crate) struct CleanRows {
     pub bytes: usize,
     /// Whether the piece stopped at a line that is not clean.
     pub stopped: bool,
+    /// The Geosoft `Line`/`Tie` records read: `(rows before it in the
+    /// piece, its number, whether a tie)`.
+    pub records: Vec<(usize, f64, bool)>,
 }
 
 impl CleanRows {
@@ -96,6 +102,7 @@ impl CleanRows {
         self.lines = 0;
         self.bytes = 0;
         self.stopped = false;
+        self.records.clear();
     }
 
     /// Counts a row (its values already pushed) on `line` of the piece.
@@ -143,7 +150,31 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
         let end = memchr::memchr(b'\n', &piece[pos..]).map_or(piece.len(), |i| pos + i);
         let body = &piece[pos..end];
         let next = (end + 1).min(piece.len());
-        let skip = if shape.whitespace {
+        let skip = if shape.geosoft {
+            // Blank lines, `/` comments and records, as the XYZ reader
+            // classifies them (it drops line-end `\r`s first).
+            let mut t = body.trim_ascii_start();
+            while let [rest @ .., b'\r'] = t {
+                t = rest;
+            }
+            if t.trim_ascii_end().is_empty() {
+                true
+            } else {
+                match crate::xyz::geosoft_kind(t) {
+                    Some(crate::xyz::Kind::Data) => false,
+                    Some(crate::xyz::Kind::Record { number, tie }) => {
+                        out.records.push((out.rows, number, tie));
+                        true
+                    }
+                    Some(_) => true,
+                    // A record without a number: the general reader's error.
+                    None => {
+                        out.stopped = true;
+                        break;
+                    }
+                }
+            }
+        } else if shape.whitespace {
             // Blank and `#` lines, as the whitespace reader classifies them.
             let t = body.trim_ascii_start();
             t.trim_ascii_end().is_empty() || t.starts_with(b"#")
@@ -497,8 +528,9 @@ fn piece_ends(text: &[u8], k: usize) -> Vec<usize> {
 
 /// Appends the clean rows of `path` from `from` (a line start after the
 /// header) to `builder`, reading rounds of `threads` pieces of about
-/// `piece_bytes`; returns where the general reader must go on (`None`: the
-/// file ended clean). See the module docs.
+/// `piece_bytes`, and shows each piece appended to `on_piece` (in file
+/// order); returns where the general reader must go on (`None`: the file
+/// ended clean). See the module docs.
 pub(crate) fn push_clean_rows(
     builder: &mut TableBuilder,
     path: &Path,
@@ -506,6 +538,7 @@ pub(crate) fn push_clean_rows(
     shape: Shape,
     threads: usize,
     piece_bytes: usize,
+    on_piece: &mut dyn FnMut(&CleanRows),
 ) -> Result<Option<Resume>> {
     let file = path.display().to_string();
     let read_err = |line| {
@@ -537,7 +570,7 @@ pub(crate) fn push_clean_rows(
             match memchr::memrchr(b'\n', &buf) {
                 Some(i) => i + 1,
                 // A line longer than a round: the general reader has the limit.
-                None => return Ok(append(builder, &parsed, &mut at).or(Some(at))),
+                None => return Ok(append(builder, &parsed, &mut at, on_piece).or(Some(at))),
             }
         };
         let ends = piece_ends(&buf[..whole], threads);
@@ -556,7 +589,7 @@ pub(crate) fn push_clean_rows(
                 let piece = &text[if i == 0 { 0 } else { ends[i - 1] }..ends[i]];
                 scope.spawn(move || parse_piece(piece, shape, part));
             }
-            let stop = append(builder, &parsed, &mut at);
+            let stop = append(builder, &parsed, &mut at, on_piece);
             let read = reader.map(|r| r.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
             (stop, read)
         });
@@ -565,7 +598,7 @@ pub(crate) fn push_clean_rows(
         }
         std::mem::swap(&mut parsing, &mut parsed);
         match read {
-            None => return Ok(append(builder, &parsed, &mut at)),
+            None => return Ok(append(builder, &parsed, &mut at, on_piece)),
             Some(r) => eof = r.map_err(read_err(at.line))?,
         }
         std::mem::swap(&mut buf, &mut next);
@@ -574,12 +607,18 @@ pub(crate) fn push_clean_rows(
 
 /// Appends the parsed pieces of a round to `builder` in order, moving `at`
 /// past them; where the general reader must go on, if a piece stopped.
-fn append(builder: &mut TableBuilder, parts: &[CleanRows], at: &mut Resume) -> Option<Resume> {
+fn append(
+    builder: &mut TableBuilder,
+    parts: &[CleanRows],
+    at: &mut Resume,
+    on_piece: &mut dyn FnMut(&CleanRows),
+) -> Option<Resume> {
     for part in parts {
         let bytes_read = at.offset + part.bytes as u64;
         if !builder.append_clean(part, at.line, bytes_read) {
             return Some(*at);
         }
+        on_piece(part);
         *at = Resume {
             offset: bytes_read,
             line: at.line + part.lines,
@@ -667,6 +706,7 @@ mod tests {
         n_fields: 2,
         crlf: false,
         whitespace: false,
+        geosoft: false,
     };
 
     fn parsed(piece: &[u8], shape: Shape) -> CleanRows {

@@ -116,6 +116,7 @@ fn read_csv_with(
         n_fields: src.n_fields,
         crlf: src.crlf,
         whitespace: false,
+        geosoft: false,
     };
     // Clean rows on all cores first; the general reader from the first
     // line that is not clean (module docs of csv_clean).
@@ -129,6 +130,7 @@ fn read_csv_with(
             shape,
             threads,
             piece_bytes,
+            &mut |_| {},
         )? {
             let src = CsvSource::open_at(path, delimiter, prefix.file_size, at)?.after_header(
                 header_line,

@@ -43,6 +43,12 @@
 //! The same tokenizer reads whitespace-separated tables with a plain header
 //! (`time lat lon` as the first line that is not a `#` comment), which
 //! [`read_csv`](crate::read_csv) hands over when it detects them.
+//!
+//! In both, the data lines after the header are read on all cores by the
+//! CSV reader's fast path ([`crate::csv_clean`], whitespace shape: the same
+//! fields, comments and records as these rules), and this reader goes on
+//! from the first line that path leaves (a text cell, a wrong field count,
+//! a record without a number), so every warning and error is its own.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
@@ -62,16 +68,26 @@ use crate::table::FlightTable;
 /// Reads a Geosoft XYZ file. See the module docs for the header rule and the
 /// `line`/`line_type` columns.
 pub fn read_xyz(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_tokens(path, opts, Dialect::Geosoft, None)
+    read_xyz_with(
+        path,
+        opts,
+        Some((csv_clean::threads(), csv_clean::PIECE_BYTES)),
+    )
 }
 
-/// Reads a whitespace-separated table with a plain header line and `#` comments.
-///
-/// Its rows of numbers and missing markers are read on all cores by the
-/// CSV reader's fast path ([`crate::csv_clean`], whitespace shape), the
-/// general reader going on from the first row that is not (a text cell, a
-/// wrong field count, another ASCII blank than spaces and tabs), so every
-/// warning and error is the general reader's.
+/// [`read_xyz`], with the clean rows read on `threads` threads in pieces
+/// of `piece_bytes` when `clean` is given, by the general reader alone
+/// otherwise (tests compare the two).
+fn read_xyz_with(
+    path: &Path,
+    opts: &ReadOptions,
+    clean: Option<(usize, usize)>,
+) -> Result<FlightTable> {
+    read_tokens(path, opts, Dialect::Geosoft, clean)
+}
+
+/// Reads a whitespace-separated table with a plain header line and `#`
+/// comments (data lines on all cores: module docs).
 pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     read_whitespace_with(
         path,
@@ -98,7 +114,7 @@ fn read_tokens(
     clean: Option<(usize, usize)>,
 ) -> Result<FlightTable> {
     let prefix = read_prefix(path)?;
-    let (src, names) = TokenSource::open(path, dialect)?;
+    let (mut src, names) = TokenSource::open(path, dialect)?;
     let layout = Layout {
         path: path.to_path_buf(),
         names,
@@ -110,26 +126,31 @@ fn read_tokens(
     let mut builder = TableBuilder::new(layout, opts)?;
     let header = builder.names().to_vec();
     let mut src = match clean {
-        // A plain table's rows start right after its header line.
-        Some((threads, piece_bytes)) if dialect == Dialect::Whitespace => {
-            let after_header = Resume {
-                offset: src.bytes,
-                line: src.line + 1,
+        Some((threads, piece_bytes)) => {
+            // The first data line: after a plain table's header line; the
+            // line the Geosoft header rule stopped at (read, to replay).
+            let (offset, line) = if src.replay {
+                (src.line_start, src.line)
+            } else {
+                (src.bytes, src.line + 1)
             };
             let shape = Shape {
                 delimiter: b' ',
                 n_fields: src.n_fields,
                 crlf: false,
                 whitespace: true,
+                geosoft: dialect == Dialect::Geosoft,
             };
-            match push_clean_rows(
+            let stop = push_clean_rows(
                 &mut builder,
                 path,
-                after_header,
+                Resume { offset, line },
                 shape,
                 threads,
                 piece_bytes,
-            )? {
+                &mut |piece| src.take_clean_piece(piece),
+            )?;
+            match stop {
                 Some(at) => {
                     let rows = builder.rows();
                     push_rows(&mut builder, src.resumed_at(at, rows)?)?
@@ -137,7 +158,7 @@ fn read_tokens(
                 None => src,
             }
         }
-        _ => push_rows(&mut builder, src)?,
+        None => push_rows(&mut builder, src)?,
     };
     let mut table = builder.finish(|| TokenSource::open(path, dialect).map(|(s, _)| s))?;
     if src.any_record {
@@ -164,7 +185,8 @@ enum Dialect {
 }
 
 /// What a physical line is.
-enum Kind {
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Kind {
     Blank,
     Comment,
     Record { number: f64, tie: bool },
@@ -181,6 +203,8 @@ struct TokenSource {
     dialect: Dialect,
     line: u64,
     bytes: u64,
+    /// File offset of the start of line `line`.
+    line_start: u64,
     n_fields: usize,
     header_line: u64,
     row: usize,
@@ -221,6 +245,7 @@ impl TokenSource {
             dialect,
             line: 0,
             bytes: 0,
+            line_start: 0,
             n_fields: 0,
             header_line: 0,
             row: 0,
@@ -231,6 +256,26 @@ impl TokenSource {
             line_values: Vec::new(),
             line_types: Vec::new(),
         })
+    }
+
+    /// The line labels of a piece of rows read by the fast path
+    /// ([`csv_clean`]), with its records (Geosoft: the current record's
+    /// number and type for each row, as [`Self::accept_row`] keeps them).
+    fn take_clean_piece(&mut self, piece: &csv_clean::CleanRows) {
+        if self.dialect != Dialect::Geosoft {
+            return;
+        }
+        let mut records = piece.records.iter().peekable();
+        for row in 0..piece.rows {
+            while let Some(&(_, number, tie)) = records.next_if(|r| r.0 <= row) {
+                self.set_record(number, tie);
+            }
+            self.line_values.push(self.current_line);
+            self.line_types.push(self.current_type);
+        }
+        for &(_, number, tie) in records {
+            self.set_record(number, tie);
+        }
     }
 
     /// This source (its header read) moved to the line start `at`, with
@@ -377,6 +422,7 @@ impl TokenSource {
         if n as u64 == MAX_LINE_BYTES + 2 && self.buf.last() != Some(&b'\n') {
             return Err(line_too_long(&self.file, self.line + 1));
         }
+        self.line_start = self.bytes;
         self.bytes += n as u64;
         self.line += 1;
         if self.line == 1 && self.buf.starts_with(BOM) {
@@ -402,31 +448,14 @@ impl TokenSource {
             } else {
                 Kind::Data
             }),
-            Dialect::Geosoft => {
-                if t.starts_with(b"/") {
-                    return Ok(Kind::Comment);
-                }
-                let mut words = t
-                    .split(|b| b.is_ascii_whitespace())
-                    .filter(|w| !w.is_empty());
-                let first = words.next().unwrap_or_default();
-                let tie = first.eq_ignore_ascii_case(b"tie");
-                if !tie && !first.eq_ignore_ascii_case(b"line") {
-                    return Ok(Kind::Data);
-                }
-                let word = words.next().unwrap_or_default();
-                match record_number(word) {
-                    Some(number) => Ok(Kind::Record { number, tie }),
-                    None => Err(IoError::XyzHeader {
-                        file: self.file.clone(),
-                        line: self.line,
-                        message: format!(
-                            "line record '{}' has no line number (expected e.g. 'Line 1010' or 'Tie 2010')",
-                            String::from_utf8_lossy(t)
-                        ),
-                    }),
-                }
-            }
+            Dialect::Geosoft => geosoft_kind(t).ok_or_else(|| IoError::XyzHeader {
+                file: self.file.clone(),
+                line: self.line,
+                message: format!(
+                    "line record '{}' has no line number (expected e.g. 'Line 1010' or 'Tie 2010')",
+                    String::from_utf8_lossy(t)
+                ),
+            }),
         }
     }
 
@@ -517,6 +546,25 @@ impl RowFields for TokenSource {
     }
 }
 
+/// What a line of a Geosoft XYZ file is (`t`: the line without its line
+/// end and leading blanks, not blank): a `/` comment, a `Line`/`Tie`
+/// record, or data; `None` for a record word without a number.
+pub(crate) fn geosoft_kind(t: &[u8]) -> Option<Kind> {
+    if t.starts_with(b"/") {
+        return Some(Kind::Comment);
+    }
+    let mut words = t
+        .split(|b| b.is_ascii_whitespace())
+        .filter(|w| !w.is_empty());
+    let first = words.next().unwrap_or_default();
+    let tie = first.eq_ignore_ascii_case(b"tie");
+    if !tie && !first.eq_ignore_ascii_case(b"line") {
+        return Some(Kind::Data);
+    }
+    let number = record_number(words.next().unwrap_or_default())?;
+    Some(Kind::Record { number, tie })
+}
+
 /// The number of a `Line`/`Tie` record word: leading letters dropped, then
 /// the leading digits and dots (`L1010` → 1010, `1010.1` → 1010.1, `10:2` → 10).
 fn record_number(word: &[u8]) -> Option<f64> {
@@ -551,7 +599,7 @@ mod tests {
         /// One line of a whitespace table of three columns: mostly plain
         /// decimals with runs of spaces and tabs around them, and what the
         /// fast path leaves to the general reader.
-        fn line() -> impl Strategy<Value = String> {
+        pub(super) fn line() -> impl Strategy<Value = String> {
             let blank = prop::sample::select(vec![" ", "  ", "\t", " \t ", "   "]);
             let num = prop_oneof![
                 6 => (-99999i32..99999, 0u32..4).prop_map(|(m, k)| {
@@ -651,6 +699,117 @@ mod tests {
             assert_eq!(
                 format!("{fast:?}"),
                 format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
+            );
+        }
+    }
+
+    mod geosoft_fast_path {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// One line of a Geosoft XYZ file of three columns: a whitespace
+        /// table's line, a `/` comment, a `Line`/`Tie` record (with and
+        /// without a number), a `#` line (data here).
+        fn line() -> impl Strategy<Value = String> {
+            prop_oneof![
+                10 => super::whitespace_fast_path::line(),
+                1 => Just("/ a comment".to_string()),
+                1 => Just("  // units".to_string()),
+                2 => (1u32..3000).prop_map(|n| format!("Line {n}")),
+                1 => (1u32..3000).prop_map(|n| format!("  tie L{n}.5\r")),
+                1 => Just("LINE".to_string()),
+                1 => Just("# not a comment here".to_string()),
+            ]
+        }
+
+        /// A file: comments, the names, maybe a record, then lines among
+        /// runs of clean rows (some runs after a record of their own).
+        fn file() -> impl Strategy<Value = Vec<u8>> {
+            (
+                proptest::collection::vec(
+                    prop_oneof![8 => line().prop_map(Some), 1 => Just(None)],
+                    0..60,
+                ),
+                any::<bool>(),
+                any::<bool>(),
+                any::<bool>(),
+            )
+                .prop_map(|(lines, crlf, last_newline, first_record)| {
+                    let end = if crlf { "\r\n" } else { "\n" };
+                    let record = if first_record {
+                        format!("Line 1000{end}")
+                    } else {
+                        String::new()
+                    };
+                    csv_clean::check::text(
+                        &format!("/ XYZ EXPORT{end}/ time  mag note{end}{record}"),
+                        &lines,
+                        |k, i| {
+                            let head = if i == 0 && k % 2 == 0 {
+                                format!("Line {k}{end}")
+                            } else {
+                                String::new()
+                            };
+                            format!("{head} {k}.{i}   -5300{i}.25\t{i}")
+                        },
+                        end,
+                        last_newline,
+                    )
+                })
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+
+            /// The fast path changes nothing: the same table (with its
+            /// `line` and `line_type` columns) or the same error as the
+            /// general reader alone, for any thread count and piece size.
+            #[test]
+            fn clean_rows_read_as_the_general_reader_reads_them(
+                text in file(),
+                threads in 1usize..4,
+                piece in 8usize..300,
+            ) {
+                let opts = ReadOptions::default();
+                csv_clean::check::reads_as_the_general_reader(
+                    &text,
+                    |path, clean| read_xyz_with(path, &opts, clean),
+                    threads,
+                    piece,
+                )?;
+            }
+        }
+
+        /// Records between rows label the rows after them, read by the
+        /// fast path (with pieces that end between a record and its rows).
+        #[test]
+        fn records_label_the_rows_after_them() {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("s.xyz");
+            let mut text = String::from("/ time mag\n");
+            for i in 0..3000 {
+                if i % 1000 == 0 {
+                    text.push_str(&format!(
+                        "{} {}\n",
+                        if i == 2000 { "Tie" } else { "Line" },
+                        1001 + i / 1000
+                    ));
+                }
+                text.push_str(&format!("  {}.{}  {}.5\n", i / 10, i % 10, 53000 + i));
+            }
+            std::fs::write(&path, &text).unwrap();
+            let opts = ReadOptions::default();
+            let fast = read_xyz_with(&path, &opts, Some((2, 1000))).unwrap();
+            let line = fast.column("line").unwrap();
+            let kind = fast.column("line_type").unwrap();
+            assert_eq!(
+                (line[0], line[999], line[1000], line[2999]),
+                (1001.0, 1001.0, 1002.0, 1003.0)
+            );
+            assert_eq!((kind[1999], kind[2000]), (0.0, 1.0));
+            assert_eq!(
+                format!("{fast:?}"),
+                format!("{:?}", read_xyz_with(&path, &opts, None).unwrap())
             );
         }
     }
