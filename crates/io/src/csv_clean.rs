@@ -20,6 +20,11 @@
 //! On two cores this reads a 10⁷-row flight about 1.5× faster than the
 //! general reader, whose tokenizer and cell parser run one thread each
 //! (README, reading benchmark).
+//!
+//! Whitespace tables and Geosoft XYZ files ([`crate::xyz`]) take the same
+//! path with a whitespace [`Shape`]: fields parted by runs of spaces and
+//! tabs, their comment lines, and for XYZ the `Line`/`Tie` records, kept
+//! per piece ([`CleanRows::records`]) for the reader's line columns.
 
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
