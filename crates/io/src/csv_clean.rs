@@ -337,16 +337,8 @@ fn whitespace_clean_row(
         if f.iter().any(u8::is_ascii_whitespace) {
             return false;
         }
-        match parse_cell(f) {
-            Ok(Cell::Value(v)) => {
-                column.push(v);
-                integers[i] &= is_integer_text(f);
-            }
-            Ok(Cell::Missing(kind)) => {
-                column.push(f64::NAN);
-                missing.push((i, kind));
-            }
-            Err(_) => return false,
+        if !push_cell(f, i, column, integers, missing) {
+            return false;
         }
     }
     fields.next().is_none() // else a long row
@@ -412,18 +404,36 @@ fn clean_row(
         } else {
             f
         };
-        match parse_cell(f) {
-            Ok(Cell::Value(v)) => {
-                column.push(v);
-                integers[i] &= is_integer_text(f);
-            }
-            Ok(Cell::Missing(kind)) => {
-                column.push(f64::NAN);
-                missing.push((i, kind));
-            }
-            Err(_) => return false,
+        if !push_cell(f, i, column, integers, missing) {
+            return false;
         }
         start += len + 1;
+    }
+    true
+}
+
+/// The cell `f` of column `i` read by [`parse_cell`] onto `column`: a
+/// number (clearing the column's integer flag unless written as an
+/// integer) or NaN with its reason in `missing`; `false` for a cell that
+/// is neither (text, a NUL, invalid UTF-8).
+#[inline]
+fn push_cell(
+    f: &[u8],
+    i: usize,
+    column: &mut Vec<f64>,
+    integers: &mut [bool],
+    missing: &mut Vec<(usize, MissingKind)>,
+) -> bool {
+    match parse_cell(f) {
+        Ok(Cell::Value(v)) => {
+            column.push(v);
+            integers[i] &= is_integer_text(f);
+        }
+        Ok(Cell::Missing(kind)) => {
+            column.push(f64::NAN);
+            missing.push((i, kind));
+        }
+        Err(_) => return false,
     }
     true
 }

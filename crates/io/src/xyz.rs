@@ -592,14 +592,14 @@ mod tests {
         assert_eq!(record_number(b""), None);
     }
 
-    mod whitespace_fast_path {
+    mod fast_path {
         use super::*;
         use proptest::prelude::*;
 
         /// One line of a whitespace table of three columns: mostly plain
         /// decimals with runs of spaces and tabs around them, and what the
         /// fast path leaves to the general reader.
-        pub(super) fn line() -> impl Strategy<Value = String> {
+        fn whitespace_line() -> impl Strategy<Value = String> {
             let blank = prop::sample::select(vec![" ", "  ", "\t", " \t ", "   "]);
             let num = prop_oneof![
                 6 => (-99999i32..99999, 0u32..4).prop_map(|(m, k)| {
@@ -627,23 +627,60 @@ mod tests {
             ]
         }
 
-        /// A table: a header, lines (runs of 40 clean rows among them, so
-        /// that pieces hold many), LF or CRLF, a final line end or none.
-        fn file() -> impl Strategy<Value = Vec<u8>> {
+        /// One line of a Geosoft XYZ file of three columns: a whitespace
+        /// table's line, a `/` comment, a `Line`/`Tie` record (with and
+        /// without a number), a `#` line (data here).
+        fn geosoft_line() -> impl Strategy<Value = String> {
+            prop_oneof![
+                10 => whitespace_line(),
+                1 => Just("/ a comment".to_string()),
+                1 => Just("  // units".to_string()),
+                2 => (1u32..3000).prop_map(|n| format!("Line {n}")),
+                1 => (1u32..3000).prop_map(|n| format!("  tie L{n}.5\r")),
+                1 => Just("LINE".to_string()),
+                1 => Just("# not a comment here".to_string()),
+            ]
+        }
+
+        /// A file of `dialect`: its header (an XYZ file: comments, the
+        /// names, maybe a record), then lines among runs of 40 clean rows
+        /// (so that pieces hold many; in an XYZ file every other run after
+        /// a record of its own), LF or CRLF, a final line end or none.
+        fn file(dialect: Dialect) -> impl Strategy<Value = Vec<u8>> {
+            let line = match dialect {
+                Dialect::Whitespace => whitespace_line().boxed(),
+                Dialect::Geosoft => geosoft_line().boxed(),
+            };
             (
                 proptest::collection::vec(
-                    prop_oneof![8 => line().prop_map(Some), 1 => Just(None)],
+                    prop_oneof![8 => line.prop_map(Some), 1 => Just(None)],
                     0..60,
                 ),
                 any::<bool>(),
                 any::<bool>(),
+                any::<bool>(),
             )
-                .prop_map(|(lines, crlf, last_newline)| {
+                .prop_map(move |(lines, crlf, last_newline, first_record)| {
                     let end = if crlf { "\r\n" } else { "\n" };
+                    let geosoft = dialect == Dialect::Geosoft;
+                    let head = match (geosoft, first_record) {
+                        (false, _) => format!("# head{end}time  mag\tnote{end}"),
+                        (true, false) => format!("/ XYZ EXPORT{end}/ time  mag note{end}"),
+                        (true, true) => {
+                            format!("/ XYZ EXPORT{end}/ time  mag note{end}Line 1000{end}")
+                        }
+                    };
                     csv_clean::check::text(
-                        &format!("# head{end}time  mag\tnote{end}"),
+                        &head,
                         &lines,
-                        |k, i| format!(" {k}.{i}   -5300{i}.25\t{i}"),
+                        |k, i| {
+                            let record = if geosoft && i == 0 && k % 2 == 0 {
+                                format!("Line {k}{end}")
+                            } else {
+                                String::new()
+                            };
+                            format!("{record} {k}.{i}   -5300{i}.25\t{i}")
+                        },
                         end,
                         last_newline,
                     )
@@ -654,19 +691,26 @@ mod tests {
             #![proptest_config(ProptestConfig::with_cases(300))]
 
             /// The fast path changes nothing: the same table (values,
-            /// missing counts, integer flags, text columns, line numbers)
-            /// or the same error as the general reader alone, for any
-            /// thread count and piece size.
+            /// missing counts, integer flags, line numbers; an XYZ file's
+            /// `line` and `line_type` columns) or the same error as the
+            /// general reader alone, for any thread count and piece size.
             #[test]
             fn clean_rows_read_as_the_general_reader_reads_them(
-                text in file(),
+                table in file(Dialect::Whitespace),
+                xyz in file(Dialect::Geosoft),
                 threads in 1usize..4,
                 piece in 8usize..300,
             ) {
                 let opts = ReadOptions::default();
                 csv_clean::check::reads_as_the_general_reader(
-                    &text,
+                    &table,
                     |path, clean| read_whitespace_with(path, &opts, clean),
+                    threads,
+                    piece,
+                )?;
+                csv_clean::check::reads_as_the_general_reader(
+                    &xyz,
+                    |path, clean| read_xyz_with(path, &opts, clean),
                     threads,
                     piece,
                 )?;
@@ -700,84 +744,6 @@ mod tests {
                 format!("{fast:?}"),
                 format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
             );
-        }
-    }
-
-    mod geosoft_fast_path {
-        use super::*;
-        use proptest::prelude::*;
-
-        /// One line of a Geosoft XYZ file of three columns: a whitespace
-        /// table's line, a `/` comment, a `Line`/`Tie` record (with and
-        /// without a number), a `#` line (data here).
-        fn line() -> impl Strategy<Value = String> {
-            prop_oneof![
-                10 => super::whitespace_fast_path::line(),
-                1 => Just("/ a comment".to_string()),
-                1 => Just("  // units".to_string()),
-                2 => (1u32..3000).prop_map(|n| format!("Line {n}")),
-                1 => (1u32..3000).prop_map(|n| format!("  tie L{n}.5\r")),
-                1 => Just("LINE".to_string()),
-                1 => Just("# not a comment here".to_string()),
-            ]
-        }
-
-        /// A file: comments, the names, maybe a record, then lines among
-        /// runs of clean rows (some runs after a record of their own).
-        fn file() -> impl Strategy<Value = Vec<u8>> {
-            (
-                proptest::collection::vec(
-                    prop_oneof![8 => line().prop_map(Some), 1 => Just(None)],
-                    0..60,
-                ),
-                any::<bool>(),
-                any::<bool>(),
-                any::<bool>(),
-            )
-                .prop_map(|(lines, crlf, last_newline, first_record)| {
-                    let end = if crlf { "\r\n" } else { "\n" };
-                    let record = if first_record {
-                        format!("Line 1000{end}")
-                    } else {
-                        String::new()
-                    };
-                    csv_clean::check::text(
-                        &format!("/ XYZ EXPORT{end}/ time  mag note{end}{record}"),
-                        &lines,
-                        |k, i| {
-                            let head = if i == 0 && k % 2 == 0 {
-                                format!("Line {k}{end}")
-                            } else {
-                                String::new()
-                            };
-                            format!("{head} {k}.{i}   -5300{i}.25\t{i}")
-                        },
-                        end,
-                        last_newline,
-                    )
-                })
-        }
-
-        proptest! {
-            #![proptest_config(ProptestConfig::with_cases(300))]
-
-            /// The fast path changes nothing: the same table (with its
-            /// `line` and `line_type` columns) or the same error as the
-            /// general reader alone, for any thread count and piece size.
-            #[test]
-            fn clean_rows_read_as_the_general_reader_reads_them(
-                text in file(),
-                threads in 1usize..4,
-                piece in 8usize..300,
-            ) {
-                let opts = ReadOptions::default();
-                csv_clean::check::reads_as_the_general_reader(
-                    &text,
-                    |path, clean| read_xyz_with(path, &opts, clean),
-                    threads,
-                    piece,
-                )?;
-            }
         }
 
         /// Records between rows label the rows after them, read by the
