@@ -35,6 +35,7 @@ use crate::builder::{TableBuilder, is_integer_text};
 use crate::cell::{Cell, EXACT_POWERS_OF_TEN, MissingKind, parse_cell, plain_decimal_prefix};
 use crate::error::{IoError, Result};
 use crate::table::Missing;
+use crate::xyz::{Dialect, Kind, line_kind};
 
 /// Bytes per piece (one per thread and round).
 pub(crate) const PIECE_BYTES: usize = 4 << 20;
@@ -53,13 +54,11 @@ pub(crate) struct Shape {
     pub n_fields: usize,
     /// The header ended with `\r\n`: the last field of each row loses a final `\r`.
     pub crlf: bool,
-    /// Fields separated by runs of spaces and tabs, with any before the
-    /// first and after the last (a whitespace table, [`crate::xyz`]):
-    /// `delimiter` and `crlf` are not used.
-    pub whitespace: bool,
-    /// With `whitespace`: the lines of a Geosoft XYZ file (`/` comments,
-    /// `Line`/`Tie` records, [`crate::xyz`]) rather than `#` comments.
-    pub geosoft: bool,
+    /// A whitespace table or XYZ file ([`crate::xyz`]) of this dialect:
+    /// fields separated by runs of spaces and tabs, with any before the
+    /// first and after the last, lines classified by
+    /// [`crate::xyz::line_kind`]; `delimiter` and `crlf` are not used.
+    pub whitespace: Option<Dialect>,
 }
 
 /// The clean rows at the start of one piece, column by column.
@@ -132,7 +131,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
     let mut line = 0u64;
     while pos < piece.len() {
         // Most lines: plain decimals and the line end, in one pass.
-        let row = if shape.whitespace {
+        let row = if shape.whitespace.is_some() {
             whitespace_row(
                 piece,
                 pos,
@@ -155,40 +154,32 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
         let end = memchr::memchr(b'\n', &piece[pos..]).map_or(piece.len(), |i| pos + i);
         let body = &piece[pos..end];
         let next = (end + 1).min(piece.len());
-        let skip = if shape.geosoft {
-            // Blank lines, `/` comments and records, as the XYZ reader
-            // classifies them (it drops line-end `\r`s first).
-            let mut t = body.trim_ascii_start();
+        let skip = if let Some(dialect) = shape.whitespace {
+            // As the whitespace reader classifies the line (it drops
+            // line-end `\r`s first).
+            let mut t = body;
             while let [rest @ .., b'\r'] = t {
                 t = rest;
             }
-            if t.trim_ascii_end().is_empty() {
-                true
-            } else {
-                match crate::xyz::geosoft_kind(t) {
-                    Some(crate::xyz::Kind::Data) => false,
-                    Some(crate::xyz::Kind::Record { number, tie }) => {
-                        out.records.push((out.rows, number, tie));
-                        true
-                    }
-                    Some(_) => true,
-                    // A record without a number: the general reader's error.
-                    None => {
-                        out.stopped = true;
-                        break;
-                    }
+            match line_kind(dialect, t) {
+                Some(Kind::Data) => false,
+                Some(Kind::Record { number, tie }) => {
+                    out.records.push((out.rows, number, tie));
+                    true
+                }
+                Some(Kind::Blank | Kind::Comment) => true,
+                // A record without a number: the general reader's error.
+                None => {
+                    out.stopped = true;
+                    break;
                 }
             }
-        } else if shape.whitespace {
-            // Blank and `#` lines, as the whitespace reader classifies them.
-            let t = body.trim_ascii_start();
-            t.trim_ascii_end().is_empty() || t.starts_with(b"#")
         } else {
             body.first() == Some(&b'#')
                 || (body.trim_ascii().is_empty() && !body.contains(&shape.delimiter))
         };
         if !skip {
-            let clean = if shape.whitespace {
+            let clean = if shape.whitespace.is_some() {
                 whitespace_clean_row(
                     body,
                     shape.n_fields,
@@ -514,6 +505,12 @@ fn digit_run(text: &[u8], p: usize) -> Option<(u64, usize)> {
     Some((v, len))
 }
 
+/// The fast path's setting for the readers: all cores
+/// ([`threads`]), pieces of [`PIECE_BYTES`].
+pub(crate) fn on_all_cores() -> Option<(usize, usize)> {
+    Some((threads(), PIECE_BYTES))
+}
+
 /// Threads of the fast path: the available cores, at most 8 (as
 /// `aeromag_core::parallel::threads`; this crate does not depend on core).
 pub(crate) fn threads() -> usize {
@@ -720,8 +717,7 @@ mod tests {
         delimiter: b',',
         n_fields: 2,
         crlf: false,
-        whitespace: false,
-        geosoft: false,
+        whitespace: None,
     };
 
     fn parsed(piece: &[u8], shape: Shape) -> CleanRows {

@@ -57,7 +57,7 @@ use crate::builder::{
     too_many_columns,
 };
 use crate::cell::check_text;
-use crate::csv_clean::{self, PIECE_BYTES, Resume, Shape, push_clean_rows};
+use crate::csv_clean::{self, Resume, Shape, push_clean_rows};
 use crate::error::{IoError, Result};
 use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, first_content_line, read_prefix};
@@ -66,7 +66,7 @@ use crate::xyz;
 
 /// Reads a CSV (or whitespace-separated) flight-data file. See the module docs.
 pub fn read_csv(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_csv_with(path, opts, Some((csv_clean::threads(), PIECE_BYTES)))
+    read_csv_with(path, opts, csv_clean::on_all_cores())
 }
 
 /// [`read_csv`], with the clean rows read by [`csv_clean`] on `threads`
@@ -115,8 +115,7 @@ fn read_csv_with(
         delimiter,
         n_fields: src.n_fields,
         crlf: src.crlf,
-        whitespace: false,
-        geosoft: false,
+        whitespace: None,
     };
     // Clean rows on all cores first; the general reader from the first
     // line that is not clean (module docs of csv_clean).

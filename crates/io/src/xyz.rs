@@ -68,45 +68,18 @@ use crate::table::FlightTable;
 /// Reads a Geosoft XYZ file. See the module docs for the header rule and the
 /// `line`/`line_type` columns.
 pub fn read_xyz(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_xyz_with(
-        path,
-        opts,
-        Some((csv_clean::threads(), csv_clean::PIECE_BYTES)),
-    )
-}
-
-/// [`read_xyz`], with the clean rows read on `threads` threads in pieces
-/// of `piece_bytes` when `clean` is given, by the general reader alone
-/// otherwise (tests compare the two).
-fn read_xyz_with(
-    path: &Path,
-    opts: &ReadOptions,
-    clean: Option<(usize, usize)>,
-) -> Result<FlightTable> {
-    read_tokens(path, opts, Dialect::Geosoft, clean)
+    read_tokens(path, opts, Dialect::Geosoft, csv_clean::on_all_cores())
 }
 
 /// Reads a whitespace-separated table with a plain header line and `#`
 /// comments (data lines on all cores: module docs).
 pub(crate) fn read_whitespace(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
-    read_whitespace_with(
-        path,
-        opts,
-        Some((csv_clean::threads(), csv_clean::PIECE_BYTES)),
-    )
+    read_tokens(path, opts, Dialect::Whitespace, csv_clean::on_all_cores())
 }
 
-/// [`read_whitespace`], with the clean rows read on `threads` threads in
+/// A file of `dialect`, with the clean rows read on `threads` threads in
 /// pieces of `piece_bytes` when `clean` is given, by the general reader
 /// alone otherwise (tests compare the two).
-fn read_whitespace_with(
-    path: &Path,
-    opts: &ReadOptions,
-    clean: Option<(usize, usize)>,
-) -> Result<FlightTable> {
-    read_tokens(path, opts, Dialect::Whitespace, clean)
-}
-
 fn read_tokens(
     path: &Path,
     opts: &ReadOptions,
@@ -138,8 +111,7 @@ fn read_tokens(
                 delimiter: b' ',
                 n_fields: src.n_fields,
                 crlf: false,
-                whitespace: true,
-                geosoft: dialect == Dialect::Geosoft,
+                whitespace: Some(dialect),
             };
             let stop = push_clean_rows(
                 &mut builder,
@@ -177,7 +149,7 @@ fn read_tokens(
 
 /// Which text layout is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Dialect {
+pub(crate) enum Dialect {
     /// Geosoft XYZ: `/` comments, header in a comment, `Line`/`Tie` records.
     Geosoft,
     /// Plain whitespace table: `#` comments, first content line is the header.
@@ -438,25 +410,14 @@ impl TokenSource {
     }
 
     fn classify(&self) -> Result<Kind> {
-        let t = self.buf.trim_ascii_start();
-        if t.trim_ascii_end().is_empty() {
-            return Ok(Kind::Blank);
-        }
-        match self.dialect {
-            Dialect::Whitespace => Ok(if t.starts_with(b"#") {
-                Kind::Comment
-            } else {
-                Kind::Data
-            }),
-            Dialect::Geosoft => geosoft_kind(t).ok_or_else(|| IoError::XyzHeader {
-                file: self.file.clone(),
-                line: self.line,
-                message: format!(
-                    "line record '{}' has no line number (expected e.g. 'Line 1010' or 'Tie 2010')",
-                    String::from_utf8_lossy(t)
-                ),
-            }),
-        }
+        line_kind(self.dialect, &self.buf).ok_or_else(|| IoError::XyzHeader {
+            file: self.file.clone(),
+            line: self.line,
+            message: format!(
+                "line record '{}' has no line number (expected e.g. 'Line 1010' or 'Tie 2010')",
+                String::from_utf8_lossy(self.buf.trim_ascii_start())
+            ),
+        })
     }
 
     fn set_record(&mut self, number: f64, tie: bool) {
@@ -546,10 +507,25 @@ impl RowFields for TokenSource {
     }
 }
 
-/// What a line of a Geosoft XYZ file is (`t`: the line without its line
-/// end and leading blanks, not blank): a `/` comment, a `Line`/`Tie`
-/// record, or data; `None` for a record word without a number.
-pub(crate) fn geosoft_kind(t: &[u8]) -> Option<Kind> {
+/// What a line of a file of `dialect` is (`line`: without its line end
+/// and line-end `\r`s), for this reader and the fast path
+/// ([`csv_clean`]): blank, a comment (`#` in a plain table, `/` in an XYZ
+/// file), a `Line`/`Tie` record (XYZ) or data; `None` for a record word
+/// without a number.
+pub(crate) fn line_kind(dialect: Dialect, line: &[u8]) -> Option<Kind> {
+    let t = line.trim_ascii_start();
+    if t.trim_ascii_end().is_empty() {
+        return Some(Kind::Blank);
+    }
+    match dialect {
+        Dialect::Whitespace if t.starts_with(b"#") => Some(Kind::Comment),
+        Dialect::Whitespace => Some(Kind::Data),
+        Dialect::Geosoft => geosoft_kind(t),
+    }
+}
+
+/// [`line_kind`] of an XYZ line (`t`: not blank, without leading blanks).
+fn geosoft_kind(t: &[u8]) -> Option<Kind> {
     if t.starts_with(b"/") {
         return Some(Kind::Comment);
     }
@@ -704,13 +680,13 @@ mod tests {
                 let opts = ReadOptions::default();
                 csv_clean::check::reads_as_the_general_reader(
                     &table,
-                    |path, clean| read_whitespace_with(path, &opts, clean),
+                    |path, clean| read_tokens(path, &opts, Dialect::Whitespace, clean),
                     threads,
                     piece,
                 )?;
                 csv_clean::check::reads_as_the_general_reader(
                     &xyz,
-                    |path, clean| read_xyz_with(path, &opts, clean),
+                    |path, clean| read_tokens(path, &opts, Dialect::Geosoft, clean),
                     threads,
                     piece,
                 )?;
@@ -729,20 +705,26 @@ mod tests {
             }
             std::fs::write(&path, &text).unwrap();
             let opts = ReadOptions::default();
-            let fast = read_whitespace_with(&path, &opts, Some((2, 4096))).unwrap();
+            let fast = read_tokens(&path, &opts, Dialect::Whitespace, Some((2, 4096))).unwrap();
             assert_eq!(fast.n_rows(), 5000);
             assert_eq!(fast.column("mag").unwrap()[4999], 57999.5);
             assert_eq!(
                 format!("{fast:?}"),
-                format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
+                format!(
+                    "{:?}",
+                    read_tokens(&path, &opts, Dialect::Whitespace, None).unwrap()
+                )
             );
             let dummy = text.replacen("53100.5", "*", 1);
             std::fs::write(&path, &dummy).unwrap();
-            let fast = read_whitespace_with(&path, &opts, Some((2, 4096))).unwrap();
+            let fast = read_tokens(&path, &opts, Dialect::Whitespace, Some((2, 4096))).unwrap();
             assert!(fast.column("mag").unwrap()[100].is_nan());
             assert_eq!(
                 format!("{fast:?}"),
-                format!("{:?}", read_whitespace_with(&path, &opts, None).unwrap())
+                format!(
+                    "{:?}",
+                    read_tokens(&path, &opts, Dialect::Whitespace, None).unwrap()
+                )
             );
         }
 
@@ -765,7 +747,7 @@ mod tests {
             }
             std::fs::write(&path, &text).unwrap();
             let opts = ReadOptions::default();
-            let fast = read_xyz_with(&path, &opts, Some((2, 1000))).unwrap();
+            let fast = read_tokens(&path, &opts, Dialect::Geosoft, Some((2, 1000))).unwrap();
             let line = fast.column("line").unwrap();
             let kind = fast.column("line_type").unwrap();
             assert_eq!(
@@ -775,7 +757,10 @@ mod tests {
             assert_eq!((kind[1999], kind[2000]), (0.0, 1.0));
             assert_eq!(
                 format!("{fast:?}"),
-                format!("{:?}", read_xyz_with(&path, &opts, None).unwrap())
+                format!(
+                    "{:?}",
+                    read_tokens(&path, &opts, Dialect::Geosoft, None).unwrap()
+                )
             );
         }
     }
