@@ -177,23 +177,37 @@ impl<'a> TlInputs<'a> {
     /// extra channels finite, and the flux not exactly zero (a dropped-out
     /// fluxgate).
     pub fn usable(&self) -> Vec<bool> {
-        // Column by column with `&` (no early exit), so each pass vectorises.
+        // Column by column with `&` (no early exit), so each pass
+        // vectorises; parts of the rows on the cores (a pass over five
+        // flight-long columns is bound by memory, which two cores read
+        // faster than one). Each row's flag is its own, whatever the parts.
         let [x, y, z] = self.flux;
-        let mut ok: Vec<bool> = (0..self.time.len())
-            .map(|i| {
-                let finite = self.time[i].is_finite()
-                    & self.mag[i].is_finite()
+        let (time, mag, channels) = (self.time, self.mag, &self.channels);
+        let mut ok = vec![false; time.len()];
+        let threads = aeromag_core::parallel::threads();
+        aeromag_core::parallel::for_each_part_mut(&mut ok, threads, 1 << 16, |a, part| {
+            let r = a..a + part.len();
+            let (t, m, x, y, z) = (
+                &time[r.clone()],
+                &mag[r.clone()],
+                &x[r.clone()],
+                &y[r.clone()],
+                &z[r.clone()],
+            );
+            for (i, o) in part.iter_mut().enumerate() {
+                let finite = t[i].is_finite()
+                    & m[i].is_finite()
                     & x[i].is_finite()
                     & y[i].is_finite()
                     & z[i].is_finite();
-                finite & ((x[i] != 0.0) | (y[i] != 0.0) | (z[i] != 0.0))
-            })
-            .collect();
-        for c in &self.channels {
-            for (o, v) in ok.iter_mut().zip(c.iter()) {
-                *o &= v.is_finite();
+                *o = finite & ((x[i] != 0.0) | (y[i] != 0.0) | (z[i] != 0.0));
             }
-        }
+            for c in channels {
+                for (o, v) in part.iter_mut().zip(c.get(a..).unwrap_or(&[])) {
+                    *o &= v.is_finite();
+                }
+            }
+        });
         ok
     }
 
@@ -255,5 +269,52 @@ mod tests {
         bare.add_column("time", vec![0.0]).unwrap();
         let e = TlInputs::of(&Flight::from_table(bare).unwrap()).unwrap_err();
         assert!(e.is_bad_input() && e.to_string().contains("flux_x"), "{e}");
+    }
+
+    /// A long flight's flags, worked out on the cores by parts, are each
+    /// row's own: a missing value in any input or channel, or a dead
+    /// fluxgate, on either side of every part boundary.
+    #[test]
+    fn usable_rows_of_a_long_flight_are_each_rows_own() {
+        let n = 5 * (1 << 16) + 123;
+        let bad = |k: usize, col: usize| (k * 7 + col * 13) % 101 == 0 || (k % (1 << 16)) == col;
+        let series = |col: usize, v: f64| -> Vec<f64> {
+            (0..n)
+                .map(|k| if bad(k, col) { f64::NAN } else { v + k as f64 })
+                .collect()
+        };
+        let time = series(0, 0.0);
+        let mag = series(1, 50_000.0);
+        let mut x = series(2, 20_000.0);
+        let (y, z) = (series(3, 1_000.0), series(4, 45_000.0));
+        let channel = series(5, 3.0);
+        // Dead fluxgates (all three components zero) and one live one with
+        // x alone zero.
+        let (mut y, mut z) = (y, z);
+        for k in [0, 65_535, 65_536, 65_537, 200_000, n - 1] {
+            x[k] = 0.0;
+            y[k] = 0.0;
+            z[k] = 0.0;
+        }
+        x[131_122] = 0.0;
+        let inputs = TlInputs {
+            time: &time,
+            flux: [&x, &y, &z],
+            mag: &mag,
+            line: None,
+            channels: vec![&channel],
+        };
+        let expected: Vec<bool> = (0..n)
+            .map(|k| {
+                [time[k], mag[k], x[k], y[k], z[k], channel[k]]
+                    .iter()
+                    .all(|v| v.is_finite())
+                    && (x[k], y[k], z[k]) != (0.0, 0.0, 0.0)
+            })
+            .collect();
+        let usable = inputs.usable();
+        assert_eq!(usable, expected);
+        assert!(usable[131_122] && !usable[65_536]);
+        assert!(expected.iter().filter(|u| !**u).count() > 1000);
     }
 }
