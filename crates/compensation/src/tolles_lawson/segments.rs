@@ -134,7 +134,8 @@ const BRACKET_BLOCK: usize = 4096;
 /// from text differs in its last bits from row to row) fall on the
 /// bracket's ends or outside it at random, and a branch per step,
 /// mispredicted half the time, cost twice the rest: 50 → 25 ms on the 10⁷
-/// samples of the peer benchmark.
+/// samples of the peer benchmark. The blocks are counted in contiguous
+/// runs on the cores (31 → 24 ms, best of 15 on 10⁷ decimal time stamps).
 fn bracket_counts(time: &[f64], lo: f64, hi: f64) -> (usize, usize, usize, usize, Vec<f64>) {
     // One block's counts: valid, below, at `lo`, at `hi`, inside.
     let count = |a: &[f64], b: &[f64]| -> [usize; 5] {
@@ -151,23 +152,40 @@ fn bracket_counts(time: &[f64], lo: f64, hi: f64) -> (usize, usize, usize, usize
         }
         n
     };
+    // The blocks in contiguous runs on the cores, each run's counts and
+    // kept steps in block order; counts add up and the kept steps are
+    // joined in run order (the same steps as one pass).
+    let blocks = time.len().saturating_sub(1).div_ceil(BRACKET_BLOCK);
+    let threads = aeromag_core::parallel::threads().clamp(1, blocks.max(1));
+    let runs = aeromag_core::parallel::parallel_map(threads, threads, |r| {
+        let mut sums = [0usize; 4];
+        let mut inside: Vec<f64> = Vec::new();
+        for blk in blocks * r / threads..blocks * (r + 1) / threads {
+            let start = 1 + blk * BRACKET_BLOCK;
+            let end = (start + BRACKET_BLOCK).min(time.len());
+            let (a, b) = (&time[start - 1..end - 1], &time[start..end]);
+            let n = count(a, b);
+            for (s, c) in sums.iter_mut().zip(n) {
+                *s += c;
+            }
+            if n[4] > 0 {
+                inside.extend(
+                    a.iter()
+                        .zip(b)
+                        .map(|(x, y)| y - x)
+                        .filter(|&d| (d > lo) & (d < hi)),
+                );
+            }
+        }
+        (sums, inside)
+    });
     let mut sums = [0usize; 4];
     let mut inside: Vec<f64> = Vec::new();
-    for start in (1..time.len()).step_by(BRACKET_BLOCK) {
-        let end = (start + BRACKET_BLOCK).min(time.len());
-        let (a, b) = (&time[start - 1..end - 1], &time[start..end]);
-        let n = count(a, b);
-        for (s, c) in sums.iter_mut().zip(n) {
-            *s += c;
+    for (s, kept) in runs {
+        for (t, c) in sums.iter_mut().zip(s) {
+            *t += c;
         }
-        if n[4] > 0 {
-            inside.extend(
-                a.iter()
-                    .zip(b)
-                    .map(|(x, y)| y - x)
-                    .filter(|&d| (d > lo) & (d < hi)),
-            );
-        }
+        inside.extend(kept);
     }
     let [total, below, at_lo, at_hi] = sums;
     (total, below, at_lo, at_hi, inside)
