@@ -18,7 +18,13 @@ pub fn split_segments(
     max_gap_factor: f64,
     min_len: usize,
 ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
-    let dt = median_step(time);
+    // An infinite factor makes every step a continuation whatever the
+    // median (which is then not worked out).
+    let dt = if max_gap_factor == f64::INFINITY {
+        0.0
+    } else {
+        median_step(time)
+    };
     let max_gap = if dt > 0.0 {
         dt * max_gap_factor
     } else {
@@ -38,10 +44,6 @@ pub fn split_at_steps(
     min_len: usize,
 ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
     let n = time.len();
-    let same_line = |a: usize, b: usize| match line {
-        Some(l) => l[a] == l[b] || (l[a].is_nan() && l[b].is_nan()),
-        None => true,
-    };
     let mut kept = Vec::new();
     let mut short = Vec::new();
     let mut i = 0;
@@ -51,10 +53,7 @@ pub fn split_at_steps(
             continue;
         }
         let start = i;
-        i += 1;
-        while i < n && usable[i] && same_line(i - 1, i) && (time[i] - time[i - 1]) <= max_gap {
-            i += 1;
-        }
+        i = first_break(time, line, usable, max_gap, i + 1);
         if i - start >= min_len {
             kept.push(start..i)
         } else {
@@ -62,6 +61,53 @@ pub fn split_at_steps(
         }
     }
     (kept, short)
+}
+
+/// Rows a block of [`first_break`] tests at once.
+const BREAK_BLOCK: usize = 1024;
+
+/// The first row `i ≥ from` that does not continue the segment of row
+/// `i − 1` ([`split_at_steps`]: unusable, on another line, or after a step
+/// that is not `≤ max_gap`), `time.len()` if none. A block of rows is
+/// tested in one pass without a branch per row (a run of good rows, the
+/// usual case, is skipped whole), and only a block with a break is
+/// searched row by row.
+fn first_break(
+    time: &[f64],
+    line: Option<&[f64]>,
+    usable: &[bool],
+    max_gap: f64,
+    from: usize,
+) -> usize {
+    let n = time.len();
+    let goes_on = |i: usize| {
+        let same_line = match line {
+            Some(l) => (l[i - 1] == l[i]) | (l[i - 1].is_nan() & l[i].is_nan()),
+            None => true,
+        };
+        usable[i] & same_line & ((time[i] - time[i - 1]) <= max_gap)
+    };
+    debug_assert!(from >= 1, "row 0 starts a segment");
+    let mut a = from;
+    while a < n {
+        let b = (a + BREAK_BLOCK).min(n);
+        let all_go_on = match line {
+            // The two cases apart, so that each block's test vectorises.
+            Some(l) => (a..b).fold(true, |ok, i| {
+                ok & usable[i]
+                    & ((l[i - 1] == l[i]) | (l[i - 1].is_nan() & l[i].is_nan()))
+                    & ((time[i] - time[i - 1]) <= max_gap)
+            }),
+            None => (a..b).fold(true, |ok, i| {
+                ok & usable[i] & ((time[i] - time[i - 1]) <= max_gap)
+            }),
+        };
+        if !all_go_on {
+            return (a..b).find(|&i| !goes_on(i)).unwrap_or(b);
+        }
+        a = b;
+    }
+    n
 }
 
 /// Median of the positive finite time steps, s (0 if there are none): the
@@ -261,5 +307,67 @@ mod tests {
         let (kept, short) = split_segments(&t, Some(&line), &usable, 1.5, 20);
         assert_eq!(kept, vec![0..30, 60..100]);
         assert_eq!(short, vec![30..45, 46..60]);
+    }
+
+    /// The block-wise search for breaks cuts a long record where the
+    /// row-by-row rule does: unusable rows, line changes (NaN labels the
+    /// same line), gaps and missing times on either side of every block
+    /// boundary, with and without lines.
+    #[test]
+    fn breaks_are_the_row_by_row_ones_across_blocks() {
+        let plain = |time: &[f64], line: Option<&[f64]>, usable: &[bool], max_gap: f64| {
+            let same = |a: usize, b: usize| match line {
+                Some(l) => l[a] == l[b] || (l[a].is_nan() && l[b].is_nan()),
+                None => true,
+            };
+            let (mut kept, mut i) = (Vec::new(), 0);
+            while i < time.len() {
+                if !usable[i] {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                i += 1;
+                while i < time.len()
+                    && usable[i]
+                    && same(i - 1, i)
+                    && time[i] - time[i - 1] <= max_gap
+                {
+                    i += 1;
+                }
+                kept.push(start..i);
+            }
+            kept
+        };
+        let n = 4 * BREAK_BLOCK + 17;
+        let mut time: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
+        let mut line: Vec<f64> = vec![1.0; n];
+        let mut usable = vec![true; n];
+        for (k, at) in [
+            1,
+            BREAK_BLOCK - 1,
+            BREAK_BLOCK,
+            BREAK_BLOCK + 1,
+            2 * BREAK_BLOCK,
+            3 * BREAK_BLOCK + 1,
+            n - 1,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            match k % 4 {
+                0 => usable[at] = false,
+                1 => line[at..].iter_mut().for_each(|l| *l += 1.0),
+                2 => time[at..].iter_mut().for_each(|t| *t += 3.0),
+                _ => time[at] = f64::NAN,
+            }
+        }
+        line[2 * BREAK_BLOCK + 5..2 * BREAK_BLOCK + 9].fill(f64::NAN);
+        for l in [None, Some(&line[..])] {
+            let (kept, short) = split_at_steps(&time, l, &usable, 0.15, 1);
+            assert!(short.is_empty());
+            assert_eq!(kept, plain(&time, l, &usable, 0.15));
+            assert!(kept.len() >= 7, "{kept:?}");
+        }
     }
 }
