@@ -285,12 +285,10 @@ mod tests {
         };
         let time = series(0, 0.0);
         let mag = series(1, 50_000.0);
-        let mut x = series(2, 20_000.0);
-        let (y, z) = (series(3, 1_000.0), series(4, 45_000.0));
+        let (mut x, mut y, mut z) = (series(2, 20_000.0), series(3, 1_000.0), series(4, 45_000.0));
         let channel = series(5, 3.0);
         // Dead fluxgates (all three components zero) and one live one with
         // x alone zero.
-        let (mut y, mut z) = (y, z);
         for k in [0, 65_535, 65_536, 65_537, 200_000, n - 1] {
             x[k] = 0.0;
             y[k] = 0.0;

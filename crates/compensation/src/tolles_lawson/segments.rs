@@ -80,27 +80,18 @@ fn first_break(
     from: usize,
 ) -> usize {
     let n = time.len();
-    let goes_on = |i: usize| {
-        let same_line = match line {
-            Some(l) => (l[i - 1] == l[i]) | (l[i - 1].is_nan() & l[i].is_nan()),
-            None => true,
-        };
-        usable[i] & same_line & ((time[i] - time[i - 1]) <= max_gap)
-    };
+    // Row `i` continues row `i − 1`: its step and usability, and its line.
+    let step_ok = |i: usize| usable[i] & ((time[i] - time[i - 1]) <= max_gap);
+    let same_line = |l: &[f64], i: usize| (l[i - 1] == l[i]) | (l[i - 1].is_nan() & l[i].is_nan());
+    let goes_on = |i: usize| step_ok(i) & line.is_none_or(|l| same_line(l, i));
     debug_assert!(from >= 1, "row 0 starts a segment");
     let mut a = from;
     while a < n {
         let b = (a + BREAK_BLOCK).min(n);
         let all_go_on = match line {
             // The two cases apart, so that each block's test vectorises.
-            Some(l) => (a..b).fold(true, |ok, i| {
-                ok & usable[i]
-                    & ((l[i - 1] == l[i]) | (l[i - 1].is_nan() & l[i].is_nan()))
-                    & ((time[i] - time[i - 1]) <= max_gap)
-            }),
-            None => (a..b).fold(true, |ok, i| {
-                ok & usable[i] & ((time[i] - time[i - 1]) <= max_gap)
-            }),
+            Some(l) => (a..b).fold(true, |ok, i| ok & step_ok(i) & same_line(l, i)),
+            None => (a..b).fold(true, |ok, i| ok & step_ok(i)),
         };
         if !all_go_on {
             return (a..b).find(|&i| !goes_on(i)).unwrap_or(b);
