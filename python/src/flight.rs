@@ -43,24 +43,6 @@ struct NumpyBuffer {
 unsafe impl Send for NumpyBuffer {}
 unsafe impl Sync for NumpyBuffer {}
 
-/// The NaN values of `v`, a long column counted in contiguous parts on the
-/// cores (a pass over a flight-long column is bound by memory, which two
-/// cores read faster than one).
-fn nan_count(v: &[f64]) -> usize {
-    const PART: usize = 1 << 20;
-    let parts = aeromag::core::parallel::threads()
-        .min(v.len() / PART)
-        .max(1);
-    aeromag::core::parallel::parallel_map(parts, parts, |p| {
-        v[v.len() * p / parts..v.len() * (p + 1) / parts]
-            .iter()
-            .filter(|x| x.is_nan())
-            .count()
-    })
-    .into_iter()
-    .sum()
-}
-
 impl SharedBuffer for NumpyBuffer {
     fn values(&self) -> &[f64] {
         // SAFETY: `ptr` and `len` describe the contiguous data of the array
@@ -217,7 +199,7 @@ impl PyFlight {
                             bad_argument(format!("column '{name}' must be one-dimensional"))
                         })?;
                     let values = NumpyBuffer::share(a)?;
-                    let nan = nan_count(&values);
+                    let nan = aeromag::io::nan_count(&values);
                     ColumnData::Numeric {
                         values,
                         missing: Missing {

@@ -172,7 +172,7 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         check_units_attribute(file, &path, &name, &ds)?;
         let (values, integer) = read_f64(&ds).map_err(|e| h5err(Some(&path), e))?;
         let missing = Missing {
-            nan: values.iter().filter(|v| v.is_nan()).count(),
+            nan: crate::parts::nan_count(&values),
             ..Missing::default()
         };
         columns.push((

@@ -257,7 +257,7 @@ impl FlightTable {
     pub fn add_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
         let values = Values::Owned(values);
         let missing = Missing {
-            nan: values.iter().filter(|v| v.is_nan()).count(),
+            nan: crate::parts::nan_count(&values),
             ..Missing::default()
         };
         self.push_column(Column {
@@ -284,7 +284,7 @@ impl FlightTable {
             Some(i) => {
                 self.check_len(name, values.len())?;
                 let missing = Missing {
-                    nan: values.iter().filter(|v| v.is_nan()).count(),
+                    nan: crate::parts::nan_count(&values),
                     ..Missing::default()
                 };
                 self.columns[i].data = ColumnData::Numeric { values, missing };
@@ -412,7 +412,7 @@ impl FlightTable {
             match &mut c.data {
                 ColumnData::Numeric { values, missing } => {
                     filter(values.to_mut(), keep);
-                    let n = values.iter().filter(|v| v.is_nan()).count();
+                    let n = crate::parts::nan_count(values);
                     *missing = match (missing.blank, missing.nan, missing.dummy) {
                         (_, 0, 0) => Missing {
                             blank: n,

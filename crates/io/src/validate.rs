@@ -447,26 +447,13 @@ fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {
 }
 
 /// The largest finite `|value|` of `v` (`None` when there is none); a
-/// long column in contiguous parts on the cores (one pass over a
-/// flight-long column is bound by memory, which two cores read faster than
-/// one), the parts' maxima then compared: the same value either way.
+/// long column in parts on the cores ([`crate::parts`]), the parts'
+/// maxima then compared: the same value either way.
 fn max_abs(v: &[f64]) -> Option<f64> {
-    const PART: usize = 1 << 20;
-    let threads = crate::csv_clean::threads().min(v.len() / PART).max(1);
-    if threads == 1 {
-        return max_abs_serial(v);
-    }
-    let per = v.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        let parts: Vec<_> = v
-            .chunks(per)
-            .map(|part| scope.spawn(move || max_abs_serial(part)))
-            .collect();
-        parts
-            .into_iter()
-            .filter_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .reduce(f64::max)
-    })
+    crate::parts::on_parts(v, max_abs_serial)
+        .into_iter()
+        .flatten()
+        .reduce(f64::max)
 }
 
 /// [`max_abs`] in one pass on the calling thread.

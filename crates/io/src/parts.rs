@@ -1,0 +1,66 @@
+//! Passes over a long column in contiguous parts on the cores.
+//!
+//! A pass that reads a flight-long column once (a NaN count, a maximum) is
+//! bound by memory, which two cores read faster than one: a column of
+//! 10⁷ values is split into one part per core and each part's result is
+//! combined by the caller (a sum, a maximum: the same value as one pass).
+//! Short columns are passed over on the calling thread.
+
+/// Columns shorter than two of these are passed over in one part.
+const PART: usize = 1 << 20;
+
+/// `f` of contiguous parts of `v` in order, one part per core (up to
+/// [`crate::csv_clean::threads`]), each at least [`PART`] long; one part,
+/// on the calling thread, for a short column.
+pub(crate) fn on_parts<T: Send>(v: &[f64], f: impl Fn(&[f64]) -> T + Sync) -> Vec<T> {
+    let parts = crate::csv_clean::threads().min(v.len() / PART).max(1);
+    if parts == 1 {
+        return vec![f(v)];
+    }
+    let per = v.len().div_ceil(parts);
+    std::thread::scope(|scope| {
+        let f = &f;
+        let jobs: Vec<_> = v
+            .chunks(per)
+            .map(|part| scope.spawn(move || f(part)))
+            .collect();
+        jobs.into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    })
+}
+
+/// The NaN values of `v`.
+pub fn nan_count(v: &[f64]) -> usize {
+    on_parts(v, |p| p.iter().filter(|x| x.is_nan()).count())
+        .into_iter()
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A long column's parts cover it once, in order, whatever its length
+    /// against the parts (the NaN count is the one pass's).
+    #[test]
+    fn parts_cover_a_long_column_once_in_order() {
+        for n in [0, 5, 2 * PART - 1, 2 * PART, 3 * PART + 7] {
+            let v: Vec<f64> = (0..n)
+                .map(|k| {
+                    if k % 1000 == 999 || k + 1 == n {
+                        f64::NAN
+                    } else {
+                        k as f64
+                    }
+                })
+                .collect();
+            let parts = on_parts(&v, |p| p.to_vec());
+            let expected = crate::csv_clean::threads().min(n / PART).max(1);
+            assert_eq!(parts.len(), expected, "{n} values");
+            let bits = |x: &f64| x.to_bits();
+            assert!(parts.concat().iter().map(bits).eq(v.iter().map(bits)));
+            assert_eq!(nan_count(&v), v.iter().filter(|x| x.is_nan()).count());
+        }
+    }
+}
