@@ -678,18 +678,14 @@ mod tests {
                 piece in 8usize..300,
             ) {
                 let opts = ReadOptions::default();
-                csv_clean::check::reads_as_the_general_reader(
-                    &table,
-                    |path, clean| read_tokens(path, &opts, Dialect::Whitespace, clean),
-                    threads,
-                    piece,
-                )?;
-                csv_clean::check::reads_as_the_general_reader(
-                    &xyz,
-                    |path, clean| read_tokens(path, &opts, Dialect::Geosoft, clean),
-                    threads,
-                    piece,
-                )?;
+                for (text, dialect) in [(&table, Dialect::Whitespace), (&xyz, Dialect::Geosoft)] {
+                    csv_clean::check::reads_as_the_general_reader(
+                        text,
+                        |path, clean| read_tokens(path, &opts, dialect, clean),
+                        threads,
+                        piece,
+                    )?;
+                }
             }
         }
 
