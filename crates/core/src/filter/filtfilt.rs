@@ -30,7 +30,7 @@
 //! [`sosfiltfilt`] holds one copy of the signal besides the input and
 //! [`sosfiltfilt_in_place`] writes back into the input.
 
-use super::sos::Sos;
+use super::sos::{Gather, Scatter, Sos};
 use super::transfer::{LinearFilter, TransferFunction};
 use super::validate::{check_finite, check_len};
 use crate::error::Result;
@@ -60,6 +60,11 @@ pub const FILTER_LANES: usize = 4;
 /// a time in interleaved lanes (several times faster than one at a time:
 /// a single biquad chain is bound by the latency of its recurrence, not by
 /// arithmetic). Scratch memory: `FILTER_LANES × (n + 2·padlen)` samples.
+/// The forward pass reads the signals straight into the lanes and the
+/// backward pass writes its results straight back out of them (copying
+/// them in and out in passes of their own took a quarter of the time:
+/// `cargo bench --bench filters`, `bandpass_20_columns_1e5/in_lanes`
+/// 8.9 → 6.6 ms).
 ///
 /// Errors, before anything is written: `TooShort` for a signal shorter than
 /// `sos.padlen() + 1`, `NonFinite` for a non-finite sample (the first
@@ -92,46 +97,55 @@ pub fn sosfiltfilt_columns_with(
     ext.resize(n + 2 * pad, [0.0; FILTER_LANES]);
     let mut state = vec![[0.0; FILTER_LANES]; zi.len()];
     for group in columns.chunks_mut(FILTER_LANES) {
-        // The odd extension of every signal (see the module docs).
-        // Lanes beyond the group's signals repeat its first signal (their
-        // results are not used).
-        let src: [&[f64]; FILTER_LANES] =
-            std::array::from_fn(|l| &group.get(l).unwrap_or(&group[0])[..n]);
-        for (k, e) in ext[pad..pad + n].iter_mut().enumerate() {
-            *e = std::array::from_fn(|l| src[l][k]);
+        // The odd extension of every signal (see the module docs) in the
+        // buffer's ends; the signals themselves go into lanes as the
+        // forward pass reads them and come back out of lanes as the
+        // backward pass writes them. Lanes beyond the group's signals
+        // repeat its first signal (their results are not kept).
+        let (head, rest) = ext.split_at_mut(pad);
+        let (mid, tail) = rest.split_at_mut(n);
+        {
+            let src: [&[f64]; FILTER_LANES] =
+                std::array::from_fn(|l| &group.get(l).unwrap_or(&group[0])[..n]);
+            for (i, e) in head.iter_mut().enumerate() {
+                *e = std::array::from_fn(|l| odd_extended(src[l], pad, i));
+            }
+            for (i, e) in (pad + n..).zip(tail.iter_mut()) {
+                *e = std::array::from_fn(|l| odd_extended(src[l], pad, i));
+            }
+            let start = head
+                .first()
+                .copied()
+                .unwrap_or_else(|| std::array::from_fn(|l| src[l][0]));
+            for (s, z) in state.iter_mut().zip(&zi) {
+                *s = start.map(|v| z * v);
+            }
+            sos.run_lanes(&mut *head, &mut state, false);
+            sos.run_lanes(
+                Gather {
+                    src,
+                    dst: &mut *mid,
+                },
+                &mut state,
+                false,
+            );
+            sos.run_lanes(&mut *tail, &mut state, false);
         }
-        for i in (0..pad).chain(pad + n..n + 2 * pad) {
-            ext[i] = std::array::from_fn(|l| odd_extended(src[l], pad, i));
-        }
-        let start = ext[0];
-        for (s, z) in state.iter_mut().zip(&zi) {
-            *s = start.map(|v| z * v);
-        }
-        sos.run_lanes(ext, &mut state, false);
-        let end = ext[ext.len() - 1];
+        let end = *tail.last().or(mid.last()).expect("n ≥ 1 samples");
         for (s, z) in state.iter_mut().zip(&zi) {
             *s = end.map(|v| z * v);
         }
-        sos.run_lanes(ext, &mut state, true);
-        let filtered = &ext[pad..pad + n];
-        if let [a, b, c, d] = group {
-            // A full group in one pass over the lanes.
-            for ((((e, a), b), c), d) in filtered
-                .iter()
-                .zip(a.iter_mut())
-                .zip(b.iter_mut())
-                .zip(c.iter_mut())
-                .zip(d.iter_mut())
-            {
-                [*a, *b, *c, *d] = *e;
-            }
-        } else {
-            for (l, x) in group.iter_mut().enumerate() {
-                for (v, e) in x.iter_mut().zip(filtered) {
-                    *v = e[l];
-                }
-            }
-        }
+        sos.run_lanes(&mut *tail, &mut state, true);
+        sos.run_lanes(
+            Scatter {
+                src: mid,
+                dst: group,
+            },
+            &mut state,
+            true,
+        );
+        // The backward pass over the leading pad is not run: its results
+        // are cut off and nothing comes after it.
     }
     Ok(())
 }
@@ -345,7 +359,8 @@ mod invariants {
 
         /// Filtering columns together in lanes gives, for every column,
         /// exactly the bits of filtering it alone (whatever the number of
-        /// columns: full groups, a partial last group, one column), with
+        /// columns: full groups, a partial last group, one column; and
+        /// whatever their length, down to the shortest a filter takes), with
         /// the Butterworth sections as designed (`b0 = b2 = 1` after the
         /// first, the lanes' shortcut) and with a factor moved from the
         /// first section's numerator to the last's (the general kernel).
@@ -354,6 +369,7 @@ mod invariants {
             designed in filter_spec(),
             moved in prop_oneof![Just(1.0), 0.5f64..2.0],
             xs in proptest::collection::vec(signal(300), 1..10),
+            cut in 0usize..300,
         ) {
             let mut sections = designed.sections().to_vec();
             let last = sections.len() - 1;
@@ -362,6 +378,9 @@ mod invariants {
                 (0..3).for_each(|i| sections[last][i] /= moved);
             }
             let sos = Sos::new(sections).unwrap();
+            // Lengths down to the shortest a filter takes (`padlen + 1`).
+            let n = cut.max(sos.padlen() + 1);
+            let xs: Vec<Vec<f64>> = xs.iter().map(|x| x[..n].to_vec()).collect();
             let mut together = xs.clone();
             let mut refs: Vec<&mut [f64]> = together.iter_mut().map(|c| c.as_mut_slice()).collect();
             sosfiltfilt_columns_in_place(&sos, &mut refs).unwrap();
