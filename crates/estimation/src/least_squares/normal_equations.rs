@@ -30,7 +30,6 @@
 //! [`NormalEquations::solve_with_dof`].
 
 use crate::error::{EstError, Result};
-use aeromag_core::simd::all_finite;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 /// Accumulated normal equations of a linear least-squares problem.
@@ -354,16 +353,17 @@ impl BlockProducts {
     /// The products of the block `columns` (column-major: `columns[j][k]`
     /// is row `k`, column `j`) with observations `y`. Errors: columns of
     /// unequal length, non-finite values.
+    ///
+    /// Non-finite values are found from the products themselves rather
+    /// than in a pass of their own: a column's sum of squares over a run of
+    /// rows is finite exactly when each of its values there is finite and
+    /// none is so large (`|x| ≳ 10¹⁵⁴`) that its square overflows, which is
+    /// an error too.
     pub fn of(columns: &[&[f64]], y: &[f64]) -> Result<BlockProducts> {
         let n = columns.len();
         let m = y.len();
         if columns.iter().any(|c| c.len() != m) {
             return Err(EstError::Dimension("columns of unequal length".into()));
-        }
-        if !all_finite(y) || !columns.iter().all(|c| all_finite(c)) {
-            return Err(EstError::NonFinite {
-                what: "least-squares block",
-            });
         }
         // Rows in runs that stay in cache while all the products are
         // formed (instead of streaming every pair of columns from memory).
@@ -406,6 +406,11 @@ impl BlockProducts {
             }
             for &(i, j) in quads.remainder() {
                 out[plan.pos(i, j)] = dot(block[i], block[j]);
+            }
+            if (0..=n).any(|i| !out[plan.pos(i, i)].is_finite()) {
+                return Err(EstError::NonFinite {
+                    what: "least-squares block",
+                });
             }
         }
         Ok(BlockProducts { n, rows: m, sums })
@@ -699,5 +704,34 @@ mod tests {
             Err(EstError::Underdetermined { .. })
         ));
         assert!(ne.solve(-1.0).is_err());
+    }
+
+    /// A block with a NaN, an infinity or a value whose square overflows,
+    /// in any column or `y`, at the start, the end, on either side of a
+    /// run's boundary, or in the rows after the last whole group of four,
+    /// is an error; every finite block that does not overflow is not.
+    #[test]
+    fn block_products_find_every_non_finite_value() {
+        let m = 2 * ROW_BLOCK + 7;
+        let cols: Vec<Vec<f64>> = (0..6)
+            .map(|j| (0..m).map(|k| ((k * (j + 2)) as f64 * 0.37).sin() * 1e3).collect())
+            .collect();
+        let of = |cols: &[Vec<f64>]| {
+            let refs: Vec<&[f64]> = cols[..5].iter().map(|c| c.as_slice()).collect();
+            BlockProducts::of(&refs, &cols[5])
+        };
+        assert!(of(&cols).is_ok());
+        for j in 0..6 {
+            for k in [0, ROW_BLOCK - 1, ROW_BLOCK, 2 * ROW_BLOCK + 2, m - 1] {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e200] {
+                    let mut c = cols.clone();
+                    c[j][k] = bad;
+                    assert!(
+                        matches!(of(&c), Err(EstError::NonFinite { .. })),
+                        "column {j}, row {k}, {bad}"
+                    );
+                }
+            }
+        }
     }
 }
