@@ -1,11 +1,24 @@
-//! Kernels compiled twice: for any x86-64 and with AVX, chosen at run time.
+//! Kernels compiled three times: for any x86-64, with AVX, and with AVX and
+//! fused multiply-add (FMA), chosen at run time.
 //!
 //! The release build targets every x86-64 processor (SSE2 only), so a loop
 //! over `[f64; 4]` lanes runs two lanes per instruction. [`run`] calls a
 //! [`Kernel`] through a copy compiled with AVX (four lanes per instruction)
 //! when the processor has it. Both copies do the same multiplications and
-//! additions in the same order (Rust never fuses them into FMA), so the
-//! results are bit-identical on every machine; only the speed differs.
+//! additions in the same order (Rust never fuses them into FMA by itself),
+//! so their results are bit-identical; only the speed differs.
+//!
+//! A kernel may also say how to run with FMA ([`Kernel::run_fused`]: a
+//! product and a sum in one instruction, rounded once). [`run`] calls it
+//! only where the processor has FMA (x86-64 from 2013 on) and the
+//! environment variable `AEROMAG_FMA` is set (to anything; read once per
+//! process). It is off by default because its results differ from those
+//! without FMA by rounding, so the same flight would give other last
+//! digits on another processor (the quick demo's `eddy_nt` 0.09046 against
+//! 0.09047), and because it gains little: the Tolles-Lawson fit is bound
+//! by memory, not arithmetic (10⁷ samples: 2 % faster; the band-pass of
+//! 20 columns alone 8 %, `cargo bench --bench filters`). With or without,
+//! one machine gives the same bits whatever the thread count.
 //!
 //! Where the compiler's own vectorisation of such a loop goes wrong (it may
 //! pack the loop across independent sums instead of along the lanes, and
@@ -33,32 +46,130 @@
 //! assert_eq!(run(SumOfSquares(&[1.0, 2.0, 3.0, 4.0])), 30.0);
 //! ```
 
-/// A computation to compile with and without AVX. Mark `run` (and the
-/// functions it calls in its hot loop) `#[inline(always)]`: code that is
-/// not inlined into the AVX copy is compiled for plain x86-64.
-pub trait Kernel {
+/// A computation to compile with and without AVX (and FMA). Mark `run`
+/// (and the functions it calls in its hot loop) `#[inline(always)]`: code
+/// that is not inlined into the AVX copy is compiled for plain x86-64.
+pub trait Kernel: Sized {
     /// What the kernel returns.
     type Output;
     /// Do the work.
     fn run(self) -> Self::Output;
+    /// Do the work where the processor has FMA, with fused multiply-adds
+    /// (`f64::mul_add`, one instruction there) where the kernel wants them.
+    /// The default is [`Kernel::run`]: the same bits as without FMA.
+    #[inline(always)]
+    fn run_fused(self) -> Self::Output {
+        self.run()
+    }
 }
 
-/// Run `kernel` with AVX when the processor has it, otherwise as compiled.
+/// A copy of the kernels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Level {
+    /// Plain x86-64 (or another architecture).
+    Plain,
+    /// AVX, without fused multiply-adds.
+    Avx,
+    /// AVX with fused multiply-adds ([`Kernel::run_fused`]).
+    AvxFma,
+}
+
+impl Level {
+    /// Whether this processor can run the copy.
+    pub fn available(self) -> bool {
+        match self {
+            Level::Plain => true,
+            #[cfg(target_arch = "x86_64")]
+            Level::Avx => std::arch::is_x86_feature_detected!("avx"),
+            #[cfg(target_arch = "x86_64")]
+            Level::AvxFma => {
+                std::arch::is_x86_feature_detected!("avx")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+}
+
+/// The copy of the kernels [`run`] calls: AVX where the processor has it,
+/// with FMA only where it has that too and `AEROMAG_FMA` is set (read once
+/// per process; module docs).
+pub fn level() -> Level {
+    static LEVEL: std::sync::OnceLock<Level> = std::sync::OnceLock::new();
+    *LEVEL.get_or_init(|| {
+        if std::env::var_os("AEROMAG_FMA").is_some() && Level::AvxFma.available() {
+            Level::AvxFma
+        } else if Level::Avx.available() {
+            Level::Avx
+        } else {
+            Level::Plain
+        }
+    })
+}
+
+thread_local! {
+    /// [`with_level`]'s choice for this thread.
+    static CHOSEN: std::cell::Cell<Option<Level>> = const { std::cell::Cell::new(None) };
+}
+
+/// `f()` with the kernels that run on this thread at `level` instead of
+/// [`level`] (kernels that `f` runs on other threads are not affected):
+/// for tests and comparisons of the copies. `None` if the processor
+/// cannot run `level`.
+pub fn with_level<R>(level: Level, f: impl FnOnce() -> R) -> Option<R> {
+    if !level.available() {
+        return None;
+    }
+    /// Puts back the thread's previous choice, also if `f` panics.
+    struct Restore(Option<Level>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            CHOSEN.with(|c| c.set(self.0));
+        }
+    }
+    let _restore = Restore(CHOSEN.with(|c| c.replace(Some(level))));
+    Some(f())
+}
+
+/// Every copy of the kernels, plainest first.
+pub const LEVELS: [Level; 3] = [Level::Plain, Level::Avx, Level::AvxFma];
+
+/// Run `kernel` with AVX (and FMA) when the processor has it, otherwise as
+/// compiled ([`level`], [`with_level`]).
 #[inline]
 pub fn run<K: Kernel>(kernel: K) -> K::Output {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: the processor supports AVX (checked just above), the only
-        // requirement of calling a function compiled with it.
-        return unsafe { run_avx(kernel) };
+    match CHOSEN.with(|c| c.get()).unwrap_or_else(level) {
+        // SAFETY: the processor supports AVX and FMA (checked by `level`
+        // or `with_level`), the only requirement of calling a function
+        // compiled with them.
+        #[cfg(target_arch = "x86_64")]
+        Level::AvxFma => unsafe { run_avx_fma(kernel) },
+        // SAFETY: as above, for AVX.
+        #[cfg(target_arch = "x86_64")]
+        Level::Avx => unsafe { run_avx(kernel) },
+        _ => kernel.run(),
     }
-    kernel.run()
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn run_avx<K: Kernel>(kernel: K) -> K::Output {
     kernel.run()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+fn run_avx_fma<K: Kernel>(kernel: K) -> K::Output {
+    kernel.run_fused()
+}
+
+/// `a · b + c`, rounded once (one FMA instruction) when `FUSED`, else the
+/// product rounded and then the sum: for kernels written once for both
+/// [`Kernel::run`] (`FUSED = false`) and [`Kernel::run_fused`].
+#[inline(always)]
+pub fn mul_add<const FUSED: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FUSED { a.mul_add(b, c) } else { a * b + c }
 }
 
 /// Dot products in lanes, a tile of them at a time:

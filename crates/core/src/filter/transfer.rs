@@ -32,9 +32,10 @@ pub(crate) trait LinearFilter {
     fn padlen(&self) -> usize;
     /// Steady-state state for a unit step, flattened.
     fn steady_state(&self) -> Result<Vec<f64>>;
-    /// Filters `samples` in place, in iteration order, starting from and
-    /// updating `state` (layout of [`LinearFilter::steady_state`]).
-    fn run<'a>(&self, samples: impl Iterator<Item = &'a mut f64>, state: &mut [f64]);
+    /// Filters `x` in place, first to last (last to first when
+    /// `reverse`), starting from and updating `state` (layout of
+    /// [`LinearFilter::steady_state`]).
+    fn run(&self, x: &mut [f64], state: &mut [f64], reverse: bool);
 }
 
 /// A rational transfer function `B(z)/A(z)` (SciPy's `b`, `a` arrays).
@@ -126,7 +127,18 @@ impl LinearFilter for TransferFunction {
         self.zi()
     }
 
-    fn run<'a>(&self, samples: impl Iterator<Item = &'a mut f64>, z: &mut [f64]) {
+    fn run(&self, x: &mut [f64], z: &mut [f64], reverse: bool) {
+        if reverse {
+            self.run_in_order(x.iter_mut().rev(), z)
+        } else {
+            self.run_in_order(x.iter_mut(), z)
+        }
+    }
+}
+
+impl TransferFunction {
+    /// [`LinearFilter::run`] over `samples` in iteration order.
+    fn run_in_order<'a>(&self, samples: impl Iterator<Item = &'a mut f64>, z: &mut [f64]) {
         let (b, a) = (&self.bn, &self.an);
         let n = b.len();
         for v in samples {
@@ -162,7 +174,7 @@ pub fn lfilter(tf: &TransferFunction, x: &[f64]) -> Result<Vec<f64>> {
     check_finite("x", x)?;
     let mut y = x.to_vec();
     let mut state = vec![0.0; tf.bn.len() - 1];
-    tf.run(y.iter_mut(), &mut state);
+    tf.run(&mut y, &mut state, false);
     Ok(y)
 }
 
@@ -195,7 +207,7 @@ mod tests {
         let mut z = tf.zi().unwrap();
         let dc = 0.8 / (1.0 - 0.5 + 0.3 - 0.05);
         let mut x = vec![1.0; 10];
-        tf.run(x.iter_mut(), &mut z);
+        tf.run(&mut x, &mut z, false);
         for v in x {
             assert!((v - dc).abs() < 1e-14);
         }
