@@ -35,8 +35,9 @@ use super::eddy_lag::FirstOrderLag;
 use super::segments::median_step;
 use crate::error::{CompError, Result};
 use aeromag_core::filter::sos::Sos;
-use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_with};
+use aeromag_core::filter::{Band, FILTER_LANES, butter, sosfiltfilt_columns_propagating_with};
 use aeromag_core::parallel::for_each_weighted_mut;
+use aeromag_core::simd::all_finite;
 use aeromag_estimation::least_squares::{BlockProducts, LsSolution, NormalEquations};
 use serde::{Deserialize, Serialize};
 
@@ -182,7 +183,9 @@ const BLOCK_TOLERANCE: f64 = 1e-15;
 /// through `map` on `threads` threads, one block per thread (a single
 /// block spreads its columns over the threads instead); `reduce` receives
 /// the mapped blocks in order on the calling thread. Each block is the same
-/// bits whatever the thread count.
+/// bits whatever the thread count. A column with a non-finite value is
+/// non-finite throughout after the filter ([`filter_columns`]): `map` must
+/// not let that pass unseen ([`BlockProducts::of`] is an error for it).
 fn for_each_filtered_block<T: Send>(
     seg: &Segment,
     dt_s: f64,
@@ -426,9 +429,17 @@ pub(crate) fn band_passed_residuals(
             sos.as_ref(),
             threads,
             |cols, y| {
-                Ok((0..y.len())
+                let r: Vec<f64> = (0..y.len())
                     .map(|i| y[i] - cols.iter().zip(coef).map(|(c, b)| c[i] * b).sum::<f64>())
-                    .collect::<Vec<f64>>())
+                    .collect();
+                // A non-finite input spoils its filtered column throughout.
+                if all_finite(&r) {
+                    Ok(r)
+                } else {
+                    Err(CompError::data(format!(
+                        "segment {k}: a non-finite value in the band-passed residual"
+                    )))
+                }
             },
             |block| {
                 r.extend(block);
@@ -758,7 +769,9 @@ fn validate(cfg: &LsConfig) -> Result<()> {
 /// Zero-phase filter every non-constant column in place (MagNav's rule:
 /// standard deviation ≤ ε means constant), spread over the available cores.
 /// Each column is filtered independently, so the result does not depend on
-/// the number of threads.
+/// the number of threads. A column with a non-finite value comes out
+/// non-finite throughout rather than as an error (no pass of its own to
+/// look for one): the callers' maps find it in what they use.
 fn filter_columns(
     sos: &Sos,
     cols: &mut [Vec<f64>],
@@ -780,7 +793,7 @@ fn filter_columns(
     let threads = threads.max(1);
     if threads == 1 {
         scratch.resize_with(1, Vec::new);
-        return sosfiltfilt_columns_with(sos, &mut varying, &mut scratch[0])
+        return sosfiltfilt_columns_propagating_with(sos, &mut varying, &mut scratch[0])
             .map_err(CompError::from);
     }
     let groups = varying.len().div_ceil(FILTER_LANES);
@@ -797,7 +810,7 @@ fn filter_columns(
         threads,
         |_| 1,
         |(chunk, ext, out)| {
-            *out = sosfiltfilt_columns_with(sos, chunk, ext);
+            *out = sosfiltfilt_columns_propagating_with(sos, chunk, ext);
         },
     );
     jobs.into_iter()
@@ -1158,6 +1171,59 @@ pub(crate) mod tests {
             direction: None,
         };
         assert!(fit_band_pass_ls(&[seg], &cfg).is_err());
+    }
+
+    /// A non-finite value inside a segment (the callers split segments at
+    /// missing values, so this guards the fit itself) is an error of the
+    /// fit and of the band-passed residual, wherever it falls in the
+    /// blocks, in a flux component or in `mag`.
+    #[test]
+    fn a_non_finite_value_in_a_segment_is_an_error() {
+        let terms = TermSet::observable16();
+        let (t, f, m) = leg_n(0.0, &coef16(), &terms, 0.0, true, 6000);
+        let cfg = LsConfig {
+            block_len: 1024,
+            ..LsConfig::default()
+        };
+        let seg = |f: &[Vec<f64>; 3], m: &[f64]| -> Vec<f64> {
+            let s = Segment {
+                time: &t,
+                flux: [&f[0], &f[1], &f[2]],
+                mag: m,
+                channels: Default::default(),
+                direction: None,
+            };
+            match fit_band_pass_ls(&[s], &cfg) {
+                Ok(fit) => fit.coef,
+                Err(_) => Vec::new(),
+            }
+        };
+        let coef = seg(&f, &m);
+        assert_eq!(coef.len(), 16);
+        for at in [0, 1500, 3000, 5999] {
+            for bad in [f64::NAN, f64::INFINITY] {
+                for which in 0..4 {
+                    let (mut f2, mut m2) = (f.clone(), m.clone());
+                    if which < 3 {
+                        f2[which][at] = bad;
+                    } else {
+                        m2[at] = bad;
+                    }
+                    assert!(seg(&f2, &m2).is_empty(), "{bad} at {at} in {which}");
+                    let s = Segment {
+                        time: &t,
+                        flux: [&f2[0], &f2[1], &f2[2]],
+                        mag: &m2,
+                        channels: Default::default(),
+                        direction: None,
+                    };
+                    assert!(
+                        band_passed_residuals(&[s], &cfg, &coef).is_err(),
+                        "{bad} at {at} in {which}"
+                    );
+                }
+            }
+        }
     }
 
     proptest::proptest! {

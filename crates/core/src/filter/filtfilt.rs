@@ -80,6 +80,35 @@ pub fn sosfiltfilt_columns_with(
     columns: &mut [&mut [f64]],
     ext: &mut Vec<[f64; FILTER_LANES]>,
 ) -> Result<()> {
+    columns_with(sos, columns, ext, true)
+}
+
+/// [`sosfiltfilt_columns_with`] without its check that every sample is
+/// finite (a pass over every signal before the filter's own): a signal
+/// with a non-finite sample comes out non-finite throughout instead of
+/// being an error (the forward pass carries NaN or infinity to the end,
+/// where the backward pass starts, and neither recovers), for a caller
+/// that checks what it uses of the results (the Tolles-Lawson fit's normal
+/// equations do). The other signals are filtered as always.
+///
+/// Errors, before anything is written: `TooShort`, `InvalidArgument` as
+/// [`sosfiltfilt_columns_in_place`].
+pub fn sosfiltfilt_columns_propagating_with(
+    sos: &Sos,
+    columns: &mut [&mut [f64]],
+    ext: &mut Vec<[f64; FILTER_LANES]>,
+) -> Result<()> {
+    columns_with(sos, columns, ext, false)
+}
+
+/// [`sosfiltfilt_columns_with`], checking that every sample is finite
+/// first when `finite_check`.
+fn columns_with(
+    sos: &Sos,
+    columns: &mut [&mut [f64]],
+    ext: &mut Vec<[f64; FILTER_LANES]>,
+    finite_check: bool,
+) -> Result<()> {
     let pad = sos.padlen();
     let n = columns.first().map_or(0, |c| c.len());
     for c in columns.iter() {
@@ -90,7 +119,9 @@ pub fn sosfiltfilt_columns_with(
             });
         }
         check_len("x", n, pad + 1)?;
-        check_finite("x", c)?;
+        if finite_check {
+            check_finite("x", c)?;
+        }
     }
     let zi = sos.steady_state()?;
     ext.clear();
@@ -220,6 +251,54 @@ mod tests {
 
     fn sos() -> Sos {
         Sos::new(vec![[0.2, 0.4, 0.2, 1.0, -0.5, 0.3]]).unwrap()
+    }
+
+    /// Without the finite check, a signal with a NaN or an infinity
+    /// anywhere comes out non-finite everywhere; the signals beside it in
+    /// its group and in the others are the checked filter's bits.
+    #[test]
+    fn propagating_filter_spoils_exactly_the_non_finite_signals() {
+        let band = crate::filter::butter(
+            4,
+            crate::filter::Band::Bandpass {
+                low_hz: 0.1,
+                high_hz: 0.9,
+            },
+            10.0,
+        )
+        .unwrap();
+        for s in [sos(), band] {
+            let n = s.padlen() + 60;
+            let signal = |j: usize| -> Vec<f64> {
+                (0..n)
+                    .map(|k| ((k * (j + 1)) as f64 * 0.3).sin() * 100.0 + j as f64)
+                    .collect()
+            };
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for at in [0, 1, n / 2, n - 2, n - 1] {
+                    for spoiled in [0, 2, 5] {
+                        let cols: Vec<Vec<f64>> = (0..6).map(signal).collect();
+                        let mut checked = cols.clone();
+                        let mut refs: Vec<&mut [f64]> =
+                            checked.iter_mut().map(|c| c.as_mut_slice()).collect();
+                        sosfiltfilt_columns_in_place(&s, &mut refs).unwrap();
+                        let mut out = cols.clone();
+                        out[spoiled][at] = bad;
+                        let mut refs: Vec<&mut [f64]> =
+                            out.iter_mut().map(|c| c.as_mut_slice()).collect();
+                        sosfiltfilt_columns_propagating_with(&s, &mut refs, &mut Vec::new())
+                            .unwrap();
+                        for (j, (o, c)) in out.iter().zip(&checked).enumerate() {
+                            if j == spoiled {
+                                assert!(o.iter().all(|v| !v.is_finite()), "{bad} at {at}");
+                            } else {
+                                assert!(o.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits()));
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -53,8 +53,8 @@ pub use bandpass::BandPass;
 pub use butterworth::{Band, MAX_ORDER, buttap, butter, butter_zpk};
 pub use chebwin::chebwin;
 pub use filtfilt::{
-    FILTER_LANES, filtfilt, sosfiltfilt, sosfiltfilt_columns_in_place, sosfiltfilt_columns_with,
-    sosfiltfilt_in_place,
+    FILTER_LANES, filtfilt, sosfiltfilt, sosfiltfilt_columns_in_place,
+    sosfiltfilt_columns_propagating_with, sosfiltfilt_columns_with, sosfiltfilt_in_place,
 };
 pub use firwin::firwin_lowpass;
 pub use kaiser::{bessel_i0, kaiser};
