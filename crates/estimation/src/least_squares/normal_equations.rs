@@ -714,7 +714,11 @@ mod tests {
     fn block_products_find_every_non_finite_value() {
         let m = 2 * ROW_BLOCK + 7;
         let cols: Vec<Vec<f64>> = (0..6)
-            .map(|j| (0..m).map(|k| ((k * (j + 2)) as f64 * 0.37).sin() * 1e3).collect())
+            .map(|j| {
+                (0..m)
+                    .map(|k| ((k * (j + 2)) as f64 * 0.37).sin() * 1e3)
+                    .collect()
+            })
             .collect();
         let of = |cols: &[Vec<f64>]| {
             let refs: Vec<&[f64]> = cols[..5].iter().map(|c| c.as_slice()).collect();
