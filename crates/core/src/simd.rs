@@ -135,11 +135,17 @@ pub fn with_level<R>(level: Level, f: impl FnOnce() -> R) -> Option<R> {
 /// Every copy of the kernels, plainest first.
 pub const LEVELS: [Level; 3] = [Level::Plain, Level::Avx, Level::AvxFma];
 
+/// The copy of the kernels that runs on this thread: [`with_level`]'s
+/// choice, else [`level`].
+fn current() -> Level {
+    CHOSEN.with(|c| c.get()).unwrap_or_else(level)
+}
+
 /// Run `kernel` with AVX (and FMA) when the processor has it, otherwise as
 /// compiled ([`level`], [`with_level`]).
 #[inline]
 pub fn run<K: Kernel>(kernel: K) -> K::Output {
-    match CHOSEN.with(|c| c.get()).unwrap_or_else(level) {
+    match current() {
         // SAFETY: the processor supports AVX and FMA (checked by `level`
         // or `with_level`), the only requirement of calling a function
         // compiled with them.
@@ -208,9 +214,9 @@ fn lane_dots_of<const R: usize, const C: usize, const DIAGONAL: bool>(
     let m = a.iter().chain(&b).map(|x| x.len()).min().unwrap_or(0);
     let (a, b) = (a.map(|x| &x[..m]), b.map(|x| &x[..m]));
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: the processor supports AVX (checked just above), and
-        // every slice holds `m` values.
+    if current() != Level::Plain {
+        // SAFETY: the processor supports AVX (checked by `level` or
+        // `with_level`), and every slice holds `m` values.
         return unsafe { lane_dots_avx::<R, C, DIAGONAL>(a, b, m / 4) };
     }
     lane_dots_portable::<R, C, DIAGONAL>(a, b, m / 4)

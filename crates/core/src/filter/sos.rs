@@ -171,12 +171,14 @@ impl Sos {
     /// [`LinearFilter::run`] on `L` independent signals at once, interleaved
     /// sample by sample (sample `k` of signal `l` is lane `l` of
     /// `io.load(k)`; `state` holds `2 × sections` rows of `L` lanes). Every
-    /// lane does exactly the arithmetic of the one-signal loop (no fused
-    /// multiply-add), so each output is bit-identical to filtering its
-    /// signal alone; the `L` recurrences are independent, so they run in
-    /// SIMD lanes instead of waiting on one biquad chain's latency. Uses AVX
-    /// where the processor has it (detected at run time; same bits either
-    /// way). `io` says where the samples come from and where the results
+    /// lane does exactly the arithmetic of the one-signal loop
+    /// ([`LinearFilter::run`] runs this kernel with one lane), so each
+    /// output is bit-identical to filtering its signal alone; the `L`
+    /// recurrences are independent, so they run in SIMD lanes instead of
+    /// waiting on one biquad chain's latency. Uses AVX where the processor
+    /// has it (detected at run time; the same bits either way) and fused
+    /// multiply-adds where it has them and they are asked for
+    /// ([`crate::simd`]). `io` says where the samples come from and where the results
     /// go: in place ([`LaneIo`] for `&mut [[f64; L]]`), from separate
     /// signals into lanes ([`Gather`]) or from lanes into separate signals
     /// ([`Scatter`]), so that a zero-phase pass need not copy its signals
