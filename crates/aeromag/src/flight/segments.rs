@@ -1,6 +1,6 @@
 //! Contiguous stretches of a flight: the one gap rule of every workflow.
 
-use aeromag_compensation::tolles_lawson::segments::split_segments;
+use aeromag_compensation::tolles_lawson::segments::{median_step, split_segments_with};
 use std::ops::Range;
 
 /// A time step longer than this multiple of the median step is a gap: the
@@ -54,12 +54,26 @@ impl SegmentRule {
     /// Split `time` (s) where `usable` holds, with the `line` labels when
     /// the rule splits at lines.
     pub fn split(&self, time: &[f64], line: Option<&[f64]>, usable: &[bool]) -> Segments {
-        let (kept, short) = split_segments(
+        self.split_with(time, line, usable, || median_step(time))
+    }
+
+    /// [`SegmentRule::split`] with the median step of `time` (s) given by
+    /// `median` (called only when the gap rule needs it), for a caller
+    /// that has it already ([`crate::Flight::median_step_s`]).
+    pub fn split_with(
+        &self,
+        time: &[f64],
+        line: Option<&[f64]>,
+        usable: &[bool],
+        median: impl FnOnce() -> f64,
+    ) -> Segments {
+        let (kept, short) = split_segments_with(
             time,
             if self.split_lines { line } else { None },
             usable,
             self.gap_factor,
             self.min_len,
+            median,
         );
         Segments { kept, short }
     }

@@ -5,6 +5,7 @@ use crate::error::Result;
 use aeromag_compensation::tolles_lawson::ExtraTerm;
 use aeromag_compensation::tolles_lawson::design::Channels;
 use aeromag_compensation::tolles_lawson::fit_ls::Segment;
+use aeromag_compensation::tolles_lawson::segments::median_step;
 
 /// `time` (s), `flux_x/y/z` (nT, body frame), `mag` (nT), `line` (when
 /// numeric) and the channels of the extra regressors of a flight: what the
@@ -22,6 +23,9 @@ pub struct TlInputs<'a> {
     /// The channels of the extra regressors, in the terms' order
     /// ([`TlInputs::with_extras`]).
     pub channels: Vec<&'a [f64]>,
+    /// The flight whose `time` this is, for its median step
+    /// ([`Flight::median_step_s`]; `None`: worked out from `time`).
+    pub flight: Option<&'a Flight>,
 }
 
 /// The columns of one scalar magnetometer and the vector magnetometer its
@@ -149,6 +153,7 @@ impl<'a> TlInputs<'a> {
             mag: flight.require(&sensor.mag)?,
             line: flight.column("line"),
             channels: Vec::new(),
+            flight: Some(flight),
         })
     }
 
@@ -213,7 +218,14 @@ impl<'a> TlInputs<'a> {
 
     /// The segments of usable rows under `rule`.
     pub fn segments(&self, rule: &SegmentRule) -> Segments {
-        rule.split(self.time, self.line, &self.usable())
+        let usable = self.usable();
+        // The flight's median step, worked out once for all its splits,
+        // and only when the rule needs it.
+        let median = || match self.flight.map(Flight::median_step_s) {
+            Some(Ok(step)) => step,
+            _ => median_step(self.time),
+        };
+        rule.split_with(self.time, self.line, &usable, median)
     }
 
     /// All rows as one fitting segment, to be sliced into legs.
@@ -248,6 +260,61 @@ mod tests {
         assert_eq!(stem("mag_x_uc"), "mag_x_uc");
         assert_eq!(stem("mag_2"), "mag_2");
         assert_eq!(stem("mag"), "mag");
+    }
+
+    /// A flight's segments, with its median step worked out once, are
+    /// those of the time column's own median under every rule (a gap, a
+    /// step just under the gap rule, a line change, a missing value), and
+    /// its median step is the time steps' median.
+    #[test]
+    fn the_flights_median_step_splits_as_the_time_columns() {
+        let n = 400;
+        let mut time: Vec<f64> = (0..n).map(|k| k as f64 * 0.1).collect();
+        for (from, by) in [(100, 0.04), (250, 0.3)] {
+            for t in &mut time[from..] {
+                *t += by;
+            }
+        }
+        let line: Vec<f64> = (0..n).map(|k| if k < 300 { 7.0 } else { 8.0 }).collect();
+        let mut mag = vec![50_000.0; n];
+        mag[180] = f64::NAN;
+        let mut t = FlightTable::new();
+        t.add_column("time", time.clone()).unwrap();
+        t.add_column("line", line.clone()).unwrap();
+        t.add_column("mag", mag).unwrap();
+        for (c, v) in [
+            ("flux_x", 20_000.0),
+            ("flux_y", 1_000.0),
+            ("flux_z", 45_000.0),
+        ] {
+            t.add_column(c, vec![v; n]).unwrap();
+        }
+        let flight = Flight::from_table(t).unwrap();
+        let step = median_step(&time);
+        assert_eq!(flight.median_step_s().unwrap().to_bits(), step.to_bits());
+        assert_eq!(flight.median_step_s().unwrap().to_bits(), step.to_bits());
+        let inputs = TlInputs::of_sensor(&flight, &SensorColumns::default()).unwrap();
+        let alone = TlInputs {
+            flight: None,
+            ..inputs.clone()
+        };
+        for rule in [
+            SegmentRule::default(),
+            SegmentRule::ignoring_lines(),
+            SegmentRule::default().min_len(120),
+            SegmentRule {
+                gap_factor: f64::INFINITY,
+                ..SegmentRule::default()
+            },
+        ] {
+            let ours = inputs.segments(&rule);
+            assert_eq!(ours, alone.segments(&rule));
+            assert_eq!(ours, rule.split(&time, Some(&line), &inputs.usable()));
+        }
+        assert_eq!(
+            inputs.segments(&SegmentRule::default()).kept,
+            vec![0..180, 181..250, 250..300, 300..400]
+        );
     }
 
     #[test]
@@ -301,6 +368,7 @@ mod tests {
             mag: &mag,
             line: None,
             channels: vec![&channel],
+            flight: None,
         };
         let expected: Vec<bool> = (0..n)
             .map(|k| {

@@ -18,12 +18,28 @@ pub fn split_segments(
     max_gap_factor: f64,
     min_len: usize,
 ) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+    split_segments_with(time, line, usable, max_gap_factor, min_len, || {
+        median_step(time)
+    })
+}
+
+/// [`split_segments`] with the median step of `time` given by `median`
+/// (called only when the factor is finite), for a caller that has it
+/// already.
+pub fn split_segments_with(
+    time: &[f64],
+    line: Option<&[f64]>,
+    usable: &[bool],
+    max_gap_factor: f64,
+    min_len: usize,
+    median: impl FnOnce() -> f64,
+) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
     // An infinite factor makes every step a continuation whatever the
     // median (which is then not worked out).
     let dt = if max_gap_factor == f64::INFINITY {
         0.0
     } else {
-        median_step(time)
+        median()
     };
     let max_gap = if dt > 0.0 {
         dt * max_gap_factor
