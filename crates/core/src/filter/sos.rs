@@ -266,15 +266,8 @@ impl<const L: usize> LaneIo<L> for Scatter<'_, '_, L> {
     }
     #[inline(always)]
     fn store(&mut self, k: usize, v: [f64; L]) {
-        if let [a, b, c, d] = &mut *self.dst
-            && L == 4
-        {
-            // A full group of four: four stores without a loop.
-            [a[k], b[k], c[k], d[k]] = [v[0], v[1], v[2], v[3]];
-        } else {
-            for (x, v) in self.dst.iter_mut().zip(v) {
-                x[k] = v;
-            }
+        for (x, v) in self.dst.iter_mut().zip(v) {
+            x[k] = v;
         }
     }
 }
