@@ -110,7 +110,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
 /// interrupted write never leaves a complete-looking partial file.
 pub fn write_streamed(
     path: &Path,
-    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<()>,
+    write: impl FnOnce(&mut std::io::BufWriter<aeromag_io::atomic::Output>) -> Result<()>,
 ) -> Result<()> {
     // The library error of `write`, kept while the I/O layer sees a plain
     // I/O error.

@@ -20,7 +20,8 @@
 //! column (column types are not stored in CSV).
 //!
 //! Rows are formatted in chunks of 16 384 rows on the available cores and
-//! written in order (the same bytes whatever the thread count). A chunk of
+//! written in order (the same bytes whatever the thread count), each round
+//! of chunks written while the next is formatted. A chunk of
 //! numbers only is formatted into a buffer sized for its longest text, each
 //! cell moved with fixed-size copies (1.32× faster `compensate` of 10⁶ rows
 //! than a copy call per cell: 300 against 396 ms, hyperfine).
@@ -69,31 +70,31 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     let threads = std::thread::available_parallelism()
         .map_or(1, |t| t.get())
         .clamp(1, 8);
-    // Rows are formatted in chunks, `threads` chunks at a time on as many
-    // threads, and written in order: the same bytes for any thread count.
-    let mut chunks: Vec<Vec<u8>> = vec![Vec::new(); threads];
+    // Rows are formatted in rounds of `threads` chunks on as many threads
+    // while the calling thread writes the round before: the same bytes, in
+    // order, for any thread count.
     let span = WRITE_CHUNK_ROWS * threads;
-    for first in (0..n).step_by(span) {
-        let ranges: Vec<std::ops::Range<usize>> = (0..threads)
-            .map(|t| {
-                let a = (first + t * WRITE_CHUNK_ROWS).min(n);
-                a..(a + WRITE_CHUNK_ROWS).min(n)
-            })
-            .filter(|r| !r.is_empty())
-            .collect();
-        if ranges.len() == 1 {
-            format_rows(&columns, ranges[0].clone(), missing, &mut chunks[0]);
-        } else {
-            std::thread::scope(|scope| {
-                for (r, buf) in ranges.iter().zip(chunks.iter_mut()) {
-                    let columns = &columns;
-                    scope.spawn(move || format_rows(columns, r.clone(), missing, buf));
-                }
-            });
-        }
-        for buf in &chunks[..ranges.len()] {
-            out.write_all(buf)?;
-        }
+    let chunks = |first: usize| -> Vec<std::ops::Range<usize>> {
+        (first..(first + span).min(n))
+            .step_by(WRITE_CHUNK_ROWS)
+            .map(|a| a..(a + WRITE_CHUNK_ROWS).min(n))
+            .collect()
+    };
+    let (mut formatting, mut writing) = (vec![Vec::new(); threads], vec![Vec::new(); threads]);
+    let mut to_write = 0;
+    for first in (0..n).step_by(span).map(Some).chain([None]) {
+        let ranges = first.map_or_else(Vec::new, chunks);
+        std::thread::scope(|scope| {
+            for (r, buf) in ranges.iter().zip(formatting.iter_mut()) {
+                let columns = &columns;
+                scope.spawn(move || format_rows(columns, r.clone(), missing, buf));
+            }
+            writing[..to_write]
+                .iter()
+                .try_for_each(|buf| out.write_all(buf))
+        })?;
+        std::mem::swap(&mut formatting, &mut writing);
+        to_write = ranges.len();
     }
     Ok(())
 }
@@ -290,6 +291,13 @@ mod tests {
         let text = String::from_utf8(out).unwrap();
         assert_eq!(text.lines().count(), n + 1);
         assert_eq!(text.lines().nth(8).unwrap(), ",r7");
+        // No rows: the header alone.
+        let mut empty = FlightTable::new();
+        empty.add_column("x", Vec::new()).unwrap();
+        empty.add_column("y", Vec::new()).unwrap();
+        let mut out = Vec::new();
+        write_csv_to(&empty, &mut out).unwrap();
+        assert_eq!(out, b"x,y\n");
     }
 
     /// The numbers-only path (fixed-size moves into a chunk sized for its
