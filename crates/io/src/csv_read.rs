@@ -575,7 +575,7 @@ mod tests {
         /// The fast path changes nothing: the same table (values, missing
         /// counts, integer flags, text columns, line numbers) or the same
         /// error as the general reader alone, for any thread count and
-        /// piece size (small pieces: rounds end inside long lines).
+        /// piece size (small pieces: pieces end inside long lines).
         #[test]
         fn clean_rows_read_as_the_general_reader_reads_them(
             text in file(),
