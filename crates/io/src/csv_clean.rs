@@ -27,16 +27,16 @@
 //! tabs, their comment lines, and for XYZ the `Line`/`Tie` records, kept
 //! per piece ([`CleanRows::records`]) for the reader's line columns.
 
-use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{Read as _, Seek, SeekFrom};
 use std::ops::Range;
 use std::path::Path;
-use std::sync::{Mutex, mpsc};
+use std::sync::Mutex;
 
 use crate::builder::{TableBuilder, is_integer_text};
 use crate::cell::{Cell, EXACT_POWERS_OF_TEN, MissingKind, parse_cell, plain_decimal_prefix};
 use crate::error::{IoError, Result};
+use crate::ordered::{in_order, lock};
 use crate::table::Missing;
 use crate::xyz::{Dialect, Kind, line_kind};
 
@@ -528,11 +528,10 @@ pub(crate) fn threads() -> usize {
 /// `on_piece` (in file order); returns where the general reader must go on
 /// (`None`: the file ended clean). See the module docs.
 ///
-/// An ordered pipeline: each worker takes the file's next piece (in turn,
-/// under a lock, numbered) and parses it; the calling thread appends the
-/// parsed pieces in their numbers' order and hands their buffers back.
-/// [`PIECES`] buffers per worker go round, so memory stays bounded, and no
-/// thread waits for a round of pieces to end. Against the reader before
+/// An ordered pipeline ([`in_order`]): each worker reads the file's next
+/// piece (in turn, under a lock, numbered) and parses it; the calling
+/// thread appends the parsed pieces in file order. [`PIECES`] buffers per
+/// worker go round, so memory stays bounded. Against the reader before
 /// (rounds of one 4 MiB piece per thread, the next round read and the last
 /// appended during each, all joined after it), reading alone, whole
 /// process (`examples/read_time` `FILE 1`, hyperfine, 30 runs each, on two
@@ -561,7 +560,6 @@ pub(crate) fn push_clean_rows(
     })?;
     f.seek(SeekFrom::Start(from.offset))
         .map_err(|e| read_err(from.line, e))?;
-    let threads = threads.max(1);
     let source = Mutex::new(Pieces {
         file: f,
         piece_bytes: piece_bytes.max(1),
@@ -569,61 +567,67 @@ pub(crate) fn push_clean_rows(
         next: 0,
         ended: false,
     });
-    let (free_tx, free_rx) = mpsc::channel::<Piece>();
-    for _ in 0..threads * PIECES {
-        free_tx
-            .send(Piece::default())
-            .expect("the receiver is here");
-    }
-    let free_rx = Mutex::new(free_rx);
-    let (done_tx, done_rx) = mpsc::channel::<(usize, Piece)>();
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            let (source, free_rx, done_tx) = (&source, &free_rx, done_tx.clone());
-            scope.spawn(move || work(source, free_rx, done_tx, shape));
+    let mut at = from;
+    let mut stop = None;
+    // Appends a piece in order; `Ok(false)` (`stop` set) where the general
+    // reader must go on.
+    let mut append = |piece: &mut Piece| -> Result<bool> {
+        // Where the general reader goes on if this piece is not all appended.
+        stop = Some(at);
+        match std::mem::take(&mut piece.read) {
+            Read::Lines => {}
+            // A line longer than a piece: the general reader has the limit.
+            Read::LongLine => return Ok(false),
+            Read::Failed(e) => return Err(read_err(at.line, e)),
         }
-        drop(done_tx);
-        let mut at = from;
-        let mut waiting: BTreeMap<usize, Piece> = BTreeMap::new();
-        let mut next = 0;
-        let mut append_all = || -> Result<Option<Resume>> {
-            // Ends when every worker has ended (the file's end, an error).
-            for (number, piece) in &done_rx {
-                waiting.insert(number, piece);
-                while let Some(piece) = waiting.remove(&next) {
-                    next += 1;
-                    match piece.read {
-                        Read::Lines => {}
-                        // A line longer than a piece: the general reader
-                        // has the limit.
-                        Read::LongLine => return Ok(Some(at)),
-                        Read::Failed(e) => return Err(read_err(at.line, e)),
-                    }
-                    let part = &piece.rows;
-                    let bytes_read = at.offset + part.bytes as u64;
-                    if !builder.append_clean(part, at.line, bytes_read) {
-                        return Ok(Some(at));
-                    }
-                    on_piece(part);
-                    at = Resume {
-                        offset: bytes_read,
-                        line: at.line + part.lines,
-                    };
-                    if part.stopped {
-                        return Ok(Some(at));
-                    }
-                    // The workers may have ended: the buffer is not needed.
-                    let _ = free_tx.send(piece);
-                }
-            }
-            Ok(None)
+        let part = &piece.rows;
+        let bytes_read = at.offset + part.bytes as u64;
+        if !builder.append_clean(part, at.line, bytes_read) {
+            return Ok(false);
+        }
+        on_piece(part);
+        at = Resume {
+            offset: bytes_read,
+            line: at.line + part.lines,
         };
-        let outcome = append_all();
-        // Stop the workers: no piece after this, no buffer for one.
-        lock(&source).ended = true;
-        drop(free_tx);
-        outcome
-    })
+        stop = part.stopped.then_some(at);
+        Ok(!part.stopped)
+    };
+    in_order(
+        threads,
+        PIECES,
+        |piece: &mut Piece| {
+            let number = {
+                let mut src = lock(&source);
+                if src.ended {
+                    return None;
+                }
+                piece.read = match src.read_into(&mut piece.text) {
+                    Ok((false, _)) => return None,
+                    Ok((true, read)) => read,
+                    Err(e) => {
+                        src.ended = true;
+                        Read::Failed(e)
+                    }
+                };
+                src.next += 1;
+                src.next - 1
+            };
+            if matches!(piece.read, Read::Lines) {
+                parse_piece(&piece.text, shape, &mut piece.rows);
+            }
+            Some(number)
+        },
+        |piece| {
+            let go_on = append(piece);
+            if !matches!(go_on, Ok(true)) {
+                // No piece read after this.
+                lock(&source).ended = true;
+            }
+            go_on
+        },
+    )?;
+    Ok(stop)
 }
 
 /// Pieces each worker of [`push_clean_rows`] may have read ahead of the
@@ -685,48 +689,6 @@ impl Pieces {
                 self.ended = true;
                 Ok((true, Read::LongLine))
             }
-        }
-    }
-}
-
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// A worker of [`push_clean_rows`]: takes a free buffer, reads the next
-/// piece into it (numbered, in turn), parses it and sends it on, until the
-/// pieces or the buffers end.
-fn work(
-    source: &Mutex<Pieces>,
-    free: &Mutex<mpsc::Receiver<Piece>>,
-    done: mpsc::Sender<(usize, Piece)>,
-    shape: Shape,
-) {
-    loop {
-        let Ok(mut piece) = lock(free).recv() else {
-            return;
-        };
-        let number = {
-            let mut src = lock(source);
-            if src.ended {
-                return;
-            }
-            piece.read = match src.read_into(&mut piece.text) {
-                Ok((false, _)) => return,
-                Ok((true, read)) => read,
-                Err(e) => {
-                    src.ended = true;
-                    Read::Failed(e)
-                }
-            };
-            src.next += 1;
-            src.next - 1
-        };
-        if matches!(piece.read, Read::Lines) {
-            parse_piece(&piece.text, shape, &mut piece.rows);
-        }
-        if done.send((number, piece)).is_err() {
-            return;
         }
     }
 }

@@ -70,34 +70,27 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     let threads = std::thread::available_parallelism()
         .map_or(1, |t| t.get())
         .clamp(1, 8);
-    // Rows are formatted in rounds of `threads` chunks on as many threads
-    // while the calling thread writes the round before: the same bytes, in
-    // order, for any thread count.
-    let span = WRITE_CHUNK_ROWS * threads;
-    let chunks = |first: usize| -> Vec<std::ops::Range<usize>> {
-        (first..(first + span).min(n))
-            .step_by(WRITE_CHUNK_ROWS)
-            .map(|a| a..(a + WRITE_CHUNK_ROWS).min(n))
-            .collect()
-    };
-    let (mut formatting, mut writing) = (vec![Vec::new(); threads], vec![Vec::new(); threads]);
-    let mut to_write = 0;
-    for first in (0..n).step_by(span).map(Some).chain([None]) {
-        let ranges = first.map_or_else(Vec::new, chunks);
-        std::thread::scope(|scope| {
-            for (r, buf) in ranges.iter().zip(formatting.iter_mut()) {
-                let columns = &columns;
-                scope.spawn(move || format_rows(columns, r.clone(), missing, buf));
-            }
-            writing[..to_write]
-                .iter()
-                .try_for_each(|buf| out.write_all(buf))
-        })?;
-        std::mem::swap(&mut formatting, &mut writing);
-        to_write = ranges.len();
-    }
-    Ok(())
+    // Chunks of rows are formatted by `threads` workers, each taking the
+    // next chunk in turn, and written in order by the calling thread
+    // ([`crate::ordered`]): the same bytes for any thread count.
+    let n_chunks = n.div_ceil(WRITE_CHUNK_ROWS);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    crate::ordered::in_order(
+        threads.min(n_chunks),
+        CHUNKS,
+        |buf: &mut Vec<u8>| {
+            let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let a = k.checked_mul(WRITE_CHUNK_ROWS).filter(|&a| a < n)?;
+            format_rows(&columns, a..(a + WRITE_CHUNK_ROWS).min(n), missing, buf);
+            Some(k)
+        },
+        |buf| out.write_all(buf).map(|()| true),
+    )
 }
+
+/// Buffers per worker of [`write_csv_to`] (chunks formatted ahead of the
+/// writing).
+const CHUNKS: usize = 2;
 
 /// Rows per chunk formatted by one thread of [`write_csv_to`].
 const WRITE_CHUNK_ROWS: usize = 16 * 1024;

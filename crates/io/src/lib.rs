@@ -43,6 +43,7 @@ mod error;
 mod fields;
 mod hdf5;
 mod number_text;
+mod ordered;
 mod parts;
 mod read_ahead;
 pub mod select;
