@@ -417,7 +417,10 @@ impl Design {
                     // `Iterator::sum` starts from), so this is the bits of
                     // `row · c`.
                     acc.fill(-0.0);
-                    for (col, c) in cols.iter().zip(*coef) {
+                    // A zero coefficient adds nothing (the columns are
+                    // finite) but the sign of an exact zero: skipped (a
+                    // part of the model has most of them).
+                    for (col, c) in cols.iter().zip(*coef).filter(|(_, c)| **c != 0.0) {
                         for (a, v) in acc.iter_mut().zip(col) {
                             *a += v * c;
                         }
