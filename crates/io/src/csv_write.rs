@@ -78,13 +78,13 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     crate::ordered::in_order(
         threads.min(n_chunks),
         CHUNKS,
-        |buf: &mut Vec<u8>| {
+        |(buf, len): &mut (Vec<u8>, usize)| {
             let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let a = k.checked_mul(WRITE_CHUNK_ROWS).filter(|&a| a < n)?;
-            format_rows(&columns, a..(a + WRITE_CHUNK_ROWS).min(n), missing, buf);
+            *len = format_rows(&columns, a..(a + WRITE_CHUNK_ROWS).min(n), missing, buf);
             Some(k)
         },
-        |buf| out.write_all(buf).map(|()| true),
+        |(buf, len)| out.write_all(&buf[..*len]).map(|()| true),
     )
 }
 
@@ -115,19 +115,21 @@ impl<'a> Cells<'a> {
     }
 }
 
-/// The text of `rows` of `columns` (each row ending in `\n`) into `out`
-/// (cleared first); missing values as `missing`.
+/// The text of `rows` of `columns` (each row ending in `\n`) into
+/// `out[..len]`, returning `len`; missing values as `missing`. What `out`
+/// holds after `len` is left over (a buffer reused chunk after chunk is
+/// neither zeroed nor cut each time).
 fn format_rows(
     columns: &[&Column],
     rows: std::ops::Range<usize>,
     missing: &[u8],
     out: &mut Vec<u8>,
-) {
-    out.clear();
+) -> usize {
     let cells: Vec<Cells> = columns.iter().map(|c| Cells::of(c)).collect();
     let mut int = itoa::Buffer::new();
     let mut float = NumberText::new();
     if cells.iter().any(|c| matches!(c, Cells::Text(_))) {
+        out.clear();
         for row in rows {
             for (i, c) in cells.iter().enumerate() {
                 if i > 0 {
@@ -140,14 +142,17 @@ fn format_rows(
             }
             out.push(b'\n');
         }
-        return;
+        return out.len();
     }
     // Numbers only: every cell fits in NUMBER_MAX bytes, so the chunk's
-    // longest text is known. `out` is sized for it once and each cell is
-    // copied with fixed-size moves (`put`) instead of a copy call per cell;
-    // the unused end is cut off.
+    // longest text is known. `out` is sized for it (grown, never cut) and
+    // each cell is copied with fixed-size moves (`put`) instead of a copy
+    // call per cell.
     let row_max = cells.len() * (NUMBER_MAX.max(missing.len()) + 1);
-    out.resize(rows.len() * row_max, 0);
+    let need = rows.len() * row_max;
+    if out.len() < need {
+        out.resize(need, 0);
+    }
     let mut pos = 0;
     for row in rows {
         for (i, c) in cells.iter().enumerate() {
@@ -160,7 +165,7 @@ fn format_rows(
         out[pos] = b'\n';
         pos += 1;
     }
-    out.truncate(pos);
+    pos
 }
 
 /// The text of a number cell (`c` is not a text column): `missing` for a
@@ -209,6 +214,12 @@ fn put(out: &mut [u8], pos: usize, text: &[u8]) -> usize {
         4..=7 => {
             dst[..4].copy_from_slice(&text[..4]);
             dst[n - 4..].copy_from_slice(&text[n - 4..]);
+        }
+        // `1`, `0.0`: three byte moves cover 1 to 3 bytes.
+        1..=3 => {
+            dst[0] = text[0];
+            dst[n / 2] = text[n / 2];
+            dst[n - 1] = text[n - 1];
         }
         _ => dst.copy_from_slice(text),
     }
@@ -278,7 +289,8 @@ mod tests {
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut one = b"x,tag\n".to_vec();
         let mut rows = Vec::new();
-        format_rows(&columns, 0..n, b"", &mut rows);
+        let len = format_rows(&columns, 0..n, b"", &mut rows);
+        rows.truncate(len);
         one.extend(rows);
         assert_eq!(out, one);
         let text = String::from_utf8(out).unwrap();
@@ -335,7 +347,8 @@ mod tests {
         t.add_column("b", shifted.clone()).unwrap();
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut got = Vec::new();
-        format_rows(&columns, 0..n, b"", &mut got);
+        let len = format_rows(&columns, 0..n, b"", &mut got);
+        got.truncate(len);
         let mut text = NumberText::new();
         let mut cell = |v: f64| {
             if v.is_nan() {
@@ -362,14 +375,57 @@ mod tests {
         // Integer columns as read (`1003`, not `1003.0`).
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("in.csv");
-        std::fs::write(&p, "n,x\n1003,1.5\n-42,\n9,2\n").unwrap();
+        std::fs::write(&p, "n,x\n1003,1.5\n-42,\n9,2\n10,3\n").unwrap();
         let read = crate::read_csv(&p, &crate::ReadOptions::default()).unwrap();
         let mut out = Vec::new();
         write_csv_to(&read, &mut out).unwrap();
         assert_eq!(
             String::from_utf8(out).unwrap(),
-            "n,x\n1003,1.5\n-42,\n9,2.0\n"
+            "n,x\n1003,1.5\n-42,\n9,2.0\n10,3.0\n"
         );
+    }
+
+    /// A chunk buffer reused for a chunk of shorter rows than the last
+    /// (it is neither cut nor zeroed in between) gives that chunk's text
+    /// alone, and a whole table of such chunks is written in order.
+    #[test]
+    fn a_reused_chunk_buffer_holds_only_its_chunk() {
+        let n = 2 * WRITE_CHUNK_ROWS + 5;
+        let long: Vec<f64> = (0..n)
+            .map(|i| {
+                if i < WRITE_CHUNK_ROWS {
+                    1.0 / (i as f64 + 3.0)
+                } else {
+                    (i % 7) as f64
+                }
+            })
+            .collect();
+        let mut t = FlightTable::new();
+        t.add_column("a", long.clone()).unwrap();
+        t.add_column("b", long.iter().map(|v| -v).collect())
+            .unwrap();
+        let columns: Vec<&Column> = t.columns().iter().collect();
+        let mut buf = Vec::new();
+        let first = format_rows(&columns, 0..WRITE_CHUNK_ROWS, b"", &mut buf);
+        let second = format_rows(&columns, WRITE_CHUNK_ROWS..n, b"", &mut buf);
+        assert!(second < first && buf.len() > second);
+        let mut text = NumberText::new();
+        let want: String = (WRITE_CHUNK_ROWS..n)
+            .map(|i| {
+                let a = text.format(long[i]).to_string();
+                format!("{a},{}\n", text.format(-long[i]))
+            })
+            .collect();
+        assert_eq!(std::str::from_utf8(&buf[..second]).unwrap(), want);
+        let mut out = Vec::new();
+        write_csv_to(&t, &mut out).unwrap();
+        let all: String = (0..n)
+            .map(|i| {
+                let a = text.format(long[i]).to_string();
+                format!("{a},{}\n", text.format(-long[i]))
+            })
+            .collect();
+        assert_eq!(String::from_utf8(out).unwrap(), format!("a,b\n{all}"));
     }
 
     #[test]
