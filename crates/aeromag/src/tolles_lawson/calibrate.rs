@@ -370,11 +370,23 @@ pub(super) fn second_order_note(
     if design.magnitude != Magnitude::FirstOrder {
         return;
     }
-    let mut span = super::compensate::Span::default();
     let sample = within_budget(segments, SECOND_ORDER_NOTE_ROWS, DEFAULT_SELECTION_BLOCK);
-    for s in &sample {
-        span.add(design, coef, s);
-    }
+    // The sampled blocks on the cores (short blocks take one thread each);
+    // their lowest and highest values are the same in any order.
+    let span = aeromag_core::parallel::parallel_map(
+        sample.len(),
+        aeromag_core::parallel::threads(),
+        |i| {
+            let mut span = super::compensate::Span::default();
+            span.add(design, coef, &sample[i]);
+            span
+        },
+    )
+    .into_iter()
+    .fold(
+        super::compensate::Span::default(),
+        super::compensate::Span::merge,
+    );
     if span.range() > SECOND_ORDER_NOTE_NT {
         let rows: usize = segments.iter().map(|s| s.time.len()).sum();
         let over = if rows > SECOND_ORDER_NOTE_ROWS {

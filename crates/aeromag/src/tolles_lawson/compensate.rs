@@ -174,6 +174,14 @@ impl Span {
         }
     }
 
+    /// The span of both.
+    pub(super) fn merge(self, other: Self) -> Self {
+        Self {
+            lo: self.lo.min(other.lo),
+            hi: self.hi.max(other.hi),
+        }
+    }
+
     /// Peak to peak, nT (0 when empty).
     pub(super) fn range(&self) -> f64 {
         (self.hi - self.lo).max(0.0)
