@@ -28,7 +28,7 @@
 //! per piece ([`CleanRows::records`]) for the reader's line columns.
 
 use std::fs::File;
-use std::io::{Read as _, Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom};
 use std::ops::Range;
 use std::path::Path;
 use std::sync::Mutex;
@@ -574,11 +574,11 @@ pub(crate) fn push_clean_rows(
     let mut append = |piece: &mut Piece| -> Result<bool> {
         // Where the general reader goes on if this piece is not all appended.
         stop = Some(at);
-        match std::mem::take(&mut piece.read) {
-            Read::Lines => {}
+        match std::mem::take(&mut piece.cut) {
+            Cut::Lines => {}
             // A line longer than a piece: the general reader has the limit.
-            Read::LongLine => return Ok(false),
-            Read::Failed(e) => return Err(read_err(at.line, e)),
+            Cut::LongLine => return Ok(false),
+            Cut::Failed(e) => return Err(read_err(at.line, e)),
         }
         let part = &piece.rows;
         let bytes_read = at.offset + part.bytes as u64;
@@ -602,18 +602,18 @@ pub(crate) fn push_clean_rows(
                 if src.ended {
                     return None;
                 }
-                piece.read = match src.read_into(&mut piece.text) {
+                piece.cut = match src.read_into(&mut piece.text) {
                     Ok((false, _)) => return None,
-                    Ok((true, read)) => read,
+                    Ok((true, cut)) => cut,
                     Err(e) => {
                         src.ended = true;
-                        Read::Failed(e)
+                        Cut::Failed(e)
                     }
                 };
                 src.next += 1;
                 src.next - 1
             };
-            if matches!(piece.read, Read::Lines) {
+            if matches!(piece.cut, Cut::Lines) {
                 parse_piece(&piece.text, shape, &mut piece.rows);
             }
             Some(number)
@@ -652,12 +652,12 @@ struct Pieces {
 struct Piece {
     text: Vec<u8>,
     rows: CleanRows,
-    read: Read,
+    cut: Cut,
 }
 
-/// How a piece was read.
+/// How a piece was cut from the file.
 #[derive(Default)]
-enum Read {
+enum Cut {
     /// Whole lines (the last may lack its line end at the file's end).
     #[default]
     Lines,
@@ -670,24 +670,24 @@ impl Pieces {
     /// The next piece into `text`: the carried text, then the file's next
     /// bytes up to `piece_bytes`, cut after the last line end (the rest
     /// carried); `false` at the end of the file with nothing left.
-    fn read_into(&mut self, text: &mut Vec<u8>) -> std::io::Result<(bool, Read)> {
+    fn read_into(&mut self, text: &mut Vec<u8>) -> std::io::Result<(bool, Cut)> {
         text.clear();
         text.append(&mut self.carry);
         let want = self.piece_bytes.saturating_sub(text.len()) as u64;
         let got = (&mut self.file).take(want).read_to_end(text)? as u64;
         if got < want {
             self.ended = true;
-            return Ok((!text.is_empty(), Read::Lines));
+            return Ok((!text.is_empty(), Cut::Lines));
         }
         match memchr::memrchr(b'\n', text) {
             Some(i) => {
                 self.carry.extend_from_slice(&text[i + 1..]);
                 text.truncate(i + 1);
-                Ok((true, Read::Lines))
+                Ok((true, Cut::Lines))
             }
             None => {
                 self.ended = true;
-                Ok((true, Read::LongLine))
+                Ok((true, Cut::LongLine))
             }
         }
     }
@@ -874,7 +874,7 @@ mod tests {
             while !pieces.ended {
                 match pieces.read_into(&mut buf).unwrap() {
                     (false, _) => break,
-                    (true, Read::Lines) => {
+                    (true, Cut::Lines) => {
                         assert!(
                             buf.ends_with(b"\n") || pieces.ended,
                             "{piece_bytes}: {buf:?}"
@@ -882,8 +882,8 @@ mod tests {
                         assert!(buf.len() <= piece_bytes.max(7), "{piece_bytes}: {buf:?}");
                         all.extend_from_slice(&buf);
                     }
-                    (true, Read::LongLine) => long = true,
-                    (true, Read::Failed(e)) => panic!("{e}"),
+                    (true, Cut::LongLine) => long = true,
+                    (true, Cut::Failed(e)) => panic!("{e}"),
                 }
             }
             // The longest line with its line end is 7 bytes.
