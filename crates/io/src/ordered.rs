@@ -13,6 +13,7 @@
 //! outcome is the same for any number of threads.
 
 use std::collections::BTreeMap;
+use std::panic::AssertUnwindSafe;
 use std::sync::{Mutex, MutexGuard, mpsc};
 
 /// Runs `work` on `workers` threads with `per_worker` buffers each going
@@ -27,7 +28,9 @@ use std::sync::{Mutex, MutexGuard, mpsc};
 ///   ends the taking (items in flight are dropped, the workers end once
 ///   the free buffers have run out).
 ///
-/// Returns `take`'s error if it failed.
+/// Returns `take`'s error if it failed. A panic of `work` stops the
+/// taking and is resumed on the calling thread once every worker has
+/// ended.
 pub(crate) fn in_order<B, E>(
     workers: usize,
     per_worker: usize,
@@ -43,19 +46,29 @@ where
         free_tx.send(B::default()).expect("the receiver is here");
     }
     let free_rx = Mutex::new(free_rx);
-    let (done_tx, done_rx) = mpsc::channel::<(usize, B)>();
-    std::thread::scope(|scope| {
+    // `None`: a worker panicked. The taking stops, so that nobody waits for
+    // its item, and its panic is the caller's once every thread has ended.
+    let (done_tx, done_rx) = mpsc::channel::<Option<(usize, B)>>();
+    let panicked: Mutex<Option<Box<dyn std::any::Any + Send>>> = Mutex::new(None);
+    let outcome = std::thread::scope(|scope| {
         for _ in 0..workers {
-            let (work, free_rx, done_tx) = (&work, &free_rx, done_tx.clone());
+            let (work, free_rx, done_tx, panicked) = (&work, &free_rx, done_tx.clone(), &panicked);
             scope.spawn(move || {
                 loop {
                     let Ok(mut buffer) = lock(free_rx).recv() else {
                         return;
                     };
-                    let Some(number) = work(&mut buffer) else {
-                        return;
-                    };
-                    if done_tx.send((number, buffer)).is_err() {
+                    let number =
+                        match std::panic::catch_unwind(AssertUnwindSafe(|| work(&mut buffer))) {
+                            Ok(Some(number)) => number,
+                            Ok(None) => return,
+                            Err(panic) => {
+                                *lock(panicked) = Some(panic);
+                                let _ = done_tx.send(None);
+                                return;
+                            }
+                        };
+                    if done_tx.send(Some((number, buffer))).is_err() {
                         return;
                     }
                 }
@@ -65,8 +78,8 @@ where
         let mut waiting: BTreeMap<usize, B> = BTreeMap::new();
         let mut next = 0;
         let outcome = (|| {
-            // Ends when every worker has ended.
-            for (number, buffer) in &done_rx {
+            // Ends when every worker has ended, or one has panicked.
+            while let Ok(Some((number, buffer))) = done_rx.recv() {
                 waiting.insert(number, buffer);
                 while let Some(mut buffer) = waiting.remove(&next) {
                     next += 1;
@@ -82,7 +95,11 @@ where
         // No buffer for another item: the workers end.
         drop(free_tx);
         outcome
-    })
+    });
+    if let Some(panic) = lock(&panicked).take() {
+        std::panic::resume_unwind(panic);
+    }
+    outcome
 }
 
 /// A lock whose holder may have panicked (the panic reaches the caller at
@@ -146,5 +163,32 @@ mod tests {
         assert_eq!(r, Err("failed"));
         // The workers ended after at most the buffers' worth of items.
         assert!(next.load(Ordering::Relaxed) <= 4);
+    }
+
+    /// A worker that panics ends the work (nobody waits for its item) and
+    /// its panic reaches the caller, for any number of workers.
+    #[test]
+    fn a_panicking_worker_ends_the_work_with_its_panic() {
+        for workers in 1..4 {
+            let next = AtomicUsize::new(0);
+            let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                in_order(
+                    workers,
+                    2,
+                    |_: &mut ()| {
+                        let k = next.fetch_add(1, Ordering::Relaxed);
+                        assert!(k != 5, "item 5");
+                        Some(k)
+                    },
+                    |_| Ok::<_, ()>(true),
+                )
+            }));
+            let panic = outcome.expect_err("the worker's panic");
+            let message = panic
+                .downcast_ref::<&str>()
+                .copied()
+                .or(panic.downcast_ref::<String>().map(String::as_str));
+            assert_eq!(message, Some("item 5"), "{workers} workers");
+        }
     }
 }
