@@ -30,6 +30,31 @@ pub(crate) fn on_parts<T: Send>(v: &[f64], f: impl Fn(&[f64]) -> T + Sync) -> Ve
     })
 }
 
+/// `[f(&jobs[0]), f(&jobs[1]), …]` worked out on the cores (up to
+/// [`crate::csv_clean::threads`] threads, the jobs dealt out in turn), in
+/// the jobs' order: for a few independent passes of unequal length.
+pub(crate) fn each_on_cores<J: Sync, T: Send>(jobs: &[J], f: impl Fn(&J) -> T + Sync) -> Vec<T> {
+    let threads = crate::csv_clean::threads().min(jobs.len()).max(1);
+    if threads == 1 {
+        return jobs.iter().map(f).collect();
+    }
+    let f = &f;
+    let dealt: Vec<Vec<T>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| scope.spawn(move || jobs.iter().skip(t).step_by(threads).map(f).collect()))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    // Job i is the (i / threads)-th of thread i % threads.
+    let mut dealt: Vec<std::vec::IntoIter<T>> = dealt.into_iter().map(Vec::into_iter).collect();
+    (0..jobs.len())
+        .map(|i| dealt[i % threads].next().expect("one result per job"))
+        .collect()
+}
+
 /// The NaN values of `v`.
 pub fn nan_count(v: &[f64]) -> usize {
     on_parts(v, |p| p.iter().filter(|x| x.is_nan()).count())
@@ -40,6 +65,18 @@ pub fn nan_count(v: &[f64]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Jobs dealt out to the cores come back in their order, each once,
+    /// for any number of jobs.
+    #[test]
+    fn jobs_on_the_cores_keep_their_order() {
+        for n in [0, 1, 2, 3, 7, 13] {
+            let jobs: Vec<usize> = (0..n).collect();
+            let got = each_on_cores(&jobs, |&j| (j, j * j));
+            let want: Vec<(usize, usize)> = (0..n).map(|j| (j, j * j)).collect();
+            assert_eq!(got, want, "{n} jobs");
+        }
+    }
 
     /// A long column's parts cover it once, in order, whatever its length
     /// against the parts (the NaN count is the one pass's).
