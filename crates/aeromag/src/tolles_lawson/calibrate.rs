@@ -366,6 +366,7 @@ pub(super) fn second_order_note(
     segments: &[Segment],
     notes: &mut Notes,
 ) {
+    use super::compensate::Span;
     use aeromag_compensation::tolles_lawson::Magnitude;
     if design.magnitude != Magnitude::FirstOrder {
         return;
@@ -377,16 +378,13 @@ pub(super) fn second_order_note(
         sample.len(),
         aeromag_core::parallel::threads(),
         |i| {
-            let mut span = super::compensate::Span::default();
+            let mut span = Span::default();
             span.add(design, coef, &sample[i]);
             span
         },
     )
     .into_iter()
-    .fold(
-        super::compensate::Span::default(),
-        super::compensate::Span::merge,
-    );
+    .fold(Span::default(), Span::merge);
     if span.range() > SECOND_ORDER_NOTE_NT {
         let rows: usize = segments.iter().map(|s| s.time.len()).sum();
         let over = if rows > SECOND_ORDER_NOTE_ROWS {
