@@ -898,3 +898,60 @@ fn a_perturbed_cabin_meets_its_oracle_with_the_stinger_fitted_through_the_turns(
     assert!(stinger < stinger_by_legs, "{stinger} {stinger_by_legs}");
     assert!(mag_5 <= 1.5 * mag_5_oracle, "{mag_5} {mag_5_oracle}");
 }
+
+/// `Contributions::of` evaluates a model without lagged columns block by
+/// block into the moments; the table is the one of the four flight-long
+/// part series, bit for bit: a box repeated past one moment block (2¹⁶
+/// rows) without manoeuvre codes, and with them, missing values splitting
+/// segments inside a block and across a block's edge. A model with lagged
+/// columns takes the series.
+#[test]
+fn contributions_block_by_block_are_the_part_series_bits() {
+    use aeromag::tolles_lawson::{Contributions, InterferenceParts};
+    let cal = calibration(3);
+    let (classical, lagged) = (
+        classical_model(&cal),
+        calibrate(&cal, &CalibrateOptions::default(), &mut Silent)
+            .unwrap()
+            .model,
+    );
+    assert!(classical.design.rows_apart() && !lagged.design.rows_apart());
+    let n = cal.n_rows();
+    let copies = (1 << 16) / n + 2;
+    let long = |codes: bool| {
+        let mut t = FlightTable::new();
+        let dt = cal.require("time").unwrap()[1] - cal.require("time").unwrap()[0];
+        for c in cal.columns() {
+            if c.name() == "manoeuvre" && !codes {
+                continue;
+            }
+            let v = c.values().unwrap();
+            let mut all: Vec<f64> = (0..copies * n)
+                .map(|i| match c.name() {
+                    "time" => i as f64 * dt,
+                    _ => v[i % n],
+                })
+                .collect();
+            if c.name() == "flux_x" {
+                for hole in [1000, 65_530, 65_545, 65_536 + 4000] {
+                    all[hole] = f64::NAN;
+                }
+            }
+            t.add_column(c.name(), all).unwrap();
+        }
+        Flight::from_table(t).unwrap()
+    };
+    for codes in [false, true] {
+        let flight = long(codes);
+        for model in [&classical, &lagged] {
+            let p = InterferenceParts::of(model, &flight, &SensorColumns::default()).unwrap();
+            let series = Contributions::from_series(
+                [&p.permanent, &p.induced, &p.eddy, &p.currents],
+                flight.column("manoeuvre"),
+            );
+            let blocks = Contributions::of(model, &flight).unwrap();
+            assert_eq!(blocks, series, "codes {codes}, {}", model.design.terms);
+            assert!(series.groups.iter().all(|g| g.total_nt > 0.0));
+        }
+    }
+}

@@ -96,6 +96,59 @@ fn tl_interferences<const K: usize>(
     Ok(outs)
 }
 
+/// [`tl_interferences`] over the rows of each of `blocks` (rows of
+/// `flight`) in turn, handed to `f(block, outputs)` instead of kept: the
+/// same bits row by row, with memory for a block per thread instead of
+/// `K` flight-long series (32 MB at 10⁶ rows for the four parts). Blocks
+/// on the cores; `f`'s results in block order. `None` when the model's
+/// rows cannot be computed apart from those before them
+/// ([`Design::rows_apart`]: lagged columns, the exact magnitude).
+pub(super) fn tl_interference_blocks<const K: usize, R: Send>(
+    model: &TlModel,
+    coefs: [&[f64]; K],
+    flight: &Flight,
+    sensor: &SensorColumns,
+    blocks: &[std::ops::Range<usize>],
+    f: impl Fn(usize, [&[f64]; K]) -> R + Sync,
+) -> Result<Option<Vec<R>>> {
+    if !model.design.rows_apart() {
+        return Ok(None);
+    }
+    let (cols, segs) = model_segments(model, flight, sensor)?;
+    let whole = cols.whole();
+    let threads = if flight.n_rows() < 1 << 16 {
+        1
+    } else {
+        aeromag_core::parallel::threads()
+    };
+    let results = aeromag_core::parallel::parallel_map(blocks.len(), threads, |b| {
+        let rows = &blocks[b];
+        // NaN between the segments.
+        let mut outs: [Vec<f64>; K] = std::array::from_fn(|_| vec![f64::NAN; rows.len()]);
+        // The segments that overlap the block (in row order, apart).
+        let first = segs.partition_point(|s| s.end <= rows.start);
+        for s in segs[first..].iter().take_while(|s| s.start < rows.end) {
+            let (a, e) = (s.start.max(rows.start), s.end.min(rows.end));
+            let mut parts: Vec<&mut [f64]> = outs
+                .iter_mut()
+                .map(|o| &mut o[a - rows.start..e - rows.start])
+                .collect();
+            let seg = whole.slice(s.clone());
+            let apart = model.design.interferences_of_rows(
+                &coefs,
+                seg.time,
+                seg.flux,
+                seg.channels,
+                a - s.start,
+                &mut parts,
+            );
+            debug_assert!(apart, "checked by rows_apart above");
+        }
+        f(b, outs.each_ref().map(|o| &o[..]))
+    });
+    Ok(Some(results))
+}
+
 /// The stretches of `flight` that `model` applies to at the sensor
 /// `sensor` (no gaps or missing values; line changes do not matter), and
 /// the inputs they are read from.
@@ -207,20 +260,7 @@ pub struct InterferenceParts {
 impl InterferenceParts {
     /// The parts of `model` at the sensor `sensor` of `flight`.
     pub fn of(model: &TlModel, flight: &Flight, sensor: &SensorColumns) -> Result<Self> {
-        // The coefficients of one part, the others' set to zero.
-        let part = |keep: &dyn Fn(&str) -> bool| -> Vec<f64> {
-            model
-                .coefficients
-                .iter()
-                .map(|c| if keep(&c.name) { c.value } else { 0.0 })
-                .collect()
-        };
-        let coefs = [
-            part(&|n| n.starts_with("p_")),
-            part(&|n| n.starts_with("i_")),
-            part(&|n| n.starts_with("e_") || n.starts_with('l')),
-            part(&|n| n.contains(':')),
-        ];
+        let coefs = Self::coefficients(model);
         let [permanent, induced, eddy, currents] =
             tl_interferences(model, coefs.each_ref().map(|c| &c[..]), flight, sensor)?;
         Ok(Self {
@@ -229,5 +269,23 @@ impl InterferenceParts {
             eddy,
             currents,
         })
+    }
+
+    /// The coefficients of each part (permanent, induced, eddy, currents):
+    /// `model`'s, the other parts' set to zero.
+    pub(super) fn coefficients(model: &TlModel) -> [Vec<f64>; 4] {
+        let part = |keep: &dyn Fn(&str) -> bool| -> Vec<f64> {
+            model
+                .coefficients
+                .iter()
+                .map(|c| if keep(&c.name) { c.value } else { 0.0 })
+                .collect()
+        };
+        [
+            part(&|n| n.starts_with("p_")),
+            part(&|n| n.starts_with("i_")),
+            part(&|n| n.starts_with("e_") || n.starts_with('l')),
+            part(&|n| n.contains(':')),
+        ]
     }
 }

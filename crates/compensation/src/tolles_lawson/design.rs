@@ -303,6 +303,39 @@ impl Design {
         }
     }
 
+    /// Whether [`Design::interferences_of_rows`] computes rows apart from
+    /// those before them: under the first-order magnitude without lagged
+    /// columns (whose state runs from the segment's start).
+    pub fn rows_apart(&self) -> bool {
+        self.magnitude == Magnitude::FirstOrder && !self.lagged()
+    }
+
+    /// Rows `start..start + len` of [`Design::interferences_into`] on a
+    /// segment (`outs[k]` of `len` rows each): the bits of those rows of
+    /// the whole call, without computing the others. `false` (nothing
+    /// written) when the design does not compute rows apart
+    /// ([`Design::rows_apart`]).
+    pub fn interferences_of_rows(
+        &self,
+        coefs: &[&[f64]],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        start: usize,
+        outs: &mut [&mut [f64]],
+    ) -> bool {
+        if !self.rows_apart() {
+            return false;
+        }
+        self.project_rows(coefs, time, flux, channels, None, start, outs);
+        true
+    }
+
+    /// Whether the design has lagged columns (eddy lags, lagged extras).
+    fn lagged(&self) -> bool {
+        !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some()
+    }
+
     /// The modelled interference vector `ΔB` (nT, body frame; [`Magnitude`]
     /// docs) of every sample, and the bias coefficient (0 without a `bias`
     /// term), which is not part of the vector.
@@ -387,51 +420,66 @@ impl Design {
     ) {
         let n = time.len();
         debug_assert!(outs.iter().all(|o| o.len() == n) && outs.len() == coefs.len());
-        let lagged =
-            !self.terms.eddy_lags_s().is_empty() || self.terms.extra_lags_s().next().is_some();
         let threads = aeromag_core::parallel::threads();
-        // Rows `start..start + len` into `parts` (the outputs' rows there).
         let project = |start: usize, parts: &mut [&mut [f64]]| {
-            let len = parts.first().map_or(0, |p| p.len());
-            let mut lags = Lags::new(&self.terms);
-            let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
-            let mut db: [Vec<f64>; 3] = Default::default();
-            for a in (0..len).step_by(PROJECTION_BLOCK) {
-                let local = a..(a + PROJECTION_BLOCK).min(len);
-                let r = start + local.start..start + local.end;
-                self.derivatives_into(time, flux, r.clone(), &mut db);
-                self.block_columns(
-                    r,
-                    time,
-                    flux,
-                    dir,
-                    channels,
-                    [&db[0][..], &db[1][..], &db[2][..]],
-                    &mut lags,
-                    &mut scratch,
-                    &mut cols,
-                );
-                for (part, coef) in parts.iter_mut().zip(coefs) {
-                    let acc = &mut part[local.clone()];
-                    // −0.0 is the identity of f64 addition (what
-                    // `Iterator::sum` starts from), so this is the bits of
-                    // `row · c`.
-                    acc.fill(-0.0);
-                    // A zero coefficient adds nothing (the columns are
-                    // finite) but the sign of an exact zero: skipped (a
-                    // part of the model has most of them).
-                    for (col, c) in cols.iter().zip(*coef).filter(|(_, c)| **c != 0.0) {
-                        for (a, v) in acc.iter_mut().zip(col) {
-                            *a += v * c;
-                        }
-                    }
-                }
-            }
+            self.project_rows(coefs, time, flux, channels, dir, start, parts)
         };
-        if lagged || n < 4 * PROJECTION_BLOCK {
+        if self.lagged() || n < 4 * PROJECTION_BLOCK {
             project(0, outs);
         } else {
             aeromag_core::parallel::for_each_rows_mut(outs, threads, PROJECTION_BLOCK, project);
+        }
+    }
+
+    /// Rows `start..start + len` of [`Design::projections_into`] into
+    /// `parts` (the outputs' rows there), in blocks of
+    /// [`PROJECTION_BLOCK`]; lagged columns start at `start` (the
+    /// segment's first row for them).
+    #[allow(clippy::too_many_arguments)]
+    fn project_rows(
+        &self,
+        coefs: &[&[f64]],
+        time: &[f64],
+        flux: [&[f64]; 3],
+        channels: Channels,
+        dir: Option<[&[f64]; 3]>,
+        start: usize,
+        parts: &mut [&mut [f64]],
+    ) {
+        let len = parts.first().map_or(0, |p| p.len());
+        let mut lags = Lags::new(&self.terms);
+        let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
+        let mut db: [Vec<f64>; 3] = Default::default();
+        for a in (0..len).step_by(PROJECTION_BLOCK) {
+            let local = a..(a + PROJECTION_BLOCK).min(len);
+            let r = start + local.start..start + local.end;
+            self.derivatives_into(time, flux, r.clone(), &mut db);
+            self.block_columns(
+                r,
+                time,
+                flux,
+                dir,
+                channels,
+                [&db[0][..], &db[1][..], &db[2][..]],
+                &mut lags,
+                &mut scratch,
+                &mut cols,
+            );
+            for (part, coef) in parts.iter_mut().zip(coefs) {
+                let acc = &mut part[local.clone()];
+                // −0.0 is the identity of f64 addition (what
+                // `Iterator::sum` starts from), so this is the bits of
+                // `row · c`.
+                acc.fill(-0.0);
+                // A zero coefficient adds nothing (the columns are
+                // finite) but the sign of an exact zero: skipped (a
+                // part of the model has most of them).
+                for (col, c) in cols.iter().zip(*coef).filter(|(_, c)| **c != 0.0) {
+                    for (a, v) in acc.iter_mut().zip(col) {
+                        *a += v * c;
+                    }
+                }
+            }
         }
     }
 
