@@ -21,6 +21,10 @@ command -v hyperfine >/dev/null || { apt-get install -y hyperfine >/dev/null 2>&
 cargo build --release -p aeromag-cli
 bin=$PWD/target/release/aeromag
 mkdir -p "$dir"
+# GMT writes its gmt.history beside the commands it runs: in the bench
+# folder, not the repository.
+export GMT_TMPDIR="$(cd "$dir" && pwd)/gmt-tmp"
+mkdir -p "$GMT_TMPDIR"
 if [ ! -f "$dir/survey.csv" ]; then
     python3 - "$dir" <<'PY'
 import sys, numpy as np
