@@ -649,9 +649,15 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
         Ok(())
     })?;
     if used == 0 {
-        return Err(CompError::data(
-            "no segment is long enough to fit (see the warnings)",
-        ));
+        // The reasons would otherwise be lost with the warnings.
+        let why = match warnings.as_slice() {
+            [] => String::new(),
+            [w] => format!(": {w}"),
+            [w, rest @ ..] => format!(": {w} (and {} more)", rest.len()),
+        };
+        return Err(CompError::data(format!(
+            "no segment is long enough to fit{why}"
+        )));
     }
     let independent_fraction = match cfg.band_hz {
         Some((lo, hi)) => {

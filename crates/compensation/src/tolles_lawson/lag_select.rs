@@ -204,11 +204,21 @@ pub const DEFAULT_EXTRA_SELECTION_ROWS: usize = 30_000;
 /// Length of the blocks [`within_budget`] samples, rows (default).
 pub const DEFAULT_SELECTION_BLOCK: usize = 3_000;
 
-/// At most about `max_rows` rows of `segments`: each segment gives the same
-/// fraction of its length, as blocks of about `block_rows` rows spread
-/// evenly over it (a calibration leg flies its manoeuvres one after the
-/// other, so a prefix would hold only the first). Each block is its own
-/// segment (filtered and trimmed on its own).
+/// At most about `max_rows` rows of `segments`, each block its own segment
+/// (filtered and trimmed on its own):
+/// - a segment whose share of the budget (the same fraction of every
+///   segment's length) is at least half a block (`block_rows / 2`), or the
+///   whole segment when shorter, gives its share as blocks of about
+///   `block_rows` rows spread evenly over it (a calibration leg flies its
+///   manoeuvres one after the other, so a prefix would hold only the first);
+/// - the shorter shares are pooled in segment order, and each time they add
+///   up to half a piece the next segment gives one whole piece (itself up
+///   to `block_rows` rows, its middle block beyond), so a flight of many
+///   short legs is sampled in whole legs spread over the flight rather than
+///   in slivers too short to filter. Before, 3·10⁶ rows in legs of 850
+///   (the peers' flight repeated) left 57-row slivers, and `calibrate`
+///   stopped: "no segment is long enough to fit". A budget below half a
+///   piece still gives one: the longest segment's.
 pub fn within_budget<'a>(
     segments: &[Segment<'a>],
     max_rows: usize,
@@ -218,12 +228,26 @@ pub fn within_budget<'a>(
     if total <= max_rows {
         return segments.to_vec();
     }
+    let block_rows = block_rows.max(1);
     let frac = max_rows as f64 / total as f64;
     let mut out = Vec::new();
+    // The pooled shares not yet taken, rows.
+    let mut owed = 0.0;
     for s in segments {
         let len = s.time.len();
-        let share = ((len as f64 * frac).ceil() as usize).min(len);
-        let blocks = share.div_ceil(block_rows.max(1)).max(1);
+        let exact = len as f64 * frac;
+        if exact < len.min(block_rows / 2).max(1) as f64 {
+            owed += exact;
+            let piece = len.min(block_rows);
+            if owed >= piece as f64 / 2.0 {
+                owed -= piece as f64;
+                let a = (len - piece) / 2;
+                out.push(s.slice(a..a + piece));
+            }
+            continue;
+        }
+        let share = (exact.ceil() as usize).min(len);
+        let blocks = share.div_ceil(block_rows).max(1);
         let blk = share / blocks;
         for k in 0..blocks {
             let a = if blocks > 1 {
@@ -233,6 +257,14 @@ pub fn within_budget<'a>(
             };
             out.push(s.slice(a..a + blk));
         }
+    }
+    if out.is_empty()
+        && let Some(s) = segments.iter().rev().max_by_key(|s| s.time.len())
+    {
+        let len = s.time.len();
+        let piece = len.min(block_rows);
+        let a = (len - piece) / 2;
+        out.push(s.slice(a..a + piece));
     }
     out
 }
@@ -656,6 +688,47 @@ pub(crate) mod tests {
             sel.candidates.iter().all(|c| c.lr_statistic < c.threshold),
             "{sel:?}"
         );
+    }
+
+    /// Many legs too short for the budget's share of each (25 rows of
+    /// 180, too few to filter): whole legs are taken, spread over the
+    /// flight, about the budget in all, and the search runs on them. A
+    /// budget below half a leg still gives one leg, the longest.
+    #[test]
+    fn short_legs_are_sampled_whole_not_in_slivers() {
+        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
+        let coef: Vec<f64> = coef16()
+            .into_iter()
+            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
+            .collect();
+        let legs = boxed(&truth, &coef);
+        let segs = segments_of(&legs);
+        let short: Vec<Segment> = segs
+            .iter()
+            .flat_map(|s| (0..10).map(move |k| s.slice(180 * k..180 * (k + 1))))
+            .collect();
+        assert_eq!(short.len(), 40);
+        let cut = within_budget(&short, 1000, 3000);
+        let rows: usize = cut.iter().map(|s| s.time.len()).sum();
+        assert!(cut.iter().all(|s| s.time.len() == 180), "{rows}");
+        assert!((1000 - 180..=1000 + 180).contains(&rows), "{rows}");
+        // Spread: the first taken within the first tenth, the last within
+        // the last tenth of the legs.
+        let index = |c: &Segment| short.iter().position(|s| s.time[0] == c.time[0]).unwrap();
+        assert!(index(&cut[0]) < 4 && index(&cut[cut.len() - 1]) >= 36);
+        select_eddy_lags(
+            &cut,
+            &LsConfig::default(),
+            &DEFAULT_LAG_GRID_S,
+            2,
+            DEFAULT_ALPHA,
+        )
+        .unwrap();
+        let mut uneven = short.clone();
+        uneven[13] = segs[1].slice(0..300);
+        let one = within_budget(&uneven, 10, 3000);
+        assert_eq!(one.len(), 1);
+        assert_eq!((one[0].time.len(), one[0].time[0]), (300, segs[1].time[0]));
     }
 
     /// The budget samples every segment alike, and the lag is still found
