@@ -349,8 +349,9 @@ pub(super) fn calibrate_with(
 pub const SECOND_ORDER_NOTE_NT: f64 = 0.1;
 
 /// Rows [`second_order_note`] evaluates at most: a longer flight is
-/// sampled in blocks spread evenly over every segment (`within_budget`,
-/// as the lag search), since the remainder needs the interference vector
+/// sampled as the lag search samples it (`within_budget`: blocks spread
+/// evenly over every segment, or whole short legs spread over the
+/// flight), since the remainder needs the interference vector
 /// (three evaluations of the design) and follows the attitude and heading,
 /// which a tenth of a long flight samples fully. On a 10⁷-row flight the
 /// note cost as much as the fit.
