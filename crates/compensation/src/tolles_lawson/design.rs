@@ -273,7 +273,15 @@ impl Design {
         outs: &mut [&mut [f64]],
     ) {
         match self.magnitude {
-            Magnitude::FirstOrder => self.projections_into(coefs, time, flux, channels, None, outs),
+            Magnitude::FirstOrder => {
+                let inputs = Inputs {
+                    time,
+                    flux,
+                    channels,
+                    dir: None,
+                };
+                self.projections_into(coefs, inputs, outs)
+            }
             Magnitude::Exact => {
                 for (coef, out) in coefs.iter().zip(outs.iter_mut()) {
                     self.interference_with_into(coef, time, flux, channels, out);
@@ -327,7 +335,17 @@ impl Design {
         if !self.rows_apart() {
             return false;
         }
-        self.project_rows(coefs, time, flux, channels, None, start, outs);
+        self.project_rows(
+            coefs,
+            Inputs {
+                time,
+                flux,
+                channels,
+                dir: None,
+            },
+            start,
+            outs,
+        );
         true
     }
 
@@ -396,7 +414,13 @@ impl Design {
         dir: Option<[&[f64]; 3]>,
         out: &mut [f64],
     ) {
-        self.projections_into(&[coef], time, flux, channels, dir, &mut [out]);
+        let inputs = Inputs {
+            time,
+            flux,
+            channels,
+            dir,
+        };
+        self.projections_into(&[coef], inputs, &mut [out]);
     }
 
     /// `A c_k` for each coefficient vector `coefs[k]` into `outs[k]` (each
@@ -409,21 +433,12 @@ impl Design {
     /// are shared out over the available cores (each row's sum is the same
     /// bits whatever the thread count); lagged columns carry their state
     /// from block to block, one thread.
-    fn projections_into(
-        &self,
-        coefs: &[&[f64]],
-        time: &[f64],
-        flux: [&[f64]; 3],
-        channels: Channels,
-        dir: Option<[&[f64]; 3]>,
-        outs: &mut [&mut [f64]],
-    ) {
-        let n = time.len();
+    fn projections_into(&self, coefs: &[&[f64]], inputs: Inputs, outs: &mut [&mut [f64]]) {
+        let n = inputs.time.len();
         debug_assert!(outs.iter().all(|o| o.len() == n) && outs.len() == coefs.len());
         let threads = aeromag_core::parallel::threads();
-        let project = |start: usize, parts: &mut [&mut [f64]]| {
-            self.project_rows(coefs, time, flux, channels, dir, start, parts)
-        };
+        let project =
+            |start: usize, parts: &mut [&mut [f64]]| self.project_rows(coefs, inputs, start, parts);
         if self.lagged() || n < 4 * PROJECTION_BLOCK {
             project(0, outs);
         } else {
@@ -435,17 +450,19 @@ impl Design {
     /// `parts` (the outputs' rows there), in blocks of
     /// [`PROJECTION_BLOCK`]; lagged columns start at `start` (the
     /// segment's first row for them).
-    #[allow(clippy::too_many_arguments)]
     fn project_rows(
         &self,
         coefs: &[&[f64]],
-        time: &[f64],
-        flux: [&[f64]; 3],
-        channels: Channels,
-        dir: Option<[&[f64]; 3]>,
+        inputs: Inputs,
         start: usize,
         parts: &mut [&mut [f64]],
     ) {
+        let Inputs {
+            time,
+            flux,
+            channels,
+            dir,
+        } = inputs;
         let len = parts.first().map_or(0, |p| p.len());
         let mut lags = Lags::new(&self.terms);
         let (mut scratch, mut cols) = (Scratch::default(), Vec::new());
@@ -571,6 +588,17 @@ impl Design {
             }
         }
     }
+}
+
+/// What a projection reads of a segment: its times, the vector
+/// magnetometer's readings (nT), the extra regressors' channels, and the
+/// series the direction cosines come from (`dir`; default `flux`).
+#[derive(Clone, Copy)]
+struct Inputs<'a> {
+    time: &'a [f64],
+    flux: [&'a [f64]; 3],
+    channels: Channels<'a>,
+    dir: Option<[&'a [f64]; 3]>,
 }
 
 /// Rows per block of [`Design::projected_into`].

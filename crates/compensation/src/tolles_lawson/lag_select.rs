@@ -579,6 +579,17 @@ pub(crate) mod tests {
             .collect()
     }
 
+    /// The box with eddy currents lagging by 0.5 s (the lagged group at 20×
+    /// the classical one's size).
+    fn lagging_box() -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
+        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
+        let coef: Vec<f64> = coef16()
+            .into_iter()
+            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
+            .collect();
+        boxed(&truth, &coef)
+    }
+
     fn select(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> LagSelection {
         let segs = segments_of(&legs);
         select_eddy_lags(
@@ -595,12 +606,7 @@ pub(crate) mod tests {
     /// falls to the noise (uniform ±0.01 nT, RMS 0.0058 nT before filtering).
     #[test]
     fn finds_the_lag_of_lagging_eddy_currents() {
-        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16()
-            .into_iter()
-            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
-            .collect();
-        let sel = select(&boxed(&truth, &coef));
+        let sel = select(&lagging_box());
         assert!(sel.taus_s.contains(&0.5), "{sel:?}");
         assert!(
             sel.base_residual_rms_nt > 3.0 * sel.residual_rms_nt,
@@ -696,12 +702,7 @@ pub(crate) mod tests {
     /// budget below half a leg still gives one leg, the longest.
     #[test]
     fn short_legs_are_sampled_whole_not_in_slivers() {
-        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16()
-            .into_iter()
-            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
-            .collect();
-        let legs = boxed(&truth, &coef);
+        let legs = lagging_box();
         let segs = segments_of(&legs);
         let short: Vec<Segment> = segs
             .iter()
@@ -735,12 +736,7 @@ pub(crate) mod tests {
     /// from a third of the rows.
     #[test]
     fn a_row_budget_cuts_every_segment_alike() {
-        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16()
-            .into_iter()
-            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
-            .collect();
-        let legs = boxed(&truth, &coef);
+        let legs = lagging_box();
         let segs = segments_of(&legs);
         // 4 legs of 1800 rows, a third of each: 4 blocks of 150 rows per leg,
         // spread over the leg (first at its start, last at its end).
@@ -866,12 +862,7 @@ pub(crate) mod tests {
         // Lagging eddy currents are still found under weaker geology. (Under
         // the strong one they are not: the price of the test's caution, and
         // why the Kalman method, which models the geology, matters there.)
-        let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
-        let coef: Vec<f64> = coef16()
-            .into_iter()
-            .chain(coef_lag9().into_iter().map(|c| 20.0 * c))
-            .collect();
-        let mut legs = boxed(&truth, &coef);
+        let mut legs = lagging_box();
         geology(&mut legs, 0.1);
         let sel = select(&legs);
         assert!(sel.taus_s.contains(&0.5), "{sel:?}");
