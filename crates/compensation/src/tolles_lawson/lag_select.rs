@@ -207,8 +207,9 @@ pub const DEFAULT_SELECTION_BLOCK: usize = 3_000;
 /// At most about `max_rows` rows of `segments`, each block its own segment
 /// (filtered and trimmed on its own):
 /// - a segment whose share of the budget (the same fraction of every
-///   segment's length) is at least half a block (`block_rows / 2`), or the
-///   whole segment when shorter, gives its share as blocks of about
+///   segment's length) is at least a tenth of a block (`block_rows / 10`,
+///   300 rows by default: three periods of a 0.1 Hz band edge at 10 Hz),
+///   or the whole segment when shorter, gives its share as blocks of about
 ///   `block_rows` rows spread evenly over it (a calibration leg flies its
 ///   manoeuvres one after the other, so a prefix would hold only the first);
 /// - the shorter shares are pooled in segment order, and each time they add
@@ -236,7 +237,7 @@ pub fn within_budget<'a>(
     for s in segments {
         let len = s.time.len();
         let exact = len as f64 * frac;
-        if exact < len.min(block_rows / 2).max(1) as f64 {
+        if exact < len.min(block_rows / 10).max(1) as f64 {
             owed += exact;
             let piece = len.min(block_rows);
             if owed >= piece as f64 / 2.0 {
