@@ -880,17 +880,15 @@ pub(crate) mod tests {
     use aeromag_core::frames::Attitude;
     use nalgebra::Vector3;
 
+    /// A synthetic leg: its times (s), vector readings (nT) and scalar
+    /// readings (nT).
+    pub(crate) type Leg = (Vec<f64>, [Vec<f64>; 3], Vec<f64>);
+
     /// A synthetic calibration leg: heading `yaw0` (deg), roll/pitch/yaw
     /// oscillations, Earth field (NED) fixed, interference from `coef`
     /// through the design row itself (a solver test, not a physics test),
     /// plus a slow external variation and white noise.
-    fn leg(
-        yaw0: f64,
-        coef: &[f64],
-        terms: &TermSet,
-        t0: f64,
-        maneuvers: bool,
-    ) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+    fn leg(yaw0: f64, coef: &[f64], terms: &TermSet, t0: f64, maneuvers: bool) -> Leg {
         leg_n(yaw0, coef, terms, t0, maneuvers, 1800)
     }
 
@@ -901,7 +899,7 @@ pub(crate) mod tests {
         t0: f64,
         maneuvers: bool,
         n: usize,
-    ) -> (Vec<f64>, [Vec<f64>; 3], Vec<f64>) {
+    ) -> Leg {
         let b_ned = Vector3::new(17_000.0, 1_500.0, 48_000.0);
         let dt = 0.1;
         let (mut t, mut fx, mut fy, mut fz) = (vec![], vec![], vec![], vec![]);
@@ -1052,7 +1050,7 @@ pub(crate) mod tests {
     }
 
     /// Segments over synthetic legs.
-    pub(crate) fn segments_of(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> Vec<Segment<'_>> {
+    pub(crate) fn segments_of(legs: &[Leg]) -> Vec<Segment<'_>> {
         legs.iter()
             .map(|(t, f, m)| Segment {
                 time: t,

@@ -554,11 +554,11 @@ pub(crate) mod tests {
     use super::*;
     use crate::tolles_lawson::Design;
     use crate::tolles_lawson::TermSet;
-    use crate::tolles_lawson::fit_ls::tests::{coef_lag9, coef16, leg_n, segments_of};
+    use crate::tolles_lawson::fit_ls::tests::{Leg, coef_lag9, coef16, leg_n, segments_of};
 
     /// The segments of `legs`, each with its extra-regressor channels.
     pub(crate) fn with_channels<'a, const N: usize>(
-        legs: &'a [(Vec<f64>, [Vec<f64>; 3], Vec<f64>)],
+        legs: &'a [Leg],
         channels: &'a [[&'a [f64]; N]],
     ) -> Vec<Segment<'a>> {
         use super::super::design::Channels;
@@ -572,7 +572,7 @@ pub(crate) mod tests {
             .collect()
     }
 
-    pub(crate) fn boxed(terms: &TermSet, coef: &[f64]) -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
+    pub(crate) fn boxed(terms: &TermSet, coef: &[f64]) -> Vec<Leg> {
         [0.0, 90.0, 180.0, 270.0]
             .iter()
             .enumerate()
@@ -582,7 +582,7 @@ pub(crate) mod tests {
 
     /// The box with eddy currents lagging by 0.5 s (the lagged group at 20×
     /// the classical one's size).
-    fn lagging_box() -> Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)> {
+    fn lagging_box() -> Vec<Leg> {
         let truth = TermSet::observable16().with_eddy_lags(&[0.5]).unwrap();
         let coef: Vec<f64> = coef16()
             .into_iter()
@@ -591,8 +591,8 @@ pub(crate) mod tests {
         boxed(&truth, &coef)
     }
 
-    fn select(legs: &[(Vec<f64>, [Vec<f64>; 3], Vec<f64>)]) -> LagSelection {
-        let segs = segments_of(&legs);
+    fn select(legs: &[Leg]) -> LagSelection {
+        let segs = segments_of(legs);
         select_eddy_lags(
             &segs,
             &LsConfig::default(),
@@ -838,7 +838,7 @@ pub(crate) mod tests {
     /// no lag is taken for it, while the eddy currents' lag is still found.
     #[test]
     fn geology_in_the_band_does_not_buy_a_lag() {
-        let geology = |legs: &mut Vec<(Vec<f64>, [Vec<f64>; 3], Vec<f64>)>, amp: f64| {
+        let geology = |legs: &mut Vec<Leg>, amp: f64| {
             for (k, (t, _, m)) in legs.iter_mut().enumerate() {
                 for (ti, mi) in t.iter().zip(m.iter_mut()) {
                     *mi += (0..8)
