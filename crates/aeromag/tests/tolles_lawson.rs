@@ -955,3 +955,55 @@ fn contributions_block_by_block_are_the_part_series_bits() {
         }
     }
 }
+
+/// A long flight of many legs with current channels: the cabin box
+/// repeated 60 times (about 370 000 rows in some 420 legs). The current
+/// channels' lag search samples 30 000 rows of it; it used to take the
+/// same fraction of every leg, slivers too short to filter beside the
+/// lagged eddy columns, and the calibration with the default lag search
+/// stopped ("no segment is long enough to fit"). Whole legs are sampled
+/// now: the default calibration keeps both currents, the flap one with a
+/// lag; with the box's own classical eddy terms the flap current's field
+/// lag (0.4 s in the simulator) is found within the box's own bound.
+#[test]
+fn a_long_flight_of_many_legs_calibrates_with_current_channels() {
+    use aeromag::compensation::tolles_lawson::ExtraRequest;
+    let cal = cabin_calibration();
+    let (n, copies) = (cal.n_rows(), 60);
+    let time = cal.require("time").unwrap();
+    let dt = time[1] - time[0];
+    let mut t = FlightTable::new();
+    for c in cal.columns() {
+        let v = c.values().unwrap();
+        let all: Vec<f64> = (0..copies * n)
+            .map(|i| match c.name() {
+                "time" => time[0] + i as f64 * dt,
+                "line" => v[i % n] + 1000.0 * (i / n) as f64,
+                _ => v[i % n],
+            })
+            .collect();
+        t.add_column(c.name(), all).unwrap();
+    }
+    let long = Flight::from_table(t).unwrap();
+    let opts = CalibrateOptions {
+        sensor: SensorColumns::find(&long, "mag_2", Some("flux_b")).unwrap(),
+        extra: ExtraRequest::parse_list("cur_strb,cur_flap:lag").unwrap(),
+        ..CalibrateOptions::default()
+    };
+    let fit = calibrate(&long, &opts, &mut Silent).unwrap();
+    let extras = fit.model.design.terms.extras();
+    assert_eq!(extras.len(), 2, "{:?}", fit.model.design.terms);
+    assert!(extras[1].lag_s.is_some(), "{extras:?}");
+    // With the classical eddy terms, as the box alone chooses them (copies
+    // of one box make lags look significant: the same rows counted 60
+    // times), the bound of the box's own test
+    // (`current_terms_compensate_a_cabin_sensor`).
+    let classical = CalibrateOptions {
+        eddy_lag: EddyLag::None,
+        ..opts
+    };
+    let fit = calibrate(&long, &classical, &mut Silent).unwrap();
+    let terms = &fit.model.design.terms;
+    let tau = terms.extras()[1].lag_s.unwrap();
+    assert!((tau - 0.4).abs() < 0.02, "{terms:?}");
+}
