@@ -127,3 +127,30 @@ fn main() {
         std::process::exit(exit::classify(&e));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// Every command, and every command under it, says what it does: none
+    /// shows the shared input arguments' description as its own (a command
+    /// without a doc comment of its own inherits it from the flattened
+    /// `InputArgs`, as `level` did in `aeromag --help`).
+    #[test]
+    fn every_command_describes_itself() {
+        fn check(cmd: &clap::Command, path: &str) {
+            for sub in cmd.get_subcommands() {
+                let path = format!("{path} {}", sub.get_name());
+                let about = sub.get_about().map(|a| a.to_string()).unwrap_or_default();
+                assert!(!about.trim().is_empty(), "`{path}` has no description");
+                assert!(
+                    !about.starts_with("Input-file arguments"),
+                    "`{path}` shows the input arguments' description: {about}"
+                );
+                check(sub, &path);
+            }
+        }
+        check(&Cli::command(), "aeromag");
+    }
+}

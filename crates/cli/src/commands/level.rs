@@ -9,6 +9,19 @@ use aeromag::compensation::levelling::{HUBER_K, LevellingConfig};
 use aeromag::level::{LevelFitChoices, LevelOptions, level};
 use std::path::PathBuf;
 
+/// Level a (compensated) survey at the crossovers of its lines and tie
+/// lines, and write it with the levelled column `<value>_level`.
+///
+/// The crossovers are found at the sensor's position; one level per line
+/// (and with --drift a linear drift) is fitted jointly with `k` of the
+/// survey-altitude `k·d|B0|/dt` term (the field's rate along the track
+/// times the scalar channel's lag), the altitude term and robust weights.
+/// It prints the crossovers' differences before and after and `k`.
+///
+/// Examples:
+///   aeromag level -i survey_comp.csv --out levelled.csv
+///   aeromag level -i survey_comp.csv --reference auto --crossovers x.csv --out levelled.csv
+///   aeromag level -i survey.xyz --tie-only --out levelled.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
