@@ -97,7 +97,7 @@ fn tl_interferences<const K: usize>(
 }
 
 /// [`tl_interferences`] over the rows of each of `blocks` (rows of
-/// `flight`) in turn, handed to `f(block, outputs)` instead of kept: the
+/// `flight`) in turn, handed to `f(outputs)` instead of kept: the
 /// same bits row by row, with memory for a block per thread instead of
 /// `K` flight-long series (32 MB at 10⁶ rows for the four parts). Blocks
 /// on the cores; `f`'s results in block order. `None` when the model's
@@ -109,7 +109,7 @@ pub(super) fn tl_interference_blocks<const K: usize, R: Send>(
     flight: &Flight,
     sensor: &SensorColumns,
     blocks: &[std::ops::Range<usize>],
-    f: impl Fn(usize, [&[f64]; K]) -> R + Sync,
+    f: impl Fn([&[f64]; K]) -> R + Sync,
 ) -> Result<Option<Vec<R>>> {
     if !model.design.rows_apart() {
         return Ok(None);
@@ -144,7 +144,7 @@ pub(super) fn tl_interference_blocks<const K: usize, R: Send>(
             );
             debug_assert!(apart, "checked by rows_apart above");
         }
-        f(b, outs.each_ref().map(|o| &o[..]))
+        f(outs.each_ref().map(|o| &o[..]))
     });
     Ok(Some(results))
 }

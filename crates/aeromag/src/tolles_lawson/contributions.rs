@@ -77,7 +77,7 @@ impl Contributions {
             flight,
             &SensorColumns::default(),
             &ranges,
-            |_, parts| Moments::of_parts(&(0..parts[0].len()), values_of(parts)),
+            |parts| Moments::of_parts(&(0..parts[0].len()), values_of(parts)),
         )?;
         let moments = match moments {
             Some(m) => merged(&runs, &blocks, m),

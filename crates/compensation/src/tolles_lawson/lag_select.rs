@@ -231,6 +231,11 @@ pub fn within_budget<'a>(
     }
     let block_rows = block_rows.max(1);
     let frac = max_rows as f64 / total as f64;
+    // The middle `rows` rows of `s`.
+    let middle = |s: &Segment<'a>, rows: usize| {
+        let a = (s.time.len() - rows) / 2;
+        s.slice(a..a + rows)
+    };
     let mut out = Vec::new();
     // The pooled shares not yet taken, rows.
     let mut owed = 0.0;
@@ -242,30 +247,26 @@ pub fn within_budget<'a>(
             let piece = len.min(block_rows);
             if owed >= piece as f64 / 2.0 {
                 owed -= piece as f64;
-                let a = (len - piece) / 2;
-                out.push(s.slice(a..a + piece));
+                out.push(middle(s, piece));
             }
             continue;
         }
         let share = (exact.ceil() as usize).min(len);
         let blocks = share.div_ceil(block_rows).max(1);
         let blk = share / blocks;
+        if blocks == 1 {
+            out.push(middle(s, blk));
+            continue;
+        }
         for k in 0..blocks {
-            let a = if blocks > 1 {
-                k * (len - blk) / (blocks - 1)
-            } else {
-                (len - blk) / 2
-            };
+            let a = k * (len - blk) / (blocks - 1);
             out.push(s.slice(a..a + blk));
         }
     }
     if out.is_empty()
         && let Some(s) = segments.iter().rev().max_by_key(|s| s.time.len())
     {
-        let len = s.time.len();
-        let piece = len.min(block_rows);
-        let a = (len - piece) / 2;
-        out.push(s.slice(a..a + piece));
+        out.push(middle(s, s.time.len().min(block_rows)));
     }
     out
 }
