@@ -3,7 +3,9 @@
 # Tolles-Lawson calibration + compensation with the MagNav settings (18
 # terms, MagNav's derivative convention, band-pass 0.1–0.9 Hz, no eddy lag,
 # no reference field, lines not split) on the same generated flights, by
-#   - aeromag (the CLI: calibrate then compensate),
+#   - aeromag (the CLI: calibrate then compensate; and calibrate
+#     --compensated, which writes the same model and compensated flight
+#     from one reading of the file, as the peers read it once),
 #   - a NumPy/SciPy port of MagNav.jl's create_TL_A + create_TL_coef,
 #   - deinterf (PyPI) with plain least squares and with its default RidgeCV;
 # end to end (CSV in, CSV out; hyperfine) and compute alone (fit + apply on
@@ -32,12 +34,16 @@ magnav_settings="--terms p3,i6,e9 --convention magnav --eddy-lag none --referenc
 for n in "${sizes[@]}"; do
     f=$dir/flight-$n.csv
     [ -f "$f" ] || "$py" tools/bench/peers.py gen "$n" "$f"
-    runs=3
-    [ "$n" -lt 10000000 ] || runs=1
-    echo "== $n samples ($(du -h "$f" | cut -f1) CSV), end to end, $runs run(s) each"
-    hyperfine --runs "$runs" --export-json "$dir/e2e-$n.json" \
+    # One warm-up run each below 10⁷ (the first run of a command reads
+    # its binary or its libraries from disk).
+    runs=3 warmup=1
+    [ "$n" -lt 10000000 ] || { runs=1; warmup=0; }
+    echo "== $n samples ($(du -h "$f" | cut -f1) CSV), end to end, $runs run(s) each after $warmup warm-up"
+    hyperfine --warmup "$warmup" --runs "$runs" --export-json "$dir/e2e-$n.json" \
         -n "aeromag calibrate + compensate" \
         "$bin calibrate -i $f --model $dir/m.json $magnav_settings >/dev/null && $bin compensate --model $dir/m.json -i $f --out $dir/a-out.csv >/dev/null" \
+        -n "aeromag calibrate --compensated (one run)" \
+        "$bin calibrate -i $f --model $dir/m1.json $magnav_settings --compensated $dir/a1-out.csv >/dev/null" \
         -n "NumPy/SciPy MagNav port" "$py tools/bench/peers.py magnav $f $dir/m-out.csv" \
         -n "deinterf, plain least squares" "$py tools/bench/peers.py deinterf $f $dir/d-out.csv plain" \
         -n "deinterf, default RidgeCV" "$py tools/bench/peers.py deinterf $f $dir/d-out.csv"

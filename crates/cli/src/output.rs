@@ -3,7 +3,7 @@
 
 use crate::exit::bad_input;
 use aeromag::io::atomic::{check_writable, check_writable_folder};
-use aeromag::{Compensated, Flight};
+use aeromag::{Compensated, Flight, SensorsCompensated};
 use std::path::Path;
 
 /// Add the compensation columns to the flight, write it to `out` and tell
@@ -36,6 +36,42 @@ pub fn write_compensated(
         "compensated {} of {n} rows with {}{detail}; written to {}",
         n - missing,
         model.display(),
+        path.display()
+    );
+    Ok(())
+}
+
+/// What `compensate` and `calibrate --compensated` say of a model: its
+/// terms and method, and `how` it was applied (`, causal`; empty).
+pub fn model_detail(model: &aeromag::TlModel, how: &str) -> String {
+    format!("{} terms, method {}{how}", model.design.terms, model.method)
+}
+
+/// Writes `flight` with every sensor's compensated columns to `path` and
+/// prints what was written (`compensate` and `calibrate --compensated` with
+/// a multi-sensor model from `model`).
+pub fn write_compensated_sensors(
+    flight: Flight,
+    out: SensorsCompensated,
+    path: &Path,
+    model: &Path,
+    sensors: usize,
+) -> anyhow::Result<()> {
+    let missing = out.missing();
+    let names: Vec<String> = out.columns().into_iter().map(|(n, _)| n).collect();
+    let mut table = flight.into_table();
+    out.add_to(&mut table)?;
+    aeromag::io::write_csv(&table, path)?;
+    let n = table.n_rows();
+    if missing > 0 {
+        eprintln!(
+            "warning: {missing} of {n} rows could not be compensated for every sensor (missing values); their columns are empty there"
+        );
+    }
+    println!(
+        "compensated {sensors} sensors on {n} rows with {}: {}; written to {}",
+        model.display(),
+        names.join(", "),
         path.display()
     );
     Ok(())

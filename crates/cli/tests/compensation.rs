@@ -107,6 +107,62 @@ fn calibrate_compensate_report_keep_every_row() {
     assert_eq!(v["estimability"].as_array().unwrap().len(), 16);
 }
 
+/// `calibrate --compensated` writes the model `calibrate` writes and the
+/// flight `compensate` writes with it, from one reading of the flight;
+/// the same file for both outputs is bad input.
+#[test]
+fn calibrate_writes_the_compensated_flight_as_compensate_does() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration-truncated", "4");
+    let path = |name: &str| d.path().join(name);
+    let (m1, c1, m2, c2) = (
+        path("m1.json"),
+        path("c1.csv"),
+        path("m2.json"),
+        path("c2.csv"),
+    );
+    let input = cal.to_str().unwrap();
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        input,
+        "--model",
+        m1.to_str().unwrap(),
+        "--compensated",
+        c1.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let out = stdout(&o);
+    let last = out.lines().last().unwrap();
+    assert!(
+        last.starts_with("compensated ") && last.ends_with(&format!("written to {}", c1.display())),
+        "{out}"
+    );
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        input,
+        "--model",
+        m2.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    assert_code(&compensate(&m2, &cal, &c2), 0);
+    let read = |p: &std::path::Path| std::fs::read(p).unwrap();
+    assert_eq!(read(&m1), read(&m2), "the model files");
+    assert_eq!(read(&c1), read(&c2), "the compensated flights");
+    let o = aeromag(&[
+        "calibrate",
+        "--input",
+        input,
+        "--model",
+        m1.to_str().unwrap(),
+        "--compensated",
+        m1.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("name the same file"), "{}", stderr(&o));
+}
+
 #[test]
 fn model_and_argument_errors_exit_2() {
     let d = tempfile::tempdir().unwrap();
@@ -419,6 +475,8 @@ fn several_sensors_with_current_terms() {
         "cur_strb,cur_flap:lag",
         "--model",
         m.to_str().unwrap(),
+        "--compensated",
+        d.path().join("c_cal.csv").to_str().unwrap(),
     ]);
     assert_code(&o, 0);
     let out = stdout(&o);
@@ -427,6 +485,7 @@ fn several_sensors_with_current_terms() {
         "{out}"
     );
     assert!(out.contains("2 sensor models written"), "{out}");
+    assert!(out.contains("compensated 2 sensors on"), "{out}");
     let model = std::fs::read_to_string(&m).unwrap();
     assert!(
         model.contains("\"kind\": \"tolles-lawson-sensors\"")
@@ -444,6 +503,11 @@ fn several_sensors_with_current_terms() {
         comp.to_str().unwrap(),
     ]);
     assert_code(&o, 0);
+    // `calibrate --compensated` wrote the same file from its one reading.
+    assert_eq!(
+        std::fs::read(&comp).unwrap(),
+        std::fs::read(d.path().join("c_cal.csv")).unwrap()
+    );
     let header = std::fs::read_to_string(&comp).unwrap();
     let header = header
         .lines()

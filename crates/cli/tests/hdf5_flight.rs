@@ -171,6 +171,25 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
     }
     // The same compensated survey, row for row.
     assert_same_column(&outputs, "mag_comp");
+    // `calibrate --compensated` on the HDF5 box writes every field of the
+    // file (not only those the fit reads), as `compensate` does.
+    let (m, c1, c2) = (d.join("box.json"), d.join("box1.csv"), d.join("box2.csv"));
+    let o = aeromag(&[
+        "calibrate",
+        "-i",
+        h5.to_str().unwrap(),
+        "--lines",
+        "1002.02",
+        "--model",
+        m.to_str().unwrap(),
+        "--compensated",
+        c1.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    compensate_lines(&h5, "1002.02", &m, &c2);
+    let box_text = std::fs::read_to_string(&c1).unwrap();
+    assert!(box_text.lines().next().unwrap().contains("mag_5_uc"));
+    assert_eq!(box_text, std::fs::read_to_string(&c2).unwrap());
     // Every survey row is written, none of the box or the transit.
     let lines = column(&outputs[1], "line");
     assert!(

@@ -59,6 +59,7 @@ use std::path::PathBuf;
 /// Example:
 ///   aeromag calibrate --input cal.csv --model model.json
 ///   aeromag calibrate --input cal.csv --model m.json --terms p3,i6,e9 --convention magnav --lambda 0.01
+///   aeromag calibrate --input cal.csv --model model.json --compensated cal_comp.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
@@ -67,6 +68,12 @@ pub struct Args {
     /// Where to write the model file (JSON).
     #[arg(long, value_name = "MODEL.json")]
     model: PathBuf,
+    /// Also write the calibration flight compensated by the fitted model to
+    /// this CSV: what `aeromag compensate --model MODEL.json` writes for the
+    /// same input (every input column plus the interference, compensated
+    /// and flag columns), from the flight read once.
+    #[arg(long, value_name = "OUT.csv")]
+    compensated: Option<PathBuf>,
     /// Fitting method: `ls` (band-pass least squares) or `kalman` (Kalman
     /// filter and smoother with a stochastic model of the external field;
     /// needs `alt` and ground speed from `vn`,`ve` or positions; the
@@ -231,7 +238,16 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = options(&a)?;
-    crate::output::check_files(std::iter::once(a.model.as_path()).chain(a.series.as_deref()))?;
+    if a.compensated.as_ref() == Some(&a.model) {
+        anyhow::bail!(aeromag::Error::bad_input(
+            "--compensated and --model name the same file"
+        ));
+    }
+    crate::output::check_files(
+        std::iter::once(a.model.as_path())
+            .chain(a.series.as_deref())
+            .chain(a.compensated.as_deref()),
+    )?;
     if a.input.several_sensors() || a.reference_sensor.is_some() {
         return run_sensors(&a, &opts);
     }
@@ -245,7 +261,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // The simulator's manoeuvre codes, when present, split the table of
     // contributions by manoeuvre.
     extra.push("manoeuvre");
-    let flight = a.input.load_canonical(&extra)?;
+    // The compensated flight has every input column.
+    let flight = match &a.compensated {
+        Some(_) => a.input.load()?,
+        None => a.input.load_canonical(&extra)?,
+    };
     let cal = calibrate(&flight, &opts, &mut Bars::new())?;
     let model = &cal.model;
     if let Some(k) = &cal.kalman {
@@ -328,6 +348,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     println!("model written to {}", a.model.display());
+    if let Some(out) = &a.compensated {
+        use aeromag::Compensator;
+        let compensated = model.compensate(&flight)?;
+        let detail = crate::output::model_detail(model, "");
+        crate::output::write_compensated(flight, compensated, out, &a.model, &detail)?;
+    }
     Ok(())
 }
 
@@ -368,5 +394,16 @@ fn run_sensors(a: &Args, opts: &CalibrateOptions) -> anyhow::Result<()> {
         cal.model.sensors.len(),
         a.model.display()
     );
+    if let Some(out) = &a.compensated {
+        use aeromag::CompensateSensors;
+        let compensated = cal.model.compensate(&flight)?;
+        crate::output::write_compensated_sensors(
+            flight,
+            compensated,
+            out,
+            &a.model,
+            cal.model.sensors.len(),
+        )?;
+    }
     Ok(())
 }

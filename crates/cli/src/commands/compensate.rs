@@ -55,7 +55,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         (model.compensate(&flight)?, "")
     };
-    let detail = format!("{} terms, method {}{how}", model.design.terms, model.method);
+    let detail = crate::output::model_detail(&model, how);
     crate::output::write_compensated(flight, out, &a.out, &a.model, &detail)
 }
 
@@ -69,23 +69,5 @@ fn run_sensors(a: &Args) -> anyhow::Result<()> {
     } else {
         model.compensate(&flight)?
     };
-    let missing = out.missing();
-    let names: Vec<String> = out.columns().into_iter().map(|(n, _)| n).collect();
-    let mut table = flight.into_table();
-    out.add_to(&mut table)?;
-    aeromag::io::write_csv(&table, &a.out)?;
-    let n = table.n_rows();
-    if missing > 0 {
-        eprintln!(
-            "warning: {missing} of {n} rows could not be compensated for every sensor (missing values); their columns are empty there"
-        );
-    }
-    println!(
-        "compensated {} sensors on {n} rows with {}: {}; written to {}",
-        model.sensors.len(),
-        a.model.display(),
-        names.join(", "),
-        a.out.display()
-    );
-    Ok(())
+    crate::output::write_compensated_sensors(flight, out, &a.out, &a.model, model.sensors.len())
 }
