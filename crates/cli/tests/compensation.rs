@@ -121,16 +121,16 @@ fn calibrate_writes_the_compensated_flight_as_compensate_does() {
         path("m2.json"),
         path("c2.csv"),
     );
-    let input = cal.to_str().unwrap();
-    let o = aeromag(&[
-        "calibrate",
-        "--input",
-        input,
-        "--model",
-        m1.to_str().unwrap(),
-        "--compensated",
-        c1.to_str().unwrap(),
-    ]);
+    // `calibrate` with the model file `m` and, if given, `--compensated c`.
+    let calibrate = |m: &std::path::Path, c: Option<&std::path::Path>| {
+        let mut args = vec!["calibrate", "--input", cal.to_str().unwrap()];
+        args.extend(["--model", m.to_str().unwrap()]);
+        if let Some(c) = c {
+            args.extend(["--compensated", c.to_str().unwrap()]);
+        }
+        aeromag(&args)
+    };
+    let o = calibrate(&m1, Some(&c1));
     assert_code(&o, 0);
     let out = stdout(&o);
     let last = out.lines().last().unwrap();
@@ -138,27 +138,12 @@ fn calibrate_writes_the_compensated_flight_as_compensate_does() {
         last.starts_with("compensated ") && last.ends_with(&format!("written to {}", c1.display())),
         "{out}"
     );
-    let o = aeromag(&[
-        "calibrate",
-        "--input",
-        input,
-        "--model",
-        m2.to_str().unwrap(),
-    ]);
-    assert_code(&o, 0);
+    assert_code(&calibrate(&m2, None), 0);
     assert_code(&compensate(&m2, &cal, &c2), 0);
     let read = |p: &std::path::Path| std::fs::read(p).unwrap();
     assert_eq!(read(&m1), read(&m2), "the model files");
     assert_eq!(read(&c1), read(&c2), "the compensated flights");
-    let o = aeromag(&[
-        "calibrate",
-        "--input",
-        input,
-        "--model",
-        m1.to_str().unwrap(),
-        "--compensated",
-        m1.to_str().unwrap(),
-    ]);
+    let o = calibrate(&m1, Some(&m1));
     assert_code(&o, 2);
     assert!(stderr(&o).contains("name the same file"), "{}", stderr(&o));
 }
