@@ -418,8 +418,9 @@ mod tests {
     /// Rows of more cells than one stage of [`format_rows`] (the cells of
     /// a row are formatted [`STAGED`] at a time and copied after) and rows
     /// filling a stage exactly are each cell's text in column order, with
-    /// integer columns, missing cells and texts of every length, over more
-    /// rows than one growth of the buffer ([`GROW_ROWS`]).
+    /// whole values, missing cells and texts of many lengths, over more
+    /// rows than one growth of the buffer ([`GROW_ROWS`]). (Columns read as
+    /// integers are in `number_rows_are_each_cells_text`.)
     #[test]
     fn rows_wider_than_a_stage_are_each_cells_text() {
         let rows = 2 * GROW_ROWS + 3;
