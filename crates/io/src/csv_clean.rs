@@ -514,12 +514,17 @@ pub(crate) fn on_all_cores() -> Option<(usize, usize)> {
     Some((threads(), PIECE_BYTES))
 }
 
-/// Threads of the fast path: the available cores, at most 8 (as
-/// `aeromag_core::parallel::threads`; this crate does not depend on core).
+/// Threads of the fast path and of the writer: the available cores, at
+/// most 8, asked of the system once per process (as
+/// `aeromag_core::parallel::threads`, whose docs say why; this crate does
+/// not depend on core).
 pub(crate) fn threads() -> usize {
-    std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .clamp(1, 8)
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *THREADS.get_or_init(|| {
+        std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .clamp(1, 8)
+    })
 }
 
 /// Appends the clean rows of `path` from `from` (a line start after the
