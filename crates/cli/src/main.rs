@@ -103,7 +103,7 @@ fn main() {
     restore_sigpipe();
     handle_interrupts();
     let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
-    let result = match cli.command {
+    let result = check_environment().and_then(|()| match cli.command {
         Command::Demo(a) => commands::demo::run(a),
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Inspect(a) => commands::inspect::run(a),
@@ -121,11 +121,23 @@ fn main() {
         Command::Rotor(a) => commands::rotor::run(a),
         Command::Pod(a) => commands::pod::run(a),
         Command::Observability(a) => commands::observability::run(a),
-    };
+    });
     if let Err(e) = result {
         eprintln!("error: {}", exit::message(&e));
         std::process::exit(exit::classify(&e));
     }
+}
+
+/// The environment variables that set how aeromag runs, checked before any
+/// work: `AEROMAG_THREADS` (the number of threads; the library would ignore
+/// a value it refuses) must be a whole number from 1 to 64.
+fn check_environment() -> anyhow::Result<()> {
+    use aeromag::core::parallel::{THREADS_VAR, threads_setting};
+    if let Some(v) = std::env::var_os(THREADS_VAR) {
+        let v = v.to_string_lossy();
+        threads_setting(&v).map_err(|e| exit::bad_input!("{e}"))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -8,19 +8,55 @@
 //! result does not depend on the number of threads (the chunks only decide
 //! which thread computes what).
 
-/// Threads for a parallel loop: the available cores, at most 8.
+/// Threads for a parallel loop: the number the environment variable
+/// [`THREADS_VAR`] (`AEROMAG_THREADS`) sets, or else the available cores,
+/// at most 8. Every result of the workspace is the same bits whatever the
+/// number (the command-line tests run the commands with 1, 2, 3 and 7); the
+/// variable limits the cores a run takes on a shared machine. A value that
+/// [`threads_setting`] refuses is ignored here (the command-line program
+/// refuses it before any work).
 ///
-/// Asked of the system once per process: `available_parallelism` reads the
-/// cgroup's CPU quota files on every call (three files opened and read),
-/// and the loops ask for every block — 4 673 times in one `calibrate` of
-/// 10⁶ rows.
+/// Asked once per process: `available_parallelism` reads the cgroup's CPU
+/// quota files on every call (three files opened and read), and the loops
+/// ask for every block — 4 673 times in one `calibrate` of 10⁶ rows.
 pub fn threads() -> usize {
     static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     *THREADS.get_or_init(|| {
-        std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .clamp(1, 8)
+        std::env::var(THREADS_VAR)
+            .ok()
+            .and_then(|v| threads_setting(&v).ok())
+            .unwrap_or_else(|| {
+                std::thread::available_parallelism()
+                    .map_or(1, |n| n.get())
+                    .clamp(1, 8)
+            })
     })
+}
+
+/// The environment variable that sets the number of threads ([`threads`]).
+pub const THREADS_VAR: &str = "AEROMAG_THREADS";
+
+/// Most threads [`THREADS_VAR`] may ask for.
+pub const MAX_THREADS: usize = 64;
+
+/// The number of threads that `value`, the text of [`THREADS_VAR`], asks
+/// for: a whole number from 1 to [`MAX_THREADS`] (spaces around it
+/// allowed).
+///
+/// ```
+/// use aeromag_core::parallel::threads_setting;
+/// assert_eq!(threads_setting(" 3 "), Ok(3));
+/// assert!(threads_setting("0").is_err());
+/// assert!(threads_setting("two").is_err());
+/// ```
+pub fn threads_setting(value: &str) -> crate::error::Result<usize> {
+    match value.trim().parse::<usize>() {
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(crate::error::CoreError::InvalidArgument {
+            name: THREADS_VAR,
+            reason: format!("expected a whole number from 1 to {MAX_THREADS}, got '{value}'"),
+        }),
+    }
 }
 
 /// `[f(0), f(1), …, f(n − 1)]`, computed on up to `threads` threads (≥ 1) in

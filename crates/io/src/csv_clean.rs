@@ -514,16 +514,22 @@ pub(crate) fn on_all_cores() -> Option<(usize, usize)> {
     Some((threads(), PIECE_BYTES))
 }
 
-/// Threads of the fast path and of the writer: the available cores, at
-/// most 8, asked of the system once per process (as
-/// `aeromag_core::parallel::threads`, whose docs say why; this crate does
-/// not depend on core).
+/// Threads of the fast path and of the writer, as
+/// `aeromag_core::parallel::threads` counts them (this crate does not
+/// depend on core; see there): `AEROMAG_THREADS` when it is a whole number
+/// from 1 to 64, or else the available cores, at most 8; asked once per
+/// process. The table read and the bytes written are the same whatever the
+/// number.
 pub(crate) fn threads() -> usize {
     static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     *THREADS.get_or_init(|| {
-        std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .clamp(1, 8)
+        let set = std::env::var("AEROMAG_THREADS").ok();
+        match set.and_then(|v| v.trim().parse::<usize>().ok()) {
+            Some(n @ 1..=64) => n,
+            _ => std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .clamp(1, 8),
+        }
     })
 }
 

@@ -409,7 +409,7 @@ fn approximation_blocks(points: &[RangePoint], trials: usize, passes: usize) -> 
 /// 3 instead of 7 ratios.
 fn run_study(quick: bool) -> Result<GradiometryOutcome> {
     let (trials, grid) = if quick { (12, 10) } else { (40, 16) };
-    let threads = std::thread::available_parallelism().map_or(2, |n| n.get().min(4));
+    let threads = crate::core::parallel::threads().min(4);
     let mut tensor = Vec::new();
     let mut scalar = Vec::new();
     for motion in [SystemMotion::Stationary, SystemMotion::Mobile] {
