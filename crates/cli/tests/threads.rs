@@ -1,9 +1,10 @@
 //! The same bytes whatever the number of threads (`AEROMAG_THREADS`).
 //!
 //! The reader's pieces, the fit's blocks and the eddy-lag search, the
-//! Kalman tuning's runs, the writer's chunks and the levelling, gridding
-//! and micro-levelling loops are shared out differently with 1, 2, 3 and 7
-//! threads; every file written and every line printed must be the same.
+//! Kalman tuning's runs, the writer's chunks, the levelling, gridding and
+//! micro-levelling loops and the EM detection's channels and windows are
+//! shared out differently with 1, 2, 3 and 7 threads; every file written
+//! and every line printed must be the same.
 
 mod common;
 use common::*;
@@ -40,12 +41,19 @@ fn every_output_is_the_same_with_1_2_3_and_7_threads() {
     let cal100 = calibration_at_100_hz(d.path());
     let cal10 = simulate(d.path(), "calibration", "4");
     let survey = simulate(d.path(), "survey", "2");
-    let (cal100, cal10, survey) = (
+    let em = d.path().join("em");
+    assert_code(
+        &aeromag(&["em", "simulate", "--out", em.to_str().unwrap()]),
+        0,
+    );
+    let raw = em.join("em.raw");
+    let (cal100, cal10, survey, raw) = (
         cal100.to_str().unwrap(),
         cal10.to_str().unwrap(),
         survey.to_str().unwrap(),
+        raw.to_str().unwrap(),
     );
-    let steps: [&[&str]; 6] = [
+    let steps: [&[&str]; 7] = [
         &[
             "calibrate",
             "--input",
@@ -77,9 +85,10 @@ fn every_output_is_the_same_with_1_2_3_and_7_threads() {
         &["level", "--input", "s.csv", "--out", "lev.csv"],
         &["grid", "--input", "lev.csv", "--out", "g.asc"],
         &["microlevel", "--input", "lev.csv", "--out", "ml.csv"],
+        &["em", "detect", "--input", raw, "--out", "det.csv"],
     ];
     let files = [
-        "m.json", "c.csv", "k.json", "s.csv", "lev.csv", "g.asc", "ml.csv",
+        "m.json", "c.csv", "k.json", "s.csv", "lev.csv", "g.asc", "ml.csv", "det.csv",
     ];
     // What each run printed and wrote, per number of threads.
     let run = |threads: &str| -> Vec<(String, Vec<u8>)> {
