@@ -103,8 +103,9 @@ impl InputArgs {
     }
 
     /// Read and check only the canonical columns and `extra` (an HDF5
-    /// flight of 100 fields then reads about 20), for the commands that do
-    /// not write the input's columns back.
+    /// flight of 100 fields then reads about 20 datasets; a CSV or XYZ file
+    /// parses about 20 fields of each row), for the commands that do not
+    /// write the input's columns back.
     pub fn load_canonical(&self, extra: &[&str]) -> anyhow::Result<Flight> {
         self.load_fields(Fields::canonical_and(extra))
     }

@@ -14,6 +14,10 @@
 //! second pass over those rows only (usually none: a text column such as a
 //! flight id already fails on the first row).
 //!
+//! A column that [`Fields::Only`](crate::Fields::Only) does not ask for
+//! is skipped: its cells are not parsed or checked, it holds no memory,
+//! and the table leaves it out ([`FlightTable::unread_columns`] names it).
+//!
 //! # Memory
 //!
 //! Cells are parsed straight into one `Vec<f64>` per column; the file's text
@@ -36,6 +40,7 @@ use crate::cell::{Cell, CellError, check_text, parse_cell};
 use crate::columns::{MappedColumn, must_be_numeric, resolve};
 use crate::error::{IoError, Result};
 use crate::table::{ColumnData, FlightTable, Missing};
+use crate::wanted::wanted_fields;
 
 /// Rows read before the capacity of the columns is estimated.
 pub(crate) const RESERVE_AFTER_ROWS: usize = 1024;
@@ -116,6 +121,9 @@ enum ColState {
         values: Vec<String>,
         from_row: usize,
     },
+    /// Not read ([`crate::Fields::Only`] does not ask for it): its cells
+    /// are neither parsed nor checked, and the table does not have it.
+    Skipped,
 }
 
 /// Builds a [`FlightTable`] row by row (see the module docs).
@@ -195,12 +203,15 @@ impl TableBuilder {
             })
             .collect();
         let numeric_only = names.iter().map(|n| must_be_numeric(&role_of(n))).collect();
-        let cols = names
-            .iter()
-            .map(|_| ColState::Numeric {
-                values: Vec::new(),
-                missing: Missing::default(),
-                integers: true,
+        let cols = wanted_fields(&names, &aliases, opts)
+            .into_iter()
+            .map(|wanted| match wanted {
+                true => ColState::Numeric {
+                    values: Vec::new(),
+                    missing: Missing::default(),
+                    integers: true,
+                },
+                false => ColState::Skipped,
             })
             .collect();
         Ok(TableBuilder {
@@ -226,6 +237,16 @@ impl TableBuilder {
         &self.names
     }
 
+    /// Which columns are read (header order); `None` when every one is.
+    pub(crate) fn wanted(&self) -> Option<Vec<bool>> {
+        let wanted: Vec<bool> = self
+            .cols
+            .iter()
+            .map(|c| !matches!(c, ColState::Skipped))
+            .collect();
+        wanted.contains(&false).then_some(wanted)
+    }
+
     /// Data rows so far.
     pub(crate) fn rows(&self) -> usize {
         self.n_rows
@@ -239,6 +260,9 @@ impl TableBuilder {
             self.reserve(src.bytes_read());
         }
         for (i, col) in self.cols.iter_mut().enumerate() {
+            if matches!(col, ColState::Skipped) {
+                continue;
+            }
             let bytes = src.field(i);
             match col {
                 ColState::Numeric {
@@ -275,6 +299,7 @@ impl TableBuilder {
                         ));
                     }
                 },
+                ColState::Skipped => {}
                 ColState::Text { values, .. } => match check_text(bytes) {
                     Ok(s) => values.push(s.to_string()),
                     Err(e) => {
@@ -358,6 +383,7 @@ impl TableBuilder {
                 ColState::Text { values, .. } => {
                     values.reserve_exact(estimate.saturating_sub(values.len()))
                 }
+                ColState::Skipped => {}
             }
         }
     }
@@ -421,9 +447,26 @@ impl TableBuilder {
                 }
             }
         }
+        let read = |name: &str| {
+            names
+                .iter()
+                .zip(&cols)
+                .any(|(n, c)| n == name && !matches!(c, ColState::Skipped))
+        };
+        let unread: Vec<String> = names
+            .iter()
+            .zip(&cols)
+            .filter(|(_, c)| matches!(c, ColState::Skipped))
+            .map(|(n, _)| n.clone())
+            .collect();
+        let aliases = aliases
+            .into_iter()
+            .filter(|m| read(&m.file_column))
+            .collect();
         let columns = names
             .into_iter()
             .zip(cols)
+            .filter(|(_, col)| !matches!(col, ColState::Skipped))
             .map(|(name, col)| {
                 let data = match col {
                     ColState::Numeric {
@@ -446,13 +489,14 @@ impl TableBuilder {
                         shrink(&mut values);
                         (ColumnData::Text(values), false)
                     }
+                    ColState::Skipped => unreachable!("skipped columns are left out above"),
                 };
                 (name, data.0, data.1)
             })
             .collect();
-        Ok(FlightTable::from_parts(
-            path, n_rows, columns, aliases, row_lines,
-        ))
+        let mut table = FlightTable::from_parts(path, n_rows, columns, aliases, row_lines);
+        table.set_unread(unread);
+        Ok(table)
     }
 }
 

@@ -52,7 +52,7 @@ pub(crate) struct Resume {
 
 /// How the rows of the file are laid out (from the header).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Shape {
+pub(crate) struct Shape<'a> {
     pub delimiter: u8,
     pub n_fields: usize,
     /// The header ended with `\r\n`: the last field of each row loses a final `\r`.
@@ -62,6 +62,36 @@ pub(crate) struct Shape {
     /// first and after the last, lines classified by
     /// [`crate::xyz::line_kind`]; `delimiter` and `crlf` are not used.
     pub whitespace: Option<Dialect>,
+    /// The fields read, when not all are ([`crate::Fields::Only`]): the
+    /// others are only delimited, as the general reader leaves them
+    /// unparsed. A line whose unread fields hold a quote or, in a
+    /// whitespace table, an ASCII space other than a blank is not clean:
+    /// the general reader splits it its own way.
+    pub wanted: Option<&'a [bool]>,
+}
+
+/// Whether field `i` of `shape` is read.
+#[inline(always)]
+fn read(shape: &Shape, i: usize) -> bool {
+    shape.wanted.is_none_or(|w| w[i])
+}
+
+/// The end of the unread field at `piece[p..]` of a delimited row, for
+/// [`plain_row`]: the position of the delimiter, line end (`\n` or the
+/// file's end) or `\r` that ends it (a CRLF line end, or a `\r` within the
+/// line, which [`plain_row`] leaves to [`clean_row`]); `None` at a quote,
+/// which leaves the line to the general reader.
+#[inline]
+fn unread_field_end(piece: &[u8], p: usize, delimiter: u8) -> Option<usize> {
+    let rest = piece.get(p..).unwrap_or_default();
+    match rest
+        .iter()
+        .position(|&b| b == delimiter || matches!(b, b'\n' | b'\r' | b'"'))
+    {
+        Some(k) if rest[k] == b'"' => None,
+        Some(k) => Some(p + k),
+        None => Some(piece.len()),
+    }
 }
 
 /// The clean rows at the start of one piece, column by column.
@@ -124,7 +154,7 @@ impl CleanRows {
 
 /// Parses the clean rows at the start of `piece` (whole lines; only the
 /// file's last line may lack its line end).
-pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
+pub(crate) fn parse_piece(piece: &[u8], shape: Shape<'_>, out: &mut CleanRows) {
     let n = shape.n_fields;
     out.clear(n);
     let quotes = memchr::memchr(b'"', piece).is_some();
@@ -135,13 +165,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
     while pos < piece.len() {
         // Most lines: plain decimals and the line end, in one pass.
         let row = if shape.whitespace.is_some() {
-            whitespace_row(
-                piece,
-                pos,
-                shape.n_fields,
-                &mut out.values,
-                &mut out.integers,
-            )
+            whitespace_row(piece, pos, shape, &mut out.values, &mut out.integers)
         } else {
             plain_row(piece, pos, shape, &mut out.values, &mut out.integers)
         };
@@ -185,7 +209,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
             let clean = if shape.whitespace.is_some() {
                 whitespace_clean_row(
                     body,
-                    shape.n_fields,
+                    shape,
                     &mut out.values,
                     &mut out.integers,
                     &mut missing,
@@ -231,17 +255,21 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape, out: &mut CleanRows) {
 fn plain_row(
     piece: &[u8],
     start: usize,
-    shape: Shape,
+    shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
 ) -> Option<usize> {
     let last = shape.n_fields.saturating_sub(1);
     let mut p = start;
     for (i, (column, integer)) in values.iter_mut().zip(integers.iter_mut()).enumerate() {
-        let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
-        column.push(v);
-        *integer &= is_integer;
-        let end = p + len;
+        let end = if read(&shape, i) {
+            let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
+            column.push(v);
+            *integer &= is_integer;
+            p + len
+        } else {
+            unread_field_end(piece, p, shape.delimiter)?
+        };
         if i < last {
             if piece.get(end) != Some(&shape.delimiter) {
                 return None;
@@ -271,7 +299,7 @@ fn plain_row(
 fn whitespace_row(
     piece: &[u8],
     start: usize,
-    n_fields: usize,
+    shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
 ) -> Option<usize> {
@@ -280,11 +308,26 @@ fn whitespace_row(
     while blank(p) {
         p += 1;
     }
-    for (column, integer) in values.iter_mut().zip(integers.iter_mut()).take(n_fields) {
-        let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
-        column.push(v);
-        *integer &= is_integer;
-        p += len;
+    let fields = values.iter_mut().zip(integers.iter_mut());
+    for (i, (column, integer)) in fields.take(shape.n_fields).enumerate() {
+        if read(&shape, i) {
+            let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
+            column.push(v);
+            *integer &= is_integer;
+            p += len;
+        } else {
+            // An unread field: its bytes up to any ASCII space (one other
+            // than a blank or a line end is then not clean).
+            let rest = piece.get(p..).unwrap_or_default();
+            let len = rest
+                .iter()
+                .position(u8::is_ascii_whitespace)
+                .unwrap_or(rest.len());
+            if len == 0 {
+                return None;
+            }
+            p += len;
+        }
         // A field ends at a blank or the line's end.
         if !blank(p) && !matches!(piece.get(p), None | Some(b'\n' | b'\r')) {
             return None;
@@ -311,7 +354,7 @@ fn whitespace_row(
 #[inline]
 fn whitespace_clean_row(
     line: &[u8],
-    n_fields: usize,
+    shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
     missing: &mut Vec<(usize, MissingKind)>,
@@ -324,14 +367,14 @@ fn whitespace_clean_row(
     let mut fields = line
         .split(|b| matches!(b, b' ' | b'\t'))
         .filter(|f| !f.is_empty());
-    for (i, column) in values.iter_mut().enumerate().take(n_fields) {
+    for (i, column) in values.iter_mut().enumerate().take(shape.n_fields) {
         let Some(f) = fields.next() else {
             return false; // short row
         };
         if f.iter().any(u8::is_ascii_whitespace) {
             return false;
         }
-        if !push_cell(f, i, column, integers, missing) {
+        if read(&shape, i) && !push_cell(f, i, column, integers, missing) {
             return false;
         }
     }
@@ -353,7 +396,7 @@ fn whitespace_clean_row(
 fn clean_row(
     piece: &[u8],
     line: Range<usize>,
-    shape: Shape,
+    shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
     missing: &mut Vec<(usize, MissingKind)>,
@@ -366,7 +409,8 @@ fn clean_row(
             return false; // short row
         }
         // Most cells: a plain decimal ended by the delimiter or the line.
-        if let Some((v, integer, len)) = plain_decimal_field(piece, start, line.end) {
+        let read = read(&shape, i);
+        if read && let Some((v, integer, len)) = plain_decimal_field(piece, start, line.end) {
             let end = start + len;
             let end_ok = if i == last {
                 end == line.end || (shape.crlf && end + 1 == line.end && piece[end] == b'\r')
@@ -398,7 +442,7 @@ fn clean_row(
         } else {
             f
         };
-        if !push_cell(f, i, column, integers, missing) {
+        if read && !push_cell(f, i, column, integers, missing) {
             return false;
         }
         start += len + 1;
@@ -739,6 +783,73 @@ pub(crate) mod check {
         text.into_bytes()
     }
 
+    /// `text` read with `fields` has the columns of the whole read that
+    /// `fields` asks for (the first when it asks for none the file has),
+    /// each the same, with the same rows and lines, when the whole read
+    /// succeeds.
+    pub(crate) fn some_fields_are_those_of_the_whole(
+        text: &[u8],
+        fields: crate::Fields,
+        read: impl Fn(&Path, &crate::ReadOptions) -> Result<FlightTable>,
+    ) -> std::result::Result<(), TestCaseError> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.txt");
+        std::fs::write(&path, text).unwrap();
+        let Ok(whole) = read(&path, &crate::ReadOptions::default()) else {
+            return Ok(());
+        };
+        let asked = crate::ReadOptions {
+            fields: fields.clone(),
+            ..crate::ReadOptions::default()
+        };
+        let some = read(&path, &asked);
+        let some = some.map_err(|e| TestCaseError::fail(format!("{fields:?}: {e}")))?;
+        let wanted: Vec<&str> = match &fields {
+            crate::Fields::All => whole.column_names(),
+            crate::Fields::Only(names) => {
+                let named: Vec<&str> = whole
+                    .column_names()
+                    .into_iter()
+                    .filter(|c| names.iter().any(|n| n.eq_ignore_ascii_case(c)))
+                    .collect();
+                if named.is_empty() {
+                    whole.column_names()[..1].to_vec()
+                } else {
+                    named
+                }
+            }
+        };
+        proptest::prop_assert_eq!(some.column_names(), wanted.clone());
+        proptest::prop_assert_eq!(some.n_rows(), whole.n_rows());
+        for name in wanted {
+            // Compared as text: a missing value is a NaN, unequal to itself.
+            let (a, b) = (some.get(name), whole.get(name));
+            proptest::prop_assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+        for r in 0..whole.n_rows() {
+            proptest::prop_assert_eq!(some.line_of_row(r), whole.line_of_row(r));
+        }
+        Ok(())
+    }
+
+    /// The field selections the property tests read their files with
+    /// (files of the columns `time`, `mag` and `note`): all, one or two of
+    /// them, or none that the file has (its first field is then read).
+    pub(crate) fn fields() -> impl proptest::strategy::Strategy<Value = crate::Fields> {
+        use crate::Fields;
+        let only = |names: &[&str]| Fields::Only(names.iter().map(|n| n.to_string()).collect());
+        proptest::sample::select(vec![
+            Fields::All,
+            Fields::All,
+            only(&["time"]),
+            only(&["mag"]),
+            only(&["note"]),
+            only(&["time", "note"]),
+            only(&["MAG", "note"]),
+            only(&["absent"]),
+        ])
+    }
+
     /// `text` written to a file and read by `read` with the fast path on
     /// `threads` threads in pieces of `piece` bytes (and of the default
     /// size) gives the same table (values, missing counts, integer flags,
@@ -772,6 +883,7 @@ mod tests {
         n_fields: 2,
         crlf: false,
         whitespace: None,
+        wanted: None,
     };
 
     fn parsed(piece: &[u8], shape: Shape) -> CleanRows {

@@ -44,6 +44,11 @@
 //!
 //! The table, the warnings and the errors are the general reader's own
 //! either way (a property test reads generated files both ways).
+//!
+//! With [`Fields::Only`](crate::Fields::Only) both readers only delimit the
+//! fields not asked for: their cells are neither parsed nor checked, and
+//! the table does not have them (a property test: the same columns as the
+//! whole read's).
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -111,11 +116,13 @@ fn read_csv_with(
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     src.n_fields = builder.names().len();
+    let wanted = builder.wanted();
     let shape = Shape {
         delimiter,
         n_fields: src.n_fields,
         crlf: src.crlf,
         whitespace: None,
+        wanted: wanted.as_deref(),
     };
     // Clean rows on all cores first; the general reader from the first
     // line that is not clean (module docs of csv_clean).
@@ -581,8 +588,9 @@ mod tests {
             text in file(),
             threads in 1usize..4,
             piece in 8usize..300,
+            fields in csv_clean::check::fields(),
         ) {
-            let opts = ReadOptions::default();
+            let opts = ReadOptions { fields, ..ReadOptions::default() };
             csv_clean::check::reads_as_the_general_reader(
                 &text,
                 |path, clean| read_csv_with(path, &opts, clean),
@@ -590,6 +598,67 @@ mod tests {
                 piece,
             )?;
         }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Reading some fields gives those columns of the whole read, the
+        /// same values, missing counts, integer flags and lines (when the
+        /// whole read succeeds: the fields not read are not checked).
+        #[test]
+        fn some_fields_are_those_columns_of_the_whole_read(
+            text in file(),
+            fields in csv_clean::check::fields(),
+        ) {
+            csv_clean::check::some_fields_are_those_of_the_whole(&text, fields, |path, opts| {
+                read_csv(path, opts)
+            })?;
+        }
+    }
+
+    /// A read of some fields: those columns, typed and checked; the others
+    /// not parsed (text in a numeric-only column passes), listed, and named
+    /// in the message for a missing column.
+    #[test]
+    fn a_selection_reads_its_fields_and_names_the_others() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("wide.csv");
+        let mut text = String::from("time,lat,magnetic,true_mag,flux_x,note\n");
+        for i in 0..3000 {
+            let truth = if i == 2000 {
+                "oops".to_string()
+            } else {
+                format!("{i}.5")
+            };
+            text.push_str(&format!(
+                "{}.{},56.{i},5300{},{truth},1{i}.25,\"a, b\"\n",
+                i / 10,
+                i % 10,
+                i % 10
+            ));
+        }
+        std::fs::write(&path, &text).unwrap();
+        // The whole read fails at the text in `true_mag` (numeric only).
+        let e = read_csv(&path, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("true_mag"), "{e}");
+        let opts = ReadOptions {
+            fields: crate::Fields::Only(vec!["time".into(), "FLUX_X".into()]),
+            ..ReadOptions::default()
+        };
+        let t = read_csv(&path, &opts).unwrap();
+        assert_eq!(t.column_names(), ["time", "flux_x"]);
+        assert_eq!(t.n_rows(), 3000);
+        assert_eq!(t.column("flux_x").unwrap()[2999], 12999.25);
+        assert_eq!(t.line_of_row(2999), Some(3001));
+        assert_eq!(t.unread_columns(), ["lat", "magnetic", "true_mag", "note"]);
+        let e = t.require("mag").unwrap_err().to_string();
+        assert!(
+            e.contains("columns present: time, flux_x, lat, magnetic, true_mag, note"),
+            "{e}"
+        );
     }
 
     #[test]

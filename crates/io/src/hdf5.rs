@@ -10,7 +10,7 @@
 //! ones, e.g. a sample count) hold no rows and are skipped; any other shape
 //! is not this layout.
 //!
-//! **Only the fields a command needs are read** ([`Fields::Only`]): the
+//! **Only the fields a command needs are read** ([`Fields::Only`](crate::Fields::Only)): the
 //! datasets' headers are parsed when the file is opened, the data of a
 //! dataset only when it is read, so 4 fields of a 100-field flight cost 4
 //! fields.
@@ -39,11 +39,11 @@ use std::path::Path;
 
 use hdf5_reader::{Dataset, Datatype, H5Type, Hdf5File, OpenOptions, group::Group};
 
+use crate::ReadOptions;
 use crate::columns::resolve;
-use crate::derive::DERIVATIONS;
 use crate::error::{IoError, Result};
 use crate::table::{ColumnData, FlightTable, Missing};
-use crate::{Fields, ReadOptions};
+use crate::wanted::wanted_fields;
 
 /// Largest single read, bytes (4 GiB, 5·10⁸ float64 values): far above any flight's field, far
 /// below what a forged header could claim.
@@ -156,16 +156,15 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         &opts.sensors,
         opts.magnav_preset,
     )?;
-    let mut wanted = wanted_fields(&header, &aliases, opts);
     // The row count comes from data actually read, never from headers alone
     // (a forged header could claim 10^12 rows that nothing then checks): with
     // none of the fields asked for present, the first field is read.
-    if !wanted.contains(&true) {
-        wanted[0] = true;
-    }
+    let wanted = wanted_fields(&header, &aliases, opts);
     let mut columns = Vec::new();
+    let mut unread = Vec::new();
     for ((name, ds, _), want) in fields.into_iter().zip(wanted) {
         if !want {
+            unread.push(name);
             continue;
         }
         let path = format!("{prefix}{name}");
@@ -204,66 +203,10 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         .into_iter()
         .filter(|m| columns.iter().any(|c| c.0 == m.file_column))
         .collect();
-    Ok(FlightTable::from_parts(
-        path.to_path_buf(),
-        n_rows,
-        columns,
-        aliases,
-        Vec::new(),
-    ))
-}
-
-/// Which of the file's fields to read: all, or those [`Fields::Only`] names
-/// (a file name, a canonical name through its alias, the source of a
-/// derived canonical column), plus `line`/`time` for a row selection.
-fn wanted_fields(
-    header: &[String],
-    aliases: &[crate::MappedColumn],
-    opts: &ReadOptions,
-) -> Vec<bool> {
-    let Fields::Only(names) = &opts.fields else {
-        return vec![true; header.len()];
-    };
-    let mut asked: Vec<&str> = names.iter().map(String::as_str).collect();
-    if !opts.rows.lines.is_empty() {
-        asked.extend(["line", "line_type"]);
-    }
-    if opts.rows.time_range.is_some() {
-        asked.push("time");
-    }
-    header
-        .iter()
-        .map(|h| {
-            asked.iter().any(|a| {
-                name_matches(h, a)
-                    || aliases
-                        .iter()
-                        .any(|m| m.canonical == *a && m.file_column == *h)
-                    || DERIVATIONS.iter().any(|(c, sources, _)| {
-                        c == a && sources.iter().any(|s| h.eq_ignore_ascii_case(s))
-                    })
-            })
-        })
-        .collect()
-}
-
-/// `name` against an asked name without regard to case; an asked name
-/// ending in `*` is a prefix (`true_*`), one starting with `*` a suffix
-/// (`*_level`).
-fn name_matches(name: &str, asked: &str) -> bool {
-    let same = |a: Option<&str>, b: &str| a.is_some_and(|a| a.eq_ignore_ascii_case(b));
-    if let Some(prefix) = asked.strip_suffix('*') {
-        same(name.get(..prefix.len()), prefix)
-    } else if let Some(suffix) = asked.strip_prefix('*') {
-        same(
-            name.len()
-                .checked_sub(suffix.len())
-                .and_then(|i| name.get(i..)),
-            suffix,
-        )
-    } else {
-        name.eq_ignore_ascii_case(asked)
-    }
+    let mut table =
+        FlightTable::from_parts(path.to_path_buf(), n_rows, columns, aliases, Vec::new());
+    table.set_unread(unread);
+    Ok(table)
 }
 
 /// A `units` attribute that contradicts the unit the layout gives the field

@@ -143,6 +143,9 @@ pub struct FlightTable {
     /// every row of the file is kept (row `r` is data row `r`).
     row_origin: Vec<(usize, usize)>,
     derived: Vec<DerivedColumn>,
+    /// The file's columns that were not read ([`crate::Fields::Only`]),
+    /// in file order: named in messages about a missing column.
+    unread: Vec<String>,
 }
 
 /// Name used in messages for tables that were not read from a file.
@@ -239,7 +242,7 @@ impl FlightTable {
             None => Err(IoError::MissingColumn {
                 file: self.file_label(),
                 column: name.to_string(),
-                present: self.column_names().join(", "),
+                present: self.present_columns(),
                 // Only canonical and truth names can be mapped.
                 hint: if crate::columns::is_canonical(name) || crate::columns::is_truth_column(name)
                 {
@@ -249,6 +252,28 @@ impl FlightTable {
                 },
             }),
         }
+    }
+
+    /// The columns of the table, then the file's columns that were not
+    /// read ([`FlightTable::unread_columns`]), comma-separated: what a
+    /// message about a missing column lists.
+    pub fn present_columns(&self) -> String {
+        let names = self.column_names().into_iter();
+        names
+            .chain(self.unread.iter().map(String::as_str))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The file's columns that were not read, because the read asked for
+    /// others only ([`crate::Fields::Only`]), in file order.
+    pub fn unread_columns(&self) -> &[String] {
+        &self.unread
+    }
+
+    /// Records the file's columns that the read left out.
+    pub(crate) fn set_unread(&mut self, names: Vec<String>) {
+        self.unread = names;
     }
 
     /// Adds a numeric column; `NaN` values count as missing (`Missing::nan`).
@@ -386,6 +411,7 @@ impl FlightTable {
             row_lines,
             row_origin: Vec::new(),
             derived: Vec::new(),
+            unread: Vec::new(),
         }
     }
 

@@ -98,6 +98,7 @@ fn read_tokens(
     };
     let mut builder = TableBuilder::new(layout, opts)?;
     let header = builder.names().to_vec();
+    let wanted = builder.wanted();
     let mut src = match clean {
         Some((threads, piece_bytes)) => {
             // The first data line: after a plain table's header line; the
@@ -112,6 +113,7 @@ fn read_tokens(
                 n_fields: src.n_fields,
                 crlf: false,
                 whitespace: Some(dialect),
+                wanted: wanted.as_deref(),
             };
             let stop = push_clean_rows(
                 &mut builder,
@@ -676,8 +678,9 @@ mod tests {
                 xyz in file(Dialect::Geosoft),
                 threads in 1usize..4,
                 piece in 8usize..300,
+                fields in csv_clean::check::fields(),
             ) {
-                let opts = ReadOptions::default();
+                let opts = ReadOptions { fields, ..ReadOptions::default() };
                 for (text, dialect) in [(&table, Dialect::Whitespace), (&xyz, Dialect::Geosoft)] {
                     csv_clean::check::reads_as_the_general_reader(
                         text,
@@ -686,6 +689,23 @@ mod tests {
                         piece,
                     )?;
                 }
+            }
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(200))]
+
+            /// Reading some fields gives those columns of the whole read
+            /// (an XYZ file's `line` and `line_type` columns as well, from
+            /// its records).
+            #[test]
+            fn some_fields_are_those_columns_of_the_whole_read(
+                table in file(Dialect::Whitespace),
+                fields in csv_clean::check::fields(),
+            ) {
+                csv_clean::check::some_fields_are_those_of_the_whole(&table, fields, |path, opts| {
+                    read_tokens(path, opts, Dialect::Whitespace, csv_clean::on_all_cores())
+                })?;
             }
         }
 

@@ -72,7 +72,7 @@ impl SensorColumns {
                 flight.label(),
                 format!(
                     "has no {what} `{name}`; columns present: {}",
-                    names.join(", ")
+                    flight.table().present_columns()
                 ),
             )
         };

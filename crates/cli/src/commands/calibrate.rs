@@ -252,7 +252,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return run_sensors(&a, &opts);
     }
     // Only the canonical columns and named reference channels are read
-    // (an HDF5 flight's other fields stay on disk).
+    // (an HDF5 flight's other fields stay on disk, a text file's are not
+    // parsed).
     let mut extra: Vec<&str> = match &a.reference {
         aeromag::ReferenceChannels::Columns(c) => c.iter().map(String::as_str).collect(),
         _ => Vec::new(),
