@@ -453,12 +453,7 @@ impl TableBuilder {
                 .zip(&cols)
                 .any(|(n, c)| n == name && !matches!(c, ColState::Skipped))
         };
-        let unread: Vec<String> = names
-            .iter()
-            .zip(&cols)
-            .filter(|(_, c)| matches!(c, ColState::Skipped))
-            .map(|(n, _)| n.clone())
-            .collect();
+        let file_columns = names.clone();
         let aliases = aliases
             .into_iter()
             .filter(|m| read(&m.file_column))
@@ -495,7 +490,7 @@ impl TableBuilder {
             })
             .collect();
         let mut table = FlightTable::from_parts(path, n_rows, columns, aliases, row_lines);
-        table.set_unread(unread);
+        table.set_file_columns(file_columns);
         Ok(table)
     }
 }

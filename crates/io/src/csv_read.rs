@@ -656,7 +656,7 @@ mod tests {
         assert_eq!(t.unread_columns(), ["lat", "magnetic", "true_mag", "note"]);
         let e = t.require("mag").unwrap_err().to_string();
         assert!(
-            e.contains("columns present: time, flux_x, lat, magnetic, true_mag, note"),
+            e.contains("columns present: time, lat, magnetic, true_mag, flux_x, note ("),
             "{e}"
         );
     }

@@ -161,10 +161,8 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     // none of the fields asked for present, the first field is read.
     let wanted = wanted_fields(&header, &aliases, opts);
     let mut columns = Vec::new();
-    let mut unread = Vec::new();
     for ((name, ds, _), want) in fields.into_iter().zip(wanted) {
         if !want {
-            unread.push(name);
             continue;
         }
         let path = format!("{prefix}{name}");
@@ -205,7 +203,7 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         .collect();
     let mut table =
         FlightTable::from_parts(path.to_path_buf(), n_rows, columns, aliases, Vec::new());
-    table.set_unread(unread);
+    table.set_file_columns(header);
     Ok(table)
 }
 

@@ -143,9 +143,9 @@ pub struct FlightTable {
     /// every row of the file is kept (row `r` is data row `r`).
     row_origin: Vec<(usize, usize)>,
     derived: Vec<DerivedColumn>,
-    /// The file's columns that were not read ([`crate::Fields::Only`]),
-    /// in file order: named in messages about a missing column.
-    unread: Vec<String>,
+    /// Every column of the file, in file order, read or not
+    /// ([`crate::Fields::Only`]); empty for in-memory tables.
+    file_columns: Vec<String>,
 }
 
 /// Name used in messages for tables that were not read from a file.
@@ -254,26 +254,35 @@ impl FlightTable {
         }
     }
 
-    /// The columns of the table, then the file's columns that were not
-    /// read ([`FlightTable::unread_columns`]), comma-separated: what a
-    /// message about a missing column lists.
+    /// What a message about a missing column lists, comma-separated: the
+    /// file's columns in file order, read or not
+    /// ([`FlightTable::unread_columns`]), then the table's other columns
+    /// (derived or added).
     pub fn present_columns(&self) -> String {
-        let names = self.column_names().into_iter();
-        names
-            .chain(self.unread.iter().map(String::as_str))
+        let in_file = |c: &&str| self.file_columns.iter().any(|f| f == c);
+        let added = self.column_names().into_iter().filter(|c| !in_file(c));
+        self.file_columns
+            .iter()
+            .map(String::as_str)
+            .chain(added)
             .collect::<Vec<_>>()
             .join(", ")
     }
 
     /// The file's columns that were not read, because the read asked for
     /// others only ([`crate::Fields::Only`]), in file order.
-    pub fn unread_columns(&self) -> &[String] {
-        &self.unread
+    pub fn unread_columns(&self) -> Vec<&str> {
+        self.file_columns
+            .iter()
+            .map(String::as_str)
+            .filter(|c| self.get(c).is_none())
+            .collect()
     }
 
-    /// Records the file's columns that the read left out.
-    pub(crate) fn set_unread(&mut self, names: Vec<String>) {
-        self.unread = names;
+    /// Records every column of the file the table was read from, in file
+    /// order (read or not).
+    pub(crate) fn set_file_columns(&mut self, names: Vec<String>) {
+        self.file_columns = names;
     }
 
     /// Adds a numeric column; `NaN` values count as missing (`Missing::nan`).
@@ -411,7 +420,7 @@ impl FlightTable {
             row_lines,
             row_origin: Vec::new(),
             derived: Vec::new(),
-            unread: Vec::new(),
+            file_columns: Vec::new(),
         }
     }
 

@@ -76,8 +76,8 @@ fn only_the_fields_asked_for_are_read() {
         assert_eq!(names, ["ins_vn", "mag_1_uc", "tt"], "{file}");
         // The others are listed, and named when a column is missing.
         let unread = t.unread_columns();
-        assert!(unread.iter().any(|c| c == "mag_2_uc"), "{file}: {unread:?}");
-        assert!(!unread.iter().any(|c| c == "tt"), "{file}: {unread:?}");
+        assert!(unread.contains(&"mag_2_uc"), "{file}: {unread:?}");
+        assert!(!unread.contains(&"tt"), "{file}: {unread:?}");
         let e = t.require("flux_x").unwrap_err().to_string();
         assert!(e.contains("mag_2_uc"), "{file}: {e}");
         // Patterns: a prefix and a suffix.
