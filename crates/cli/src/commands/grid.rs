@@ -80,7 +80,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (Some(_), None) => return Err(crate::exit::bad_input!("--extent needs --cell")),
         (None, _) => None,
     };
-    let flight = a.input.load()?;
+    // The canonical columns and the magnetic ones it may grid: a wide
+    // survey file's other fields are not parsed.
+    let mut extra: Vec<&str> = aeromag::map::MOST_PROCESSED.to_vec();
+    extra.extend(a.column.as_deref());
+    let flight = a.input.load_canonical(&extra)?;
     let opts = GridOptions {
         geometry,
         column: a.column.clone(),
