@@ -695,9 +695,10 @@ mod tests {
         proptest! {
             #![proptest_config(ProptestConfig::with_cases(200))]
 
-            /// Reading some fields gives those columns of the whole read
-            /// (an XYZ file's `line` and `line_type` columns as well, from
-            /// its records).
+            /// Reading some fields of a whitespace table gives those
+            /// columns of the whole read (an XYZ file's records add its
+            /// `line` and `line_type` columns whatever the selection; the
+            /// property above covers its fields).
             #[test]
             fn some_fields_are_those_columns_of_the_whole_read(
                 table in file(Dialect::Whitespace),
