@@ -88,6 +88,7 @@ def read_flight(
     vector: Optional[str] = None,
     lines: Union[None, str, float, Iterable[Any]] = None,
     time_range: Optional[Tuple[float, float]] = None,
+    fields: Union[None, str, Iterable[str]] = None,
 ) -> Flight:
     """Read a flight file: CSV, Geosoft XYZ or HDF5 (MagNav/SGL layout).
 
@@ -101,12 +102,27 @@ def read_flight(
     - ``vector``: the vector magnetometer by prefix (``"flux_b"``);
     - ``lines``: keep only the rows on these line labels (``"1002.02"``,
       ``[1003.01, 1003.02]``, ``"L1020,T901"``);
-    - ``time_range``: keep only the rows with ``t0 ≤ time ≤ t1`` (s).
+    - ``time_range``: keep only the rows with ``t0 ≤ time ≤ t1`` (s);
+    - ``fields``: read only these fields (default: every one): file names,
+      canonical names (through the map, the preset or a derivation: ``lat``
+      brings ``ins_lat``), ``true_*`` by prefix and ``*_level`` by suffix,
+      without regard to case; the ``line`` and ``time`` a row selection
+      needs are added. An HDF5 file then reads only those datasets and a
+      text file parses only those fields: less time and memory for a wide
+      file. ``Flight.unread_columns`` lists the others.
 
     Raises :class:`BadInputError` naming file, line, row and column.
     """
+    if isinstance(fields, str):
+        fields = [fields]
     return _aeromag.read_flight(
-        os.fspath(path), columns=columns, mag=mag, vector=vector, lines=lines, time_range=time_range
+        os.fspath(path),
+        columns=columns,
+        mag=mag,
+        vector=vector,
+        lines=lines,
+        time_range=time_range,
+        fields=None if fields is None else list(fields),
     )
 
 

@@ -143,7 +143,8 @@ fn python_read_options(
 /// Read a flight file (CSV, Geosoft XYZ or HDF5) with the Python layer's
 /// choices already turned into the CLI's strings.
 #[pyfunction]
-#[pyo3(signature = (path, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+#[pyo3(signature = (path, columns=None, mag=None, vector=None, lines=None, time_range=None, fields=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn read_flight(
     py: Python<'_>,
     path: PathBuf,
@@ -152,8 +153,12 @@ pub fn read_flight(
     vector: Option<String>,
     lines: Option<Bound<'_, PyAny>>,
     time_range: Option<(f64, f64)>,
+    fields: Option<Vec<String>>,
 ) -> PyResult<PyFlight> {
-    let opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
+    let mut opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
+    if let Some(names) = fields {
+        opts.fields = aeromag::Fields::Only(names);
+    }
     let flight = py.detach(|| Flight::read_with(&path, &opts)).py_err()?;
     Ok(PyFlight::new(flight))
 }
@@ -322,6 +327,17 @@ impl PyFlight {
     fn columns(&self) -> Vec<String> {
         self.inner
             .column_names()
+            .into_iter()
+            .map(String::from)
+            .collect()
+    }
+
+    /// The file's columns that were not read, because `read_flight` was
+    /// asked for others only (`fields=`), in file order.
+    #[getter]
+    fn unread_columns(&self) -> Vec<String> {
+        self.inner
+            .unread_columns()
             .into_iter()
             .map(String::from)
             .collect()

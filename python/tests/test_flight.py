@@ -39,6 +39,26 @@ def test_hdf5_sgl_layout_with_sensor_and_line_choice():
     assert len(aeromag.read_flight(path, lines="1001")) == len(g)
 
 
+def test_only_the_fields_asked_for(cal_csv):
+    # A CSV: the fields named, a canonical one through its derivation or
+    # alias, the others listed as not read; the same values as a whole read.
+    whole = aeromag.read_flight(cal_csv)
+    f = aeromag.read_flight(cal_csv, fields=["time", "MAG", "true_*"])
+    assert f.columns == [c for c in whole.columns if c in ("time", "mag") or c.startswith("true_")]
+    assert "flux_x" in f.unread_columns and "mag" not in f.unread_columns
+    assert whole.unread_columns == []
+    for c in f.columns:
+        assert np.array_equal(f[c], whole[c], equal_nan=True)
+    assert len(aeromag.read_flight(cal_csv, fields="mag").columns) == 1
+    with pytest.raises(aeromag.BadInputError, match="flux_x"):
+        aeromag.TollesLawson(terms="p3").fit(aeromag.read_flight(cal_csv, fields="mag"))
+    # An HDF5 file: only those datasets.
+    path = HDF5 / "root_gzip.h5"
+    g = aeromag.read_flight(path, fields=["mag", "lat"])
+    assert sorted(g.columns) == ["ins_lat", "lat", "mag_1_uc"]
+    assert "mag_2_uc" in g.unread_columns
+
+
 def test_time_range_and_column_map(cal_csv):
     f = aeromag.read_flight(cal_csv)
     t0 = f["time"][0]
