@@ -77,21 +77,15 @@ fn read(shape: &Shape, i: usize) -> bool {
 }
 
 /// The end of the unread field at `piece[p..]` of a delimited row, for
-/// [`plain_row`]: the position of the delimiter, line end (`\n` or the
-/// file's end) or `\r` that ends it (a CRLF line end, or a `\r` within the
-/// line, which [`plain_row`] leaves to [`clean_row`]); `None` at a quote,
-/// which leaves the line to the general reader.
+/// [`plain_row`]: the position of the first delimiter, `\n`, `\r` or quote
+/// (the file's end without one). [`plain_row`] takes a delimiter, a line
+/// end or a CRLF there as [`plain_decimal_field`]'s end, and leaves the line
+/// to [`clean_row`] at anything else (a quote: to the general reader).
 #[inline]
-fn unread_field_end(piece: &[u8], p: usize, delimiter: u8) -> Option<usize> {
+fn unread_field_end(piece: &[u8], p: usize, delimiter: u8) -> usize {
     let rest = piece.get(p..).unwrap_or_default();
-    match rest
-        .iter()
-        .position(|&b| b == delimiter || matches!(b, b'\n' | b'\r' | b'"'))
-    {
-        Some(k) if rest[k] == b'"' => None,
-        Some(k) => Some(p + k),
-        None => Some(piece.len()),
-    }
+    let stop = |&b: &u8| b == delimiter || matches!(b, b'\n' | b'\r' | b'"');
+    p + rest.iter().position(stop).unwrap_or(rest.len())
 }
 
 /// The clean rows at the start of one piece, column by column.
@@ -268,7 +262,7 @@ fn plain_row(
             *integer &= is_integer;
             p + len
         } else {
-            unread_field_end(piece, p, shape.delimiter)?
+            unread_field_end(piece, p, shape.delimiter)
         };
         if i < last {
             if piece.get(end) != Some(&shape.delimiter) {
@@ -409,8 +403,8 @@ fn clean_row(
             return false; // short row
         }
         // Most cells: a plain decimal ended by the delimiter or the line.
-        let read = read(&shape, i);
-        if read && let Some((v, integer, len)) = plain_decimal_field(piece, start, line.end) {
+        let wanted = read(&shape, i);
+        if wanted && let Some((v, integer, len)) = plain_decimal_field(piece, start, line.end) {
             let end = start + len;
             let end_ok = if i == last {
                 end == line.end || (shape.crlf && end + 1 == line.end && piece[end] == b'\r')
@@ -442,7 +436,7 @@ fn clean_row(
         } else {
             f
         };
-        if read && !push_cell(f, i, column, integers, missing) {
+        if wanted && !push_cell(f, i, column, integers, missing) {
             return false;
         }
         start += len + 1;
