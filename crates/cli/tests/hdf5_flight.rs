@@ -135,19 +135,24 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
     }
     assert!(s.contains("derived  lat=ins_lat (rad → deg) [deg]"), "{s}");
     let survey_lines = "1003.01,1003.02,1003.03,1003.04,1003.05,1003.51,1003.52";
-    let mut models = Vec::new();
-    let mut outputs = Vec::new();
-    for (k, input) in [&csv, &h5].into_iter().enumerate() {
-        let model = d.join(format!("model{k}.json"));
-        let o = aeromag(&[
+    // `calibrate` on the box (line 1002.02) of `input`, with `more` arguments.
+    let calibrate_box = |input: &Path, model: &Path, more: &[&str]| {
+        let mut args = vec![
             "calibrate",
             "-i",
             input.to_str().unwrap(),
             "--lines",
             "1002.02",
-            "--model",
-            model.to_str().unwrap(),
-        ]);
+        ];
+        args.extend(["--model", model.to_str().unwrap()]);
+        args.extend(more);
+        aeromag(&args)
+    };
+    let mut models = Vec::new();
+    let mut outputs = Vec::new();
+    for (k, input) in [&csv, &h5].into_iter().enumerate() {
+        let model = d.join(format!("model{k}.json"));
+        let o = calibrate_box(input, &model, &[]);
         assert_code(&o, 0);
         let out = d.join(format!("comp{k}.csv"));
         compensate_lines(input, survey_lines, &model, &out);
@@ -174,17 +179,7 @@ fn whole_flight_in_sgl_hdf5_gives_the_numbers_of_the_csv_route() {
     // `calibrate --compensated` on the HDF5 box writes every field of the
     // file (not only those the fit reads), as `compensate` does.
     let (m, c1, c2) = (d.join("box.json"), d.join("box1.csv"), d.join("box2.csv"));
-    let o = aeromag(&[
-        "calibrate",
-        "-i",
-        h5.to_str().unwrap(),
-        "--lines",
-        "1002.02",
-        "--model",
-        m.to_str().unwrap(),
-        "--compensated",
-        c1.to_str().unwrap(),
-    ]);
+    let o = calibrate_box(&h5, &m, &["--compensated", c1.to_str().unwrap()]);
     assert_code(&o, 0);
     compensate_lines(&h5, "1002.02", &m, &c2);
     let box_text = std::fs::read_to_string(&c1).unwrap();
