@@ -233,6 +233,51 @@ fn an_overlong_line_is_malformed_and_the_stream_goes_on() {
     assert_eq!(s.counts().malformed, 1);
 }
 
+/// Comment lines (`#` first) and blank lines before the header, and comment
+/// lines among the data, are written back as they are, in their place, and
+/// are not data lines: the data lines get the values they get without them.
+#[test]
+fn comment_lines_are_written_back_in_their_place() {
+    use aeromag::online::LineStream;
+    let model = model();
+    let header = "time,flux_x,flux_y,flux_z,mag";
+    let data = [
+        "0.0,20000,1000,45000,49300",
+        "0.1,20001,1001,45001,49301",
+        "0.2,20002,1002,45002,49302",
+    ];
+    let serve = |input: &str| -> (Vec<String>, u64, u64) {
+        let mut s = LineStream::new(&model, &StreamOptions::default(), None).unwrap();
+        let mut out = Vec::new();
+        s.serve(input.as_bytes(), &mut out, "test").unwrap();
+        let lines = String::from_utf8(out)
+            .unwrap()
+            .lines()
+            .map(str::to_string)
+            .collect();
+        (lines, s.counts().lines, s.counts().malformed)
+    };
+    let (plain, n, bad) = serve(&format!("{header}\n{}\n", data.join("\n")));
+    assert_eq!((plain.len(), n, bad), (4, 3, 0));
+    let commented = format!(
+        "# units: time[s] mag[nT]\n\n# seed 3\r\n{header}\n{}\n# a note\n{}\n",
+        data[..2].join("\n"),
+        data[2]
+    );
+    let (got, n, bad) = serve(&commented);
+    assert_eq!((n, bad), (3, 0), "{got:?}");
+    let want: Vec<String> = ["# units: time[s] mag[nT]", "", "# seed 3"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(plain[..3].iter().cloned())
+        .chain(["# a note".to_string(), plain[3].clone()])
+        .collect();
+    assert_eq!(got, want);
+    // A connection of comments alone writes them back and has no header.
+    let (got, n, _) = serve("# nothing yet\n");
+    assert_eq!((got, n), (vec!["# nothing yet".to_string()], 0));
+}
+
 /// A multi-sensor model under the causal convention (`compensate --causal`
 /// with a `tolles-lawson-sensors` file): the batch path's columns, and on
 /// the SGL-like installation every sensor within 5 % of its batch

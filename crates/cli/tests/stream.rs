@@ -126,6 +126,40 @@ fn a_pipe_gives_the_causal_batch_values_and_flags_bad_lines() {
     );
 }
 
+/// A file as `aeromag simulate` writes it, its `#` lines first, streams as
+/// the same lines without them do: the comment lines come back as they
+/// are, in their place, and are not counted as data lines.
+#[test]
+fn a_simulated_file_streams_with_its_comment_lines() {
+    let d = tempfile::tempdir().unwrap();
+    let (model, lines, want) = setup(d.path());
+    let file = std::fs::read_to_string(d.path().join("survey").join("survey.csv")).unwrap();
+    let comments: Vec<String> = file
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(str::to_string)
+        .collect();
+    assert!(comments.len() >= 2, "{comments:?}");
+    let mut input = comments.clone();
+    input.extend(lines[..3001].iter().cloned());
+    input.push("# a note among the data".into());
+    input.extend(lines[3001..].iter().cloned());
+    let (out, err) = through_pipe(&model, &[], &input);
+    assert_eq!(out[..comments.len()], comments[..]);
+    let rest = &out[comments.len()..];
+    assert_eq!(
+        rest[0],
+        format!("{},mag_interf,mag_comp,comp_flag", lines[0])
+    );
+    assert_eq!(rest[3001], "# a note among the data");
+    let data: Vec<String> = rest[1..3001].iter().chain(&rest[3002..]).cloned().collect();
+    assert_same(&data, &want[1..]);
+    assert!(
+        err.contains("6000 lines: 6000 compensated (0 runs restarted), 0 with missing values, 0 with time going back, 0 malformed"),
+        "{err}"
+    );
+}
+
 /// A running `aeromag stream` server and the address it listens on.
 struct Server(Child, String);
 

@@ -360,6 +360,11 @@ impl LineCompensator {
     }
 }
 
+/// Whether a line is a comment (`#` first), as in a CSV file.
+fn is_comment(line: &[u8]) -> bool {
+    line.first() == Some(&b'#')
+}
+
 /// The longest line read, bytes: a longer one is malformed (and skipped to
 /// its end), so a hostile peer cannot make the stream hold unbounded text.
 pub const MAX_STREAM_LINE_BYTES: usize = 1 << 20;
@@ -370,6 +375,10 @@ pub const MAX_STREAM_LINE_BYTES: usize = 1 << 20;
 /// header as the last continues its state (the gap rule decides whether
 /// the run goes on), another header starts afresh. The counts add up over
 /// connections.
+///
+/// Comment lines (`#` first, as in a CSV file: the `# units:` lines that
+/// `aeromag simulate` writes) are written back as they are, in their
+/// place, and are not data lines; so are blank lines before the header.
 #[derive(Debug, Clone)]
 pub struct LineStream {
     model: TlModel,
@@ -420,13 +429,24 @@ impl LineStream {
         output: &mut impl std::io::Write,
         peer: &str,
     ) -> Result<bool> {
+        // The comment and blank lines before the header, written back.
+        let mut before = String::new();
         if self.columns_in.is_none() {
             let mut buf = Vec::new();
-            if !read_line(input, &mut buf, &mut false, peer, || Ok(()))? {
-                return Ok(false);
-            }
-            let header = String::from_utf8_lossy(&buf);
-            let header = header.trim_end_matches(['\r', '\n']);
+            let header = loop {
+                if !read_line(input, &mut buf, &mut false, peer, || Ok(()))? {
+                    write_flushed(output, &before, peer)?;
+                    return Ok(false);
+                }
+                let line = String::from_utf8_lossy(&buf);
+                let line = line.trim_end_matches(['\r', '\n']);
+                if !(is_comment(&buf) || line.trim().is_empty()) {
+                    break line.to_string();
+                }
+                before.push_str(line);
+                before.push('\n');
+            };
+            let header = header.as_str();
             if self
                 .comp
                 .as_ref()
@@ -439,7 +459,7 @@ impl LineStream {
             }
         }
         let comp = self.comp.as_ref().expect("a header");
-        let out = format!("{}\n", comp.header());
+        let out = format!("{before}{}\n", comp.header());
         write_flushed(output, &out, peer)?;
         Ok(true)
     }
@@ -474,6 +494,10 @@ impl LineStream {
             }
             if buf.len() > MAX_STREAM_LINE_BYTES {
                 comp.malformed(&mut out);
+            } else if is_comment(&buf) {
+                // A comment, written back as it is.
+                out.push_str(String::from_utf8_lossy(&buf).trim_end_matches(['\r', '\n']));
+                out.push('\n');
             } else {
                 match std::str::from_utf8(&buf) {
                     Ok(text) => comp.line(text, &mut out),

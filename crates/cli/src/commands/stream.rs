@@ -20,7 +20,10 @@ use std::path::PathBuf;
 /// `mag_interf` and `mag_comp` (nT) and `comp_flag`: 0 compensated,
 /// 1 missing value, 2 compensated after a gap (run restarted), 3 time
 /// going back (ignored), 4 malformed line. Bad lines never stop the
-/// stream; the counts go to standard error when a stream ends.
+/// stream; the counts go to standard error when a stream ends. Comment
+/// lines (`#` first, as in a CSV file: a simulated file's `# units:`
+/// lines) are written back as they are, in their place, and so are blank
+/// lines before the header.
 ///
 /// With --adapt the coefficients start at the model's and are updated by
 /// every compensated sample, after it is compensated: `kalman`, the
