@@ -429,13 +429,10 @@ impl LineStream {
         output: &mut impl std::io::Write,
         peer: &str,
     ) -> Result<bool> {
-        // The comment and blank lines before the header, written back.
-        let mut before = String::new();
         if self.columns_in.is_none() {
             let mut buf = Vec::new();
             let header = loop {
                 if !read_line(input, &mut buf, &mut false, peer, || Ok(()))? {
-                    write_flushed(output, &before, peer)?;
                     return Ok(false);
                 }
                 let line = String::from_utf8_lossy(&buf);
@@ -443,8 +440,9 @@ impl LineStream {
                 if !(is_comment(&buf) || line.trim().is_empty()) {
                     break line.to_string();
                 }
-                before.push_str(line);
-                before.push('\n');
+                // A comment or blank line before the header, written back
+                // at once (however many come, none is held).
+                write_flushed(output, &format!("{line}\n"), peer)?;
             };
             let header = header.as_str();
             if self
@@ -459,7 +457,7 @@ impl LineStream {
             }
         }
         let comp = self.comp.as_ref().expect("a header");
-        let out = format!("{before}{}\n", comp.header());
+        let out = format!("{}\n", comp.header());
         write_flushed(output, &out, peer)?;
         Ok(true)
     }
