@@ -56,6 +56,60 @@ fn both_methods_honour_consistent_line_data() {
     }
 }
 
+/// A row whose latitude reads 0 (a GPS dropout) in a survey at 56° N is
+/// left out with a `[position-glitch]` warning that names it: the grid has
+/// the clean survey's nodes, and its values at the data are as good (the
+/// grid was 6 200 km tall before, its solve running for minutes).
+#[test]
+fn a_position_glitch_is_left_out_with_a_warning() {
+    let flight = survey(
+        "[pattern]\nline_count = 6\nline_length_m = 4000.0\ntie_count = 2\n",
+        12,
+    );
+    let opts = GridOptions {
+        column: Some("true_anomaly".into()),
+        cell_m: Some(100.0),
+        ..GridOptions::default()
+    };
+    let clean = grid_flight(&flight, &opts, &mut Silent).unwrap();
+    assert!(clean.survey.off_track.is_empty());
+    let row = flight
+        .require("line")
+        .unwrap()
+        .iter()
+        .position(|&l| l != 0.0)
+        .unwrap()
+        + 200;
+    let mut table = flight.table().clone();
+    let mut lat = table.column("lat").unwrap().to_vec();
+    lat[row] = 0.0;
+    table.set_column("lat", lat).unwrap();
+    let glitched = Flight::from_table(table).unwrap();
+    // Before gridding: with the glitch kept the solve would run for minutes.
+    let projected = aeromag::map::ProjectedSurvey::of(&glitched, None, None).unwrap();
+    assert_eq!(projected.off_track, [row]);
+    let g = grid_flight(&glitched, &opts, &mut Silent).unwrap();
+    assert_eq!(g.survey.off_track, [row]);
+    assert_eq!(g.grid.geometry, clean.grid.geometry);
+    let warned: Vec<&str> = g
+        .notes
+        .iter()
+        .filter(|n| n.is_warning() && n.message.contains("[position-glitch]"))
+        .map(|n| n.message.as_str())
+        .collect();
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(
+        warned[0].contains(&format!("data row {}", row + 1)) && warned[0].contains("lat 0,"),
+        "{}",
+        warned[0]
+    );
+    let (a, b) = (
+        misfit_at_data(&flight, &clean),
+        misfit_at_data(&glitched, &g),
+    );
+    assert!(b < 1.05 * a, "misfit {b} against {a} without the glitch");
+}
+
 #[test]
 fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
     let flight = survey(

@@ -7,7 +7,9 @@
 //! - [`ReferenceChannels`] — the known external-field channels removed from
 //!   the scalar reading before a fit or a score;
 //! - [`LeverArm`] and [`sensor_track`] — where the sensor is relative to
-//!   the navigation point.
+//!   the navigation point;
+//! - [`position_glitches`] — rows whose position jumps off the track faster
+//!   than anything flies.
 //!
 //! Files hold nT, m, s and degrees; frames are NED and body (x forward,
 //! y right, z down). Columns have the canonical names of
@@ -15,12 +17,14 @@
 //! `yaw`, `mag`, `flux_x`, …) after the column map.
 
 mod line_labels;
+mod position_glitches;
 mod reference;
 mod segments;
 mod tl_inputs;
 
 pub use aeromag_compensation::reference_field::LeverArm;
 pub use line_labels::LineLabels;
+pub use position_glitches::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub(crate) use reference::reduced;
 pub use reference::{ReferenceChannels, reference_sum};
 pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};

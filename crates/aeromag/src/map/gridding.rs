@@ -130,6 +130,9 @@ pub fn grid_flight(
     let values = flight.require(&column)?;
     notes.stage("projecting");
     let survey = ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m)?;
+    if let Some(w) = survey.off_track_warning(flight) {
+        notes.warn(w);
+    }
     let cell = match (opts.geometry.map(|g| g.cell).or(opts.cell_m), &survey.lines) {
         (Some(c), _) => c,
         (None, Some(l)) => l.default_cell_m(),

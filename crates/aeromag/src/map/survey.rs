@@ -10,10 +10,15 @@
 //! spacing). The line spacing is the median gap between successive
 //! traverse lines across the survey direction, gaps below a tenth of the
 //! median (re-flown parts such as 1003.01 beside 1003) left out.
+//!
+//! Rows whose position jumps off the track faster than anything flies
+//! ([`position_glitches`]; a GPS dropout written as 0) are not projected:
+//! their easting and northing are NaN, as for a missing position, and
+//! [`ProjectedSurvey::off_track`] lists them.
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
-use crate::flight::{LineLabels, sensor_track};
+use crate::flight::{LineLabels, position_glitches, sensor_track};
 use aeromag_grid::projection::{Utm, UtmZone};
 
 /// A flight's rows in UTM (m) and its lines' geometry.
@@ -25,6 +30,9 @@ pub struct ProjectedSurvey {
     pub x: Vec<f64>,
     /// Northing of every row, m.
     pub y: Vec<f64>,
+    /// Rows (0-based, ascending) whose position is off the track
+    /// ([`position_glitches`]; needs a `time` column): not projected.
+    pub off_track: Vec<usize>,
     /// Per row the id of its line (0: on no line), when the flight has a
     /// `line` column.
     pub line_ids: Option<Vec<f64>>,
@@ -66,15 +74,28 @@ impl ProjectedSurvey {
             Some([la, lo, _]) => (la.as_slice(), lo.as_slice()),
             None => (flight.require("lat")?, flight.require("lon")?),
         };
+        let off_track = flight
+            .column("time")
+            .map_or_else(Vec::new, |t| position_glitches(t, lat, lon));
+        let on_track = |k: usize| off_track.binary_search(&k).is_err();
         let zone = match zone {
-            Some(z) => z,
-            None => UtmZone::for_points(lat, lon)
-                .map_err(|e| Error::bad_file(flight.label(), e.to_string()))?,
-        };
+            Some(z) => Ok(z),
+            None if off_track.is_empty() => UtmZone::for_points(lat, lon),
+            None => {
+                let kept = |v: &[f64]| -> Vec<f64> {
+                    (0..v.len())
+                        .filter(|&k| on_track(k))
+                        .map(|k| v[k])
+                        .collect()
+                };
+                UtmZone::for_points(&kept(lat), &kept(lon))
+            }
+        }
+        .map_err(|e| Error::bad_file(flight.label(), e.to_string()))?;
         let utm = Utm::new(zone);
         let (mut x, mut y) = (Vec::with_capacity(lat.len()), Vec::with_capacity(lat.len()));
         for (k, (&la, &lo)) in lat.iter().zip(lon).enumerate() {
-            if !(la.is_finite() && lo.is_finite()) {
+            if !(la.is_finite() && lo.is_finite() && on_track(k)) {
                 x.push(f64::NAN);
                 y.push(f64::NAN);
                 continue;
@@ -96,9 +117,49 @@ impl ProjectedSurvey {
             zone,
             x,
             y,
+            off_track,
             line_ids,
             lines,
         })
+    }
+
+    /// The warning for the rows off the track (`None` when there are
+    /// none): how many, and the first few with their file rows, lines and
+    /// positions, named `[position-glitch]`.
+    pub fn off_track_warning(&self, flight: &Flight) -> Option<String> {
+        const SHOWN: usize = 5;
+        let n = self.off_track.len();
+        if n == 0 {
+            return None;
+        }
+        let (lat, lon) = (flight.column("lat"), flight.column("lon"));
+        let rows: Vec<String> = self.off_track[..n.min(SHOWN)]
+            .iter()
+            .map(|&k| {
+                let line = flight
+                    .line_of_row(k)
+                    .map_or(String::new(), |l| format!(" (line {l})"));
+                let at = |c: Option<&[f64]>| c.map_or(f64::NAN, |c| c[k]);
+                format!(
+                    "data row {}{line}: lat {}, lon {}",
+                    flight.file_row(k) + 1,
+                    at(lat),
+                    at(lon)
+                )
+            })
+            .collect();
+        let more = if n > SHOWN {
+            format!(" and {} more", n - SHOWN)
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "{n} {} off the track (the position jumps away and back faster than {} m/s: a GPS dropout or a corrupted cell?) and {} left out: {}{more} [position-glitch]",
+            if n == 1 { "row is" } else { "rows are" },
+            crate::flight::MAX_GROUND_SPEED_M_S,
+            if n == 1 { "is" } else { "are" },
+            rows.join("; ")
+        ))
     }
 
     /// Whether row `k` is survey data: on a line when there are lines

@@ -17,7 +17,9 @@ use std::path::PathBuf;
 /// Latitude and longitude are projected to UTM (the zone of the data, or
 /// --utm-zone); rows on lines (line label ≠ 0) are gridded. Defaults
 /// follow the lines: the cell is a quarter of the line spacing, nodes
-/// farther than one line spacing from the data are blank.
+/// farther than one line spacing from the data are blank. Rows whose
+/// position jumps off the track and back faster than 1000 m/s (a GPS
+/// dropout written as 0) are left out with a warning that names them.
 ///
 /// Examples:
 ///   aeromag grid -i levelled.csv --cell 50 --out mag.tif
