@@ -15,6 +15,7 @@
 //! | columns | error | warning |
 //! |---|---|---|
 //! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
+//! | `mag`, `igrf`, `flux_x/y/z`, `diurnal` | once the units pass: any \|value\| > [`MAX_FIELD_NT`] (a corrupted cell, a numeric dummy such as −1e32), naming the first row | — |
 //! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 15 000–75 000 nT; median relative difference from `mag` above 10 % (`vector-vs-scalar`) |
 //! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
 //! | `lat` | \|lat\| > 90 | all \|lat\| ≤ π/2 and \|lon\| ≤ π (radians?) |
@@ -112,6 +113,13 @@ impl WarningKind {
 /// total channel mapped as a component gives tens of per cent or more.
 pub const VECTOR_SCALAR_TOLERANCE: f64 = 0.10;
 
+/// The largest magnetic reading taken as one, nT (1 mT): Earth's field is
+/// below 70 000 nT and an aircraft's at its sensors a few thousand; a value
+/// beyond is a corrupted cell or a numeric dummy (−1e32), which would
+/// otherwise run through every computation (a flux component of 1e300 gave
+/// its neighbours an interference of 10²⁹⁵ nT, flagged compensated).
+pub const MAX_FIELD_NT: f64 = 1e6;
+
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
 
@@ -176,9 +184,13 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     let mut warnings = Vec::new();
     let ctx = Ctx { table };
     let stats = Stats::of(table);
-    for (name, m) in [("mag", stats.mag), ("igrf", stats.igrf)] {
+    for (name, m, max) in [
+        ("mag", stats.mag, stats.mag_max),
+        ("igrf", stats.igrf, stats.igrf_max),
+    ] {
         if table.column(name).is_some() {
             ctx.total_field(name, m, &mut warnings)?;
+            ctx.within_field(name, max)?;
         }
     }
     for (name, c) in ["flux_x", "flux_y", "flux_z", "diurnal"]
@@ -187,6 +199,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     {
         if table.column(name).is_some() {
             ctx.component(name, c)?;
+            ctx.within_field(name, c.0)?;
         }
     }
     if let Some((norm, vs_mag)) = stats.vector {
@@ -246,6 +259,9 @@ struct Stats {
     /// Median |value| of `mag` and of `igrf`.
     mag: Option<f64>,
     igrf: Option<f64>,
+    /// Maximum |value| of `mag` and of `igrf`.
+    mag_max: Option<f64>,
+    igrf_max: Option<f64>,
     /// Maximum and median |value| of `flux_x`, `flux_y`, `flux_z`, `diurnal`.
     components: [(Option<f64>, Option<f64>); 4],
     /// With all three flux components: the median vector magnitude, and
@@ -288,6 +304,13 @@ impl Stats {
                 .column("alt")
                 .map(|alt| Box::new(move || median(alt.len(), |i| alt[i])) as Job<'_>),
         );
+        for name in ["mag", "igrf"] {
+            jobs.push(
+                table
+                    .column(name)
+                    .map(|v| Box::new(move || max_abs(v)) as Job<'_>),
+            );
+        }
         let v = crate::parts::each_on_cores(&jobs, |job| job.as_ref().and_then(|f| f()));
         Self {
             mag: v[0],
@@ -295,6 +318,8 @@ impl Stats {
             components: [(v[2], v[3]), (v[4], v[5]), (v[6], v[7]), (v[8], v[9])],
             vector: flux.map(|_| (v[10], v[11])),
             alt: v[12],
+            mag_max: v[13],
+            igrf_max: v[14],
         }
     }
 }
@@ -384,6 +409,28 @@ impl Ctx<'_> {
                 ));
         }
         Ok(())
+    }
+
+    /// No `|value|` of `name` above [`MAX_FIELD_NT`] (`max`: its largest),
+    /// or bad input naming the first row that has one.
+    fn within_field(&self, name: &str, max: Option<f64>) -> Result<()> {
+        if max.is_none_or(|m| m <= MAX_FIELD_NT) {
+            return Ok(());
+        }
+        let Some((i, v)) = self
+            .table
+            .column(name)
+            .and_then(|c| first_where(c, |v| v.abs() > MAX_FIELD_NT))
+        else {
+            return Ok(());
+        };
+        Err(self.units(
+            name,
+            format!(
+                "{v:e} at {} is no magnetic field reading in nT (at most {MAX_FIELD_NT:e} nT in magnitude): a corrupted cell, or a number standing for a missing value? leave the cell empty for a missing value",
+                data_row(self.table, i)
+            ),
+        ))
     }
 
     fn position(&self, w: &mut Vec<Warning>) -> Result<()> {

@@ -187,6 +187,43 @@ fn field_range_and_vector_against_scalar_are_named_warnings() {
     assert!(check_units(&field(0.85)).unwrap().len() == 1);
 }
 
+/// One reading beyond any magnetic field in nT (a corrupted cell, a
+/// numeric dummy) is bad input naming its column, row and line, once the
+/// column's units pass; a file in picotesla is still reported as such.
+#[test]
+fn a_reading_beyond_any_field_names_its_row() {
+    let fx = Fixtures::new();
+    let t = fx
+        .read(
+            "flux.csv",
+            "time,mag,flux_x,flux_y,flux_z\n0,53000,20000,1000,45000\n0.1,53001,20001,1e300,45001\n0.2,53002,20002,1002,45002\n",
+        )
+        .unwrap();
+    let e = check_units(&t).unwrap_err();
+    assert!(matches!(e, IoError::Units { .. }), "{e:?}");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            "flux.csv",
+            "'flux_y'",
+            "1e300",
+            "data row 2 (line 3)",
+            "empty",
+        ],
+    );
+    for (name, dummy) in [("mag", -1e32), ("igrf", 2e6), ("diurnal", -1.5e6)] {
+        let mut v = vec![53_000.0; 9];
+        v[6] = dummy;
+        let e = check_units(&table(&[(name, v)])).unwrap_err();
+        assert_mentions(&e.to_string(), &[&format!("'{name}'"), "data row 7"]);
+    }
+    // At the limit, and a picotesla file's median first.
+    let t = table(&[("mag", vec![53_000.0, -1e6, 53_000.0])]);
+    assert!(check_units(&t).is_ok());
+    let t = table(&[("mag", vec![5.3e7, 5.3e7, 5.3e7])]);
+    assert_mentions(&check_units(&t).unwrap_err().to_string(), &["picotesla"]);
+}
+
 #[test]
 fn position_checks() {
     let fx = Fixtures::new();
