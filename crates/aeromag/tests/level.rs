@@ -222,3 +222,67 @@ fn text_decimal_and_typed_labels_level_like_integer_labels() {
             .is_bad_input()
     );
 }
+
+/// A file that marks no tie says nothing about ties: a `line_type` column
+/// of zeros (a Geosoft XYZ export that labels every line `Line`, tie lines
+/// too) or labels that all start with `L` level as plain labels do (any
+/// two crossing lines), where before they found no crossover; ties given
+/// by the caller are ties whatever the file says.
+#[test]
+fn a_file_that_marks_no_tie_levels_as_plain_labels_and_given_ties_count() {
+    use aeromag::flight::LineLabels;
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
+    let line = survey.require("line").unwrap().to_vec();
+    let with = |edit: &dyn Fn(&mut FlightTable)| {
+        let mut t = survey.table().clone();
+        edit(&mut t);
+        Flight::from_table(t).unwrap()
+    };
+    let untyped = with(&|t| t.add_column("line_type", vec![0.0; line.len()]).unwrap());
+    let l_only = with(&|t| {
+        let text: Vec<String> = line
+            .iter()
+            .map(|&l| {
+                if l == 0.0 {
+                    String::new()
+                } else {
+                    format!("L{l}")
+                }
+            })
+            .collect();
+        let mut fresh = FlightTable::new();
+        for c in t.columns() {
+            match c.name() {
+                "line" => fresh.add_text_column("line", text.clone()).unwrap(),
+                n => fresh.add_column(n, c.values().unwrap().to_vec()).unwrap(),
+            }
+        }
+        *t = fresh;
+    });
+    let ties: Vec<String> = (2001..=2005).map(|l| l.to_string()).collect();
+    let opts = LevelOptions::default();
+    let plain = level(&survey, &opts, &mut Silent).unwrap();
+    for f in [&untyped, &l_only] {
+        assert_eq!(LineLabels::of(f, &[]).unwrap().ties, None);
+        let lev = level(f, &opts, &mut Silent).unwrap();
+        assert_eq!(
+            lev.levelling.crossovers.crossovers.len(),
+            plain.levelling.crossovers.crossovers.len()
+        );
+        assert_eq!(lev.levelling.fit.k_s, plain.levelling.fit.k_s);
+        // The ties given count on such a file too.
+        let given = LineLabels::of(f, &ties).unwrap().ties.unwrap();
+        assert_eq!(given.iter().filter(|&&t| t).count(), 5);
+    }
+    // A file that marks ties, and one more given: both count.
+    let typed = with(&|t| {
+        let v = line.iter().map(|&l| f64::from(l >= 2001.0)).collect();
+        t.add_column("line_type", v).unwrap();
+    });
+    let marked = LineLabels::of(&typed, &[]).unwrap();
+    let both = LineLabels::of(&typed, &["1001".to_string()]).unwrap();
+    let count = |l: &LineLabels| l.ties.as_ref().unwrap().iter().filter(|&&t| t).count();
+    assert_eq!((count(&marked), count(&both)), (5, 6));
+    let k = both.labels.iter().position(|l| l == "1001").unwrap();
+    assert!(both.ties.as_ref().unwrap()[k] && !marked.ties.as_ref().unwrap()[k]);
+}

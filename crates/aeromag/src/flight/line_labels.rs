@@ -3,12 +3,15 @@
 //! `T901`) gets an integer id, and each line is a survey line or a tie
 //! line when that is known.
 //!
-//! Whether a line is a tie comes, in this order, from
+//! Whether a line is a tie comes from
 //! 1. the `line_type` column (0 line, 1 tie; the Geosoft XYZ reader writes
-//!    it from `Line`/`Tie` records),
-//! 2. the labels themselves when every label starts with `L` or `T` (any
-//!    case: `L1020` line, `T901` tie),
-//! 3. the labels given as ties by the caller (`level --ties 901,902`).
+//!    it from `Line`/`Tie` records) when it marks at least one tie: an
+//!    export that labels every line `Line` (tie lines too) says nothing
+//!    about ties;
+//! 2. otherwise the labels themselves when every label starts with `L` or
+//!    `T` (any case: `L1020` line, `T901` tie) and one is a tie;
+//! 3. and in either case the labels given as ties by the caller (`level
+//!    --ties 901,902`), which are ties whatever the file says.
 //!
 //! When it is known, crossovers are formed only between a line and a tie;
 //! otherwise between any two lines that cross.
@@ -81,7 +84,7 @@ impl LineLabels {
         let numbers: Option<Vec<f64>> = column
             .values()
             .and_then(|_| labels.iter().map(|l| l.parse::<f64>().ok()).collect());
-        let ties = if let Some(types) = flight.column("line_type") {
+        let marked = if let Some(types) = flight.column("line_type") {
             let mut tie = vec![None; labels.len()];
             for (i, k) in kind_of_row.iter().enumerate() {
                 let Some(k) = *k else { continue };
@@ -96,19 +99,29 @@ impl LineLabels {
                 tie[k].get_or_insert(t == 1.0);
             }
             Some(tie.into_iter().map(|t| t.unwrap_or(false)).collect())
-        } else if !labels.is_empty()
-            && labels
+        } else {
+            None
+        };
+        let prefixed = || -> Option<Vec<bool>> {
+            labels
                 .iter()
                 .all(|l| matches!(l.as_bytes()[0], b'L' | b'l' | b'T' | b't'))
-        {
-            Some(
-                labels
-                    .iter()
-                    .map(|l| matches!(l.as_bytes()[0], b'T' | b't'))
-                    .collect(),
-            )
-        } else if !ties.is_empty() {
-            let mut tie = vec![false; labels.len()];
+                .then(|| {
+                    labels
+                        .iter()
+                        .map(|l| matches!(l.as_bytes()[0], b'T' | b't'))
+                        .collect()
+                })
+        };
+        // A file that marks no tie says nothing about ties.
+        let some_tie = |t: &Vec<bool>| t.contains(&true);
+        let marked = marked
+            .filter(some_tie)
+            .or_else(|| prefixed().filter(some_tie));
+        let ties = if ties.is_empty() {
+            marked
+        } else {
+            let mut tie = marked.unwrap_or_else(|| vec![false; labels.len()]);
             for t in ties {
                 let hit = labels.iter().enumerate().filter(|(_, l)| {
                     l.eq_ignore_ascii_case(t)
@@ -128,8 +141,6 @@ impl LineLabels {
                 }
             }
             Some(tie)
-        } else {
-            None
         };
         Ok(LineLabels {
             ids,

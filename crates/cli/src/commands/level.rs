@@ -79,8 +79,10 @@ pub struct Args {
     /// Labels of the tie lines (e.g. `901,902`), for files whose labels
     /// do not say it: crossovers are then formed only between a line and a
     /// tie. Not needed with a `line_type` column (Geosoft XYZ `Line`/`Tie`
-    /// records) or labels such as `L1020`/`T901`; without any of these,
-    /// any two crossing lines form a crossover.
+    /// records) or labels such as `L1020`/`T901` that mark ties; the labels
+    /// given are ties whatever the file says. Without any of these (or a
+    /// file whose records are all `Line`), any two crossing lines form a
+    /// crossover.
     #[arg(long, value_name = "LABEL,LABEL", value_delimiter = ',')]
     ties: Vec<String>,
     /// Also write the crossover table to this CSV: one row per crossover
