@@ -233,7 +233,10 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
             WarningKind::AltitudeUnit,
             "alt",
             None,
-            format!("median altitude {m} m is above 20 km: feet or another unit? expected m"),
+            format!(
+                "median altitude {} m is above 20 km: feet or another unit? expected m",
+                shown(m)
+            ),
         ));
     }
     Ok(warnings)
@@ -382,7 +385,7 @@ impl Ctx<'_> {
                 WarningKind::FieldRange,
                 name,
                 None,
-                format!("median |value| = {m} nT is outside Earth's total field (22 000 to 67 000 nT): anomaly or corrected data, or other units?"),
+                format!("median |value| = {} nT is outside Earth's total field (22 000 to 67 000 nT): anomaly or corrected data, or other units?", shown(m)),
             ));
         }
         Ok(())
@@ -441,7 +444,7 @@ impl Ctx<'_> {
         {
             return Err(self.units(
                     "lat",
-                    format!("latitude {v} at {} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", data_row(self.table, i)),
+                    format!("latitude {} at {} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", shown(v), data_row(self.table, i)),
                 ));
         }
         if let Some(lon) = lon
@@ -450,7 +453,8 @@ impl Ctx<'_> {
             return Err(self.units(
                 "lon",
                 format!(
-                    "longitude {v} at {} is outside ±360°: projected coordinates? expected degrees",
+                    "longitude {} at {} is outside ±360°: projected coordinates? expected degrees",
+                    shown(v),
                     data_row(self.table, i)
                 ),
             ));
@@ -483,7 +487,8 @@ impl Ctx<'_> {
                 return Err(self.units(
                     name,
                     format!(
-                        "{name} {x} at {} is outside ±{limit}°: expected degrees",
+                        "{name} {} at {} is outside ±{limit}°: expected degrees",
+                        shown(x),
                         data_row(t, i)
                     ),
                 ));
@@ -496,7 +501,7 @@ impl Ctx<'_> {
                 WarningKind::YawRange,
                 "yaw",
                 Some(i),
-                format!("yaw {x} is outside ±360°: expected degrees"),
+                format!("yaw {} is outside ±360°: expected degrees", shown(x)),
             ));
         }
         let (Some(roll), Some(pitch), Some(yaw)) =
@@ -540,6 +545,17 @@ fn data_row(table: &FlightTable, row: usize) -> String {
         .map(|l| format!(" (line {l})"))
         .unwrap_or_default();
     format!("data row {}{line}", table.file_row(row) + 1)
+}
+
+/// A value in a message: as Rust writes it (`-100.5`, `500000`), or in
+/// exponent form when that would be long (`1e300`, not 301 digits).
+fn shown(v: f64) -> String {
+    let plain = v.to_string();
+    if plain.len() > 24 {
+        format!("{v:e}")
+    } else {
+        plain
+    }
 }
 
 fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {

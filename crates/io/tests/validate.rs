@@ -299,3 +299,20 @@ fn altitude_warning_and_tesla_conversion() {
     assert_eq!(t.column("time").unwrap(), &[0.0, 1.0]);
     check_units(&t).unwrap();
 }
+
+/// A huge value is named in exponent form, not as hundreds of digits.
+#[test]
+fn huge_values_are_named_shortly() {
+    let t = table(&[("lat", vec![45.0, 1e300]), ("lon", vec![-75.0, -75.0])]);
+    let e = check_units(&t).unwrap_err().to_string();
+    assert!(
+        e.contains("latitude 1e300 at data row 2") && e.len() < 200,
+        "{e}"
+    );
+    let t = table(&[("yaw", vec![10.0, -1e300])]);
+    let w = check_units(&t).unwrap();
+    assert!(w[0].message.contains("yaw -1e300 is outside"), "{w:?}");
+    let t = table(&[("roll", vec![0.0, 181.5])]);
+    let e = check_units(&t).unwrap_err().to_string();
+    assert!(e.contains("roll 181.5 at data row 2"), "{e}");
+}
