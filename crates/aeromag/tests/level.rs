@@ -124,6 +124,37 @@ fn with_the_base_station_removed_k_is_recovered() {
     );
 }
 
+/// `survey` with its table edited by `edit`, checked again.
+fn edited(survey: &Flight, edit: &dyn Fn(&mut FlightTable)) -> Flight {
+    let mut t = survey.table().clone();
+    edit(&mut t);
+    Flight::from_table(t).unwrap()
+}
+
+/// The ties of the default survey (labels 2001…) in a `line_type` column.
+fn typed_ties(t: &mut FlightTable) {
+    let v = t
+        .column("line")
+        .unwrap()
+        .iter()
+        .map(|&l| f64::from(l >= 2001.0))
+        .collect();
+    t.add_column("line_type", v).unwrap();
+}
+
+/// `t` with its numeric `line` labels replaced by the text ones `text`
+/// under the same name (the other columns as they are).
+fn text_labels(t: &mut FlightTable, text: &[String]) {
+    let mut fresh = FlightTable::new();
+    for c in t.columns() {
+        match c.name() {
+            "line" => fresh.add_text_column("line", text.to_vec()).unwrap(),
+            n => fresh.add_column(n, c.values().unwrap().to_vec()).unwrap(),
+        }
+    }
+    *t = fresh;
+}
+
 /// Line labels are labels: the default survey (lines 1001…, ties 2001…)
 /// relabelled as text (`L1001`, `T2001`), as SGL-style decimals
 /// (`1001.01`), or with a `line_type` column levels to the same k and line
@@ -135,11 +166,7 @@ fn text_decimal_and_typed_labels_level_like_integer_labels() {
     let opts = LevelOptions::default();
     let base = level(&survey, &opts, &mut Silent).unwrap();
     let line = survey.require("line").unwrap().to_vec();
-    let relabelled = |edit: &dyn Fn(&mut FlightTable)| {
-        let mut t = survey.table().clone();
-        edit(&mut t);
-        Flight::from_table(t).unwrap()
-    };
+    let relabelled = |edit: &dyn Fn(&mut FlightTable)| edited(&survey, edit);
     let text: Vec<String> = line
         .iter()
         .map(|&l| match l {
@@ -148,17 +175,7 @@ fn text_decimal_and_typed_labels_level_like_integer_labels() {
             l => format!("L{l}"),
         })
         .collect();
-    let as_text = relabelled(&|t| {
-        // Replace the numeric labels by text ones under the same name.
-        let mut fresh = FlightTable::new();
-        for c in t.columns() {
-            match c.name() {
-                "line" => fresh.add_text_column("line", text.clone()).unwrap(),
-                n => fresh.add_column(n, c.values().unwrap().to_vec()).unwrap(),
-            }
-        }
-        *t = fresh;
-    });
+    let as_text = relabelled(&|t| text_labels(t, &text));
     let decimal = relabelled(&|t| {
         let v = line
             .iter()
@@ -166,10 +183,7 @@ fn text_decimal_and_typed_labels_level_like_integer_labels() {
             .collect();
         t.set_column("line", v).unwrap();
     });
-    let typed = relabelled(&|t| {
-        let v = line.iter().map(|&l| f64::from(l >= 2001.0)).collect();
-        t.add_column("line_type", v).unwrap();
-    });
+    let typed = relabelled(&typed_ties);
     let declared = LevelOptions {
         ties: (2001..=2005).map(|l| l.to_string()).collect(),
         ..LevelOptions::default()
@@ -233,32 +247,19 @@ fn a_file_that_marks_no_tie_levels_as_plain_labels_and_given_ties_count() {
     use aeromag::flight::LineLabels;
     let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
     let line = survey.require("line").unwrap().to_vec();
-    let with = |edit: &dyn Fn(&mut FlightTable)| {
-        let mut t = survey.table().clone();
-        edit(&mut t);
-        Flight::from_table(t).unwrap()
-    };
+    let with = |edit: &dyn Fn(&mut FlightTable)| edited(&survey, edit);
     let untyped = with(&|t| t.add_column("line_type", vec![0.0; line.len()]).unwrap());
-    let l_only = with(&|t| {
-        let text: Vec<String> = line
-            .iter()
-            .map(|&l| {
-                if l == 0.0 {
-                    String::new()
-                } else {
-                    format!("L{l}")
-                }
-            })
-            .collect();
-        let mut fresh = FlightTable::new();
-        for c in t.columns() {
-            match c.name() {
-                "line" => fresh.add_text_column("line", text.clone()).unwrap(),
-                n => fresh.add_column(n, c.values().unwrap().to_vec()).unwrap(),
+    let l_text: Vec<String> = line
+        .iter()
+        .map(|&l| {
+            if l == 0.0 {
+                String::new()
+            } else {
+                format!("L{l}")
             }
-        }
-        *t = fresh;
-    });
+        })
+        .collect();
+    let l_only = with(&|t| text_labels(t, &l_text));
     let ties: Vec<String> = (2001..=2005).map(|l| l.to_string()).collect();
     let opts = LevelOptions::default();
     let plain = level(&survey, &opts, &mut Silent).unwrap();
@@ -275,10 +276,7 @@ fn a_file_that_marks_no_tie_levels_as_plain_labels_and_given_ties_count() {
         assert_eq!(given.iter().filter(|&&t| t).count(), 5);
     }
     // A file that marks ties, and one more given: both count.
-    let typed = with(&|t| {
-        let v = line.iter().map(|&l| f64::from(l >= 2001.0)).collect();
-        t.add_column("line_type", v).unwrap();
-    });
+    let typed = with(&typed_ties);
     let marked = LineLabels::of(&typed, &[]).unwrap();
     let both = LineLabels::of(&typed, &["1001".to_string()]).unwrap();
     let count = |l: &LineLabels| l.ties.as_ref().unwrap().iter().filter(|&&t| t).count();
