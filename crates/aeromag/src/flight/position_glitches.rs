@@ -35,9 +35,9 @@ const EARTH_RADIUS_M: f64 = 6_371_000.0;
 /// docs): `time_s` (s, increasing), `lat_deg` and `lon_deg` (degrees) of
 /// every row; rows with a missing value are neither judged nor judge.
 pub fn position_glitches(time_s: &[f64], lat_deg: &[f64], lon_deg: &[f64]) -> Vec<usize> {
-    let rows: Vec<usize> = (0..time_s.len().min(lat_deg.len()).min(lon_deg.len()))
-        .filter(|&k| time_s[k].is_finite() && lat_deg[k].is_finite() && lon_deg[k].is_finite())
-        .collect();
+    let n = time_s.len().min(lat_deg.len()).min(lon_deg.len());
+    let valid =
+        |k: usize| time_s[k].is_finite() && lat_deg[k].is_finite() && lon_deg[k].is_finite();
     let consistent = |a: usize, b: usize| {
         let most = MIN_JUMP_M.max(MAX_GROUND_SPEED_M_S * (time_s[b] - time_s[a]).abs());
         within(
@@ -46,34 +46,40 @@ pub fn position_glitches(time_s: &[f64], lat_deg: &[f64], lon_deg: &[f64]) -> Ve
             most,
         )
     };
-    // Runs of `rows` (index ranges) between jumps.
-    let mut runs: Vec<std::ops::Range<usize>> = Vec::new();
-    let mut start = 0;
-    for i in 1..rows.len() {
-        if !consistent(rows[i - 1], rows[i]) {
-            runs.push(start..i);
-            start = i;
+    // Runs between jumps, each its first and last valid row and how many
+    // valid rows it holds (no per-row memory: 10⁷ rows take none).
+    let mut runs: Vec<Run> = Vec::new();
+    for k in (0..n).filter(|&k| valid(k)) {
+        match runs.last_mut() {
+            Some(run) if consistent(run.last, k) => {
+                run.last = k;
+                run.rows += 1;
+            }
+            _ => runs.push(Run {
+                first: k,
+                last: k,
+                rows: 1,
+            }),
         }
     }
-    if runs.is_empty() {
+    if runs.len() < 2 {
         return Vec::new();
     }
-    runs.push(start..rows.len());
-    let longest = runs.iter().map(|r| r.len()).max().unwrap_or(0);
-    let anchor = runs.iter().position(|r| r.len() == longest).unwrap_or(0);
+    let longest = runs.iter().map(|r| r.rows).max().unwrap_or(0);
+    let anchor = runs.iter().position(|r| r.rows == longest).unwrap_or(0);
     let mut off = vec![false; runs.len()];
-    let mut last = rows[runs[anchor].end - 1];
+    let mut last = runs[anchor].last;
     for (r, run) in runs.iter().enumerate().skip(anchor + 1) {
-        if consistent(last, rows[run.start]) {
-            last = rows[run.end - 1];
+        if consistent(last, run.first) {
+            last = run.last;
         } else {
             off[r] = true;
         }
     }
-    let mut first = rows[runs[anchor].start];
+    let mut first = runs[anchor].first;
     for (r, run) in runs.iter().enumerate().take(anchor).rev() {
-        if consistent(rows[run.end - 1], first) {
-            first = rows[run.start];
+        if consistent(run.last, first) {
+            first = run.first;
         } else {
             off[r] = true;
         }
@@ -81,8 +87,15 @@ pub fn position_glitches(time_s: &[f64], lat_deg: &[f64], lon_deg: &[f64]) -> Ve
     runs.iter()
         .zip(off)
         .filter(|(_, off)| *off)
-        .flat_map(|(run, _)| rows[run.clone()].iter().copied())
+        .flat_map(|(run, _)| (run.first..=run.last).filter(|&k| valid(k)))
         .collect()
+}
+
+/// Successive valid rows without a jump between them ([`position_glitches`]).
+struct Run {
+    first: usize,
+    last: usize,
+    rows: usize,
 }
 
 /// Whether the great-circle distance between `a` and `b` (latitude,
