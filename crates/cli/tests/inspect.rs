@@ -31,6 +31,27 @@ fn summarises_a_good_file() {
     assert_code(&j, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
     assert_eq!(v["rows"], 4);
+    assert_eq!(v["position_glitch_rows"], serde_json::json!([]));
+    assert!(!s.contains("off the track"), "{s}");
+}
+
+/// A row whose latitude reads 0 among rows at 45° N is named as off the
+/// track, in the text and in the JSON.
+#[test]
+fn a_position_off_the_track_is_named() {
+    let d = tempfile::tempdir().unwrap();
+    let glitch = GOOD.replacen("0.2,45.0,", "0.2,0,", 1);
+    let p = write(&d, "glitch.csv", glitch.as_bytes());
+    let o = aeromag(&["inspect", "--input", p.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(
+        s.contains("position 1 row off the track") && s.contains("data row 3 [position-glitch]"),
+        "{s}"
+    );
+    let j = aeromag(&["inspect", "--input", p.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    assert_eq!(v["position_glitch_rows"], serde_json::json!([2]));
 }
 
 #[test]

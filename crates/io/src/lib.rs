@@ -4,8 +4,9 @@
 //! The crate reads CSV, Geosoft XYZ and HDF5 files (MagNav/SGL layout,
 //! [`read_hdf5`], pure Rust) into a column-major [`FlightTable`], maps file
 //! column names onto aeromag's canonical names ([`ColumnMap`], MagNav
-//! preset), checks time and units ([`check_time`], [`check_units`]),
-//! summarizes a table for `aeromag inspect` ([`summarize`]) and writes CSV
+//! preset), checks time and units ([`check_time`], [`check_units`]), finds
+//! positions off the track ([`position_glitches`]), summarizes a table for
+//! `aeromag inspect` ([`summarize`]) and writes CSV
 //! ([`write_csv`]) and other outputs atomically ([`atomic`]).
 //!
 //! ```no_run
@@ -45,6 +46,7 @@ mod hdf5;
 mod number_text;
 mod ordered;
 mod parts;
+mod position_glitches;
 mod read_ahead;
 pub mod select;
 mod sniff;
@@ -70,6 +72,7 @@ pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use number_text::NumberText;
 pub use parts::nan_count;
+pub use position_glitches::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};

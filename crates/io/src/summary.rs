@@ -47,6 +47,10 @@ pub struct Summary {
     pub mag_range_nt: Option<Range>,
     /// Range of the vector magnitude `sqrt(flux_x² + flux_y² + flux_z²)` (nT).
     pub flux_magnitude_range_nt: Option<Range>,
+    /// 0-based data rows whose position jumps off the track and back
+    /// faster than anything flies ([`crate::position_glitches`]); `None`
+    /// without numeric `time`, `lat` and `lon` columns.
+    pub position_glitch_rows: Option<Vec<usize>>,
 }
 
 /// Minimum and maximum.
@@ -191,6 +195,14 @@ pub fn summarize(table: &FlightTable) -> Summary {
         lines: line_counts(table),
         mag_range_nt: table.column("mag").and_then(|v| range(v.iter().copied())),
         flux_magnitude_range_nt: flux,
+        position_glitch_rows: match (
+            table.column("time"),
+            table.column("lat"),
+            table.column("lon"),
+        ) {
+            (Some(t), Some(lat), Some(lon)) => Some(crate::position_glitches(t, lat, lon)),
+            _ => None,
+        },
     }
 }
 
@@ -341,6 +353,19 @@ mod tests {
         assert!((s.jitter_max_s - 0.01).abs() < 1e-9, "{}", s.jitter_max_s);
         assert!((s.duration_s - 1.11).abs() < 1e-12);
         assert!(time_summary(&[1.0]).is_none());
+    }
+
+    #[test]
+    fn positions_off_the_track_need_time_lat_and_lon() {
+        let mut t = FlightTable::new();
+        t.add_column("time", (0..50).map(|k| k as f64).collect())
+            .unwrap();
+        let mut lat = vec![45.0; 50];
+        lat[20] = 0.0;
+        t.add_column("lat", lat).unwrap();
+        assert_eq!(summarize(&t).position_glitch_rows, None);
+        t.add_column("lon", vec![-75.0; 50]).unwrap();
+        assert_eq!(summarize(&t).position_glitch_rows, Some(vec![20]));
     }
 
     #[test]

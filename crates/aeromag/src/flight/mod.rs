@@ -17,14 +17,13 @@
 //! `yaw`, `mag`, `flux_x`, …) after the column map.
 
 mod line_labels;
-mod position_glitches;
 mod reference;
 mod segments;
 mod tl_inputs;
 
 pub use aeromag_compensation::reference_field::LeverArm;
+pub use aeromag_io::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub use line_labels::LineLabels;
-pub use position_glitches::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub(crate) use reference::reduced;
 pub use reference::{ReferenceChannels, reference_sum};
 pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};

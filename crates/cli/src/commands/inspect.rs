@@ -104,6 +104,24 @@ pub fn render(s: &Summary) -> String {
     if let Some(r) = &s.flux_magnitude_range_nt {
         let _ = writeln!(o, "|flux|   {:.1} … {:.1} nT", r.min, r.max);
     }
+    if let Some(rows) = s.position_glitch_rows.as_ref().filter(|r| !r.is_empty()) {
+        let shown: Vec<String> = rows.iter().take(10).map(|r| (r + 1).to_string()).collect();
+        let more = if rows.len() > 10 {
+            format!(" … and {} more", rows.len() - 10)
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            o,
+            "position {} {} off the track (jumping away and back faster than {} m/s: GPS dropouts?): data {} {}{} [position-glitch]",
+            rows.len(),
+            if rows.len() == 1 { "row" } else { "rows" },
+            aeromag_io::MAX_GROUND_SPEED_M_S,
+            if rows.len() == 1 { "row" } else { "rows" },
+            shown.join(", "),
+            more
+        );
+    }
     if !s.mapping.is_empty() {
         let _ = writeln!(
             o,
