@@ -547,28 +547,11 @@ fn digit_run(text: &[u8], p: usize) -> Option<(u64, usize)> {
 }
 
 /// The fast path's setting for the readers: all cores
-/// ([`threads`]), pieces of [`PIECE_BYTES`].
+/// (`aeromag_core::parallel::threads`: `AEROMAG_THREADS` or the available
+/// cores, at most 8; the table read is the same whatever the number),
+/// pieces of [`PIECE_BYTES`].
 pub(crate) fn on_all_cores() -> Option<(usize, usize)> {
-    Some((threads(), PIECE_BYTES))
-}
-
-/// Threads of the fast path and of the writer, as
-/// `aeromag_core::parallel::threads` counts them (this crate does not
-/// depend on core; see there): `AEROMAG_THREADS` when it is a whole number
-/// from 1 to 64, or else the available cores, at most 8; asked once per
-/// process. The table read and the bytes written are the same whatever the
-/// number.
-pub(crate) fn threads() -> usize {
-    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *THREADS.get_or_init(|| {
-        let set = std::env::var("AEROMAG_THREADS").ok();
-        match set.and_then(|v| v.trim().parse::<usize>().ok()) {
-            Some(n @ 1..=64) => n,
-            _ => std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .clamp(1, 8),
-        }
-    })
+    Some((aeromag_core::parallel::threads(), PIECE_BYTES))
 }
 
 /// Appends the clean rows of `path` from `from` (a line start after the

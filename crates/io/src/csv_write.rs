@@ -70,7 +70,7 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     out.write_all(&line)?;
     let missing: &[u8] = if columns.len() == 1 { b"NaN" } else { b"" };
     let n = table.n_rows();
-    let threads = crate::csv_clean::threads();
+    let threads = aeromag_core::parallel::threads();
     // Chunks of rows are formatted by `threads` workers, each taking the
     // next chunk in turn, and written in order by the calling thread
     // ([`crate::ordered`]): the same bytes for any thread count.

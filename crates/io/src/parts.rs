@@ -10,10 +10,10 @@
 const PART: usize = 1 << 20;
 
 /// `f` of contiguous parts of `v` in order, one part per core (up to
-/// [`crate::csv_clean::threads`]), each at least [`PART`] long; one part,
+/// `aeromag_core::parallel::threads`), each at least [`PART`] long; one part,
 /// on the calling thread, for a short column.
 pub(crate) fn on_parts<T: Send>(v: &[f64], f: impl Fn(&[f64]) -> T + Sync) -> Vec<T> {
-    let parts = crate::csv_clean::threads().min(v.len() / PART).max(1);
+    let parts = aeromag_core::parallel::threads().min(v.len() / PART).max(1);
     if parts == 1 {
         return vec![f(v)];
     }
@@ -31,10 +31,10 @@ pub(crate) fn on_parts<T: Send>(v: &[f64], f: impl Fn(&[f64]) -> T + Sync) -> Ve
 }
 
 /// `[f(&jobs[0]), f(&jobs[1]), …]` worked out on the cores (up to
-/// [`crate::csv_clean::threads`] threads, the jobs dealt out in turn), in
+/// `aeromag_core::parallel::threads` threads, the jobs dealt out in turn), in
 /// the jobs' order: for a few independent passes of unequal length.
 pub(crate) fn each_on_cores<J: Sync, T: Send>(jobs: &[J], f: impl Fn(&J) -> T + Sync) -> Vec<T> {
-    let threads = crate::csv_clean::threads().min(jobs.len()).max(1);
+    let threads = aeromag_core::parallel::threads().min(jobs.len()).max(1);
     if threads == 1 {
         return jobs.iter().map(f).collect();
     }
@@ -93,7 +93,7 @@ mod tests {
                 })
                 .collect();
             let parts = on_parts(&v, |p| p.to_vec());
-            let expected = crate::csv_clean::threads().min(n / PART).max(1);
+            let expected = aeromag_core::parallel::threads().min(n / PART).max(1);
             assert_eq!(parts.len(), expected, "{n} values");
             let bits = |x: &f64| x.to_bits();
             assert!(parts.concat().iter().map(bits).eq(v.iter().map(bits)));
