@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::flight::Flight;
 use crate::observer::{Note, Notes, Observer, Silent};
 use aeromag_io::FlightTable;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The columns a compensation adds to a flight, and why a row may be left
 /// uncompensated (for the message).
@@ -60,13 +61,18 @@ pub trait Compensator {
     ) -> Result<Vec<f64>>;
 
     /// The modelled interference of every row of `flight`, nT (NaN where
-    /// it cannot be computed).
+    /// it cannot be computed); bad input naming the first row where a
+    /// value is beyond any magnetic field ([`aeromag_io::MAX_FIELD_NT`]:
+    /// a model file that does not fit the flight).
     fn interference(&self, flight: &Flight) -> Result<Vec<f64>> {
-        self.interference_observed(flight, &mut Silent)
+        let v = self.interference_observed(flight, &mut Silent)?;
+        check_interference(flight, &v)?;
+        Ok(v)
     }
 
     /// The interference, the compensated reading and the flags of every
-    /// row, with the notes raised.
+    /// row, with the notes raised (bad input where the interference is
+    /// beyond any magnetic field, as [`Compensator::interference`]).
     fn compensate_observed(
         &self,
         flight: &Flight,
@@ -92,6 +98,35 @@ pub trait Compensator {
         minus_from_mag(flight, &mut out)?;
         Ok(out)
     }
+}
+
+/// Bad input, naming the first row, where a modelled interference
+/// `interference_nt` of `flight` is infinite or beyond any magnetic field
+/// ([`aeromag_io::MAX_FIELD_NT`]): the inputs are checked to be within it,
+/// so such a value comes from a model file that does not fit the flight
+/// (an edited or corrupted coefficient or `bt_scale`, another aircraft's
+/// terms); written out, it would pass for a compensated reading. NaN is a
+/// row the model could not be applied to, not an error.
+pub(crate) fn check_interference(flight: &Flight, interference_nt: &[f64]) -> Result<()> {
+    match interference_nt.iter().position(|v| beyond_any_field(*v)) {
+        Some(row) => Err(interference_error(flight, row, interference_nt[row])),
+        None => Ok(()),
+    }
+}
+
+/// `|v| > MAX_FIELD_NT`, ∞ included (NaN not).
+fn beyond_any_field(v: f64) -> bool {
+    v.abs() > aeromag_io::MAX_FIELD_NT
+}
+
+fn interference_error(flight: &Flight, row: usize, v: f64) -> Error {
+    flight.bad_row(
+        row,
+        format!(
+            "the model's interference here is {v:e} nT, beyond any magnetic field (at most {:e} nT in magnitude): the model file does not fit this flight (an edited or corrupted coefficient or bt_scale, or another aircraft's model?)",
+            aeromag_io::MAX_FIELD_NT
+        ),
+    )
 }
 
 /// `values ← mag − values` on the rows both have (`values` cut to them),
@@ -124,7 +159,9 @@ pub struct Compensated {
 }
 
 impl Compensated {
-    /// `mag − interference` of `flight`.
+    /// `mag − interference` of `flight`; bad input naming the first row
+    /// where the interference is beyond any magnetic field
+    /// ([`aeromag_io::MAX_FIELD_NT`]: a model that does not fit the flight).
     pub fn new(flight: &Flight, output: OutputColumns, interference_nt: Vec<f64>) -> Result<Self> {
         let mag = flight.require("mag")?;
         let n = interference_nt.len().min(mag.len());
@@ -132,7 +169,10 @@ impl Compensated {
         // difference and the count of rows not compensated in one pass on
         // the cores.
         let mut compensated_nt = vec![0.0; n];
-        let missing = std::sync::atomic::AtomicUsize::new(0);
+        let missing = AtomicUsize::new(0);
+        // The first row beyond any field (check_interference), found in
+        // the same pass.
+        let beyond = AtomicUsize::new(usize::MAX);
         let threads = aeromag_core::parallel::threads();
         aeromag_core::parallel::for_each_part_mut(
             &mut compensated_nt,
@@ -144,9 +184,21 @@ impl Compensated {
                     *c = m - i;
                 }
                 let not = interference.iter().filter(|v| !v.is_finite()).count();
-                missing.fetch_add(not, std::sync::atomic::Ordering::Relaxed);
+                missing.fetch_add(not, Ordering::Relaxed);
+                if let Some(k) = interference.iter().position(|v| beyond_any_field(*v)) {
+                    beyond.fetch_min(a + k, Ordering::Relaxed);
+                }
             },
         );
+        let tail = interference_nt[n..]
+            .iter()
+            .position(|v| beyond_any_field(*v));
+        let first = Some(beyond.into_inner())
+            .filter(|&row| row < n)
+            .or(tail.map(|k| n + k));
+        if let Some(row) = first {
+            return Err(interference_error(flight, row, interference_nt[row]));
+        }
         let missing = missing.into_inner()
             + interference_nt[n..]
                 .iter()
@@ -215,7 +267,6 @@ mod tests {
         for &k in &holes {
             interference[k] = f64::NAN;
         }
-        interference[7] = f64::INFINITY;
         let mut t = FlightTable::new();
         t.add_column("time", (0..n).map(|k| k as f64 * 0.1).collect())
             .unwrap();
@@ -226,8 +277,22 @@ mod tests {
             flag: "comp_flag",
             why_missing: "test",
         };
+        // Beyond any field (∞ included) in several parts: the first such
+        // row is named, whichever part's thread finds its own first.
+        for (rows, first) in [(vec![7], 7), (vec![3 * (1 << 16) + 3, 70_000], 70_000)] {
+            let mut bad = interference.clone();
+            for &r in &rows {
+                bad[r] = if r == 7 { f64::INFINITY } else { -2e6 };
+            }
+            let e = Compensated::new(&flight, output, bad).unwrap_err();
+            assert!(e.is_bad_input(), "{e}");
+            assert!(
+                e.to_string().contains(&format!("data row {}:", first + 1)),
+                "{e}"
+            );
+        }
         let out = Compensated::new(&flight, output, interference.clone()).unwrap();
-        assert_eq!(out.missing, holes.len() + 1);
+        assert_eq!(out.missing, holes.len());
         assert_eq!(out.compensated_nt.len(), n);
         for k in 0..n {
             let want = mag[k] - interference[k];

@@ -207,6 +207,43 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
     );
 }
 
+/// A `mag` or `flux_*` value beyond any magnetic field (10⁶ nT) is a
+/// corrupted cell: the line is malformed, the run goes on. A model whose
+/// interference is beyond any field (a corrupted coefficient) leaves the
+/// line's values empty, flagged 1, instead of writing them as compensated.
+#[test]
+fn readings_and_interference_beyond_any_field_are_not_written_as_compensated() {
+    let model = model();
+    let header = "time,flux_x,flux_y,flux_z,mag";
+    let lines = [
+        "0.0,20000,1000,45000,49300",
+        "0.1,20001,2e6,45001,49301",
+        "0.2,20001,1001,45001,-1e32",
+        "0.3,20002,1002,45002,1000000",
+        "0.4,20003,1003,45003,49303",
+    ];
+    let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
+    let mut out = String::new();
+    let flags: Vec<StreamFlag> = lines.iter().map(|l| lc.line(l, &mut out)).collect();
+    use StreamFlag::*;
+    // (The malformed lines are no samples: the step 0.0 → 0.3 s restarts
+    // the run.)
+    assert_eq!(flags, [Started, Malformed, Malformed, Started, Compensated]);
+    assert!(
+        out.lines().nth(1).unwrap().ends_with("2e6,45001,49301,,,4"),
+        "{out}"
+    );
+
+    let mut corrupt = model.clone();
+    corrupt.coefficients[0].value = 1e300;
+    let mut lc = LineCompensator::new(&corrupt, header, &StreamOptions::default()).unwrap();
+    let mut out = String::new();
+    let flags: Vec<StreamFlag> = lines[..1].iter().map(|l| lc.line(l, &mut out)).collect();
+    assert_eq!(flags, [Missing]);
+    assert_eq!(out, format!("{},,,1\n", lines[0]));
+    assert_eq!(lc.counts().missing, 1);
+}
+
 /// A line longer than the limit is flagged malformed and skipped to its
 /// end; the stream goes on (a hostile or broken peer cannot make it hold
 /// unbounded text).

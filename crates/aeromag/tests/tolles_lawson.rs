@@ -129,6 +129,51 @@ fn every_row_is_kept_and_rows_with_missing_inputs_are_flagged() {
     }
 }
 
+/// A model whose interference is beyond any magnetic field on a flight (a
+/// corrupted coefficient) is bad input naming the first such row, for
+/// every way of applying it; before, the rows were written as compensated
+/// with an interference of 10³⁰⁰ nT.
+#[test]
+fn an_interference_beyond_any_field_is_bad_input_naming_its_row() {
+    let cal = calibration(5);
+    let mut model = classical_model(&cal);
+    let good = model.interference(&cal).unwrap();
+    // p_x raised so that the interference passes 10⁶ nT on some rows only.
+    let col = model
+        .coefficients
+        .iter()
+        .position(|c| c.name == "p_x")
+        .unwrap();
+    model.coefficients[col].value += 3e6;
+    let expect: Vec<f64> = model.design.interference(
+        &model.coef(),
+        cal.require("time").unwrap(),
+        [
+            cal.require("flux_x").unwrap(),
+            cal.require("flux_y").unwrap(),
+            cal.require("flux_z").unwrap(),
+        ],
+    );
+    let first = expect.iter().position(|v| v.abs() > 1e6).unwrap();
+    assert!(first > 0);
+    assert!(expect[..first].iter().all(|v| v.is_finite()));
+    assert!(good.iter().all(|v| v.abs() < 1e5));
+    let want = format!("data row {}", first + 1);
+    let errors = [
+        model.compensate(&cal).unwrap_err(),
+        model.interference(&cal).unwrap_err(),
+        model.compensated(&cal).unwrap_err(),
+    ];
+    for e in errors {
+        assert!(e.is_bad_input(), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&want) && msg.contains("beyond any magnetic field"),
+            "{msg}"
+        );
+    }
+}
+
 /// The rows `rows` of every column of `f`, as a flight.
 fn rows_of(f: &FlightTable, rows: std::ops::Range<usize>) -> Flight {
     let mut t = FlightTable::new();
@@ -647,6 +692,15 @@ fn several_sensors_and_the_reference_sensor_mode() {
     let text = both.model.to_json().unwrap();
     assert_eq!(SensorsModel::parse(&text, "m.json").unwrap(), both.model);
     let comp = both.model.compensate(&survey).unwrap();
+    // A corrupted coefficient of the second sensor's model: bad input, not
+    // an interference of 10³⁰⁰ nT written as compensated.
+    let mut corrupt = both.model.clone();
+    corrupt.sensors[1].model.coefficients[0].value = 1e300;
+    let e = corrupt.compensate(&survey).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("beyond any magnetic field"),
+        "{e}"
+    );
     let names: Vec<String> = comp.columns().into_iter().map(|c| c.0).collect();
     assert_eq!(
         names,

@@ -361,6 +361,22 @@ fn model_and_argument_errors_exit_2() {
     let o = compensate(&junk, std::path::Path::new(p), &d.path().join("o.csv"));
     assert_code(&o, 2);
     assert!(stderr(&o).contains("junk.json"));
+    // A model with a corrupted coefficient: exit 2 naming the first row
+    // whose interference is beyond any field, and no output file.
+    let model_text = std::fs::read_to_string(&model).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&model_text).unwrap();
+    v["coefficients"][0]["value"] = 1e300.into();
+    let corrupt = d.path().join("corrupt.json");
+    std::fs::write(&corrupt, v.to_string()).unwrap();
+    let out = d.path().join("c.csv");
+    let o = compensate(&corrupt, std::path::Path::new(p), &out);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("line") && stderr(&o).contains("beyond any magnetic field"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
     // Data without the vector magnetometer: the message names what is missing.
     let text = std::fs::read_to_string(&cal).unwrap();
     let stripped = text.replace("flux_x", "fx");

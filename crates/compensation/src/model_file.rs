@@ -100,8 +100,15 @@ pub struct Coefficient {
     pub name: String,
     /// Value.
     pub value: f64,
-    /// Standard deviation (NaN when unknown).
+    /// Standard deviation (NaN when unknown: JSON `null`, which
+    /// `serde_json` writes for NaN).
+    #[serde(deserialize_with = "null_as_nan")]
     pub std: f64,
+}
+
+/// JSON has no NaN: `serde_json` writes it as `null`; read `null` back as NaN.
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 impl Coefficient {
@@ -279,6 +286,15 @@ impl TlModel {
         }
         if m.coefficients.iter().any(|c| !c.value.is_finite()) {
             return Err(model_error(origin, "a coefficient is not finite"));
+        }
+        if let Some(c) = m.coefficients.iter().find(|c| c.std < 0.0) {
+            return Err(model_error(
+                origin,
+                format!(
+                    "coefficient `{}` has a negative standard deviation {}",
+                    c.name, c.std
+                ),
+            ));
         }
         Ok(m)
     }
@@ -500,6 +516,45 @@ mod tests {
         let m = sample();
         let back = TlModel::from_json(&m.to_json().unwrap(), "m.json").unwrap();
         assert_eq!(m, back);
+    }
+
+    /// An unknown standard deviation (NaN, written as JSON `null`) reads
+    /// back; a negative one, or a `bt_scale` that is no field magnitude
+    /// (which made every row's interference overflow), is a bad file.
+    #[test]
+    fn unknown_std_reads_back_and_impossible_values_are_refused() {
+        let mut m = sample();
+        m.coefficients[1].std = f64::NAN;
+        let text = m.to_json().unwrap();
+        assert!(text.contains("\"std\": null"), "{text}");
+        let back = TlModel::from_json(&text, "m.json").unwrap();
+        assert!(back.coefficients[1].std.is_nan());
+        assert_eq!(back.coef(), m.coef());
+
+        m.coefficients[1].std = -0.5;
+        let e = TlModel::from_json(&m.to_json().unwrap(), "m.json").unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        assert!(
+            e.to_string()
+                .contains("`p_y` has a negative standard deviation"),
+            "{e}"
+        );
+
+        for (bt, ok) in [
+            (1e-308, false),
+            (0.5, false),
+            (1.0, true),
+            (1e6, true),
+            (2e6, false),
+        ] {
+            let mut m = sample();
+            m.design.bt_scale_nt = bt;
+            let r = TlModel::from_json(&m.to_json().unwrap(), "m.json");
+            assert_eq!(r.is_ok(), ok, "{bt}: {r:?}");
+            if let Err(e) = r {
+                assert!(e.is_bad_input() && e.to_string().contains("m.json"), "{e}");
+            }
+        }
     }
 
     #[test]

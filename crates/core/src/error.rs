@@ -47,9 +47,29 @@ impl CoreError {
 /// Result alias of this crate.
 pub type Result<T> = std::result::Result<T, CoreError>;
 
+/// A value in a message: as Rust writes it (`-100.5`, `500000`), or in
+/// exponent form when that would be long (`1e300`, not 301 digits).
+pub fn shown(v: f64) -> String {
+    let plain = v.to_string();
+    if plain.len() > 24 {
+        format!("{v:e}")
+    } else {
+        plain
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_values_are_shown_in_exponent_form() {
+        assert_eq!(shown(-100.5), "-100.5");
+        assert_eq!(shown(500000.0), "500000");
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(1e-308), "1e-308");
+        assert_eq!(shown(f64::NAN), "NaN");
+    }
 
     #[test]
     fn every_core_error_is_bad_input() {

@@ -36,6 +36,7 @@ use serde::Serialize;
 use crate::columns::MAGNETIC_COLUMNS;
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
+use aeromag_core::error::shown;
 
 /// Medians are computed over at most this many samples.
 pub const MEDIAN_SAMPLES: usize = 100_000;
@@ -545,17 +546,6 @@ fn data_row(table: &FlightTable, row: usize) -> String {
         .map(|l| format!(" (line {l})"))
         .unwrap_or_default();
     format!("data row {}{line}", table.file_row(row) + 1)
-}
-
-/// A value in a message: as Rust writes it (`-100.5`, `500000`), or in
-/// exponent form when that would be long (`1e300`, not 301 digits).
-fn shown(v: f64) -> String {
-    let plain = v.to_string();
-    if plain.len() > 24 {
-        format!("{v:e}")
-    } else {
-        plain
-    }
 }
 
 fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {

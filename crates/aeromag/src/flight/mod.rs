@@ -156,12 +156,22 @@ impl Flight {
     /// A bad-input error at `row` (0-based) and `column` of this flight,
     /// with the file's line when it is known.
     pub fn bad_value(&self, row: usize, column: &str, reason: impl Into<String>) -> Error {
+        self.bad_at(row, Some(column.to_string()), reason.into())
+    }
+
+    /// A bad-input error at `row` (0-based) of this flight as a whole (no
+    /// one column to blame), with the file's line when it is known.
+    pub fn bad_row(&self, row: usize, reason: impl Into<String>) -> Error {
+        self.bad_at(row, None, reason.into())
+    }
+
+    fn bad_at(&self, row: usize, column: Option<String>, reason: String) -> Error {
         Error::BadInput {
             file: Some(self.label()),
             line: self.line_of_row(row),
             row: Some(self.file_row(row)),
-            column: Some(column.to_string()),
-            reason: reason.into(),
+            column,
+            reason,
         }
     }
 

@@ -18,7 +18,10 @@ pub enum StreamFlag {
     /// 0: compensated.
     Compensated = 0,
     /// 1: not compensated, an input is missing (empty, `NaN`) or the field
-    /// is all zero.
+    /// is all zero, or the interference the model gives is beyond any
+    /// magnetic field ([`aeromag_io::MAX_FIELD_NT`]: a model file that does
+    /// not fit, or a time step too short for the derivative); its values
+    /// are left empty.
     Missing = 1,
     /// 2: compensated, the first sample of a run (the stream's first, after
     /// a gap or after a sample that could not be used): derivative 0, lags
@@ -28,7 +31,8 @@ pub enum StreamFlag {
     /// goes on as if it had not arrived).
     TimeBackwards = 3,
     /// 4: not compensated, the line is malformed (wrong number of fields,
-    /// text where a number is needed).
+    /// text where a number is needed, a `mag` or `flux_*` value beyond any
+    /// magnetic field: a corrupted cell).
     Malformed = 4,
 }
 
@@ -272,7 +276,16 @@ impl LineCompensator {
                         alt_m: alt,
                     },
                 );
-                (o.interference_nt, o.compensated_nt, o.status.into())
+                let flag = StreamFlag::from(o.status);
+                // NaN too: neither is a compensated value.
+                let within_any_field = o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT;
+                if matches!(flag, StreamFlag::Compensated | StreamFlag::Started)
+                    && !within_any_field
+                {
+                    (f64::NAN, f64::NAN, StreamFlag::Missing)
+                } else {
+                    (o.interference_nt, o.compensated_nt, flag)
+                }
             }
         };
         self.counts.add(flag);
@@ -339,7 +352,16 @@ impl LineCompensator {
         if k + 1 + memchr::memchr_iter(b',', &bytes[end.min(bytes.len())..]).count() != f.count {
             return None;
         }
-        Some((time?, [flux[0]?, flux[1]?, flux[2]?], mag?))
+        let (flux, mag) = ([flux[0]?, flux[1]?, flux[2]?], mag?);
+        // Beyond any magnetic field: a corrupted cell (NaN is missing).
+        if flux
+            .iter()
+            .chain([&mag])
+            .any(|v| v.abs() > aeromag_io::MAX_FIELD_NT)
+        {
+            return None;
+        }
+        Some((time?, flux, mag))
     }
 
     /// What became of the lines so far.

@@ -12,6 +12,12 @@ use super::terms::{
 use crate::error::{CompError, Result};
 use serde::{Deserialize, Serialize};
 
+/// The range of `bt_scale`, nT: the field magnitude the induced and eddy
+/// terms are divided by (MagNav's `Bt_scale`, 50 000 nT), 1 nT (no scaling)
+/// to 10⁶ nT (beyond any magnetic field). A smaller value makes the terms
+/// overflow (1e-308 gave every row an infinite interference).
+pub const BT_SCALE_RANGE_NT: (f64, f64) = (1.0, 1e6);
+
 /// The terms, the derivative convention of the eddy columns and `bt_scale`
 /// (nT) of a Tolles-Lawson model.
 ///
@@ -147,12 +153,14 @@ impl Design {
         }
     }
 
-    /// Check the terms and that `bt_scale` is finite and positive.
+    /// Check the terms and that `bt_scale` is a field magnitude
+    /// ([`BT_SCALE_RANGE_NT`]).
     pub fn validate(&self) -> Result<()> {
-        if !(self.bt_scale_nt > 0.0 && self.bt_scale_nt.is_finite()) {
+        let (lo, hi) = BT_SCALE_RANGE_NT;
+        if !(self.bt_scale_nt >= lo && self.bt_scale_nt <= hi) {
             return Err(CompError::setting(format!(
-                "bt_scale {} must be positive",
-                self.bt_scale_nt
+                "bt_scale {} must be a field magnitude from {lo} to {hi:e} nT (MagNav's 50000)",
+                aeromag_core::error::shown(self.bt_scale_nt)
             )));
         }
         self.terms.validate()
