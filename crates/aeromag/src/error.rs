@@ -260,7 +260,8 @@ pub fn classify(e: &(dyn std::error::Error + 'static)) -> Option<bool> {
         aeromag_gradiometry::GradiometryError,
         aeromag_report::ReportError,
         aeromag_core::CoreError,
-        aeromag_estimation::EstError
+        aeromag_estimation::EstError,
+        aeromag_grid::GridError
     );
     None
 }

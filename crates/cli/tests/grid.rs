@@ -93,6 +93,25 @@ fn bad_arguments_and_files_exit_with_code_2() {
         (vec!["--tension", "1.5"], "g.tif", "tension"),
         (vec!["--utm-zone", "61N"], "g.tif", "61"),
         (vec!["--cell", "0"], "g.tif", "cell"),
+        (vec!["--tension", "1e300"], "g.tif", "tension = 1e300 is"),
+        // The grid library's own errors (the extent is checked before the
+        // file is read) are bad input too; they exited 1.
+        (
+            vec!["--cell", "100", "--extent=1,0,0,1"],
+            "g.tif",
+            "not a finite area",
+        ),
+        (
+            vec!["--cell", "100", "--extent=0,1e9,0,1e9"],
+            "g.tif",
+            "10000001 × 10000001 nodes",
+        ),
+        // Beyond the integers: it was "a 0 × 2 grid".
+        (
+            vec!["--cell", "100", "--extent=-1e300,1e300,0,1"],
+            "g.tif",
+            "2e298 × 2 nodes at a 100 m cell is more than",
+        ),
     ] {
         let o = grid(&input, &d.path().join(out), &extra);
         assert_code(&o, 2);

@@ -1,5 +1,6 @@
 //! The crate's error type.
 
+use aeromag_core::error::shown;
 use thiserror::Error;
 
 /// Errors of the gridding library (bad input or settings, a failed write;
@@ -9,7 +10,7 @@ use thiserror::Error;
 pub enum GridError {
     /// A setting that must be positive and finite is not (cell size,
     /// blanking distance, …).
-    #[error("{name} must be positive and finite, got {value}")]
+    #[error("{name} must be positive and finite, got {}", shown(*value))]
     NotPositive {
         /// Name of the setting.
         name: &'static str,
@@ -17,7 +18,7 @@ pub enum GridError {
         value: f64,
     },
     /// A setting outside its range.
-    #[error("{name} = {value} is out of range: {expected}")]
+    #[error("{name} = {} is out of range: {expected}", shown(*value))]
     OutOfRange {
         /// Name of the setting.
         name: &'static str,

@@ -7,6 +7,7 @@
 
 use crate::error::{GridError, Result, positive};
 use crate::projection::Crs;
+use aeromag_core::error::shown;
 
 /// Where the nodes of a grid are (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,26 +39,35 @@ impl GridGeometry {
             || y_max < y_min
         {
             return Err(GridError::Data(format!(
-                "the extent [{x_min}, {x_max}] × [{y_min}, {y_max}] m is not a finite area"
+                "the extent [{}, {}] × [{}, {}] m is not a finite area",
+                shown(x_min),
+                shown(x_max),
+                shown(y_min),
+                shown(y_max)
             )));
         }
         let x0 = (x_min / cell).floor() * cell;
         let y0 = (y_min / cell).floor() * cell;
-        let nx = ((x_max - x0) / cell).ceil() as usize + 1;
-        let ny = ((y_max - y0) / cell).ceil() as usize + 1;
-        let g = Self {
+        // Counted in f64 first: an extent of 10³⁰⁰ m would overflow the
+        // integers (and did: "a 0 × 2 grid").
+        let nodes = |lo: f64, hi: f64| ((hi - lo) / cell).ceil() + 1.0;
+        let (fx, fy) = (nodes(x0, x_max), nodes(y0, y_max));
+        let n = fx * fy;
+        if n.is_nan() || n > MAX_NODES as f64 {
+            return Err(GridError::Data(format!(
+                "{} × {} nodes at a {} m cell is more than {MAX_NODES}: choose a larger cell",
+                shown(fx),
+                shown(fy),
+                shown(cell)
+            )));
+        }
+        Ok(Self {
             x0,
             y0,
             cell,
-            nx,
-            ny,
-        };
-        if nx.saturating_mul(ny) > MAX_NODES {
-            return Err(GridError::Data(format!(
-                "{nx} × {ny} nodes at a {cell} m cell is more than {MAX_NODES}: choose a larger cell"
-            )));
-        }
-        Ok(g)
+            nx: fx as usize,
+            ny: fy as usize,
+        })
     }
 
     /// Number of nodes.
