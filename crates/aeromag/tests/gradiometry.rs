@@ -156,3 +156,32 @@ fn multi_start_converges_from_every_start_of_the_seeds_map() {
     assert_eq!(fraction("multi-start"), 1.0);
     assert!(fraction("plain IEKF") < 1.0);
 }
+
+/// A scenario file's `nan` or `inf` is bad input naming the key, and
+/// finite values too large for the simulator (a noise of 10³⁰⁸ nT, which
+/// wrote ±inf readings) are bad input naming the column, for the
+/// gradiometer and the EM scenarios as for the flights.
+#[test]
+fn non_finite_and_overflowing_scenario_values_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("g.toml");
+    std::fs::write(&file, "[object]\nyaw_rad = -inf\n").unwrap();
+    let e = aeromag::gradiometry::read_config(Some(&file)).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("g.toml") && msg.contains("object.yaw_rad"),
+        "{msg}"
+    );
+
+    let cfg =
+        GradiometerConfig::from_toml("[sensors.vector]\nnoise_nt = 1e308\nbias_sigma_nt = 5.0\n")
+            .unwrap();
+    let e = aeromag::gradiometry::simulate_pass(&cfg).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    assert!(e.to_string().contains("too large for the simulator"), "{e}");
+
+    let e = aeromag::em::parse_config(Some("range_period_s = nan\n"), "em.toml").unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    assert!(e.to_string().contains("range_period_s"), "{e}");
+}

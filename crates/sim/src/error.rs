@@ -23,6 +23,22 @@ pub enum SimError {
         /// What is wrong and what is allowed.
         reason: String,
     },
+    /// Values of the scenario file too large for the simulator: a
+    /// simulated value came out NaN or infinite (the simulator models
+    /// nothing as missing).
+    #[error(
+        "the scenario's values are too large for the simulator: the simulated `{column}` is {value} at sample {sample}{at}"
+    )]
+    Overflow {
+        /// The output column.
+        column: String,
+        /// 1-based sample.
+        sample: usize,
+        /// The value (NaN or ±∞).
+        value: f64,
+        /// ` (time T s)` when the simulation has a time column.
+        at: String,
+    },
     /// An error of the core library (IGRF date range, dates, …).
     #[error(transparent)]
     Core(#[from] aeromag_core::CoreError),
@@ -60,9 +76,10 @@ impl SimError {
     /// pattern that cannot be flown. Running and writing failures are not.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            SimError::ConfigParse(_) | SimError::InvalidConfig { .. } | SimError::Trajectory(_) => {
-                true
-            }
+            SimError::ConfigParse(_)
+            | SimError::InvalidConfig { .. }
+            | SimError::Trajectory(_)
+            | SimError::Overflow { .. } => true,
             SimError::Core(e) => e.is_bad_input(),
             SimError::Io(e) => e.is_bad_input(),
             SimError::Numerics(_) | SimError::Write { .. } | SimError::Serialize { .. } => false,

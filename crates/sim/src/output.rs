@@ -77,6 +77,28 @@ impl Simulation {
         self.columns.iter().map(|c| c.name.as_str()).collect()
     }
 
+    /// Every value finite: the simulator models nothing as missing, so a
+    /// NaN or ∞ is an overflow of values too large for it (an area of
+    /// 10³⁰⁸ m²), [`SimError::Overflow`] naming the first such column and
+    /// sample.
+    pub fn check_finite(&self) -> Result<()> {
+        for c in &self.columns {
+            if let Some(k) = c.values.iter().position(|v| !v.is_finite()) {
+                let at = self
+                    .column("time")
+                    .map(|t| format!(" (time {} s)", t[k]))
+                    .unwrap_or_default();
+                return Err(SimError::Overflow {
+                    column: c.name.clone(),
+                    sample: k + 1,
+                    value: c.values[k],
+                    at,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The columns as an [`aeromag_io::FlightTable`] (in memory, numeric
     /// columns in output order), for processing without a file.
     pub fn to_flight_table(&self) -> Result<aeromag_io::FlightTable> {

@@ -408,6 +408,59 @@ fn configuration_errors_are_clear() {
     assert!(matches!(bad_toml, Err(SimError::ConfigParse(_))));
     let huge_seed = simulate(ScenarioKind::Calibration, None, Some(u64::MAX));
     assert!(matches!(huge_seed, Err(SimError::InvalidConfig { .. })));
+    // TOML's nan and inf are refused naming the key, in every scenario
+    // (they went through to NaN columns written as data).
+    for (kind, text, key) in [
+        (
+            ScenarioKind::Calibration,
+            "[anomaly]\nsource_depth_m = nan\n",
+            "anomaly.source_depth_m",
+        ),
+        (
+            ScenarioKind::Survey,
+            "[[aircraft.parts]]\nname = \"x\"\nposition_m = [1.0, -inf, 0.0]\n",
+            "aircraft.parts[0].position_m[1]",
+        ),
+        (
+            ScenarioKind::Helicopter,
+            "[rotor]\nroot_m = inf\n",
+            "rotor.root_m",
+        ),
+        (ScenarioKind::Pod, "swing_amp_deg = -nan\n", "swing_amp_deg"),
+    ] {
+        match simulate(kind, Some(text), None) {
+            Err(SimError::InvalidConfig { field, reason }) => {
+                assert_eq!(field, key);
+                assert!(reason.contains("not a finite number"), "{reason}");
+            }
+            other => panic!("{text}: expected an invalid value, got {other:?}"),
+        }
+    }
+    // Finite values too large for the simulator: an overflow naming the
+    // first non-finite column and sample, bad input (they were written).
+    for (text, column) in [
+        ("field_nt = 1e308\n", "mag"),
+        ("speed_m_s = 1e308\n", "lat"),
+    ] {
+        match simulate(ScenarioKind::Pod, Some(text), None) {
+            Err(e @ SimError::Overflow { .. }) => {
+                assert!(e.is_bad_input());
+                assert!(e.to_string().contains(&format!("`{column}`")), "{e}");
+            }
+            other => panic!("{text}: expected an overflow, got {other:?}"),
+        }
+    }
+    // A turn longer than a flight: an error, not an allocation of 1.7 TB.
+    let e = simulate(
+        ScenarioKind::Calibration,
+        Some("[kinematics]\nturn_ramp_s = 2147483648.0\n"),
+        None,
+    )
+    .unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("longer than a flight"),
+        "{e}"
+    );
 }
 
 #[test]

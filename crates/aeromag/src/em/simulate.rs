@@ -38,6 +38,7 @@ pub fn parse_config(text: Option<&str>, origin: &str) -> Result<EmSimConfig> {
     };
     if let Some(text) = text {
         let user: toml::Table = toml::from_str(text).map_err(|e| bad(&e))?;
+        aeromag_sim::scenario::config::check_finite_numbers(&user).map_err(|e| bad(&e))?;
         table.extend(user);
     }
     toml::Value::Table(table).try_into().map_err(|e| bad(&e))

@@ -42,8 +42,12 @@ pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
         None => Ok(GradiometerConfig::default()),
         Some(p) => {
             let text = std::fs::read_to_string(p).map_err(|e| Error::read(p, e))?;
-            GradiometerConfig::from_toml(&text)
-                .map_err(|e| Error::bad_file(p.display().to_string(), e.to_string()))
+            let bad =
+                |e: &dyn std::fmt::Display| Error::bad_file(p.display().to_string(), e.to_string());
+            let cfg = GradiometerConfig::from_toml(&text).map_err(|e| bad(&e))?;
+            // (The text parsed as TOML just above.)
+            aeromag_sim::scenario::config::parse_table(&text).map_err(|e| bad(&e))?;
+            Ok(cfg)
         }
     }
 }
@@ -115,7 +119,22 @@ pub fn simulate_pass(cfg: &GradiometerConfig) -> Result<FlightTable> {
     cfg.validate()
         .map_err(|e| Error::bad_input(format!("scenario: {e}")))?;
     let sim = simulate(&cfg.scenario()?)?;
-    pass_table(cfg, &sim)
+    let table = pass_table(cfg, &sim)?;
+    // The simulator models nothing as missing: NaN or ∞ is an overflow of
+    // the scenario's values (a noise of 10³⁰⁸ nT).
+    for c in table.columns() {
+        if let Some(v) = c.values()
+            && let Some(k) = v.iter().position(|x| !x.is_finite())
+        {
+            return Err(Error::bad_input(format!(
+                "scenario: the values are too large for the simulator: the simulated `{}` is {} at epoch {}",
+                c.name(),
+                v[k],
+                k + 1
+            )));
+        }
+    }
+    Ok(table)
 }
 
 /// The files [`simulate_to_dir`] writes.

@@ -228,8 +228,7 @@ impl<P: Pattern> FixedWingConfig<P> {
                 // Pass 1: syntax, unknown fields and types, with line numbers.
                 let _: Self =
                     toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
-                let mut user: toml::Table =
-                    toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+                let mut user = parse_table(text)?;
                 apply_area_preset(&mut user);
                 let mut defaults = defaults;
                 if user.get("installation").and_then(|v| v.as_str()) == Some("sgl") {
@@ -347,6 +346,43 @@ fn merge(base: &mut toml::Table, over: toml::Table) {
             }
         }
     }
+}
+
+/// Every number of a scenario file is finite: TOML's `nan` and `inf` are
+/// refused, naming the key (`anomaly.depth_m`, `pattern.legs[2].heading_deg`),
+/// before any field is used (a NaN swing amplitude or an infinite yaw
+/// went through to NaN columns, written as data).
+pub fn check_finite_numbers(table: &toml::Table) -> Result<()> {
+    fn walk(v: &toml::Value, path: &str) -> Result<()> {
+        match v {
+            toml::Value::Float(x) if !x.is_finite() => {
+                Err(invalid(path, format!("{x} is not a finite number")))
+            }
+            toml::Value::Array(items) => items
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, x)| walk(x, &format!("{path}[{i}]"))),
+            toml::Value::Table(t) => t.iter().try_for_each(|(k, x)| walk(x, &key(path, k))),
+            _ => Ok(()),
+        }
+    }
+    fn key(path: &str, k: &str) -> String {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    }
+    table.iter().try_for_each(|(k, v)| walk(v, k))
+}
+
+/// A scenario file's text as a TOML table (syntax errors with the parser's
+/// line and column), its numbers checked finite ([`check_finite_numbers`]).
+pub fn parse_table(text: &str) -> Result<toml::Table> {
+    let table: toml::Table =
+        toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+    check_finite_numbers(&table)?;
+    Ok(table)
 }
 
 #[cfg(test)]

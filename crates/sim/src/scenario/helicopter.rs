@@ -141,8 +141,7 @@ impl HelicopterConfig {
             let base = FixedWingConfig::parse_over(defaults.base, kind, None, seed)?;
             return Ok(Self { base, ..defaults });
         };
-        let mut user: toml::Table =
-            toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+        let mut user = super::config::parse_table(text)?;
         let rotor = match user.remove("rotor") {
             None => defaults.rotor,
             Some(v) => v

@@ -166,7 +166,7 @@ pub fn simulate(
     config_toml: Option<&str>,
     seed: Option<u64>,
 ) -> Result<Simulation> {
-    match kind {
+    let sim = match kind {
         ScenarioKind::Calibration | ScenarioKind::CalibrationTruncated => {
             let defaults = calibration_defaults(kind == ScenarioKind::CalibrationTruncated);
             let cfg = FixedWingConfig::parse_over(defaults, kind, config_toml, seed)?;
@@ -185,7 +185,9 @@ pub fn simulate(
             helicopter::run(&cfg)
         }
         ScenarioKind::Pod => pod::run(&pod::PodConfig::parse_over(config_toml, seed)?),
-    }
+    }?;
+    sim.check_finite()?;
+    Ok(sim)
 }
 
 /// The default scenario file of `kind` (every field, TOML), a starting point

@@ -561,8 +561,11 @@ impl PodConfig {
     pub fn parse_over(text: Option<&str>, seed: Option<u64>) -> Result<Self> {
         let mut cfg = match text {
             None => Self::default(),
-            Some(t) => toml::from_str::<Self>(t)
-                .map_err(|e| crate::error::SimError::ConfigParse(e.to_string()))?,
+            Some(t) => {
+                super::config::parse_table(t)?;
+                toml::from_str::<Self>(t)
+                    .map_err(|e| crate::error::SimError::ConfigParse(e.to_string()))?
+            }
         };
         if let Some(s) = seed {
             cfg.seed = s;

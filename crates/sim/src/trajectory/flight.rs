@@ -247,7 +247,7 @@ pub fn fly(
     let mut bank_g = 0.0; // lagged guidance bank
     let mut seg = 0usize;
     let mut seg_k0 = 0usize;
-    let mut active = activate(&plan.segments[0], n, e, chi, kin, dt_s);
+    let mut active = activate(&plan.segments[0], n, e, chi, kin, dt_s)?;
     let max_samples = (MAX_FLIGHT_S / dt_s) as usize;
 
     // Commands of the active segment for its local sample `i_loc`, position
@@ -370,7 +370,7 @@ pub fn fly(
                 chi + dt_s * G_M_S2 * bank.tan() / v,
                 kin,
                 dt_s,
-            );
+            )?;
         }
         if k + 1 >= max_samples {
             return Err(SimError::Trajectory(format!(
@@ -452,8 +452,15 @@ fn push(
 }
 
 /// Runtime state for a segment entered at position (n, e) with track angle `chi`.
-fn activate(seg: &Segment, n: f64, e: f64, chi: f64, kin: &KinematicsConfig, dt_s: f64) -> Runtime {
-    match seg {
+fn activate(
+    seg: &Segment,
+    n: f64,
+    e: f64,
+    chi: f64,
+    kin: &KinematicsConfig,
+    dt_s: f64,
+) -> Result<Runtime> {
+    Ok(match seg {
         Segment::Track { line, .. } => {
             let line = match line {
                 TrackLine::Fixed(l) => *l,
@@ -476,20 +483,32 @@ fn activate(seg: &Segment, n: f64, e: f64, chi: f64, kin: &KinematicsConfig, dt_
                 heading_rad: *heading_rad,
             },
             captured: false,
-            rates: turn_rates(wrap_pi(heading_rad - chi), kin, dt_s),
+            rates: turn_rates(wrap_pi(heading_rad - chi), kin, dt_s)?,
         },
-    }
+    })
 }
 
 /// Turn-rate samples (rad/s) of a scheduled turn by `delta` rad: raised-cosine
 /// roll-in and roll-out of `turn_ramp_s`, constant rate in between, scaled so
 /// that `Σ r_i Δt = delta` exactly.
-fn turn_rates(delta: f64, kin: &KinematicsConfig, dt_s: f64) -> Vec<f64> {
+/// A turn longer than a whole flight may last ([`MAX_FLIGHT_S`]: a tiny
+/// turn rate or a huge ramp) is an error, before its samples are allocated.
+fn turn_rates(delta: f64, kin: &KinematicsConfig, dt_s: f64) -> Result<Vec<f64>> {
     let rmax = kin.turn_rate_deg_s.to_radians();
     if delta.abs() < 1e-12 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let total = delta.abs() / rmax + kin.turn_ramp_s;
+    if total.is_nan() || total > MAX_FLIGHT_S {
+        return Err(SimError::Trajectory(format!(
+            "a turn of {:.0}° would last {} s at kinematics.turn_rate_deg_s = {} with kinematics.turn_ramp_s = {}, longer than a flight ({} h)",
+            delta.abs().to_degrees(),
+            aeromag_core::error::shown(total.round()),
+            aeromag_core::error::shown(kin.turn_rate_deg_s),
+            aeromag_core::error::shown(kin.turn_ramp_s),
+            MAX_FLIGHT_S / 3600.0
+        )));
+    }
     let n = ((total / dt_s).round() as usize).max(1);
     let t_total = n as f64 * dt_s;
     let ramp = kin.turn_ramp_s.min(0.5 * t_total);
@@ -505,7 +524,7 @@ fn turn_rates(delta: f64, kin: &KinematicsConfig, dt_s: f64) -> Vec<f64> {
         })
         .collect();
     let sum: f64 = shape.iter().sum::<f64>() * dt_s;
-    shape.iter().map(|s| delta * s / sum).collect()
+    Ok(shape.iter().map(|s| delta * s / sum).collect())
 }
 
 #[cfg(test)]
@@ -698,6 +717,26 @@ mod tests {
         assert!(max_bank <= 25f64.to_radians() + 1e-12);
     }
 
+    /// A turn that would outlast a flight (the ramp of 2³¹ s of a mutated
+    /// scenario file asked for 1.7 TB) is an error, not an allocation.
+    #[test]
+    fn a_turn_longer_than_a_flight_is_an_error() {
+        for (rate, ramp) in [(3.0, 2_147_483_648.0), (1e-9, 4.0)] {
+            let kin = KinematicsConfig {
+                turn_rate_deg_s: rate,
+                turn_ramp_s: ramp,
+                ..Default::default()
+            };
+            let e = turn_rates(1.0, &kin, 0.1).unwrap_err().to_string();
+            assert!(e.contains("longer than a flight (24 h)"), "{e}");
+        }
+        let kin = KinematicsConfig {
+            turn_ramp_s: 3600.0,
+            ..Default::default()
+        };
+        assert!(turn_rates(1.0, &kin, 0.1).is_ok());
+    }
+
     proptest::proptest! {
         /// A scheduled turn changes the heading by exactly the requested
         /// angle and never exceeds the turn rate by more than the
@@ -706,7 +745,7 @@ mod tests {
         fn turn_profile_is_exact(delta in -3.1f64..3.1, rate in 1.0f64..6.0, ramp in 0.0f64..8.0, fine in proptest::bool::ANY) {
             let dt = if fine { 0.01 } else { 0.1 };
             let kin = KinematicsConfig { turn_rate_deg_s: rate, turn_ramp_s: ramp, ..Default::default() };
-            let r = turn_rates(delta, &kin, dt);
+            let r = turn_rates(delta, &kin, dt).unwrap();
             let total: f64 = r.iter().sum::<f64>() * dt;
             // Exact up to the rounding of summing r.len() terms (ε per addition),
             // e.g. 13 700 samples of a 3 rad turn at 0.01 s: ~1e-11 rad.
