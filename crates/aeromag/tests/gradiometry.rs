@@ -184,4 +184,11 @@ fn non_finite_and_overflowing_scenario_values_are_bad_input() {
     let e = aeromag::em::parse_config(Some("range_period_s = nan\n"), "em.toml").unwrap_err();
     assert!(e.is_bad_input(), "{e}");
     assert!(e.to_string().contains("range_period_s"), "{e}");
+    // 10⁸ sferics a second ran for minutes on a 10-second record.
+    let cfg = aeromag::em::parse_config(Some("sferic_rate_hz = 1e8\n"), "em.toml").unwrap();
+    let e = aeromag::em::simulate_to_dir(&cfg, 2, dir.path()).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("sferic_rate_hz"),
+        "{e}"
+    );
 }

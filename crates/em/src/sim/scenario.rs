@@ -68,11 +68,16 @@ pub struct EmSimConfig {
     pub coil_noise_v: f64,
     /// 400 Hz fundamental amplitude, V (odd harmonics fall as 1/h).
     pub power_line_v: f64,
-    /// Mean sferic rate, 1/s.
+    /// Mean sferic rate, 1/s (0 to [`MAX_SFERIC_RATE_HZ`]).
     pub sferic_rate_hz: f64,
     /// Median sferic peak amplitude, V.
     pub sferic_amplitude_v: f64,
 }
+
+/// The highest sferic rate simulated, 1/s: every sferic is a waveform of
+/// its own, so 10⁸/s (a mutated scenario file) ran for minutes on a
+/// 10-second record; lightning gives tens to hundreds per second.
+pub const MAX_SFERIC_RATE_HZ: f64 = 1000.0;
 
 impl Default for EmSimConfig {
     fn default() -> Self {
@@ -146,6 +151,14 @@ impl EmScenario {
         {
             return Err(EmError::InvalidArgument {
                 reason: "rate, duration and ranges must be positive".into(),
+            });
+        }
+        if !(c.sferic_rate_hz >= 0.0 && c.sferic_rate_hz <= MAX_SFERIC_RATE_HZ) {
+            return Err(EmError::InvalidArgument {
+                reason: format!(
+                    "sferic_rate_hz {} must be from 0 to {MAX_SFERIC_RATE_HZ} /s (sferics arrive at tens to hundreds per second)",
+                    aeromag_core::error::shown(c.sferic_rate_hz)
+                ),
             });
         }
         if c.mean_direction.norm() == 0.0 {
