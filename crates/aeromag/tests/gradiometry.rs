@@ -159,8 +159,8 @@ fn multi_start_converges_from_every_start_of_the_seeds_map() {
 
 /// A scenario file's `nan` or `inf` is bad input naming the key, and
 /// finite values too large for the simulator (a noise of 10³⁰⁸ nT, which
-/// wrote ±inf readings) are bad input naming the column, for the
-/// gradiometer and the EM scenarios as for the flights.
+/// wrote ±inf readings) or for memory are bad input, for the gradiometer
+/// and the EM scenarios as for the flights.
 #[test]
 fn non_finite_and_overflowing_scenario_values_are_bad_input() {
     let dir = tempfile::tempdir().unwrap();
@@ -184,11 +184,23 @@ fn non_finite_and_overflowing_scenario_values_are_bad_input() {
     let e = aeromag::em::parse_config(Some("range_period_s = nan\n"), "em.toml").unwrap_err();
     assert!(e.is_bad_input(), "{e}");
     assert!(e.to_string().contains("range_period_s"), "{e}");
-    // 10⁸ sferics a second ran for minutes on a 10-second record.
-    let cfg = aeromag::em::parse_config(Some("sferic_rate_hz = 1e8\n"), "em.toml").unwrap();
-    let e = aeromag::em::simulate_to_dir(&cfg, 2, dir.path()).unwrap_err();
-    assert!(
-        e.is_bad_input() && e.to_string().contains("sferic_rate_hz"),
-        "{e}"
-    );
+    // 10⁸ sferics a second ran for minutes on a 10-second record; 10⁸
+    // samples a second asked for 12 GB; a rotation rate of −10³⁰⁸ °/s
+    // wrote NaN voltages.
+    for (text, needle) in [
+        ("sferic_rate_hz = 1e8\n", "sferic_rate_hz"),
+        ("sample_rate_hz = 1e8\n", "frames, more than"),
+        (
+            "rotation_rate_deg_s = -1e308\n",
+            "too large for the simulator",
+        ),
+    ] {
+        let cfg = aeromag::em::parse_config(Some(text), "em.toml").unwrap();
+        let e = aeromag::em::simulate_to_dir(&cfg, 2, dir.path()).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains(needle),
+            "{text}: {e}"
+        );
+    }
+    assert!(!dir.path().join("em.raw").exists());
 }

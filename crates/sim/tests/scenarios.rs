@@ -450,6 +450,21 @@ fn configuration_errors_are_clear() {
             other => panic!("{text}: expected an overflow, got {other:?}"),
         }
     }
+    // A pod flight whose samples would not fit in memory (10⁸ Hz asked for
+    // 576 GB) or that outlasts a day.
+    for (text, key) in [
+        ("sample_rate_hz = 1e8\n", "pod.sample_rate_hz"),
+        ("manoeuvre_s = 1e6\n", "pod.manoeuvre_s"),
+        (
+            "sample_rate_hz = 10000.0\nmanoeuvre_s = 1000.0\n",
+            "pod.manoeuvre_s",
+        ),
+    ] {
+        match simulate(ScenarioKind::Pod, Some(text), None) {
+            Err(SimError::InvalidConfig { field, .. }) => assert_eq!(field, key, "{text}"),
+            other => panic!("{text}: expected an invalid value, got {other:?}"),
+        }
+    }
     // A turn longer than a flight: an error, not an allocation of 1.7 TB.
     let e = simulate(
         ScenarioKind::Calibration,

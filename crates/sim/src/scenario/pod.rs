@@ -363,6 +363,27 @@ fn check(cfg: &PodConfig) -> Result<()> {
             "need at least one finite heading",
         ));
     }
+    // As a fixed-wing flight's: the samples are allocated up front (10⁸ Hz
+    // asked for 576 GB).
+    if cfg.sample_rate_hz > 10_000.0 {
+        return Err(invalid("pod.sample_rate_hz", "must be ≤ 10 000 Hz"));
+    }
+    let flight_s = 3.0 * cfg.manoeuvre_s * cfg.headings_deg.len() as f64;
+    let samples = flight_s * cfg.sample_rate_hz;
+    if flight_s > crate::trajectory::flight::MAX_FLIGHT_S
+        || samples > crate::trajectory::flight::MAX_SAMPLES as f64
+    {
+        return Err(invalid(
+            "pod.manoeuvre_s",
+            format!(
+                "3 × manoeuvre_s × {} headings = {} s of flight, more than {} h or {} samples",
+                cfg.headings_deg.len(),
+                aeromag_core::error::shown(flight_s),
+                crate::trajectory::flight::MAX_FLIGHT_S / 3600.0,
+                crate::trajectory::flight::MAX_SAMPLES
+            ),
+        ));
+    }
     Ok(())
 }
 

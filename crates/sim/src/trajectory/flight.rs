@@ -194,7 +194,11 @@ pub struct FlightPlan {
 const CAPTURE_CROSS_M: f64 = 30.0;
 const CAPTURE_ANGLE_RAD: f64 = 0.087;
 /// Longest flight accepted, s (a plan that never ends is an error).
-const MAX_FLIGHT_S: f64 = 24.0 * 3600.0;
+pub(crate) const MAX_FLIGHT_S: f64 = 24.0 * 3600.0;
+/// Most samples of a simulated flight: its 50-odd columns take 8 GB at
+/// this length (a day at 231 Hz; a high sample rate would otherwise run
+/// out of memory before the day's limit).
+pub const MAX_SAMPLES: usize = 20_000_000;
 
 /// Runtime state of the active segment.
 struct Runtime {
@@ -248,7 +252,7 @@ pub fn fly(
     let mut seg = 0usize;
     let mut seg_k0 = 0usize;
     let mut active = activate(&plan.segments[0], n, e, chi, kin, dt_s)?;
-    let max_samples = (MAX_FLIGHT_S / dt_s) as usize;
+    let max_samples = ((MAX_FLIGHT_S / dt_s) as usize).min(MAX_SAMPLES);
 
     // Commands of the active segment for its local sample `i_loc`, position
     // (n, e) and track angle chi; updates the lagged guidance bank.
@@ -373,11 +377,21 @@ pub fn fly(
             )?;
         }
         if k + 1 >= max_samples {
-            return Err(SimError::Trajectory(format!(
-                "segment {} did not end within {} h of flight: the plan cannot be flown",
-                seg + 1,
-                MAX_FLIGHT_S / 3600.0
-            )));
+            return Err(SimError::Trajectory(if max_samples == MAX_SAMPLES {
+                format!(
+                    "the flight needs more than {MAX_SAMPLES} samples at {} Hz (segment {} of {} not ended after {:.2} h): lower the sample rate or shorten the pattern",
+                    aeromag_core::error::shown(1.0 / dt_s),
+                    seg + 1,
+                    plan.segments.len(),
+                    max_samples as f64 * dt_s / 3600.0
+                )
+            } else {
+                format!(
+                    "segment {} did not end within {} h of flight: the plan cannot be flown",
+                    seg + 1,
+                    MAX_FLIGHT_S / 3600.0
+                )
+            }));
         }
         // Sample k+1.
         chi += dt_s * G_M_S2 * bank.tan() / v;
