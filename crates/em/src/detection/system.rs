@@ -59,7 +59,12 @@ impl EmSystem {
                 "fields 'coil_gain_v_per_t_s' and 'pilot_offset_hz' must be non-zero and positive",
             );
         }
-        if self.moments_am2.determinant().abs() < 1e-12 * self.moments_am2.norm().powi(3) {
+        // |det| < 1e-12 ‖M‖³ on M scaled by its largest entry (both sides
+        // scale alike): unscaled, the norm's cube overflowed for a moment
+        // of 1e308, and the stage-2 fit then failed on it (exit 1).
+        let largest = self.moments_am2.amax();
+        let m = self.moments_am2 / largest;
+        if largest == 0.0 || m.determinant().abs() < 1e-12 * m.norm().powi(3) {
             return bad("field 'moments_am2' is singular");
         }
         if self.chi.iter().any(|m| m.try_inverse().is_none()) {
@@ -109,14 +114,24 @@ mod tests {
     fn validate_names_the_bad_field() {
         let good = EmScenario::new(EmSimConfig::default()).unwrap().system();
         assert!(good.validate().is_ok());
+        let refused_for_moments = |edit: &dyn Fn(&mut super::EmSystem)| {
+            let mut s = good.clone();
+            edit(&mut s);
+            let e = s.validate().unwrap_err().to_string();
+            assert!(e.contains("moments_am2"), "{e}");
+        };
+        refused_for_moments(&|s| {
+            s.moments_am2
+                .set_column(2, &s.moments_am2.column(0).into_owned())
+        });
+        // One moment of 1e308 (a corrupted file): as singular as it is, for
+        // all that the unscaled test overflowed.
+        refused_for_moments(&|s| s.moments_am2[(1, 2)] = -1e308);
         let mut s = good.clone();
-        s.moments_am2
-            .set_column(2, &s.moments_am2.column(0).into_owned());
+        s.moments_am2 *= 1e300;
         assert!(
-            s.validate()
-                .unwrap_err()
-                .to_string()
-                .contains("moments_am2")
+            s.validate().is_ok(),
+            "a well-conditioned matrix at any scale"
         );
         let mut s = good.clone();
         s.chi[1] = nalgebra::Matrix3::zeros();
