@@ -45,7 +45,7 @@ pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
             let bad =
                 |e: &dyn std::fmt::Display| Error::bad_file(p.display().to_string(), e.to_string());
             let cfg = GradiometerConfig::from_toml(&text).map_err(|e| bad(&e))?;
-            // (The text parsed as TOML just above.)
+            // TOML nan and inf, which the configuration's own checks let through.
             aeromag_sim::scenario::config::parse_table(&text).map_err(|e| bad(&e))?;
             Ok(cfg)
         }
