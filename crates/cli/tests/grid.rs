@@ -106,6 +106,8 @@ fn bad_arguments_and_files_exit_with_code_2() {
             "g.tif",
             "10000001 × 10000001 nodes",
         ),
+        // Not metres: every position moved off the survey.
+        (vec!["--lever-arm=5000,0,0"], "g.tif", "longer than 1000 m"),
         // Beyond the integers: it was "a 0 × 2 grid".
         (
             vec!["--cell", "100", "--extent=-1e300,1e300,0,1"],

@@ -25,6 +25,25 @@ use aeromag_core::frames::{Attitude, Geodetic};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+/// The longest lever arm taken, m: towed birds and pods hang some tens of
+/// metres from the aircraft; beyond a kilometre the numbers are not metres
+/// (`--lever-arm 1e300,0,0` moved every position off the survey and left
+/// "no crossovers to level").
+pub const MAX_LEVER_ARM_M: f64 = 1000.0;
+
+/// A lever arm (body frame, m) is finite and at most [`MAX_LEVER_ARM_M`]
+/// long (bad input otherwise).
+pub fn check_lever_arm(arm_m: [f64; 3]) -> Result<()> {
+    let len = Vector3::from(arm_m).norm();
+    if len <= MAX_LEVER_ARM_M {
+        return Ok(());
+    }
+    let shown = arm_m.map(aeromag_core::error::shown).join(", ");
+    Err(CompError::setting(format!(
+        "lever arm ({shown}) m is longer than {MAX_LEVER_ARM_M} m: no sensor is that far from the navigation point (metres expected, body frame X,Y,Z)"
+    )))
+}
+
 /// Where the scalar sensor is relative to the navigation point.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LeverArm {
@@ -64,6 +83,7 @@ pub fn lever_arm_correction_nt(
     pitch_deg: &[f64],
     yaw_deg: &[f64],
 ) -> Result<Vec<f64>> {
+    check_lever_arm(lever.arm_m)?;
     let n = roll_deg.len();
     if [
         lat_deg.len(),
@@ -114,6 +134,39 @@ pub fn lever_arm_correction_nt(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A lever arm is finite and at most a kilometre (1e300 m moved every
+    /// position off the survey); both uses refuse it.
+    #[test]
+    fn lever_arms_beyond_a_kilometre_or_not_finite_are_refused() {
+        assert!(check_lever_arm([-9.5, 0.0, -0.6]).is_ok());
+        assert!(check_lever_arm([0.0, 0.0, 1000.0]).is_ok());
+        for arm in [[1e300, 0.0, 0.0], [0.0, 600.0, 900.0], [f64::NAN, 0.0, 0.0]] {
+            let e = check_lever_arm(arm).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("lever arm"),
+                "{e}"
+            );
+        }
+        let lever = LeverArm {
+            arm_m: [5000.0, 0.0, 0.0],
+            decimal_year: 2025.0,
+        };
+        let one = [0.0];
+        assert!(
+            lever_arm_correction_nt(&lever, &[56.0], &[38.0], &[300.0], &one, &one, &one).is_err()
+        );
+        let pos = crate::levelling::sensor_positions(
+            &[56.0],
+            &[38.0],
+            &[300.0],
+            &one,
+            &one,
+            &one,
+            lever.arm_m,
+        );
+        assert!(pos.is_err());
+    }
 
     /// ∇F against a finite difference of F itself, and the size of the
     /// vertical gradient against the dipole estimate 3F/r.

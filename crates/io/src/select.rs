@@ -29,6 +29,7 @@
 
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
+use aeromag_core::error::shown;
 
 /// Rows to keep: those on any of `lines` (all when empty) and, with a
 /// `time_range`, those whose `time` lies in `[t0, t1]` (s, inclusive).
@@ -71,7 +72,10 @@ impl RowSelection {
             match nums[..] {
                 [Some(t0), Some(t1)] if t0 <= t1 => sel.time_range = Some((t0, t1)),
                 [Some(t0), Some(t1)] => {
-                    return Err(err("--time-range", format!("start {t0} is after end {t1}")));
+                    return Err(err(
+                        "--time-range",
+                        format!("start {} is after end {}", shown(t0), shown(t1)),
+                    ));
                 }
                 _ => {
                     return Err(err(

@@ -229,6 +229,7 @@ pub fn sensor_positions(
     yaw_deg: &[f64],
     lever_arm_m: [f64; 3],
 ) -> Result<[Vec<f64>; 3]> {
+    crate::reference_field::check_lever_arm(lever_arm_m)?;
     let n = lat.len();
     for (name, c) in [
         ("lon", lon),
