@@ -166,6 +166,16 @@ fn a_fitted_model_leaves_under_10_percent_on_an_independent_flight() {
             .unwrap_err()
             .is_bad_input()
     );
+    // 100 000 blades ran the fit out of memory; a coning of 1e300° was
+    // fitted and reported. Both are bad input before any fitting.
+    let mut many = opts.clone();
+    many.geometry.blades = 100_000;
+    let mut coned = opts.clone();
+    coned.nominal_angles.coning_rad = 1e300;
+    for (o, needle) in [(many, "blades"), (coned, "coning")] {
+        let e = fit_rotor(&learn, &o, &mut Silent).unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains(needle), "{e}");
+    }
 }
 
 #[test]

@@ -6,6 +6,7 @@ use crate::error::{Error, Result};
 use crate::flight::{Flight, GAP_FACTOR};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::model_file::MODEL_FORMAT;
+use aeromag_compensation::rotor::blade::MAX_FLAP_RAD;
 use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile, TailModel};
 use aeromag_compensation::rotor::tail::split;
 use aeromag_compensation::rotor::{
@@ -13,6 +14,7 @@ use aeromag_compensation::rotor::{
     SlowAngleOptions, TailRotor, fit_records, fit_slow_angles, fit_with_tail, refine_phase_offset,
 };
 use aeromag_compensation::tolles_lawson::segments::median_step;
+use aeromag_core::error::shown;
 
 /// Longest dropout (consecutive rows with a missing value, time steps
 /// regular) that the fit bridges by linear interpolation, s.
@@ -245,8 +247,24 @@ impl RotorOptions {
         let [lo, hi] = self.rotor_hz_range;
         if !(lo > 0.0 && hi > lo && hi.is_finite()) {
             return Err(Error::bad_input(format!(
-                "rotor frequency band {lo},{hi} Hz: need 0 < LO < HI"
+                "rotor frequency band {},{} Hz: need 0 < LO < HI",
+                shown(lo),
+                shown(hi)
             )));
+        }
+        let a = &self.nominal_angles;
+        for (name, v) in [
+            ("coning", a.coning_rad),
+            ("longitudinal tilt", a.tilt_lon_rad),
+            ("lateral tilt", a.tilt_lat_rad),
+        ] {
+            if v.is_nan() || v.abs() > MAX_FLAP_RAD {
+                return Err(Error::bad_input(format!(
+                    "nominal {name} {}° must be within ±{}°",
+                    shown(v.to_degrees()),
+                    MAX_FLAP_RAD.to_degrees().round()
+                )));
+            }
         }
         if !(self.window_s.is_finite() && self.window_s > 0.0) {
             return Err(Error::bad_input(format!(

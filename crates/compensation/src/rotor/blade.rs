@@ -61,6 +61,15 @@ fn main_zero_azimuth() -> [f64; 3] {
     [1.0, 0.0, 0.0]
 }
 
+/// Most blades of a rotor (main rotors have 2 to 8, tail rotors up to 10 or
+/// so): each blade carries its own parameters, and 100 000 blades ran the
+/// fit out of memory.
+pub const MAX_BLADES: usize = 16;
+
+/// Largest flap angle taken, rad (30°): a coning or tilt beyond is not a
+/// rotor cone (1e300° was fitted and reported as a mean coning of 10¹⁷°).
+pub const MAX_FLAP_RAD: f64 = std::f64::consts::FRAC_PI_6;
+
 /// Flap angles of the rotor cone (rad): coning `β0` and the tip-path-plane
 /// tilts `a1` (longitudinal), `b1` (lateral).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -130,13 +139,13 @@ impl RotorGeometry {
             && self.root_m >= 0.0
             && self.tip_m.is_finite()
             && self.tip_m > self.root_m
-            && self.blades >= 2;
+            && (2..=MAX_BLADES).contains(&self.blades);
         if ok {
             self.body_from_hub().map(|_| ())
         } else {
-            Err(CompError::setting(
-                "rotor geometry: finite positions, 0 ≤ root < tip and ≥ 2 blades required",
-            ))
+            Err(CompError::setting(format!(
+                "rotor geometry: finite positions, 0 ≤ root < tip and 2 to {MAX_BLADES} blades required"
+            )))
         }
     }
 
