@@ -96,6 +96,18 @@ fn missing_values_are_kept_and_flagged_and_bad_input_exits_2() {
     let o = aeromag(&args);
     assert_code(&o, 0);
     assert!(stdout(&o).contains("learning heading"), "{}", stdout(&o));
+    // A source point at 1e300 m ran the fit until killed (the SVD never
+    // returned on NaN); a declination of 1e300° was taken.
+    for (extra, needle) in [
+        (["--source-points", "1e300,0,0"], "source point"),
+        (["--declination-deg", "1e300"], "declination"),
+    ] {
+        let mut bad_args = args.clone();
+        bad_args.extend(extra);
+        let o = aeromag(&bad_args);
+        assert_code(&o, 2);
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    }
     // Blank a `mag` cell of the test file: rows kept, flagged.
     let text = std::fs::read_to_string(&test).unwrap();
     let lines: Vec<&str> = text.lines().collect();

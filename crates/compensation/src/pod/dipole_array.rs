@@ -80,6 +80,10 @@ fn columns(sources: &[[f64; 3]], h: &PodHeading, hp: bool) -> Result<(Vec<Vec<f6
     Ok((cols, p.s0))
 }
 
+/// Farthest source point taken, m (the helicopter hangs some tens of metres
+/// above the pod; 1e300 m made the design NaN).
+pub const MAX_SOURCE_M: f64 = 1000.0;
+
 /// Fit the equivalent dipole array at `sources` (body frame, m) jointly on
 /// all `headings`. Errors: no sources or headings, bad data.
 pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result<DipoleArrayModel> {
@@ -90,6 +94,15 @@ pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result
     }
     if sources.iter().flatten().any(|x| !x.is_finite()) {
         return Err(CompError::data("non-finite source point"));
+    }
+    if let Some(p) = sources
+        .iter()
+        .find(|p| p.iter().map(|x| x * x).sum::<f64>().sqrt() > MAX_SOURCE_M)
+    {
+        return Err(CompError::setting(format!(
+            "source point ({}) m is more than {MAX_SOURCE_M} m from the body frame's origin: metres expected",
+            p.map(aeromag_core::error::shown).join(", ")
+        )));
     }
     let m = sources.len() * PER_SOURCE;
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); m];

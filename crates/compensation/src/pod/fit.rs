@@ -170,7 +170,20 @@ pub(super) fn lstsq(a: DMatrix<f64>, y: &DVector<f64>) -> Result<DVector<f64>> {
     for (j, s) in scale.iter().enumerate() {
         a.column_mut(j).scale_mut(*s);
     }
-    let svd = a.svd(true, true);
+    // nalgebra's SVD never returns on NaN (a source point of 1e300 m ran
+    // `pod fit` until killed): refuse non-finite values, and bound the
+    // iterations.
+    if a.iter().chain(y.iter()).any(|v| !v.is_finite()) {
+        return Err(CompError::data(
+            "pod least squares: non-finite values in the design",
+        ));
+    }
+    let svd = a
+        // `svd`'s own tolerance (5 ε), so the same bits where it converges.
+        .try_svd(true, true, 5.0 * f64::EPSILON, 10_000)
+        .ok_or_else(|| CompError::Singular {
+            reason: "pod least squares: the SVD did not converge".into(),
+        })?;
     let smax = svd.singular_values.max();
     let x = svd
         .solve(y, RCOND * smax)
@@ -398,6 +411,19 @@ pub fn compensation_rate_pooled<H: std::borrow::Borrow<PodHeading>>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// NaN in the design is an error at once (nalgebra's SVD never
+    /// returned on it: `pod fit` with a source point at 1e300 m hung).
+    #[test]
+    fn a_non_finite_design_is_an_error_not_a_hang() {
+        let mut a = DMatrix::from_fn(20, 3, |i, j| {
+            ((i + 1) * (j + 2)) as f64 % 7.0 + 0.1 * i as f64
+        });
+        let y = DVector::from_fn(20, |i, _| i as f64);
+        assert!(lstsq(a.clone(), &y).is_ok());
+        a[(4, 1)] = f64::NAN;
+        assert!(lstsq(a, &y).unwrap_err().is_bad_input());
+    }
 
     #[test]
     fn detrend_removes_lines_only() {

@@ -123,9 +123,14 @@ pub struct PodModelFile {
     pub software_version: String,
 }
 
+/// Largest regional field gradient of a pod setup, nT/km (Earth's main
+/// field varies by some nT/km; 10 nT/m is far beyond).
+pub const MAX_GRADIENT_NT_PER_KM: f64 = 10_000.0;
+
 impl PodSetup {
     /// Check the values: a positive cable length (m), an inclination in
-    /// (−90°, 90°), a finite declination and finite gradients.
+    /// (−90°, 90°), a declination within ±180° and gradients within
+    /// ±[`MAX_GRADIENT_NT_PER_KM`].
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(CompError::setting(m));
         if !(self.cable_length_m.is_finite() && self.cable_length_m > 0.0) {
@@ -140,15 +145,24 @@ impl PodSetup {
                 self.inclination_deg
             ));
         }
-        if [
-            self.declination_deg,
-            self.grad_north_nt_per_km,
-            self.grad_up_nt_per_km,
-        ]
-        .iter()
-        .any(|x| !x.is_finite())
-        {
-            return bad("declination and gradients must be finite".into());
+        if self.declination_deg.is_nan() || self.declination_deg.abs() > 180.0 {
+            return bad(format!(
+                "declination {}° must be within ±180°",
+                aeromag_core::error::shown(self.declination_deg)
+            ));
+        }
+        // A regional gradient: Earth's is some nT/km (1e300 gave a
+        // compensation rate of −∞ %).
+        for (name, g) in [
+            ("north", self.grad_north_nt_per_km),
+            ("upward", self.grad_up_nt_per_km),
+        ] {
+            if g.is_nan() || g.abs() > MAX_GRADIENT_NT_PER_KM {
+                return bad(format!(
+                    "{name} gradient {} nT/km must be within ±{MAX_GRADIENT_NT_PER_KM} nT/km",
+                    aeromag_core::error::shown(g)
+                ));
+            }
         }
         Ok(())
     }
@@ -219,6 +233,17 @@ mod tests {
             software_version: "test".into(),
         };
         m.validate().unwrap();
+        // A declination beyond ±180° or a gradient beyond 10 nT/m (1e300
+        // gave a compensation rate of −∞ %) is refused.
+        for edit in [
+            |s: &mut PodSetup| s.declination_deg = 1e300,
+            |s: &mut PodSetup| s.grad_north_nt_per_km = 1e300,
+            |s: &mut PodSetup| s.grad_up_nt_per_km = -2e4,
+        ] {
+            let mut s = setup;
+            edit(&mut s);
+            assert!(s.validate().unwrap_err().is_bad_input());
+        }
         assert_eq!(
             PodModelFile::from_json(&serde_json::to_string(&m).unwrap(), "p.json").unwrap(),
             m
