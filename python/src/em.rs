@@ -295,7 +295,7 @@ pub fn locate_em(
             .map_err(|e| aeromag::Error::read(&path, e))
             .py_err()?;
         CalibrationFile::from_json(&text)
-            .map_err(|e| aeromag::Error::bad_file(&path.display().to_string(), e.to_string()))
+            .map_err(|e| aeromag::Error::bad_file(path.display().to_string(), e.to_string()))
             .py_err()?
     };
     let mut obs = PyProgress::new(progress);

@@ -15,6 +15,8 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 
 /// A rotor or a pod model.
+// One per Python model object: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum AnyModel {
     Rotor(RotorModelFile),
     Pod(PodModelFile),

@@ -11,7 +11,10 @@ use aeromag_compensation::tolles_lawson::{Convention, DEFAULT_BT_SCALE_NT, Desig
 use aeromag_estimation::least_squares::NormalEquations;
 use std::error::Error;
 
-fn read_rows(path: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), Box<dyn Error>> {
+/// A file's column names and its rows.
+type Rows = (Vec<String>, Vec<Vec<f64>>);
+
+fn read_rows(path: &str) -> Result<Rows, Box<dyn Error>> {
     let text = std::fs::read_to_string(path)?;
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let first = lines.next().ok_or("empty file")?;

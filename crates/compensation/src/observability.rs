@@ -81,7 +81,7 @@ pub fn observability(
     };
     let mut weak = Vec::new();
     for (pos, &k) in order.iter().enumerate() {
-        if !(w[pos] < wmax / weak_ratio) {
+        if w[pos].partial_cmp(&(wmax / weak_ratio)) != Some(std::cmp::Ordering::Less) {
             break;
         }
         let v = eig.eigenvectors.column(k);

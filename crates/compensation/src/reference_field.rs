@@ -224,7 +224,7 @@ mod tests {
         .unwrap();
         let g = total_field_gradient_ned(&Geodetic::new(45.0, -75.0, 3000.0), 2025.0).unwrap();
         // Heading east: the tail points west.
-        assert!((c[0] - g[1] * 9.5 * -1.0).abs() < 1e-12);
+        assert!((c[0] + g[1] * 9.5).abs() < 1e-12);
         let down = 9.5 * 10f64.to_radians().sin();
         let west = -9.5 * 10f64.to_radians().cos();
         assert!((c[1] - (g[2] * down + g[1] * west)).abs() < 1e-12);

@@ -10,6 +10,7 @@ use aeromag_compensation::tolles_lawson::{DEFAULT_BT_SCALE_NT, Design, TermSet};
 use aeromag_core::frames::Attitude;
 use nalgebra::Vector3;
 use proptest::prelude::*;
+use std::f64::consts::PI;
 
 /// A field in NED of magnitude `f` (nT) with inclination `inc` and
 /// declination `dec` (rad).
@@ -22,12 +23,11 @@ fn field_ned(f: f64, inc: f64, dec: f64) -> Vector3<f64> {
 }
 
 fn attitude() -> impl Strategy<Value = (f64, f64, f64)> {
-    (-0.8f64..0.8, -0.5f64..0.5, -3.14f64..3.14)
+    (-0.8f64..0.8, -0.5f64..0.5, -PI..PI)
 }
 
 fn earth_field() -> impl Strategy<Value = Vector3<f64>> {
-    (20_000.0f64..70_000.0, -1.5f64..1.5, -3.14f64..3.14)
-        .prop_map(|(f, inc, dec)| field_ned(f, inc, dec))
+    (20_000.0f64..70_000.0, -1.5f64..1.5, -PI..PI).prop_map(|(f, inc, dec)| field_ned(f, inc, dec))
 }
 
 proptest! {

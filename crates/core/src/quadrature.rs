@@ -10,7 +10,10 @@
 
 /// The weight `w_i` of node `i` of `m` intervals (`m` even, `i ≤ m`).
 pub fn simpson_weight(i: usize, m: usize) -> f64 {
-    debug_assert!(m % 2 == 0 && i <= m, "Simpson: node {i} of {m} intervals");
+    debug_assert!(
+        m.is_multiple_of(2) && i <= m,
+        "Simpson: node {i} of {m} intervals"
+    );
     if i == 0 || i == m {
         1.0 / 3.0
     } else if i % 2 == 1 {

@@ -130,7 +130,7 @@ fn check_finite(path: &Path, body_offset: u64, first: u64, samples: &[f32]) -> R
     {
         let frame = first + (k / 3) as u64;
         return Err(Error::bad_file(
-            &path.display().to_string(),
+            path.display().to_string(),
             format!(
                 "frame {frame} channel {} (byte offset {}) is {}",
                 k % 3,

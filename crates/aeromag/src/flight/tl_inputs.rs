@@ -344,7 +344,8 @@ mod tests {
     #[test]
     fn usable_rows_of_a_long_flight_are_each_rows_own() {
         let n = 5 * (1 << 16) + 123;
-        let bad = |k: usize, col: usize| (k * 7 + col * 13) % 101 == 0 || (k % (1 << 16)) == col;
+        let bad =
+            |k: usize, col: usize| (k * 7 + col * 13).is_multiple_of(101) || (k % (1 << 16)) == col;
         let series = |col: usize, v: f64| -> Vec<f64> {
             (0..n)
                 .map(|k| if bad(k, col) { f64::NAN } else { v + k as f64 })

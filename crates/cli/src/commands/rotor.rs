@@ -18,6 +18,8 @@ pub struct Args {
     command: Sub,
 }
 
+// Parsed once per run: the variants' sizes do not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, clap::Subcommand)]
 enum Sub {
     Study(StudyArgs),

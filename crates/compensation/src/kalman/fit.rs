@@ -309,7 +309,9 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         unusable += usable.iter().filter(|u| !**u).count();
         let (kept, _) = split_segments(d.time, None, &usable, f64::INFINITY, 1);
         for r in kept {
-            if let Some(k) = (r.start + 1..r.end).find(|&k| !(d.time[k] > d.time[k - 1])) {
+            if let Some(k) = (r.start + 1..r.end).find(|&k| {
+                d.time[k].partial_cmp(&d.time[k - 1]) != Some(std::cmp::Ordering::Greater)
+            }) {
                 return Err(CompError::data(format!(
                     "segment {si}: time does not increase at row {k}"
                 )));

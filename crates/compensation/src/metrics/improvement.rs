@@ -67,6 +67,8 @@ mod tests {
     use super::*;
 
     #[test]
+    // One window over the whole series.
+    #[allow(clippy::single_range_in_vec_init)]
     fn ratio_of_in_band_amplitudes() {
         let n = 3000;
         let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();

@@ -135,7 +135,7 @@ pub fn detect_maneuvers(
         return Vec::new();
     }
     let dt = median_step(time);
-    if !(dt > 0.0) {
+    if dt.is_nan() || dt <= 0.0 {
         return Vec::new();
     }
     let samples = |s: f64| ((s / dt).round() as usize).max(1);
@@ -278,10 +278,14 @@ pub fn circular_mean_deg(a: &[f64]) -> f64 {
 pub(crate) mod tests {
     use super::*;
 
+    /// Time, attitude series and the manoeuvres flown (axis, first and
+    /// last sample, amplitude).
+    type Fom = (Vec<f64>, [Vec<f64>; 3], Vec<(Axis, usize, usize, f64)>);
+
     /// A synthetic FOM flight at 10 Hz: 4 headings joined by standard-rate
     /// turns; on each heading straight flight, roll, pitch and yaw
     /// oscillations (5 s period, 4 cycles) separated by straight flight.
-    pub(crate) fn synthetic_fom() -> (Vec<f64>, [Vec<f64>; 3], Vec<(Axis, usize, usize, f64)>) {
+    pub(crate) fn synthetic_fom() -> Fom {
         let dt = 0.1;
         let (mut t, mut r, mut p, mut y) = (vec![], vec![], vec![], vec![]);
         let mut truth = vec![];

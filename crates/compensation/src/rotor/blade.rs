@@ -175,7 +175,7 @@ pub fn dipole_integral(
 ) -> Result<Matrix3<f64>> {
     let p = a.dot(u);
     let h2 = a.norm_squared() - p * p;
-    if !(h2 > 1e-12) {
+    if h2.is_nan() || h2 <= 1e-12 {
         return Err(CompError::data(
             "dipole integral: the sensor lies on the blade's line",
         ));

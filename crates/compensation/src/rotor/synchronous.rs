@@ -20,7 +20,7 @@ pub fn synchronous_template(
     highpass_hz: f64,
 ) -> Result<Vec<f64>> {
     let n = x.len();
-    if phase_rad.len() != n || bins < 2 || !(block_s > 0.0) {
+    if phase_rad.len() != n || bins < 2 || block_s.is_nan() || block_s <= 0.0 {
         return Err(CompError::data(
             "synchronous averaging: lengths differ, < 2 bins or block ≤ 0",
         ));

@@ -785,9 +785,9 @@ pub(crate) mod tests {
         let k_nt_per_a = [30.0, -12.0, 20.0];
         // A load switched on and off every 3.7 s, with ramps, and a
         // second one (field without lag) of a 5.3 s cycle.
-        let current = |t: f64| 8.0 * f64::from(u8::from((t / 3.7) as u64 % 2 == 0));
+        let current = |t: f64| 8.0 * f64::from(u8::from(((t / 3.7) as u64).is_multiple_of(2)));
         const TAU: f64 = 0.42; // between the grid's 0.3 and 0.5 s
-        let other = |t: f64| 3.0 * f64::from(u8::from((t / 5.3) as u64 % 2 == 1));
+        let other = |t: f64| 3.0 * f64::from(u8::from(!((t / 5.3) as u64).is_multiple_of(2)));
         let mut chans: Vec<[Vec<f64>; 2]> = Vec::new();
         for (t, f, m) in legs.iter_mut() {
             let (mut lag, mut i1, mut i2) = (FirstOrderLag::new(TAU), vec![], vec![]);

@@ -133,7 +133,7 @@ impl CoefficientEstimator for Rls {
 
     fn update(&mut self, step: &AdaptiveStep) -> Result<()> {
         let m = self.m();
-        if step.row.len() != m || !step.y_nt.is_finite() || !(step.dt_s >= 0.0) {
+        if step.row.len() != m || !step.y_nt.is_finite() || step.dt_s.is_nan() || step.dt_s < 0.0 {
             return Err(CompError::data(format!(
                 "RLS step: row of {} for {m} coefficients, y {} nT, dt {} s",
                 step.row.len(),

@@ -106,7 +106,7 @@ impl Sos {
     /// samples on each side reproduces whole-series filtering to `tol`.
     pub fn settling_samples(&self, tol: f64) -> Option<usize> {
         let rho = self.pole_radius();
-        if !(rho < 1.0) || !(tol > 0.0 && tol < 1.0) {
+        if rho.is_nan() || rho >= 1.0 || tol.is_nan() || tol <= 0.0 || tol >= 1.0 {
             return None;
         }
         if rho == 0.0 {

@@ -54,7 +54,7 @@ impl ConventionalKalmanFilter {
         if h.len() != n {
             return Err(EstError::Dimension("measurement row length".into()));
         }
-        if !(r > 0.0) || !y.is_finite() {
+        if r.is_nan() || r <= 0.0 || !y.is_finite() {
             return Err(EstError::NonFinite {
                 what: "measurement",
             });

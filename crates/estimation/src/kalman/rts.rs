@@ -72,7 +72,7 @@ impl SqrtRts {
         let (sf, ph, sp) = (s_f.as_slice(), phi.as_slice(), s_p.as_slice());
         for i in 0..n {
             let dii = sp[i + i * n];
-            if !(dii.abs() > 0.0) || !dii.is_finite() {
+            if dii == 0.0 || !dii.is_finite() {
                 return Err(EstError::Singular(format!(
                     "predicted covariance factor has diagonal {dii} at state {i}"
                 )));

@@ -296,14 +296,14 @@ impl NormalEquations {
 impl LsSolution {
     /// Whether the scaled condition number exceeds [`ILL_CONDITIONED`].
     pub fn is_ill_conditioned(&self) -> bool {
-        !(self.condition < ILL_CONDITIONED)
+        self.condition.is_nan() || self.condition >= ILL_CONDITIONED
     }
 
     /// Indices of unknowns whose variance inflation factor exceeds `max_vif`
     /// (e.g. 1e4: the unknown is largely a combination of the others).
     pub fn poorly_determined(&self, max_vif: f64) -> Vec<usize> {
         (0..self.vif.len())
-            .filter(|&j| !(self.vif[j] <= max_vif))
+            .filter(|&j| self.vif[j].is_nan() || self.vif[j] > max_vif)
             .collect()
     }
 

@@ -18,7 +18,7 @@ use crate::error::{EstError, Result};
 
 /// `ln Γ(k/2)` for an integer `k ≥ 1`, exact up to rounding.
 fn ln_gamma_half(k: u32) -> f64 {
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         // Γ(m) = (m − 1)!
         (1..k / 2).map(|i| (i as f64).ln()).sum()
     } else {
