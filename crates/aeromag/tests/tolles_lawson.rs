@@ -323,6 +323,16 @@ fn observability_tells_a_full_box_from_a_single_heading() {
     let un = one.undetermined();
     assert!(un.contains(&"p_x") && un.contains(&"i_xx"), "{un:?}");
     assert_eq!(one.observability.estimability.len(), 16);
+    // Lagged eddy terms are not assessed: bad input, alone (which left no
+    // column and panicked) or with other groups (where they were dropped).
+    for spec in ["l9", "p3,i5,e8,l9"] {
+        let lagged = aeromag::compensation::tolles_lawson::TermSet::parse(spec).unwrap();
+        let e = aeromag::observability(&cal, &lagged, None, &mut Silent).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("l9"),
+            "{spec}: {e}"
+        );
+    }
 }
 
 /// Current terms in the observability check (issue 20): a strobe switching

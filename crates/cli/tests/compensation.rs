@@ -97,6 +97,25 @@ fn calibrate_compensate_report_keep_every_row() {
         assert!(html.contains(k), "{k} missing in the report");
     }
     assert!(rep.join("figures.json").exists());
+    // One row selected: no time step to score by (was "invalid argument
+    // `fs_hz`", naming neither the file nor the flag).
+    let t0 = rows[1].split(',').next().unwrap();
+    let one = d.path().join("rep1");
+    let o = aeromag(&[
+        "report",
+        "--input",
+        out.to_str().unwrap(),
+        "--out",
+        one.to_str().unwrap(),
+        "--time-range",
+        &format!("{t0},{t0}"),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("comp.csv") && stderr(&o).contains("no time step"),
+        "{}",
+        stderr(&o)
+    );
     // `observability` prints the verdicts, or JSON.
     let o = aeromag(&["observability", "--input", cal.to_str().unwrap()]);
     assert_code(&o, 0);

@@ -151,7 +151,11 @@ impl RowSelection {
                 return Err(err(
                     "--time-range",
                     format!(
-                        "no selected row has a time in [{t0}, {t1}] s; the file's time runs from {lo} to {hi} s"
+                        "no selected row has a time in [{}, {}] s; the file's time runs from {} to {} s",
+                        shown(t0),
+                        shown(t1),
+                        shown(lo),
+                        shown(hi)
                     ),
                 ));
             }
@@ -303,6 +307,13 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("from 0 to 4 s"), "{e}");
+        // Far values in exponent form, not 300 digits.
+        let e = RowSelection::parse(None, Some("-1e300,-1e299"))
+            .unwrap()
+            .mask(&table())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[-1e300, -1e299]") && e.len() < 200, "{e}");
         assert!(RowSelection::parse(Some("1,,2"), None).is_err());
     }
 

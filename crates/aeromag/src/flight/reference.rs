@@ -84,6 +84,18 @@ impl fmt::Display for ReferenceChannels {
     }
 }
 
+/// Canonical columns that cannot be references: the readings compensated
+/// and what compensation writes (subtracting one from itself leaves
+/// nothing to fit or score).
+const NOT_REFERENCES: [&str; 6] = [
+    "mag",
+    "mag_comp",
+    "mag_interf",
+    "flux_x",
+    "flux_y",
+    "flux_z",
+];
+
 /// The sum of the named reference channels of `flight` (zeros if none),
 /// nT. With a lever arm, the `igrf` channel is moved from the navigation
 /// point to the sensor (needs `lat`, `lon`, `alt`, `roll`, `pitch`, `yaw`;
@@ -93,6 +105,13 @@ pub fn reference_sum(
     cols: &[String],
     lever: Option<&LeverArm>,
 ) -> Result<Vec<f64>> {
+    if let Some(c) = cols.iter().find(|c| NOT_REFERENCES.contains(&c.as_str())) {
+        return Err(Error::bad_input(format!(
+            "reference channel `{c}` is a magnetometer reading or its compensation, not a \
+             reference: a reference is a field the aircraft does not make (igrf, diurnal, a base \
+             station's record)"
+        )));
+    }
     let mut r = vec![0.0; flight.n_rows()];
     for c in cols {
         for (a, b) in r.iter_mut().zip(flight.require(c)?) {
@@ -145,5 +164,10 @@ mod tests {
             reduced(f.require("mag").unwrap(), &sum),
             [50_000.0, 50_000.0]
         );
+        // The reading itself is no reference (all coefficients 0, residual 0).
+        for c in ["mag", "mag_comp"] {
+            let e = reference_sum(&f, &["diurnal".into(), c.into()], None).unwrap_err();
+            assert!(e.is_bad_input() && e.to_string().contains(c), "{e}");
+        }
     }
 }

@@ -16,7 +16,7 @@ pub use sensors::{
     ChannelCorrelation, GroupRms, SensorScore, SensorsFigures, channel_correlations, score_sensors,
 };
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::flight::{Flight, LeverArm, SegmentRule, reduced, reference_sum};
 use aeromag_compensation::metrics::{
     FomReport, LineResidual, ManeuverDetection, band_pass_segments, detect_maneuvers,
@@ -189,7 +189,17 @@ pub fn score_series(
     let comp_raw = s.comp;
     let comp = reduced(comp_raw, &ref_sum);
     let segs = segments(t, &mag, &comp)?;
-    let fs = 1.0 / median_step(time);
+    let step = median_step(time);
+    if step.is_nan() || step <= 0.0 {
+        return Err(Error::bad_file(
+            t.file_label(),
+            format!(
+                "{} row(s) with no time step: scoring needs a record sampled in time",
+                time.len()
+            ),
+        ));
+    }
+    let fs = 1.0 / step;
     let bpf = BandPass::compensation_default(fs)?;
     let ir = improvement_ratio(&mag, &comp, &segs, &bpf)?;
     let (mut fom_before, mut fom_after) = (None, None);

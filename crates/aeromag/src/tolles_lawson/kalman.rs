@@ -13,7 +13,7 @@ use aeromag_compensation::kalman::altitude::{
 use aeromag_compensation::kalman::{
     CoefficientPass, DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries,
     NoiseModel, ORDERS, X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions,
-    ground_speed_from_velocity, q1_unit,
+    ground_speed_from_velocity,
 };
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
@@ -64,16 +64,10 @@ impl KalmanOptions {
             )));
         }
         let noise = match self.noise {
-            Some(n) if !n.is_valid() => {
-                return Err(Error::bad_input(format!(
-                    "Kalman noise {},{},{}: need q1 ≥ 0 ({}), q2 ≥ 0 (nT²/m⁵) and r > 0 (nT²)",
-                    n.q1,
-                    n.q2_nt2_per_m5,
-                    n.r_nt2,
-                    q1_unit(self.field_order)
-                )));
+            Some(n) => {
+                n.check(self.field_order)?;
+                n
             }
-            Some(n) => n,
             None => NoiseModel::calibration_default_for(self.field_order),
         };
         let mut cfg = KalmanConfig {

@@ -32,7 +32,13 @@ impl KalmanOutcome {
          in {} runs.",
         f.field_order,
         f.field_order,
-        if f.tuning.is_some() { "tuned by maximum likelihood" } else { "(defaults)" },
+        if f.tuning.is_some() {
+            "tuned by maximum likelihood"
+        } else if f.noise == aeromag_compensation::kalman::NoiseModel::calibration_default_for(f.field_order) {
+            "(defaults)"
+        } else {
+            "(as given)"
+        },
         f.noise.q1,
         aeromag_compensation::kalman::q1_unit(f.field_order),
         f.noise.q2_nt2_per_m5,

@@ -8,7 +8,7 @@ use crate::flight::{Flight, LeverArm, TlInputs};
 use crate::observer::{Note, Observer};
 use aeromag_compensation::observability::Observability;
 use aeromag_compensation::tolles_lawson::fit_ls::LsConfig;
-use aeromag_compensation::tolles_lawson::{Design, TermSet};
+use aeromag_compensation::tolles_lawson::{Design, TermGroup, TermSet};
 use serde::Serialize;
 
 /// How well the flight determines one coefficient, from its effect
@@ -116,6 +116,11 @@ pub fn observability(
     lever_arm: Option<LeverArm>,
     observer: &mut dyn Observer,
 ) -> Result<FlightObservability> {
+    if terms.groups().contains(&TermGroup::L9) {
+        return Err(Error::bad_input(
+            "the lagged eddy-current terms (l9) are not assessed here; give the terms without l9",
+        ));
+    }
     let opts = CalibrateOptions {
         ls: LsConfig {
             design: Design::new(terms.clone()),

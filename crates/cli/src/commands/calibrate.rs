@@ -291,7 +291,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     "tuned by maximum likelihood, {} filter runs on {} samples",
                     t.evaluations, t.rows
                 ),
-                None => "defaults".into(),
+                None if fit.noise == NoiseModel::calibration_default_for(order) =>
+                    "defaults".into(),
+                None => "as given".into(),
             }
         );
         println!(

@@ -151,6 +151,15 @@ pub fn q1_unit(order: usize) -> String {
     format!("nT²/m{e}")
 }
 
+/// How many decades a given `q` may lie from its default
+/// ([`NoiseModel::check`]).
+pub const NOISE_DECADES: f64 = 12.0;
+
+/// The measurement noise variances `r` a magnetometer can have, nT²: from
+/// (10 fT)² (below any airborne sensor) to (100 nT)² (a reading that
+/// noisy holds no interference to fit).
+pub const R_RANGE_NT2: (f64, f64) = (1e-10, 1e4);
+
 /// Noise intensities of the model (module docs for the units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NoiseModel {
@@ -204,6 +213,39 @@ impl NoiseModel {
             q1: c.q1 * ON_BOARD_Q1_FACTOR,
             ..c
         }
+    }
+
+    /// Intensities given for a chain of order `order` checked against what
+    /// a field and a magnetometer can be: each `q` zero or within
+    /// [`NOISE_DECADES`] decades of its default
+    /// ([`Self::calibration_default_for`]), `r` within [`R_RANGE_NT2`].
+    /// Further out is a unit or order mistake, and the filter's arithmetic
+    /// fails (an innovation variance of 10³⁰⁸ nT², or one below rounding).
+    pub fn check(&self, order: usize) -> Result<()> {
+        let d = Self::calibration_default_for(order);
+        let near = |v: f64, default: f64| {
+            v == 0.0 || (v > 0.0 && (v / default).log10().abs() <= NOISE_DECADES)
+        };
+        let (lo, hi) = R_RANGE_NT2;
+        if near(self.q1, d.q1)
+            && near(self.q2_nt2_per_m5, d.q2_nt2_per_m5)
+            && (lo..=hi).contains(&self.r_nt2)
+        {
+            return Ok(());
+        }
+        Err(CompError::setting(format!(
+            "Kalman noise {:e},{:e},{:e}: q1 must be 0 or within 10^±{NOISE_DECADES} of {:.2e} {}, \
+             q2 0 or within 10^±{NOISE_DECADES} of {:.0e} nT²/m⁵, and r from {lo:e} to {hi:e} nT² \
+             ({:e} to {} nT RMS)",
+            self.q1,
+            self.q2_nt2_per_m5,
+            self.r_nt2,
+            d.q1,
+            q1_unit(order),
+            d.q2_nt2_per_m5,
+            lo.sqrt(),
+            hi.sqrt(),
+        )))
     }
 
     /// Whether every intensity is finite, `q ≥ 0` and `r > 0`.
@@ -555,6 +597,49 @@ mod tests {
     }
 
     /// The thesis' closed form for n = 3: Q₁ = q₁ [[d⁵/20, d⁴/8, d³/6], …].
+    #[test]
+    fn noise_intensities_are_checked_against_the_order() {
+        for order in ORDERS {
+            let d = NoiseModel::calibration_default_for(order);
+            assert!(d.check(order).is_ok());
+            assert!(NoiseModel::on_board_for(order).check(order).is_ok());
+            let zero_q = NoiseModel {
+                q1: 0.0,
+                q2_nt2_per_m5: 0.0,
+                ..d
+            };
+            assert!(zero_q.check(order).is_ok());
+            let at = |q1: f64, q2: f64, r: f64| {
+                NoiseModel {
+                    q1,
+                    q2_nt2_per_m5: q2,
+                    r_nt2: r,
+                }
+                .check(order)
+            };
+            // Twelve decades either way, r from (10 fT)² to (100 nT)².
+            assert!(at(d.q1 * 0.9e12, d.q2_nt2_per_m5 * 1.1e-12, 1e4).is_ok());
+            assert!(at(d.q1, d.q2_nt2_per_m5, 1e-10).is_ok());
+            for bad in [
+                at(d.q1 * 2e12, d.q2_nt2_per_m5, d.r_nt2),
+                at(d.q1 * 0.5e-12, d.q2_nt2_per_m5, d.r_nt2),
+                at(-d.q1, d.q2_nt2_per_m5, d.r_nt2),
+                at(f64::NAN, d.q2_nt2_per_m5, d.r_nt2),
+                at(d.q1, 1e308, d.r_nt2),
+                at(d.q1, d.q2_nt2_per_m5, 1e308),
+                at(d.q1, d.q2_nt2_per_m5, 0.0),
+                at(d.q1, d.q2_nt2_per_m5, 5e-324),
+                at(d.q1, d.q2_nt2_per_m5, f64::INFINITY),
+            ] {
+                let e = bad.unwrap_err();
+                assert!(
+                    e.is_bad_input() && !e.to_string().contains("0000000000"),
+                    "{e}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn order_three_is_the_thesis_model() {
         let noise = NoiseModel {

@@ -375,6 +375,21 @@ fn segment_filter(
         )?),
         None => None,
     };
+    if let (Some(s), Some((lo, hi))) = (&sos, cfg.band_hz)
+        && !s
+            .settling_samples(BLOCK_TOLERANCE)
+            .is_some_and(|k| k <= MAX_SETTLING_SAMPLES)
+    {
+        let shown = aeromag_core::error::shown;
+        return Err(CompError::setting(format!(
+            "pass band {}–{} Hz at {} Hz sampling: the filter's response does not die out within \
+             {MAX_SETTLING_SAMPLES} samples (its poles lie too near the unit circle); widen the band \
+             or raise its low edge (the default is 0.1–0.9 Hz)",
+            shown(lo),
+            shown(hi),
+            shown((1e3 / dt).round() / 1e3)
+        )));
+    }
     let ncol = cfg.design.n_columns();
     let min_len = sos
         .as_ref()
@@ -703,6 +718,9 @@ pub(crate) fn solve_accumulated(
         )));
     }
     warnings.extend(diagnose(&sol, &names, cfg.max_vif));
+    if let Some(w) = ridge_warning(cfg.lambda, &ne.ata()) {
+        warnings.push(w);
+    }
     Ok(LsFit {
         coef: sol.coef.iter().copied().collect(),
         std: sol.std.iter().copied().collect(),
@@ -714,6 +732,23 @@ pub(crate) fn solve_accumulated(
         segments_used: used,
         names,
         warnings,
+    })
+}
+
+/// A warning when the ridge λ (added to each diagonal element of `AᵀA`)
+/// outweighs the data: beyond the largest diagonal element every
+/// coefficient is pulled towards zero, whatever the flight says, and the
+/// standard deviations are those of the prior, not of the data.
+fn ridge_warning(lambda: f64, ata: &nalgebra::DMatrix<f64>) -> Option<String> {
+    let largest = ata.diagonal().iter().copied().fold(0.0, f64::max);
+    (lambda > largest).then(|| {
+        format!(
+            "ridge λ = {} exceeds every diagonal element of AᵀA (the largest is {:.3e}): \
+             the coefficients are shrunk towards zero whatever the flight says; \
+             a λ of a small fraction of the diagonal is usual",
+            aeromag_core::error::shown(lambda),
+            largest
+        )
     })
 }
 
@@ -755,7 +790,25 @@ pub fn diagnose(sol: &LsSolution, names: &[String], max_vif: f64) -> Vec<String>
     w
 }
 
+/// The longest response of the band-pass filter (to 10⁻¹⁵ of its peak),
+/// samples. The default band's lasts about 1.2·10⁵ samples at 1 kHz;
+/// 10⁷ is over 11 days at 10 Hz, longer than any leg: a band so narrow,
+/// or so low against the sample rate, leaves nothing of the manoeuvres to
+/// fit (and beyond it the filter's arithmetic fails).
+pub const MAX_SETTLING_SAMPLES: usize = 10_000_000;
+
+/// The most samples [`LsConfig::trim`] may drop at each end of a leg: a
+/// filter's transients last some periods of its low edge (tens of seconds,
+/// hundreds of samples); 10⁶ samples is over a day at 10 Hz.
+pub const MAX_TRIM: usize = 1_000_000;
+
 fn validate(cfg: &LsConfig) -> Result<()> {
+    if cfg.trim > MAX_TRIM {
+        return Err(CompError::setting(format!(
+            "trim {} samples at each end of a leg: at most {MAX_TRIM}",
+            cfg.trim
+        )));
+    }
     if let Some((lo, hi)) = cfg.band_hz
         && !(lo > 0.0 && hi > lo && hi.is_finite())
     {
@@ -1093,6 +1146,17 @@ pub(crate) mod tests {
         assert!(rms < 0.01, "interference error RMS {rms} nT");
         assert!(fit.warnings.is_empty(), "{:?}", fit.warnings);
         assert!(fit.residual_rms_nt < 0.02, "{}", fit.residual_rms_nt);
+        // A ridge beyond every diagonal element of AᵀA zeroes the model:
+        // said in a warning; a small one is not.
+        for (lambda, warned) in [(1e-6, false), (1e12, true)] {
+            let cfg = LsConfig {
+                lambda,
+                ..LsConfig::default()
+            };
+            let fit = fit_band_pass_ls(&segs, &cfg).unwrap();
+            let ridge = fit.warnings.iter().any(|w| w.contains("ridge λ"));
+            assert_eq!(ridge, warned, "λ {lambda}: {:?}", fit.warnings);
+        }
     }
 
     #[test]
@@ -1176,6 +1240,28 @@ pub(crate) mod tests {
             direction: None,
         };
         assert!(fit_band_pass_ls(&[seg], &cfg).is_err());
+        // A trim whose double overflows is a bad setting, not a panic.
+        for trim in [MAX_TRIM + 1, usize::MAX / 2 + 1, usize::MAX] {
+            let cfg = LsConfig {
+                trim,
+                ..LsConfig::default()
+            };
+            let e = fit_band_pass_ls(&[seg], &cfg).unwrap_err();
+            assert!(e.is_bad_input() && e.to_string().contains("trim"), "{e}");
+        }
+        // Bands whose filter never settles (they ended in "unstable
+        // band-pass filter", a singular fit, or a fit of nothing).
+        for band in [(1e-308, 0.9), (1e-6, 2e-6), (0.1, 0.1 + 1e-10)] {
+            let cfg = LsConfig {
+                band_hz: Some(band),
+                ..LsConfig::default()
+            };
+            let e = fit_band_pass_ls(&[seg], &cfg).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("does not die out"),
+                "{e}"
+            );
+        }
     }
 
     /// A non-finite value inside a segment (the callers split segments at

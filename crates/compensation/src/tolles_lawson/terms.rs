@@ -285,6 +285,27 @@ pub struct ExtraSeries<'a> {
     pub lagged: &'a [f64],
 }
 
+/// The eddy-current lags a model may have (s): the decay times of an
+/// airframe's eddy currents are some tens of milliseconds to about a second
+/// (the lag search tries 0.1–1 s); outside this range a lag is a typing
+/// error, and a lag far below the sample interval makes the lagged column
+/// the plain eddy column.
+pub const EDDY_LAG_RANGE_S: (f64, f64) = (0.01, 10.0);
+
+/// Each of `taus_s` within [`EDDY_LAG_RANGE_S`].
+fn check_eddy_lags(taus_s: &[f64]) -> Result<()> {
+    let (lo, hi) = EDDY_LAG_RANGE_S;
+    match taus_s.iter().find(|t| !(lo..=hi).contains(*t)) {
+        Some(t) => Err(CompError::InvalidTerms {
+            reason: format!(
+                "eddy-current lag {} s: must be from {lo} to {hi} s",
+                aeromag_core::error::shown(*t)
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 const XYZ: [&str; 3] = ["x", "y", "z"];
 const PAIRS6: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
@@ -408,11 +429,7 @@ impl TermSet {
                 extras: self.extras.clone(),
             });
         }
-        if let Some(t) = taus_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-            return Err(CompError::InvalidTerms {
-                reason: format!("eddy-current lag {t} s: must be finite and > 0"),
-            });
-        }
+        check_eddy_lags(taus_s)?;
         if !groups
             .iter()
             .any(|g| matches!(g, TermGroup::E9 | TermGroup::E8))
@@ -481,15 +498,7 @@ impl TermSet {
                 reason: "the lagged eddy group l9 and the eddy lags must be given together".into(),
             });
         }
-        if let Some(t) = self
-            .eddy_lags_s
-            .iter()
-            .find(|t| !(t.is_finite() && **t > 0.0))
-        {
-            return Err(CompError::InvalidTerms {
-                reason: format!("eddy-current lag {t} s: must be finite and > 0"),
-            });
-        }
+        check_eddy_lags(&self.eddy_lags_s)?;
         self.validate_extras()
     }
 
@@ -1101,6 +1110,20 @@ mod tests {
         );
         assert!(TermSet::observable16().with_eddy_lags(&[0.0]).is_err());
         assert!(TermSet::observable16().with_eddy_lags(&[f64::NAN]).is_err());
+        // Lags outside the physical range, in a setting and in a file.
+        for tau in [1e-9, 0.009, 10.5, 1e6, 1e308] {
+            let e = TermSet::observable16().with_eddy_lags(&[tau]).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("from 0.01 to 10 s"),
+                "{e}"
+            );
+            let mut read = t.clone();
+            read.eddy_lags_s = vec![tau];
+            assert!(read.validate().is_err(), "{tau}");
+        }
+        for tau in [0.01, 10.0] {
+            assert!(TermSet::observable16().with_eddy_lags(&[tau]).is_ok());
+        }
         assert!(TermSet::parse("p3,e8,l9").unwrap().validate().is_err());
         assert!(t.validate().is_ok());
         // Serialised with its lags; a set without lags stays as before.
