@@ -154,6 +154,24 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
         .unwrap_err();
     assert!(missing.is_bad_input());
     assert!(missing.to_string().contains("flux_z"), "{missing}");
+    // A file with \r line ends only arrives as one header line; a column
+    // named twice; a header of a million names is not echoed whole.
+    let opts = StreamOptions::default();
+    for (header, says) in [
+        ("time,flux_x,flux_y,flux_z,mag\r0,1,2,3,4", "\\r alone"),
+        ("time,flux_x,flux_y,flux_z,mag,MAG", "\"MAG\" twice"),
+    ] {
+        let e = LineCompensator::new(&model, header, &opts).unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains(says), "{e}");
+    }
+    let wide: Vec<String> = (0..1_000_000).map(|k| format!("c{k}")).collect();
+    let wide = wide.join(",");
+    let e = LineCompensator::new(&model, &wide, &opts).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().len() < 1000,
+        "{} bytes",
+        e.to_string().len()
+    );
     let mut old = model.clone();
     old.fit.sample_interval_s = None;
     let e = CausalTl::new(&old, None).unwrap_err();
@@ -163,6 +181,24 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
     );
     assert!(CausalTl::new(&old, Some(10.0)).is_ok());
     assert!(CausalTl::new(&old, Some(-1.0)).unwrap_err().is_bad_input());
+    // Rates no magnetometer records at, given or in the model file (every
+    // step broke a run, or none did).
+    for hz in [5e-324, 1e-3, 1e6, 1e308] {
+        let e = CausalTl::new(&old, Some(hz)).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("from 0.01 to 1e5 Hz"),
+            "{e}"
+        );
+    }
+    for interval_s in [0.0, 1e-308, 1e308] {
+        let mut odd = model.clone();
+        odd.fit.sample_interval_s = Some(interval_s);
+        let e = CausalTl::new(&odd, None).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("sample_interval_s"),
+            "{e}"
+        );
+    }
 
     let header = "time,flux_x,flux_y,flux_z,mag";
     let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
@@ -441,4 +477,21 @@ fn adaptive_stream_equals_the_adaptive_flight_bit_for_bit() {
         no_speed.is_bad_input() && no_speed.to_string().contains("--speed"),
         "{no_speed}"
     );
+    // A ground speed no platform flies (1e308 made every coefficient NaN).
+    for speed in [1000.5, 1e308, -1.0] {
+        let e = LineCompensator::new(
+            &model,
+            "time,flux_x,flux_y,flux_z,mag",
+            &StreamOptions {
+                adapt: Some(Adapt::Kalman),
+                speed_m_s: Some(speed),
+                ..StreamOptions::default()
+            },
+        )
+        .unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("from 0 to 1000"),
+            "{e}"
+        );
+    }
 }

@@ -8,6 +8,7 @@ use crate::tolles_lawson::{CompensateSensors, SensorsCompensated, SensorsModel, 
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::online::OnlineTl;
 use aeromag_compensation::tolles_lawson::segments::split_at_steps;
+use aeromag_core::error::shown;
 
 /// A model applied under the causal convention ([module docs](super)):
 /// what an on-board compensator gives, sample for sample, on a recorded
@@ -18,6 +19,11 @@ pub struct CausalTl {
     max_step_s: f64,
 }
 
+/// The sample rates a causal compensation takes, Hz: a reading every
+/// 100 s to 100 kHz. Runs break at gaps of a few sample intervals, so a
+/// rate far off the data's breaks every step (or none).
+pub const SAMPLE_RATE_RANGE_HZ: (f64, f64) = (0.01, 1e5);
+
 impl CausalTl {
     /// `model` under the causal convention. Runs break at time steps over
     /// [`GAP_FACTOR`] × the sample interval: `1 / sample_rate_hz` when
@@ -25,19 +31,31 @@ impl CausalTl {
     /// (`fit.sample_interval_s`); a model file without it and no rate is
     /// bad input.
     pub fn new(model: &TlModel, sample_rate_hz: Option<f64>) -> Result<Self> {
+        let (lo, hi) = SAMPLE_RATE_RANGE_HZ;
         let interval_s = match sample_rate_hz {
-            Some(hz) if hz > 0.0 && hz.is_finite() => 1.0 / hz,
+            Some(hz) if (lo..=hi).contains(&hz) => 1.0 / hz,
             Some(hz) => {
                 return Err(Error::bad_input(format!(
-                    "sample rate {hz} Hz: must be positive"
+                    "sample rate {} Hz: must be from {lo} to {hi:e} Hz",
+                    shown(hz)
                 )));
             }
-            None => model.fit.sample_interval_s.ok_or_else(|| {
-                Error::bad_input(
-                    "the model file does not record its calibration's sample interval \
-                     (written before it was): give the sample rate (--sample-rate HZ)",
-                )
-            })?,
+            None => match model.fit.sample_interval_s {
+                Some(s) if (lo..=hi).contains(&(1.0 / s)) => s,
+                Some(s) => {
+                    return Err(Error::bad_input(format!(
+                        "the model's calibration sample interval {} s (fit.sample_interval_s) \
+                         is not that of a sample rate from {lo} to {hi:e} Hz",
+                        shown(s)
+                    )));
+                }
+                None => {
+                    return Err(Error::bad_input(
+                        "the model file does not record its calibration's sample interval \
+                         (written before it was): give the sample rate (--sample-rate HZ)",
+                    ));
+                }
+            },
         };
         Ok(Self {
             model: model.clone(),

@@ -12,6 +12,10 @@ use aeromag_io::ColumnMap;
 /// The columns a stream's lines gain.
 pub const STREAM_OUTPUT: [&str; 3] = ["mag_interf", "mag_comp", "comp_flag"];
 
+/// The largest ground speed `--speed` may give, m/s: three times a jet
+/// survey's; beyond it the along-track field model's arithmetic fails.
+pub const MAX_GROUND_SPEED_M_S: f64 = 1000.0;
+
 /// `comp_flag` of an output line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum StreamFlag {
@@ -160,6 +164,25 @@ impl LineCompensator {
     pub fn new(model: &TlModel, header: &str, opts: &StreamOptions) -> Result<Self> {
         let causal = CausalTl::new(model, opts.sample_rate_hz)?;
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        if let Some(c) = header.chars().find(|c| c.is_control() && *c != '\t') {
+            return Err(Error::bad_input(format!(
+                "the header line holds the control character {c:?}{}: {}",
+                if c == '\r' {
+                    " (lines must end in \\n or \\r\\n, not \\r alone)"
+                } else {
+                    ""
+                },
+                listed(&names)
+            )));
+        }
+        let mut seen = std::collections::HashSet::with_capacity(names.len());
+        if let Some(n) = names.iter().find(|n| !seen.insert(n.to_ascii_lowercase())) {
+            return Err(Error::bad_input(format!(
+                "the header names the column {:?} twice: {}",
+                clipped(n),
+                listed(&names)
+            )));
+        }
         let lookup = |canonical: &str| -> Option<usize> {
             let by = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
             opts.columns
@@ -177,7 +200,7 @@ impl LineCompensator {
                             .get(canonical)
                             .map(|n| format!(" (the model was fitted on `{n}`)"))
                             .unwrap_or_default(),
-                        names.join(", ")
+                        listed(&names)
                     ))
                 })
         };
@@ -186,9 +209,10 @@ impl LineCompensator {
             None => [None; 3],
         };
         let speed_m_s = match opts.speed_m_s {
-            Some(v) if !(v >= 0.0 && v.is_finite()) => {
+            Some(v) if !(0.0..=MAX_GROUND_SPEED_M_S).contains(&v) => {
                 return Err(Error::bad_input(format!(
-                    "ground speed {v} m/s: must be finite and ≥ 0"
+                    "ground speed {} m/s: must be from 0 to {MAX_GROUND_SPEED_M_S}",
+                    aeromag_core::error::shown(v)
                 )));
             }
             Some(v) => v,
@@ -590,6 +614,28 @@ fn number(cell: &str) -> Option<f64> {
     } else {
         c.parse::<f64>().ok()
     }
+}
+
+/// At most 40 characters of a name, for messages.
+fn clipped(name: &str) -> String {
+    match name.char_indices().nth(40) {
+        Some((i, _)) => format!("{}…", &name[..i]),
+        None => name.to_string(),
+    }
+}
+
+/// A header's names for a message: the first 30, each clipped, control
+/// characters escaped.
+fn listed(names: &[&str]) -> String {
+    let mut shown: Vec<String> = names
+        .iter()
+        .take(30)
+        .map(|n| clipped(n).escape_default().to_string())
+        .collect();
+    if names.len() > 30 {
+        shown.push(format!("… ({} columns)", names.len()));
+    }
+    shown.join(", ")
 }
 
 /// A header's names, trimmed, joined by commas.

@@ -67,18 +67,19 @@ pub struct Args {
     #[arg(long, value_name = "METHOD")]
     adapt: Option<Adapt>,
     /// Ground speed, m/s, when the stream has no vn, ve columns (--adapt
-    /// kalman).
+    /// kalman; at most 1000).
     #[arg(long, value_name = "M/S", requires = "adapt")]
     speed: Option<f64>,
     /// Random-walk intensity of the permanent coefficients, nT/√h
-    /// (--adapt kalman; default 0.5).
+    /// (--adapt kalman; default 0.5, at most 50).
     #[arg(long, value_name = "NT_PER_SQRT_H", requires = "adapt")]
     permanent_drift: Option<f64>,
     /// q₁ of the field model, nT²/m^(2n−1) (--adapt kalman; default: the
     /// on-board value of the model's order).
     #[arg(long, value_name = "Q1", requires = "adapt")]
     field_q1: Option<f64>,
-    /// Memory of the recursive least squares, s (--adapt rls; default 1800).
+    /// Memory of the recursive least squares, s (--adapt rls; default 1800,
+    /// at least 300).
     #[arg(long, value_name = "S", requires = "adapt")]
     memory: Option<f64>,
 }

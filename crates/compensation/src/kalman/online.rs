@@ -58,6 +58,12 @@ use crate::tolles_lawson::adaptive::{AdaptiveStep, CoefficientEstimator};
 use crate::tolles_lawson::terms::Column;
 use serde::{Deserialize, Serialize};
 
+/// The largest random walk of the permanent coefficients
+/// ([`OnlineKalmanSettings::permanent_drift_nt_per_sqrt_h`]), nT/√h: a
+/// hundred times the default, 50 nT in an hour, far beyond an airframe's
+/// creep.
+pub const MAX_PERMANENT_DRIFT_NT_PER_SQRT_H: f64 = 50.0;
+
 /// Settings of the online Kalman filter ([module docs](self)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -160,11 +166,13 @@ impl OnlineKalman {
             )));
         }
         let drift = settings.permanent_drift_nt_per_sqrt_h;
-        if !(drift >= 0.0 && drift.is_finite()) {
+        if !(0.0..=MAX_PERMANENT_DRIFT_NT_PER_SQRT_H).contains(&drift) {
             return Err(CompError::setting(format!(
-                "permanent drift {drift} nT/√h must be finite and ≥ 0"
+                "permanent drift {} nT/√h must be from 0 to {MAX_PERMANENT_DRIFT_NT_PER_SQRT_H}",
+                aeromag_core::error::shown(drift)
             )));
         }
+        settings.noise.check(settings.field_prior.order)?;
         let permanent = design
             .terms
             .column_indices(|c| matches!(c, Column::Direction(_)));

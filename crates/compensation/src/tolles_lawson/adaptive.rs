@@ -337,21 +337,51 @@ mod tests {
         let design = Design::new(TermSet::parse("p3").unwrap());
         let s = OnlineKalmanSettings::default();
         assert!(OnlineKalman::new(&design, &[1.0; 2], &[1.0; 2], &s).is_err());
-        let bad = OnlineKalmanSettings {
-            permanent_drift_nt_per_sqrt_h: -1.0,
-            ..s.clone()
-        };
-        assert!(OnlineKalman::new(&design, &[1.0; 3], &[1.0; 3], &bad).is_err());
+        for drift in [-1.0, 50.5, 1e308, f64::NAN] {
+            let bad = OnlineKalmanSettings {
+                permanent_drift_nt_per_sqrt_h: drift,
+                ..s.clone()
+            };
+            let e = OnlineKalman::new(&design, &[1.0; 3], &[1.0; 3], &bad).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("from 0 to 50"),
+                "{e}"
+            );
+        }
+        // Noise intensities beyond a field's and a magnetometer's (the
+        // filter's arithmetic failed on them: NaN coefficients).
+        for q1 in [1e308, 1e-300] {
+            let mut bad = s.clone();
+            bad.noise.q1 = q1;
+            let e = OnlineKalman::new(&design, &[1.0; 3], &[1.0; 3], &bad).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("Kalman noise"),
+                "{e}"
+            );
+        }
         let bad = OnlineKalmanSettings {
             coef_std_floor: 0.0,
             ..s.clone()
         };
         assert!(OnlineKalman::new(&design, &[1.0; 3], &[1.0; 3], &bad).is_err());
+        // A memory too short to hold the coefficients diverged (311 nT of
+        // interference where there are 23).
+        for memory_s in [0.0, 1.0, 30.0, 299.0, f64::NAN] {
+            let rls = RlsSettings {
+                memory_s,
+                ..RlsSettings::default()
+            };
+            let e = Rls::new(&[1.0; 3], &[1.0; 3], rls).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("at least 300 s"),
+                "{e}"
+            );
+        }
         let rls = RlsSettings {
-            memory_s: 0.0,
+            memory_s: 300.0,
             ..RlsSettings::default()
         };
-        assert!(Rls::new(&[1.0; 3], &[1.0; 3], rls).is_err());
+        assert!(Rls::new(&[1.0; 3], &[1.0; 3], rls).is_ok());
         let est = Box::new(Rls::new(&[1.0; 2], &[1.0; 2], RlsSettings::default()).unwrap());
         assert!(AdaptiveTl::new(&design, 0.15, est).is_err());
     }
