@@ -24,7 +24,7 @@ use aeromag_gradiometry::convergence::{
 };
 use aeromag_gradiometry::efficiency::{scalar_pass_crlb, tensor_pass_crlb};
 use aeromag_gradiometry::forward::Background;
-use aeromag_gradiometry::locate::{Located, locate_scalar, locate_tensor};
+use aeromag_gradiometry::locate::{LocateConfig, Located, locate_scalar, locate_tensor};
 use aeromag_gradiometry::motion::{Motion, NavFix};
 use aeromag_gradiometry::sim::{
     Epoch, Gradiometer, SimEpoch, scalar_epochs, simulate, tensor_epochs,
@@ -649,13 +649,60 @@ pub fn locate_pass<E: Borrow<Epoch>>(
     Ok(match cfg.system.gradiometer {
         Gradiometer::Tensor => {
             let input = tensor_epochs(epochs, &geometry, &cfg.processing());
-            Track::from_tensor(&locate_tensor(&input, &lc)?)
+            let out = locate_tensor(&input, &lc)?;
+            if lc.passes > 1 {
+                let filter = locate_tensor(&input, &LocateConfig { passes: 1, ..lc })?;
+                check_passes_agree(&filter, &out)?;
+            }
+            Track::from_tensor(&out)
         }
         Gradiometer::Scalar => {
             let input = scalar_epochs(epochs, &geometry, positions, &cfg.processing())?;
             Track::from_scalar(&locate_scalar(&input, &lc)?, positions)
         }
     })
+}
+
+/// How far the re-linearised passes' final position may lie from the
+/// filter's, as a fraction of the filter's range to the object, before the
+/// passes count as diverged. Both estimate the same object from the same
+/// data: they differ in precision (the filter is over-confident where it
+/// linearised early epochs about a poor estimate: 17 of its σ on the
+/// well-posed pass, 0.4 % of the range), not by a tenth of the distance to
+/// the object.
+pub const PASSES_AGREEMENT_FRACTION: f64 = 0.1;
+
+/// The re-linearised passes' final position within
+/// [`PASSES_AGREEMENT_FRACTION`] of the range of the filter's, else a
+/// failure ([`aeromag_gradiometry::GradiometryError::Diverged`], not bad
+/// input).
+///
+/// The passes linearise every epoch about the trajectory carried back from
+/// the first pass's *final* estimate; that pass runs with the extra noise
+/// `estimator.first_pass_extra_*`, and when the pass ends far from the
+/// object (the default 120 m pass ends 60 m away, 60 baselines) it forgets
+/// the object and ends at the zero-moment solution next to the
+/// gradiometer. The passes then converge confidently to that wrong point.
+fn check_passes_agree(filter: &[Option<Located<6>>], passes: &[Option<Located<6>>]) -> Result<()> {
+    let (Some(Some(f)), Some(Some(p))) = (filter.last(), passes.last()) else {
+        return Ok(());
+    };
+    let (xf, xp) = (f.step.posterior.x, p.step.posterior.x);
+    let (rf, rp) = (xf.fixed_rows::<3>(0), xp.fixed_rows::<3>(0));
+    if (rp - rf).norm() <= PASSES_AGREEMENT_FRACTION * rf.norm() {
+        return Ok(());
+    }
+    let fmt = |x: &SVector<f64, 6>| format!("({:.3}, {:.3}, {:.3})", x[0], x[1], x[2]);
+    Err(Error::Gradiometry(GradiometryError::Diverged(format!(
+        "the re-linearised passes end at {} m, {:.3} m from the filter's {} m (more than {} of its \
+         range): their first pass, with the extra noise estimator.first_pass_extra_position_m / \
+         _moment_am2, lost the object before the end of the pass; use passes = 1 (the filter) \
+         or smaller extra noise",
+        fmt(&xp),
+        (rp - rf).norm(),
+        fmt(&xf),
+        PASSES_AGREEMENT_FRACTION
+    ))))
 }
 
 /// CRLB standard deviations at epoch `j` from every epoch up to it, state

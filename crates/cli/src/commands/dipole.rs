@@ -101,7 +101,11 @@ struct LocateArgs {
     /// Sensor noise σ, nT (overrides the file).
     #[arg(long)]
     noise_nt: Option<f64>,
-    /// Passes over the data (overrides the file; 1 = filter).
+    /// Passes over the data (overrides the file), 1…100: 1 = the filter;
+    /// more = re-linearised passes, a failure (exit 1) when they end
+    /// farther from the filter's position than a tenth of its range (their
+    /// noisier first pass lost the object, as on a pass that ends far from
+    /// it).
     #[arg(long)]
     passes: Option<usize>,
     /// Multi-start initialisation (the default of the scenario file).
