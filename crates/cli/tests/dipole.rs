@@ -425,3 +425,17 @@ fn re_linearised_passes_that_lose_the_object_fail_instead_of_answering_wrongly()
     let o = locate_with(&csv, &toml, &out, &["--passes", "1"]);
     assert_code(&o, 0);
 }
+
+#[test]
+fn scalar_gradiometer_says_its_position_sigma_is_not_estimated() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(
+        &d.path().join("sim"),
+        Some("[system]\ngradiometer = \"scalar\"\n[trajectory]\nepochs = 120\n"),
+    );
+    let out = d.path().join("est.csv");
+    let o = locate_with(&csv, &toml, &out, &[]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("σ not estimated") && !s.contains("NaN"), "{s}");
+}

@@ -78,6 +78,9 @@ pub struct SimulateArgs {
 /// mz_am2` (body frame), their standard deviations `sd_…`, `iterations,
 /// residual_nt, converged` and the estimability measures `mu_…`
 /// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior).
+/// The scalar gradiometer does not estimate the position (it is known from
+/// the tracks): its `sd_x_m … mu_z` cells are empty and the summary says
+/// "σ not estimated".
 ///
 /// Example: `aeromag dipole locate --input grad/gradiometer.csv --config grad/gradiometer.toml --out est.csv`
 #[derive(Debug, clap::Args)]
@@ -213,9 +216,14 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
                 time[j0],
                 track.converged.iter().filter(|&&c| c).count()
             );
+            let sigma = if sd[..3].iter().all(|v| v.is_finite()) {
+                format!("σ {:.3e} {:.3e} {:.3e}", sd[0], sd[1], sd[2])
+            } else {
+                "σ not estimated (known from the tracks)".to_string()
+            };
             println!(
-                "final position (m)    {:9.3} {:9.3} {:9.3}  σ {:.3e} {:.3e} {:.3e}",
-                x[0], x[1], x[2], sd[0], sd[1], sd[2]
+                "final position (m)    {:9.3} {:9.3} {:9.3}  {sigma}",
+                x[0], x[1], x[2]
             );
             println!(
                 "final moment (A·m²)   {:9.2} {:9.2} {:9.2}  σ {:.3e} {:.3e} {:.3e}",
