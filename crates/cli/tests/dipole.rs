@@ -439,3 +439,25 @@ fn scalar_gradiometer_says_its_position_sigma_is_not_estimated() {
     let s = stdout(&o);
     assert!(s.contains("σ not estimated") && !s.contains("NaN"), "{s}");
 }
+
+#[test]
+fn convergence_on_the_smallest_grids_and_threads_zero() {
+    let d = tempfile::tempdir().unwrap();
+    for g in ["2", "3"] {
+        let dir = d.path().join(g);
+        let o = aeromag(&["dipole", "convergence", "--grid", g, "--out", p(&dir)]);
+        assert_code(&o, 0);
+        assert!(dir.join("index.html").exists());
+    }
+    let o = aeromag(&[
+        "dipole",
+        "convergence",
+        "--grid",
+        "4",
+        "--threads",
+        "0",
+        "--out",
+        p(&d.path().join("t")),
+    ]);
+    assert_bad(&o, &["--threads 0"]);
+}

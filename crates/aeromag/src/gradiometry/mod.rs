@@ -794,9 +794,19 @@ pub fn map_figures(
     let mut out = Vec::new();
     for (tag, map, _) in maps {
         for (axis, v) in [(2, case.position_m.z), (1, case.position_m.y)] {
-            out.push(Block::Figure {
-                svg: slice_heatmap(case, map, axis, v, tag).to_svg()?,
-                caption: format!("{tag}: iterations per start (grey: no convergence)."),
+            let heatmap = slice_heatmap(case, map, axis, v, tag);
+            // A slice where no start converged (likely on a coarse grid) is
+            // a result, not a plot: say so instead of drawing nothing.
+            out.push(if heatmap.values.iter().any(|v| v.is_finite()) {
+                Block::Figure {
+                    svg: heatmap.to_svg()?,
+                    caption: format!("{tag}: iterations per start (grey: no convergence)."),
+                }
+            } else {
+                Block::Paragraph(format!(
+                    "{}: no start of this slice converged (nothing to draw).",
+                    heatmap.title
+                ))
             });
         }
     }

@@ -7,6 +7,7 @@
 //! - `convergence`: the seed's fig. 2 convergence map.
 
 use crate::exit::bad_input;
+use aeromag::core::parallel::MAX_THREADS;
 use aeromag::gradiometry::{
     LocateSettings, STATE_NAMES, both_maps, locate_pass, map_figures, parse_name, read_config,
     read_pass,
@@ -154,7 +155,7 @@ struct ConvergenceArgs {
     /// Starts per axis (n³ in all).
     #[arg(long, default_value_t = 40)]
     grid: usize,
-    /// Worker threads (the result does not depend on it).
+    /// Worker threads, 1…64 (the result does not depend on it).
     #[arg(long, default_value_t = 2)]
     threads: usize,
     /// Output folder for the report.
@@ -275,6 +276,12 @@ fn crlb(a: CrlbArgs) -> anyhow::Result<()> {
 fn convergence(a: ConvergenceArgs) -> anyhow::Result<()> {
     if !(2..=200).contains(&a.grid) {
         return Err(bad_input!("--grid {} must be in 2…200", a.grid));
+    }
+    if !(1..=MAX_THREADS).contains(&a.threads) {
+        return Err(bad_input!(
+            "--threads {} must be in 1…{MAX_THREADS}",
+            a.threads
+        ));
     }
     let case = ConvergenceCase::seed_fig2(a.grid);
     let toward = case.position_m.normalize();
