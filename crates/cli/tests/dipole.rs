@@ -293,3 +293,171 @@ fn bad_input_exits_2_naming_file_row_and_column() {
         );
     }
 }
+
+/// `aeromag dipole locate` on `csv` with extra flags: the output.
+fn locate_with(csv: &Path, toml: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "dipole",
+        "locate",
+        "--input",
+        p(csv),
+        "--config",
+        p(toml),
+        "--out",
+        p(out),
+    ];
+    args.extend(extra);
+    aeromag(&args)
+}
+
+fn assert_bad(o: &std::process::Output, needles: &[&str]) {
+    assert_code(o, 2);
+    let e = stderr(o);
+    for n in needles {
+        assert!(e.contains(n), "no '{n}' in {e}");
+    }
+    assert!(e.len() < 600 && !e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn values_beyond_their_physical_range_name_the_column_key_or_flag() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(&d.path().join("sim"), Some("[trajectory]\nepochs = 120\n"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let edit = |name: &str, line: usize, value: &str| -> String {
+        let col = header.iter().position(|&h| h == name).unwrap();
+        text.lines()
+            .enumerate()
+            .map(|(i, l)| {
+                let mut f: Vec<String> = l.split(',').map(String::from).collect();
+                if i == line {
+                    f[col] = value.to_string();
+                }
+                f.join(",") + "\n"
+            })
+            .collect()
+    };
+    let out = d.path().join("est.csv");
+    for (column, value) in [
+        ("north_m", "1e308"),
+        ("obj_north_m", "1e308"),
+        ("b1_x", "1e308"),
+        ("b1_x", "1e300"),
+        ("time", "1e300"),
+        ("roll", "1e308"),
+    ] {
+        let f = d.path().join(format!("{column}.csv"));
+        std::fs::write(&f, edit(column, 60, value)).unwrap();
+        assert_bad(
+            &locate_with(&f, &toml, &out, &[]),
+            &[
+                &format!("{column}.csv"),
+                &format!("column '{column}'"),
+                "data row",
+            ],
+        );
+    }
+    for (flag, value) in [
+        ("--baseline-m", "1e308"),
+        ("--noise-nt", "1e-308"),
+        ("--passes", "0"),
+        ("--passes", "1000000"),
+    ] {
+        assert_bad(&locate_with(&csv, &toml, &out, &[flag, value]), &[flag]);
+    }
+    // scenario keys: checked before anything is allocated or simulated
+    let cfg = d.path().join("cfg.toml");
+    for (text, key) in [
+        ("[trajectory]\nepochs = 100000000\n", "trajectory.epochs"),
+        ("[trajectory]\ndt_s = 1e-300\n", "trajectory.dt_s"),
+        (
+            "[estimator]\nmax_iterations = 1000000000\n",
+            "max_iterations",
+        ),
+        ("[estimator]\nmax_iterations = 0\n", "max_iterations"),
+        (
+            "[environment]\ndecimal_year = 2100.0\n",
+            "environment.decimal_year",
+        ),
+        ("[environment]\nlat_deg = 91.0\n", "environment.lat_deg"),
+        (
+            "[system]\nattitude_deg = [1e308, 0.0, 0.0]\n",
+            "attitude_deg",
+        ),
+    ] {
+        std::fs::write(&cfg, text).unwrap();
+        let t = std::time::Instant::now();
+        for args in [
+            vec!["dipole", "crlb", "--config", p(&cfg)],
+            vec![
+                "dipole",
+                "simulate",
+                "--config",
+                p(&cfg),
+                "--out",
+                p(&d.path().join("x")),
+            ],
+        ] {
+            let o = aeromag(&args);
+            assert_bad(&o, &["cfg.toml", key]);
+            assert!(!stderr(&o).contains("must be finite"), "{}", stderr(&o));
+        }
+        assert!(t.elapsed().as_secs() < 10, "{text}");
+    }
+}
+
+#[test]
+fn re_linearised_passes_that_lose_the_object_fail_instead_of_answering_wrongly() {
+    let d = tempfile::tempdir().unwrap();
+    // The default pass ends 60 m (60 baselines) from the object: the noisy
+    // first of several passes loses it and they ended at (8.9, −0.5, −0.5) m
+    // with σ 0.04 m instead of the true (59.9, 6, 2) m.
+    let (csv, toml) = simulate_into(&d.path().join("sim"), None);
+    let out = d.path().join("est.csv");
+    let o = locate_with(&csv, &toml, &out, &["--passes", "2"]);
+    assert_code(&o, 1);
+    assert!(
+        stderr(&o).contains("re-linearised passes"),
+        "{}",
+        stderr(&o)
+    );
+    let o = locate_with(&csv, &toml, &out, &["--passes", "1"]);
+    assert_code(&o, 0);
+}
+
+#[test]
+fn scalar_gradiometer_says_its_position_sigma_is_not_estimated() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(
+        &d.path().join("sim"),
+        Some("[system]\ngradiometer = \"scalar\"\n[trajectory]\nepochs = 120\n"),
+    );
+    let out = d.path().join("est.csv");
+    let o = locate_with(&csv, &toml, &out, &[]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("σ not estimated") && !s.contains("NaN"), "{s}");
+}
+
+#[test]
+fn convergence_on_the_smallest_grids_and_threads_zero() {
+    let d = tempfile::tempdir().unwrap();
+    for g in ["2", "3"] {
+        let dir = d.path().join(g);
+        let o = aeromag(&["dipole", "convergence", "--grid", g, "--out", p(&dir)]);
+        assert_code(&o, 0);
+        assert!(dir.join("index.html").exists());
+    }
+    let o = aeromag(&[
+        "dipole",
+        "convergence",
+        "--grid",
+        "4",
+        "--threads",
+        "0",
+        "--out",
+        p(&d.path().join("t")),
+    ]);
+    assert_bad(&o, &["--threads 0"]);
+}

@@ -542,3 +542,170 @@ fn em_commands_reject_bad_input_with_file_row_and_column() {
         &["neg.toml"],
     );
 }
+
+/// `bytes` (a raw record) with its JSON header edited by `f`.
+fn with_header(bytes: &[u8], f: &dyn Fn(&mut serde_json::Value)) -> Vec<u8> {
+    let hl = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+    let mut h: serde_json::Value = serde_json::from_slice(&bytes[12..12 + hl]).unwrap();
+    f(&mut h);
+    let text = serde_json::to_vec(&h).unwrap();
+    let mut out = bytes[..8].to_vec();
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(text);
+    out.extend(&bytes[12 + hl..]);
+    out
+}
+
+#[test]
+fn header_attitudes_and_rotations_out_of_range_are_bad_input_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cfg = d.join("short.toml");
+    std::fs::write(&cfg, "duration_s = 1.28\n").unwrap();
+    let sim = simulate(d, &["--config", s(&cfg)]);
+    let raw = sim.join("em.raw");
+    let bytes = std::fs::read(&raw).unwrap();
+    let out = d.join("o.csv");
+    let short = |args: &[&str], frags: &[&str]| {
+        bad(args, frags);
+        let e = stderr(&aeromag(args));
+        assert!(e.len() < 400, "long message: {e}");
+    };
+    let edits: [(&str, serde_json::Value, &str); 8] = [
+        ("start_index", serde_json::json!(u64::MAX), "start_index"),
+        ("sample_rate_hz", serde_json::json!(1e308), "sample_rate_hz"),
+        (
+            "frequencies_hz",
+            serde_json::json!([1025.0, 1025.0, 1025.0]),
+            "frequencies_hz",
+        ),
+        (
+            "coil_gain_v_per_t_s",
+            serde_json::json!(-1.0),
+            "coil_gain_v_per_t_s",
+        ),
+        (
+            "pilot_field_t",
+            serde_json::json!([-1e-9, -1e-9, -1e-9]),
+            "pilot_field_t",
+        ),
+        (
+            "pilot_field_t",
+            serde_json::json!([1e308, 1e308, 1e308]),
+            "pilot_field_t",
+        ),
+        (
+            "pilot_offset_hz",
+            serde_json::json!(1e-308),
+            "pilot_offset_hz",
+        ),
+        (
+            "pilot_offset_hz",
+            serde_json::json!(1e308),
+            "pilot_offset_hz",
+        ),
+    ];
+    for (k, (key, value, needle)) in edits.into_iter().enumerate() {
+        let b = with_header(&bytes, &|h| {
+            if h.get(key).is_some() {
+                h[key] = value.clone();
+            } else {
+                h["system"][key] = value.clone();
+            }
+        });
+        let p = d.join(format!("h{k}.raw"));
+        std::fs::write(&p, b).unwrap();
+        short(
+            &["em", "detect", "--input", s(&p), "--out", s(&out)],
+            &[&format!("h{k}.raw"), needle],
+        );
+    }
+
+    // A known attitude of 1e308 deg, a time of 1e308 s.
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&["em", "detect", "--input", s(&raw), "--out", s(&det)]),
+        0,
+    );
+    let known = std::fs::read_to_string(sim.join("em.known.csv")).unwrap();
+    let system = sim.join("em.system.json");
+    let cal = d.join("cal.json");
+    let calibrate = |k: &Path| {
+        vec![
+            "em",
+            "calibrate",
+            "--input",
+            s(&det),
+            "--known",
+            s(k),
+            "--system",
+            s(&system),
+            "--out",
+            s(&cal),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>()
+    };
+    let first_attitude_row = known
+        .lines()
+        .position(|l| l.split(',').nth(4).is_some_and(|c| !c.is_empty()))
+        .unwrap();
+    for (col, value, needle) in [(4, "1e308", "roll_deg"), (0, "1e308", "time_s")] {
+        let edited: String = known
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                let mut f: Vec<String> = l.split(',').map(String::from).collect();
+                if i == first_attitude_row {
+                    f[col] = value.into();
+                }
+                f.join(",") + "\n"
+            })
+            .collect();
+        let p = d.join(format!("k_{needle}.csv"));
+        std::fs::write(&p, edited).unwrap();
+        let args = calibrate(&p);
+        short(
+            &args.iter().map(String::as_str).collect::<Vec<_>>(),
+            &[needle, "1e308"],
+        );
+    }
+
+    // A calibration whose attitude correction is not a rotation.
+    let args = calibrate(&sim.join("em.known.csv"));
+    assert_code(
+        &aeromag(&args.iter().map(String::as_str).collect::<Vec<_>>()),
+        0,
+    );
+    let c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
+    for (name, q) in [
+        (
+            "zero",
+            serde_json::json!([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        ),
+        (
+            "five",
+            serde_json::json!([5.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0, 5.0]),
+        ),
+    ] {
+        let mut bad_cal = c.clone();
+        bad_cal["calibration"]["attitude_q"] = q;
+        let p = d.join(format!("cal_{name}.json"));
+        std::fs::write(&p, serde_json::to_string(&bad_cal).unwrap()).unwrap();
+        short(
+            &[
+                "em",
+                "locate",
+                "--input",
+                s(&det),
+                "--calibration",
+                s(&p),
+                "--out",
+                s(&out),
+            ],
+            &[&format!("cal_{name}.json"), "attitude_q", "not a rotation"],
+        );
+    }
+}

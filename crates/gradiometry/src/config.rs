@@ -22,13 +22,16 @@
 //!                # difference_model = "exact" | "gradient_tensor"
 //! ```
 
-use crate::error::{GradiometryError, Result};
+use crate::error::{GradiometryError, Result, in_range};
 use crate::geometry::{Geometry, Layout};
 use crate::locate::LocateConfig;
 use crate::motion::MotionNoise;
-use crate::sim::{Gradiometer, Processing, Scenario, SensorSpec, SystemMotion};
+use crate::sim::{
+    DT_RANGE_S, Gradiometer, MAX_EPOCHS, Processing, Scenario, SensorSpec, SystemMotion,
+};
 use crate::sr_iekf::IekfConfig;
 use crate::tensor_approx::DifferenceModel;
+use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
 use nalgebra::Vector3;
@@ -46,9 +49,11 @@ pub struct SystemConfig {
     pub gradiometer: Gradiometer,
     /// Sensor layout. Default `"tetrahedron"`.
     pub layout: Layout,
-    /// Distance between neighbouring sensors, m. Default 1.
+    /// Distance between neighbouring sensors, m, 0.001…100
+    /// ([`crate::geometry::BASELINE_RANGE_M`]). Default 1.
     pub baseline_m: f64,
-    /// Roll, pitch, yaw of the system (fixed during the pass), deg. Default 0, 0, 0.
+    /// Roll, pitch, yaw of the system (fixed during the pass), deg, each
+    /// within ±360. Default 0, 0, 0.
     pub attitude_deg: [f64; 3],
 }
 
@@ -68,7 +73,9 @@ impl Default for SystemConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensorConfig {
-    /// White noise σ per sample (per axis for vector sensors), nT.
+    /// White noise σ per sample (per axis for vector sensors), nT; the
+    /// estimator's σ of the configured gradiometer must be within
+    /// [`NOISE_RANGE_NT`].
     pub noise_nt: f64,
     /// σ of the fixed per-sensor bias (per axis), nT.
     pub bias_sigma_nt: f64,
@@ -105,13 +112,16 @@ impl Default for SensorsConfig {
 pub struct EnvironmentConfig {
     /// Amplitude of the natural variations common to all sensors, nT. Default 5.
     pub variation_nt: f64,
-    /// Latitude of the local origin, deg. Default 55.
+    /// Latitude of the local origin, deg, −90…90. Default 55.
     pub lat_deg: f64,
-    /// Longitude of the local origin, deg. Default 37.
+    /// Longitude of the local origin, deg, −360…360. Default 37.
     pub lon_deg: f64,
-    /// Height of the origin above the ellipsoid, m. Default 150.
+    /// Height of the origin above the ellipsoid, m, −10 000…1 000 000
+    /// (deepest mine to low Earth orbit: where the IGRF describes the
+    /// field). Default 150.
     pub alt_m: f64,
-    /// Epoch of the IGRF (Earth's field and gradient), decimal year. Default 2025.5.
+    /// Epoch of the IGRF (Earth's field and gradient), decimal year, within
+    /// the IGRF's years. Default 2025.5.
     pub decimal_year: f64,
 }
 
@@ -158,9 +168,10 @@ impl Default for ObjectConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TrajectoryConfig {
-    /// Sample interval, s. Default 0.1.
+    /// Sample interval, s, 10⁻⁶…3600 ([`crate::sim::DT_RANGE_S`]). Default 0.1.
     pub dt_s: f64,
-    /// Number of epochs. Default 600 (a 120 m pass at 2 m/s).
+    /// Number of epochs, 2…1 000 000 ([`crate::sim::MAX_EPOCHS`]: a
+    /// million samples are 28 h at 10 Hz). Default 600 (a 120 m pass at 2 m/s).
     pub epochs: usize,
     /// Speed of the moving body, m/s. Default 2.
     pub speed_m_s: f64,
@@ -204,7 +215,8 @@ pub struct EstimatorConfig {
     /// Multi-start initialisation at the detection epoch (default true);
     /// false = the plain IEKF from `initial_position_m` with zero moment.
     pub multistart: bool,
-    /// Epochs of the multi-start window ([`crate::locate::window_multistart`]). Default 30.
+    /// Epochs of the multi-start window ([`crate::locate::window_multistart`]),
+    /// at least 1. Default 30.
     pub multistart_window_epochs: usize,
     /// Start position of the plain IEKF, body frame, m. Default (10, 0, 0).
     pub initial_position_m: [f64; 3],
@@ -213,13 +225,13 @@ pub struct EstimatorConfig {
     /// Prior σ of each moment component, A·m². Default 3000.
     pub prior_sigma_moment_am2: f64,
     /// Passes over the data (1 = filter; more = re-linearised passes,
-    /// [`crate::pass::run_pass_relinearised`]). Default 1.
+    /// [`crate::pass::run_pass_relinearised`]), 1…[`MAX_PASSES`]. Default 1.
     pub passes: usize,
     /// Extra position noise per step of the first of several passes, m. Default 0.3.
     pub first_pass_extra_position_m: f64,
     /// Extra moment noise per step of the first of several passes, A·m². Default 30.
     pub first_pass_extra_moment_am2: f64,
-    /// Maximum IEKF iterations per epoch. Default 30.
+    /// Maximum IEKF iterations per epoch, 1…[`MAX_ITERATIONS`]. Default 30.
     pub max_iterations: usize,
     /// `k` of the residual threshold `k σ √Z`. Default 1.5.
     pub residual_factor: f64,
@@ -287,6 +299,19 @@ impl Default for GradiometerConfig {
     }
 }
 
+/// Most IEKF iterations per epoch (`estimator.max_iterations`): the iteration converges in a few
+/// steps where it converges at all (30 by default); a thousand is ample,
+/// and the run time grows linearly with it.
+pub const MAX_ITERATIONS: usize = 1000;
+
+/// Most re-linearised passes (`estimator.passes`): each is one
+/// Gauss–Newton step; the studies use 10 to 30.
+pub const MAX_PASSES: usize = 100;
+
+/// Range of the estimator's sensor noise σ, nT: 1 fT (below any
+/// magnetometer) to 10 µT (a fifth of the Earth's field).
+pub const NOISE_RANGE_NT: (f64, f64) = (1e-6, 1e4);
+
 fn cfg_err(e: impl std::fmt::Display) -> GradiometryError {
     GradiometryError::Config(e.to_string())
 }
@@ -323,11 +348,32 @@ impl GradiometerConfig {
             return Err(cfg_err("seed must be < 2^63"));
         }
         let wrap = |field: &str, e: GradiometryError| cfg_err(format!("{field}: {e}"));
+        // Before anything is allocated or simulated, with the keys' names.
+        let t = &self.trajectory;
+        if !(2..=MAX_EPOCHS).contains(&t.epochs) {
+            return Err(cfg_err(format!(
+                "trajectory.epochs must be in 2…{MAX_EPOCHS}, got {}",
+                t.epochs
+            )));
+        }
+        let env = &self.environment;
+        let sys = &self.system;
+        let checks = [
+            ("trajectory.dt_s", t.dt_s, DT_RANGE_S.0, DT_RANGE_S.1),
+            ("environment.lat_deg", env.lat_deg, -90.0, 90.0),
+            ("environment.lon_deg", env.lon_deg, -360.0, 360.0),
+            ("environment.alt_m", env.alt_m, -1e4, 1e6),
+            ("system.attitude_deg[0]", sys.attitude_deg[0], -360.0, 360.0),
+            ("system.attitude_deg[1]", sys.attitude_deg[1], -360.0, 360.0),
+            ("system.attitude_deg[2]", sys.attitude_deg[2], -360.0, 360.0),
+        ];
+        for (name, v, lo, hi) in checks {
+            in_range(name, v, lo, hi).map_err(cfg_err)?;
+        }
+        IgrfModel::new(env.decimal_year)
+            .map_err(|e| cfg_err(format!("environment.decimal_year: {e}")))?;
         let s = self.scenario().map_err(|e| wrap("system/trajectory", e))?;
         s.validate().map_err(|e| wrap("scenario", e))?;
-        if self.trajectory.epochs < 2 {
-            return Err(cfg_err("trajectory.epochs must be ≥ 2"));
-        }
         if self.estimator.quiet_epochs >= self.trajectory.epochs {
             return Err(cfg_err(
                 "estimator.quiet_epochs must be smaller than trajectory.epochs",
@@ -417,7 +463,24 @@ impl GradiometerConfig {
                 return Err(GradiometryError::NotPositive { name, value: v });
             }
         }
-        let mut iekf = IekfConfig::new(sigma_nt.unwrap_or(self.sensor_sigma_nt()))?;
+        let sigma = in_range(
+            "sigma_nt (noise_nt of the configured gradiometer's sensors)",
+            sigma_nt.unwrap_or(self.sensor_sigma_nt()),
+            NOISE_RANGE_NT.0,
+            NOISE_RANGE_NT.1,
+        )?;
+        for (name, v, max) in [
+            ("max_iterations", e.max_iterations, MAX_ITERATIONS),
+            (
+                "multistart_window_epochs",
+                e.multistart_window_epochs,
+                MAX_EPOCHS,
+            ),
+            ("passes", e.passes, MAX_PASSES),
+        ] {
+            in_range(name, v as f64, 1.0, max as f64)?;
+        }
+        let mut iekf = IekfConfig::new(sigma)?;
         iekf.max_iterations = e.max_iterations;
         iekf.residual_factor = crate::error::positive("residual_factor", e.residual_factor)?;
         let c = LocateConfig {
@@ -501,6 +564,35 @@ mod tests {
                 "sigma_nt",
             ),
             ("seed = \"x\"\n", "seed"),
+            // 48.8 GB would have been allocated for this one
+            ("[trajectory]\nepochs = 100000000\n", "trajectory.epochs"),
+            ("[trajectory]\ndt_s = 1e-300\n", "trajectory.dt_s"),
+            (
+                "[estimator]\nmax_iterations = 1000000000\n",
+                "max_iterations",
+            ),
+            ("[estimator]\nmax_iterations = 0\n", "max_iterations"),
+            ("[estimator]\npasses = 0\n", "passes"),
+            (
+                "[estimator]\nmultistart_window_epochs = 0\n",
+                "multistart_window_epochs",
+            ),
+            ("[environment]\nlat_deg = 91.0\n", "environment.lat_deg"),
+            ("[environment]\nlat_deg = 1e308\n", "1e308"),
+            ("[environment]\nalt_m = 1e308\n", "environment.alt_m"),
+            (
+                "[environment]\ndecimal_year = 2100.0\n",
+                "environment.decimal_year",
+            ),
+            (
+                "[system]\nattitude_deg = [1e308, 0.0, 0.0]\n",
+                "attitude_deg[0]",
+            ),
+            ("[system]\nbaseline_m = 1e308\n", "baseline_m"),
+            (
+                "[sensors.vector]\nnoise_nt = 1e-308\nbias_sigma_nt = 1.0\n",
+                "noise_nt",
+            ),
         ] {
             let e = GradiometerConfig::from_toml(text).unwrap_err();
             assert!(matches!(e, GradiometryError::Config(_)), "{e:?}");

@@ -1,5 +1,6 @@
 //! The crate's error type.
 
+use aeromag_core::error::shown;
 use thiserror::Error;
 
 /// Errors of the gradiometry library (bad configuration or input; never a panic).
@@ -7,7 +8,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum GradiometryError {
     /// A length, noise level or count that must be positive and finite is not.
-    #[error("{name} must be positive and finite, got {value}")]
+    #[error("{name} must be positive and finite, got {}", shown(*value))]
     NotPositive {
         /// Name of the parameter.
         name: &'static str,
@@ -20,6 +21,23 @@ pub enum GradiometryError {
         /// Name of the parameter.
         name: &'static str,
     },
+    /// A value outside its physically meaningful range (the message gives
+    /// the range).
+    #[error("{name} must be in {min}…{max}, got {}", shown(*value))]
+    OutOfRange {
+        /// Name of the parameter (the scenario-file key or the flag).
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// Smallest allowed value.
+        min: f64,
+        /// Largest allowed value.
+        max: f64,
+    },
+    /// The estimate left the solution the data support: a failed fit (not
+    /// bad input).
+    #[error("estimate diverged: {0}")]
+    Diverged(String),
     /// The four sensor offsets do not span three dimensions or are too close.
     #[error("degenerate gradiometer geometry: {0}")]
     DegenerateGeometry(String),
@@ -44,10 +62,14 @@ pub enum GradiometryError {
 
 impl GradiometryError {
     /// Whether the caller's input caused the error: every variant but a
-    /// singular matrix (the data do not determine the estimate) is a value,
-    /// geometry, scenario file or length the caller gave.
+    /// singular matrix (the data do not determine the estimate) and a
+    /// diverged estimate is a value, geometry, scenario file or length the
+    /// caller gave.
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, GradiometryError::Singular(_))
+        !matches!(
+            self,
+            GradiometryError::Singular(_) | GradiometryError::Diverged(_)
+        )
     }
 }
 
@@ -63,6 +85,21 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
     }
 }
 
+/// `Ok(v)` when `min ≤ v ≤ max` (so finite), else
+/// [`GradiometryError::OutOfRange`].
+pub(crate) fn in_range(name: &'static str, value: f64, min: f64, max: f64) -> Result<f64> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(GradiometryError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,5 +109,12 @@ mod tests {
         assert!(GradiometryError::NotFinite { name: "x" }.is_bad_input());
         assert!(GradiometryError::Config("bad".into()).is_bad_input());
         assert!(!GradiometryError::Singular("information").is_bad_input());
+        assert!(!GradiometryError::Diverged("passes".into()).is_bad_input());
+        let e = in_range("estimator.passes", 1e300, 1.0, 100.0).unwrap_err();
+        assert!(e.is_bad_input());
+        assert_eq!(
+            e.to_string(),
+            "estimator.passes must be in 1…100, got 1e300"
+        );
     }
 }

@@ -16,7 +16,7 @@
 //!   sensors in the body x–y plane; the vertical gradient is then seen only
 //!   through the exact, non-linear differences).
 
-use crate::error::{GradiometryError, Result, positive};
+use crate::error::{GradiometryError, Result, in_range};
 use nalgebra::{Matrix3, Vector3};
 
 /// The arrangement of the four sensors (`"tetrahedron"`, `"cross"`,
@@ -32,6 +32,11 @@ pub enum Layout {
     Planar,
 }
 
+/// Baseline range of a gradiometer, m: 1 mm (sensor heads cannot be closer)
+/// to 100 m (beyond that the sensors no longer see one object's gradient,
+/// and a dipole source would be inside the array).
+pub const BASELINE_RANGE_M: (f64, f64) = (1e-3, 100.0);
+
 /// Four sensor offsets (m) from the measuring centre, body frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Geometry {
@@ -39,9 +44,16 @@ pub struct Geometry {
 }
 
 impl Geometry {
-    /// A standard `layout` with neighbour distance `baseline_m` (m, > 0).
+    /// A standard `layout` with neighbour distance `baseline_m` (m).
+    ///
+    /// `baseline_m` must be within [`BASELINE_RANGE_M`].
     pub fn new(layout: Layout, baseline_m: f64) -> Result<Self> {
-        let b = positive("baseline_m", baseline_m)?;
+        let b = in_range(
+            "baseline_m",
+            baseline_m,
+            BASELINE_RANGE_M.0,
+            BASELINE_RANGE_M.1,
+        )?;
         let raw = match layout {
             Layout::Tetrahedron => {
                 // Edge of (±1,±1,±1)-tetrahedron is 2√2.

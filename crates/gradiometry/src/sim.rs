@@ -33,7 +33,7 @@
 //! WGS84 flat-earth offsets about the origin ([`Geodetic::offset_by`]).
 
 use crate::decorrelate::{contrasts_scalar, contrasts_vector};
-use crate::error::{GradiometryError, Result, positive};
+use crate::error::{GradiometryError, Result, in_range, positive};
 use crate::forward::{Background, ScalarForward, TensorForward};
 use crate::geometry::Geometry;
 use crate::motion::{Motion, MotionNoise, motion_mt, motion_mv};
@@ -116,6 +116,15 @@ pub struct Scenario {
     pub seed: u64,
 }
 
+/// Most epochs of one simulated pass: a million samples (28 h at 10 Hz,
+/// where a pass by one object lasts minutes) take about 0.5 GB; a hundred
+/// times more did not fit in memory.
+pub const MAX_EPOCHS: usize = 1_000_000;
+
+/// Sample-interval range of a pass, s: 1 µs (a 1 MHz ADC, faster than any
+/// magnetometer) to one hour.
+pub const DT_RANGE_S: (f64, f64) = (1e-6, 3600.0);
+
 impl Scenario {
     /// Defaults: tetrahedron 1 m; fluxgates 0.5 nT noise, 5 nT bias;
     /// scalar 0.02 nT noise, 0.5 nT bias; 10 Hz for 30 s; 2 m/s; pass line
@@ -155,10 +164,19 @@ impl Scenario {
         }
     }
 
-    /// Check the values: positive step, speed, epochs; non-negative noise,
-    /// bias and variation amplitudes.
+    /// Check the values: step within [`DT_RANGE_S`], positive speed, 1 to
+    /// [`MAX_EPOCHS`] epochs; non-negative noise, bias and variation
+    /// amplitudes.
     pub fn validate(&self) -> Result<()> {
-        positive("dt_s", self.dt_s)?;
+        in_range("dt_s", self.dt_s, DT_RANGE_S.0, DT_RANGE_S.1)?;
+        if self.epochs > MAX_EPOCHS {
+            return Err(GradiometryError::OutOfRange {
+                name: "epochs",
+                value: self.epochs as f64,
+                min: 1.0,
+                max: MAX_EPOCHS as f64,
+            });
+        }
         positive("speed_m_s", self.speed_m_s)?;
         for (name, v) in [
             ("vector noise_nt", self.vector_sensor.noise_nt),
@@ -261,9 +279,8 @@ fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
 /// Simulate the scenario (deterministic for a given `seed`).
 pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
     s.validate()?;
-    let igrf = IgrfModel::new(s.decimal_year).map_err(|_| GradiometryError::NotFinite {
-        name: "decimal_year",
-    })?;
+    let igrf = IgrfModel::new(s.decimal_year)
+        .map_err(|e| GradiometryError::Config(format!("decimal_year: {e}")))?;
     let mut bias_rng = rng(s.seed, Stream::Bias);
     let mut noise_rng = rng(s.seed, Stream::Noise);
     let mut var_rng = rng(s.seed, Stream::Variation);

@@ -7,19 +7,25 @@
 //! |---|---|
 //! | `time_s` | time of the point, s; within half an epoch spacing of a detected epoch's `time_s` |
 //! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty) |
-//! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg (all three, or all three empty; the columns may be omitted) |
+//! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg, each within ±360 (all three, or all three empty; the columns may be omitted) |
 //!
 //! A row gives a position, an attitude or both.
 
 use super::HalfSpace;
 use crate::error::{Error, Result};
 use crate::flight::Flight;
+use aeromag_core::error::shown;
 use aeromag_core::frames::Attitude;
 use aeromag_em::calibration::{Calibration, CalibrationFile, FitCounts, KnownPoints};
 use aeromag_em::detection::{EmSystem, FieldEpoch};
 use aeromag_em::positioning::Hemisphere;
 use aeromag_em::study::rms;
 use nalgebra::Vector3;
+
+/// Largest |roll|, |pitch|, |yaw| of a known attitude, deg: one turn
+/// either way (the rotation is the same modulo 360°; beyond that a value
+/// is a corrupted cell, not an angle).
+pub const MAX_ANGLE_DEG: f64 = 360.0;
 
 /// The known points of a KNOWN.csv table (module docs) against the
 /// detected epochs' times: each row's time must fall within half an epoch
@@ -70,10 +76,11 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                     row,
                     "time_s",
                     format!(
-                        "{tk} s is not within half an epoch ({:.4} s) of any detected epoch ({} … {} s)",
+                        "{} s is not within half an epoch ({:.4} s) of any detected epoch ({} … {} s)",
+                        shown(tk),
                         0.5 * spacing,
-                        epochs.first().map_or(f64::NAN, |e| e.time_s),
-                        epochs.last().map_or(f64::NAN, |e| e.time_s)
+                        shown(epochs.first().map_or(f64::NAN, |e| e.time_s)),
+                        shown(epochs.last().map_or(f64::NAN, |e| e.time_s))
                     ),
                 )
             })?;
@@ -99,6 +106,18 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                             .copied()
                             .collect::<Vec<_>>()
                             .join(" and ")
+                    ),
+                ));
+            }
+            if g[0] == "roll_deg"
+                && let Some(j) = (0..3).find(|&j| v[j].abs() > MAX_ANGLE_DEG)
+            {
+                return Err(t.bad_value(
+                    row,
+                    g[j],
+                    format!(
+                        "{} deg is not an angle (within ±{MAX_ANGLE_DEG})",
+                        shown(v[j])
                     ),
                 ));
             }

@@ -6,6 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
+use aeromag_core::error::shown;
 use aeromag_em::detection::{EmSystem, FieldEpoch};
 use aeromag_em::sim::{RawReader, field_epoch_from_values, value_columns};
 use aeromag_io::{ReadOptions, read_table};
@@ -70,8 +71,18 @@ pub fn read_system(path: &Path) -> Result<EmSystem> {
     Ok(s)
 }
 
+/// ADC rates a raw record may have, Hz: 1 Hz to 100 MHz (the working
+/// frequencies are kHz; no receiver digitises faster).
+pub const RAW_SAMPLE_RATE_RANGE_HZ: (f64, f64) = (1.0, 1e8);
+
+/// Largest absolute frame index of a raw record (`start_index + frames`):
+/// 2⁵³, beyond which the time `index / rate` is not exact (and `u64`
+/// wraps); at 100 kHz it is 2800 years.
+pub const MAX_FRAME_INDEX: u64 = 1 << 53;
+
 /// Open a raw record for streaming: header read and checked (3 channels,
-/// valid system).
+/// sample rate within [`RAW_SAMPLE_RATE_RANGE_HZ`], frame indices up to
+/// [`MAX_FRAME_INDEX`], valid system).
 pub fn open_raw(path: &Path) -> Result<RawReader<BufReader<File>>> {
     let f = File::open(path).map_err(|e| Error::read(path, e))?;
     raw_reader(path, BufReader::new(f))
@@ -88,6 +99,31 @@ fn raw_reader<R: std::io::Read>(path: &Path, source: R) -> Result<RawReader<R>> 
             format!(
                 "header field 'channels' is {}, the EM receiver has 3",
                 h.channels
+            ),
+        ));
+    }
+    let (lo, hi) = RAW_SAMPLE_RATE_RANGE_HZ;
+    if !(lo..=hi).contains(&h.sample_rate_hz) {
+        return Err(Error::bad_file(
+            &file,
+            format!(
+                "header field 'sample_rate_hz' is {}, expected {}…{} Hz",
+                shown(h.sample_rate_hz),
+                shown(lo),
+                shown(hi)
+            ),
+        ));
+    }
+    if h.start_index
+        .checked_add(h.frames)
+        .is_none_or(|end| end > MAX_FRAME_INDEX)
+    {
+        return Err(Error::bad_file(
+            &file,
+            format!(
+                "header fields 'start_index' {} + 'frames' {} exceed 2^53 = {MAX_FRAME_INDEX} \
+                 (frame indices beyond it have no exact time)",
+                h.start_index, h.frames
             ),
         ));
     }

@@ -14,6 +14,7 @@ pub use aeromag_gradiometry::{
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
+use aeromag_core::error::shown;
 use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
@@ -23,7 +24,7 @@ use aeromag_gradiometry::convergence::{
 };
 use aeromag_gradiometry::efficiency::{scalar_pass_crlb, tensor_pass_crlb};
 use aeromag_gradiometry::forward::Background;
-use aeromag_gradiometry::locate::{Located, locate_scalar, locate_tensor};
+use aeromag_gradiometry::locate::{LocateConfig, Located, locate_scalar, locate_tensor};
 use aeromag_gradiometry::motion::{Motion, NavFix};
 use aeromag_gradiometry::sim::{
     Epoch, Gradiometer, SimEpoch, scalar_epochs, simulate, tensor_epochs,
@@ -76,6 +77,35 @@ impl LocateSettings {
     /// Apply these choices to `cfg` and check the result (bad input naming
     /// what is wrong).
     pub fn apply(&self, cfg: &mut GradiometerConfig) -> Result<()> {
+        use aeromag_gradiometry::config::{MAX_PASSES, NOISE_RANGE_NT};
+        use aeromag_gradiometry::geometry::BASELINE_RANGE_M;
+        let check = |flag: &str, v: Option<f64>, (lo, hi): (f64, f64), unit: &str| match v {
+            Some(v) if !(lo..=hi).contains(&v) => Err(Error::bad_input(format!(
+                "{flag} {}: expected {}…{}{unit}",
+                shown(v),
+                shown(lo),
+                shown(hi)
+            ))),
+            _ => Ok(()),
+        };
+        check(
+            "--baseline-m (baseline_m)",
+            self.baseline_m,
+            BASELINE_RANGE_M,
+            " m",
+        )?;
+        check(
+            "--noise-nt (noise_nt)",
+            self.noise_nt,
+            NOISE_RANGE_NT,
+            " nT",
+        )?;
+        check(
+            "--passes (passes)",
+            self.passes.map(|p| p as f64),
+            (1.0, MAX_PASSES as f64),
+            "",
+        )?;
         if let Some(g) = self.gradiometer {
             cfg.system.gradiometer = g;
         }
@@ -340,9 +370,17 @@ pub struct MeasuredPass {
     pub positions_m: Vec<Vector3<f64>>,
 }
 
+/// Extent of a pass's local frame, m (positions `north_m`, `obj_north_m`,
+/// …): 1000 km, far beyond the range at which a gradiometer sees a dipole.
+pub const PASS_EXTENT_M: f64 = 1e6;
+
 /// Read a measured pass for the configured gradiometer from `t`: every
-/// value must be a finite number (bad input naming file, line, row and
-/// column otherwise).
+/// value must be a finite number within its physical range — readings
+/// within ±[`aeromag_io::MAX_FIELD_NT`], positions within
+/// ±[`PASS_EXTENT_M`], angles within ±360°, latitudes within ±90°,
+/// heights −10 km…1000 km, time steps increasing and within
+/// [`aeromag_gradiometry::sim::DT_RANGE_S`] (bad input naming file, line,
+/// row and column otherwise).
 pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
     if t.n_rows() <= cfg.estimator.quiet_epochs {
         return Err(Error::bad_file(
@@ -354,15 +392,68 @@ pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
             ),
         ));
     }
-    let col = |n: &str| t.finite(n);
-    let time = col("time")?;
-    let (lat, lon, alt) = (col("lat")?, col("lon")?, col("alt")?);
-    let sys = [col("north_m")?, col("east_m")?, col("down_m")?];
-    let att = [col("roll")?, col("pitch")?, col("yaw")?];
-    let obj = [col("obj_north_m")?, col("obj_east_m")?, col("obj_down_m")?];
-    let obj_yaw = col("obj_yaw")?;
+    // Every value finite and within what the quantity can physically be
+    // (a cell of 1e308 would otherwise surface as a failed fit far away).
+    let within = |n: &str, (lo, hi): (f64, f64), what: &str| -> Result<&[f64]> {
+        let v = t.finite(n)?;
+        match v.iter().position(|x| !(lo..=hi).contains(x)) {
+            Some(row) => Err(t.bad_value(
+                row,
+                n,
+                format!(
+                    "{} is not {what} ({}…{})",
+                    shown(v[row]),
+                    shown(lo),
+                    shown(hi)
+                ),
+            )),
+            None => Ok(v),
+        }
+    };
+    let angle = (-360.0, 360.0);
+    let local = (-PASS_EXTENT_M, PASS_EXTENT_M);
+    let local_what = "a position in the pass's local frame, m";
+    let time = t.finite("time")?;
+    let (lo, hi) = aeromag_gradiometry::sim::DT_RANGE_S;
+    if let Some(j) = (1..time.len()).find(|&j| !(lo..=hi).contains(&(time[j] - time[j - 1]))) {
+        return Err(t.bad_value(
+            j,
+            "time",
+            format!(
+                "step {} s from the previous row is not a sample interval ({}…{} s, increasing)",
+                shown(time[j] - time[j - 1]),
+                shown(lo),
+                shown(hi)
+            ),
+        ));
+    }
+    let (lat, lon) = (
+        within("lat", (-90.0, 90.0), "a latitude, deg")?,
+        within("lon", angle, "a longitude, deg")?,
+    );
+    let alt = within("alt", (-1e4, 1e6), "a height where the IGRF holds, m")?;
+    let sys = [
+        within("north_m", local, local_what)?,
+        within("east_m", local, local_what)?,
+        within("down_m", local, local_what)?,
+    ];
+    let att = [
+        within("roll", angle, "an angle, deg")?,
+        within("pitch", angle, "an angle, deg")?,
+        within("yaw", angle, "an angle, deg")?,
+    ];
+    let obj = [
+        within("obj_north_m", local, local_what)?,
+        within("obj_east_m", local, local_what)?,
+        within("obj_down_m", local, local_what)?,
+    ];
+    let obj_yaw = within("obj_yaw", angle, "an angle, deg")?;
     let names = sensor_columns(cfg.system.gradiometer);
-    let readings = names.iter().map(|n| col(n)).collect::<Result<Vec<_>>>()?;
+    let field = (-aeromag_io::MAX_FIELD_NT, aeromag_io::MAX_FIELD_NT);
+    let readings = names
+        .iter()
+        .map(|n| within(n, field, "a magnetic field reading, nT"))
+        .collect::<Result<Vec<_>>>()?;
     let igrf = IgrfModel::new(cfg.environment.decimal_year)?;
     let fix = |j: usize| NavFix {
         system_position_ned_m: Vector3::new(sys[0][j], sys[1][j], sys[2][j]),
@@ -558,13 +649,60 @@ pub fn locate_pass<E: Borrow<Epoch>>(
     Ok(match cfg.system.gradiometer {
         Gradiometer::Tensor => {
             let input = tensor_epochs(epochs, &geometry, &cfg.processing());
-            Track::from_tensor(&locate_tensor(&input, &lc)?)
+            let out = locate_tensor(&input, &lc)?;
+            if lc.passes > 1 {
+                let filter = locate_tensor(&input, &LocateConfig { passes: 1, ..lc })?;
+                check_passes_agree(&filter, &out)?;
+            }
+            Track::from_tensor(&out)
         }
         Gradiometer::Scalar => {
             let input = scalar_epochs(epochs, &geometry, positions, &cfg.processing())?;
             Track::from_scalar(&locate_scalar(&input, &lc)?, positions)
         }
     })
+}
+
+/// How far the re-linearised passes' final position may lie from the
+/// filter's, as a fraction of the filter's range to the object, before the
+/// passes count as diverged. Both estimate the same object from the same
+/// data: they differ in precision (the filter is over-confident where it
+/// linearised early epochs about a poor estimate: 17 of its σ on the
+/// well-posed pass, 0.4 % of the range), not by a tenth of the distance to
+/// the object.
+pub const PASSES_AGREEMENT_FRACTION: f64 = 0.1;
+
+/// The re-linearised passes' final position within
+/// [`PASSES_AGREEMENT_FRACTION`] of the range of the filter's, else a
+/// failure ([`aeromag_gradiometry::GradiometryError::Diverged`], not bad
+/// input).
+///
+/// The passes linearise every epoch about the trajectory carried back from
+/// the first pass's *final* estimate; that pass runs with the extra noise
+/// `estimator.first_pass_extra_*`, and when the pass ends far from the
+/// object (the default 120 m pass ends 60 m away, 60 baselines) it forgets
+/// the object and ends at the zero-moment solution next to the
+/// gradiometer. The passes then converge confidently to that wrong point.
+fn check_passes_agree(filter: &[Option<Located<6>>], passes: &[Option<Located<6>>]) -> Result<()> {
+    let (Some(Some(f)), Some(Some(p))) = (filter.last(), passes.last()) else {
+        return Ok(());
+    };
+    let (xf, xp) = (f.step.posterior.x, p.step.posterior.x);
+    let (rf, rp) = (xf.fixed_rows::<3>(0), xp.fixed_rows::<3>(0));
+    if (rp - rf).norm() <= PASSES_AGREEMENT_FRACTION * rf.norm() {
+        return Ok(());
+    }
+    let fmt = |x: &SVector<f64, 6>| format!("({:.3}, {:.3}, {:.3})", x[0], x[1], x[2]);
+    Err(Error::Gradiometry(GradiometryError::Diverged(format!(
+        "the re-linearised passes end at {} m, {:.3} m from the filter's {} m (more than {} of its \
+         range): their first pass, with the extra noise estimator.first_pass_extra_position_m / \
+         _moment_am2, lost the object before the end of the pass; use passes = 1 (the filter) \
+         or smaller extra noise",
+        fmt(&xp),
+        (rp - rf).norm(),
+        fmt(&xf),
+        PASSES_AGREEMENT_FRACTION
+    ))))
 }
 
 /// CRLB standard deviations at epoch `j` from every epoch up to it, state
@@ -656,9 +794,19 @@ pub fn map_figures(
     let mut out = Vec::new();
     for (tag, map, _) in maps {
         for (axis, v) in [(2, case.position_m.z), (1, case.position_m.y)] {
-            out.push(Block::Figure {
-                svg: slice_heatmap(case, map, axis, v, tag).to_svg()?,
-                caption: format!("{tag}: iterations per start (grey: no convergence)."),
+            let heatmap = slice_heatmap(case, map, axis, v, tag);
+            // A slice where no start converged (likely on a coarse grid) is
+            // a result, not a plot: say so instead of drawing nothing.
+            out.push(if heatmap.values.iter().any(|v| v.is_finite()) {
+                Block::Figure {
+                    svg: heatmap.to_svg()?,
+                    caption: format!("{tag}: iterations per start (grey: no convergence)."),
+                }
+            } else {
+                Block::Paragraph(format!(
+                    "{}: no start of this slice converged (nothing to draw).",
+                    heatmap.title
+                ))
             });
         }
     }

@@ -7,6 +7,7 @@
 //! - `convergence`: the seed's fig. 2 convergence map.
 
 use crate::exit::bad_input;
+use aeromag::core::parallel::MAX_THREADS;
 use aeromag::gradiometry::{
     LocateSettings, STATE_NAMES, both_maps, locate_pass, map_figures, parse_name, read_config,
     read_pass,
@@ -78,6 +79,9 @@ pub struct SimulateArgs {
 /// mz_am2` (body frame), their standard deviations `sd_…`, `iterations,
 /// residual_nt, converged` and the estimability measures `mu_…`
 /// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior).
+/// The scalar gradiometer does not estimate the position (it is known from
+/// the tracks): its `sd_x_m … mu_z` cells are empty and the summary says
+/// "σ not estimated".
 ///
 /// Example: `aeromag dipole locate --input grad/gradiometer.csv --config grad/gradiometer.toml --out est.csv`
 #[derive(Debug, clap::Args)]
@@ -101,7 +105,11 @@ struct LocateArgs {
     /// Sensor noise σ, nT (overrides the file).
     #[arg(long)]
     noise_nt: Option<f64>,
-    /// Passes over the data (overrides the file; 1 = filter).
+    /// Passes over the data (overrides the file), 1…100: 1 = the filter;
+    /// more = re-linearised passes, a failure (exit 1) when they end
+    /// farther from the filter's position than a tenth of its range (their
+    /// noisier first pass lost the object, as on a pass that ends far from
+    /// it).
     #[arg(long)]
     passes: Option<usize>,
     /// Multi-start initialisation (the default of the scenario file).
@@ -147,7 +155,7 @@ struct ConvergenceArgs {
     /// Starts per axis (n³ in all).
     #[arg(long, default_value_t = 40)]
     grid: usize,
-    /// Worker threads (the result does not depend on it).
+    /// Worker threads, 1…64 (the result does not depend on it).
     #[arg(long, default_value_t = 2)]
     threads: usize,
     /// Output folder for the report.
@@ -209,9 +217,14 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
                 time[j0],
                 track.converged.iter().filter(|&&c| c).count()
             );
+            let sigma = if sd[..3].iter().all(|v| v.is_finite()) {
+                format!("σ {:.3e} {:.3e} {:.3e}", sd[0], sd[1], sd[2])
+            } else {
+                "σ not estimated (known from the tracks)".to_string()
+            };
             println!(
-                "final position (m)    {:9.3} {:9.3} {:9.3}  σ {:.3e} {:.3e} {:.3e}",
-                x[0], x[1], x[2], sd[0], sd[1], sd[2]
+                "final position (m)    {:9.3} {:9.3} {:9.3}  {sigma}",
+                x[0], x[1], x[2]
             );
             println!(
                 "final moment (A·m²)   {:9.2} {:9.2} {:9.2}  σ {:.3e} {:.3e} {:.3e}",
@@ -263,6 +276,12 @@ fn crlb(a: CrlbArgs) -> anyhow::Result<()> {
 fn convergence(a: ConvergenceArgs) -> anyhow::Result<()> {
     if !(2..=200).contains(&a.grid) {
         return Err(bad_input!("--grid {} must be in 2…200", a.grid));
+    }
+    if !(1..=MAX_THREADS).contains(&a.threads) {
+        return Err(bad_input!(
+            "--threads {} must be in 1…{MAX_THREADS}",
+            a.threads
+        ));
     }
     let case = ConvergenceCase::seed_fig2(a.grid);
     let toward = case.position_m.normalize();

@@ -14,12 +14,18 @@
 
 use super::Calibration;
 use crate::{EmError, Result};
+use aeromag_core::error::shown;
 use nalgebra::Matrix3;
 
 /// Value of the `format` field.
 pub const CALIBRATION_FORMAT: &str = "aeromag-em-calibration";
 /// Current `version` (readers reject other versions).
 pub const CALIBRATION_VERSION: u32 = 1;
+
+/// Largest entry of `QᵀQ − I` of a stored attitude correction `Q`: a
+/// rotation written by `calibrate` is orthonormal to rounding (~10⁻¹⁵);
+/// 10⁻⁶ leaves room for a hand-edited file with 7 significant digits.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
 
 /// How many epochs and known points the stages were fitted from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -67,7 +73,9 @@ impl CalibrationFile {
         })
     }
 
-    /// Parse and check format, version and finiteness.
+    /// Parse and check format, version and finiteness, and that
+    /// `calibration.attitude_q` is a rotation (orthonormal within
+    /// [`ROTATION_TOLERANCE`], determinant +1).
     ///
     /// Errors ([`EmError::InvalidData`]) with serde's line and column for
     /// malformed JSON, or naming the offending field.
@@ -102,6 +110,18 @@ impl CalibrationFile {
         {
             return Err(EmError::InvalidData {
                 reason: "non-finite number in the calibration".into(),
+            });
+        }
+        let q = &c.attitude_q;
+        let off = (q.transpose() * q - Matrix3::identity()).amax();
+        if off > ROTATION_TOLERANCE || q.determinant() <= 0.0 {
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'calibration.attitude_q' is not a rotation (QᵀQ differs from I by {}, \
+                     det {}; expected orthonormal within {ROTATION_TOLERANCE}, det +1)",
+                    shown(off),
+                    shown(q.determinant())
+                ),
             });
         }
         if f.moments_am2.determinant().abs() == 0.0 {
@@ -141,6 +161,19 @@ mod tests {
         let mut singular = f.clone();
         singular.moments_am2 = Matrix3::zeros();
         assert!(err(&singular.to_json().unwrap()).contains("moments_am2"));
+        for q in [Matrix3::zeros(), Matrix3::from_diagonal_element(5.0)] {
+            let mut bad = f.clone();
+            bad.calibration.attitude_q = q;
+            let e = err(&bad.to_json().unwrap());
+            assert!(
+                e.contains("attitude_q") && e.contains("not a rotation"),
+                "{e}"
+            );
+        }
+        let mut mirror = f.clone();
+        mirror.calibration.attitude_q =
+            Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, -1.0));
+        assert!(err(&mirror.to_json().unwrap()).contains("attitude_q"));
         let mut nan = f;
         nan.calibration.attitude_q[(0, 1)] = f64::NAN;
         // serde_json writes NaN as null, which does not parse as a number.

@@ -10,20 +10,41 @@
 
 use super::{Complex64, DetectorConfig, FieldChain, SyncDetector};
 use crate::{EmError, Result};
+use aeromag_core::error::shown;
 use aeromag_core::filter::Window;
 use nalgebra::{Matrix3, Vector3};
+
+/// Working frequencies of the dipoles, Hz: 1 Hz to 1 MHz (induction
+/// coils are used from a few Hz to some hundred kHz).
+pub const FREQUENCY_RANGE_HZ: (f64, f64) = (1.0, 1e6);
+
+/// Pilot offset δ, Hz: 1 mHz (a tone the detector can still resolve within
+/// a flight) to 100 kHz (pilots beyond the working frequencies' band).
+pub const PILOT_OFFSET_RANGE_HZ: (f64, f64) = (1e-3, 1e5);
+
+/// Induction-coil gain, V per (T/s): positive (the polarity is in `χ`),
+/// 10⁻⁶ to 10¹⁰.
+pub const COIL_GAIN_RANGE: (f64, f64) = (1e-6, 1e10);
+
+/// Pilot field amplitude per axis, T: positive, at most 100 µT (twice the
+/// Earth's field; a pilot is a small calibration field).
+pub const PILOT_FIELD_RANGE_T: (f64, f64) = (0.0, 1e-4);
 
 /// Instrument constants of a three-dipole EM positioning system.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EmSystem {
-    /// Working frequencies `f_i` of the three dipoles, Hz.
+    /// Working frequencies `f_i` of the three dipoles, Hz; distinct,
+    /// within [`FREQUENCY_RANGE_HZ`].
     pub frequencies_hz: [f64; 3],
-    /// Pilot offset `δ`, Hz (pilot tones at `f_i ± δ`, eq. 4).
+    /// Pilot offset `δ`, Hz (pilot tones at `f_i ± δ`, eq. 4); within
+    /// [`PILOT_OFFSET_RANGE_HZ`].
     pub pilot_offset_hz: f64,
-    /// Induction-coil gain `g`, V per (T/s) (the coil voltage ∝ dB/dt).
+    /// Induction-coil gain `g`, V per (T/s) (the coil voltage ∝ dB/dt);
+    /// within [`COIL_GAIN_RANGE`].
     pub coil_gain_v_per_t_s: f64,
-    /// Pilot field amplitude in bird axes, T (the seed's `A`).
+    /// Pilot field amplitude in bird axes, T (the seed's `A`); each
+    /// component positive and at most [`PILOT_FIELD_RANGE_T`]`.1`.
     pub pilot_field_t: Vector3<f64>,
     /// Bench-measured receiver cross-coupling `χ(ω_i)` per working
     /// frequency (complex, unit diagonal, eq. 3); in JSON each matrix is a
@@ -35,8 +56,10 @@ pub struct EmSystem {
 }
 
 impl EmSystem {
-    /// Check a system read from a file: every number finite, pilot offset
-    /// and coil gain non-zero, moments and every `χ_i` invertible.
+    /// Check a system read from a file: every number finite; frequencies
+    /// distinct; frequencies, pilot offset, coil gain and pilot field
+    /// positive and within their ranges (the constants above); moments and
+    /// every `χ_i` invertible.
     ///
     /// Errors ([`EmError::InvalidData`]) naming the offending field.
     pub fn validate(&self) -> Result<()> {
@@ -54,10 +77,50 @@ impl EmSystem {
         if !finite {
             return bad("non-finite number in the system description");
         }
-        if self.coil_gain_v_per_t_s == 0.0 || self.pilot_offset_hz <= 0.0 {
-            return bad(
-                "fields 'coil_gain_v_per_t_s' and 'pilot_offset_hz' must be non-zero and positive",
-            );
+        let out_of = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str| {
+            Err(EmError::InvalidData {
+                reason: format!(
+                    "field '{field}' is {}, expected {}…{} {unit}",
+                    shown(v),
+                    shown(lo),
+                    shown(hi)
+                ),
+            })
+        };
+        for (k, &f) in self.frequencies_hz.iter().enumerate() {
+            if !(FREQUENCY_RANGE_HZ.0..=FREQUENCY_RANGE_HZ.1).contains(&f) {
+                return out_of(&format!("frequencies_hz[{k}]"), f, FREQUENCY_RANGE_HZ, "Hz");
+            }
+            if self.frequencies_hz[..k].contains(&f) {
+                return bad(&format!(
+                    "field 'frequencies_hz' holds {} Hz twice: the three dipoles need distinct frequencies",
+                    shown(f)
+                ));
+            }
+        }
+        let checks = [
+            (
+                "pilot_offset_hz",
+                self.pilot_offset_hz,
+                PILOT_OFFSET_RANGE_HZ,
+                "Hz",
+            ),
+            (
+                "coil_gain_v_per_t_s",
+                self.coil_gain_v_per_t_s,
+                COIL_GAIN_RANGE,
+                "V/(T/s)",
+            ),
+        ];
+        for (field, v, range, unit) in checks {
+            if !(range.0..=range.1).contains(&v) {
+                return out_of(field, v, range, unit);
+            }
+        }
+        for (k, &a) in self.pilot_field_t.iter().enumerate() {
+            if !(a > 0.0 && a <= PILOT_FIELD_RANGE_T.1) {
+                return out_of(&format!("pilot_field_t[{k}]"), a, PILOT_FIELD_RANGE_T, "T");
+            }
         }
         // |det| < 1e-12 ‖M‖³ on M scaled by its largest entry (both sides
         // scale alike): unscaled, the norm's cube overflowed for a moment
@@ -133,6 +196,19 @@ mod tests {
             s.validate().is_ok(),
             "a well-conditioned matrix at any scale"
         );
+        // Values the fuzzer found accepted, each refused naming its field.
+        let refused = |edit: &dyn Fn(&mut super::EmSystem), field: &str| {
+            let mut s = good.clone();
+            edit(&mut s);
+            let e = s.validate().unwrap_err().to_string();
+            assert!(e.contains(field) && e.len() < 200, "{field}: {e}");
+        };
+        refused(&|s| s.frequencies_hz = [1025.0; 3], "frequencies_hz");
+        refused(&|s| s.coil_gain_v_per_t_s = -1.0, "coil_gain_v_per_t_s");
+        refused(&|s| s.pilot_field_t[1] = -1e-9, "pilot_field_t[1]");
+        refused(&|s| s.pilot_field_t[0] = 1e308, "pilot_field_t[0]");
+        refused(&|s| s.pilot_offset_hz = 1e-308, "pilot_offset_hz");
+        refused(&|s| s.pilot_offset_hz = 1e308, "pilot_offset_hz");
         let mut s = good.clone();
         s.chi[1] = nalgebra::Matrix3::zeros();
         assert!(s.validate().unwrap_err().to_string().contains("chi"));
