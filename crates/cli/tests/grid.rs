@@ -232,3 +232,163 @@ fn derived_grids_and_micro_levelling_from_the_command_line() {
         2,
     );
 }
+
+/// An ESRI ASCII grid `name` in `dir`: `ncols × nrows` at `cell` m, the
+/// rows `body` (north first).
+fn asc(dir: &Path, name: &str, size: (usize, usize), cell: &str, body: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(
+        &path,
+        format!(
+            "ncols {}\nnrows {}\nxllcenter 0\nyllcenter 0\ncellsize {cell}\nNODATA_value -99999\n{body}",
+            size.0, size.1
+        ),
+    )
+    .unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// `aeromag derive -i INPUT <product…> --out OUT`.
+fn derive(input: &str, product: &[&str], out: &Path) -> std::process::Output {
+    let mut a = vec!["derive", "-i", input];
+    a.extend(product);
+    a.extend(["--out", out.to_str().unwrap()]);
+    aeromag(&a)
+}
+
+/// Exit code 2, a message naming `what`, of reasonable length, and no
+/// output file.
+fn assert_refused(o: &std::process::Output, what: &[&str], out: &Path) {
+    assert_code(o, 2);
+    let e = stderr(o);
+    for w in what {
+        assert!(e.contains(w), "{w}: {e}");
+    }
+    assert!(e.len() < 400 && !e.contains("inf "), "{e}");
+    assert!(!out.exists(), "{e}");
+}
+
+#[test]
+fn derive_refuses_values_heights_and_cells_it_cannot_process() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.asc");
+    let rows = "1 2 3\n4 5 6\n7 8 9\n";
+    let ok = asc(d.path(), "ok.asc", (3, 3), "100", rows);
+    // Values beyond float32, or infinite: refused naming row and column
+    // (they gave inf/-inf nodes and a 300-digit mean with exit code 0).
+    let huge = asc(
+        d.path(),
+        "v.asc",
+        (3, 3),
+        "100",
+        "1e300 2 3\n4 5 6\n7 8 9\n",
+    );
+    for product in [&["--vertical-derivative"][..], &["--upward", "100"]] {
+        let o = derive(&huge, product, &out);
+        assert_refused(&o, &["v.asc", "row 1, column 1", "1e300"], &out);
+    }
+    for (name, value, shown) in [
+        ("big.asc", "1e400", "is inf"),
+        ("neg.asc", "-1e308", "is -1e308"),
+        ("inf.asc", "inf", "is inf"),
+        ("max.asc", "1e308", "is 1e308"),
+    ] {
+        let bad = asc(
+            d.path(),
+            name,
+            (3, 3),
+            "100",
+            &format!("1 2 3\n4 {value} 6\n7 8 9\n"),
+        );
+        let o = derive(&ok, &["--minus", &bad], &out);
+        assert_refused(&o, &[name, "row 2, column 2", shown], &out);
+        let o = derive(&bad, &["--vertical-derivative"], &out);
+        assert_refused(&o, &[name, "row 2, column 2", shown], &out);
+    }
+    // NaN is a blank node (documented): it stays blank.
+    let nan = asc(
+        d.path(),
+        "nan.asc",
+        (3, 3),
+        "100",
+        "1 2 3\n4 nan 6\n7 8 9\n",
+    );
+    let o = derive(&nan, &["--vertical-derivative"], &out);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("8 not blank"), "{}", stdout(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(
+        text.lines().nth(7).unwrap().split(' ').nth(1),
+        Some("-99999")
+    );
+    std::fs::remove_file(&out).unwrap();
+    // Heights: 1e-8 cell to 10 × the extent (3 × 100 m here).
+    for h in ["1e308", "5e-324", "0", "3001"] {
+        let o = derive(&ok, &["--upward", h], &out);
+        assert_refused(
+            &o,
+            &["continuation height", "between 0.000001 and 3000 m"],
+            &out,
+        );
+    }
+    let o = derive(&ok, &["--upward", "3000"], &out);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("continued up 3000 m"), "{}", stdout(&o));
+    std::fs::remove_file(&out).unwrap();
+    // Cell sizes: 1e-6 to 1e6 m.
+    for cell in ["1e-308", "1e308", "-1e308"] {
+        let bad = asc(d.path(), "c.asc", (3, 3), cell, rows);
+        let o = derive(&bad, &["--vertical-derivative"], &out);
+        assert_refused(&o, &["c.asc", "cell size", cell], &out);
+    }
+}
+
+#[test]
+fn derive_refuses_a_header_larger_than_its_file_without_allocating_it() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.asc");
+    let hd = asc(d.path(), "hd.asc", (15800, 15800), "1", "1 2 3\n");
+    let start = std::time::Instant::now();
+    let o = derive(&hd, &["--vertical-derivative"], &out);
+    assert_refused(&o, &["hd.asc", "declares 15800 × 15800"], &out);
+    // It allocated 2 GB and took 2 s.
+    assert!(start.elapsed().as_secs_f64() < 1.0, "{:?}", start.elapsed());
+}
+
+#[test]
+fn derive_on_tiny_and_blank_grids_gives_an_error_or_a_valid_grid() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.asc");
+    let one = asc(d.path(), "one.asc", (1, 1), "100", "5\n");
+    let row = asc(d.path(), "row.asc", (2, 1), "100", "5 6\n");
+    let square = asc(d.path(), "sq.asc", (2, 2), "100", "5 6\n7 8\n");
+    let blank = asc(
+        d.path(),
+        "blank.asc",
+        (2, 2),
+        "100",
+        "-99999 -99999\n-99999 -99999\n",
+    );
+    for grid in [&one, &row] {
+        for product in [&["--vertical-derivative"][..], &["--upward", "10"]] {
+            let o = derive(grid, product, &out);
+            assert_refused(&o, &[grid.as_str(), "too small to filter"], &out);
+        }
+    }
+    for product in [&["--vertical-derivative"][..], &["--upward", "10"]] {
+        let o = derive(&blank, product, &out);
+        assert_refused(&o, &["blank.asc", "no value"], &out);
+        let o = derive(&square, product, &out);
+        assert_code(&o, 0);
+        assert!(stdout(&o).contains("4 not blank"), "{}", stdout(&o));
+        std::fs::remove_file(&out).unwrap();
+    }
+    // A difference without any value (it wrote a blank grid, "mean NaN").
+    let o = derive(&blank, &["--minus", &blank], &out);
+    assert_refused(&o, &["blank.asc", "no value"], &out);
+    for grid in [&one, &row, &square] {
+        let o = derive(grid, &["--minus", grid], &out);
+        assert_code(&o, 0);
+        assert!(stdout(&o).contains("mean 0.0000"), "{}", stdout(&o));
+    }
+}

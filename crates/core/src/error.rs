@@ -58,9 +58,32 @@ pub fn shown(v: f64) -> String {
     }
 }
 
+/// Characters of a text [`shown_text`] keeps.
+pub const SHOWN_TEXT_CHARS: usize = 40;
+
+/// A text from a file in a message: quoted and escaped as Rust's `{:?}`
+/// writes it (control characters and NULs as `\0`, `\u{1}`, …), cut to
+/// its first [`SHOWN_TEXT_CHARS`] characters with `…` after the quote, so
+/// that binary garbage is never echoed raw nor by the kilobyte.
+pub fn shown_text(s: &str) -> String {
+    match s.char_indices().nth(SHOWN_TEXT_CHARS) {
+        Some((end, _)) => format!("{:?}…", &s[..end]),
+        None => format!("{s:?}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn texts_are_escaped_and_cut() {
+        assert_eq!(shown_text("long_name"), "\"long_name\"");
+        assert_eq!(shown_text("y\0\u{1}é"), "\"y\\0\\u{1}é\"");
+        let garbage = "\0".repeat(500);
+        let s = shown_text(&garbage);
+        assert_eq!(s, format!("\"{}\"…", "\\0".repeat(SHOWN_TEXT_CHARS)));
+    }
 
     #[test]
     fn long_values_are_shown_in_exponent_form() {

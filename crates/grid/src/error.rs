@@ -56,6 +56,44 @@ pub enum GridError {
         /// What is wrong.
         reason: String,
     },
+    /// A node value of a grid file that is not a grid value: infinite, or
+    /// larger in magnitude than [`MAX_VALUE`](crate::grid::MAX_VALUE)
+    /// (float32's largest).
+    /// (NaN is a blank node, not an error.)
+    #[error(
+        "reading '{path}': the value at row {row}, column {column} (from the north-west \
+         corner, 1-based) is {}: grid values must be finite and within float32's range, \
+         ±3.4e38",
+        shown(*value)
+    )]
+    BadValue {
+        /// The file.
+        path: String,
+        /// Row, 1-based, counted from the northern row.
+        row: usize,
+        /// Column, 1-based, counted from the western column.
+        column: usize,
+        /// The value read.
+        value: f64,
+    },
+    /// A continuation height outside what changes the grid and stays
+    /// meaningful for it ([`crate::products::height_range`]).
+    #[error(
+        "continuation height {} m is out of range: between {} and {} m for this grid \
+         (1e-8 cell: lower heights change no value at float32 precision; 10 times the \
+         grid's extent: higher ones leave only its mean)",
+        shown(*value),
+        shown(*min),
+        shown(*max)
+    )]
+    Height {
+        /// The height asked for, m.
+        value: f64,
+        /// The lowest allowed, m.
+        min: f64,
+        /// The highest allowed, m.
+        max: f64,
+    },
     /// Writing a grid file failed.
     #[error("writing '{path}': {source}")]
     Write {

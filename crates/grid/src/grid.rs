@@ -28,6 +28,31 @@ pub struct GridGeometry {
 /// size is an error and not an out-of-memory abort.
 pub const MAX_NODES: usize = 250_000_000;
 
+/// Smallest cell size of a grid read from a file, m (1 µm). Survey grids
+/// have cells of decimetres (drone, ground) to kilometres (compilations);
+/// a smaller "cell" is a corrupt header, and would put wavenumbers of
+/// order 1/cell beyond what the derivative products can multiply by.
+pub const MIN_CELL: f64 = 1e-6;
+
+/// Largest cell size of a grid read from a file, m (1000 km: forty cells
+/// go round the Earth).
+pub const MAX_CELL: f64 = 1e6;
+
+/// Largest magnitude of a node coordinate of a grid read from a file, m
+/// (10⁹ m, 25 times the Earth's circumference: far beyond the easting or
+/// northing of any projection of the Earth).
+pub const MAX_COORDINATE: f64 = 1e9;
+
+/// Largest magnitude of a node value of a grid read from a file: that of
+/// float32 (3.4·10³⁸). Every grid file this crate writes stores float32,
+/// so a larger value could not be written back, and no field (nT, the
+/// Earth's at most 7·10⁴ nT), gradient or other survey quantity comes
+/// near it: it is a corrupt file. The bound keeps every product finite in
+/// f64: a spectral product sums at most 4·[`MAX_NODES`] values times at
+/// most π√2/[`MIN_CELL`], about 10⁵⁴ in all, far from f64's 10³⁰⁸ (a
+/// result beyond float32 is then refused when written).
+pub const MAX_VALUE: f64 = f32::MAX as f64;
+
 impl GridGeometry {
     /// The smallest grid of spacing `cell` whose nodes cover
     /// `[x_min, x_max] × [y_min, y_max]`, with its western and southern
@@ -213,13 +238,27 @@ impl Grid {
                 self.geometry, other.geometry
             )));
         }
+        let values: Vec<f64> = self
+            .values
+            .iter()
+            .zip(&other.values)
+            .map(|(a, b)| a - b)
+            .collect();
+        // Grids read from files hold values within MAX_VALUE, whose
+        // differences are finite; one built in memory may not.
+        if let Some(k) = (0..values.len()).find(|&k| {
+            !values[k].is_finite() && !self.values[k].is_nan() && !other.values[k].is_nan()
+        }) {
+            return Err(GridError::Data(format!(
+                "the difference at node ({}, {}) is not finite: {} − {}",
+                k % self.geometry.nx,
+                k / self.geometry.nx,
+                shown(self.values[k]),
+                shown(other.values[k])
+            )));
+        }
         Ok(Grid {
-            values: self
-                .values
-                .iter()
-                .zip(&other.values)
-                .map(|(a, b)| a - b)
-                .collect(),
+            values,
             name: format!("{} - {}", self.name, other.name),
             ..self.clone()
         })
@@ -274,5 +313,24 @@ mod tests {
         let s = grid.stats();
         assert_eq!(s.count, 20);
         assert!(grid.difference(&grid).unwrap().stats().std == 0.0);
+    }
+
+    #[test]
+    fn a_difference_that_overflows_is_an_error() {
+        let geometry = GridGeometry::covering(0.0, 100.0, 0.0, 100.0, 100.0).unwrap();
+        let mut a = Grid::blank(geometry, "a", "nT");
+        let mut b = a.clone();
+        a.values = vec![1.0, f64::NAN, 1e308, 3.0];
+        b.values = vec![1.0, 2.0, -1e308, f64::NAN];
+        let m = a.difference(&b).unwrap_err().to_string();
+        assert!(
+            m.contains("node (0, 1)") && m.contains("1e308 − -1e308"),
+            "{m}"
+        );
+        b.values[2] = 1e308;
+        let d = a.difference(&b).unwrap();
+        assert_eq!(d.values[0], 0.0);
+        assert_eq!(d.values[2], 0.0);
+        assert!(d.values[1].is_nan() && d.values[3].is_nan());
     }
 }

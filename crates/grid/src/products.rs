@@ -14,7 +14,8 @@
 //! nodes are kept and the blank ones blanked again.
 
 use crate::error::{GridError, Result};
-use crate::grid::Grid;
+use crate::grid::{Grid, GridGeometry};
+use aeromag_core::error::shown;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex64;
 
@@ -71,10 +72,22 @@ impl Spectral {
     }
 }
 
+/// The continuation heights that are meaningful for a grid of `geometry`,
+/// m: from 10⁻⁸ cell (the filter `e^{−|k| h}` at the highest wavenumber,
+/// `|k| ≤ π√2/cell`, then differs from 1 by less than float32's
+/// precision, 6·10⁻⁸: a lower height changes no value) to 10 times the
+/// grid's extent `max(nx, ny) · cell` (the longest wavelength of the
+/// mirrored grid is twice the extent, so every varying component is then
+/// damped by `e^{−10π}` ≈ 2·10⁻¹⁴: only the mean is left).
+pub fn height_range(geometry: &GridGeometry) -> (f64, f64) {
+    let extent = geometry.nx.max(geometry.ny) as f64 * geometry.cell;
+    (1e-8 * geometry.cell, 10.0 * extent)
+}
+
 /// `op` applied to `grid` (module docs). The result has the grid's
 /// geometry and blanks; a vertical derivative's unit is the grid's per
 /// metre. Errors: a grid with fewer than 2 × 2 nodes or without any value,
-/// a non-finite or negative continuation height.
+/// a continuation height outside [`height_range`] ([`GridError::Height`]).
 pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
     let g = grid.geometry;
     if g.nx < 2 || g.ny < 2 {
@@ -84,12 +97,11 @@ pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
         )));
     }
     match op {
-        Spectral::UpwardContinuation(h) if !(h.is_finite() && h >= 0.0) => {
-            return Err(GridError::OutOfRange {
-                name: "continuation height",
-                value: h,
-                expected: "a finite height ≥ 0 m",
-            });
+        Spectral::UpwardContinuation(h) => {
+            let (min, max) = height_range(&g);
+            if !(min..=max).contains(&h) {
+                return Err(GridError::Height { value: h, min, max });
+            }
         }
         Spectral::Corrugation(c) => {
             crate::error::positive("cut-off wavelength", c.cutoff_wavelength_m)?;
@@ -124,7 +136,7 @@ pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
     }
     fft2(&mut a, mx, my, &mut planner, true);
     let scale = 1.0 / (mx * my) as f64;
-    let values = (0..g.len())
+    let values: Vec<f64> = (0..g.len())
         .map(|k| {
             if grid.values[k].is_nan() {
                 f64::NAN
@@ -133,13 +145,28 @@ pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
             }
         })
         .collect();
+    // Not expected for values within MAX_VALUE and a cell within MIN_CELL–
+    // MAX_CELL, but a grid built in memory has no such bounds.
+    if values
+        .iter()
+        .zip(&grid.values)
+        .any(|(v, x)| !v.is_finite() && !x.is_nan())
+    {
+        let s = grid.stats();
+        return Err(GridError::Data(format!(
+            "the result is not finite: values from {} to {} at a {} m cell are too large to filter",
+            shown(s.min),
+            shown(s.max),
+            shown(g.cell)
+        )));
+    }
     let (name, unit) = match op {
         Spectral::VerticalDerivative => (
             format!("{} vertical derivative", grid.name),
             format!("{}/m", grid.unit),
         ),
         Spectral::UpwardContinuation(h) => (
-            format!("{} continued up {h} m", grid.name),
+            format!("{} continued up {} m", grid.name, shown(h)),
             grid.unit.clone(),
         ),
         Spectral::Corrugation(_) => (format!("{} corrugation", grid.name), grid.unit.clone()),
@@ -449,5 +476,57 @@ mod tests {
         assert!(apply(&g, Spectral::UpwardContinuation(-1.0)).is_err());
         let all_blank = Grid::blank(geometry, "x", "nT");
         assert!(apply(&all_blank, Spectral::VerticalDerivative).is_err());
+    }
+
+    #[test]
+    fn continuation_heights_outside_the_meaningful_range_are_refused() {
+        let g = grid_of(|x, y| pole(x, y, 800.0));
+        // 241 × 201 nodes at 100 m: heights from 1 µm to 241 km.
+        assert_eq!(height_range(&g.geometry), (1e-6, 241_000.0));
+        for h in [
+            1e308,
+            5e-324,
+            0.0,
+            -1.0,
+            f64::NAN,
+            f64::INFINITY,
+            241_001.0,
+            9e-7,
+        ] {
+            let e = apply(&g, Spectral::UpwardContinuation(h)).unwrap_err();
+            assert!(e.is_bad_input());
+            let m = e.to_string();
+            assert!(matches!(e, GridError::Height { .. }), "{h}: {m}");
+            assert!(
+                m.len() < 250 && m.contains("between 0.000001 and 241000 m"),
+                "{m}"
+            );
+        }
+        let up = apply(&g, Spectral::UpwardContinuation(241_000.0)).unwrap();
+        assert_eq!(up.name, "T continued up 241000 m");
+        assert!(up.values.iter().all(|v| v.is_finite()));
+        assert!(apply(&g, Spectral::UpwardContinuation(1e-6)).is_ok());
+    }
+
+    #[test]
+    fn a_product_that_overflows_is_an_error_not_infinities() {
+        // Values no file may hold (grids read from files are within
+        // float32), built in memory.
+        let mut g = grid_of(|_, _| 1.0);
+        g.values[0] = 1.7e308;
+        g.values[1] = -1.7e308;
+        for op in [
+            Spectral::VerticalDerivative,
+            Spectral::UpwardContinuation(100.0),
+        ] {
+            let Err(e) = apply(&g, op) else {
+                panic!("{op:?}: no error");
+            };
+            let m = e.to_string();
+            assert!(
+                m.contains("not finite") && m.contains("-1.7e308") && m.len() < 150,
+                "{m}"
+            );
+        }
     }
 }

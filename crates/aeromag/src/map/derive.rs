@@ -2,10 +2,10 @@
 //! continuation (FFT, [`aeromag_grid::products`]) and the difference of
 //! two grids (e.g. against the truth grid of simulated data).
 
-use crate::error::Result;
-use aeromag_grid::Grid;
+use crate::error::{InFile, Result};
 use aeromag_grid::format::read_grid;
 use aeromag_grid::products::{Spectral, apply};
+use aeromag_grid::{Grid, GridError};
 use std::path::{Path, PathBuf};
 
 /// What [`derive`] computes.
@@ -21,11 +21,32 @@ pub enum GridProduct {
 
 /// Read the grid file `input` (GeoTIFF, ESRI ASCII or netCDF) and compute
 /// `product` from it; blanks stay blank.
+///
+/// Errors name the file: a grid file that cannot be read or holds values
+/// it should not ([`read_grid`]), a grid too small for the product or
+/// without any value, a continuation height out of
+/// [`height_range`](aeromag_grid::products::height_range), grids of
+/// different nodes, a difference without any value (no node is set in
+/// both grids).
 pub fn derive(input: &Path, product: &GridProduct) -> Result<Grid> {
     let grid = read_grid(input)?;
-    Ok(match product {
-        GridProduct::VerticalDerivative => apply(&grid, Spectral::VerticalDerivative)?,
-        GridProduct::Upward(h) => apply(&grid, Spectral::UpwardContinuation(*h))?,
-        GridProduct::Minus(other) => grid.difference(&read_grid(other)?)?,
-    })
+    let file = input.display().to_string();
+    let result = match product {
+        GridProduct::VerticalDerivative => {
+            apply(&grid, Spectral::VerticalDerivative).in_file(&file)?
+        }
+        GridProduct::Upward(h) => apply(&grid, Spectral::UpwardContinuation(*h)).in_file(&file)?,
+        GridProduct::Minus(other) => {
+            let both = format!("{file} minus {}", other.display());
+            let d = grid.difference(&read_grid(other)?).in_file(&both)?;
+            if d.stats().count == 0 {
+                return Err(GridError::Data(
+                    "the difference has no value: no node is set in both grids".into(),
+                ))
+                .in_file(&both);
+            }
+            d
+        }
+    };
+    Ok(result)
 }

@@ -2,6 +2,7 @@
 //! derivative, upward continuation, or difference (library:
 //! [`aeromag::map::derive`]).
 
+use aeromag::core::error::shown;
 use aeromag::map::{GridProduct, derive};
 use std::path::PathBuf;
 
@@ -10,7 +11,14 @@ use std::path::PathBuf;
 ///
 /// The vertical derivative and upward continuation are computed by FFT on
 /// the grid made complete (blanks filled harmonically) and mirrored about
-/// its edges; blanks stay blank.
+/// its edges; blanks stay blank. The filters need at least 2 × 2 nodes
+/// and one value.
+///
+/// Input grids are checked (exit code 2, naming the file): NODATA and NaN
+/// nodes are blank; an infinite value or one beyond float32's range
+/// (±3.4e38: every grid format stores float32, and no field or gradient
+/// comes near it) is an error naming its row (from the north) and column; the cell size must be 1e-6 to 1e6 m, node coordinates within
+/// ±1e9 m, and the header may not declare more nodes than the file holds.
 ///
 /// Examples:
 ///   aeromag derive --input mag.tif --vertical-derivative --out fvd.tif
@@ -29,10 +37,14 @@ pub struct Args {
     /// First vertical derivative (z down), nT/m.
     #[arg(long, group = "product")]
     vertical_derivative: bool,
-    /// Upward continuation by this height, m.
+    /// Upward continuation by this height, m: from 1e-8 cell (lower
+    /// heights change no value at float32 precision) to 10 times the
+    /// grid's extent, max(columns, rows) × cell (higher ones leave only
+    /// the grid's mean).
     #[arg(long, value_name = "M", group = "product", value_parser = crate::args::non_negative)]
     upward: Option<f64>,
-    /// The input minus this grid (the same nodes).
+    /// The input minus this grid (the same nodes; at least one node set
+    /// in both).
     #[arg(long, value_name = "GRID", group = "product")]
     minus: Option<PathBuf>,
 }
@@ -53,9 +65,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     aeromag::grid::format::write_grid(&a.out, &g)?;
     let s = g.stats();
     println!(
-        "{}: {} × {} nodes, {} not blank; mean {:.4}, std {:.4}, min {:.4}, max {:.4} {}",
-        g.name, g.geometry.nx, g.geometry.ny, s.count, s.mean, s.std, s.min, s.max, g.unit
+        "{}: {} × {} nodes, {} not blank; mean {}, std {}, min {}, max {} {}",
+        g.name,
+        g.geometry.nx,
+        g.geometry.ny,
+        s.count,
+        figure(s.mean),
+        figure(s.std),
+        figure(s.min),
+        figure(s.max),
+        g.unit
     );
     println!("wrote {}", a.out.display());
     Ok(())
+}
+
+/// A summary figure: four decimals, or in exponent form from 10¹⁵ (a
+/// float32 grid may hold values up to 3.4·10³⁸: not 39 digits).
+fn figure(v: f64) -> String {
+    if v.abs() < 1e15 {
+        format!("{v:.4}")
+    } else {
+        shown(v)
+    }
 }

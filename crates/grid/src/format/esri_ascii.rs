@@ -25,17 +25,24 @@
 //!
 //! Reading accepts `xllcorner`/`yllcorner` too (the node then half a cell
 //! in), any order of header lines, keywords in any case and an absent
-//! `NODATA_value`.
+//! `NODATA_value`. A value `nan` is a blank node too (as GDAL reads it).
+//! Refused: a header whose cell size, coordinates or node count are out
+//! of range ([`checked_geometry`]) or that declares more values than the
+//! file can hold, and values that are infinite or beyond
+//! [`MAX_VALUE`](crate::grid::MAX_VALUE) (the error names the row, from
+//! the north, and the column).
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::Path;
 
 use super::{
-    NODATA, check_grid, checked_geometry, crs_from_wkt, crs_wkt, read_error, stem, write_atomic,
+    NODATA, check_declared_size, check_grid, check_values, checked_geometry, crs_from_wkt, crs_wkt,
+    read_error, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
+use aeromag_core::error::{shown, shown_text};
 
 /// Writes `grid` as an ESRI ASCII grid to `path` and, when its CRS is
 /// known, the WKT to `path` with extension `.prj` (both atomically). Errors
@@ -65,9 +72,10 @@ fn write_asc(w: &mut impl Write, grid: &Grid) -> io::Result<()> {
     let g = &grid.geometry;
     writeln!(w, "ncols        {}", g.nx)?;
     writeln!(w, "nrows        {}", g.ny)?;
-    writeln!(w, "xllcenter    {}", g.x0)?;
-    writeln!(w, "yllcenter    {}", g.y0)?;
-    writeln!(w, "cellsize     {}", g.cell)?;
+    // As Rust writes them, or in exponent form when that would be long.
+    writeln!(w, "xllcenter    {}", shown(g.x0))?;
+    writeln!(w, "yllcenter    {}", shown(g.y0))?;
+    writeln!(w, "cellsize     {}", shown(g.cell))?;
     writeln!(w, "NODATA_value {NODATA}")?;
     let mut line = String::new();
     for j in (0..g.ny).rev() {
@@ -112,16 +120,26 @@ pub fn read(path: &Path) -> Result<Grid> {
         let key = tokens.next().unwrap().to_ascii_lowercase();
         let value = tokens
             .next()
-            .ok_or_else(|| read_error(path, format!("no value after '{key}'")))?;
+            .ok_or_else(|| read_error(path, format!("no value after {}", shown_text(&key))))?;
         let number = || -> Result<f64> {
-            value
-                .parse::<f64>()
-                .map_err(|_| read_error(path, format!("'{key}' is not a number: {value}")))
+            value.parse::<f64>().map_err(|_| {
+                read_error(
+                    path,
+                    format!(
+                        "{} is not a number: {}",
+                        shown_text(&key),
+                        shown_text(value)
+                    ),
+                )
+            })
         };
         let count = || -> Result<usize> {
-            value
-                .parse::<usize>()
-                .map_err(|_| read_error(path, format!("'{key}' is not a count: {value}")))
+            value.parse::<usize>().map_err(|_| {
+                read_error(
+                    path,
+                    format!("{} is not a count: {}", shown_text(&key), shown_text(value)),
+                )
+            })
         };
         match key.as_str() {
             "ncols" => nx = Some(count()?),
@@ -138,7 +156,12 @@ pub fn read(path: &Path) -> Result<Grid> {
             }
             "cellsize" => cell = Some(number()?),
             "nodata_value" => nodata = Some(number()?),
-            _ => return Err(read_error(path, format!("unknown header keyword '{key}'"))),
+            _ => {
+                return Err(read_error(
+                    path,
+                    format!("unknown header keyword {}", shown_text(&key)),
+                ));
+            }
         }
     }
     let missing = |k: &str| read_error(path, format!("no '{k}' in the header"));
@@ -154,6 +177,9 @@ pub fn read(path: &Path) -> Result<Grid> {
             ny: ny.ok_or_else(|| missing("nrows"))?,
         },
     )?;
+    // Each value takes at least one character and a separator (the last
+    // none): check before allocating what the header declares.
+    check_declared_size(path, geometry.nx, geometry.ny, 2.0, text.len() as u64 + 1)?;
     let mut grid = Grid::blank(geometry, &stem(path), "");
     for j in (0..geometry.ny).rev() {
         for i in 0..geometry.nx {
@@ -167,12 +193,21 @@ pub fn read(path: &Path) -> Result<Grid> {
                     ),
                 )
             })?;
-            let v: f64 = token
-                .parse()
-                .map_err(|_| read_error(path, format!("'{token}' is not a number")))?;
+            let v: f64 = token.parse().map_err(|_| {
+                read_error(
+                    path,
+                    format!(
+                        "row {}, column {}: {} is not a number",
+                        geometry.ny - j,
+                        i + 1,
+                        shown_text(token)
+                    ),
+                )
+            })?;
             grid.values[geometry.index(i, j)] = if Some(v) == nodata { f64::NAN } else { v };
         }
     }
+    check_values(path, &grid)?;
     if tokens.next().is_some() {
         return Err(read_error(
             path,
@@ -265,5 +300,156 @@ mod tests {
         assert!(read(&path).is_err());
         fs::write(&path, "ncols 2\nnrows 1\nxllcenter 0\ncellsize 1\n1 2\n").unwrap();
         assert!(read(&path).unwrap_err().to_string().contains("yllcenter"));
+    }
+
+    /// The file `name` in `dir` with a 3 × 3 header of cell `cell` and the
+    /// rows `body`, read.
+    fn read_asc(dir: &Path, name: &str, cell: &str, body: &str) -> Result<Grid> {
+        let path = dir.join(name);
+        fs::write(
+            &path,
+            format!(
+                "ncols 3\nnrows 3\nxllcenter 0\nyllcenter 0\ncellsize {cell}\n\
+                 NODATA_value -99999\n{body}"
+            ),
+        )
+        .unwrap();
+        read(&path)
+    }
+
+    #[test]
+    fn infinite_and_huge_values_are_refused_naming_row_and_column() {
+        let dir = tempfile::tempdir().unwrap();
+        for (value, shown) in [
+            ("1e300", "1e300"),
+            ("1e400", "inf"),
+            ("-1e308", "-1e308"),
+            ("inf", "inf"),
+            ("-inf", "-inf"),
+            ("1e308", "1e308"),
+            ("1e39", "1e39"),
+            ("-3.5e38", "-3.5e38"),
+        ] {
+            let e = read_asc(
+                dir.path(),
+                "v.asc",
+                "100",
+                &format!("1 2 3\n4 5 {value}\n7 8 9\n"),
+            )
+            .unwrap_err();
+            assert!(e.is_bad_input());
+            assert!(
+                matches!(
+                    e,
+                    crate::GridError::BadValue {
+                        row: 2,
+                        column: 3,
+                        ..
+                    }
+                ),
+                "{value}: {e}"
+            );
+            let m = e.to_string();
+            assert!(
+                m.contains("v.asc") && m.contains(&format!("is {shown}:")),
+                "{value}: {m}"
+            );
+        }
+        // The largest value allowed, and NaN as a blank node.
+        let g = read_asc(dir.path(), "v.asc", "100", "1 2 3\n4 nan -3.4e38\n7 8 9\n").unwrap();
+        assert!(g.get(1, 1).is_nan());
+        assert_eq!(g.get(2, 1), -3.4e38);
+        assert_eq!(g.stats().count, 8);
+    }
+
+    #[test]
+    fn cell_sizes_out_of_range_are_refused_in_short_messages() {
+        let dir = tempfile::tempdir().unwrap();
+        let body = "1 2 3\n4 5 6\n7 8 9\n";
+        for cell in [
+            "1e-308", "1e308", "-1e308", "0", "nan", "inf", "1e-7", "2e6",
+        ] {
+            let e = read_asc(dir.path(), "c.asc", cell, body).unwrap_err();
+            let m = e.to_string();
+            assert!(
+                m.contains("c.asc") && m.contains("cell size") && m.len() < 120,
+                "{cell}: {m}"
+            );
+        }
+        for cell in ["1e-6", "1e6", "0.5"] {
+            assert!(read_asc(dir.path(), "c.asc", cell, body).is_ok(), "{cell}");
+        }
+        // A corner of 1e300 m, or one past ±1e9 m by the grid's extent.
+        let path = dir.path().join("far.asc");
+        for (x, ncols) in [("1e300", 1), ("999999999", 3), ("-1e-300", 1)] {
+            fs::write(
+                &path,
+                format!(
+                    "ncols {ncols}\nnrows 1\nxllcenter {x}\nyllcenter 0\ncellsize 1\n{}\n",
+                    "1 ".repeat(ncols)
+                ),
+            )
+            .unwrap();
+            let r = read(&path);
+            if x == "-1e-300" {
+                // A tiny coordinate is fine and written back short.
+                let g = r.unwrap();
+                write_grid(&path, &g).unwrap();
+                let text = fs::read_to_string(&path).unwrap();
+                assert!(text.contains("xllcenter    -1e-300\n"), "{text}");
+            } else {
+                let m = r.unwrap_err().to_string();
+                assert!(
+                    m.contains("coordinates must be within") && m.len() < 150,
+                    "{m}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_header_declaring_more_values_than_the_file_holds_is_refused_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("hd.asc");
+        fs::write(
+            &path,
+            "ncols 15800\nnrows 15800\nxllcenter 0\nyllcenter 0\ncellsize 1\nNODATA_value -99999\n1 2 3\n",
+        )
+        .unwrap();
+        let m = read(&path).unwrap_err().to_string();
+        assert!(
+            m.contains("hd.asc") && m.contains("declares 15800 × 15800") && m.contains("86"),
+            "{m}"
+        );
+        // Exactly enough text: "1 2\n3 4" for 2 × 2.
+        fs::write(
+            &path,
+            "ncols 2\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n1 2\n3 4",
+        )
+        .unwrap();
+        assert_eq!(read(&path).unwrap().values, [3.0, 4.0, 1.0, 2.0]);
+    }
+
+    #[test]
+    fn binary_garbage_is_not_echoed() {
+        let dir = tempfile::tempdir().unwrap();
+        let garbage = format!("x\u{1}{}", "\u{7f}\u{0}\u{1b}[2J".repeat(300));
+        let e = read_asc(
+            dir.path(),
+            "b.asc",
+            "100",
+            &format!("1 2 3\n4 {garbage} 6\n7 8 9\n"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("row 2, column 2") && e.contains("\\u{1}"), "{e}");
+        assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
+        let path = dir.path().join("k.asc");
+        fs::write(&path, format!("ncols 1\n{garbage} 1\n")).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
+        fs::write(&path, format!("ncols {garbage}\n")).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
     }
 }

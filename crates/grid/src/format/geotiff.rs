@@ -40,9 +40,13 @@ use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
 use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
-use super::{NODATA, check_grid, checked_geometry, crs_from_epsg, read_error, stem, write_atomic};
+use super::{
+    NODATA, check_declared_size, check_grid, check_values, checked_geometry, crs_from_epsg,
+    read_error, stem, write_atomic,
+};
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
+use aeromag_core::error::shown;
 
 /// GeoKey ids (OGC GeoTIFF 1.1, annex).
 mod key {
@@ -230,7 +234,7 @@ pub fn read(path: &Path) -> Result<Grid> {
     if (sx - sy).abs() > 1e-9 * sx.abs() {
         return Err(read_error(
             path,
-            format!("pixels of {sx} × {sy}: not square"),
+            format!("pixels of {} × {}: not square", shown(sx), shown(sy)),
         ));
     }
     let keys = match dec.find_tag(Tag::GeoKeyDirectoryTag).map_err(err)? {
@@ -258,6 +262,24 @@ pub fn read(path: &Path) -> Result<Grid> {
             nx: nx as usize,
             ny: ny as usize,
         },
+    )?;
+    // Before the decoder allocates the image: uncompressed samples take
+    // their full size in the file; compressed ones at least 1/4096 of it
+    // (LZW's best case, a 12-bit code for 4096 bytes; deflate's is 1/1032).
+    let bytes = f64::from(dec.colortype().map_err(err)?.bit_depth()) / 8.0;
+    let compressed = dec
+        .find_tag_unsigned::<u16>(Tag::Compression)
+        .map_err(err)?
+        .is_some_and(|c| c != 1);
+    let file_len = std::fs::metadata(path)
+        .map_err(|e| read_error(path, e))?
+        .len();
+    check_declared_size(
+        path,
+        geometry.nx,
+        geometry.ny,
+        if compressed { bytes / 4096.0 } else { bytes },
+        file_len,
     )?;
     let nodata: Option<f64> = dec
         .find_tag(Tag::GdalNodata)
@@ -312,6 +334,7 @@ pub fn read(path: &Path) -> Result<Grid> {
             grid.values[geometry.index(i, j)] = if blank(v) { f64::NAN } else { v };
         }
     }
+    check_values(path, &grid)?;
     grid.crs = geokey(key::PROJECTED_CRS).and_then(|c| crs_from_epsg(c.into()));
     Ok(grid)
 }
@@ -456,5 +479,61 @@ mod tests {
         assert_eq!(xml_unescape(&xml_escape(s)), s);
         assert!(xml_escape(s).is_ascii());
         assert_eq!(xml_unescape("&#x41;&bogus;&"), "A&bogus;&");
+    }
+
+    /// The bytes of a written GeoTIFF with the value of tag `tag` in its
+    /// first IFD set to `value` (a little-endian file: tag, type, count,
+    /// value in 12-byte entries).
+    fn patched_tag(bytes: &[u8], tag: u16, value: u32) -> Vec<u8> {
+        let mut b = bytes.to_vec();
+        assert_eq!(&b[..2], b"II");
+        let ifd = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+        let n = u16::from_le_bytes(b[ifd..ifd + 2].try_into().unwrap()) as usize;
+        let entry = (0..n)
+            .map(|k| ifd + 2 + 12 * k)
+            .find(|&e| u16::from_le_bytes(b[e..e + 2].try_into().unwrap()) == tag)
+            .unwrap();
+        match u16::from_le_bytes(b[entry + 2..entry + 4].try_into().unwrap()) {
+            3 => b[entry + 8..entry + 10].copy_from_slice(&(value as u16).to_le_bytes()),
+            4 => b[entry + 8..entry + 12].copy_from_slice(&value.to_le_bytes()),
+            t => panic!("type {t}"),
+        }
+        b
+    }
+
+    #[test]
+    fn a_corrupt_geotiff_is_refused_with_a_short_message_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.tif");
+        write_grid(&path, &sample_grid()).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        // A pixel scale of ~10³⁰⁰ m: shown in exponent form.
+        let fifty = 50.0f64.to_le_bytes();
+        let at = bytes
+            .windows(16)
+            .position(|w| w[..8] == fifty && w[8..] == fifty)
+            .unwrap();
+        let mut b = bytes.clone();
+        b[at..at + 8].copy_from_slice(&9.745314011399999e300f64.to_le_bytes());
+        let bad = dir.path().join("scale.tif");
+        std::fs::write(&bad, &b).unwrap();
+        let e = read(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("scale.tif") && e.contains("9.745314011399999e300"),
+            "{e}"
+        );
+        assert!(e.len() < 150, "{e}");
+        // 15800 × 15800 float32 pixels declared in a file of a few hundred
+        // bytes: refused from the header (2 GB were allocated).
+        let b = patched_tag(&patched_tag(&bytes, 256, 15800), 257, 15800);
+        let big = dir.path().join("big.tif");
+        std::fs::write(&big, &b).unwrap();
+        let e = read(&big).unwrap_err();
+        assert!(e.is_bad_input());
+        let e = e.to_string();
+        assert!(
+            e.contains("big.tif") && e.contains("15800 × 15800") && e.contains("but the file has"),
+            "{e}"
+        );
     }
 }

@@ -38,8 +38,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{GridError, Result};
-use crate::grid::{Grid, GridGeometry, MAX_NODES};
+use crate::grid::{Grid, GridGeometry, MAX_CELL, MAX_COORDINATE, MAX_NODES, MAX_VALUE, MIN_CELL};
 use crate::projection::{Crs, UtmZone};
+use aeromag_core::error::shown;
 
 /// The value blank nodes take in the GeoTIFF (`GDAL_NODATA` tag) and ESRI
 /// ASCII (`NODATA_value`) files: −99999, exact in float32 and far outside
@@ -147,13 +148,32 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     if g.is_empty() || !(g.x0.is_finite() && g.y0.is_finite()) {
         return Err(GridError::Data(format!(
             "cannot write a grid of {} × {} nodes with origin ({}, {})",
-            g.nx, g.ny, g.x0, g.y0
+            g.nx,
+            g.ny,
+            shown(g.x0),
+            shown(g.y0)
         )));
     }
     if g.nx > i32::MAX as usize || g.ny > i32::MAX as usize {
         return Err(GridError::Data(format!(
             "{} × {} nodes is too many for a grid file",
             g.nx, g.ny
+        )));
+    }
+    // Every format stores float32: a value beyond its range (or ±∞, e.g. a
+    // product that overflowed) would be written as ±∞.
+    if let Some(k) = grid
+        .values
+        .iter()
+        .position(|v| !v.is_nan() && v.abs() > f32::MAX as f64)
+    {
+        let (i, j) = (k % g.nx, k / g.nx);
+        return Err(GridError::Data(format!(
+            "node at row {}, column {} (from the north-west corner, 1-based) is {}: \
+             not a float32 value, so not written",
+            g.ny - j,
+            i + 1,
+            shown(grid.values[k])
         )));
     }
     Ok(())
@@ -213,20 +233,87 @@ pub(crate) fn read_error(path: &Path, what: impl std::fmt::Display) -> GridError
     }
 }
 
-/// Checks the geometry of a grid read from a file (positive cell, node
-/// count within [`MAX_NODES`]).
+/// Checks the geometry of a grid read from a file: a cell size within
+/// [`MIN_CELL`]–[`MAX_CELL`], node coordinates within ±[`MAX_COORDINATE`],
+/// a node count within [`MAX_NODES`].
 pub(crate) fn checked_geometry(path: &Path, geometry: GridGeometry) -> Result<GridGeometry> {
     let g = geometry;
-    if !(g.cell.is_finite() && g.cell > 0.0 && g.x0.is_finite() && g.y0.is_finite()) {
+    if !(MIN_CELL..=MAX_CELL).contains(&g.cell) {
         return Err(read_error(
             path,
-            format!("bad geometry: origin ({}, {}), cell {}", g.x0, g.y0, g.cell),
+            format!(
+                "cell size {} m is out of range: {}–{} m",
+                shown(g.cell),
+                shown(MIN_CELL),
+                shown(MAX_CELL)
+            ),
         ));
     }
     if g.nx == 0 || g.ny == 0 || g.nx.saturating_mul(g.ny) > MAX_NODES {
-        return Err(read_error(path, format!("{} × {} nodes", g.nx, g.ny)));
+        return Err(read_error(
+            path,
+            format!("{} × {} nodes (at most {MAX_NODES})", g.nx, g.ny),
+        ));
+    }
+    let inside = |v: f64| v.abs() <= MAX_COORDINATE;
+    if !(inside(g.x0) && inside(g.y0) && inside(g.x_max()) && inside(g.y_max())) {
+        return Err(read_error(
+            path,
+            format!(
+                "nodes from ({}, {}) to ({}, {}) m: coordinates must be within ±{} m",
+                shown(g.x0),
+                shown(g.y0),
+                shown(g.x_max()),
+                shown(g.y_max()),
+                shown(MAX_COORDINATE)
+            ),
+        ));
     }
     Ok(g)
+}
+
+/// Checks, before they are allocated, that `nx × ny` nodes of at least
+/// `bytes_per_node` bytes each fit in a file of `file_len` bytes (a
+/// corrupt header must not claim gigabytes for a tiny file).
+pub(crate) fn check_declared_size(
+    path: &Path,
+    nx: usize,
+    ny: usize,
+    bytes_per_node: f64,
+    file_len: u64,
+) -> Result<()> {
+    let needed = (nx as f64 * ny as f64 * bytes_per_node).ceil();
+    if needed > file_len as f64 {
+        return Err(read_error(
+            path,
+            format!(
+                "the header declares {nx} × {ny} nodes, at least {needed} bytes, \
+                 but the file has {file_len}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks the node values of a grid read from a file: each is blank (NaN:
+/// GeoTIFF and netCDF float grids mark blanks so, and an ESRI ASCII `nan`
+/// is read the same way) or finite and at most [`MAX_VALUE`] in
+/// magnitude, else [`GridError::BadValue`] naming its row and column.
+pub(crate) fn check_values(path: &Path, grid: &Grid) -> Result<()> {
+    let g = &grid.geometry;
+    match grid
+        .values
+        .iter()
+        .position(|v| !v.is_nan() && v.abs() > MAX_VALUE)
+    {
+        Some(k) => Err(GridError::BadValue {
+            path: path.display().to_string(),
+            row: g.ny - k / g.nx,
+            column: k % g.nx + 1,
+            value: grid.values[k],
+        }),
+        None => Ok(()),
+    }
 }
 
 /// OGC WKT 1 of a coordinate system, with its EPSG authority (the `.prj`
@@ -436,6 +523,71 @@ mod tests {
             Err(GridError::Data(_))
         ));
         assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn infinite_values_are_neither_read_nor_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut grid = sample_grid();
+        // Node (2, 1): the third row from the north of four, third column.
+        let k = grid.geometry.index(2, 1);
+        grid.values[k] = 12345.0;
+        for (name, marker, inf) in [
+            (
+                "g.tif",
+                12345f32.to_le_bytes().to_vec(),
+                f32::INFINITY.to_le_bytes().to_vec(),
+            ),
+            (
+                "g.nc",
+                12345f32.to_be_bytes().to_vec(),
+                f32::NEG_INFINITY.to_be_bytes().to_vec(),
+            ),
+            ("g.asc", b"12345 ".to_vec(), b"-inf  ".to_vec()),
+        ] {
+            let path = dir.path().join(name);
+            write_grid(&path, &grid).unwrap();
+            let mut bytes = fs::read(&path).unwrap();
+            // The last: netCDF has the value in `actual_range` too.
+            let at = bytes
+                .windows(marker.len())
+                .rposition(|w| w == marker)
+                .unwrap();
+            bytes[at..at + marker.len()].copy_from_slice(&inf);
+            fs::write(&path, &bytes).unwrap();
+            let e = read_grid(&path).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    GridError::BadValue {
+                        row: 3,
+                        column: 3,
+                        ..
+                    }
+                ),
+                "{name}: {e}"
+            );
+            assert!(e.is_bad_input() && e.to_string().contains(name), "{e}");
+        }
+        // Nor written: a value beyond float32 (an overflowed product).
+        for value in [f64::INFINITY, -1e300, 3.5e38] {
+            grid.values[k] = value;
+            for name in ["w.tif", "w.asc", "w.nc"] {
+                let e = write_grid(&dir.path().join(name), &grid).unwrap_err();
+                let m = e.to_string();
+                assert!(
+                    matches!(e, GridError::Data(_)) && m.contains("row 3, column 3"),
+                    "{name}: {m}"
+                );
+                assert!(m.len() < 150, "{m}");
+            }
+        }
+        grid.values[k] = f32::MAX as f64;
+        write_grid(&dir.path().join("w.nc"), &grid).unwrap();
+        assert_eq!(
+            read_grid(&dir.path().join("w.nc")).unwrap().values[k],
+            f32::MAX as f64
+        );
     }
 
     #[test]

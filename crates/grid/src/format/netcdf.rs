@@ -42,11 +42,13 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::{
-    check_grid, checked_geometry, crs_from_epsg, crs_from_wkt, crs_wkt, read_error, write_atomic,
+    check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt, crs_wkt, read_error,
+    write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
 use crate::projection::Crs;
+use aeromag_core::error::{shown, shown_text};
 
 const NC_DIMENSION: u32 = 0x0A;
 const NC_VARIABLE: u32 = 0x0B;
@@ -500,7 +502,10 @@ fn parse_header(bytes: &[u8]) -> Parse<Header> {
         for _ in 0..ndims {
             let d = c.count()?;
             if d >= dims.len() {
-                return Err(format!("variable '{name}': dimension {d} does not exist"));
+                return Err(format!(
+                    "variable {}: dimension {d} does not exist",
+                    shown_text(&name)
+                ));
             }
             ids.push(d);
         }
@@ -527,7 +532,10 @@ impl Header {
         for &d in &v.dims {
             let len = self.dims[d].1;
             if len == 0 {
-                return Err(format!("'{}' is a record variable: not read", v.name));
+                return Err(format!(
+                    "{} is a record variable: not read",
+                    shown_text(&v.name)
+                ));
             }
             n = n.checked_mul(len).ok_or("too large")?;
         }
@@ -536,7 +544,12 @@ impl Header {
         let data = start
             .checked_add(len)
             .and_then(|end| bytes.get(start..end))
-            .ok_or_else(|| format!("the data of '{}' are past the end of the file", v.name))?;
+            .ok_or_else(|| {
+                format!(
+                    "the data of {} are past the end of the file",
+                    shown_text(&v.name)
+                )
+            })?;
         Ok(decode(data, v.nc_type))
     }
 
@@ -546,7 +559,7 @@ impl Header {
         self.vars
             .iter()
             .find(|v| &v.name == name && v.dims == [d])
-            .ok_or_else(|| format!("no coordinate variable '{name}'"))
+            .ok_or_else(|| format!("no coordinate variable {}", shown_text(name)))
     }
 }
 
@@ -564,7 +577,7 @@ fn regular(values: &[f64], name: &str) -> Parse<(f64, Option<f64>)> {
         .enumerate()
         .any(|(k, &v)| v.is_nan() || (v - (first + k as f64 * step)).abs() > tolerance);
     if irregular || step == 0.0 {
-        return Err(format!("'{name}' is not regularly spaced"));
+        return Err(format!("{} is not regularly spaced", shown_text(name)));
     }
     Ok((first, Some(step)))
 }
@@ -574,6 +587,7 @@ pub fn read(path: &Path) -> Result<Grid> {
     let bytes = fs::read(path).map_err(|e| read_error(path, e))?;
     let (geometry, grid) = read_bytes(&bytes).map_err(|e| read_error(path, e))?;
     checked_geometry(path, geometry)?;
+    check_values(path, &grid)?;
     Ok(grid)
 }
 
@@ -586,7 +600,7 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         .or_else(|| h.vars.iter().find(|v| v.dims.len() == 2))
         .ok_or("no 2-D variable")?;
     if z.nc_type == NcType::Char {
-        return Err(format!("'{}' is text", z.name));
+        return Err(format!("{} is text", shown_text(&z.name)));
     }
     let (ydim, xdim) = (z.dims[0], z.dims[1]);
     let xs = h.data(bytes, h.coordinate(xdim)?)?;
@@ -599,8 +613,11 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         (None, Some(dy)) => dy.abs(),
         (None, None) => return Err("a single node: the cell size is unknown".into()),
         _ => {
+            let step = |d: Option<f64>| d.map_or("none".into(), shown);
             return Err(format!(
-                "cells of {dx:?} × {dy:?}: x must ascend and cells be square"
+                "cells of {} × {}: x must ascend and cells be square",
+                step(dx),
+                step(dy)
             ));
         }
     };
@@ -828,5 +845,28 @@ mod tests {
         );
         let e = read(&dir.path().join("missing.nc")).unwrap_err();
         assert!(e.to_string().contains("missing.nc"), "{e}");
+    }
+
+    #[test]
+    fn a_corrupt_name_is_shown_escaped_and_short() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.nc");
+        write_grid(&path, &sample_grid()).unwrap();
+        let mut bytes = fs::read(&path).unwrap();
+        // The variable 'y' (the second name "y" of the header; the first is
+        // the dimension's): its length byte flipped from 1 to 129.
+        let name = [0u8, 0, 0, 1, b'y', 0, 0, 0];
+        let at = bytes
+            .windows(8)
+            .enumerate()
+            .filter(|(_, w)| *w == name)
+            .nth(1)
+            .unwrap()
+            .0;
+        bytes[at + 3] = 129;
+        fs::write(&path, &bytes).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(e.contains("g.nc"), "{e}");
+        assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
     }
 }
