@@ -26,6 +26,23 @@ fn read_columns(p: &Path) -> HashMap<String, Vec<f64>> {
     names.into_iter().zip(cols).collect()
 }
 
+/// The pass file `text` with the cell of `column` on line `line` (0: the
+/// header) set to `value`.
+fn edited(text: &str, column: &str, line: usize, value: &str) -> String {
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|&h| h == column).unwrap();
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let mut f: Vec<String> = l.split(',').map(String::from).collect();
+            if i == line {
+                f[col] = value.to_string();
+            }
+            f.join(",") + "\n"
+        })
+        .collect()
+}
+
 fn p(path: &Path) -> &str {
     path.to_str().unwrap()
 }
@@ -194,20 +211,7 @@ fn bad_input_exits_2_naming_file_row_and_column() {
     let d = tempfile::tempdir().unwrap();
     let (csv, toml) = simulate_into(&d.path().join("sim"), Some("[trajectory]\nepochs = 120\n"));
     let text = std::fs::read_to_string(&csv).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = header.iter().position(|&h| h == "b2_y").unwrap();
-    let edit = |row: usize, value: &str| -> String {
-        text.lines()
-            .enumerate()
-            .map(|(i, l)| {
-                let mut f: Vec<String> = l.split(',').map(String::from).collect();
-                if i == row {
-                    f[col] = value.to_string();
-                }
-                f.join(",") + "\n"
-            })
-            .collect()
-    };
+    let edit = |row: usize, value: &str| edited(&text, "b2_y", row, value);
     let out = d.path().join("est.csv");
     for (name, content, needles) in [
         (
@@ -324,20 +328,7 @@ fn values_beyond_their_physical_range_name_the_column_key_or_flag() {
     let d = tempfile::tempdir().unwrap();
     let (csv, toml) = simulate_into(&d.path().join("sim"), Some("[trajectory]\nepochs = 120\n"));
     let text = std::fs::read_to_string(&csv).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let edit = |name: &str, line: usize, value: &str| -> String {
-        let col = header.iter().position(|&h| h == name).unwrap();
-        text.lines()
-            .enumerate()
-            .map(|(i, l)| {
-                let mut f: Vec<String> = l.split(',').map(String::from).collect();
-                if i == line {
-                    f[col] = value.to_string();
-                }
-                f.join(",") + "\n"
-            })
-            .collect()
-    };
+    let edit = |name: &str, line: usize, value: &str| edited(&text, name, line, value);
     let out = d.path().join("est.csv");
     for (column, value) in [
         ("north_m", "1e308"),

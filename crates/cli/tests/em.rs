@@ -104,6 +104,13 @@ fn simulate(dir: &Path, extra: &[&str]) -> PathBuf {
     sim
 }
 
+/// A 1.28 s record simulated into `dir/sim`.
+fn simulate_short(dir: &Path) -> PathBuf {
+    let cfg = dir.join("short.toml");
+    std::fs::write(&cfg, "duration_s = 1.28\n").unwrap();
+    simulate(dir, &["--config", s(&cfg)])
+}
+
 #[test]
 fn em_file_chain_reaches_the_issue_figures_against_the_truth() {
     let dir = tempfile::tempdir().unwrap();
@@ -356,9 +363,7 @@ fn bad(args: &[&str], fragments: &[&str]) {
 fn em_commands_reject_bad_input_with_file_row_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cfg = d.join("short.toml");
-    std::fs::write(&cfg, "duration_s = 1.28\n").unwrap();
-    let sim = simulate(d, &["--config", s(&cfg)]);
+    let sim = simulate_short(d);
     let raw = sim.join("em.raw");
     let det = d.join("det.csv");
     assert_code(
@@ -560,9 +565,7 @@ fn with_header(bytes: &[u8], f: &dyn Fn(&mut serde_json::Value)) -> Vec<u8> {
 fn header_attitudes_and_rotations_out_of_range_are_bad_input_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let cfg = d.join("short.toml");
-    std::fs::write(&cfg, "duration_s = 1.28\n").unwrap();
-    let sim = simulate(d, &["--config", s(&cfg)]);
+    let sim = simulate_short(d);
     let raw = sim.join("em.raw");
     let bytes = std::fs::read(&raw).unwrap();
     let out = d.join("o.csv");

@@ -132,7 +132,13 @@ fn print_coefficients(stream: &LineStream) {
     if !c.is_empty() {
         eprintln!("coefficients now (value ± standard deviation):");
         for (name, v, s) in c {
-            eprintln!("  {name:<8} {v:>12.6} ± {s:.3e}");
+            // Far values (a hand-edited model) in exponent form.
+            let v = if v.abs() < 1e9 {
+                format!("{v:>12.6}")
+            } else {
+                format!("{v:>12.5e}")
+            };
+            eprintln!("  {name:<8} {v} ± {s:.3e}");
         }
     }
 }

@@ -151,9 +151,13 @@ pub fn q1_unit(order: usize) -> String {
     format!("nT²/m{e}")
 }
 
-/// How many decades a given `q` may lie from its default
-/// ([`NoiseModel::check`]).
-pub const NOISE_DECADES: f64 = 12.0;
+/// How many decades a given `q` may lie above its default
+/// ([`NoiseModel::check`]). On the simulated calibration flight (order 6,
+/// r = 4·10⁻⁴ nT², untuned) `q₁` 10³¹ times the default still gave a
+/// finite, if ill-conditioned, fit; 10³⁹ times gave every VIF and the
+/// condition number infinite. A `q` far below its default is as good as
+/// zero and is taken.
+pub const NOISE_DECADES: f64 = 24.0;
 
 /// The measurement noise variances `r` a magnetometer can have, nT²: from
 /// (10 fT)² (below any airborne sensor) to (100 nT)² (a reading that
@@ -216,16 +220,13 @@ impl NoiseModel {
     }
 
     /// Intensities given for a chain of order `order` checked against what
-    /// a field and a magnetometer can be: each `q` zero or within
-    /// [`NOISE_DECADES`] decades of its default
-    /// ([`Self::calibration_default_for`]), `r` within [`R_RANGE_NT2`].
-    /// Further out is a unit or order mistake, and the filter's arithmetic
-    /// fails (an innovation variance of 10³⁰⁸ nT², or one below rounding).
+    /// the filter's arithmetic holds: each `q` from 0 to [`NOISE_DECADES`]
+    /// decades above its default ([`Self::calibration_default_for`]), `r`
+    /// within [`R_RANGE_NT2`]. Further out the fit is infinite or NaN (an
+    /// innovation variance of 10³⁰⁸ nT², or one below rounding).
     pub fn check(&self, order: usize) -> Result<()> {
         let d = Self::calibration_default_for(order);
-        let near = |v: f64, default: f64| {
-            v == 0.0 || (v > 0.0 && (v / default).log10().abs() <= NOISE_DECADES)
-        };
+        let near = |v: f64, default: f64| (0.0..=default * 10f64.powf(NOISE_DECADES)).contains(&v);
         let (lo, hi) = R_RANGE_NT2;
         if near(self.q1, d.q1)
             && near(self.q2_nt2_per_m5, d.q2_nt2_per_m5)
@@ -234,9 +235,9 @@ impl NoiseModel {
             return Ok(());
         }
         Err(CompError::setting(format!(
-            "Kalman noise {:e},{:e},{:e}: q1 must be 0 or within 10^±{NOISE_DECADES} of {:.2e} {}, \
-             q2 0 or within 10^±{NOISE_DECADES} of {:.0e} nT²/m⁵, and r from {lo:e} to {hi:e} nT² \
-             ({:e} to {} nT RMS)",
+            "Kalman noise {:e},{:e},{:e}: q1 must be from 0 to 10^{NOISE_DECADES} times its default \
+             {:.2e} {}, q2 from 0 to 10^{NOISE_DECADES} times {:.0e} nT²/m⁵, and r from {lo:e} to \
+             {hi:e} nT² ({:e} to {} nT RMS)",
             self.q1,
             self.q2_nt2_per_m5,
             self.r_nt2,
@@ -617,12 +618,13 @@ mod tests {
                 }
                 .check(order)
             };
-            // Twelve decades either way, r from (10 fT)² to (100 nT)².
-            assert!(at(d.q1 * 0.9e12, d.q2_nt2_per_m5 * 1.1e-12, 1e4).is_ok());
-            assert!(at(d.q1, d.q2_nt2_per_m5, 1e-10).is_ok());
+            // Up to 24 decades above the defaults (far below is as good as
+            // zero), r from (10 fT)² to (100 nT)².
+            assert!(at(d.q1 * 0.9e24, d.q2_nt2_per_m5 * 1e-100, 1e4).is_ok());
+            assert!(at(d.q1, d.q2_nt2_per_m5 * 0.9e24, 1e-10).is_ok());
             for bad in [
-                at(d.q1 * 2e12, d.q2_nt2_per_m5, d.r_nt2),
-                at(d.q1 * 0.5e-12, d.q2_nt2_per_m5, d.r_nt2),
+                at(d.q1 * 2e24, d.q2_nt2_per_m5, d.r_nt2),
+                at(d.q1, d.q2_nt2_per_m5 * 2e24, d.r_nt2),
                 at(-d.q1, d.q2_nt2_per_m5, d.r_nt2),
                 at(f64::NAN, d.q2_nt2_per_m5, d.r_nt2),
                 at(d.q1, 1e308, d.r_nt2),
@@ -632,10 +634,7 @@ mod tests {
                 at(d.q1, d.q2_nt2_per_m5, f64::INFINITY),
             ] {
                 let e = bad.unwrap_err();
-                assert!(
-                    e.is_bad_input() && !e.to_string().contains("0000000000"),
-                    "{e}"
-                );
+                assert!(e.is_bad_input() && e.to_string().len() < 400, "{e}");
             }
         }
     }
