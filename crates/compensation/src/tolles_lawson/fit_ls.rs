@@ -376,9 +376,8 @@ fn segment_filter(
         None => None,
     };
     if let (Some(s), Some((lo, hi))) = (&sos, cfg.band_hz)
-        && !s
-            .settling_samples(BLOCK_TOLERANCE)
-            .is_some_and(|k| k <= MAX_SETTLING_SAMPLES)
+        && s.settling_samples(BLOCK_TOLERANCE)
+            .is_none_or(|k| k > MAX_SETTLING_SAMPLES)
     {
         let shown = aeromag_core::error::shown;
         return Err(CompError::setting(format!(
