@@ -60,16 +60,7 @@ fn simulate_into(dir: &Path, config: Option<&str>) -> (std::path::PathBuf, std::
 }
 
 fn locate(csv: &Path, toml: &Path, out: &Path) -> HashMap<String, Vec<f64>> {
-    let o = aeromag(&[
-        "dipole",
-        "locate",
-        "--input",
-        p(csv),
-        "--config",
-        p(toml),
-        "--out",
-        p(out),
-    ]);
+    let o = locate_with(csv, toml, out, &[]);
     assert_code(&o, 0);
     read_columns(out)
 }
