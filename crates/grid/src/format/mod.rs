@@ -162,21 +162,26 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     }
     // Every format stores float32: a value beyond its range (or ±∞, e.g. a
     // product that overflowed) would be written as ±∞.
-    if let Some(k) = grid
-        .values
-        .iter()
-        .position(|v| !v.is_nan() && v.abs() > f32::MAX as f64)
-    {
-        let (i, j) = (k % g.nx, k / g.nx);
+    if let Some((row, column, value)) = beyond_float32(grid) {
         return Err(GridError::Data(format!(
-            "node at row {}, column {} (from the north-west corner, 1-based) is {}: \
+            "node at row {row}, column {column} (from the north-west corner, 1-based) is {}: \
              not a float32 value, so not written",
-            g.ny - j,
-            i + 1,
-            shown(grid.values[k])
+            shown(value)
         )));
     }
     Ok(())
+}
+
+/// The first node (row from the north, column from the west, 1-based, and
+/// its value) that is neither blank (NaN) nor within [`MAX_VALUE`], the
+/// range of the float32 every format stores.
+fn beyond_float32(grid: &Grid) -> Option<(usize, usize, f64)> {
+    let g = &grid.geometry;
+    let k = grid
+        .values
+        .iter()
+        .position(|v| !v.is_nan() && v.abs() > MAX_VALUE)?;
+    Some((g.ny - k / g.nx, k % g.nx + 1, grid.values[k]))
 }
 
 /// Writes a file atomically: `fill` writes into a temporary file created in
@@ -300,17 +305,12 @@ pub(crate) fn check_declared_size(
 /// is read the same way) or finite and at most [`MAX_VALUE`] in
 /// magnitude, else [`GridError::BadValue`] naming its row and column.
 pub(crate) fn check_values(path: &Path, grid: &Grid) -> Result<()> {
-    let g = &grid.geometry;
-    match grid
-        .values
-        .iter()
-        .position(|v| !v.is_nan() && v.abs() > MAX_VALUE)
-    {
-        Some(k) => Err(GridError::BadValue {
+    match beyond_float32(grid) {
+        Some((row, column, value)) => Err(GridError::BadValue {
             path: path.display().to_string(),
-            row: g.ny - k / g.nx,
-            column: k % g.nx + 1,
-            value: grid.values[k],
+            row,
+            column,
+            value,
         }),
         None => Ok(()),
     }
