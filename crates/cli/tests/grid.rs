@@ -390,5 +390,24 @@ fn derive_on_tiny_and_blank_grids_gives_an_error_or_a_valid_grid() {
         let o = derive(grid, &["--minus", grid], &out);
         assert_code(&o, 0);
         assert!(stdout(&o).contains("mean 0.0000"), "{}", stdout(&o));
+        std::fs::remove_file(&out).unwrap();
+    }
+    // Grids of other nodes: said as nodes, not as a Debug dump of the
+    // geometry after "cannot grid:" (which no derived product does).
+    let o = derive(&square, &["--minus", &row], &out);
+    assert_refused(
+        &o,
+        &[
+            "sq.asc minus",
+            "the grids' nodes differ: 2 × 2 nodes of 100 m from (0, 0) against 2 × 1 nodes",
+        ],
+        &out,
+    );
+    for o in [o, derive(&one, &["--vertical-derivative"], &out)] {
+        let e = stderr(&o);
+        assert!(
+            !e.contains("GridGeometry") && !e.contains("cannot grid"),
+            "{e}"
+        );
     }
 }

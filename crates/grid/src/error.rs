@@ -40,6 +40,11 @@ pub enum GridError {
     /// Too few usable (finite) points to grid, or a grid too large.
     #[error("cannot grid: {0}")]
     Data(String),
+    /// A grid that cannot be filtered, differenced or written: too small,
+    /// without a value, of other nodes than the grid it is taken from, a
+    /// result that is not finite.
+    #[error("{0}")]
+    Unusable(String),
     /// A coordinate that cannot be projected (latitude beyond ±84°/−80° of
     /// UTM, NaN, a zone number outside 1–60).
     #[error("projection: {0}")]

@@ -130,9 +130,32 @@ impl GridGeometry {
         j * self.nx + i
     }
 
+    /// The node of value index `k` as messages and grid files' readers
+    /// count it: (row from the northern row, column from the western
+    /// column), both 1-based.
+    pub fn row_column(&self, k: usize) -> (usize, usize) {
+        (self.ny - k / self.nx, k % self.nx + 1)
+    }
+
     /// Fractional node coordinates `(u, v)` of a point: `u = (x − x0)/cell`.
     pub fn to_node(&self, x: f64, y: f64) -> (f64, f64) {
         ((x - self.x0) / self.cell, (y - self.y0) / self.cell)
+    }
+}
+
+/// `71 × 40 nodes of 50 m from (1000, -50)` (the south-western node's
+/// easting and northing, m).
+impl std::fmt::Display for GridGeometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} × {} nodes of {} m from ({}, {})",
+            self.nx,
+            self.ny,
+            shown(self.cell),
+            shown(self.x0),
+            shown(self.y0)
+        )
     }
 }
 
@@ -233,8 +256,8 @@ impl Grid {
     /// grids must have the same geometry.
     pub fn difference(&self, other: &Grid) -> Result<Grid> {
         if self.geometry != other.geometry {
-            return Err(GridError::Data(format!(
-                "grids of different geometry: {:?} and {:?}",
+            return Err(GridError::Unusable(format!(
+                "the grids' nodes differ: {} against {}",
                 self.geometry, other.geometry
             )));
         }
@@ -249,10 +272,10 @@ impl Grid {
         if let Some(k) = (0..values.len()).find(|&k| {
             !values[k].is_finite() && !self.values[k].is_nan() && !other.values[k].is_nan()
         }) {
-            return Err(GridError::Data(format!(
-                "the difference at node ({}, {}) is not finite: {} − {}",
-                k % self.geometry.nx,
-                k / self.geometry.nx,
+            let (row, column) = self.geometry.row_column(k);
+            return Err(GridError::Unusable(format!(
+                "the difference at row {row}, column {column} (from the north-west corner, \
+                 1-based) is not finite: {} − {}",
                 shown(self.values[k]),
                 shown(other.values[k])
             )));
@@ -323,9 +346,23 @@ mod tests {
         a.values = vec![1.0, f64::NAN, 1e308, 3.0];
         b.values = vec![1.0, 2.0, -1e308, f64::NAN];
         let m = a.difference(&b).unwrap_err().to_string();
+        // Index 2 is node (0, 1): the northern row, the western column.
         assert!(
-            m.contains("node (0, 1)") && m.contains("1e308 − -1e308"),
+            m.contains("row 1, column 1 (from the north-west corner, 1-based)")
+                && m.contains("1e308 − -1e308"),
             "{m}"
+        );
+        let mut c = Grid::blank(
+            GridGeometry::covering(0.0, 200.0, 0.0, 100.0, 100.0).unwrap(),
+            "c",
+            "nT",
+        );
+        c.values.fill(1.0);
+        let m = a.difference(&c).unwrap_err().to_string();
+        assert_eq!(
+            m,
+            "the grids' nodes differ: 2 × 2 nodes of 100 m from (0, 0) \
+             against 3 × 2 nodes of 100 m from (0, 0)"
         );
         b.values[2] = 1e308;
         let d = a.difference(&b).unwrap();

@@ -91,7 +91,7 @@ pub fn height_range(geometry: &GridGeometry) -> (f64, f64) {
 pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
     let g = grid.geometry;
     if g.nx < 2 || g.ny < 2 {
-        return Err(GridError::Data(format!(
+        return Err(GridError::Unusable(format!(
             "a {} × {} grid is too small to filter",
             g.nx, g.ny
         )));
@@ -153,7 +153,7 @@ pub fn apply(grid: &Grid, op: Spectral) -> Result<Grid> {
         .any(|(v, x)| !v.is_finite() && !x.is_nan())
     {
         let s = grid.stats();
-        return Err(GridError::Data(format!(
+        return Err(GridError::Unusable(format!(
             "the result is not finite: values from {} to {} at a {} m cell are too large to filter",
             shown(s.min),
             shown(s.max),
@@ -195,7 +195,7 @@ impl Spectrum {
     fn of(grid: &Grid) -> Result<Self> {
         let g = grid.geometry;
         if g.nx < 2 || g.ny < 2 {
-            return Err(GridError::Data(format!(
+            return Err(GridError::Unusable(format!(
                 "a {} × {} grid is too small to filter",
                 g.nx, g.ny
             )));
@@ -302,7 +302,7 @@ pub fn fill_blanks(grid: &Grid) -> Result<Vec<f64>> {
     let g = grid.geometry;
     let stats = grid.stats();
     if stats.count == 0 {
-        return Err(GridError::Data("the grid has no value".into()));
+        return Err(GridError::Unusable("the grid has no value".into()));
     }
     let mut v: Vec<f64> = grid
         .values

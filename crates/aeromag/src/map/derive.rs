@@ -40,7 +40,7 @@ pub fn derive(input: &Path, product: &GridProduct) -> Result<Grid> {
             let both = format!("{file} minus {}", other.display());
             let d = grid.difference(&read_grid(other)?).in_file(&both)?;
             if d.stats().count == 0 {
-                return Err(GridError::Data(
+                return Err(GridError::Unusable(
                     "the difference has no value: no node is set in both grids".into(),
                 ))
                 .in_file(&both);

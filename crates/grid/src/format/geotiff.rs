@@ -42,7 +42,7 @@ use tiff::{ColorType, TiffError};
 
 use super::{
     NODATA, check_declared_size, check_grid, check_values, checked_geometry, crs_from_epsg,
-    read_error, stem, write_atomic,
+    label_from_file, read_error, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -322,10 +322,9 @@ pub fn read(path: &Path) -> Result<Grid> {
     }
     let mut grid = Grid::blank(
         geometry,
-        &item("description").unwrap_or_else(|| stem(path)),
-        "",
+        &label_from_file(&item("description").unwrap_or_else(|| stem(path))),
+        &label_from_file(&item("unittype").unwrap_or_default()),
     );
-    grid.unit = item("unittype").unwrap_or_default();
     // Nodata compared as the file's float32 (GDAL's rule for Float32).
     let blank = |v: f64| Some(v) == nodata || nodata.is_some_and(|n| v as f32 == n as f32);
     for (r, row) in values.chunks_exact(geometry.nx).enumerate() {

@@ -111,8 +111,9 @@ impl GridFormat {
 /// format written.
 ///
 /// Errors: [`GridError::UnknownFormat`] for another extension,
-/// [`GridError::LengthMismatch`] / [`GridError::Data`] for a grid whose
-/// values do not match its geometry or that has no node,
+/// [`GridError::LengthMismatch`] / [`GridError::Unusable`] for a grid whose
+/// values do not match its geometry, that has no node or a value beyond
+/// float32's range,
 /// [`GridError::Write`] when the file cannot be written (a missing folder,
 /// no permission, a full disk).
 pub fn write_grid(path: &Path, grid: &Grid) -> Result<GridFormat> {
@@ -127,8 +128,10 @@ pub fn write_grid(path: &Path, grid: &Grid) -> Result<GridFormat> {
 /// format chosen by the extension.
 ///
 /// Errors: [`GridError::UnknownFormat`] for another extension,
-/// [`GridError::Data`] for a file that cannot be read or parsed (the
-/// message names the file).
+/// [`GridError::Read`] for a file that cannot be read or parsed,
+/// [`GridError::BadValue`] for a node that is not a grid value (both name
+/// the file). The grid's name and unit are the file's, made printable
+/// ([`label_from_file`]).
 pub fn read_grid(path: &Path) -> Result<Grid> {
     GridFormat::from_path(path)?.read(path)
 }
@@ -146,7 +149,7 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     }
     crate::error::positive("cell size", g.cell)?;
     if g.is_empty() || !(g.x0.is_finite() && g.y0.is_finite()) {
-        return Err(GridError::Data(format!(
+        return Err(GridError::Unusable(format!(
             "cannot write a grid of {} × {} nodes with origin ({}, {})",
             g.nx,
             g.ny,
@@ -155,7 +158,7 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
         )));
     }
     if g.nx > i32::MAX as usize || g.ny > i32::MAX as usize {
-        return Err(GridError::Data(format!(
+        return Err(GridError::Unusable(format!(
             "{} × {} nodes is too many for a grid file",
             g.nx, g.ny
         )));
@@ -163,7 +166,7 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     // Every format stores float32: a value beyond its range (or ±∞, e.g. a
     // product that overflowed) would be written as ±∞.
     if let Some((row, column, value)) = beyond_float32(grid) {
-        return Err(GridError::Data(format!(
+        return Err(GridError::Unusable(format!(
             "node at row {row}, column {column} (from the north-west corner, 1-based) is {}: \
              not a float32 value, so not written",
             shown(value)
@@ -172,16 +175,41 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     Ok(())
 }
 
+/// Most characters of a grid's name or unit read from a file: the longest
+/// this crate writes (a column name and two products, "mag_comp_level
+/// continued up 200 m vertical derivative") is about 60.
+pub const MAX_LABEL_CHARS: usize = 200;
+
+/// A name or unit from a grid file as the grid keeps it: control
+/// characters escaped (`\u{1b}`, `\n`), so that a corrupt attribute is
+/// never printed raw to a terminal nor written into the next file, and cut
+/// after its first [`MAX_LABEL_CHARS`] characters with `…`.
+pub fn label_from_file(text: &str) -> String {
+    let mut label = String::new();
+    for (n, c) in text.chars().enumerate() {
+        if n == MAX_LABEL_CHARS {
+            label.push('…');
+            break;
+        }
+        if c.is_control() {
+            label.extend(c.escape_debug());
+        } else {
+            label.push(c);
+        }
+    }
+    label
+}
+
 /// The first node (row from the north, column from the west, 1-based, and
 /// its value) that is neither blank (NaN) nor within [`MAX_VALUE`], the
 /// range of the float32 every format stores.
 fn beyond_float32(grid: &Grid) -> Option<(usize, usize, f64)> {
-    let g = &grid.geometry;
     let k = grid
         .values
         .iter()
         .position(|v| !v.is_nan() && v.abs() > MAX_VALUE)?;
-    Some((g.ny - k / g.nx, k % g.nx + 1, grid.values[k]))
+    let (row, column) = grid.geometry.row_column(k);
+    Some((row, column, grid.values[k]))
 }
 
 /// Writes a file atomically: `fill` writes into a temporary file created in
@@ -379,10 +407,11 @@ pub(crate) fn crs_from_wkt(wkt: &str) -> Option<Crs> {
     None
 }
 
-/// The file stem, for the name of a grid whose file does not carry one.
+/// The file stem, for the name of a grid whose file does not carry one
+/// ([`label_from_file`]).
 pub(crate) fn stem(path: &Path) -> String {
     path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
+        .map(|s| label_from_file(&s.to_string_lossy()))
         .unwrap_or_default()
 }
 
@@ -520,9 +549,53 @@ mod tests {
         grid.values.clear();
         assert!(matches!(
             write_grid(&dir.path().join("g.tif"), &grid),
-            Err(GridError::Data(_))
+            Err(GridError::Unusable(_))
         ));
         assert!(entries(dir.path()).is_empty());
+    }
+
+    /// A name or unit with control characters (an escape sequence, a
+    /// NUL, a new line) or of a megabyte was read as it stood, printed by
+    /// `derive` and written into its output.
+    #[test]
+    fn names_and_units_from_files_are_printable_and_short() {
+        assert_eq!(label_from_file("B<&>é nT/m"), "B<&>é nT/m");
+        assert_eq!(label_from_file("a\u{1b}[31m\0b\n"), "a\\u{1b}[31m\\0b\\n");
+        let long = "x".repeat(10 * MAX_LABEL_CHARS);
+        assert_eq!(
+            label_from_file(&long),
+            format!("{}…", &long[..MAX_LABEL_CHARS])
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let mut grid = sample_grid();
+        grid.name = format!("\u{1b}]0;pwned\u{7}{}", "n".repeat(100_000));
+        grid.unit = "n\0\rT".into();
+        for name in ["g.tif", "g.nc"] {
+            let path = dir.path().join(name);
+            write_grid(&path, &grid).unwrap();
+            let back = read_grid(&path).unwrap();
+            assert!(
+                back.name.starts_with("\\u{1b}]0;pwned\\u{7}nnn")
+                    && back.name.ends_with('…')
+                    // The first MAX_LABEL_CHARS characters, two escaped
+                    // (`\u{1b}` and `\u{7}`: 5 and 4 more).
+                    && back.name.chars().count() == MAX_LABEL_CHARS + 1 + 5 + 4,
+                "{name}: {} chars, ends {:?}",
+                back.name.chars().count(),
+                back.name.chars().rev().take(5).collect::<String>()
+            );
+            assert_eq!(back.unit, "n\\0\\rT", "{name}");
+            assert!(
+                !back
+                    .name
+                    .chars()
+                    .chain(back.unit.chars())
+                    .any(char::is_control)
+            );
+        }
+        let path = dir.path().join("a\u{1}b.asc");
+        write_grid(&path, &sample_grid()).unwrap();
+        assert_eq!(read_grid(&path).unwrap().name, "a\\u{1}b");
     }
 
     #[test]
@@ -576,7 +649,7 @@ mod tests {
                 let e = write_grid(&dir.path().join(name), &grid).unwrap_err();
                 let m = e.to_string();
                 assert!(
-                    matches!(e, GridError::Data(_)) && m.contains("row 3, column 3"),
+                    matches!(e, GridError::Unusable(_)) && m.contains("row 3, column 3"),
                     "{name}: {m}"
                 );
                 assert!(m.len() < 150, "{m}");

@@ -42,8 +42,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::{
-    check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt, crs_wkt, read_error,
-    write_atomic,
+    check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt, crs_wkt,
+    label_from_file, read_error, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -668,8 +668,8 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         geometry,
         values,
         crs,
-        name: text(z, "long_name").unwrap_or_else(|| z.name.clone()),
-        unit: text(z, "units").unwrap_or_default(),
+        name: label_from_file(&text(z, "long_name").unwrap_or_else(|| z.name.clone())),
+        unit: label_from_file(&text(z, "units").unwrap_or_default()),
     };
     Ok((geometry, grid))
 }
