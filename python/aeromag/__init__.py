@@ -348,6 +348,8 @@ def grid_flight(
     utm_zone: Optional[str] = None,
     lever_arm: Optional[Tuple[float, float, float]] = None,
     extent: Optional[Tuple[float, float, float, float]] = None,
+    max_sweeps: int = 500,
+    convergence: Optional[float] = None,
     progress: Any = None,
 ) -> Grid:
     """Grid a column of a survey (``aeromag grid``).
@@ -359,7 +361,10 @@ def grid_flight(
     Defaults follow the lines: ``column`` the most processed magnetic
     column, ``cell`` a quarter of the line spacing rounded down to 1, 2, 2.5
     or 5 × 10ᵏ m, ``blanking`` one line spacing; ``extent`` =
-    ``(xmin, xmax, ymin, ymax)`` in m with ``cell``.
+    ``(xmin, xmax, ymin, ymax)`` in m with ``cell``. ``max_sweeps`` (1 to
+    100000) and ``convergence`` (the largest change of a sweep, default
+    10⁻⁴ × the data's RMS about their plane) are minimum curvature's limits,
+    GMT ``surface``'s ``-N`` and ``-C``.
 
     Returns a :class:`Grid`: ``values`` (ny × nx, row 0 south, NaN blank),
     ``x``, ``y`` (m), ``epsg``, ``info`` (line spacing, blanking,
@@ -378,6 +383,8 @@ def grid_flight(
         utm_zone=utm_zone,
         lever_arm=lever_arm,
         extent=extent,
+        max_sweeps=max_sweeps,
+        convergence=convergence,
         progress=progress_callback(progress),
     )
 

@@ -354,6 +354,8 @@ def grid_flight(
     utm_zone: Optional[str] = None,
     lever_arm: Optional[Tuple[float, float, float]] = None,
     extent: Optional[Tuple[float, float, float, float]] = None,
+    max_sweeps: int = 500,
+    convergence: Optional[float] = None,
     progress: _Progress = None,
 ) -> Grid: ...
 def read_grid(path: Union[str, "os.PathLike[str]"]) -> Grid: ...

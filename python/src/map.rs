@@ -172,7 +172,7 @@ impl PyGrid {
 /// Grid a column of a survey (the keywords are `aeromag grid`'s flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, tension=0.25, method="min-curvature", blanking=None,
-    utm_zone=None, lever_arm=None, extent=None, progress=None))]
+    utm_zone=None, lever_arm=None, extent=None, max_sweeps=500, convergence=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn grid_flight(
     py: Python<'_>,
@@ -185,6 +185,8 @@ pub fn grid_flight(
     utm_zone: Option<&str>,
     lever_arm: Option<[f64; 3]>,
     extent: Option<[f64; 4]>,
+    max_sweeps: usize,
+    convergence: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyGrid> {
     let method = match method {
@@ -209,7 +211,12 @@ pub fn grid_flight(
         lever_arm_m: lever_arm,
         geometry,
         method,
-        min_curvature: MinCurvature::with_tension(tension),
+        min_curvature: MinCurvature {
+            tension,
+            max_iterations: max_sweeps,
+            convergence,
+            ..MinCurvature::default()
+        },
     };
     let mut obs = PyProgress::new(progress);
     let result = py.detach(|| lib_grid(&flight.inner, &opts, &mut obs));

@@ -60,3 +60,17 @@ def test_microlevel_and_bad_arguments(survey_csv):
         aeromag.grid_flight(survey, utm_zone="61N")
     with pytest.raises(aeromag.BadInputError):
         aeromag.read_grid("/nonexistent/grid.tif")
+
+
+def test_minimum_curvature_limits(survey_csv):
+    """max_sweeps and convergence are `aeromag grid`'s --max-sweeps and
+    --convergence: they act, and are checked."""
+    survey = aeromag.read_flight(survey_csv)
+    short = aeromag.grid_flight(survey, column="true_anomaly", max_sweeps=10)
+    assert short.info["converged"] is False
+    full = aeromag.grid_flight(survey, column="true_anomaly", max_sweeps=5000)
+    assert full.info["converged"] is True
+    with pytest.raises(aeromag.BadInputError, match="max sweeps = 0"):
+        aeromag.grid_flight(survey, max_sweeps=0)
+    with pytest.raises(aeromag.BadInputError, match="convergence"):
+        aeromag.grid_flight(survey, convergence=-1.0)

@@ -83,6 +83,41 @@ fn grids_in_every_format_with_defaults_from_the_lines() {
     assert!(stdout(&o).contains("bi-directional"), "{}", stdout(&o));
 }
 
+/// The warning of a solve stopped by the sweep limit names the flags that
+/// raise it (it said "raise the sweep limit", which no flag set), and
+/// they act: 10 sweeps stop short, a looser limit converges sooner.
+#[test]
+fn the_sweep_and_convergence_limits_are_flags() {
+    let d = tempfile::tempdir().unwrap();
+    let input = survey(d.path());
+    let sweeps = |o: &std::process::Output| -> usize {
+        let s = stdout(o);
+        let line = s.lines().find(|l| l.contains("sweeps on the final grid"));
+        let words: Vec<&str> = line.expect(&s).split_whitespace().collect();
+        let k = words.iter().position(|w| *w == "sweeps").unwrap();
+        words[k - 1].parse().unwrap()
+    };
+    let o = grid(&input, &d.path().join("a.tif"), &["--max-sweeps", "10"]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("NOT converged"), "{}", stdout(&o));
+    assert!(
+        stderr(&o).contains("raise the sweep limit (--max-sweeps) or the convergence limit"),
+        "{}",
+        stderr(&o)
+    );
+    let o = grid(&input, &d.path().join("b.tif"), &["--max-sweeps", "5000"]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains(", converged"), "{}", stdout(&o));
+    let strict = sweeps(&o);
+    let o = grid(
+        &input,
+        &d.path().join("c.tif"),
+        &["--max-sweeps", "5000", "--convergence", "1"],
+    );
+    assert_code(&o, 0);
+    assert!(sweeps(&o) < strict, "{} against {strict}", sweeps(&o));
+}
+
 #[test]
 fn bad_arguments_and_files_exit_with_code_2() {
     let d = tempfile::tempdir().unwrap();
@@ -94,6 +129,18 @@ fn bad_arguments_and_files_exit_with_code_2() {
         (vec!["--utm-zone", "61N"], "g.tif", "61"),
         (vec!["--cell", "0"], "g.tif", "cell"),
         (vec!["--tension", "1e300"], "g.tif", "tension = 1e300 is"),
+        (
+            vec!["--max-sweeps", "0"],
+            "g.tif",
+            "max sweeps = 0 is out of range",
+        ),
+        (
+            vec!["--max-sweeps", "1000000000"],
+            "g.tif",
+            "max sweeps = 1000000000 is out of range: 1 to 100000",
+        ),
+        (vec!["--convergence", "0"], "g.tif", "--convergence"),
+        (vec!["--convergence", "nan"], "g.tif", "--convergence"),
         // The grid library's own errors (the extent is checked before the
         // file is read) are bad input too; they exited 1.
         (

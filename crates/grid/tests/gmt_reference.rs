@@ -130,7 +130,7 @@ fn a_spike_beside_halfway_samples_matches_gmt_surface() {
     let (v, report) = MinCurvature {
         tension: 0.25,
         convergence: Some(1e-9),
-        max_iterations: 1_000_000,
+        max_iterations: aeromag_grid::gridding::min_curvature::MAX_ITERATIONS,
         ..Default::default()
     }
     .grid(Points::new(&x, &y, &z).unwrap(), g)

@@ -47,6 +47,16 @@ pub struct Args {
     /// Tension, 0 (minimum curvature) to 1 (harmonic).
     #[arg(long, default_value_t = 0.25)]
     tension: f64,
+    /// Most sweeps of minimum curvature on the final grid, 1 to 100000
+    /// (GMT `surface -N`; the coarser grids before it get more in
+    /// proportion to their spacing).
+    #[arg(long, value_name = "N", default_value_t = 500)]
+    max_sweeps: usize,
+    /// Convergence limit of minimum curvature: the largest change of a
+    /// sweep, in the column's unit (GMT `surface -C`; default 10⁻⁴ × the
+    /// data's RMS about their plane).
+    #[arg(long, value_name = "NT", value_parser = args::positive)]
+    convergence: Option<f64>,
     /// Gridding method.
     #[arg(long, value_enum, default_value_t = GridMethod::MinCurvature)]
     method: GridMethod,
@@ -95,7 +105,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         zone: a.utm_zone,
         lever_arm_m: a.lever_arm,
         method: a.method,
-        min_curvature: MinCurvature::with_tension(a.tension),
+        min_curvature: MinCurvature {
+            tension: a.tension,
+            max_iterations: a.max_sweeps,
+            convergence: a.convergence,
+            ..MinCurvature::default()
+        },
     };
     let g = grid_flight(&flight, &opts, &mut Bars::new())?;
     let format = g.write(&a.out)?;

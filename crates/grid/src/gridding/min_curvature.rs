@@ -65,8 +65,9 @@ use crate::grid::GridGeometry;
 pub struct MinCurvature {
     /// Tension `T`, 0–1 (default 0.25).
     pub tension: f64,
-    /// Most sweeps of each relaxation on the final grid (default 500, as
-    /// GMT); a coarser grid of spacing `s` cells gets `s` times as many.
+    /// Most sweeps of each relaxation on the final grid, 1 to
+    /// [`MAX_ITERATIONS`] (default 500, as GMT's `-N`); a coarser grid of
+    /// spacing `s` cells gets `s` times as many.
     pub max_iterations: usize,
     /// Convergence limit: the largest change of a sweep, in the data's
     /// unit; `None` = 10⁻⁴ × the data's RMS about their plane.
@@ -78,6 +79,12 @@ pub struct MinCurvature {
     /// `-Qr`).
     pub enlarge: bool,
 }
+
+/// Most sweeps [`MinCurvature::max_iterations`] may ask for: 200 times
+/// GMT's default. A limit of 10⁹ (accepted before) would keep a grid of
+/// 10⁶ nodes sweeping for days; a solve that has not converged after 10⁵
+/// sweeps needs a larger cell or a looser limit, not more sweeps.
+pub const MAX_ITERATIONS: usize = 100_000;
 
 impl Default for MinCurvature {
     fn default() -> Self {
@@ -172,11 +179,11 @@ impl MinCurvature {
         if let Some(c) = self.convergence {
             crate::error::positive("convergence limit", c)?;
         }
-        if self.max_iterations == 0 {
+        if !(1..=MAX_ITERATIONS).contains(&self.max_iterations) {
             return Err(GridError::OutOfRange {
-                name: "max_iterations",
-                value: 0.0,
-                expected: "at least 1",
+                name: "max sweeps",
+                value: self.max_iterations as f64,
+                expected: "1 to 100000",
             });
         }
         Ok(())
