@@ -172,6 +172,33 @@ fn bad_arguments_and_files_exit_with_code_2() {
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let keep: Vec<usize> = (0..header.len()).filter(|&k| header[k] != "line").collect();
+    // Lines a micrometre apart (positions shrunk about the survey): a grid
+    // of 2.5e-7 m cells was written, which derive then refused.
+    let lat = header.iter().position(|c| *c == "lat").unwrap();
+    let lon = header.iter().position(|c| *c == "lon").unwrap();
+    let mut tiny = String::new();
+    for (k, l) in text.lines().filter(|l| !l.starts_with('#')).enumerate() {
+        let mut cells: Vec<String> = l.split(',').map(str::to_string).collect();
+        if k > 0 {
+            for (c, about) in [(lat, 56.0), (lon, 38.0)] {
+                let v: f64 = cells[c].parse().unwrap();
+                cells[c] = (about + (v - about) * 1e-9).to_string();
+            }
+        }
+        tiny.push_str(&cells.join(","));
+        tiny.push('\n');
+    }
+    let tiny_path = d.path().join("tiny.csv");
+    std::fs::write(&tiny_path, tiny).unwrap();
+    let o = grid(&tiny_path, &d.path().join("t.tif"), &[]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("tiny.csv': its lines are")
+            && stderr(&o).contains("give the cell size"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!d.path().join("t.tif").exists());
     let mut csv = String::new();
     for l in std::iter::once(header.join(",").as_str()).chain(lines) {
         let cells: Vec<&str> = l.split(',').collect();

@@ -56,9 +56,19 @@ pub const MAX_VALUE: f64 = f32::MAX as f64;
 impl GridGeometry {
     /// The smallest grid of spacing `cell` whose nodes cover
     /// `[x_min, x_max] × [y_min, y_max]`, with its western and southern
-    /// nodes on multiples of `cell` (so grids of one survey line up).
+    /// nodes on multiples of `cell` (so grids of one survey line up). The
+    /// cell must lie within [`MIN_CELL`]–[`MAX_CELL`], as in the grid files
+    /// read back (a grid of 2.5·10⁻⁷ m cells, from lines half a millimetre
+    /// apart, was written and then refused by `derive`).
     pub fn covering(x_min: f64, x_max: f64, y_min: f64, y_max: f64, cell: f64) -> Result<Self> {
         let cell = positive("cell size", cell)?;
+        if !(MIN_CELL..=MAX_CELL).contains(&cell) {
+            return Err(GridError::OutOfRange {
+                name: "cell size",
+                value: cell,
+                expected: "1e-6 to 1e6 m",
+            });
+        }
         if !(x_min.is_finite() && x_max.is_finite() && y_min.is_finite() && y_max.is_finite())
             || x_max < x_min
             || y_max < y_min
@@ -316,6 +326,12 @@ mod tests {
         assert!(GridGeometry::covering(0.0, 1.0, 0.0, 1.0, 0.0).is_err());
         assert!(GridGeometry::covering(0.0, 1e9, 0.0, 1e9, 1.0).is_err());
         assert!(GridGeometry::covering(f64::NAN, 1.0, 0.0, 1.0, 1.0).is_err());
+        // Cells beyond what grid files are read with.
+        for cell in [1e-7, 2e6] {
+            let e = GridGeometry::covering(0.0, 1.0, 0.0, 1.0, cell).unwrap_err();
+            assert!(e.to_string().contains("1e-6 to 1e6 m"), "{e}");
+        }
+        assert!(GridGeometry::covering(0.0, 1e-5, 0.0, 1e-5, MIN_CELL).is_ok());
     }
 
     #[test]

@@ -5,7 +5,9 @@ use super::survey::ProjectedSurvey;
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use crate::observer::{Note, Notes, Observer};
+use aeromag_core::error::shown;
 use aeromag_grid::format::{GridFormat, write_grid};
+use aeromag_grid::grid::MIN_CELL;
 use aeromag_grid::gridding::{
     Bidirectional, BlockMeans, LinePoints, MinCurvature, MinCurvatureReport, Points, blank_beyond,
     distance_to_data,
@@ -135,6 +137,17 @@ pub fn grid_flight(
     }
     let cell = match (opts.geometry.map(|g| g.cell).or(opts.cell_m), &survey.lines) {
         (Some(c), _) => c,
+        (None, Some(l)) if l.default_cell_m() < MIN_CELL => {
+            return Err(Error::bad_file(
+                flight.label(),
+                format!(
+                    "its lines are {:.3e} m apart, which gives no cell size (at least {} m): \
+                     positions in another unit, or a corrupted file? give the cell size",
+                    l.spacing_m,
+                    shown(MIN_CELL)
+                ),
+            ));
+        }
         (None, Some(l)) => l.default_cell_m(),
         (None, None) => {
             return Err(Error::bad_file(

@@ -40,8 +40,8 @@ pub struct Args {
     /// mag_level, mag_comp, mag).
     #[arg(long)]
     column: Option<String>,
-    /// Cell size (node spacing), m (default: a quarter of the line
-    /// spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
+    /// Cell size (node spacing), m, 1e-6 to 1e6 (default: a quarter of
+    /// the line spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
     #[arg(long, value_parser = args::positive)]
     cell: Option<f64>,
     /// Tension, 0 (minimum curvature) to 1 (harmonic).
