@@ -53,7 +53,8 @@ pub fn parse_model_json(
             return Err(model_error(
                 origin,
                 format!(
-                    "model format `{other}` is not supported (expected one of {})",
+                    "model format {} is not supported (expected one of {})",
+                    aeromag_core::error::shown_text(other),
                     READ_FORMATS.map(|f| format!("`{f}`")).join(", ")
                 ),
             ));
@@ -70,8 +71,8 @@ pub fn parse_model_json(
         found => Err(model_error(
             origin,
             format!(
-                "model kind `{}` is not a `{kind}` model (written by `{writer}`)",
-                found.unwrap_or("missing")
+                "model kind {} is not a `{kind}` model (written by `{writer}`)",
+                found.map_or("missing".to_string(), aeromag_core::error::shown_text)
             ),
         )),
     }
@@ -451,6 +452,24 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("missing"), "{e}");
+    }
+
+    #[test]
+    fn long_or_binary_format_and_kind_are_not_echoed_whole() {
+        // A 100 000-character `kind` (or `format`) was echoed whole in the
+        // error; it is cut to its first characters and escaped.
+        let long = "x".repeat(100_000);
+        for text in [
+            format!(r#"{{"format":"aeromag-model/2","kind":"{long}"}}"#),
+            format!(r#"{{"format":"{long}","kind":"towed-pod"}}"#),
+            r#"{"format":"aeromag-model/2","kind":"pod\u0000\u0001"}"#.to_string(),
+        ] {
+            let e = parse_model_json(&text, "m.json", "towed-pod", "aeromag pod fit").unwrap_err();
+            let msg = e.to_string();
+            assert!(e.is_bad_input() && msg.contains("m.json"), "{msg}");
+            assert!(msg.len() < 400, "{} characters", msg.len());
+            assert!(!msg.contains('\0') && !msg.contains('\u{1}'), "{msg:?}");
+        }
     }
 
     /// The model of a Kalman fit, as `aeromag-model/1` wrote it.

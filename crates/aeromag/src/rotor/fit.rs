@@ -245,9 +245,18 @@ impl RotorOptions {
             .validate()
             .map_err(|e| Error::bad_input(e.to_string()))?;
         let [lo, hi] = self.rotor_hz_range;
+        let cutoff = RotorFitOptions::default().highpass_hz;
         if !(lo > 0.0 && hi > lo && hi.is_finite()) {
             return Err(Error::bad_input(format!(
-                "rotor frequency band {},{} Hz: need 0 < LO < HI",
+                "rotor frequency band {},{} Hz (rotor_hz, --rotor-hz): need 0 < LO < HI",
+                shown(lo),
+                shown(hi)
+            )));
+        }
+        if lo <= cutoff {
+            return Err(Error::bad_input(format!(
+                "rotor frequency band {},{} Hz (rotor_hz, --rotor-hz): LO must be above {cutoff} Hz, \
+                 the high-pass cutoff of the fit (a slower rotor's signal is removed with the manoeuvres)",
                 shown(lo),
                 shown(hi)
             )));
@@ -268,8 +277,8 @@ impl RotorOptions {
         }
         if !(self.window_s.is_finite() && self.window_s > 0.0) {
             return Err(Error::bad_input(format!(
-                "window {} s must be positive",
-                self.window_s
+                "window {} s (window_s, --window-s) must be positive",
+                shown(self.window_s)
             )));
         }
         if let Some(t) = &self.tail {
@@ -324,6 +333,94 @@ fn bridge_dropouts(time: &[f64], x: &[f64], max_len: usize, period: Option<f64>)
         }
     }
     out
+}
+
+/// Check that the window of constant cone angles spans at least
+/// [`MIN_WINDOW_SAMPLES`] samples and that every stretch fitted holds two
+/// windows (four when the phase is estimated: its refinement uses windows
+/// twice as long); bad input naming the option otherwise (the library's
+/// message named neither the option nor the file).
+fn check_window(
+    window_s: f64,
+    fs: f64,
+    segs: &[std::ops::Range<usize>],
+    estimated: bool,
+    file: &str,
+) -> Result<()> {
+    let win = (window_s * fs).round();
+    let per_stretch = if estimated { 4.0 } else { 2.0 };
+    let shortest = segs.iter().map(|s| s.len()).min().unwrap_or(0) as f64;
+    if win < MIN_WINDOW_SAMPLES as f64 || per_stretch * win > shortest {
+        return Err(Error::bad_file(
+            file,
+            format!(
+                "window {} s (window_s, --window-s) must span at least {MIN_WINDOW_SAMPLES} samples \
+                 ({} s at {fs:.3} Hz) and fit {per_stretch} times in every stretch fitted (the shortest is {} s)",
+                shown(window_s),
+                MIN_WINDOW_SAMPLES as f64 / fs,
+                shortest / fs
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Fewest samples in the window of constant cone angles (the library's
+/// slowly-varying-angle fit needs 10).
+const MIN_WINDOW_SAMPLES: usize = 10;
+
+/// Check the mean rotor frequency `f_r` (Hz) found on the fitted stretch:
+/// above the high-pass cutoff of the fit (a slower "rotor" is removed with
+/// the manoeuvres: a heading or time column given as the phase channel
+/// turns at mHz and was fitted with exit 0) and with the blade-passing
+/// frequency below Nyquist; for a tail rotor, `gear_ratio × f_r` between
+/// the cutoff and Nyquist (a gear ratio of 2⁶³ failed with a singular system, one of 10⁶
+/// was fitted on aliased garbage with exit 0).
+fn check_rotor_speed(
+    f_r: f64,
+    fs: f64,
+    blades: usize,
+    phase_col: Option<&str>,
+    tail: Option<&TailRotor>,
+    file: &str,
+) -> Result<()> {
+    let cutoff = RotorFitOptions::default().highpass_hz;
+    let nyquist = fs / 2.0;
+    let ok = |f: f64, n: usize| f > cutoff && n as f64 * f < nyquist;
+    if !ok(f_r, blades) {
+        let source = match phase_col {
+            Some(c) => format!("the phase channel `{c}` (deg) turns"),
+            None => "the rotor phase estimated from the data turns".to_string(),
+        };
+        return Err(Error::bad_file(
+            file,
+            format!(
+                "{source} at {} Hz on the fitted stretch: a rotor's frequency must be above {cutoff} Hz \
+                 (the fit's high-pass cutoff) and its {blades} blades must pass below Nyquist \
+                 ({nyquist:.3} Hz); is it the rotor phase channel, in degrees?",
+                shown(f_r)
+            ),
+        ));
+    }
+    if let Some(t) = tail {
+        // The tail's own turn, not its blade passing: with its phase geared
+        // from the channel, the blade passing may alias (the simulator's
+        // 3 blades at 21 Hz, 100 Hz sampling).
+        let f_t = t.gear_ratio * f_r;
+        if !ok(f_t, 1) {
+            return Err(Error::bad_file(
+                file,
+                format!(
+                    "tail rotor gear ratio {} (gear_ratio, --gear-ratio) makes the tail rotor turn at {} Hz \
+                     (main rotor {f_r:.4} Hz): it must be above {cutoff} Hz (the fit's high-pass cutoff) \
+                     and below Nyquist ({nyquist:.3} Hz)",
+                    shown(t.gear_ratio),
+                    shown(f_t)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Options of the phase refinement of a phase estimated from the data:
@@ -454,9 +551,19 @@ pub fn fit_rotor(
     let fit_opts = RotorFitOptions::default();
     let b = cols.field(&r);
     let mag = &cols.mag[r.clone()];
-    let (mut phase, omega) = segment_phase(&cols, &r, fs, geom.blades, opts.rotor_hz_range)?;
-    let nominal = [opts.nominal_angles];
     let estimated = phase_col.is_none();
+    check_window(opts.window_s, fs, &segs, estimated, &file)?;
+    let (mut phase, omega) = segment_phase(&cols, &r, fs, geom.blades, opts.rotor_hz_range)?;
+    let f_r = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
+    check_rotor_speed(
+        f_r,
+        fs,
+        geom.blades,
+        phase_col.as_deref(),
+        opts.tail.as_ref(),
+        &file,
+    )?;
+    let nominal = [opts.nominal_angles];
     if estimated {
         let inp = RotorInput {
             b_body_nt: &b,
@@ -515,7 +622,7 @@ pub fn fit_rotor(
             (slow, Some(tail))
         }
     };
-    let rotor_hz = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
+    let rotor_hz = f_r;
     let coning_mean_deg =
         slow.angles.iter().map(|x| x.coning_rad).sum::<f64>() / slow.angles.len() as f64 * 180.0
             / std::f64::consts::PI;
@@ -584,6 +691,54 @@ pub fn fit_rotor(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rotor_speed_and_window_out_of_range_are_bad_input_naming_the_option() {
+        let tail = RotorPreset::AeromagSimHelicopter.tail_rotor();
+        check_rotor_speed(4.8, 100.0, 4, Some("rotor_phase"), Some(&tail), "f.csv").unwrap();
+        // A time or heading column given as the phase channel turns at
+        // mHz: it was fitted with exit 0.
+        let e = check_rotor_speed(0.0028, 100.0, 4, Some("time"), None, "f.csv").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            e.is_bad_input() && msg.contains("f.csv") && msg.contains("`time`"),
+            "{msg}"
+        );
+        // Blade passing beyond Nyquist.
+        assert!(check_rotor_speed(13.0, 100.0, 4, None, None, "f.csv").is_err());
+        // A gear ratio of 2⁶³ failed as a singular fit (exit 1), one of
+        // 10⁶ was fitted on aliased data (exit 0).
+        for k in [9.3e18, 1e6, 1e-300] {
+            let mut t = tail.clone();
+            t.gear_ratio = k;
+            let e = check_rotor_speed(4.8, 100.0, 4, Some("rotor_phase"), Some(&t), "f.csv")
+                .unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("--gear-ratio"),
+                "{e}"
+            );
+        }
+        // The window: the library's message named neither option nor file.
+        let segs = [0..1000, 0..4000];
+        check_window(1.0, 100.0, &segs, true, "f.csv").unwrap();
+        for (w, estimated) in [(1e-300, false), (1e308, false), (6.0, false), (3.0, true)] {
+            let e = check_window(w, 100.0, &segs, estimated, "f.csv").unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains("--window-s"),
+                "{e}"
+            );
+        }
+        // A band under the fit's high-pass cutoff (0.01–0.02 Hz gave a
+        // mean coning of −146°, written with exit 0).
+        let mut o = RotorOptions::preset(RotorPreset::AeromagSimHelicopter);
+        o.validate().unwrap();
+        o.rotor_hz_range = [0.01, 0.02];
+        let e = o.validate().unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("--rotor-hz"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn dropouts_are_bridged_but_not_time_gaps_or_long_runs() {

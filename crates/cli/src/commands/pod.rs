@@ -47,11 +47,11 @@ pub struct FitArgs {
     /// Solve: two-step (seed), joint, dipole-array.
     #[arg(long, value_enum, default_value_t = PodMethod::default())]
     method: PodMethod,
-    /// Cable length, m.
+    /// Cable length, m (at most 1000).
     #[arg(long)]
     cable_length_m: f64,
     /// Cable attachment point, body axes (x forward, y right, z down), m
-    /// (default 0,0,0).
+    /// (default 0,0,0; within ±1000 m).
     #[arg(long, value_name = "A,B,C", allow_hyphen_values = true, value_parser = args::xyz)]
     attach_m: Option<[f64; 3]>,
     /// Inclination of the Earth field, deg (positive down).
@@ -68,7 +68,8 @@ pub struct FitArgs {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     grad_up_nt_per_km: f64,
     /// Equivalent source points of the dipole array, body axes, m
-    /// (default: x = −6, −2, 2 m along the fuselage, z = −1 m).
+    /// (default: x = −6, −2, 2 m along the fuselage, z = −1 m; 1 to 8
+    /// points within 1000 m).
     #[arg(long, value_name = "X,Y,Z;X,Y,Z;…", allow_hyphen_values = true, value_parser = source_points)]
     source_points: Option<SourcePoints>,
 }

@@ -99,18 +99,20 @@ struct FitArgs {
     #[arg(long, conflicts_with = "phase_column")]
     estimate_phase: bool,
     /// Search band of the rotor frequency when the phase is estimated, Hz
-    /// (default 4,6).
+    /// (default 4,6; LO above 2 Hz, the fit's high-pass cutoff).
     #[arg(long, value_name = "LO,HI", value_parser = args::pair)]
     rotor_hz: Option<[f64; 2]>,
-    /// Rotor hub position, body axes (x forward, y right, z down), m.
+    /// Rotor hub position, body axes (x forward, y right, z down), m
+    /// (within ±100 m).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
           required_unless_present = "preset")]
     hub_m: Option<[f64; 3]>,
-    /// Scalar sensor position, body axes, m.
+    /// Scalar sensor position, body axes, m (within ±100 m).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz,
           required_unless_present = "preset")]
     sensor_m: Option<[f64; 3]>,
-    /// Magnetised span of a blade from the hub, m.
+    /// Magnetised span of a blade from the hub, m (0 ≤ ROOT, TIP ≤ 100,
+    /// TIP − ROOT ≥ 0.01).
     #[arg(long, value_name = "ROOT,TIP", value_parser = args::pair,
           required_unless_present = "preset")]
     blade_span_m: Option<[f64; 2]>,
@@ -125,7 +127,8 @@ struct FitArgs {
     /// or the preset's).
     #[arg(long, allow_hyphen_values = true)]
     tilt_lon_deg: Option<f64>,
-    /// Window over which the cone angles are taken as constant, s (default 1).
+    /// Window over which the cone angles are taken as constant, s (default 1;
+    /// at least 10 samples, and at most half the shortest stretch fitted).
     #[arg(long)]
     window_s: Option<f64>,
     /// Also model a tail rotor, geared to the main rotor and fitted jointly
@@ -151,7 +154,8 @@ struct FitArgs {
     /// Number of tail blades.
     #[arg(long, requires = "tail_rotor")]
     tail_blades: Option<usize>,
-    /// Tail rotor speed over main rotor speed.
+    /// Tail rotor speed over main rotor speed (the tail rotor turning
+    /// between 2 Hz and Nyquist).
     #[arg(long, requires = "tail_rotor")]
     gear_ratio: Option<f64>,
 }

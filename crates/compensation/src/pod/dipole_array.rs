@@ -84,26 +84,40 @@ fn columns(sources: &[[f64; 3]], h: &PodHeading, hp: bool) -> Result<(Vec<Vec<f6
 /// above the pod; 1e300 m made the design NaN).
 pub const MAX_SOURCE_M: f64 = 1000.0;
 
-/// Fit the equivalent dipole array at `sources` (body frame, m) jointly on
-/// all `headings`. Errors: no sources or headings, bad data.
-pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result<DipoleArrayModel> {
-    if sources.is_empty() || headings.is_empty() {
-        return Err(CompError::data(
-            "dipole-array pod fit needs sources and headings",
-        ));
-    }
-    if sources.iter().flatten().any(|x| !x.is_finite()) {
-        return Err(CompError::data("non-finite source point"));
-    }
-    if let Some(p) = sources
-        .iter()
-        .find(|p| p.iter().map(|x| x * x).sum::<f64>().sqrt() > MAX_SOURCE_M)
-    {
+/// Most source points of a dipole array (the default has 3). Each adds
+/// [`PER_SOURCE`] coefficients and the solve's time grows with their
+/// square: 30 points took 60 s on a 12-minute flight at 20 Hz and 300 did
+/// not finish.
+pub const MAX_SOURCE_POINTS: usize = 8;
+
+/// Check source points: 1 to [`MAX_SOURCE_POINTS`] of them, each within
+/// [`MAX_SOURCE_M`] of the body frame's origin (bad input otherwise).
+pub fn check_source_points(sources: &[[f64; 3]]) -> Result<()> {
+    if sources.is_empty() || sources.len() > MAX_SOURCE_POINTS {
         return Err(CompError::setting(format!(
-            "source point ({}) m is more than {MAX_SOURCE_M} m from the body frame's origin: metres expected",
+            "{} source points: 1 to {MAX_SOURCE_POINTS} are taken",
+            sources.len()
+        )));
+    }
+    if let Some(p) = sources.iter().find(|p| {
+        p.iter().any(|x| x.is_nan()) || p.iter().map(|x| x * x).sum::<f64>().sqrt() > MAX_SOURCE_M
+    }) {
+        return Err(CompError::setting(format!(
+            "source point ({}) m is not within {MAX_SOURCE_M} m of the body frame's origin: metres expected",
             p.map(aeromag_core::error::shown).join(", ")
         )));
     }
+    Ok(())
+}
+
+/// Fit the equivalent dipole array at `sources` (body frame, m) jointly on
+/// all `headings`. Errors: no headings, sources refused by
+/// [`check_source_points`], bad data.
+pub fn fit_dipole_array(headings: &[PodHeading], sources: &[[f64; 3]]) -> Result<DipoleArrayModel> {
+    if headings.is_empty() {
+        return Err(CompError::data("dipole-array pod fit needs headings"));
+    }
+    check_source_points(sources)?;
     let m = sources.len() * PER_SOURCE;
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); m];
     let mut y = Vec::new();
@@ -167,6 +181,17 @@ mod tests {
         assert!(fit_dipole_array(std::slice::from_ref(&h), &[]).is_err());
         assert!(fit_dipole_array(&[], &default_source_points()).is_err());
         assert!(fit_dipole_array(std::slice::from_ref(&h), &[[f64::NAN, 0.0, 0.0]]).is_err());
+        // 300 source points ran for minutes; more than MAX_SOURCE_POINTS
+        // are refused before the solve, as bad input.
+        let many: Vec<[f64; 3]> = (0..=MAX_SOURCE_POINTS)
+            .map(|k| [k as f64, 0.0, -1.0])
+            .collect();
+        let e = fit_dipole_array(std::slice::from_ref(&h), &many).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("source points"),
+            "{e}"
+        );
+        assert!(check_source_points(&many[..MAX_SOURCE_POINTS]).is_ok());
         let m = DipoleArrayModel {
             sources_m: default_source_points(),
             coefficients: vec![0.0; 3],

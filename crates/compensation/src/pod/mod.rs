@@ -113,8 +113,8 @@ pub mod model_file;
 pub mod trajectory;
 
 pub use dipole_array::{
-    DipoleArrayModel, PER_SOURCE, default_source_points, fit_dipole_array, predict_dipole_array,
-    predict_dipole_array_raw,
+    DipoleArrayModel, MAX_SOURCE_M, MAX_SOURCE_POINTS, PER_SOURCE, check_source_points,
+    default_source_points, fit_dipole_array, predict_dipole_array, predict_dipole_array_raw,
 };
 pub use fit::{
     JointFit, PodHeading, TwoStepFit, compensation_rate, compensation_rate_pooled, detrend,

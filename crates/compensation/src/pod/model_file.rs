@@ -6,6 +6,8 @@ use crate::error::{CompError, Result};
 #[cfg(test)]
 use crate::model_file::MODEL_FORMAT;
 use crate::model_file::parse_model;
+use crate::pod::dipole_array::{MAX_SOURCE_M, PER_SOURCE, check_source_points};
+use crate::pod::model::{N_JOINT, N_PARAMS};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::str::FromStr;
@@ -128,21 +130,38 @@ pub struct PodModelFile {
 pub const MAX_GRADIENT_NT_PER_KM: f64 = 10_000.0;
 
 impl PodSetup {
-    /// Check the values: a positive cable length (m), an inclination in
-    /// (−90°, 90°), a declination within ±180° and gradients within
+    /// Check the values: a positive cable length of at most
+    /// [`MAX_SOURCE_M`] m, an attachment point within [`MAX_SOURCE_M`] of
+    /// the body frame's origin, an inclination in (−90°, 90°), a
+    /// declination within ±180° and gradients within
     /// ±[`MAX_GRADIENT_NT_PER_KM`].
     pub fn validate(&self) -> Result<()> {
+        use aeromag_core::error::shown;
         let bad = |m: String| Err(CompError::setting(m));
-        if !(self.cable_length_m.is_finite() && self.cable_length_m > 0.0) {
+        // The bound of the dipole array's source points, for the same
+        // reason: body-frame distances in metres (a cable of 2⁶³ m was
+        // fitted to a model of noise with exit 0; 1e308 m made the design
+        // NaN).
+        if !(self.cable_length_m > 0.0 && self.cable_length_m <= MAX_SOURCE_M) {
             return bad(format!(
-                "cable length {} m must be positive",
-                self.cable_length_m
+                "cable length {} m must be positive and at most {MAX_SOURCE_M} m",
+                shown(self.cable_length_m)
+            ));
+        }
+        if self
+            .attach_m
+            .iter()
+            .any(|x| x.is_nan() || x.abs() > MAX_SOURCE_M)
+        {
+            return bad(format!(
+                "attachment point ({}) m must be within ±{MAX_SOURCE_M} m of the body frame's origin",
+                self.attach_m.map(shown).join(", ")
             ));
         }
         if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
             return bad(format!(
                 "inclination {}° must be in (−90, 90)",
-                self.inclination_deg
+                shown(self.inclination_deg)
             ));
         }
         if self.declination_deg.is_nan() || self.declination_deg.abs() > 180.0 {
@@ -180,7 +199,10 @@ impl PodModelFile {
         Ok(m)
     }
 
-    /// Check the content: as many finite coefficients as names, and the
+    /// Check the content: as many finite coefficients as names, as many as
+    /// the method has (43 for `two-step`, 67 for `joint`, 21 per source
+    /// point for `dipole-array`, whose points [`check_source_points`]
+    /// checks), a reference position within [`MAX_SOURCE_M`], and the
     /// setup.
     pub fn validate(&self) -> Result<()> {
         if self.coefficients.len() != self.coefficient_names.len()
@@ -189,6 +211,31 @@ impl PodModelFile {
             return Err(CompError::data(
                 "coefficients and names differ in number or are not finite",
             ));
+        }
+        let expect = match self.method {
+            PodMethod::TwoStep => N_PARAMS,
+            PodMethod::Joint => N_JOINT,
+            PodMethod::DipoleArray => {
+                check_source_points(&self.sources_m)?;
+                self.sources_m.len() * PER_SOURCE
+            }
+        };
+        if self.coefficients.len() != expect {
+            return Err(CompError::data(format!(
+                "a `{}` model has {expect} coefficients, the file {}",
+                self.method,
+                self.coefficients.len()
+            )));
+        }
+        if self
+            .reference_m
+            .iter()
+            .any(|x| x.is_nan() || x.abs() > MAX_SOURCE_M)
+        {
+            return Err(CompError::data(format!(
+                "reference position ({}) m must be within ±{MAX_SOURCE_M} m of the body frame's origin",
+                self.reference_m.map(aeromag_core::error::shown).join(", ")
+            )));
         }
         self.setup.validate()
     }
@@ -222,8 +269,8 @@ mod tests {
             method: PodMethod::Joint,
             trajectory: "exact".into(),
             setup,
-            coefficient_names: vec!["a".into(), "b".into()],
-            coefficients: vec![1.0, 2.0],
+            coefficient_names: (0..N_JOINT).map(|k| format!("c{k}")).collect(),
+            coefficients: (0..N_JOINT).map(|k| k as f64).collect(),
             sources_m: vec![],
             reference_m: [0.0; 3],
             heading_coefficients: vec![],
@@ -253,6 +300,47 @@ mod tests {
         let mut bad = m.clone();
         bad.coefficients.push(3.0);
         assert!(bad.validate().is_err());
+        // As many coefficients as names, but not as many as the method has.
+        let mut bad = m.clone();
+        bad.coefficients.pop();
+        bad.coefficient_names.pop();
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("67 coefficients")
+        );
+        // Body-frame distances beyond 1 km (1e308 m gave NaN rates printed
+        // with exit 0, 2⁶³ m a model of noise) and a reference position
+        // that is not a position; numbers shown in exponent form.
+        for edit in [
+            |m: &mut PodModelFile| m.setup.cable_length_m = 1e308,
+            |m: &mut PodModelFile| m.setup.cable_length_m = 9.3e18,
+            |m: &mut PodModelFile| m.setup.attach_m[0] = 1e308,
+            |m: &mut PodModelFile| m.setup.attach_m[2] = -2e3,
+            |m: &mut PodModelFile| m.reference_m[1] = 1e300,
+            |m: &mut PodModelFile| m.setup.inclination_deg = 1e308,
+        ] {
+            let mut bad = m.clone();
+            edit(&mut bad);
+            let e = bad.validate().unwrap_err();
+            assert!(e.is_bad_input(), "{e}");
+            assert!(e.to_string().len() < 200, "{e}");
+        }
+        // A dipole array: 21 coefficients per source point, the points
+        // within 1 km.
+        let mut arr = m.clone();
+        arr.method = PodMethod::DipoleArray;
+        arr.sources_m = vec![[-6.0, 0.0, -1.0], [2.0, 0.0, -1.0]];
+        arr.coefficients = vec![0.5; 2 * PER_SOURCE];
+        arr.coefficient_names = (0..2 * PER_SOURCE).map(|k| format!("c{k}")).collect();
+        arr.validate().unwrap();
+        let mut far = arr.clone();
+        far.sources_m[1][0] = 1e308;
+        assert!(far.validate().unwrap_err().is_bad_input());
+        let mut none = arr;
+        none.sources_m.clear();
+        assert!(none.validate().is_err());
         let mut bad = m;
         bad.setup.cable_length_m = -1.0;
         assert!(

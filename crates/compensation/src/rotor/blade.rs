@@ -66,6 +66,17 @@ fn main_zero_azimuth() -> [f64; 3] {
 /// fit out of memory.
 pub const MAX_BLADES: usize = 16;
 
+/// Largest distance of a rotor hub, a sensor or a blade tip from the body
+/// frame's origin, m. The largest rotors are about 16 m in radius and a
+/// sensor sits on the airframe; a hub or sensor 10³⁰ m away made every
+/// regressor underflow and the fit wrote a model of zeros with exit 0.
+pub const MAX_ROTOR_EXTENT_M: f64 = 100.0;
+
+/// Shortest magnetised blade span (tip − root) taken, m: shorter is no
+/// blade (a span of 10⁻³⁰⁰ m gave zero regressors and a model of zeros,
+/// written with exit 0).
+pub const MIN_BLADE_SPAN_M: f64 = 0.01;
+
 /// Largest flap angle taken, rad (30°): a coning or tilt beyond is not a
 /// rotor cone (1e300° was fitted and reported as a mean coning of 10¹⁷°).
 pub const MAX_FLAP_RAD: f64 = std::f64::consts::FRAC_PI_6;
@@ -128,25 +139,40 @@ impl RotorGeometry {
         )
     }
 
-    /// Check the geometry.
+    /// Check the geometry: hub and sensor within [`MAX_ROTOR_EXTENT_M`] of
+    /// the body frame's origin, `0 ≤ root < tip ≤` [`MAX_ROTOR_EXTENT_M`]
+    /// with a magnetised span of at least [`MIN_BLADE_SPAN_M`], 2 to
+    /// [`MAX_BLADES`] blades and a rotor plane. The message names the value
+    /// that is wrong.
     pub fn validate(&self) -> Result<()> {
-        let ok = self
-            .hub_m
-            .iter()
-            .chain(&self.sensor_m)
-            .all(|x| x.is_finite())
-            && self.root_m.is_finite()
-            && self.root_m >= 0.0
-            && self.tip_m.is_finite()
-            && self.tip_m > self.root_m
-            && (2..=MAX_BLADES).contains(&self.blades);
-        if ok {
-            self.body_from_hub().map(|_| ())
-        } else {
-            Err(CompError::setting(format!(
-                "rotor geometry: finite positions, 0 ≤ root < tip and 2 to {MAX_BLADES} blades required"
-            )))
+        use aeromag_core::error::shown;
+        let bad = |m: String| Err(CompError::setting(format!("rotor geometry: {m}")));
+        for (name, p) in [("hub_m", self.hub_m), ("sensor_m", self.sensor_m)] {
+            if p.iter().any(|x| x.is_nan() || x.abs() > MAX_ROTOR_EXTENT_M) {
+                return bad(format!(
+                    "{name} ({}) m must be finite and within ±{MAX_ROTOR_EXTENT_M} m of the body frame's origin",
+                    p.map(shown).join(", ")
+                ));
+            }
         }
+        let (root, tip) = (self.root_m, self.tip_m);
+        if !((0.0..MAX_ROTOR_EXTENT_M).contains(&root)
+            && tip <= MAX_ROTOR_EXTENT_M
+            && tip - root >= MIN_BLADE_SPAN_M)
+        {
+            return bad(format!(
+                "blade span root_m {}, tip_m {} m: need 0 ≤ root < tip ≤ {MAX_ROTOR_EXTENT_M} m with tip − root ≥ {MIN_BLADE_SPAN_M} m",
+                shown(root),
+                shown(tip)
+            ));
+        }
+        if !(2..=MAX_BLADES).contains(&self.blades) {
+            return bad(format!(
+                "{} blades: 2 to {MAX_BLADES} required",
+                self.blades
+            ));
+        }
+        self.body_from_hub().map(|_| ())
     }
 
     /// Sensor relative to the hub, body axes, m.
@@ -203,6 +229,32 @@ mod tests {
     use super::*;
     use aeromag_core::field::dipole::dipole_matrix;
     use proptest::prelude::*;
+
+    #[test]
+    fn absurd_geometries_are_refused_naming_the_value() {
+        let ok = RotorGeometry::main_rotor([0.0, 0.0, -2.6], [5.0, 0.0, 0.6], 0.8, 7.5, 4);
+        ok.validate().unwrap();
+        // Each was taken: a hub or sensor 10³⁰ m away and a span of
+        // 10⁻³⁰⁰ m gave a model of zeros (exit 0), 1e308 the message "the
+        // sensor lies on the blade's line", a tip of 1e308 m a NaN design.
+        type Edit = fn(&mut RotorGeometry);
+        let cases: [(Edit, &str); 6] = [
+            (|g| g.hub_m[0] = 1e30, "hub_m"),
+            (|g| g.sensor_m[2] = -1e308, "sensor_m"),
+            (|g| g.sensor_m[1] = f64::NAN, "sensor_m"),
+            (|g| (g.root_m, g.tip_m) = (1e-300, 1e-299), "blade span"),
+            (|g| g.tip_m = 1e308, "blade span"),
+            (|g| g.blades = 17, "blades"),
+        ];
+        for (edit, what) in cases {
+            let mut g = ok.clone();
+            edit(&mut g);
+            let e = g.validate().unwrap_err();
+            let msg = e.to_string();
+            assert!(e.is_bad_input() && msg.contains(what), "{msg}");
+            assert!(!msg.contains("00000000000"), "{msg}");
+        }
+    }
 
     fn simpson(a: &Vector3<f64>, u: &Vector3<f64>, r0: f64, r1: f64) -> Matrix3<f64> {
         let m = 20_000;
