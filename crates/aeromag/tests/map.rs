@@ -110,6 +110,33 @@ fn a_position_glitch_is_left_out_with_a_warning() {
     assert!(b < 1.05 * a, "misfit {b} against {a} without the glitch");
 }
 
+/// The glitch warning names a position in exponent form when it would be
+/// long: a latitude of 1e-320 (a corrupted cell) was written with 320
+/// digits, five times in one `microlevel` warning.
+#[test]
+fn a_glitch_warning_names_a_tiny_latitude_shortly() {
+    let flight = survey(
+        "[pattern]\nline_count = 6\nline_length_m = 4000.0\ntie_count = 2\n",
+        12,
+    );
+    let row = flight
+        .require("line")
+        .unwrap()
+        .iter()
+        .position(|&l| l != 0.0)
+        .unwrap()
+        + 200;
+    let mut table = flight.table().clone();
+    let mut lat = table.column("lat").unwrap().to_vec();
+    lat[row] = 1e-320;
+    table.set_column("lat", lat).unwrap();
+    let glitched = Flight::from_table(table).unwrap();
+    let projected = aeromag::map::ProjectedSurvey::of(&glitched, None, None).unwrap();
+    assert_eq!(projected.off_track, [row]);
+    let w = projected.off_track_warning(&glitched).unwrap();
+    assert!(w.contains("lat 1e-320, lon ") && w.len() < 400, "{w}");
+}
+
 #[test]
 fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
     let flight = survey(

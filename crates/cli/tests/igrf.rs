@@ -62,3 +62,47 @@ fn bad_arguments_exit_with_code_2() {
         assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
     }
 }
+
+/// Extreme values are refused and named shortly: `--lon 1e308` was taken
+/// (exit 0, the longitude printed with 309 digits), `--lat 1e308` and
+/// `--alt -1e308` were refused with all their digits.
+#[test]
+fn extreme_values_are_refused_and_named_shortly() {
+    for (flag, value) in [
+        ("--lon", "1e308"),
+        ("--lon", "-400"),
+        ("--lat", "1e308"),
+        ("--alt", "-1e308"),
+    ] {
+        let mut args = vec![
+            "igrf",
+            "--lat",
+            "10",
+            "--lon",
+            "0",
+            "--alt",
+            "0",
+            "--date",
+            "2020-01-01",
+        ];
+        let k = args.iter().position(|a| *a == flag).unwrap();
+        args[k + 1] = value;
+        let o = aeromag(&args);
+        assert_code(&o, 2);
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("{flag} {value}")) && e.len() < 200,
+            "{e}"
+        );
+    }
+    let o = aeromag(&[
+        "igrf",
+        "--lat",
+        "10",
+        "--lon",
+        "-360",
+        "--date",
+        "2020-01-01",
+    ]);
+    assert_code(&o, 0);
+}

@@ -12,6 +12,8 @@
 //!   Messages print it 1-based as "data row N" (the first data row is
 //!   "data row 1"), so `row` 14 is printed as "data row 15".
 
+use aeromag_core::error::shown;
+
 /// Everything that can go wrong while reading, mapping, checking or writing
 /// flight-data tables.
 #[derive(Debug, thiserror::Error)]
@@ -267,8 +269,8 @@ pub enum IoError {
     },
     /// Time (or another column that must increase) steps back or repeats.
     #[error(
-        "'{file}': column '{column}' must be strictly increasing, but data row {}{} has {value_b} after data row {}{} has {value_a}",
-        .row_b + 1, fmt_line(*.line_b), .row_a + 1, fmt_line(*.line_a)
+        "'{file}': column '{column}' must be strictly increasing, but data row {}{} has {} after data row {}{} has {}",
+        .row_b + 1, fmt_line(*.line_b), shown(*.value_b), .row_a + 1, fmt_line(*.line_a), shown(*.value_a)
     )]
     NotIncreasing {
         /// File (or `"<in-memory table>"`).

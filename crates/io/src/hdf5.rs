@@ -46,7 +46,8 @@ use crate::table::{ColumnData, FlightTable, Missing};
 use crate::wanted::wanted_fields;
 
 /// Largest single read, bytes (4 GiB, 5·10⁸ float64 values): far above any flight's field, far
-/// below what a forged header could claim.
+/// below what a forged header could claim; also the most the fields a command asks for may take
+/// together.
 pub const MAX_READ_BYTES: usize = 4 << 30;
 
 /// The first 8 bytes of an HDF5 file (at offset 0, 512, 1024, … when the
@@ -160,6 +161,22 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     // (a forged header could claim 10^12 rows that nothing then checks): with
     // none of the fields asked for present, the first field is read.
     let wanted = wanted_fields(&header, &aliases, opts);
+    // One read is capped by the reader; the reads together here, before
+    // any: 7 fields of 4·10⁸ rows (3.2 GB each, each under the cap) in a
+    // 10 kB file of unwritten chunks aborted the process out of memory.
+    let n_wanted = wanted.iter().filter(|&&w| w).count().max(1) as u64;
+    let total = n_rows.saturating_mul(n_wanted).saturating_mul(8);
+    if total > MAX_READ_BYTES as u64 {
+        return Err(IoError::Hdf5 {
+            file: file.to_string(),
+            dataset: None,
+            message: format!(
+                "{n_wanted} fields of {n_rows} values would take {} GB, more than {} GB read from one file: damaged, or far beyond any flight",
+                total >> 30,
+                MAX_READ_BYTES >> 30
+            ),
+        });
+    }
     let mut columns = Vec::new();
     for ((name, ds, _), want) in fields.into_iter().zip(wanted) {
         if !want {

@@ -24,6 +24,7 @@ use crate::derive::DerivedColumn;
 use crate::fields::known_field;
 use crate::table::{ColumnData, FlightTable, Missing};
 use crate::validate::median_in_place;
+use aeromag_core::error::shown;
 
 /// Everything `aeromag inspect` prints about a table.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -218,10 +219,19 @@ fn min_max_mean(v: &[f64]) -> (Option<f64>, Option<f64>, Option<f64>) {
         hi = hi.max(x);
     }
     if n == 0 {
-        (None, None, None)
-    } else {
-        (Some(lo), Some(hi), Some(sum / n as f64))
+        return (None, None, None);
     }
+    let mut mean = sum / n as f64;
+    if !mean.is_finite() {
+        // The sum overflowed (values near ±1.8e308): the mean of the
+        // values divided by n does not.
+        mean = v
+            .iter()
+            .filter(|x| x.is_finite())
+            .map(|&x| x / n as f64)
+            .sum();
+    }
+    (Some(lo), Some(hi), Some(mean))
 }
 
 fn range(values: impl Iterator<Item = f64>) -> Option<Range> {
@@ -274,7 +284,11 @@ pub(crate) fn time_summary(t: &[f64]) -> Option<TimeSummary> {
         duration_s: end - start,
         sample_interval_s: interval,
         rate_hz: (interval > 0.0).then(|| 1.0 / interval),
-        jitter_std_s: if n > 0 { (sum2 / n as f64).sqrt() } else { 0.0 },
+        jitter_std_s: if n > 0 {
+            jitter_std(&steps, interval, threshold, n, sum2, jmax)
+        } else {
+            0.0
+        },
         jitter_max_s: jmax,
         gap_threshold_s: threshold,
         gaps,
@@ -327,12 +341,36 @@ fn line_counts(table: &FlightTable) -> Option<Vec<LineCount>> {
     Some(out)
 }
 
+/// The standard deviation of the steps within the gap threshold about the
+/// interval, from their `n` squared deviations' sum `sum2`; when that sum
+/// overflowed (steps near 1e300 s), again with each deviation divided by
+/// the largest, `jmax`, which does not.
+fn jitter_std(
+    steps: &[(f64, usize)],
+    interval: f64,
+    threshold: f64,
+    n: usize,
+    sum2: f64,
+    jmax: f64,
+) -> f64 {
+    let std = (sum2 / n as f64).sqrt();
+    if std.is_finite() || !(jmax.is_finite() && jmax > 0.0) {
+        return std;
+    }
+    let scaled: f64 = steps
+        .iter()
+        .filter(|(dt, _)| !(interval > 0.0 && *dt > threshold))
+        .map(|(dt, _)| ((dt - interval) / jmax).powi(2))
+        .sum();
+    jmax * (scaled / n as f64).sqrt()
+}
+
 /// A line number as text: integral values without a fractional part.
 fn format_label(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e15 {
         format!("{}", v as i64)
     } else {
-        format!("{v}")
+        shown(v)
     }
 }
 
@@ -382,5 +420,27 @@ mod tests {
             .map(|l| (l.line.as_str(), l.samples, l.first_row))
             .collect();
         assert_eq!(got, vec![("1010", 3, 0), ("2010", 1, 3), ("1010.5", 1, 5)]);
+    }
+
+    /// A label or a column of values near f64's limit is summarised
+    /// shortly and finitely: the label 1e308 was printed with 309 digits
+    /// and the mean of two 1e308 values was `inf`.
+    #[test]
+    fn huge_labels_and_values_stay_short_and_finite() {
+        let mut t = FlightTable::new();
+        t.add_column("line", vec![1e308, 1e308, 1003.0]).unwrap();
+        t.add_column("alt", vec![1e308, 1e308, f64::NAN]).unwrap();
+        let lines = line_counts(&t).unwrap();
+        assert_eq!(lines[0].line, "1e308");
+        let (lo, hi, mean) = min_max_mean(t.column("alt").unwrap());
+        assert_eq!((lo, hi, mean), (Some(1e308), Some(1e308), Some(1e308)));
+        assert_eq!(min_max_mean(&[1.0, 2.0, f64::NAN]).2, Some(1.5));
+        // Steps near 1e290 s: the jitter's sum of squares overflowed to inf.
+        let t: Vec<f64> = (0..5)
+            .map(|k| 1e300 + [0.0, 1.0, 2.1, 3.0, 4.0][k] * 1e290)
+            .collect();
+        let s = time_summary(&t).unwrap();
+        assert!(s.jitter_std_s.is_finite() && s.jitter_std_s > 0.0, "{s:?}");
+        assert!(s.jitter_std_s <= s.jitter_max_s, "{s:?}");
     }
 }

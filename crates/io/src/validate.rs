@@ -23,7 +23,8 @@
 //! | `roll`, `pitch` | \|roll\| > 180, \|pitch\| > 90 | |
 //! | `yaw` | — | outside ±360 |
 //! | `roll`, `pitch`, `yaw` | — | radians: \|roll\|, \|pitch\| ≤ π/2 while yaw stays in [−π, 2π] and spans more than π (a turn of over 180° in radians; in degrees that would be a heading range of 3–9° without a single roll above 1.6°) |
-//! | `alt` | — | median > 20 000 m (feet or km?) |
+//! | `alt` | any \|value\| > [`MAX_ALT_M`], naming the first row | median > 20 000 m (feet or km?) |
+//! | [`FINITE_COLUMNS`] (`time`, position, velocity, attitude, fields, `line`) | an infinite value (`inf` in a cell), naming the first row | — |
 //!
 //! A single flux component is tested by its maximum rather than its median,
 //! because one body-frame component can legitimately stay near zero (e.g. the
@@ -37,6 +38,15 @@ use crate::columns::MAGNETIC_COLUMNS;
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
 use aeromag_core::error::shown;
+
+/// Columns in which an infinite value is an error ([`check_units`]): the
+/// canonical navigation, attitude, field and line columns, whose
+/// infinities would otherwise pass every range rule (those test finite
+/// values) and come out of a command as `inf` or NaN.
+pub const FINITE_COLUMNS: [&str; 17] = [
+    "time", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "mag", "igrf", "flux_x",
+    "flux_y", "flux_z", "diurnal", "line",
+];
 
 /// Medians are computed over at most this many samples.
 pub const MEDIAN_SAMPLES: usize = 100_000;
@@ -121,6 +131,12 @@ pub const VECTOR_SCALAR_TOLERANCE: f64 = 0.10;
 /// its neighbours an interference of 10²⁹⁵ nT, flagged compensated).
 pub const MAX_FIELD_NT: f64 = 1e6;
 
+/// The largest height taken as one, m (1000 km, twice a magnetic satellite's
+/// orbit): a value beyond is a corrupted cell or a numeric dummy, whose
+/// height difference at a crossover made levelling's normal matrix
+/// overflow (a singular system blamed on the fit).
+pub const MAX_ALT_M: f64 = 1e6;
+
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
 
@@ -184,6 +200,7 @@ fn first_time_error(table: &FlightTable, t: &[f64], rows: std::ops::Range<usize>
 pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     let mut warnings = Vec::new();
     let ctx = Ctx { table };
+    ctx.no_infinity()?;
     let stats = Stats::of(table);
     for (name, m, max) in [
         ("mag", stats.mag, stats.mag_max),
@@ -227,6 +244,19 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     }
     ctx.position(&mut warnings)?;
     ctx.attitude(&mut warnings)?;
+    if let Some(alt) = table.column("alt")
+        && let Some((i, v)) = first_where(alt, |v| v.abs() > MAX_ALT_M)
+    {
+        return Err(ctx.units(
+            "alt",
+            format!(
+                "height {} m at {} is outside ±{} m: a corrupted cell, or a number standing for a missing value? leave the cell empty for a missing value",
+                shown(v),
+                data_row(table, i),
+                shown(MAX_ALT_M)
+            ),
+        ));
+    }
     if let Some(m) = stats.alt
         && m > 20_000.0
     {
@@ -432,6 +462,34 @@ impl Ctx<'_> {
             name,
             format!(
                 "{v:e} at {} is no magnetic field reading in nT (at most {MAX_FIELD_NT:e} nT in magnitude): a corrupted cell, or a number standing for a missing value? leave the cell empty for a missing value",
+                data_row(self.table, i)
+            ),
+        ))
+    }
+
+    /// No infinite value in a column of [`FINITE_COLUMNS`] (`inf` is a
+    /// number to the cell parser, but no position, height, field, attitude
+    /// or line number): bad input naming the first row that has one.
+    fn no_infinity(&self) -> Result<()> {
+        let columns: Vec<(&str, &[f64])> = FINITE_COLUMNS
+            .iter()
+            .filter_map(|&n| Some((n, self.table.column(n)?)))
+            .collect();
+        let any = crate::parts::each_on_cores(&columns, |(_, v)| {
+            crate::parts::on_parts(v, |p| p.iter().fold(false, |a, x| a | x.is_infinite()))
+                .contains(&true)
+        });
+        let Some((name, v)) = columns.iter().zip(any).find_map(|(c, a)| a.then_some(c)) else {
+            return Ok(());
+        };
+        let Some(i) = v.iter().position(|x| x.is_infinite()) else {
+            return Ok(());
+        };
+        Err(self.units(
+            name,
+            format!(
+                "{} at {} is no number this column can hold: a corrupted cell? leave the cell empty for a missing value",
+                v[i],
                 data_row(self.table, i)
             ),
         ))

@@ -240,3 +240,44 @@ fn fuzz_crash_rows_claimed_but_not_read() {
         }
     }
 }
+
+/// Fields each under the single-read cap but together far beyond memory
+/// (4·10⁸ rows claimed by a small file's headers) are refused before any
+/// is read: 7 such fields of unwritten chunks aborted `inspect` out of
+/// memory (exit 134, 3 GB resident); this file's were read to 3.9 GB
+/// resident before the reader gave up on one.
+#[test]
+fn fields_together_beyond_the_read_cap_are_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 250u64.to_le_bytes();
+    let rows = 400_000_000u64.to_le_bytes();
+    let mut b = std::fs::read(data("root_chunked.h5")).unwrap();
+    let mut patched = 0;
+    for (pat, dims) in [
+        ([&[1u8, 1, 1, 0, 0, 0, 0, 0][..], &n, &n].concat(), 2),
+        ([&[1u8, 1, 0, 0, 0, 0, 0, 0][..], &n].concat(), 1),
+        ([&[2u8, 1, 1, 1][..], &n, &n].concat(), 2),
+        ([&[2u8, 1, 0, 1][..], &n].concat(), 1),
+    ] {
+        let head = pat.len() - 8 * dims;
+        let mut i = 0;
+        while let Some(k) = b[i..].windows(pat.len()).position(|w| w == &pat[..]) {
+            let at = i + k + head;
+            for d in 0..dims {
+                b[at + 8 * d..at + 8 * d + 8].copy_from_slice(&rows);
+            }
+            patched += 1;
+            i = i + k + 1;
+        }
+    }
+    assert!(patched >= 5, "{patched} dataspaces patched");
+    let p = dir.path().join("many_rows.h5");
+    std::fs::write(&p, &b).unwrap();
+    let e = read_table(&p, &ReadOptions::default()).unwrap_err();
+    let m = e.to_string();
+    assert!(
+        m.contains("many_rows.h5") && m.contains("fields of 400000000 values"),
+        "{m}"
+    );
+    assert!(e.is_bad_input(), "{e}");
+}

@@ -316,3 +316,66 @@ fn huge_values_are_named_shortly() {
     let e = check_units(&t).unwrap_err().to_string();
     assert!(e.contains("roll 181.5 at data row 2"), "{e}");
 }
+
+/// `inf` in a cell is a number to the cell parser, but the range rules
+/// test finite values only: an infinite latitude, field, height or line
+/// number passed every check (fuzzing: `level` wrote `inf` into
+/// `mag_level` and the crossover table, exit 0). Now bad input naming the
+/// column and row.
+#[test]
+fn an_infinite_value_names_its_column_and_row() {
+    let fx = Fixtures::new();
+    let t = fx
+        .read(
+            "inf.csv",
+            "time,lat,lon,mag\n0,56,38,53000\n0.5,inf,38,53001\n1,56,38,53002\n",
+        )
+        .unwrap();
+    let e = check_units(&t).unwrap_err();
+    assert!(
+        matches!(e, IoError::Units { .. }) && e.is_bad_input(),
+        "{e:?}"
+    );
+    assert_mentions(&e.to_string(), &["inf.csv", "'lat'", "data row 2 (line 3)"]);
+    for name in ["mag", "alt", "line", "flux_y", "yaw", "time"] {
+        let mut v = vec![100.0; 5];
+        v[3] = if name == "alt" {
+            f64::NEG_INFINITY
+        } else {
+            f64::INFINITY
+        };
+        if name == "mag" {
+            v = v.iter().map(|x| x * 530.0).collect();
+        }
+        let e = check_units(&table(&[(name, v)])).unwrap_err();
+        assert_mentions(&e.to_string(), &[&format!("'{name}'"), "data row 4"]);
+    }
+    // A column outside the list keeps its infinities.
+    assert!(check_units(&table(&[("other", vec![0.0, f64::INFINITY])])).is_ok());
+}
+
+/// A height beyond any aircraft's (a corrupted cell) is bad input naming
+/// its row: one 1e308 m made levelling fail with a "singular system".
+#[test]
+fn a_height_beyond_any_flight_names_its_row() {
+    let t = table(&[("alt", vec![250.0, 1e308, 251.0])]);
+    let e = check_units(&t).unwrap_err().to_string();
+    assert!(
+        e.contains("'alt'") && e.contains("height 1e308 m at data row 2"),
+        "{e}"
+    );
+    let t = table(&[("alt", vec![250.0, -aeromag_io::MAX_ALT_M, 251.0])]);
+    assert!(check_units(&t).is_ok());
+}
+
+/// A time of 1e308 in the "not increasing" error is shown in exponent
+/// form (it was printed with all 309 digits).
+#[test]
+fn a_huge_time_in_the_increasing_check_is_named_shortly() {
+    let t = table(&[("time", vec![0.0, 1e308, 2.0])]);
+    let e = check_time(&t).unwrap_err().to_string();
+    assert!(
+        e.contains("has 2 after data row 2 has 1e308") && e.len() < 200,
+        "{e}"
+    );
+}

@@ -19,6 +19,7 @@
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use crate::flight::{LineLabels, position_glitches, sensor_track};
+use aeromag_core::error::shown;
 use aeromag_grid::projection::{Utm, UtmZone};
 
 /// A flight's rows in UTM (m) and its lines' geometry.
@@ -139,7 +140,7 @@ impl ProjectedSurvey {
                 let line = flight
                     .line_of_row(k)
                     .map_or(String::new(), |l| format!(" (line {l})"));
-                let at = |c: Option<&[f64]>| c.map_or(f64::NAN, |c| c[k]);
+                let at = |c: Option<&[f64]>| shown(c.map_or(f64::NAN, |c| c[k]));
                 format!(
                     "data row {}{line}: lat {}, lon {}",
                     flight.file_row(k) + 1,

@@ -1,6 +1,7 @@
 //! `aeromag igrf`: the IGRF-14 main field at a point.
 
 use crate::exit::bad_input;
+use aeromag_core::error::shown;
 use aeromag_core::field::igrf::igrf_geodetic;
 use aeromag_core::frames::Geodetic;
 use aeromag_core::time::Date;
@@ -17,7 +18,7 @@ pub struct Args {
     /// Geodetic latitude, degrees (−90 … 90, north positive).
     #[arg(long, allow_negative_numbers = true)]
     lat: f64,
-    /// Longitude, degrees (east positive).
+    /// Longitude, degrees (east positive, −360 … 360).
     #[arg(long, allow_negative_numbers = true)]
     lon: f64,
     /// Height above the WGS84 ellipsoid, metres.
@@ -31,18 +32,29 @@ pub struct Args {
     json: bool,
 }
 
+/// The largest |--lon| taken, degrees: as in a flight file's `lon` column
+/// (`aeromag_io::check_units`); 1e308 was taken and printed with 309
+/// digits, its sine and cosine meaningless.
+pub const MAX_LON_DEG: f64 = 360.0;
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     if !a.lat.is_finite() || a.lat.abs() > 90.0 {
         return Err(bad_input!(
             "--lat {} is not a latitude in −90…90 degrees",
-            a.lat
+            shown(a.lat)
         ));
     }
-    if !a.lon.is_finite() {
-        return Err(bad_input!("--lon {} is not a finite longitude", a.lon));
+    if !(-MAX_LON_DEG..=MAX_LON_DEG).contains(&a.lon) {
+        return Err(bad_input!(
+            "--lon {} is not a longitude in −360…360 degrees",
+            shown(a.lon)
+        ));
     }
     if !a.alt.is_finite() || !(-1.0e4..=1.0e6).contains(&a.alt) {
-        return Err(bad_input!("--alt {} m is outside −10 km … 1000 km", a.alt));
+        return Err(bad_input!(
+            "--alt {} m is outside −10 km … 1000 km",
+            shown(a.alt)
+        ));
     }
     let date = Date::parse(&a.date)?;
     let f = igrf_geodetic(&Geodetic::new(a.lat, a.lon, a.alt), date.decimal_year())?;

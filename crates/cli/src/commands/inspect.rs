@@ -1,6 +1,7 @@
 //! `aeromag inspect`: what a processor checks first in a flight file.
 
 use crate::input::InputArgs;
+use aeromag_core::error::shown;
 use aeromag_io::{Summary, summarize};
 
 /// Summarise a flight file: columns found and mapped, rows, duration, sample
@@ -41,6 +42,17 @@ fn fmt_opt(v: Option<f64>) -> String {
     }
 }
 
+/// `x` with `decimals` decimals, or in exponent form ([`shown`]) when that
+/// would be long: a time such as 1e300 s in a hostile file is printed as
+/// `1e300`, not as 301 digits.
+fn fixed(x: f64, decimals: usize) -> String {
+    if x.abs() < 1e15 {
+        format!("{x:.decimals$}")
+    } else {
+        shown(x)
+    }
+}
+
 /// The human-readable summary.
 pub fn render(s: &Summary) -> String {
     use std::fmt::Write;
@@ -50,16 +62,16 @@ pub fn render(s: &Summary) -> String {
     if let Some(t) = &s.time {
         let _ = writeln!(
             o,
-            "time     {:.3} … {:.3} s  (duration {:.1} s = {:.2} h)",
-            t.start_s,
-            t.end_s,
-            t.duration_s,
-            t.duration_s / 3600.0
+            "time     {} … {} s  (duration {} s = {} h)",
+            fixed(t.start_s, 3),
+            fixed(t.end_s, 3),
+            fixed(t.duration_s, 1),
+            fixed(t.duration_s / 3600.0, 2)
         );
         let _ = writeln!(
             o,
-            "sampling interval {:.6} s, rate {} Hz, jitter std {:.2e} s (max {:.2e} s)",
-            t.sample_interval_s,
+            "sampling interval {} s, rate {} Hz, jitter std {:.2e} s (max {:.2e} s)",
+            fixed(t.sample_interval_s, 6),
             fmt_opt(t.rate_hz),
             t.jitter_std_s,
             t.jitter_max_s
@@ -68,15 +80,19 @@ pub fn render(s: &Summary) -> String {
             (Some(g), Some(r)) => {
                 let _ = writeln!(
                     o,
-                    "gaps     {} longer than {:.3} s; largest {:.3} s before data row {}",
+                    "gaps     {} longer than {} s; largest {} s before data row {}",
                     t.gaps,
-                    t.gap_threshold_s,
-                    g,
+                    fixed(t.gap_threshold_s, 3),
+                    fixed(g, 3),
                     r + 1
                 );
             }
             _ => {
-                let _ = writeln!(o, "gaps     none longer than {:.3} s", t.gap_threshold_s);
+                let _ = writeln!(
+                    o,
+                    "gaps     none longer than {} s",
+                    fixed(t.gap_threshold_s, 3)
+                );
             }
         }
     } else {
@@ -99,10 +115,10 @@ pub fn render(s: &Summary) -> String {
         let _ = writeln!(o, "lines    {}: {}{}", lines.len(), shown.join(", "), more);
     }
     if let Some(r) = &s.mag_range_nt {
-        let _ = writeln!(o, "mag      {:.1} … {:.1} nT", r.min, r.max);
+        let _ = writeln!(o, "mag      {} … {} nT", fixed(r.min, 1), fixed(r.max, 1));
     }
     if let Some(r) = &s.flux_magnitude_range_nt {
-        let _ = writeln!(o, "|flux|   {:.1} … {:.1} nT", r.min, r.max);
+        let _ = writeln!(o, "|flux|   {} … {} nT", fixed(r.min, 1), fixed(r.max, 1));
     }
     if let Some(rows) = s.position_glitch_rows.as_ref().filter(|r| !r.is_empty()) {
         let shown: Vec<String> = rows.iter().take(10).map(|r| (r + 1).to_string()).collect();

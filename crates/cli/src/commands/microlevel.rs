@@ -8,6 +8,7 @@ use crate::progress::Bars;
 use aeromag::grid::gridding::MinCurvature;
 use aeromag::grid::projection::UtmZone;
 use aeromag::map::{MicrolevelOptions, microlevel};
+use aeromag_core::error::shown;
 use std::path::PathBuf;
 
 /// Micro-level a levelled survey (Minty 1991) and write it with the
@@ -62,6 +63,16 @@ pub struct Args {
     lever_arm: Option<[f64; 3]>,
 }
 
+/// `x` with `decimals` decimals, or in exponent form ([`shown`]) when that
+/// would be long or show nothing (`--cutoff 1e-300`, `--along-line 1e308`).
+fn fixed(x: f64, decimals: usize) -> String {
+    if x == 0.0 || (1e-3..1e15).contains(&x.abs()) {
+        format!("{x:.decimals$}")
+    } else {
+        shown(x)
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files(std::iter::once(a.out.as_path()))?;
     let flight = a.input.load()?;
@@ -89,12 +100,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         m.cell_m
     );
     println!(
-        "filter: high-pass cut-off {:.0} m ({} line spacings); correction {}",
-        opts.cutoff_line_spacings * m.lines.spacing_m,
-        opts.cutoff_line_spacings,
+        "filter: high-pass cut-off {} m ({} line spacings); correction {}",
+        fixed(opts.cutoff_line_spacings * m.lines.spacing_m, 0),
+        shown(opts.cutoff_line_spacings),
         m.along_line_m
             .map_or("one level per line (median)".into(), |a| format!(
-                "averaged along the lines over {a:.0} m"
+                "averaged along the lines over {} m",
+                fixed(a, 0)
             ))
     );
     println!(

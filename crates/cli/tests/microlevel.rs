@@ -1,0 +1,62 @@
+//! `aeromag microlevel` on extreme flags: refused quickly and named
+//! shortly, or printed shortly when taken.
+
+mod common;
+use common::*;
+
+/// A small survey: 6 lines 3 km long, 500 m apart, 2 ties, 2 Hz.
+fn small_survey(dir: &std::path::Path) -> std::path::PathBuf {
+    let config = dir.join("small.toml");
+    std::fs::write(
+        &config,
+        "[flight]\nsample_rate_hz = 2.0\n[pattern]\nline_count = 6\nline_length_m = 3000.0\ntie_count = 2\ntie_spacing_m = 1500.0\n",
+    )
+    .unwrap();
+    simulate_with(dir, "survey", "1", Some(&config))
+}
+
+/// `--cell 1` on a survey 500 m between lines ran for more than a minute
+/// (minimum curvature on 10⁷ nodes); `--cutoff 1e308` was refused by the
+/// filter as "got inf"; `--along-line 1e308` was printed with 309 digits.
+#[test]
+fn extreme_cell_cutoff_and_along_line() {
+    let d = tempfile::tempdir().unwrap();
+    let input = small_survey(d.path());
+    let out = d.path().join("ml.csv");
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "microlevel",
+            "-i",
+            input.to_str().unwrap(),
+            "--column",
+            "mag",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend(extra);
+        aeromag(&a)
+    };
+    let t0 = std::time::Instant::now();
+    let o = run(&["--cell", "1"]);
+    assert_code(&o, 2);
+    let e = stderr(&o);
+    assert!(
+        e.contains("cell 1 m is finer") && e.contains("at least 10.0 m"),
+        "{e}"
+    );
+    assert!(t0.elapsed().as_secs() < 20, "{:?}", t0.elapsed());
+    let o = run(&["--cutoff", "1e308"]);
+    assert_code(&o, 2);
+    let e = stderr(&o);
+    assert!(
+        e.contains("cut-off 1e308 line spacings") && !e.contains("inf"),
+        "{e}"
+    );
+    let o = run(&["--along-line", "1e308"]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(
+        s.contains("over 1e308 m") && s.lines().all(|l| l.len() < 200),
+        "{s}"
+    );
+}
