@@ -112,7 +112,10 @@ fn check_range(t: &Flight, name: &str, v: &[f64], lo: f64, hi: f64) -> Result<()
             t.file_label(),
             k,
             t.resolve(name).unwrap_or(name),
-            format!("{} deg is outside ({lo}, {hi})", v[k]),
+            format!(
+                "{} deg is outside ({lo}, {hi})",
+                aeromag_core::error::shown(v[k])
+            ),
         ));
     }
     Ok(())

@@ -149,6 +149,10 @@ fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_
         msg.contains("cable_inclination") && msg.contains("data row 12"),
         "{msg}"
     );
+    // A huge angle is named in exponent form (it printed 309 digits).
+    let e = apply_pod(&model, &edit("cable_inclination", 11, 1e308)).unwrap_err();
+    assert!(e.to_string().contains("1e308 deg is outside"), "{e}");
+    assert!(e.to_string().len() < 300, "{e}");
     // An impossible installation is refused before any work.
     let bad = PodSetup {
         cable_length_m: -1.0,

@@ -166,3 +166,30 @@ fn scenario_files_round_trip_and_typos_are_errors() {
         2,
     );
 }
+
+/// An --out that is not a folder failed after the simulation with exit 1
+/// ("File exists"); a seed of 2⁶⁴ − 1 for `em` wrote an em.toml that
+/// --config then refused (the other scenarios refuse it).
+#[test]
+fn an_out_that_is_no_folder_and_an_unwritable_seed_are_bad_input() {
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("f.txt");
+    std::fs::write(&file, "x").unwrap();
+    for scenario in ["pod", "em", "gradiometer"] {
+        let o = aeromag(&["simulate", scenario, "--out", file.to_str().unwrap()]);
+        assert_code(&o, 2);
+        assert!(stderr(&o).contains("f.txt"), "{scenario}: {}", stderr(&o));
+    }
+    let out = d.path().join("em");
+    let o = aeromag(&[
+        "simulate",
+        "em",
+        "--seed",
+        "18446744073709551615",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("must be < 2^63"), "{}", stderr(&o));
+    assert!(!out.join("em.toml").exists());
+}

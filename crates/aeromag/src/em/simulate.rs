@@ -77,6 +77,15 @@ pub fn simulate_to_dir(
     known_positions: usize,
     out: &Path,
 ) -> Result<SimulatedEm> {
+    // The scenario file written beside the record must read back: TOML
+    // integers are signed 64-bit (a seed of 2⁶⁴ − 1 was simulated and its
+    // em.toml then refused by --config).
+    if cfg.seed > i64::MAX as u64 {
+        return Err(Error::bad_input(format!(
+            "seed {} must be < 2^63 (TOML integers are signed 64-bit)",
+            cfg.seed
+        )));
+    }
     let sc = EmScenario::new(cfg.clone())?;
     let fs = cfg.sample_rate_hz;
     let frames = (cfg.duration_s * fs).round();

@@ -46,6 +46,11 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    // Before simulating: an --out that is a file (or /dev/null) failed
+    // after the simulation with exit 1.
+    if let (Some(out), false) = (&a.out, a.print_config) {
+        crate::output::check_folder(out)?;
+    }
     if a.scenario == "gradiometer" {
         return crate::output::simulate_gradiometer(
             a.config.as_deref(),

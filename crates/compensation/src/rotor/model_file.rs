@@ -40,6 +40,11 @@ pub struct TailModel {
     pub model: RotorFit,
 }
 
+/// Most slowly-varying-angle alternations a model file may ask for
+/// (default 3; each refits every window of the flight: 2⁶³ kept
+/// `rotor apply` running for ever).
+pub const MAX_SLOW_ITERATIONS: usize = 100;
+
 /// The rotor model file (versioned JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RotorModelFile {
@@ -92,10 +97,48 @@ impl RotorModelFile {
         Ok(m)
     }
 
-    /// Check the content: geometry, and `blades × per-blade` finite
-    /// parameters.
+    /// Check the content: geometry, `blades × per-blade` finite
+    /// parameters, and the options `rotor apply` runs with (finite, in
+    /// range; at most [`MAX_SLOW_ITERATIONS`] alternations).
     pub fn validate(&self) -> Result<()> {
         self.geometry.validate()?;
+        let shown = aeromag_core::error::shown;
+        let (so, fo) = (&self.slow_angles, &self.fit_options);
+        if !(1..=MAX_SLOW_ITERATIONS).contains(&so.iterations) {
+            return Err(CompError::data(format!(
+                "slow_angles.iterations = {} must be 1 to {MAX_SLOW_ITERATIONS}",
+                so.iterations
+            )));
+        }
+        let a = &self.nominal_angles;
+        let [lo, hi] = self.phase.rotor_hz_range;
+        for (name, v, ok) in [
+            ("slow_angles.window_s", so.window_s, so.window_s > 0.0),
+            (
+                "fit_options.highpass_hz",
+                fo.highpass_hz,
+                fo.highpass_hz > 0.0,
+            ),
+            ("fit_options.edge_s", fo.edge_s, fo.edge_s >= 0.0),
+            ("fit_options.ridge", fo.ridge, fo.ridge >= 0.0),
+            ("phase.rotor_hz_range", lo, lo > 0.0 && hi > lo),
+            ("phase.rotor_hz_range", hi, hi > lo),
+            (
+                "sample_rate_hz",
+                self.sample_rate_hz,
+                self.sample_rate_hz > 0.0,
+            ),
+            ("nominal_angles.coning_rad", a.coning_rad, true),
+            ("nominal_angles.tilt_lon_rad", a.tilt_lon_rad, true),
+            ("nominal_angles.tilt_lat_rad", a.tilt_lat_rad, true),
+        ] {
+            if !(ok && v.is_finite()) {
+                return Err(CompError::data(format!(
+                    "{name} = {} is not a finite value in range",
+                    shown(v)
+                )));
+            }
+        }
         let expect = self.geometry.blades * self.model.terms.per_blade();
         if self.model.params.len() != expect || self.model.params.iter().any(|p| !p.is_finite()) {
             return Err(CompError::data(format!(
@@ -188,6 +231,30 @@ mod tests {
         let mut nan = m.clone();
         nan.model.params[0] = f64::NAN;
         assert!(nan.validate().is_err());
+        // The options apply runs with: 2⁶³ alternations kept `rotor
+        // apply` running for ever; the others were not checked either.
+        let edits: [(&str, fn(&mut RotorModelFile)); 6] = [
+            ("slow_angles.iterations", |m| {
+                m.slow_angles.iterations = 1 << 63
+            }),
+            ("slow_angles.iterations", |m| m.slow_angles.iterations = 0),
+            ("slow_angles.window_s", |m| m.slow_angles.window_s = -1.0),
+            ("fit_options.highpass_hz", |m| {
+                m.fit_options.highpass_hz = f64::INFINITY
+            }),
+            ("phase.rotor_hz_range", |m| {
+                m.phase.rotor_hz_range = [6.0, 4.0]
+            }),
+            ("nominal_angles.coning_rad", |m| {
+                m.nominal_angles.coning_rad = f64::NAN
+            }),
+        ];
+        for (name, edit) in edits {
+            let mut bad = m.clone();
+            edit(&mut bad);
+            let e = bad.validate().unwrap_err().to_string();
+            assert!(e.contains(name), "{name}: {e}");
+        }
         // With a tail rotor: round trip, its parameter count, and it needs
         // a phase channel.
         let mut tail = m;
