@@ -233,7 +233,8 @@ mod tests {
         assert!(nan.validate().is_err());
         // The options apply runs with: 2⁶³ alternations kept `rotor
         // apply` running for ever; the others were not checked either.
-        let edits: [(&str, fn(&mut RotorModelFile)); 6] = [
+        type Edit = fn(&mut RotorModelFile);
+        let edits: [(&str, Edit); 6] = [
             ("slow_angles.iterations", |m| {
                 m.slow_angles.iterations = 1 << 63
             }),
