@@ -101,7 +101,7 @@
 
 use super::crossovers::Crossover;
 use super::tracks::bad;
-use crate::error::Result;
+use crate::error::{CompError, Result};
 use aeromag_estimation::least_squares::NormalEquations;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -408,15 +408,15 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
             all.add_row(&row, 0.0, 1.0)
                 .map_err(|e| bad(e.to_string()))?;
         }
+        // Classified by the solve's own error: a singular system is a
+        // failed fit (exit 1), not bad input (it was called bad input).
         let sol = all.solve(0.0).map_err(|e| {
-            bad(format!(
-                "{e}{}",
-                if cfg.lambda == 0.0 {
-                    " (use a ridge λ > 0)"
-                } else {
-                    ""
-                }
-            ))
+            let hint = if cfg.lambda == 0.0 {
+                " (use a ridge λ > 0)"
+            } else {
+                ""
+            };
+            CompError::estimation(format!("levelling{hint}"))(e)
         })?;
         let residuals: Vec<f64> = crossovers
             .iter()
@@ -939,6 +939,19 @@ pub(crate) mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("cannot determine"), "{e}");
+        // The same rate at both sides of every crossover (`--rate-of
+        // time`): the lag's column is zero, the system singular — a failed
+        // fit, not bad input (it exited 2).
+        let mut flat = x.clone();
+        for c in &mut flat {
+            c.a.derivative_nt_per_s = 1.0;
+            c.b.derivative_nt_per_s = 1.0;
+        }
+        let e = fit_levelling(&flat, &LevellingConfig::default()).unwrap_err();
+        assert!(
+            !e.is_bad_input() && e.to_string().contains("singular"),
+            "{e}"
+        );
         let mut y = x.clone();
         y[2].b.derivative_nt_per_s = f64::NAN;
         assert!(
