@@ -100,6 +100,9 @@ pub enum WarningKind {
     YawRange,
     /// An altitude that looks like feet or km.
     AltitudeUnit,
+    /// A median ground speed no aircraft flies: time in minutes or hours
+    /// (or positions in another unit).
+    TimeUnit,
 }
 
 impl WarningKind {
@@ -111,6 +114,7 @@ impl WarningKind {
             WarningKind::Radians => "radians",
             WarningKind::YawRange => "yaw-range",
             WarningKind::AltitudeUnit => "altitude-unit",
+            WarningKind::TimeUnit => "time-unit",
         }
     }
 }
@@ -136,6 +140,12 @@ pub const MAX_FIELD_NT: f64 = 1e6;
 /// height difference at a crossover made levelling's normal matrix
 /// overflow (a singular system blamed on the fit).
 pub const MAX_ALT_M: f64 = 1e6;
+
+/// The largest median ground speed taken as a flight's, m/s: an airliner
+/// cruises at 250 m/s and a fast jet at 700; above, the time is in
+/// minutes or hours (a 60 m/s survey with its time in minutes moves at
+/// 3 600 m/s), and [`check_units`] warns.
+pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = 1000.0;
 
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
@@ -467,6 +477,42 @@ impl Ctx<'_> {
         ))
     }
 
+    /// The [`WarningKind::TimeUnit`] rule: the median ground speed between
+    /// consecutive rows ([`MEDIAN_SAMPLES`] pairs at most; equirectangular
+    /// distance on a 6 371 km sphere, degrees) above
+    /// [`MAX_MEDIAN_GROUND_SPEED_M_S`].
+    fn ground_speed(&self, lat: &[f64], lon: &[f64], w: &mut Vec<Warning>) {
+        let Some(t) = self.table.column("time") else {
+            return;
+        };
+        const EARTH_RADIUS_M: f64 = 6_371_000.0;
+        let speed = |i: usize| {
+            let (dt, dlat) = (t[i + 1] - t[i], (lat[i + 1] - lat[i]).to_radians());
+            let dlon = (lon[i + 1] - lon[i]).to_radians() * lat[i].to_radians().cos();
+            if dt > 0.0 {
+                EARTH_RADIUS_M * dlat.hypot(dlon) / dt
+            } else {
+                f64::NAN
+            }
+        };
+        let Some(v) = median(t.len().saturating_sub(1), speed) else {
+            return;
+        };
+        if v > MAX_MEDIAN_GROUND_SPEED_M_S {
+            w.push(self.warn(
+                WarningKind::TimeUnit,
+                "time",
+                None,
+                format!(
+                    "the median ground speed is {} m/s, more than any aircraft flies \
+                     ({} m/s): time in minutes or hours? expected seconds",
+                    shown(v.round()),
+                    shown(MAX_MEDIAN_GROUND_SPEED_M_S)
+                ),
+            ));
+        }
+    }
+
     /// No infinite value in a column of [`FINITE_COLUMNS`] (`inf` is a
     /// number to the cell parser, but no position, height, field, attitude
     /// or line number): bad input naming the first row that has one.
@@ -519,6 +565,7 @@ impl Ctx<'_> {
             ));
         }
         if let (Some(lat), Some(lon)) = (lat, lon) {
+            self.ground_speed(lat, lon, w);
             let (Some(a), Some(o)) = (max_abs(lat), max_abs(lon)) else {
                 return Ok(());
             };

@@ -379,3 +379,41 @@ fn a_huge_time_in_the_increasing_check_is_named_shortly() {
         "{e}"
     );
 }
+
+/// A survey's time in minutes (or hours) moves it faster than any
+/// aircraft: a named warning on the time column; in seconds, none.
+#[test]
+fn time_in_minutes_is_a_named_warning() {
+    // 60 m/s due north at 10 Hz: 5.4e-5° of latitude a sample.
+    let n = 500;
+    let flight = |time_scale: f64| {
+        table(&[
+            (
+                "time",
+                (0..n).map(|k| k as f64 * 0.1 * time_scale).collect(),
+            ),
+            (
+                "lat",
+                (0..n).map(|k| 56.0 + k as f64 * 6.0 / 111_195.0).collect(),
+            ),
+            ("lon", vec![38.0; n]),
+        ])
+    };
+    assert!(check_units(&flight(1.0)).unwrap().is_empty());
+    let w = check_units(&flight(1.0 / 60.0)).unwrap();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(w[0].kind, WarningKind::TimeUnit);
+    assert_eq!(w[0].column.as_deref(), Some("time"));
+    assert!(
+        w[0].message.contains("3600 m/s") && w[0].to_string().ends_with("[time-unit]"),
+        "{}",
+        w[0]
+    );
+    // A stationary record (a base station) and a slow one are no warning.
+    let still = table(&[
+        ("time", (0..n).map(|k| k as f64).collect()),
+        ("lat", vec![56.0; n]),
+        ("lon", vec![38.0; n]),
+    ]);
+    assert!(check_units(&still).unwrap().is_empty());
+}
