@@ -73,18 +73,7 @@ fn a_position_glitch_is_left_out_with_a_warning() {
     };
     let clean = grid_flight(&flight, &opts, &mut Silent).unwrap();
     assert!(clean.survey.off_track.is_empty());
-    let row = flight
-        .require("line")
-        .unwrap()
-        .iter()
-        .position(|&l| l != 0.0)
-        .unwrap()
-        + 200;
-    let mut table = flight.table().clone();
-    let mut lat = table.column("lat").unwrap().to_vec();
-    lat[row] = 0.0;
-    table.set_column("lat", lat).unwrap();
-    let glitched = Flight::from_table(table).unwrap();
+    let (glitched, row) = lat_glitch(&flight, 0.0);
     // Before gridding: with the glitch kept the solve would run for minutes.
     let projected = aeromag::map::ProjectedSurvey::of(&glitched, None, None).unwrap();
     assert_eq!(projected.off_track, [row]);
@@ -119,18 +108,7 @@ fn a_glitch_warning_names_a_tiny_latitude_shortly() {
         "[pattern]\nline_count = 6\nline_length_m = 4000.0\ntie_count = 2\n",
         12,
     );
-    let row = flight
-        .require("line")
-        .unwrap()
-        .iter()
-        .position(|&l| l != 0.0)
-        .unwrap()
-        + 200;
-    let mut table = flight.table().clone();
-    let mut lat = table.column("lat").unwrap().to_vec();
-    lat[row] = 1e-320;
-    table.set_column("lat", lat).unwrap();
-    let glitched = Flight::from_table(table).unwrap();
+    let (glitched, row) = lat_glitch(&flight, 1e-320);
     let projected = aeromag::map::ProjectedSurvey::of(&glitched, None, None).unwrap();
     assert_eq!(projected.off_track, [row]);
     let w = projected.off_track_warning(&glitched).unwrap();
@@ -211,4 +189,21 @@ fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
             .filter(|&k| line[k] == 0.0)
             .all(|k| m.correction[k] == 0.0)
     );
+}
+
+/// `flight` with the latitude of the 201st row of its first line set to
+/// `lat` (a GPS dropout), and that row.
+fn lat_glitch(flight: &Flight, lat: f64) -> (Flight, usize) {
+    let row = flight
+        .require("line")
+        .unwrap()
+        .iter()
+        .position(|&l| l != 0.0)
+        .unwrap()
+        + 200;
+    let mut table = flight.table().clone();
+    let mut column = table.column("lat").unwrap().to_vec();
+    column[row] = lat;
+    table.set_column("lat", column).unwrap();
+    (Flight::from_table(table).unwrap(), row)
 }
