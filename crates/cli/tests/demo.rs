@@ -65,3 +65,34 @@ fn quick_demo_summary_table_and_files() {
         assert!(out.join(f).exists(), "{f}");
     }
 }
+
+/// A seed whose survey seed (seed + 1) is no scenario seed is refused at
+/// once, before minutes of work (2⁶⁴ − 1 wrapped the survey's to 0).
+#[test]
+fn a_seed_beyond_the_scenarios_is_refused_at_once() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("demo");
+    for seed in ["18446744073709551615", "9223372036854775807"] {
+        let start = std::time::Instant::now();
+        let o = aeromag(&[
+            "demo",
+            "--quick",
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains("demo seed") && stderr(&o).contains("too large"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(
+            start.elapsed().as_secs_f64() < 10.0,
+            "{:?}",
+            start.elapsed()
+        );
+        assert!(!out.join("summary.json").exists());
+    }
+}

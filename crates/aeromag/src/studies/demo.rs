@@ -13,8 +13,14 @@ use aeromag_report::{Report, ReportSection};
 use serde::Serialize;
 use std::path::PathBuf;
 
+/// The largest seed [`Demo`] takes: 2⁶³ − 2, so that the survey's
+/// `seed + 1` is a scenario seed (TOML integers are signed 64-bit). A seed
+/// of 2⁶⁴ − 1 wrapped the survey's to 0 in a release build.
+pub const MAX_DEMO_SEED: u64 = i64::MAX as u64 - 1;
+
 /// The whole demo: the fixed-wing chain (seed `seed`, survey `seed + 1`;
-/// files under `out`), the rotor, pod, EM and gradiometry studies.
+/// files under `out`), the rotor, pod, EM and gradiometry studies (seed at
+/// most [`MAX_DEMO_SEED`]).
 #[derive(Debug, Clone)]
 pub struct Demo {
     /// Seed of the simulated fixed-wing flights.
@@ -119,6 +125,15 @@ impl Study for Demo {
     /// Run every study at `size` (quick: the truncated calibration pattern,
     /// fewer trials and grid points).
     fn run(&self, size: StudySize, observer: &mut dyn Observer) -> Result<DemoOutcome> {
+        // Checked before minutes of work: the survey's seed `seed + 1`
+        // must be a scenario seed too (below 2⁶³), and must not wrap.
+        if self.seed > MAX_DEMO_SEED {
+            return Err(crate::error::Error::bad_input(format!(
+                "demo seed {} is too large: at most {MAX_DEMO_SEED} (the survey uses seed + 1, \
+                 and scenario seeds are below 2^63)",
+                self.seed
+            )));
+        }
         let fixed_wing = FixedWingStudy {
             seed: self.seed,
             out: self.out.clone(),
