@@ -58,6 +58,17 @@ pub fn shown(v: f64) -> String {
     }
 }
 
+/// `x` with `decimals` decimals, as a printed figure, or in exponent form
+/// ([`shown`]) from 10¹⁵ on, where fixed decimals would be long: a time of
+/// 1e300 s in a hostile file is printed `1e300`, not as 301 digits.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    if x.abs() < 1e15 {
+        format!("{x:.decimals$}")
+    } else {
+        shown(x)
+    }
+}
+
 /// Characters of a text [`shown_text`] keeps.
 pub const SHOWN_TEXT_CHARS: usize = 40;
 
@@ -83,6 +94,14 @@ mod tests {
         let garbage = "\0".repeat(500);
         let s = shown_text(&garbage);
         assert_eq!(s, format!("\"{}\"…", "\\0".repeat(SHOWN_TEXT_CHARS)));
+    }
+
+    #[test]
+    fn figures_have_fixed_decimals_until_they_would_be_long() {
+        assert_eq!(fixed(53064.0631, 1), "53064.1");
+        assert_eq!(fixed(-0.5, 3), "-0.500");
+        assert_eq!(fixed(1e300, 3), "1e300");
+        assert_eq!(fixed(f64::NAN, 2), "NaN");
     }
 
     #[test]

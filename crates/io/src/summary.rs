@@ -262,11 +262,12 @@ pub(crate) fn time_summary(t: &[f64]) -> Option<TimeSummary> {
     let mut dts: Vec<f64> = steps.iter().map(|s| s.0).collect();
     let interval = median_in_place(&mut dts)?;
     let threshold = 1.5 * interval;
+    let is_gap = |dt: f64| interval > 0.0 && dt > threshold;
     let mut gaps = 0;
     let mut largest: Option<(f64, usize)> = None;
     let (mut n, mut sum2, mut jmax) = (0usize, 0.0, 0.0f64);
     for &(dt, row) in &steps {
-        if interval > 0.0 && dt > threshold {
+        if is_gap(dt) {
             gaps += 1;
             if largest.is_none_or(|(g, _)| dt > g) {
                 largest = Some((dt, row));
@@ -285,7 +286,11 @@ pub(crate) fn time_summary(t: &[f64]) -> Option<TimeSummary> {
         sample_interval_s: interval,
         rate_hz: (interval > 0.0).then(|| 1.0 / interval),
         jitter_std_s: if n > 0 {
-            jitter_std(&steps, interval, threshold, n, sum2, jmax)
+            let deviations = steps
+                .iter()
+                .filter(|s| !is_gap(s.0))
+                .map(|s| s.0 - interval);
+            jitter_std(deviations, n, sum2, jmax)
         } else {
             0.0
         },
@@ -341,27 +346,17 @@ fn line_counts(table: &FlightTable) -> Option<Vec<LineCount>> {
     Some(out)
 }
 
-/// The standard deviation of the steps within the gap threshold about the
-/// interval, from their `n` squared deviations' sum `sum2`; when that sum
-/// overflowed (steps near 1e300 s), again with each deviation divided by
-/// the largest, `jmax`, which does not.
-fn jitter_std(
-    steps: &[(f64, usize)],
-    interval: f64,
-    threshold: f64,
-    n: usize,
-    sum2: f64,
-    jmax: f64,
-) -> f64 {
+/// The standard deviation of the `n` `deviations` of the steps within the
+/// gap threshold from the interval, from their squares' sum `sum2`; when
+/// that sum overflowed (steps near 1e300 s), again with each deviation
+/// divided by the largest, `jmax`, which does not (the deviations are only
+/// gone through then).
+fn jitter_std(deviations: impl Iterator<Item = f64>, n: usize, sum2: f64, jmax: f64) -> f64 {
     let std = (sum2 / n as f64).sqrt();
     if std.is_finite() || !(jmax.is_finite() && jmax > 0.0) {
         return std;
     }
-    let scaled: f64 = steps
-        .iter()
-        .filter(|(dt, _)| !(interval > 0.0 && *dt > threshold))
-        .map(|(dt, _)| ((dt - interval) / jmax).powi(2))
-        .sum();
+    let scaled: f64 = deviations.map(|d| (d / jmax).powi(2)).sum();
     jmax * (scaled / n as f64).sqrt()
 }
 

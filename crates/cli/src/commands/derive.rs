@@ -2,7 +2,7 @@
 //! derivative, upward continuation, or difference (library:
 //! [`aeromag::map::derive`]).
 
-use aeromag::core::error::shown;
+use aeromag::core::error::fixed;
 use aeromag::map::{GridProduct, derive};
 use std::path::PathBuf;
 
@@ -70,22 +70,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         g.geometry.nx,
         g.geometry.ny,
         s.count,
-        figure(s.mean),
-        figure(s.std),
-        figure(s.min),
-        figure(s.max),
+        fixed(s.mean, 4),
+        fixed(s.std, 4),
+        fixed(s.min, 4),
+        fixed(s.max, 4),
         g.unit
     );
     println!("wrote {}", a.out.display());
     Ok(())
-}
-
-/// A summary figure: four decimals, or in exponent form from 10¹⁵ (a
-/// float32 grid may hold values up to 3.4·10³⁸: not 39 digits).
-fn figure(v: f64) -> String {
-    if v.abs() < 1e15 {
-        format!("{v:.4}")
-    } else {
-        shown(v)
-    }
 }

@@ -1,7 +1,7 @@
 //! `aeromag inspect`: what a processor checks first in a flight file.
 
 use crate::input::InputArgs;
-use aeromag_core::error::shown;
+use aeromag_core::error::fixed;
 use aeromag_io::{Summary, summarize};
 
 /// Summarise a flight file: columns found and mapped, rows, duration, sample
@@ -39,17 +39,6 @@ fn fmt_opt(v: Option<f64>) -> String {
         Some(x) if x.abs() >= 1e5 || (x != 0.0 && x.abs() < 1e-3) => format!("{x:.4e}"),
         Some(x) => format!("{x:.4}"),
         None => "—".into(),
-    }
-}
-
-/// `x` with `decimals` decimals, or in exponent form ([`shown`]) when that
-/// would be long: a time such as 1e300 s in a hostile file is printed as
-/// `1e300`, not as 301 digits.
-fn fixed(x: f64, decimals: usize) -> String {
-    if x.abs() < 1e15 {
-        format!("{x:.decimals$}")
-    } else {
-        shown(x)
     }
 }
 

@@ -63,13 +63,13 @@ pub struct Args {
     lever_arm: Option<[f64; 3]>,
 }
 
-/// `x` with `decimals` decimals, or in exponent form ([`shown`]) when that
-/// would be long or show nothing (`--cutoff 1e-300`, `--along-line 1e308`).
+/// [`aeromag::core::error::fixed`], and in exponent form too below 10⁻³,
+/// where the decimals would show nothing (`--cutoff 1e-300`).
 fn fixed(x: f64, decimals: usize) -> String {
-    if x == 0.0 || (1e-3..1e15).contains(&x.abs()) {
-        format!("{x:.decimals$}")
-    } else {
+    if x != 0.0 && x.abs() < 1e-3 {
         shown(x)
+    } else {
+        aeromag::core::error::fixed(x, decimals)
     }
 }
 
