@@ -112,6 +112,18 @@ pub fn grid_flight(
     opts: &GridOptions,
     observer: &mut dyn Observer,
 ) -> Result<SurveyGrid> {
+    grid_flight_finest(flight, opts, None, observer)
+}
+
+/// [`grid_flight`], a given cell finer than `finest` line spacings (when
+/// the survey has lines) being bad input: micro-levelling's working grid
+/// ([`super::microlevel::MIN_CELL_LINE_SPACINGS`]).
+pub(crate) fn grid_flight_finest(
+    flight: &Flight,
+    opts: &GridOptions,
+    finest: Option<f64>,
+    observer: &mut dyn Observer,
+) -> Result<SurveyGrid> {
     let mut notes = Notes::new(observer);
     let column = match &opts.column {
         Some(c) => c.clone(),
@@ -136,6 +148,15 @@ pub fn grid_flight(
         notes.warn(w);
     }
     let cell = match (opts.geometry.map(|g| g.cell).or(opts.cell_m), &survey.lines) {
+        (Some(c), Some(l)) if finest.is_some_and(|f| c < f * l.spacing_m) => {
+            let f = finest.unwrap_or_default();
+            return Err(Error::bad_input(format!(
+                "the cell {} m is finer than {f} line spacings ({:.1} m between the lines): give at least {:.1} m (the default is a quarter of the spacing)",
+                shown(c),
+                l.spacing_m,
+                f * l.spacing_m
+            )));
+        }
         (Some(c), _) => c,
         (None, Some(l)) if l.default_cell_m() < MIN_CELL => {
             return Err(Error::bad_file(

@@ -2,7 +2,7 @@
 //! tie-line levelling (Minty 1991, *Simple micro-levelling for
 //! aeromagnetic data*, Exploration Geophysics 22, 591–592).
 //!
-//! 1. The column is gridded ([`grid_flight`], minimum curvature).
+//! 1. The column is gridded ([`grid_flight`](super::gridding::grid_flight), minimum curvature).
 //! 2. The corrugation is isolated on the grid by a high-pass Butterworth
 //!    filter (cut-off wavelength `cutoff_line_spacings` × the line
 //!    spacing) times a directional cosine filter aligned with the lines
@@ -25,8 +25,8 @@
 //! the grid) raises them. Their RMS before and after is reported, with a
 //! warning when micro-levelling raises it by more than half.
 
-use super::gridding::{GridOptions, grid_flight};
-use super::survey::{LineGeometry, ProjectedSurvey};
+use super::gridding::{GridOptions, grid_flight_finest};
+use super::survey::LineGeometry;
 use crate::error::{Error, InFile, Result};
 use crate::flight::{Flight, LineLabels};
 use crate::io::FlightTable;
@@ -41,9 +41,9 @@ use aeromag_grid::projection::UtmZone;
 #[derive(Debug, Clone, PartialEq)]
 pub struct MicrolevelOptions {
     /// The column (default: the most processed magnetic column, as
-    /// [`grid_flight`]).
+    /// [`grid_flight`](super::gridding::grid_flight)).
     pub column: Option<String>,
-    /// Cell of the working grid, m (default as [`grid_flight`]).
+    /// Cell of the working grid, m (default as [`grid_flight`](super::gridding::grid_flight)).
     pub cell_m: Option<f64>,
     /// UTM zone (default: the data's).
     pub zone: Option<UtmZone>,
@@ -142,22 +142,7 @@ pub fn microlevel(
             shown(opts.cutoff_line_spacings)
         )));
     }
-    if let Some(cell) = opts.cell_m {
-        let survey = ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m)?;
-        if let Some(lines) = &survey.lines {
-            let finest = lines.spacing_m * MIN_CELL_LINE_SPACINGS;
-            if cell < finest {
-                return Err(Error::bad_input(format!(
-                    "the cell {} m is finer than {} line spacings ({:.1} m between the lines): give at least {:.1} m (the default is a quarter of the spacing)",
-                    shown(cell),
-                    MIN_CELL_LINE_SPACINGS,
-                    lines.spacing_m,
-                    finest
-                )));
-            }
-        }
-    }
-    let gridded = grid_flight(
+    let gridded = grid_flight_finest(
         flight,
         &GridOptions {
             column: opts.column.clone(),
@@ -169,6 +154,7 @@ pub fn microlevel(
             min_curvature: opts.min_curvature,
             ..GridOptions::default()
         },
+        Some(MIN_CELL_LINE_SPACINGS),
         &mut notes,
     )?;
     let column = gridded.column.clone();
