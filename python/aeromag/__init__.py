@@ -404,12 +404,19 @@ def microlevel(
     tension: float = 0.25,
     utm_zone: Optional[str] = None,
     lever_arm: Optional[Tuple[float, float, float]] = None,
+    max_sweeps: int = 500,
+    convergence: Optional[float] = None,
     progress: Any = None,
 ) -> Microlevelled:
     """Micro-level a levelled survey (``aeromag microlevel``, Minty 1991).
 
+    ``cutoff`` (at least 2) is the high-pass's cut-off wavelength in line
+    spacings; ``tension``, ``max_sweeps`` and ``convergence`` are those of
+    the working grid's minimum curvature, as in :func:`grid_flight`.
+
     Returns a :class:`Microlevelled`: ``values``, ``correction`` (nT per
-    row), ``correction_nt`` (RMS, largest), ``to_flight()`` with
+    row), ``correction_nt`` (RMS, largest), ``gridding`` (the working
+    grid's sweeps and whether it converged), ``to_flight()`` with
     ``<column>_mlev`` and ``<column>_mlev_corr``.
     """
     from .tolles_lawson import progress_callback
@@ -424,6 +431,8 @@ def microlevel(
         tension=tension,
         utm_zone=utm_zone,
         lever_arm=lever_arm,
+        max_sweeps=max_sweeps,
+        convergence=convergence,
         progress=progress_callback(progress),
     )
 

@@ -341,6 +341,8 @@ class Microlevelled:
     @property
     def crossover_rms_nt(self) -> Optional[Tuple[float, float]]: ...
     @property
+    def gridding(self) -> Tuple[int, bool]: ...
+    @property
     def notes(self) -> List[str]: ...
     def to_flight(self) -> Flight: ...
 
@@ -369,6 +371,8 @@ def microlevel(
     tension: float = 0.25,
     utm_zone: Optional[str] = None,
     lever_arm: Optional[Tuple[float, float, float]] = None,
+    max_sweeps: int = 500,
+    convergence: Optional[float] = None,
     progress: _Progress = None,
 ) -> Microlevelled: ...
 def score(

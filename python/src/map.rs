@@ -322,6 +322,16 @@ impl PyMicrolevelled {
         self.m.crossover_rms_nt
     }
 
+    /// Sweeps of minimum curvature on the working grid's final level and
+    /// whether it converged (a warning in `notes` when it did not).
+    #[getter]
+    fn gridding(&self) -> (usize, bool) {
+        (
+            self.m.gridding.levels.last().map_or(0, |l| l.iterations),
+            self.m.gridding.converged,
+        )
+    }
+
     /// Notes and warnings.
     #[getter]
     fn notes(&self) -> Vec<String> {
@@ -340,7 +350,7 @@ impl PyMicrolevelled {
 /// flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0,
-    tension=0.25, utm_zone=None, lever_arm=None, progress=None))]
+    tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=500, convergence=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn microlevel(
     py: Python<'_>,
@@ -353,6 +363,8 @@ pub fn microlevel(
     tension: f64,
     utm_zone: Option<&str>,
     lever_arm: Option<[f64; 3]>,
+    max_sweeps: usize,
+    convergence: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyMicrolevelled> {
     let opts = MicrolevelOptions {
@@ -363,7 +375,12 @@ pub fn microlevel(
         cutoff_line_spacings: cutoff,
         along_line_m: along_line,
         cosine_power,
-        min_curvature: MinCurvature::with_tension(tension),
+        min_curvature: MinCurvature {
+            tension,
+            max_iterations: max_sweeps,
+            convergence,
+            ..MinCurvature::default()
+        },
     };
     let mut obs = PyProgress::new(progress);
     let result = py.detach(|| lib_microlevel(&flight.inner, &opts, &mut obs));

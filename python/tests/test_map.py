@@ -74,3 +74,22 @@ def test_minimum_curvature_limits(survey_csv):
         aeromag.grid_flight(survey, max_sweeps=0)
     with pytest.raises(aeromag.BadInputError, match="convergence"):
         aeromag.grid_flight(survey, convergence=-1.0)
+
+
+def test_microlevel_gridding_limits_and_cutoff(survey_csv):
+    """microlevel takes grid_flight's minimum-curvature limits for its
+    working grid and says how it converged; a cut-off below 2 line
+    spacings (which passed none of the stripes) is refused."""
+    survey = aeromag.read_flight(survey_csv)
+    short = aeromag.microlevel(survey, column="true_anomaly", max_sweeps=10)
+    # Each of the final grid's two relaxations stops at 10 sweeps.
+    assert short.gridding == (20, False)
+    assert any("max-sweeps" in n for n in short.notes)
+    full = aeromag.microlevel(survey, column="true_anomaly", max_sweeps=5000)
+    sweeps, converged = full.gridding
+    assert converged is True and 20 < sweeps < 10000
+    assert not any("max-sweeps" in n for n in full.notes)
+    with pytest.raises(aeromag.BadInputError, match="cut-off 1 line spacings is below 2"):
+        aeromag.microlevel(survey, column="true_anomaly", cutoff=1.0)
+    with pytest.raises(aeromag.BadInputError, match="max sweeps = 0"):
+        aeromag.microlevel(survey, column="true_anomaly", max_sweeps=0)

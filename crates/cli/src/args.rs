@@ -1,5 +1,6 @@
 //! Parsers of option values shared by several commands (clap value
-//! parsers: a bad value is a usage error, exit code 2, naming the flag).
+//! parsers: a bad value is a usage error, exit code 2, naming the flag),
+//! and the flag groups several commands flatten into theirs.
 
 use std::fmt;
 use std::str::FromStr;
@@ -35,6 +36,39 @@ pub fn decimal_year(s: &str) -> Result<f64, String> {
     aeromag::core::time::Date::parse(s)
         .map(|d| d.decimal_year())
         .map_err(|e| e.to_string())
+}
+
+/// The minimum-curvature flags of `grid` and `microlevel` (which grids
+/// the column it corrects): GMT `surface`'s `-T`, `-N` and `-C`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MinCurvatureArgs {
+    /// Tension, 0 (minimum curvature) to 1 (harmonic).
+    #[arg(long, default_value_t = 0.25)]
+    pub tension: f64,
+    /// Most sweeps of each of minimum curvature's relaxations on the final
+    /// grid (two: between the coarser grid's nodes, then with the data),
+    /// 1 to 100000 (GMT `surface -N`; the coarser grids before it get
+    /// more in proportion to their spacing).
+    #[arg(long, value_name = "N", default_value_t = 500)]
+    pub max_sweeps: usize,
+    /// Convergence limit of minimum curvature: the largest change of a
+    /// sweep, in the column's unit (GMT `surface -C`; default 10⁻⁴ × the
+    /// data's RMS about their plane).
+    #[arg(long, value_name = "NT", value_parser = positive)]
+    pub convergence: Option<f64>,
+}
+
+impl MinCurvatureArgs {
+    /// The library's settings (checked there: tension 0–1, sweeps 1 to
+    /// 100 000).
+    pub fn settings(&self) -> aeromag::grid::gridding::MinCurvature {
+        aeromag::grid::gridding::MinCurvature {
+            tension: self.tension,
+            max_iterations: self.max_sweeps,
+            convergence: self.convergence,
+            ..Default::default()
+        }
+    }
 }
 
 /// A finite number ≥ 0.

@@ -60,3 +60,58 @@ fn extreme_cell_cutoff_and_along_line() {
         "{s}"
     );
 }
+
+/// `--cutoff 1e-300` (or 1) gave a correction of zero with exit 0: the
+/// high-pass then passes none of the stripes between lines. The working
+/// grid's minimum curvature has `grid`'s limits (`--max-sweeps`,
+/// `--convergence`), which its warning named while microlevel had none,
+/// and its convergence is printed.
+#[test]
+fn short_cutoff_refused_and_gridding_limits_taken() {
+    let d = tempfile::tempdir().unwrap();
+    let input = small_survey(d.path());
+    let out = d.path().join("ml.csv");
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "microlevel",
+            "-i",
+            input.to_str().unwrap(),
+            "--column",
+            "mag",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend(extra);
+        aeromag(&a)
+    };
+    for cutoff in ["1e-300", "1", "1.99"] {
+        let o = run(&["--cutoff", cutoff]);
+        assert_code(&o, 2);
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("cut-off {cutoff} line spacings is below 2")),
+            "{e}"
+        );
+        assert!(!out.exists());
+    }
+    let o = run(&["--max-sweeps", "10"]);
+    assert_code(&o, 0);
+    let (s, e) = (stdout(&o), stderr(&o));
+    // Each of the final grid's two relaxations stops at 10 sweeps.
+    assert!(
+        s.contains("20 sweeps on the final grid, NOT converged"),
+        "{s}"
+    );
+    assert!(
+        e.contains("--max-sweeps") && e.contains("--convergence"),
+        "{e}"
+    );
+    let o = run(&["--max-sweeps", "5000", "--cutoff", "2"]);
+    assert_code(&o, 0);
+    let (s, e) = (stdout(&o), stderr(&o));
+    assert!(s.contains("sweeps on the final grid, converged"), "{s}");
+    assert!(!e.contains("--max-sweeps"), "{e}");
+    let o = run(&["--max-sweeps", "0"]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("max sweeps"), "{}", stderr(&o));
+}

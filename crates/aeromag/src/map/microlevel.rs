@@ -33,7 +33,7 @@ use crate::io::FlightTable;
 use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::levelling::{CrossoverSide, SurveyTracks, TrackConfig, find_crossovers};
 use aeromag_core::error::shown;
-use aeromag_grid::gridding::MinCurvature;
+use aeromag_grid::gridding::{MinCurvature, MinCurvatureReport};
 use aeromag_grid::products::{Corrugation, Spectral, apply};
 use aeromag_grid::projection::UtmZone;
 
@@ -98,6 +98,9 @@ pub struct Microlevelled {
     /// RMS of the crossover differences before and after the correction,
     /// nT (`None` without crossovers, e.g. no `time` column or no ties).
     pub crossover_rms_nt: Option<(f64, f64)>,
+    /// How the working grid's minimum curvature converged (a grid that
+    /// has not is also a warning, naming the settings to raise).
+    pub gridding: MinCurvatureReport,
     /// Notes and warnings.
     pub notes: Vec<Note>,
 }
@@ -129,6 +132,16 @@ impl Microlevelled {
 /// took 2.5 s, 5 m 13 s, and 1 m more than a minute.
 pub const MIN_CELL_LINE_SPACINGS: f64 = 0.02;
 
+/// The shortest cut-off micro-levelling takes, in line spacings. Level
+/// errors of single lines make stripes whose wavelength across the lines
+/// is two line spacings or more; the order-8 high-pass keeps
+/// `1/(1 + (λ/λc)¹⁶)` of a wavelength `λ` across the lines, so with its
+/// cut-off `λc` at one line spacing it keeps 1.5·10⁻⁵ of the shortest
+/// stripes and the correction is next to nothing (`--cutoff 1e-300` gave
+/// a correction of zero with exit 0). At two line spacings it keeps half
+/// of them; Minty's (1991) default is four.
+pub const MIN_CUTOFF_LINE_SPACINGS: f64 = 2.0;
+
 /// Micro-level a column of a levelled survey (module docs).
 pub fn microlevel(
     flight: &Flight,
@@ -136,9 +149,11 @@ pub fn microlevel(
     observer: &mut dyn Observer,
 ) -> Result<Microlevelled> {
     let mut notes = Notes::new(observer);
-    if !(opts.cutoff_line_spacings.is_finite() && opts.cutoff_line_spacings > 0.0) {
+    if !(opts.cutoff_line_spacings >= MIN_CUTOFF_LINE_SPACINGS) {
         return Err(Error::bad_input(format!(
-            "the cut-off {} line spacings must be positive",
+            "the cut-off {} line spacings is below {MIN_CUTOFF_LINE_SPACINGS}: the stripes between \
+             adjacent lines are {MIN_CUTOFF_LINE_SPACINGS} line spacings and more across them, and a \
+             high-pass with a shorter cut-off takes them for geology (the correction would be next to nothing)",
             shown(opts.cutoff_line_spacings)
         )));
     }
@@ -248,6 +263,7 @@ pub fn microlevel(
         correction_rms_nt: rms,
         correction_max_nt: max,
         crossover_rms_nt,
+        gridding: gridded.report.clone(),
         notes: notes.into_notes(),
     })
 }

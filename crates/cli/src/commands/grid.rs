@@ -6,7 +6,6 @@ use crate::args;
 use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::grid::GridGeometry;
-use aeromag::grid::gridding::MinCurvature;
 use aeromag::grid::projection::UtmZone;
 use aeromag::map::gridding::GridMethod;
 use aeromag::map::{GridOptions, grid_flight};
@@ -44,19 +43,8 @@ pub struct Args {
     /// the line spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
     #[arg(long, value_parser = args::positive)]
     cell: Option<f64>,
-    /// Tension, 0 (minimum curvature) to 1 (harmonic).
-    #[arg(long, default_value_t = 0.25)]
-    tension: f64,
-    /// Most sweeps of minimum curvature on the final grid, 1 to 100000
-    /// (GMT `surface -N`; the coarser grids before it get more in
-    /// proportion to their spacing).
-    #[arg(long, value_name = "N", default_value_t = 500)]
-    max_sweeps: usize,
-    /// Convergence limit of minimum curvature: the largest change of a
-    /// sweep, in the column's unit (GMT `surface -C`; default 10⁻⁴ × the
-    /// data's RMS about their plane).
-    #[arg(long, value_name = "NT", value_parser = args::positive)]
-    convergence: Option<f64>,
+    #[command(flatten)]
+    min_curvature: args::MinCurvatureArgs,
     /// Gridding method.
     #[arg(long, value_enum, default_value_t = GridMethod::MinCurvature)]
     method: GridMethod,
@@ -105,12 +93,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         zone: a.utm_zone,
         lever_arm_m: a.lever_arm,
         method: a.method,
-        min_curvature: MinCurvature {
-            tension: a.tension,
-            max_iterations: a.max_sweeps,
-            convergence: a.convergence,
-            ..MinCurvature::default()
-        },
+        min_curvature: a.min_curvature.settings(),
     };
     let g = grid_flight(&flight, &opts, &mut Bars::new())?;
     let format = g.write(&a.out)?;

@@ -5,7 +5,6 @@
 use crate::args;
 use crate::input::InputArgs;
 use crate::progress::Bars;
-use aeromag::grid::gridding::MinCurvature;
 use aeromag::grid::projection::UtmZone;
 use aeromag::map::{MicrolevelOptions, microlevel};
 use aeromag_core::error::shown;
@@ -39,8 +38,10 @@ pub struct Args {
     /// rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
     #[arg(long, value_parser = args::positive)]
     cell: Option<f64>,
-    /// Cut-off wavelength of the high-pass filter, in line spacings.
-    #[arg(long, default_value_t = 4.0, value_parser = args::positive)]
+    /// Cut-off wavelength of the high-pass filter, in line spacings, at
+    /// least 2 (the stripes between adjacent lines are 2 line spacings
+    /// and more across them).
+    #[arg(long, default_value_t = 4.0)]
     cutoff: f64,
     /// Length of an along-line running mean of the correction, m (for
     /// level errors that drift along long lines; default: one level per
@@ -51,9 +52,8 @@ pub struct Args {
     /// across-line direction).
     #[arg(long, default_value_t = 2.0, value_parser = args::non_negative)]
     cosine_power: f64,
-    /// Tension of the gridding, 0 to 1.
-    #[arg(long, default_value_t = 0.25)]
-    tension: f64,
+    #[command(flatten)]
+    min_curvature: args::MinCurvatureArgs,
     /// UTM zone, e.g. `37N` (default: the data's).
     #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
     utm_zone: Option<UtmZone>,
@@ -84,20 +84,30 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         cutoff_line_spacings: a.cutoff,
         along_line_m: a.along_line,
         cosine_power: a.cosine_power,
-        min_curvature: MinCurvature::with_tension(a.tension),
+        min_curvature: a.min_curvature.settings(),
     };
     let m = microlevel(&flight, &opts, &mut Bars::new())?;
     let mut table = flight.into_table();
     m.add_to(&mut table)?;
     aeromag::io::write_csv(&table, &a.out)?;
     println!(
-        "micro-levelled {} → {} ({} lines at {:.1}° from grid north, spacing {:.1} m; grid cell {} m)",
+        "micro-levelled {} → {} ({} lines at {:.1}° from grid north, spacing {:.1} m)",
         m.column,
         m.output_column(),
         m.lines.traverse_lines,
         m.lines.direction_deg,
         m.lines.spacing_m,
-        m.cell_m
+    );
+    println!(
+        "working grid: cell {} m, minimum curvature with tension {}, {} sweeps on the final grid, {}",
+        m.cell_m,
+        opts.min_curvature.tension,
+        m.gridding.levels.last().map_or(0, |l| l.iterations),
+        if m.gridding.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        }
     );
     println!(
         "filter: high-pass cut-off {} m ({} line spacings); correction {}",
