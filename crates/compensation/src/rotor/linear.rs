@@ -121,7 +121,11 @@ pub fn regressors(
                 r.column(1).into_owned(),
                 r.column(2).into_owned(),
             );
-            let g = dipole_integral(&a, &rp, geom.root_m, geom.tip_m)?.transpose() * e * 1e9;
+            let g = dipole_integral(&a, &rp, geom.root_m, geom.tip_m)
+                .map_err(|_| on_blade_line(geom, j, k, psi))?
+                .transpose()
+                * e
+                * 1e9;
             let c = j * pb;
             cols[c][k] = g.dot(&rp);
             cols[c + 1][k] = g.dot(&rp) * rp.dot(&b) / MU0;
@@ -135,6 +139,24 @@ pub fn regressors(
         }
     }
     Ok(cols)
+}
+
+/// The error of a sensor on blade `j`'s line at sample `k` (azimuth
+/// `psi_rad`), where the blade model's field is infinite: it names the
+/// geometry's settings (`rotor fit --sensor-m/--hub-m`, the model file's
+/// `sensor_m`/`hub_m`), not the integral that failed.
+fn on_blade_line(geom: &RotorGeometry, j: usize, k: usize, psi_rad: f64) -> CompError {
+    use aeromag_core::error::{fixed, shown};
+    let p = |v: [f64; 3]| v.map(shown).join(",");
+    CompError::setting(format!(
+        "rotor geometry: the sensor (sensor_m, --sensor-m {}) lies on the line of blade {} \
+         through the hub (hub_m, --hub-m {}) at sample {k} (azimuth {}°), where the blade's \
+         field is infinite: move the sensor off the blades' cone",
+        p(geom.sensor_m),
+        j + 1,
+        p(geom.hub_m),
+        fixed(psi_rad.to_degrees().rem_euclid(360.0), 1),
+    ))
 }
 
 /// Options of the least-squares fit.
@@ -270,5 +292,45 @@ impl RotorFit {
         Ok((0..n)
             .map(|k| cols.iter().zip(&self.params).map(|(c, p)| c[k] * p).sum())
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sensor on a blade's line (here in the rotor plane, no coning, at
+    /// the azimuth of blade 1 at the first sample) was "dipole integral:
+    /// the sensor lies on the blade's line", naming no setting.
+    #[test]
+    fn a_sensor_on_a_blades_line_names_the_geometry() {
+        let geom = RotorGeometry::main_rotor([0.0, 0.0, -2.6], [5.0, 0.0, -2.6], 0.8, 7.5, 4);
+        let b = [Vector3::new(20_000.0, 0.0, 45_000.0); 3];
+        let flat = [FlapAngles {
+            coning_rad: 0.0,
+            tilt_lon_rad: 0.0,
+            tilt_lat_rad: 0.0,
+        }];
+        let input = RotorInput {
+            b_body_nt: &b,
+            phase_rad: &[0.0, 0.1, 0.2],
+            omega_rad_s: &[40.0; 3],
+            angles: &flat,
+        };
+        let e = regressors(&geom, BladeTerms::Simplified, &input).unwrap_err();
+        let msg = e.to_string();
+        assert!(e.is_bad_input(), "{msg}");
+        for part in [
+            "sensor_m, --sensor-m 5,0,-2.6",
+            "hub_m, --hub-m 0,0,-2.6",
+            "blade 1 through the hub",
+            "at sample 0 (azimuth 0.0°)",
+        ] {
+            assert!(msg.contains(part), "{part}: {msg}");
+        }
+        // Off the plane, the same geometry is fine.
+        let mut off = geom.clone();
+        off.sensor_m[2] = -2.0;
+        assert!(regressors(&off, BladeTerms::Simplified, &input).is_ok());
     }
 }
