@@ -271,8 +271,12 @@ pub(crate) fn resolve(
 ) -> Result<Vec<MappedColumn>> {
     let has = |name: &str| header.iter().any(|h| h == name);
     // The header's spelling of `name`, compared without regard to case
-    // (an exact match first).
-    let find = |name: &str| -> Option<&String> { find_in(header, name) };
+    // (an exact match first), for canonical name `canonical`.
+    let find = |name: &str, canonical: &str| -> Result<Option<&String>> {
+        find_in(file, header, name, || {
+            format!("--columns {canonical}=COLUMN")
+        })
+    };
     let mut out: Vec<MappedColumn> = Vec::new();
     for (canonical, file_column) in map.pairs() {
         if !has(file_column) {
@@ -302,10 +306,16 @@ pub(crate) fn resolve(
         if !wanted(&out, canonical) {
             continue;
         }
-        let hit = std::iter::once(canonical)
-            .chain(candidates.iter().copied())
-            .filter_map(find)
-            .find(|c| !taken(&out, c.as_str()) && !is_canonical(c));
+        let mut hit = None;
+        for name in std::iter::once(canonical).chain(candidates.iter().copied()) {
+            if let Some(c) = find(name, canonical)?
+                && !taken(&out, c.as_str())
+                && !is_canonical(c)
+            {
+                hit = Some(c);
+                break;
+            }
+        }
         if let Some(c) = hit {
             out.push(MappedColumn {
                 canonical: canonical.to_string(),
@@ -317,7 +327,7 @@ pub(crate) fn resolve(
     // `line` and the names of the spec in another case (`LINE`).
     for canonical in CANONICAL_COLUMNS {
         if wanted(&out, canonical)
-            && let Some(c) = find(canonical).filter(|c| !taken(&out, c.as_str()))
+            && let Some(c) = find(canonical, canonical)?.filter(|c| !taken(&out, c.as_str()))
         {
             out.push(MappedColumn {
                 canonical: canonical.to_string(),
@@ -329,11 +339,14 @@ pub(crate) fn resolve(
     let flux = ["flux_x", "flux_y", "flux_z"];
     if flux.iter().all(|f| wanted(&out, f)) {
         for prefix in MAGNAV_FLUX_PREFIXES {
-            let names: Vec<&String> = ["x", "y", "z"]
-                .iter()
-                .filter_map(|a| find(&format!("{prefix}_{a}")))
-                .filter(|n| !taken(&out, n.as_str()))
-                .collect();
+            let mut names: Vec<&String> = Vec::new();
+            for (a, canonical) in ["x", "y", "z"].iter().zip(flux) {
+                if let Some(n) = find(&format!("{prefix}_{a}"), canonical)?
+                    && !taken(&out, n.as_str())
+                {
+                    names.push(n);
+                }
+            }
             if names.len() == 3 {
                 for (canonical, file_column) in flux.iter().zip(names) {
                     out.push(MappedColumn {
@@ -349,13 +362,36 @@ pub(crate) fn resolve(
     Ok(out)
 }
 
-/// The header's spelling of `name`: an exact match, else one that differs
-/// only in case.
-fn find_in<'h>(header: &'h [String], name: &str) -> Option<&'h String> {
-    header
-        .iter()
-        .find(|h| *h == name)
-        .or_else(|| header.iter().find(|h| h.eq_ignore_ascii_case(name)))
+/// The header's spelling of `name`: an exact match, else the one name
+/// that differs from it only in case. Several of those (`MAG` and `Mag`
+/// for `mag`) and no exact match is [`IoError::AmbiguousColumn`], whose
+/// advice `choose` gives: taking the first would pick a sensor or a
+/// processing stage by the order of the columns.
+fn find_in<'h>(
+    file: &str,
+    header: &'h [String],
+    name: &str,
+    choose: impl FnOnce() -> String,
+) -> Result<Option<&'h String>> {
+    if let Some(h) = header.iter().find(|h| *h == name) {
+        return Ok(Some(h));
+    }
+    let mut matches = header.iter().filter(|h| h.eq_ignore_ascii_case(name));
+    let first = matches.next();
+    if let Some(second) = matches.next() {
+        let quoted: Vec<String> = [first.unwrap(), second]
+            .into_iter()
+            .chain(matches)
+            .map(|h| format!("'{h}'"))
+            .collect();
+        return Err(IoError::AmbiguousColumn {
+            file: file.to_string(),
+            name: name.to_string(),
+            matches: quoted.join(", "),
+            choose: choose(),
+        });
+    }
+    Ok(first)
 }
 
 /// The sensors of a flight with several magnetometers that a command uses
@@ -401,18 +437,24 @@ impl Sensors {
             if map.get("mag").is_some() {
                 return Err(conflict("--mag", name, "mag"));
             }
-            let hit = sensor_names(name)
-                .iter()
-                .find_map(|n| find_in(header, n))
-                .ok_or_else(|| IoError::SensorAbsent {
-                    file: file.to_string(),
-                    option: "--mag",
-                    name: name.clone(),
-                    candidates: candidates(header, |h| {
-                        let l = h.to_ascii_lowercase();
-                        (l.starts_with("mag") || l.contains("mag")) && !l.starts_with("flux")
-                    }),
+            let mut hit = None;
+            for n in sensor_names(name) {
+                hit = find_in(file, header, &n, || {
+                    "--mag with its exact spelling".to_string()
                 })?;
+                if hit.is_some() {
+                    break;
+                }
+            }
+            let hit = hit.ok_or_else(|| IoError::SensorAbsent {
+                file: file.to_string(),
+                option: "--mag",
+                name: name.clone(),
+                candidates: candidates(header, |h| {
+                    let l = h.to_ascii_lowercase();
+                    (l.starts_with("mag") || l.contains("mag")) && !l.starts_with("flux")
+                }),
+            })?;
             push("mag", hit);
         }
         if let Some(prefix) = &self.vector {
@@ -422,13 +464,19 @@ impl Sensors {
             {
                 return Err(conflict("--vector", prefix, "flux_x/y/z"));
             }
-            let triplet = sensor_names(prefix).iter().find_map(|p| {
-                let names: Vec<&String> = ["x", "y", "z"]
-                    .iter()
-                    .filter_map(|a| find_in(header, &format!("{p}_{a}")))
-                    .collect();
-                (names.len() == 3).then_some(names)
-            });
+            let mut triplet = None;
+            for p in sensor_names(prefix) {
+                let mut names: Vec<&String> = Vec::new();
+                for a in ["x", "y", "z"] {
+                    names.extend(find_in(file, header, &format!("{p}_{a}"), || {
+                        "--vector with its exact spelling".to_string()
+                    })?);
+                }
+                if names.len() == 3 {
+                    triplet = Some(names);
+                    break;
+                }
+            }
             let Some(names) = triplet else {
                 return Err(IoError::SensorAbsent {
                     file: file.to_string(),
@@ -790,6 +838,69 @@ mod tests {
         );
         let map = ColumnMap::parse("mag=mag_1_uc").unwrap();
         assert!(resolve("f", &h5, &map, &choose("mag_3_uc", "flux_b"), true).is_err());
+    }
+
+    /// Two columns that differ only in case (`MAG`, `Mag`) both read as
+    /// `mag`: the first was taken without a word, choosing a sensor by
+    /// the columns' order. An exact spelling still wins, and the map or
+    /// an exact `--mag`/`--vector` chooses.
+    #[test]
+    fn columns_equal_without_regard_to_case_are_ambiguous() {
+        let h = header(&["time", "MAG", "Mag", "FLUX_X", "Flux_x", "flux_y", "flux_z"]);
+        let none = Sensors::default();
+        let e = resolve("f.csv", &h, &ColumnMap::new(), &none, true).unwrap_err();
+        let msg = e.to_string();
+        assert!(e.is_bad_input(), "{msg}");
+        assert!(
+            msg.contains("'f.csv': columns 'MAG', 'Mag' all read as 'mag'")
+                && msg.contains("--columns mag=COLUMN"),
+            "{msg}"
+        );
+        let map = ColumnMap::parse("mag=Mag").unwrap();
+        let e = resolve("f.csv", &h, &map, &none, true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("'FLUX_X', 'Flux_x' all read as 'flux_x'")
+                && e.contains("--columns flux_x=COLUMN"),
+            "{e}"
+        );
+        let map = ColumnMap::parse("mag=Mag,flux_x=FLUX_X").unwrap();
+        let m = resolve("f.csv", &h, &map, &none, true).unwrap();
+        assert_eq!(
+            m.iter().find(|x| x.canonical == "mag").unwrap().file_column,
+            "Mag"
+        );
+        // The exact spelling wins, as before.
+        let exact = header(&["time", "MAG", "mag", "Mag"]);
+        let m = resolve("f.csv", &exact, &ColumnMap::new(), &none, true).unwrap();
+        assert!(m.iter().all(|x| x.canonical != "mag"), "{m:?}");
+        // `--mag` with a spelling that matches two columns, then an exact one.
+        let xyz = header(&[
+            "TIME",
+            "UNCOMPMAG3",
+            "UncompMag3",
+            "FLUXB_X",
+            "FLUXB_Y",
+            "FLUXB_Z",
+        ]);
+        let choose = |mag: &str| Sensors {
+            mag: Some(mag.into()),
+            vector: None,
+        };
+        let e = resolve("f.xyz", &xyz, &ColumnMap::new(), &choose("mag_3_uc"), true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--mag with its exact spelling"), "{e}");
+        let m = resolve(
+            "f.xyz",
+            &xyz,
+            &ColumnMap::new(),
+            &choose("UncompMag3"),
+            true,
+        )
+        .unwrap();
+        assert_eq!(m[0].file_column, "UncompMag3");
     }
 
     #[test]

@@ -222,6 +222,21 @@ pub enum IoError {
         /// Comma-separated columns that look like sensors of that kind.
         candidates: String,
     },
+    /// Several columns whose names differ only in case (`MAG` and `Mag`)
+    /// would play the one name looked for (`mag`), none spelt exactly so.
+    #[error(
+        "'{file}': columns {matches} all read as '{name}' without regard to case; name the one meant: {choose}"
+    )]
+    AmbiguousColumn {
+        /// File as given.
+        file: String,
+        /// The name looked for.
+        name: String,
+        /// The header's names that match it, quoted and comma-separated.
+        matches: String,
+        /// How to choose (`--columns mag=COLUMN`).
+        choose: String,
+    },
     /// A row selection (`--lines`, `--time-range`) that is malformed or
     /// selects nothing.
     #[error("{}{option}: {reason}", file_prefix(file))]
@@ -354,6 +369,7 @@ impl IoError {
             | Hdf5 { file, .. }
             | Hdf5Layout { file, .. }
             | SensorAbsent { file, .. }
+            | AmbiguousColumn { file, .. }
             | Selection { file, .. }
             | Write { file, .. }
             | Unsupported { file, .. } => at.file = Some(file.clone()),
