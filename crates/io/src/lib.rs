@@ -77,7 +77,7 @@ pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
 pub use validate::{
-    EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MEDIAN_SAMPLES,
+    EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MAX_TIME_S, MEDIAN_SAMPLES,
     VECTOR_SCALAR_TOLERANCE, Warning, WarningKind, check_time, check_units, convert_tesla_to_nt,
 };
 pub use values::{SharedBuffer, Values};

@@ -2,7 +2,7 @@
 //!
 //! - [`check_time`]: `time` (s) must be strictly increasing and never missing
 //!   (spec `data-formats.md`: "a duplicate or a step back is an error that
-//!   names the row").
+//!   names the row"), and within ±[`MAX_TIME_S`].
 //! - [`check_units`]: plausibility of units. Errors for values that cannot
 //!   be in the expected unit, [`Warning`]s for values that are merely
 //!   suspicious. Statistics use the finite values only; medians are taken
@@ -154,7 +154,8 @@ pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
 ///
 /// Errors: [`IoError::MissingColumn`], [`IoError::MissingValue`] (a NaN time,
 /// naming the row and line), [`IoError::NotIncreasing`] (a repeat or a step
-/// back, naming both rows, their lines and values).
+/// back, naming both rows, their lines and values), [`IoError::Units`] (a
+/// time beyond ±[`MAX_TIME_S`]).
 pub fn check_time(table: &FlightTable) -> Result<()> {
     let t = table.require("time")?;
     // Blocks that increase throughout (`x < y` is false when either is
@@ -170,8 +171,34 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
             return first_time_error(table, t, start..end);
         }
     }
+    // Increasing: the first and last times are the extremes.
+    for i in [0, t.len().saturating_sub(1)] {
+        if let Some(&v) = t.get(i)
+            && v.abs() > MAX_TIME_S
+        {
+            return Err(IoError::Units {
+                file: table.file_label(),
+                column: "time".into(),
+                message: format!(
+                    "time {} s at {} is beyond ±{} s (3 000 years): milliseconds, microseconds or \
+                     nanoseconds, or a corrupted cell? expected seconds",
+                    shown(v),
+                    data_row(table, i),
+                    shown(MAX_TIME_S)
+                ),
+            });
+        }
+    }
     Ok(())
 }
+
+/// The largest time taken as one in seconds (10¹¹ s, 3 000 years; Unix
+/// time is 1.8·10⁹ s): beyond, the clock counts milliseconds (Unix time
+/// in ms is 1.8·10¹²) or smaller units, which every command would take
+/// for a flight sampled a thousand times too slowly, or a cell is
+/// corrupted (a time from −10³⁰⁸ to 10³⁰⁸ s gave `inspect` an infinite
+/// duration with exit 0).
+pub const MAX_TIME_S: f64 = 1e11;
 
 /// Rows per block of [`check_time`].
 const TIME_BLOCK: usize = 4096;
@@ -730,6 +757,38 @@ pub(crate) fn median_in_place(v: &mut [f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A time from −10³⁰⁸ to 10³⁰⁸ s gave `inspect` an infinite duration
+    /// with exit 0, and Unix time in milliseconds a flight sampled a
+    /// thousand times too slowly: times beyond ±10¹¹ s are refused,
+    /// naming the row; Unix time in seconds passes.
+    #[test]
+    fn times_beyond_any_clock_in_seconds_are_refused() {
+        let check = |t: Vec<f64>| {
+            let mut table = FlightTable::new();
+            table.add_column("time", t).unwrap();
+            check_time(&table)
+        };
+        assert!(check(vec![1.764e9, 1.764e9 + 0.1]).is_ok());
+        assert!(check(vec![-1e11, 1e11]).is_ok());
+        for (t, row, shown) in [
+            (vec![-1e308, 1e308], "data row 1", "-1e308"),
+            (
+                vec![1.764e12, 1.764e12 + 100.0],
+                "data row 1",
+                "1764000000000",
+            ),
+            (vec![0.0, 0.1, 2e11], "data row 3", "200000000000"),
+        ] {
+            let e = check(t).unwrap_err();
+            let msg = e.to_string();
+            assert!(e.is_bad_input(), "{msg}");
+            assert!(
+                msg.contains(&format!("time {shown} s at {row}")) && msg.contains("milliseconds"),
+                "{msg}"
+            );
+        }
+    }
 
     /// The block-wise check finds the error that a row-by-row pass over
     /// the whole column finds (the first one), wherever it falls against
