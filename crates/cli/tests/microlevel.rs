@@ -15,6 +15,26 @@ fn small_survey(dir: &std::path::Path) -> std::path::PathBuf {
     simulate_with(dir, "survey", "1", Some(&config))
 }
 
+/// `aeromag microlevel` of the `mag` column of `input` into `out`, with
+/// `extra` flags.
+fn microlevel_mag(
+    input: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut a = vec![
+        "microlevel",
+        "-i",
+        input.to_str().unwrap(),
+        "--column",
+        "mag",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend(extra);
+    aeromag(&a)
+}
+
 /// `--cell 1` on a survey 500 m between lines ran for more than a minute
 /// (minimum curvature on 10⁷ nodes); `--cutoff 1e308` was refused by the
 /// filter as "got inf"; `--along-line 1e308` was printed with 309 digits.
@@ -23,19 +43,7 @@ fn extreme_cell_cutoff_and_along_line() {
     let d = tempfile::tempdir().unwrap();
     let input = small_survey(d.path());
     let out = d.path().join("ml.csv");
-    let run = |extra: &[&str]| {
-        let mut a = vec![
-            "microlevel",
-            "-i",
-            input.to_str().unwrap(),
-            "--column",
-            "mag",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        a.extend(extra);
-        aeromag(&a)
-    };
+    let run = |extra: &[&str]| microlevel_mag(&input, &out, extra);
     let t0 = std::time::Instant::now();
     let o = run(&["--cell", "1"]);
     assert_code(&o, 2);
@@ -71,19 +79,7 @@ fn short_cutoff_refused_and_gridding_limits_taken() {
     let d = tempfile::tempdir().unwrap();
     let input = small_survey(d.path());
     let out = d.path().join("ml.csv");
-    let run = |extra: &[&str]| {
-        let mut a = vec![
-            "microlevel",
-            "-i",
-            input.to_str().unwrap(),
-            "--column",
-            "mag",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        a.extend(extra);
-        aeromag(&a)
-    };
+    let run = |extra: &[&str]| microlevel_mag(&input, &out, extra);
     for cutoff in ["1e-300", "1", "1.99"] {
         let o = run(&["--cutoff", cutoff]);
         assert_code(&o, 2);
