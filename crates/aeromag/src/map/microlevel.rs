@@ -149,7 +149,7 @@ pub fn microlevel(
     observer: &mut dyn Observer,
 ) -> Result<Microlevelled> {
     let mut notes = Notes::new(observer);
-    if !(opts.cutoff_line_spacings >= MIN_CUTOFF_LINE_SPACINGS) {
+    if opts.cutoff_line_spacings.is_nan() || opts.cutoff_line_spacings < MIN_CUTOFF_LINE_SPACINGS {
         return Err(Error::bad_input(format!(
             "the cut-off {} line spacings is below {MIN_CUTOFF_LINE_SPACINGS}: the stripes between \
              adjacent lines are {MIN_CUTOFF_LINE_SPACINGS} line spacings and more across them, and a \
