@@ -273,10 +273,15 @@ pub trait InFile<T> {
 }
 
 impl<T, E: Into<Error>> InFile<T> for std::result::Result<T, E> {
+    /// An error that already names a file is kept as it is (it was
+    /// printed with the file twice: "f.csv: 'f.csv': …").
     fn in_file(self, file: &str) -> Result<T> {
-        self.map_err(|e| Error::InFile {
-            file: file.to_string(),
-            error: Box::new(e.into()),
+        self.map_err(|e| match e.into() {
+            e @ (Error::BadInput { file: Some(_), .. } | Error::InFile { .. }) => e,
+            e => Error::InFile {
+                file: file.to_string(),
+                error: Box::new(e),
+            },
         })
     }
 }

@@ -269,3 +269,71 @@ fn a_tail_rotor_fitted_jointly_carries_over_to_an_independent_flight() {
         .is_bad_input()
     );
 }
+
+/// Hostile flights found by fuzzing `rotor fit/apply` (exit 0 with wrong
+/// results before): a phase channel in radians was applied (interference
+/// of ±10⁴ nT), steps alternating 0.0105/0.0095 s were taken as 95.2 Hz,
+/// a constant reading was fitted to a mean coning of −333 828°, and one
+/// missing `mag` cell every 5 s left the whole flight uncompensated.
+#[test]
+fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
+    let learn = helicopter(11, None);
+    let other = helicopter(12, None);
+    let opts = RotorOptions::preset(RotorPreset::AeromagSimHelicopter);
+    let fit = fit_rotor(&learn, &opts, &mut Silent).unwrap();
+    // The phase channel in radians: refused by apply as by fit.
+    let radians = edited(&other, |n, v| {
+        if n == "rotor_phase" {
+            v.iter_mut().for_each(|p| *p = p.to_radians());
+        }
+    });
+    let e = fit.model.compensate(&radians).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        e.is_bad_input() && msg.contains("`rotor_phase` (deg) turns at"),
+        "{msg}"
+    );
+    assert!(!msg.contains("0000000"), "{msg}");
+    // Steps alternating ±5 %: refused, naming the row.
+    let uneven = edited(&other, |n, v| {
+        if n == "time" {
+            for (k, t) in v.iter_mut().enumerate() {
+                *t += if k % 2 == 1 { 0.0005 } else { 0.0 };
+            }
+        }
+    });
+    for e in [
+        fit.model.compensate(&uneven).unwrap_err(),
+        fit_rotor(&uneven, &opts, &mut Silent).unwrap_err(),
+    ] {
+        let msg = e.to_string();
+        assert!(
+            e.is_bad_input() && msg.contains("column 'time'") && msg.contains("uniform sampling"),
+            "{msg}"
+        );
+    }
+    // A constant reading determines nothing: a failed fit (exit 1).
+    let constant = edited(&learn, |n, v| {
+        if n == "mag" {
+            v.fill(50_000.0);
+        }
+    });
+    let e = fit_rotor(&constant, &opts, &mut Silent).unwrap_err();
+    assert!(
+        !e.is_bad_input() && e.to_string().contains("mean coning"),
+        "{e}"
+    );
+    // One missing `mag` cell every 5 s: bridged, every other row compensated.
+    let holed = edited(&other, |n, v| {
+        if n == "mag" {
+            for k in (250..v.len()).step_by(500) {
+                v[k] = f64::NAN;
+            }
+        }
+    });
+    let out = fit.model.compensate(&holed).unwrap();
+    let holes = (250..holed.n_rows()).step_by(500).count();
+    let flagged = out.flags().iter().filter(|&&f| f != 0.0).count();
+    assert_eq!(flagged, holes);
+    assert!(out.interference_nt[250].is_nan() && out.interference_nt[251].is_finite());
+}

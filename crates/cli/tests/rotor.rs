@@ -110,7 +110,8 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
     let m: serde_json::Value = serde_json::from_str(&by_numbers).unwrap();
     assert_eq!(m["format"], "aeromag-model/2");
     assert_eq!(m["kind"], "helicopter-rotor");
-    // A truth column as phase is refused.
+    // A truth column as phase is refused, and (taken before) one mapped
+    // onto another column or chosen as the vector magnetometer.
     assert_code(
         &fit(&[
             "--preset",
@@ -120,6 +121,20 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
         ]),
         2,
     );
+    for extra in [
+        ["--columns", "flux_x=true_flux_x"],
+        ["--vector", "true_flux"],
+    ] {
+        let mut args = vec!["--preset", "aeromag-sim-helicopter"];
+        args.extend(extra);
+        let o = fit(&args);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains("`true_flux_x` (as flux_x) is a simulation truth column"),
+            "{}",
+            stderr(&o)
+        );
+    }
     // A tail rotor: its values need --tail-rotor (usage error), and without a
     // phase channel it cannot be geared (bad input, exit 2, says why).
     assert_code(

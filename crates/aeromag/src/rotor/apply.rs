@@ -5,14 +5,16 @@
 
 use super::MIN_SEGMENT_S;
 use crate::compensate::{Compensator, OutputColumns};
-use crate::error::{InFile, Result};
-use crate::flight::{Flight, SegmentRule, finite_segments};
+use crate::error::{Error, InFile, Result};
+use crate::flight::{Flight, GAP_FACTOR, SegmentRule, finite_segments};
 use crate::observer::{Note, Observer};
 use aeromag_compensation::rotor::model_file::RotorModelFile;
 use aeromag_compensation::rotor::{
-    FlapAngles, RotorInput, SlowAngleOptions, TailRotor, align_phase_offset, estimate_phase,
-    regressors, rotor_speed, track_slow_angles, unwrap_deg,
+    FlapAngles, RotorFitOptions, RotorInput, SlowAngleOptions, TailRotor, align_phase_offset,
+    estimate_phase, regressors, rotor_speed, track_slow_angles, unwrap_deg,
 };
+use aeromag_compensation::tolles_lawson::segments::median_step;
+use aeromag_core::error::{fixed, shown};
 use nalgebra::Vector3;
 use std::ops::Range;
 
@@ -33,7 +35,25 @@ pub(super) struct RotorColumns<'a> {
 }
 
 impl<'a> RotorColumns<'a> {
+    /// The columns of `flight` (the phase channel `phase` when used). A
+    /// simulation truth column (`true_…`) is refused, whether named as the
+    /// phase channel or mapped onto another (`--columns flux_x=true_flux_x`
+    /// was taken).
     pub fn of(flight: &'a Flight, phase: Option<&str>) -> Result<Self> {
+        let names: Vec<&str> = ["time", "mag", "flux_x", "flux_y", "flux_z"]
+            .into_iter()
+            .chain(phase)
+            .collect();
+        for (canonical, column) in flight.column_map_of(&names) {
+            if column.starts_with("true_") {
+                return Err(Error::bad_file(
+                    flight.label(),
+                    format!(
+                        "`{column}` (as {canonical}) is a simulation truth column; the rotor model never reads truth"
+                    ),
+                ));
+            }
+        }
         Ok(Self {
             time: flight.require("time")?,
             mag: flight.require("mag")?,
@@ -67,6 +87,214 @@ impl<'a> RotorColumns<'a> {
         let rule = SegmentRule::ignoring_lines().min_len(min_len);
         finite_segments(self.time, None, &self.all(), &rule).1.kept
     }
+
+    /// [`Self::stretches`], at least one, each sampled uniformly: bad input
+    /// naming the file otherwise. The rotor model runs on the sample index
+    /// (its filters and windows at `fs`), so steps alternating 0.01 and
+    /// 0.02 s were taken as 50 Hz and the rotor as turning at 3.62 Hz
+    /// instead of 4.83 (exit 0), and a float32 time (steps quantised to
+    /// a few ms) likewise; every step of a stretch must be within
+    /// [`MAX_STEP_DEVIATION`] of the median.
+    pub fn usable_stretches(&self, flight: &Flight, fs: f64) -> Result<Vec<Range<usize>>> {
+        let segs = self.stretches(fs);
+        if segs.is_empty() {
+            return Err(Error::bad_file(
+                flight.label(),
+                format!(
+                    "no stretch of ≥ {MIN_SEGMENT_S} s without gaps or missing values in time, mag, \
+                     flux_x/y/z{} at {} Hz: nothing to fit or compensate",
+                    if self.phase.is_some() {
+                        " and the phase channel"
+                    } else {
+                        ""
+                    },
+                    fixed(fs, 3)
+                ),
+            ));
+        }
+        let dt = 1.0 / fs;
+        for r in &segs {
+            if let Some(k) = (r.start + 1..r.end).find(|&k| {
+                let step = self.time[k] - self.time[k - 1];
+                !((step / dt - 1.0).abs() <= MAX_STEP_DEVIATION)
+            }) {
+                return Err(flight.bad_value(
+                    k,
+                    "time",
+                    format!(
+                        "a step of {} ms after the previous row, where the median step is {} ms: \
+                         the rotor model needs uniform sampling (every step within {} % of the median); \
+                         resample the flight (or is the time stored in float32?)",
+                        figure(1e3 * (self.time[k] - self.time[k - 1])),
+                        figure(1e3 * dt),
+                        100.0 * MAX_STEP_DEVIATION
+                    ),
+                ));
+            }
+        }
+        Ok(segs)
+    }
+
+    /// Runs of at most [`MAX_FILL_S`] of missing values (no time gap)
+    /// bridged by linear interpolation in every column (the phase the
+    /// short way round 360°): the filled columns (`mag`, flux, phase, as
+    /// [`Self::all`]) and the number of rows bridged.
+    pub fn bridged(&self, fs: f64) -> (Vec<Vec<f64>>, usize) {
+        let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
+        let raw = self.all();
+        let filled: Vec<Vec<f64>> = raw
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                let period = (k == 4).then_some(360.0);
+                bridge_dropouts(self.time, c, max_fill, period)
+            })
+            .collect();
+        let bridged = (0..self.time.len())
+            .filter(|&i| {
+                raw.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite())
+            })
+            .count();
+        (filled, bridged)
+    }
+
+    /// These columns with `filled` ([`Self::bridged`]) in place of `mag`,
+    /// the flux and the phase.
+    pub fn with<'b>(&self, filled: &'b [Vec<f64>]) -> RotorColumns<'b>
+    where
+        'a: 'b,
+    {
+        RotorColumns {
+            time: self.time,
+            mag: &filled[0],
+            flux: [&filled[1], &filled[2], &filled[3]],
+            phase: self.phase.map(|_| filled[4].as_slice()),
+        }
+    }
+}
+
+/// Longest dropout (consecutive rows with a missing value, time steps
+/// regular) that a fit or an application bridges by linear interpolation,
+/// s.
+pub(super) const MAX_FILL_S: f64 = 0.1;
+
+/// Largest relative deviation of a time step from the median within a
+/// stretch the rotor model runs on ([`RotorColumns::usable_stretches`]):
+/// 2 %, far above a logger's clock jitter and below the 5 % of steps
+/// alternating 0.0105 and 0.0095 s (taken as 95.2 Hz, the rotor at 4.60
+/// Hz instead of 4.83).
+pub const MAX_STEP_DEVIATION: f64 = 0.02;
+
+/// A figure in a message: four decimals, or three significant digits in
+/// exponent form below 10⁻³ and from 10⁶ (a phase in radians turns at
+/// 4.8·10⁻⁵ Hz, which `shown` wrote with 20 digits).
+fn figure(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.2e}")
+    } else {
+        fixed(x, 4)
+    }
+}
+
+/// The mean rotor frequency (Hz) of the rotor speeds `omega_rad_s`.
+pub(super) fn mean_rotor_hz(omega_rad_s: &[f64]) -> f64 {
+    omega_rad_s.iter().sum::<f64>() / omega_rad_s.len() as f64 / std::f64::consts::TAU
+}
+
+/// Bridge runs of at most `max_len` non-finite values between finite ones
+/// by linear interpolation in time (`period`: interpolate the shortest way
+/// round, for a phase in degrees), when the time steps across the run are
+/// regular (no gap: [`GAP_FACTOR`]).
+pub(super) fn bridge_dropouts(
+    time: &[f64],
+    x: &[f64],
+    max_len: usize,
+    period: Option<f64>,
+) -> Vec<f64> {
+    let mut out = x.to_vec();
+    let dt = median_step(time);
+    let n = x.len();
+    let mut k = 0;
+    while k < n {
+        if x[k].is_finite() {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        while k < n && !x[k].is_finite() {
+            k += 1;
+        }
+        let (a, b) = (start.wrapping_sub(1), k);
+        if start == 0 || b >= n || b - start > max_len {
+            continue;
+        }
+        let span = time[b] - time[a];
+        if !(span > 0.0 && span <= (b - a) as f64 * dt * GAP_FACTOR) {
+            continue;
+        }
+        let mut d = x[b] - x[a];
+        if let Some(p) = period {
+            d = (d + 0.5 * p).rem_euclid(p) - 0.5 * p;
+        }
+        for i in start..b {
+            out[i] = x[a] + d * (time[i] - time[a]) / span;
+        }
+    }
+    out
+}
+
+/// Check the mean rotor frequency `f_r` (Hz) found on the fitted stretch:
+/// above the high-pass cutoff of the fit (a slower "rotor" is removed with
+/// the manoeuvres: a heading or time column given as the phase channel
+/// turns at mHz and was fitted with exit 0) and with the blade-passing
+/// frequency below Nyquist; for a tail rotor, `gear_ratio × f_r` between
+/// the cutoff and Nyquist (a gear ratio of 2⁶³ failed with a singular system, one of 10⁶
+/// was fitted on aliased garbage with exit 0).
+pub(super) fn check_rotor_speed(
+    f_r: f64,
+    fs: f64,
+    blades: usize,
+    phase_col: Option<&str>,
+    tail: Option<&TailRotor>,
+    file: &str,
+) -> Result<()> {
+    let cutoff = RotorFitOptions::default().highpass_hz;
+    let nyquist = fs / 2.0;
+    let ok = |f: f64, n: usize| f > cutoff && n as f64 * f < nyquist;
+    if !ok(f_r, blades) {
+        let source = match phase_col {
+            Some(c) => format!("the phase channel `{c}` (deg) turns"),
+            None => "the rotor phase estimated from the data turns".to_string(),
+        };
+        return Err(Error::bad_file(
+            file,
+            format!(
+                "{source} at {} Hz on the fitted stretch: a rotor's frequency must be above {cutoff} Hz \
+                 (the fit's high-pass cutoff) and its {blades} blades must pass below Nyquist \
+                 ({nyquist:.3} Hz); is it the rotor phase channel, in degrees?",
+                figure(f_r)
+            ),
+        ));
+    }
+    if let Some(t) = tail {
+        // The tail's own turn, not its blade passing: with its phase geared
+        // from the channel, the blade passing may alias (the simulator's
+        // 3 blades at 21 Hz, 100 Hz sampling).
+        let f_t = t.gear_ratio * f_r;
+        if !ok(f_t, 1) {
+            return Err(Error::bad_file(
+                file,
+                format!(
+                    "tail rotor gear ratio {} (gear_ratio, --gear-ratio) makes the tail rotor turn at {} Hz \
+                     (main rotor {f_r:.4} Hz): it must be above {cutoff} Hz (the fit's high-pass cutoff) \
+                     and below Nyquist ({nyquist:.3} Hz)",
+                    shown(t.gear_ratio),
+                    figure(f_t)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Phase (rad, unwrapped) and rotor speed (rad/s) of one segment: from the
@@ -163,11 +391,23 @@ pub(super) fn track_segment(
     cols: &RotorColumns,
     r: &Range<usize>,
     fs: f64,
+    file: &str,
 ) -> Result<TrackedSegment> {
     let g = &model.geometry;
     let nominal = [model.nominal_angles];
     let b = cols.field(r);
     let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
+    // The phase channel checked as the fit checks it: a phase in radians,
+    // reversed, stuck or random was applied with exit 0 (interference of
+    // ±10⁴ nT).
+    check_rotor_speed(
+        mean_rotor_hz(&omega),
+        fs,
+        g.blades,
+        model.phase.column.as_deref(),
+        model.tail.as_ref().map(|t| &t.rotor),
+        file,
+    )?;
     let recorded_phase = phase.clone();
     // The slow angles are tracked on the reading minus the tail rotor's part.
     let rest;
@@ -230,7 +470,7 @@ impl Compensator for RotorModelFile {
         flight: &Flight,
         observer: &mut dyn Observer,
     ) -> Result<Vec<f64>> {
-        let cols = RotorColumns::of(flight, self.phase.column.as_deref())?;
+        let raw = RotorColumns::of(flight, self.phase.column.as_deref())?;
         let fs = flight.sample_rate_hz()?;
         if (fs / self.sample_rate_hz - 1.0).abs() > 0.01 {
             observer.note(&Note::warning(format!(
@@ -239,12 +479,55 @@ impl Compensator for RotorModelFile {
                 self.sample_rate_hz
             )));
         }
+        // Dropouts bridged as the fit bridges them (one missing cell every
+        // 5 s left the whole flight uncompensated, with exit 0).
+        let (filled, bridged) = raw.bridged(fs);
+        let cols = raw.with(&filled);
+        if bridged > 0 {
+            observer.note(&Note::note(format!(
+                "{}: {bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation",
+                flight.label()
+            )));
+        }
         let mut out = vec![f64::NAN; flight.n_rows()];
-        for r in cols.stretches(fs) {
-            let t = track_segment(self, &cols, &r, fs).in_file(&flight.label())?;
+        for r in cols.usable_stretches(flight, fs)? {
+            let t = track_segment(self, &cols, &r, fs, &flight.label()).in_file(&flight.label())?;
             let p = t.predict(self, fs)?;
             out[r].copy_from_slice(&p);
         }
+        // A bridged row keeps its stretch whole, but its interference is
+        // given only where its own readings are.
+        let raw_cols = raw.all();
+        for (i, o) in out.iter_mut().enumerate() {
+            if raw_cols.iter().any(|c| !c[i].is_finite()) {
+                *o = f64::NAN;
+            }
+        }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dropouts_are_bridged_but_not_time_gaps_or_long_runs() {
+        let t: Vec<f64> = (0..10).map(|k| k as f64 * 0.01).collect();
+        let nan = f64::NAN;
+        let x = [0.0, 1.0, nan, 3.0, nan, nan, nan, 7.0, 8.0, nan];
+        let y = bridge_dropouts(&t, &x, 2, None);
+        assert_eq!(y[2], 2.0);
+        assert!(
+            y[4].is_nan() && y[5].is_nan() && y[6].is_nan(),
+            "a run of 3 > 2 stays"
+        );
+        assert!(y[9].is_nan(), "no value after the run");
+        // A phase in degrees is interpolated the short way round 360°.
+        let p = bridge_dropouts(&t[..3], &[350.0, nan, 10.0], 1, Some(360.0));
+        assert!((p[1] - 360.0).abs() < 1e-9, "{}", p[1]);
+        // A time gap across the run: left alone.
+        let tg = [0.0, 0.01, 0.02, 0.5, 0.51];
+        assert!(bridge_dropouts(&tg, &[0.0, 1.0, nan, 3.0, 4.0], 2, None)[2].is_nan());
     }
 }

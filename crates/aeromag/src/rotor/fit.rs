@@ -1,10 +1,13 @@
 //! Fitting the physical rotor model on a flight.
 
-use super::apply::{RotorColumns, segment_phase, track_segment};
+use super::apply::{
+    MAX_FILL_S, RotorColumns, check_rotor_speed, mean_rotor_hz, segment_phase, track_segment,
+};
 use super::{MIN_SEGMENT_S, RotorPreset};
 use crate::error::{Error, Result};
-use crate::flight::{Flight, GAP_FACTOR};
+use crate::flight::Flight;
 use crate::observer::{Note, Notes, Observer};
+use aeromag_compensation::CompError;
 use aeromag_compensation::model_file::MODEL_FORMAT;
 use aeromag_compensation::rotor::blade::MAX_FLAP_RAD;
 use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile, TailModel};
@@ -13,12 +16,7 @@ use aeromag_compensation::rotor::{
     BladeTerms, FlapAngles, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleFit,
     SlowAngleOptions, TailRotor, fit_records, fit_slow_angles, fit_with_tail, refine_phase_offset,
 };
-use aeromag_compensation::tolles_lawson::segments::median_step;
 use aeromag_core::error::shown;
-
-/// Longest dropout (consecutive rows with a missing value, time steps
-/// regular) that the fit bridges by linear interpolation, s.
-const MAX_FILL_S: f64 = 0.1;
 
 /// Alternations of tracking the angles on every stretch and refitting the
 /// parameters on all of them, when a record has several stretches between
@@ -298,43 +296,6 @@ pub struct RotorFitResult {
     pub notes: Vec<Note>,
 }
 
-/// Bridge runs of at most `max_len` non-finite values between finite ones
-/// by linear interpolation in time (`period`: interpolate the shortest way
-/// round, for a phase in degrees), when the time steps across the run are
-/// regular (no gap: [`GAP_FACTOR`]).
-fn bridge_dropouts(time: &[f64], x: &[f64], max_len: usize, period: Option<f64>) -> Vec<f64> {
-    let mut out = x.to_vec();
-    let dt = median_step(time);
-    let n = x.len();
-    let mut k = 0;
-    while k < n {
-        if x[k].is_finite() {
-            k += 1;
-            continue;
-        }
-        let start = k;
-        while k < n && !x[k].is_finite() {
-            k += 1;
-        }
-        let (a, b) = (start.wrapping_sub(1), k);
-        if start == 0 || b >= n || b - start > max_len {
-            continue;
-        }
-        let span = time[b] - time[a];
-        if !(span > 0.0 && span <= (b - a) as f64 * dt * GAP_FACTOR) {
-            continue;
-        }
-        let mut d = x[b] - x[a];
-        if let Some(p) = period {
-            d = (d + 0.5 * p).rem_euclid(p) - 0.5 * p;
-        }
-        for i in start..b {
-            out[i] = x[a] + d * (time[i] - time[a]) / span;
-        }
-    }
-    out
-}
-
 /// Check that the window of constant cone angles spans at least
 /// [`MIN_WINDOW_SAMPLES`] samples and that every stretch fitted holds two
 /// windows (four when the phase is estimated: its refinement uses windows
@@ -369,56 +330,23 @@ fn check_window(
 /// slowly-varying-angle fit needs 10).
 const MIN_WINDOW_SAMPLES: usize = 10;
 
-/// Check the mean rotor frequency `f_r` (Hz) found on the fitted stretch:
-/// above the high-pass cutoff of the fit (a slower "rotor" is removed with
-/// the manoeuvres: a heading or time column given as the phase channel
-/// turns at mHz and was fitted with exit 0) and with the blade-passing
-/// frequency below Nyquist; for a tail rotor, `gear_ratio × f_r` between
-/// the cutoff and Nyquist (a gear ratio of 2⁶³ failed with a singular system, one of 10⁶
-/// was fitted on aliased garbage with exit 0).
-fn check_rotor_speed(
-    f_r: f64,
-    fs: f64,
-    blades: usize,
-    phase_col: Option<&str>,
-    tail: Option<&TailRotor>,
-    file: &str,
-) -> Result<()> {
-    let cutoff = RotorFitOptions::default().highpass_hz;
-    let nyquist = fs / 2.0;
-    let ok = |f: f64, n: usize| f > cutoff && n as f64 * f < nyquist;
-    if !ok(f_r, blades) {
-        let source = match phase_col {
-            Some(c) => format!("the phase channel `{c}` (deg) turns"),
-            None => "the rotor phase estimated from the data turns".to_string(),
-        };
-        return Err(Error::bad_file(
-            file,
-            format!(
-                "{source} at {} Hz on the fitted stretch: a rotor's frequency must be above {cutoff} Hz \
-                 (the fit's high-pass cutoff) and its {blades} blades must pass below Nyquist \
-                 ({nyquist:.3} Hz); is it the rotor phase channel, in degrees?",
-                shown(f_r)
+/// A fitted cone whose mean coning goes beyond ±[`MAX_FLAP_RAD`] is no
+/// rotor's: the data do not determine it (a constant reading gave a mean
+/// coning of −333 828°, a phase channel quantised to 90° one of −39.6°,
+/// both written with exit 0). A failed fit, not bad input. (The angles of
+/// single windows may stray further on valid flights: they absorb what the
+/// model leaves, e.g. 62° in one window with an estimated phase.)
+fn check_fitted_coning(coning_mean_deg: f64) -> Result<()> {
+    if coning_mean_deg.is_nan() || coning_mean_deg.abs() > MAX_FLAP_RAD.to_degrees() {
+        return Err(CompError::Failed {
+            reason: format!(
+                "the fitted rotor's mean coning is {}° (a rotor's stays within ±{}°): the flight does \
+                 not determine the model (a constant reading, a coarse or wrong phase channel?)",
+                aeromag_core::error::fixed(coning_mean_deg, 1),
+                MAX_FLAP_RAD.to_degrees().round()
             ),
-        ));
-    }
-    if let Some(t) = tail {
-        // The tail's own turn, not its blade passing: with its phase geared
-        // from the channel, the blade passing may alias (the simulator's
-        // 3 blades at 21 Hz, 100 Hz sampling).
-        let f_t = t.gear_ratio * f_r;
-        if !ok(f_t, 1) {
-            return Err(Error::bad_file(
-                file,
-                format!(
-                    "tail rotor gear ratio {} (gear_ratio, --gear-ratio) makes the tail rotor turn at {} Hz \
-                     (main rotor {f_r:.4} Hz): it must be above {cutoff} Hz (the fit's high-pass cutoff) \
-                     and below Nyquist ({nyquist:.3} Hz)",
-                    shown(t.gear_ratio),
-                    shown(f_t)
-                ),
-            ));
         }
+        .into());
     }
     Ok(())
 }
@@ -478,14 +406,6 @@ pub fn fit_rotor(
         PhaseChoice::Column(c) => Some(c.clone()),
         PhaseChoice::Auto => flight.get("rotor_phase").map(|_| "rotor_phase".to_string()),
     };
-    if let Some(c) = &phase_col
-        && c.starts_with("true_")
-    {
-        return Err(Error::bad_file(
-            file,
-            format!("`{c}` is a simulation truth column; the rotor model never reads truth"),
-        ));
-    }
     if opts.tail.is_some() && phase_col.is_none() {
         return Err(Error::bad_file(
             file,
@@ -497,47 +417,19 @@ pub fn fit_rotor(
     let fs = flight.sample_rate_hz()?;
     // Short dropouts (missing cells, no time gap) are bridged so that the
     // stretches on both sides are fitted as one record.
-    let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
-    let raw_cols = raw.all();
-    let filled: Vec<Vec<f64>> = raw_cols
-        .iter()
-        .enumerate()
-        .map(|(k, c)| {
-            bridge_dropouts(
-                raw.time,
-                c,
-                max_fill,
-                if k == 4 { Some(360.0) } else { None },
-            )
-        })
-        .collect();
-    let bridged = (0..raw.time.len())
-        .filter(|&i| {
-            raw_cols.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite())
-        })
-        .count();
-    let cols = RotorColumns {
-        time: raw.time,
-        mag: &filled[0],
-        flux: [&filled[1], &filled[2], &filled[3]],
-        phase: raw.phase.map(|_| filled[4].as_slice()),
-    };
+    let (filled, bridged) = raw.bridged(fs);
+    let cols = raw.with(&filled);
     if bridged > 0 {
         notes.note(format!(
             "{bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation for the fit"
         ));
     }
-    let segs = cols.stretches(fs);
+    let segs = cols.usable_stretches(flight, fs)?;
     let r = segs
         .iter()
         .max_by_key(|r| r.len())
         .cloned()
-        .ok_or_else(|| {
-            Error::bad_file(
-                &file,
-                format!("no stretch of ≥ {MIN_SEGMENT_S} s without gaps or missing values"),
-            )
-        })?;
+        .expect("usable_stretches returns at least one");
     let used: usize = segs.iter().map(|s| s.len()).sum();
     if used < flight.n_rows() {
         notes.warn(format!(
@@ -554,7 +446,7 @@ pub fn fit_rotor(
     let estimated = phase_col.is_none();
     check_window(opts.window_s, fs, &segs, estimated, &file)?;
     let (mut phase, omega) = segment_phase(&cols, &r, fs, geom.blades, opts.rotor_hz_range)?;
-    let f_r = omega.iter().sum::<f64>() / omega.len() as f64 / std::f64::consts::TAU;
+    let f_r = mean_rotor_hz(&omega);
     check_rotor_speed(
         f_r,
         fs,
@@ -626,6 +518,7 @@ pub fn fit_rotor(
     let coning_mean_deg =
         slow.angles.iter().map(|x| x.coning_rad).sum::<f64>() / slow.angles.len() as f64 * 180.0
             / std::f64::consts::PI;
+    check_fitted_coning(coning_mean_deg)?;
     let names: Vec<&str> = ["time", "mag", "flux_x", "flux_y", "flux_z"]
         .into_iter()
         .chain(phase_col.as_deref())
@@ -657,7 +550,7 @@ pub fn fit_rotor(
         for _ in 0..REFINE_ITERATIONS {
             let tracked = segs
                 .iter()
-                .map(|s| track_segment(&model, &cols, s, fs))
+                .map(|s| track_segment(&model, &cols, s, fs, &file))
                 .collect::<Result<Vec<_>>>()?;
             let regs: Vec<Vec<Vec<f64>>> = tracked
                 .iter()
@@ -738,25 +631,5 @@ mod tests {
             e.is_bad_input() && e.to_string().contains("--rotor-hz"),
             "{e}"
         );
-    }
-
-    #[test]
-    fn dropouts_are_bridged_but_not_time_gaps_or_long_runs() {
-        let t: Vec<f64> = (0..10).map(|k| k as f64 * 0.01).collect();
-        let nan = f64::NAN;
-        let x = [0.0, 1.0, nan, 3.0, nan, nan, nan, 7.0, 8.0, nan];
-        let y = bridge_dropouts(&t, &x, 2, None);
-        assert_eq!(y[2], 2.0);
-        assert!(
-            y[4].is_nan() && y[5].is_nan() && y[6].is_nan(),
-            "a run of 3 > 2 stays"
-        );
-        assert!(y[9].is_nan(), "no value after the run");
-        // A phase in degrees is interpolated the short way round 360°.
-        let p = bridge_dropouts(&t[..3], &[350.0, nan, 10.0], 1, Some(360.0));
-        assert!((p[1] - 360.0).abs() < 1e-9, "{}", p[1]);
-        // A time gap across the run: left alone.
-        let tg = [0.0, 0.01, 0.02, 0.5, 0.51];
-        assert!(bridge_dropouts(&tg, &[0.0, 1.0, nan, 3.0, 4.0], 2, None)[2].is_nan());
     }
 }
