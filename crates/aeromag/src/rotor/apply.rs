@@ -116,7 +116,7 @@ impl<'a> RotorColumns<'a> {
         for r in &segs {
             if let Some(k) = (r.start + 1..r.end).find(|&k| {
                 let step = self.time[k] - self.time[k - 1];
-                !((step / dt - 1.0).abs() <= MAX_STEP_DEVIATION)
+                (step / dt - 1.0).abs() > MAX_STEP_DEVIATION
             }) {
                 return Err(flight.bad_value(
                     k,
