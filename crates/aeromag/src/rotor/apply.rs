@@ -135,31 +135,39 @@ impl<'a> RotorColumns<'a> {
         Ok(segs)
     }
 
-    /// Runs of at most [`MAX_FILL_S`] of missing values (no time gap)
-    /// bridged by linear interpolation in every column (the phase the
-    /// short way round 360°): the filled columns (`mag`, flux, phase, as
-    /// [`Self::all`]) and the number of rows bridged.
-    pub fn bridged(&self, fs: f64) -> (Vec<Vec<f64>>, usize) {
+    /// The columns with their dropouts bridged and the spikes of `mag`
+    /// left out ([`Bridged`]).
+    pub fn bridged(&self, fs: f64) -> Bridged {
         let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
         let raw = self.all();
-        let filled: Vec<Vec<f64>> = raw
+        let spikes = spikes(self.mag);
+        let mut mag = self.mag.to_vec();
+        for &k in &spikes {
+            mag[k] = f64::NAN;
+        }
+        let columns: Vec<Vec<f64>> = raw
             .iter()
             .enumerate()
             .map(|(k, c)| {
                 let period = (k == 4).then_some(360.0);
+                let c = if k == 0 { &mag[..] } else { c };
                 bridge_dropouts(self.time, c, max_fill, period)
             })
             .collect();
-        let bridged = (0..self.time.len())
+        let rows = (0..self.time.len())
             .filter(|&i| {
-                raw.iter().any(|c| !c[i].is_finite()) && filled.iter().all(|c| c[i].is_finite())
+                raw.iter().any(|c| !c[i].is_finite()) && columns.iter().all(|c| c[i].is_finite())
             })
             .count();
-        (filled, bridged)
+        Bridged {
+            columns,
+            rows,
+            spikes,
+        }
     }
 
-    /// These columns with `filled` ([`Self::bridged`]) in place of `mag`,
-    /// the flux and the phase.
+    /// These columns with `filled` ([`Bridged::columns`]) in place of
+    /// `mag`, the flux and the phase.
     pub fn with<'b>(&self, filled: &'b [Vec<f64>]) -> RotorColumns<'b>
     where
         'a: 'b,
@@ -171,6 +179,98 @@ impl<'a> RotorColumns<'a> {
             phase: self.phase.map(|_| filled[4].as_slice()),
         }
     }
+}
+
+/// [`RotorColumns`] made fit to run on: runs of at most [`MAX_FILL_S`] of
+/// missing values (no time gap) bridged by linear interpolation in every
+/// column (the phase the short way round 360°), and the spikes of `mag`
+/// ([`spikes`]) bridged likewise, so that one bad sample does not corrupt
+/// the fit or the slowly varying angles of its window.
+pub(super) struct Bridged {
+    /// `mag`, the flux and the phase (as [`RotorColumns::all`]).
+    pub columns: Vec<Vec<f64>>,
+    /// Rows with a missing value that are bridged.
+    pub rows: usize,
+    /// The rows (0-based) whose `mag` is a spike.
+    pub spikes: Vec<usize>,
+}
+
+impl Bridged {
+    /// What was bridged, as notes for `flight` (`purpose`: "for the fit").
+    pub fn notes(&self, flight: &Flight, purpose: &str) -> Vec<Note> {
+        let mut notes = Vec::new();
+        if self.rows > 0 {
+            notes.push(Note::note(format!(
+                "{} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation {purpose}",
+                self.rows
+            )));
+        }
+        if let Some(&first) = self.spikes.first() {
+            let n = self.spikes.len();
+            notes.push(Note::warning(format!(
+                "{}: {n} {} of mag {} out from {} neighbours by more than {SPIKE_SIGMAS} times the \
+                 flight's typical second difference (spikes; the first at data row {}, {} nT): \
+                 bridged {purpose}, left as they are in the output",
+                flight.label(),
+                if n == 1 { "sample" } else { "samples" },
+                if n == 1 { "stands" } else { "stand" },
+                if n == 1 { "its" } else { "their" },
+                flight.file_row(first) + 1,
+                fixed(flight.require("mag").map_or(f64::NAN, |m| m[first]), 1)
+            )));
+        }
+        notes
+    }
+}
+
+/// Spikes of `mag` ([`spikes`]): a sample whose second difference
+/// `m[k] − (m[k−1] + m[k+1])/2` exceeds this many times the flight's
+/// robust scale of it (1.4826 × its median absolute value). The rotor's
+/// own signal gives second differences of about its amplitude at the
+/// blade-passing frequency, so a spike must stand out by tens of times
+/// the rotor's interference: one sample of 0 nT (a logger's dummy) made
+/// the fit's residual 362 nT instead of 0.07, and a good model's applied
+/// interference wrong by up to 230 nT over 5 s. None is found on the
+/// simulated helicopter flights.
+pub const SPIKE_SIGMAS: f64 = 50.0;
+
+/// The rows of `mag` that are spikes ([`SPIKE_SIGMAS`]): samples far from
+/// the mean of their neighbours, and farther than either neighbour is
+/// from its own.
+pub(super) fn spikes(mag: &[f64]) -> Vec<usize> {
+    let n = mag.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    let second = |k: usize| mag[k] - 0.5 * (mag[k - 1] + mag[k + 1]);
+    let mut d: Vec<f64> = (1..n - 1)
+        .map(|k| second(k).abs())
+        .filter(|x| x.is_finite())
+        .collect();
+    if d.is_empty() {
+        return Vec::new();
+    }
+    let mid = d.len() / 2;
+    let (_, &mut median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    let limit = SPIKE_SIGMAS * 1.4826 * median;
+    if limit.is_nan() || limit <= 0.0 {
+        return Vec::new();
+    }
+    // A spike's neighbours have half its second difference: the spike is
+    // the largest of the three.
+    let size = |k: usize| {
+        if (1..n - 1).contains(&k) {
+            second(k).abs()
+        } else {
+            0.0
+        }
+    };
+    (1..n - 1)
+        .filter(|&k| {
+            let d = size(k);
+            d > limit && d >= size(k - 1) && d >= size(k + 1)
+        })
+        .collect()
 }
 
 /// Longest dropout (consecutive rows with a missing value, time steps
@@ -481,13 +581,10 @@ impl Compensator for RotorModelFile {
         }
         // Dropouts bridged as the fit bridges them (one missing cell every
         // 5 s left the whole flight uncompensated, with exit 0).
-        let (filled, bridged) = raw.bridged(fs);
-        let cols = raw.with(&filled);
-        if bridged > 0 {
-            observer.note(&Note::note(format!(
-                "{}: {bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation",
-                flight.label()
-            )));
+        let bridged = raw.bridged(fs);
+        let cols = raw.with(&bridged.columns);
+        for n in bridged.notes(flight, "to track the rotor") {
+            observer.note(&n);
         }
         let mut out = vec![f64::NAN; flight.n_rows()];
         for r in cols.usable_stretches(flight, fs)? {

@@ -1,8 +1,6 @@
 //! Fitting the physical rotor model on a flight.
 
-use super::apply::{
-    MAX_FILL_S, RotorColumns, check_rotor_speed, mean_rotor_hz, segment_phase, track_segment,
-};
+use super::apply::{RotorColumns, check_rotor_speed, mean_rotor_hz, segment_phase, track_segment};
 use super::{MIN_SEGMENT_S, RotorPreset};
 use crate::error::{Error, Result};
 use crate::flight::Flight;
@@ -417,12 +415,10 @@ pub fn fit_rotor(
     let fs = flight.sample_rate_hz()?;
     // Short dropouts (missing cells, no time gap) are bridged so that the
     // stretches on both sides are fitted as one record.
-    let (filled, bridged) = raw.bridged(fs);
-    let cols = raw.with(&filled);
-    if bridged > 0 {
-        notes.note(format!(
-            "{bridged} rows with a missing value in a dropout of at most {MAX_FILL_S} s are bridged by linear interpolation for the fit"
-        ));
+    let bridged = raw.bridged(fs);
+    let cols = raw.with(&bridged.columns);
+    for n in bridged.notes(flight, "for the fit") {
+        notes.push(n);
     }
     let segs = cols.usable_stretches(flight, fs)?;
     let r = segs
