@@ -74,15 +74,16 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     // Chunks of rows are formatted by `threads` workers, each taking the
     // next chunk in turn, and written in order by the calling thread
     // ([`crate::ordered`]): the same bytes for any thread count.
-    let n_chunks = n.div_ceil(WRITE_CHUNK_ROWS);
+    let chunk_rows = WRITE_CHUNK_ROWS.min((WRITE_CHUNK_CELLS / columns.len().max(1)).max(1));
+    let n_chunks = n.div_ceil(chunk_rows);
     let next = std::sync::atomic::AtomicUsize::new(0);
     crate::ordered::in_order(
         threads.min(n_chunks),
         CHUNKS,
         |(buf, len): &mut (Vec<u8>, usize)| {
             let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let a = k.checked_mul(WRITE_CHUNK_ROWS).filter(|&a| a < n)?;
-            *len = format_rows(&columns, a..(a + WRITE_CHUNK_ROWS).min(n), missing, buf);
+            let a = k.checked_mul(chunk_rows).filter(|&a| a < n)?;
+            *len = format_rows(&columns, a..(a + chunk_rows).min(n), missing, buf);
             Some(k)
         },
         |(buf, len)| out.write_all(&buf[..*len]).map(|()| true),
@@ -95,6 +96,12 @@ const CHUNKS: usize = 2;
 
 /// Rows per chunk formatted by one thread of [`write_csv_to`].
 const WRITE_CHUNK_ROWS: usize = 16 * 1024;
+
+/// Cells per chunk of [`write_csv_to`] at most: a wide table's chunks hold
+/// fewer rows (tables of up to 16 columns keep [`WRITE_CHUNK_ROWS`]), so
+/// that an 11 s flight of 99 019 columns is formatted on every core
+/// instead of as one chunk on one.
+const WRITE_CHUNK_CELLS: usize = 16 * WRITE_CHUNK_ROWS;
 
 /// One column as [`format_rows`] writes it.
 enum Cells<'a> {
@@ -158,7 +165,9 @@ fn format_rows(
     let mut pos = 0;
     for row in rows.clone() {
         if out.len() < pos + row_max {
-            let ahead = (rows.end - row).min(GROW_ROWS);
+            let ahead = (rows.end - row)
+                .min(GROW_ROWS)
+                .min((GROW_BYTES / row_max).max(1));
             out.resize(pos + ahead * row_max, 0);
         }
         for group in cells.chunks(STAGED) {
@@ -197,6 +206,13 @@ const STAGED: usize = 16;
 /// Rows' worth of their longest text by which [`format_rows`] grows its
 /// buffer.
 const GROW_ROWS: usize = 1024;
+
+/// The most bytes of longest text by which [`format_rows`] grows its
+/// buffer at once (at least one row's): [`GROW_ROWS`] rows of a table of
+/// 99 019 columns asked for 3.3 GB, which `rotor apply` of an 11 s flight
+/// of that width zeroed and held for 30 s and 4.7 GB (`inspect` of it:
+/// 4.8 s, 1.5 GB). The peers' 9-column output grows by 300 kB as before.
+const GROW_BYTES: usize = 4 << 20;
 
 /// The text of a number cell (`c` is not a text column): `missing` for a
 /// missing value, an integer column's whole values without `.0` (read as
@@ -294,6 +310,30 @@ mod tests {
             s,
             "time,mag,note,id\n0.1,,\"a,b\",\"#1\"\n1e-7,-0.0,\"say \"\"hi\"\"\",plain\n"
         );
+    }
+
+    /// A wide table is written in chunks of fewer rows
+    /// ([`WRITE_CHUNK_CELLS`]), its buffer growing by at most
+    /// [`GROW_BYTES`] at once (here 25 of its 165 kB rows): the bytes of
+    /// one pass over every row.
+    #[test]
+    fn a_wide_table_is_written_in_small_chunks_with_the_same_bytes() {
+        let (n, width) = (2 * WRITE_CHUNK_CELLS / 5000 + 3, 5000);
+        let mut t = FlightTable::new();
+        for c in 0..width {
+            let v: Vec<f64> = (0..n)
+                .map(|i| (i * width + c) as f64 * 0.25 - 7.0)
+                .collect();
+            t.add_column(&format!("c{c}"), v).unwrap();
+        }
+        let mut out = Vec::new();
+        write_csv_to(&t, &mut out).unwrap();
+        let columns: Vec<&Column> = t.columns().iter().collect();
+        let mut rows = Vec::new();
+        let len = format_rows(&columns, 0..n, b"", &mut rows);
+        let header_end = out.iter().position(|&b| b == b'\n').unwrap() + 1;
+        assert_eq!(&out[header_end..], &rows[..len]);
+        assert_eq!(String::from_utf8_lossy(&out).lines().count(), n + 1);
     }
 
     /// Rows formatted in chunks on several threads are the bytes of one
