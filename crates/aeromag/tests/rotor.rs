@@ -312,6 +312,26 @@ fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
             "{msg}"
         );
     }
+    // A time in milliseconds (0.1 Hz) named the library's `cutoff_hz`; a
+    // row of zeros on the three flux axes named neither file nor row.
+    let ms = edited(&other, |n, v| {
+        if n == "time" {
+            v.iter_mut().for_each(|t| *t *= 1e3);
+        }
+    });
+    let zero = edited(&other, |n, v| {
+        if n.starts_with("flux_") {
+            v[777] = 0.0;
+        }
+    });
+    for (flight, needle) in [(&ms, "sample rate 0.1000 Hz"), (&zero, "data row 778")] {
+        for e in [
+            fit.model.compensate(flight).unwrap_err(),
+            fit_rotor(flight, &opts, &mut Silent).unwrap_err(),
+        ] {
+            assert!(e.is_bad_input() && e.to_string().contains(needle), "{e}");
+        }
+    }
     // A constant reading determines nothing: a failed fit (exit 1).
     let constant = edited(&learn, |n, v| {
         if n == "mag" {

@@ -54,14 +54,25 @@ impl<'a> RotorColumns<'a> {
                 ));
             }
         }
+        let flux = [
+            flight.require("flux_x")?,
+            flight.require("flux_y")?,
+            flight.require("flux_z")?,
+        ];
+        // A dropout written as zeros on the three axes: the field has no
+        // direction there ("rotor input: field at sample 5000 is zero"
+        // named neither the file nor the row).
+        if let Some(k) = (0..flight.n_rows()).find(|&k| flux.iter().all(|c| c[k] == 0.0)) {
+            return Err(flight.bad_row(
+                k,
+                "flux_x, flux_y and flux_z are all 0 nT: the field has no direction here \
+                 (a dropout written as zeros? leave the cells empty for missing values)",
+            ));
+        }
         Ok(Self {
             time: flight.require("time")?,
             mag: flight.require("mag")?,
-            flux: [
-                flight.require("flux_x")?,
-                flight.require("flux_y")?,
-                flight.require("flux_z")?,
-            ],
+            flux,
             phase: phase.map(|p| flight.require(p)).transpose()?,
         })
     }
@@ -96,6 +107,21 @@ impl<'a> RotorColumns<'a> {
     /// a few ms) likewise; every step of a stretch must be within
     /// [`MAX_STEP_DEVIATION`] of the median.
     pub fn usable_stretches(&self, flight: &Flight, fs: f64) -> Result<Vec<Range<usize>>> {
+        // The fit high-passes at 2 Hz: a slower sampling (a time in ms
+        // reads as 0.1 Hz) gave messages naming the library's `cutoff_hz`
+        // or `window_s`.
+        let cutoff = RotorFitOptions::default().highpass_hz;
+        if fs <= 2.0 * cutoff {
+            return Err(Error::bad_file(
+                flight.label(),
+                format!(
+                    "sample rate {} Hz: the rotor model needs more than {} Hz (its high-pass is at \
+                     {cutoff} Hz, and the blades pass at tens of Hz); is the time in seconds?",
+                    figure(fs),
+                    2.0 * cutoff
+                ),
+            ));
+        }
         let segs = self.stretches(fs);
         if segs.is_empty() {
             return Err(Error::bad_file(
@@ -574,9 +600,10 @@ impl Compensator for RotorModelFile {
         let fs = flight.sample_rate_hz()?;
         if (fs / self.sample_rate_hz - 1.0).abs() > 0.01 {
             observer.note(&Note::warning(format!(
-                "{}: sample rate {fs:.3} Hz differs from the model's {:.3} Hz",
+                "{}: sample rate {} Hz differs from the model's {} Hz",
                 flight.label(),
-                self.sample_rate_hz
+                figure(fs),
+                figure(self.sample_rate_hz)
             )));
         }
         // Dropouts bridged as the fit bridges them (one missing cell every
