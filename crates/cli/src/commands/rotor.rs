@@ -59,10 +59,13 @@ struct StudyArgs {
 /// `rotor_phase` when the file has it. Without a phase channel (or with
 /// --estimate-phase) the rotor frequency and phase are estimated from the
 /// scalar data (search band --rotor-hz). Dropouts of up to 0.1 s (missing
-/// values, regular time steps) are bridged by linear interpolation; across
+/// values, regular time steps) and spikes of `mag` (a sample standing out
+/// from its neighbours by 50 times the flight's typical second difference;
+/// a warning names them) are bridged by linear interpolation; across
 /// longer gaps the model is fitted on the longest stretch and its
-/// parameters refined on every stretch of at least 10 s. Columns named
-/// `true_…` are never read.
+/// parameters refined on every stretch of at least 10 s. Within a stretch
+/// every time step must be within 2 % of the median (resample an irregular
+/// record first). Columns named `true_…` are never read, however mapped.
 ///
 /// The rotor geometry is required: either a named installation
 /// (--preset aeromag-sim-helicopter: the helicopter of `aeromag simulate
@@ -165,7 +168,10 @@ struct FitArgs {
 /// Writes every input column plus `rotor_interf` (modelled rotor
 /// interference, nT), `mag_comp` (mag − rotor_interf, nT) and `rotor_flag`
 /// (0 compensated, 1 not: a missing value in the row, or a stretch shorter
-/// than 10 s between gaps). Every input row is written, in order.
+/// than 10 s between gaps). Every input row is written, in order. The
+/// flight is checked as `rotor fit` checks it (the phase channel's rotor
+/// speed, uniform time steps), and dropouts and spikes of `mag` are
+/// bridged alike to track the rotor's slowly varying cone.
 ///
 /// Example:
 ///   aeromag rotor apply --model rotor.json --input heli2.csv --out heli2_comp.csv
