@@ -369,7 +369,7 @@ pub(super) fn bridge_dropouts(
     out
 }
 
-/// Check the mean rotor frequency `f_r` (Hz) found on the fitted stretch:
+/// Check the mean rotor frequency `f_r` (Hz) found on a stretch (the fitted one, or one tracked by `rotor apply`):
 /// above the high-pass cutoff of the fit (a slower "rotor" is removed with
 /// the manoeuvres: a heading or time column given as the phase channel
 /// turns at mHz and was fitted with exit 0) and with the blade-passing
@@ -395,7 +395,7 @@ pub(super) fn check_rotor_speed(
         return Err(Error::bad_file(
             file,
             format!(
-                "{source} at {} Hz on the fitted stretch: a rotor's frequency must be above {cutoff} Hz \
+                "{source} at {} Hz on a stretch of the flight: a rotor's frequency must be above {cutoff} Hz \
                  (the fit's high-pass cutoff) and its {blades} blades must pass below Nyquist \
                  ({nyquist:.3} Hz); is it the rotor phase channel, in degrees?",
                 figure(f_r)
