@@ -369,8 +369,9 @@ pub(super) fn bridge_dropouts(
     out
 }
 
-/// Check the mean rotor frequency `f_r` (Hz) found on a stretch (the fitted one, or one tracked by `rotor apply`):
-/// above the high-pass cutoff of the fit (a slower "rotor" is removed with
+/// Check the mean rotor frequency `f_r` (Hz) found on a stretch (the
+/// fitted one, or one `rotor apply` tracks): above the high-pass cutoff of
+/// the fit (a slower "rotor" is removed with
 /// the manoeuvres: a heading or time column given as the phase channel
 /// turns at mHz and was fitted with exit 0) and with the blade-passing
 /// frequency below Nyquist; for a tail rotor, `gear_ratio × f_r` between
