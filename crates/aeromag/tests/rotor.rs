@@ -324,7 +324,17 @@ fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
             v[777] = 0.0;
         }
     });
-    for (flight, needle) in [(&ms, "sample rate 0.1000 Hz"), (&zero, "data row 778")] {
+    // An infinite phase was bridged as a missing one.
+    let infinite = edited(&other, |n, v| {
+        if n == "rotor_phase" {
+            v[4321] = f64::INFINITY;
+        }
+    });
+    for (flight, needle) in [
+        (&ms, "sample rate 0.1000 Hz"),
+        (&zero, "data row 778"),
+        (&infinite, "data row 4322, column 'rotor_phase'"),
+    ] {
         for e in [
             fit.model.compensate(flight).unwrap_err(),
             fit_rotor(flight, &opts, &mut Silent).unwrap_err(),

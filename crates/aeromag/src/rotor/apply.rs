@@ -54,6 +54,14 @@ impl<'a> RotorColumns<'a> {
                 ));
             }
         }
+        // An infinite phase was taken as missing (bridged), while an
+        // infinite `mag` or flux is refused on reading.
+        if let Some(p) = phase {
+            let v = flight.require(p)?;
+            if let Some(k) = v.iter().position(|x| x.is_infinite()) {
+                return Err(flight.bad_value(k, p, "the rotor phase is infinite"));
+            }
+        }
         let flux = [
             flight.require("flux_x")?,
             flight.require("flux_y")?,
@@ -393,13 +401,24 @@ pub(super) fn check_rotor_speed(
             Some(c) => format!("the phase channel `{c}` (deg) turns"),
             None => "the rotor phase estimated from the data turns".to_string(),
         };
+        // A plausible rotor under a sampling too slow for its blades: say
+        // so, rather than doubt the phase channel.
+        let hint = if f_r > cutoff && f_r.is_finite() {
+            format!(
+                "the flight is sampled too slowly for this rotor (at least {} Hz needed)",
+                fixed(2.0 * blades as f64 * f_r, 1)
+            )
+        } else {
+            "is it the rotor phase channel, in degrees?".to_string()
+        };
         return Err(Error::bad_file(
             file,
             format!(
                 "{source} at {} Hz on a stretch of the flight: a rotor's frequency must be above {cutoff} Hz \
                  (the fit's high-pass cutoff) and its {blades} blades must pass below Nyquist \
-                 ({nyquist:.3} Hz); is it the rotor phase channel, in degrees?",
-                figure(f_r)
+                 ({} Hz); {hint}",
+                figure(f_r),
+                fixed(nyquist, 3)
             ),
         ));
     }

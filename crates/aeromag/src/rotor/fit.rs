@@ -594,7 +594,13 @@ mod tests {
             "{msg}"
         );
         // Blade passing beyond Nyquist.
-        assert!(check_rotor_speed(13.0, 100.0, 4, None, None, "f.csv").is_err());
+        // A rotor whose blades pass above Nyquist: the sampling is named.
+        let e = check_rotor_speed(13.0, 100.0, 4, None, None, "f.csv").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("sampled too slowly for this rotor (at least 104.0 Hz needed)"),
+            "{e}"
+        );
         // A gear ratio of 2⁶³ failed as a singular fit (exit 1), one of
         // 10⁶ was fitted on aliased data (exit 0).
         for k in [9.3e18, 1e6, 1e-300] {
