@@ -403,4 +403,28 @@ fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
         "{}",
         worst(&again, &clean.interference_nt)
     );
+    // One corrupted phase cell (1e300) turned the fitted rotor to 3.62 Hz
+    // instead of 4.83: bridged as a glitch of the phase's line.
+    let glitched = |f: &Flight| {
+        edited(f, |n, v| {
+            if n == "rotor_phase" {
+                v[5000] = 1e300;
+            }
+        })
+    };
+    let out = fit.model.compensate(&glitched(&other)).unwrap();
+    assert!(
+        out.notes
+            .iter()
+            .any(|n| n.message.contains("1 sample of the rotor phase jumps"))
+    );
+    assert!(worst(&out.interference_nt, &clean.interference_nt) < 0.5);
+    let refit = fit_rotor(&glitched(&learn), &opts, &mut Silent).unwrap();
+    assert!((refit.model.rotor_hz - fit.model.rotor_hz).abs() < 1e-3);
+    let again = refit.model.interference(&other).unwrap();
+    assert!(
+        worst(&again, &clean.interference_nt) < 0.5,
+        "{}",
+        worst(&again, &clean.interference_nt)
+    );
 }

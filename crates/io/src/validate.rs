@@ -174,6 +174,11 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
     // Increasing: the first and last times are the extremes.
     for i in [0, t.len().saturating_sub(1)] {
         if let Some(&v) = t.get(i)
+            && v.is_infinite()
+        {
+            return Err(infinite_time(table, i, v));
+        }
+        if let Some(&v) = t.get(i)
             && v.abs() > MAX_TIME_S
         {
             return Err(IoError::Units {
@@ -192,6 +197,16 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
     Ok(())
 }
 
+/// An infinite time at row `i` (it was reported as time going backwards,
+/// at the row after it).
+fn infinite_time(table: &FlightTable, i: usize, v: f64) -> IoError {
+    IoError::Units {
+        file: table.file_label(),
+        column: "time".into(),
+        message: format!("time {v} at {} is no time", data_row(table, i)),
+    }
+}
+
 /// The largest time taken as one in seconds (10¹¹ s, 3 000 years; Unix
 /// time is 1.8·10⁹ s): beyond, the clock counts milliseconds (Unix time
 /// in ms is 1.8·10¹²) or smaller units, which every command would take
@@ -208,6 +223,9 @@ const TIME_BLOCK: usize = 4096;
 fn first_time_error(table: &FlightTable, t: &[f64], rows: std::ops::Range<usize>) -> Result<()> {
     for i in rows {
         let v = t[i];
+        if v.is_infinite() {
+            return Err(infinite_time(table, i, v));
+        }
         if v.is_nan() {
             return Err(IoError::MissingValue {
                 file: table.file_label(),
@@ -771,6 +789,24 @@ mod tests {
         };
         assert!(check(vec![1.764e9, 1.764e9 + 0.1]).is_ok());
         assert!(check(vec![-1e11, 1e11]).is_ok());
+        for (t, row, needle) in [
+            (
+                vec![0.0, f64::INFINITY, 1.0],
+                "data row 2",
+                "time inf at data row 2 is no time",
+            ),
+            (
+                vec![0.0, 1.0, f64::INFINITY],
+                "data row 3",
+                "time inf at data row 3 is no time",
+            ),
+        ] {
+            let e = check(t).unwrap_err();
+            assert!(
+                e.is_bad_input() && e.to_string().contains(needle),
+                "{e} ({row})"
+            );
+        }
         for (t, row, shown) in [
             (vec![-1e308, 1e308], "data row 1", "-1e308"),
             (

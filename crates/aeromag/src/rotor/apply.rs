@@ -174,17 +174,29 @@ impl<'a> RotorColumns<'a> {
     pub fn bridged(&self, fs: f64) -> Bridged {
         let max_fill = (MAX_FILL_S * fs).round().max(1.0) as usize;
         let raw = self.all();
-        let spikes = spikes(self.mag);
-        let mut mag = self.mag.to_vec();
-        for &k in &spikes {
-            mag[k] = f64::NAN;
-        }
+        let mag_spikes = spikes(self.mag, 0.0);
+        let without = |x: &[f64], at: &[usize]| {
+            let mut x = x.to_vec();
+            at.iter().for_each(|&k| x[k] = f64::NAN);
+            x
+        };
+        let mag = without(self.mag, &mag_spikes);
+        // A glitch of the phase channel (a corrupted cell) stands out of
+        // its unwrapped line by up to 180°.
+        let phase_spikes = self
+            .phase
+            .map_or_else(Vec::new, |p| spikes(&unwrapped_deg(p), PHASE_GLITCH_DEG));
+        let phase = self.phase.map(|p| without(p, &phase_spikes));
         let columns: Vec<Vec<f64>> = raw
             .iter()
             .enumerate()
             .map(|(k, c)| {
                 let period = (k == 4).then_some(360.0);
-                let c = if k == 0 { &mag[..] } else { c };
+                let c = match k {
+                    0 => &mag[..],
+                    4 => phase.as_deref().unwrap_or(c),
+                    _ => c,
+                };
                 bridge_dropouts(self.time, c, max_fill, period)
             })
             .collect();
@@ -196,7 +208,8 @@ impl<'a> RotorColumns<'a> {
         Bridged {
             columns,
             rows,
-            spikes,
+            spikes: mag_spikes,
+            phase_spikes,
         }
     }
 
@@ -227,6 +240,8 @@ pub(super) struct Bridged {
     pub rows: usize,
     /// The rows (0-based) whose `mag` is a spike.
     pub spikes: Vec<usize>,
+    /// The rows (0-based) whose phase is a glitch ([`PHASE_GLITCH_DEG`]).
+    pub phase_spikes: Vec<usize>,
 }
 
 impl Bridged {
@@ -253,8 +268,50 @@ impl Bridged {
                 fixed(flight.require("mag").map_or(f64::NAN, |m| m[first]), 1)
             )));
         }
+        if let Some(&first) = self.phase_spikes.first() {
+            let n = self.phase_spikes.len();
+            notes.push(Note::warning(format!(
+                "{}: {n} {} of the rotor phase {} from the line of {} neighbours by more than \
+                 {PHASE_GLITCH_DEG}° (glitches; the first at data row {}): bridged {purpose}",
+                flight.label(),
+                if n == 1 { "sample" } else { "samples" },
+                if n == 1 { "jumps" } else { "jump" },
+                if n == 1 { "its" } else { "their" },
+                flight.file_row(first) + 1,
+            )));
+        }
         notes
     }
+}
+
+/// The smallest glitch of the phase channel that is bridged, deg (with
+/// [`SPIKE_SIGMAS`] times the channel's own scale, when larger): the
+/// phase of a rotor turning steadily is a straight line whose second
+/// differences are a fraction of a degree, and one corrupted cell (1e300)
+/// turned the fitted rotor to 3.62 Hz instead of 4.83.
+pub const PHASE_GLITCH_DEG: f64 = 10.0;
+
+/// A phase in degrees unwrapped (each step taken the short way round
+/// 360°, between the values reduced to [0°, 360°) first, so that a
+/// corrupted 1e300 is a spike of the line and not a step of it); a
+/// missing value stays missing and the next one follows the last present.
+fn unwrapped_deg(p: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(p.len());
+    let mut last: Option<(f64, f64)> = None;
+    for &x in p {
+        if !x.is_finite() {
+            out.push(f64::NAN);
+            continue;
+        }
+        let x = x.rem_euclid(360.0);
+        let u = match last {
+            None => x,
+            Some((raw, u)) => u + ((x - raw) + 180.0).rem_euclid(360.0) - 180.0,
+        };
+        last = Some((x, u));
+        out.push(u);
+    }
+    out
 }
 
 /// Spikes of `mag` ([`spikes`]): a sample whose second difference
@@ -268,10 +325,11 @@ impl Bridged {
 /// simulated helicopter flights.
 pub const SPIKE_SIGMAS: f64 = 50.0;
 
-/// The rows of `mag` that are spikes ([`SPIKE_SIGMAS`]): samples far from
+/// The rows of `mag` (or another series) that are spikes
+/// ([`SPIKE_SIGMAS`], and at least `floor` in its unit): samples far from
 /// the mean of their neighbours, and farther than either neighbour is
 /// from its own.
-pub(super) fn spikes(mag: &[f64]) -> Vec<usize> {
+pub(super) fn spikes(mag: &[f64], floor: f64) -> Vec<usize> {
     let n = mag.len();
     if n < 3 {
         return Vec::new();
@@ -286,7 +344,7 @@ pub(super) fn spikes(mag: &[f64]) -> Vec<usize> {
     }
     let mid = d.len() / 2;
     let (_, &mut median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    let limit = SPIKE_SIGMAS * 1.4826 * median;
+    let limit = (SPIKE_SIGMAS * 1.4826 * median).max(floor);
     if limit.is_nan() || limit <= 0.0 {
         return Vec::new();
     }
