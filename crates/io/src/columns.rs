@@ -376,22 +376,24 @@ fn find_in<'h>(
     if let Some(h) = header.iter().find(|h| *h == name) {
         return Ok(Some(h));
     }
-    let mut matches = header.iter().filter(|h| h.eq_ignore_ascii_case(name));
-    let first = matches.next();
-    if let Some(second) = matches.next() {
-        let quoted: Vec<String> = [first.unwrap(), second]
-            .into_iter()
-            .chain(matches)
-            .map(|h| format!("'{h}'"))
-            .collect();
-        return Err(IoError::AmbiguousColumn {
+    let matches: Vec<&String> = header
+        .iter()
+        .filter(|h| h.eq_ignore_ascii_case(name))
+        .collect();
+    match matches[..] {
+        [] => Ok(None),
+        [one] => Ok(Some(one)),
+        _ => Err(IoError::AmbiguousColumn {
             file: file.to_string(),
             name: name.to_string(),
-            matches: quoted.join(", "),
+            matches: matches
+                .iter()
+                .map(|h| format!("'{h}'"))
+                .collect::<Vec<_>>()
+                .join(", "),
             choose: choose(),
-        });
+        }),
     }
-    Ok(first)
 }
 
 /// The sensors of a flight with several magnetometers that a command uses

@@ -173,14 +173,11 @@ pub fn check_time(table: &FlightTable) -> Result<()> {
     }
     // Increasing: the first and last times are the extremes.
     for i in [0, t.len().saturating_sub(1)] {
-        if let Some(&v) = t.get(i)
-            && v.is_infinite()
-        {
+        let Some(&v) = t.get(i) else { continue };
+        if v.is_infinite() {
             return Err(infinite_time(table, i, v));
         }
-        if let Some(&v) = t.get(i)
-            && v.abs() > MAX_TIME_S
-        {
+        if v.abs() > MAX_TIME_S {
             return Err(IoError::Units {
                 file: table.file_label(),
                 column: "time".into(),
