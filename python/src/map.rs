@@ -326,10 +326,7 @@ impl PyMicrolevelled {
     /// whether it converged (a warning in `notes` when it did not).
     #[getter]
     fn gridding(&self) -> (usize, bool) {
-        (
-            self.m.gridding.levels.last().map_or(0, |l| l.iterations),
-            self.m.gridding.converged,
-        )
+        (self.m.gridding.final_sweeps(), self.m.gridding.converged)
     }
 
     /// Notes and warnings.

@@ -258,7 +258,7 @@ pub(crate) fn grid_flight_finest(
         notes.warn(format!(
             "minimum curvature stopped after {} sweeps with a change of {:.3e} (limit {:.3e}); \
              raise the sweep limit (--max-sweeps) or the convergence limit (--convergence)",
-            report.levels.last().map_or(0, |l| l.iterations),
+            report.final_sweeps(),
             report.levels.last().map_or(f64::NAN, |l| l.max_change),
             report.convergence_limit
         ));

@@ -102,7 +102,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "working grid: cell {} m, minimum curvature with tension {}, {} sweeps on the final grid, {}",
         m.cell_m,
         opts.min_curvature.tension,
-        m.gridding.levels.last().map_or(0, |l| l.iterations),
+        m.gridding.final_sweeps(),
         if m.gridding.converged {
             "converged"
         } else {

@@ -135,6 +135,11 @@ pub struct MinCurvatureReport {
 }
 
 impl MinCurvatureReport {
+    /// Sweeps run on the final grid (0 when none ran).
+    pub fn final_sweeps(&self) -> usize {
+        self.levels.last().map_or(0, |l| l.iterations)
+    }
+
     /// The report of a grid made otherwise (no sweeps; the data counts of
     /// `means`).
     pub fn not_run(means: &BlockMeans) -> Self {
