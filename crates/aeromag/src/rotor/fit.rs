@@ -1,6 +1,7 @@
 //! Fitting the physical rotor model on a flight.
 
-use super::apply::{RotorColumns, check_rotor_speed, mean_rotor_hz, segment_phase, track_segment};
+use super::apply::{segment_phase, track_segment};
+use super::columns::{RotorColumns, check_rotor_speed, mean_rotor_hz};
 use super::{MIN_SEGMENT_S, RotorPreset};
 use crate::error::{Error, Result};
 use crate::flight::Flight;
@@ -413,8 +414,9 @@ pub fn fit_rotor(
     }
     let raw = RotorColumns::of(flight, phase_col.as_deref())?;
     let fs = flight.sample_rate_hz()?;
-    // Short dropouts (missing cells, no time gap) are bridged so that the
-    // stretches on both sides are fitted as one record.
+    // Short dropouts (missing cells, no time gap), spikes of `mag` and
+    // glitches of the phase are bridged, so that the stretches on both
+    // sides are fitted as one record and one bad sample spoils nothing.
     let bridged = raw.bridged(fs);
     let cols = raw.with(&bridged.columns);
     for n in bridged.notes(flight, "for the fit") {
@@ -442,9 +444,9 @@ pub fn fit_rotor(
     let estimated = phase_col.is_none();
     check_window(opts.window_s, fs, &segs, estimated, &file)?;
     let (mut phase, omega) = segment_phase(&cols, &r, fs, geom.blades, opts.rotor_hz_range)?;
-    let f_r = mean_rotor_hz(&omega);
+    let rotor_hz = mean_rotor_hz(&omega);
     check_rotor_speed(
-        f_r,
+        rotor_hz,
         fs,
         geom.blades,
         phase_col.as_deref(),
@@ -510,7 +512,6 @@ pub fn fit_rotor(
             (slow, Some(tail))
         }
     };
-    let rotor_hz = f_r;
     let coning_mean_deg =
         slow.angles.iter().map(|x| x.coning_rad).sum::<f64>() / slow.angles.len() as f64 * 180.0
             / std::f64::consts::PI;
@@ -593,7 +594,6 @@ mod tests {
             e.is_bad_input() && msg.contains("f.csv") && msg.contains("`time`"),
             "{msg}"
         );
-        // Blade passing beyond Nyquist.
         // A rotor whose blades pass above Nyquist: the sampling is named.
         let e = check_rotor_speed(13.0, 100.0, 4, None, None, "f.csv").unwrap_err();
         assert!(

@@ -17,6 +17,7 @@
 //!   helicopter.
 
 mod apply;
+mod columns;
 mod fit;
 
 pub use aeromag_compensation::rotor::model_file::{
@@ -24,6 +25,7 @@ pub use aeromag_compensation::rotor::model_file::{
 };
 pub use aeromag_compensation::rotor::{FlapAngles, RotorGeometry, TailRotor};
 pub use apply::ROTOR_OUTPUT;
+pub use columns::{MAX_STEP_DEVIATION, PHASE_GLITCH_DEG, SPIKE_SIGMAS};
 pub use fit::{PhaseChoice, RotorChoices, RotorFitResult, RotorOptions, fit_rotor};
 
 use crate::error::{Error, Result};

@@ -23,7 +23,7 @@ mod rotor;
 mod sites;
 mod stream;
 
-pub use demo::{Demo, DemoOutcome, DemoSummary};
+pub use demo::{Demo, DemoOutcome, DemoSummary, MAX_DEMO_SEED};
 pub use em::{EmOutcome, EmStudy, EmSummary};
 pub use fixed_wing::{
     CompensationSummary, FixedWingOutcome, FixedWingStudy, FixedWingSummary, GeologySummary,
