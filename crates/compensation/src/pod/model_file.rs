@@ -3,6 +3,12 @@
 //! and write the same files.
 
 use crate::error::{CompError, Result};
+/// A body-frame point (m) with a coordinate that is NaN or beyond
+/// ±[`MAX_SOURCE_M`]: the attachment and reference points' check.
+fn beyond_reach(p: &[f64; 3]) -> bool {
+    p.iter().any(|x| x.is_nan() || x.abs() > MAX_SOURCE_M)
+}
+
 #[cfg(test)]
 use crate::model_file::MODEL_FORMAT;
 use crate::model_file::parse_model;
@@ -148,11 +154,7 @@ impl PodSetup {
                 shown(self.cable_length_m)
             ));
         }
-        if self
-            .attach_m
-            .iter()
-            .any(|x| x.is_nan() || x.abs() > MAX_SOURCE_M)
-        {
+        if beyond_reach(&self.attach_m) {
             return bad(format!(
                 "attachment point ({}) m must be within ±{MAX_SOURCE_M} m of the body frame's origin",
                 self.attach_m.map(shown).join(", ")
@@ -227,11 +229,7 @@ impl PodModelFile {
                 self.coefficients.len()
             )));
         }
-        if self
-            .reference_m
-            .iter()
-            .any(|x| x.is_nan() || x.abs() > MAX_SOURCE_M)
-        {
+        if beyond_reach(&self.reference_m) {
             return Err(CompError::data(format!(
                 "reference position ({}) m must be within ±{MAX_SOURCE_M} m of the body frame's origin",
                 self.reference_m.map(aeromag_core::error::shown).join(", ")
