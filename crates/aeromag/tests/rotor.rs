@@ -197,6 +197,62 @@ fn without_a_phase_channel_the_phase_is_estimated() {
     assert!(share <= 0.10, "{share}");
 }
 
+#[test]
+fn a_rotor_band_without_this_rotor_is_refused_or_fails() {
+    // The simulated rotor turns at 4.83 Hz, its four blades pass at 19.3 Hz.
+    let learn = helicopter(13, Some("[rotor]\nphase_channel = false\n"));
+    let band = |rotor_hz_range| RotorOptions {
+        rotor_hz_range,
+        ..RotorOptions::preset(RotorPreset::AeromagSimHelicopter)
+    };
+    // Below the rotor: the band's largest power was the flank of the
+    // second harmonic (9.66 Hz) at its edge, tracked out of the band to a
+    // 2.42 Hz "rotor" and written with exit 0.
+    let e = fit_rotor(&learn, &band([2.5, 3.5]), &mut Silent).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        e.is_bad_input() && msg.contains("--rotor-hz") && msg.contains("no blade-passing peak"),
+        "{msg}"
+    );
+    // Above: the fifth harmonic (24.2 Hz) passes for four blades of a
+    // 6.04 Hz rotor, written with exit 0: its cone is absurd.
+    let e = fit_rotor(&learn, &band([5.0, 7.0]), &mut Silent).unwrap_err();
+    let msg = e.to_string();
+    assert!(!e.is_bad_input() && msg.contains("coning"), "{msg}");
+    // Blades passing above Nyquist: the sampling is named.
+    let e = fit_rotor(&learn, &band([4.0, 20.0]), &mut Silent).unwrap_err();
+    let msg = e.to_string();
+    assert!(e.is_bad_input() && msg.contains("Nyquist"), "{msg}");
+    // A band around the rotor: fitted.
+    let fit = fit_rotor(&learn, &band([4.8, 5.5]), &mut Silent).unwrap();
+    assert!(
+        (fit.model.rotor_hz - 4.83).abs() < 0.01,
+        "{}",
+        fit.model.rotor_hz
+    );
+}
+
+#[test]
+fn a_phase_channel_that_is_not_the_rotors_fails() {
+    // A phase turning at a plausible 3.7 Hz that the rotor does not follow.
+    let learn = edited(&helicopter(11, None), |n, v| {
+        if n == "rotor_phase" {
+            for (k, p) in v.iter_mut().enumerate() {
+                *p = (k as f64 * 0.01 * 3.7 * 360.0).rem_euclid(360.0);
+            }
+        }
+    });
+    let opts = RotorOptions::preset(RotorPreset::AeromagSimHelicopter);
+    let e = fit_rotor(&learn, &opts, &mut Silent).unwrap_err();
+    let msg = e.to_string();
+    // Its model's cone is absurd (−111°), so the coning check fails it
+    // first; the share explained names the channel where the cone is not.
+    assert!(
+        !e.is_bad_input() && (msg.contains("coning") || msg.contains("--phase-column")),
+        "{msg}"
+    );
+}
+
 /// A sensor under the tail boom with the simulator's tail rotor.
 const TAIL_BOOM: &str = "[tail_rotor]\n[scalar]\nposition_m = [-10.0, 0.0, 0.3]\n[fluxgate]\nposition_m = [-9.5, 0.0, 0.3]\n";
 
@@ -218,6 +274,11 @@ fn a_tail_rotor_fitted_jointly_carries_over_to_an_independent_flight() {
     );
     let fit0 = fit_rotor(&learn, &main_only, &mut Silent).unwrap();
     let fit1 = fit_rotor(&learn, &with_tail, &mut Silent).unwrap();
+    // The main rotor alone explains a few per cent of what this sensor
+    // sees: said, naming the tail rotor's option.
+    let explains = |n: &Note| n.message.contains("explains") && n.message.contains("--tail-rotor");
+    assert!(fit0.notes.iter().any(explains), "{:?}", fit0.notes);
+    assert!(!fit1.notes.iter().any(explains), "{:?}", fit1.notes);
     let tail = fit1.model.tail.as_ref().unwrap();
     assert!((tail.offset_rad.to_degrees() - 37.0).abs() < 1.0);
     let s0 = residual_share(&other, &fit0.model.interference(&other).unwrap());

@@ -13,6 +13,7 @@ use aeromag_compensation::rotor::{
     FlapAngles, RotorInput, SlowAngleOptions, TailRotor, align_phase_offset, estimate_phase,
     regressors, rotor_speed, track_slow_angles, unwrap_deg,
 };
+use aeromag_core::error::shown;
 use nalgebra::Vector3;
 use std::ops::Range;
 
@@ -24,17 +25,32 @@ pub const ROTOR_OUTPUT: OutputColumns = OutputColumns {
 };
 
 /// Phase (rad, unwrapped) and rotor speed (rad/s) of one segment: from the
-/// channel, or estimated from `mag` (steps 1–2 of the library's `phase`).
+/// channel, or estimated from `mag` (steps 1–2 of the library's `phase`)
+/// in the rotor band `band` (Hz), an error naming the band's option and
+/// `file` when the data show no rotor there.
 pub(super) fn segment_phase(
     cols: &RotorColumns,
     r: &Range<usize>,
     fs: f64,
     blades: usize,
     band: [f64; 2],
+    file: &str,
 ) -> Result<(Vec<f64>, Vec<f64>)> {
     let phase = match cols.phase {
         Some(p) => unwrap_deg(&p[r.clone()]),
-        None => estimate_phase(&cols.mag[r.clone()], fs, blades, band[0], band[1])?.phase_rad,
+        None => {
+            estimate_phase(&cols.mag[r.clone()], fs, blades, band[0], band[1])
+                .map_err(|e| {
+                    e.at(format!(
+                        "the rotor phase estimated from `mag` in the rotor band {},{} Hz \
+                         (--rotor-hz of `rotor fit`, kept in the model as phase.rotor_hz_range)",
+                        shown(band[0]),
+                        shown(band[1])
+                    ))
+                })
+                .in_file(file)?
+                .phase_rad
+        }
     };
     let omega = rotor_speed(&phase, fs, 1.0)?;
     Ok((phase, omega))
@@ -122,7 +138,8 @@ pub(super) fn track_segment(
     let g = &model.geometry;
     let nominal = [model.nominal_angles];
     let b = cols.field(r);
-    let (mut phase, omega) = segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range)?;
+    let (mut phase, omega) =
+        segment_phase(cols, r, fs, g.blades, model.phase.rotor_hz_range, file)?;
     // The phase channel checked as the fit checks it: a phase in radians,
     // reversed, stuck or random was applied with exit 0 (interference of
     // ±10⁴ nT).

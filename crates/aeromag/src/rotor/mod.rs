@@ -26,7 +26,9 @@ pub use aeromag_compensation::rotor::model_file::{
 pub use aeromag_compensation::rotor::{FlapAngles, RotorGeometry, TailRotor};
 pub use apply::ROTOR_OUTPUT;
 pub use columns::{MAX_STEP_DEVIATION, PHASE_GLITCH_DEG, SPIKE_SIGMAS};
-pub use fit::{PhaseChoice, RotorChoices, RotorFitResult, RotorOptions, fit_rotor};
+pub use fit::{
+    MIN_EXPLAINED_VARIANCE, PhaseChoice, RotorChoices, RotorFitResult, RotorOptions, fit_rotor,
+};
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};

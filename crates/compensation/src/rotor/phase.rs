@@ -17,6 +17,7 @@
 //!    minimising the rotor-model fit residual over a grid and a
 //!    golden-section search ([`super::refine_phase_offset`]).
 
+use aeromag_core::error::{fixed, shown};
 use aeromag_core::filter::{Band, butter, sosfiltfilt};
 use aeromag_core::spectrum::welch::{WelchConfig, welch};
 
@@ -102,10 +103,23 @@ pub fn estimate_phase(
     f_max_hz: f64,
 ) -> Result<PhaseEstimate> {
     let nb = blades as f64;
-    if blades < 2 || !(f_min_hz > 0.0 && f_max_hz > f_min_hz) || nb * f_max_hz >= 0.5 * fs_hz {
-        return Err(CompError::setting(
-            "rotor phase: need ≥ 2 blades and 0 < f_min < f_max with the blade-passing frequency below Nyquist",
-        ));
+    if blades < 2 || !(f_min_hz > 0.0 && f_max_hz > f_min_hz) {
+        return Err(CompError::setting(format!(
+            "rotor phase: {blades} blades and the rotor band {}–{} Hz: need at least 2 blades and 0 < f_min < f_max",
+            shown(f_min_hz),
+            shown(f_max_hz)
+        )));
+    }
+    if nb * f_max_hz >= 0.5 * fs_hz {
+        return Err(CompError::setting(format!(
+            "rotor phase: {blades} blades of a rotor turning at up to {} Hz pass at up to {} Hz, \
+             at or above the Nyquist frequency ({} Hz of the {} Hz sampling): the blade passing \
+             cannot be found in data sampled this slowly",
+            shown(f_max_hz),
+            fixed(nb * f_max_hz, 2),
+            fixed(0.5 * fs_hz, 2),
+            fixed(fs_hz, 2)
+        )));
     }
     let x = highpass(mag_nt, fs_hz, 0.5 * f_min_hz)?;
     let nper = ((20.0 * fs_hz) as usize).min(x.len());
@@ -119,6 +133,26 @@ pub fn estimate_phase(
         .max_by(|a, b| psd.values[a.0].total_cmp(&psd.values[b.0]))
         .map(|(i, _)| i)
         .ok_or_else(|| CompError::data("rotor phase: no spectral bin in the search band"))?;
+    // The band's largest power must be a peak, not the flank of a line
+    // outside the band (a band below the rotor's found its second
+    // harmonic's flank at the band's edge, and the tracking then followed
+    // that line out of the band).
+    if let Some(up) = [best.wrapping_sub(1), best + 1]
+        .into_iter()
+        .filter(|&i| i < psd.values.len() && psd.values[i] > psd.values[best])
+        .max_by(|&a, &b| psd.values[a].total_cmp(&psd.values[b]))
+    {
+        return Err(CompError::data(format!(
+            "rotor phase: no blade-passing peak between {} and {} Hz ({blades} blades × the rotor band \
+             {}–{} Hz): the spectrum of the reading rises towards {} Hz, outside the band; is the \
+             rotor's frequency within the band?",
+            fixed(lo, 2),
+            fixed(hi, 2),
+            shown(f_min_hz),
+            shown(f_max_hz),
+            fixed(psd.freqs_hz[up], 2)
+        )));
+    }
     let df = psd.freqs_hz[1] - psd.freqs_hz[0];
     let mut f_bp = psd.freqs_hz[best];
     if best > 0 && best + 1 < psd.values.len() {
@@ -163,6 +197,19 @@ pub fn estimate_phase(
     } else {
         f_r
     };
+    // The tracking follows the strongest line near f_bp; one Welch bin of
+    // blade passing is the spectral peak's own resolution.
+    let slack = df / nb;
+    if !(rotor_hz >= f_min_hz - slack && rotor_hz <= f_max_hz + slack) {
+        return Err(CompError::data(format!(
+            "rotor phase: the rotor tracked from the blade-passing peak at {} Hz turns at {} Hz, \
+             outside the rotor band {}–{} Hz: the peak is not this rotor's blade passing",
+            fixed(f_bp, 2),
+            fixed(rotor_hz, 4),
+            shown(f_min_hz),
+            shown(f_max_hz)
+        )));
+    }
     Ok(PhaseEstimate {
         rotor_hz,
         phase_rad: phase,
