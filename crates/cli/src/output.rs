@@ -4,6 +4,7 @@
 use crate::exit::bad_input;
 use aeromag::io::atomic::{check_writable, check_writable_folder};
 use aeromag::{Compensated, Flight, SensorsCompensated};
+use aeromag_core::output_target::{OutputTarget, output_target, same_file};
 use std::path::Path;
 
 /// Add the compensation columns to the flight, write it to `out` and tell
@@ -158,11 +159,43 @@ pub fn simulate_gradiometer(
 }
 
 /// Check, before any work, that every output file can be written (its
-/// folder is created if missing): bad input otherwise, so a long run never
-/// ends on an unwritable path.
-pub fn check_files<'a>(paths: impl IntoIterator<Item = &'a Path>) -> anyhow::Result<()> {
-    for p in paths {
+/// folder is created if missing) and is neither one of the command's
+/// `inputs` nor another of its outputs: bad input otherwise, so a long run
+/// never ends on an unwritable path, and `--out` naming the input (which
+/// the output replaced: 17 rows became 5 with `--time-range`) is refused.
+/// A device or FIFO (`/dev/null`) is written as it is and may be named
+/// twice.
+pub fn check_files<'a>(
+    outputs: impl IntoIterator<Item = &'a Path>,
+    inputs: &[&Path],
+) -> anyhow::Result<()> {
+    let mut files: Vec<(&Path, std::path::PathBuf)> = Vec::new();
+    for p in outputs {
         check_writable(p).map_err(|e| bad_input!("cannot write '{}': {e}", p.display()))?;
+        let OutputTarget::File(target) =
+            output_target(p).map_err(|e| bad_input!("cannot write '{}': {e}", p.display()))?
+        else {
+            continue;
+        };
+        if let Some(i) = inputs.iter().find(|i| same_file(&target, i)) {
+            return Err(bad_input!(
+                "'{}' is also an input of the command ('{}'): writing it would replace the input; \
+                 name another output file",
+                p.display(),
+                i.display()
+            ));
+        }
+        if let Some((q, _)) = files
+            .iter()
+            .find(|(_, t)| *t == target || same_file(t, &target))
+        {
+            return Err(bad_input!(
+                "'{}' and '{}' name the same output file",
+                q.display(),
+                p.display()
+            ));
+        }
+        files.push((p, target));
     }
     Ok(())
 }

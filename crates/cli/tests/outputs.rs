@@ -119,3 +119,81 @@ fn output_paths_are_checked_before_the_work() {
     );
     assert!(files(&dir.path().join("a")).is_empty());
 }
+
+/// Found by fuzzing: `--out` naming the input replaced it (17 rows became
+/// 5 with `--time-range`), a device or FIFO was replaced by a regular file
+/// (`--out /dev/full` reported success; as root `/dev/null` was lost), and
+/// a symbolic link by the file instead of writing the file it names.
+#[cfg(unix)]
+#[test]
+fn outputs_never_replace_inputs_devices_or_links() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let flight = simulate(d, "calibration", "1");
+    let model = d.join("m.json");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    assert_code(
+        &aeromag(&["calibrate", "-i", &s(&flight), "--model", &s(&model)]),
+        0,
+    );
+    let before = std::fs::read(&flight).unwrap();
+    let model_before = std::fs::read(&model).unwrap();
+    // The input, or the model, as the output: refused before any work.
+    for (out, named) in [(&flight, "calibration.csv"), (&model, "m.json")] {
+        let o = compensate(&model, &flight, out);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains("also an input") && stderr(&o).contains(named),
+            "{}",
+            stderr(&o)
+        );
+    }
+    // Also through a link to the input.
+    let link_to_input = d.join("link.csv");
+    std::os::unix::fs::symlink(&flight, &link_to_input).unwrap();
+    assert_code(&compensate(&model, &flight, &link_to_input), 2);
+    assert_eq!(std::fs::read(&flight).unwrap(), before);
+    assert_eq!(std::fs::read(&model).unwrap(), model_before);
+    // Two outputs naming one file.
+    let o = aeromag(&[
+        "level",
+        "-i",
+        &s(&flight),
+        "--out",
+        &s(&d.join("l.csv")),
+        "--crossovers",
+        &s(&d.join("l.csv")),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("name the same output file"),
+        "{}",
+        stderr(&o)
+    );
+    // A link to an output: the file it names is written, the link stays.
+    let target = d.join("comp.csv");
+    let link = d.join("comp-link.csv");
+    std::os::unix::fs::symlink("comp.csv", &link).unwrap();
+    assert_code(&compensate(&model, &flight, &link), 0);
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    let written = std::fs::read(&target).unwrap();
+    assert!(written.starts_with(b"time,") || written.starts_with(b"#"));
+    // A FIFO: written through, and still a FIFO afterwards.
+    let fifo = d.join("fifo");
+    let c = std::ffi::CString::new(s(&fifo)).unwrap();
+    // SAFETY: a valid NUL-terminated path; mkfifo reads nothing else.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    assert_code(&compensate(&model, &flight, &fifo), 0);
+    assert_eq!(reader.join().unwrap(), written);
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+}

@@ -25,6 +25,7 @@
 //! | [`time`] | calendar dates and decimal years |
 //! | [`quadrature`] | composite Simpson's rule (reference integrals in tests) |
 //! | [`simd`] | kernels compiled with and without AVX, chosen at run time |
+//! | [`output_target`] | where an output goes: a regular file (written atomically) or a device, FIFO or socket |
 //! | [`error`] | [`CoreError`], with `is_bad_input()` |
 
 pub mod error;
@@ -32,6 +33,7 @@ pub mod estimability;
 pub mod field;
 pub mod filter;
 pub mod frames;
+pub mod output_target;
 pub mod parallel;
 pub mod quadrature;
 pub mod random;

@@ -22,6 +22,7 @@
 //! # Ok::<(), std::io::Error>(())
 //! ```
 
+use aeromag_core::output_target::{OutputTarget, output_target};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -67,7 +68,9 @@ fn unregister(tmp: &Path) {
 /// Writes `path` through a registered temporary beside it: `write` fills a
 /// buffered writer ([`Output`]), which is flushed and synced, then the
 /// temporary is renamed to `path`. On any error the temporary is removed
-/// and `path` is left as it was.
+/// and `path` is left as it was. A symbolic link is followed (the file it
+/// names is written); a device, FIFO or socket (`/dev/null`, a pipe) is
+/// written directly ([`output_target`]).
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<Output>) -> std::io::Result<()>,
@@ -83,6 +86,18 @@ pub fn write_atomically(
         }
     };
     interrupted()?;
+    let path = match output_target(path)? {
+        // A device, FIFO or socket is written as it is: a rename would
+        // replace it by a regular file.
+        OutputTarget::Stream(p) => {
+            let f = std::fs::OpenOptions::new().write(true).open(p)?;
+            let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
+            write(&mut w)?;
+            return w.flush();
+        }
+        OutputTarget::File(p) => p,
+    };
+    let path = path.as_path();
     let tmp = temporary(path);
     let result = File::create(&tmp).and_then(|f| {
         let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
@@ -120,8 +135,15 @@ pub fn remove_temporaries() -> usize {
 /// Checks, before any work, that `path` can be written: its folder is
 /// created if missing, must be a folder, and must take a new file (a probe
 /// file is created and removed); `path` itself must not be a folder.
+/// Symbolic links are followed; a device, FIFO or socket passes (it is
+/// written directly).
 pub fn check_writable(path: &Path) -> std::io::Result<()> {
     let err = |kind, msg: String| std::io::Error::new(kind, msg);
+    let path = match output_target(path)? {
+        OutputTarget::Stream(_) => return Ok(()),
+        OutputTarget::File(p) => p,
+    };
+    let path = path.as_path();
     if path.is_dir() {
         return Err(err(
             std::io::ErrorKind::IsADirectory,

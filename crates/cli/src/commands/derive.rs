@@ -50,7 +50,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_files(std::iter::once(a.out.as_path()))?;
+    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
     let product = match (a.vertical_derivative, a.upward, &a.minus) {
         (true, _, _) => GridProduct::VerticalDerivative,
         (_, Some(h), _) => GridProduct::Upward(h),

@@ -178,7 +178,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 fn locate(a: LocateArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()])?;
+    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
     let mut cfg = read_config(a.config.as_deref())?;
     let settings = LocateSettings {
         gradiometer: a

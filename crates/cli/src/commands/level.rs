@@ -93,7 +93,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_files(std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()))?;
+    crate::output::check_files(
+        std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()),
+        &[a.input.input.as_path()],
+    )?;
     let flight = a.input.load()?;
     let opts = LevelOptions {
         value: a.value.clone(),

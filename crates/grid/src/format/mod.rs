@@ -41,6 +41,7 @@ use crate::error::{GridError, Result};
 use crate::grid::{Grid, GridGeometry, MAX_CELL, MAX_COORDINATE, MAX_NODES, MAX_VALUE, MIN_CELL};
 use crate::projection::{Crs, UtmZone};
 use aeromag_core::error::shown;
+use aeromag_core::output_target::{OutputTarget, output_target};
 
 /// The value blank nodes take in the GeoTIFF (`GDAL_NODATA` tag) and ESRI
 /// ASCII (`NODATA_value`) files: −99999, exact in float32 and far outside
@@ -215,7 +216,9 @@ fn beyond_float32(grid: &Grid) -> Option<(usize, usize, f64)> {
 /// Writes a file atomically: `fill` writes into a temporary file created in
 /// the folder of `path` (`.<name>.<pid>.<n>.tmp`), which is then flushed,
 /// synced and renamed to `path`. On any error the temporary file is
-/// removed and the error is [`GridError::Write`] naming `path`.
+/// removed and the error is [`GridError::Write`] naming `path`. A symbolic
+/// link is followed; a device, FIFO or socket is written directly
+/// ([`output_target`]).
 pub(crate) fn write_atomic(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
@@ -224,6 +227,20 @@ pub(crate) fn write_atomic(
     let write_error = |source| GridError::Write {
         path: path.display().to_string(),
         source,
+    };
+    let target = output_target(path).map_err(write_error)?;
+    let path = match &target {
+        // A device, FIFO or socket is written as it is: a rename would
+        // replace it by a regular file.
+        OutputTarget::Stream(p) => {
+            let file = OpenOptions::new()
+                .write(true)
+                .open(p)
+                .map_err(write_error)?;
+            let mut w = BufWriter::with_capacity(1 << 16, file);
+            return fill(&mut w).and_then(|()| w.flush()).map_err(write_error);
+        }
+        OutputTarget::File(p) => p.as_path(),
     };
     let name = path.file_name().ok_or_else(|| {
         write_error(io::Error::new(

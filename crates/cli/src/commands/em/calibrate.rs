@@ -59,7 +59,10 @@ pub struct CalibrateArgs {
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()])?;
+    crate::output::check_files(
+        [a.out.as_path()],
+        &[a.input.as_path(), a.known.as_path(), a.system.as_path()],
+    )?;
     let system = read_system(&a.system)?;
     let epochs = read_detected(&a.input)?;
     let known = known_points(&load_table(&a.known)?, &epochs)?;

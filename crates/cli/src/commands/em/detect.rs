@@ -83,7 +83,7 @@ fn window(name: &str) -> Result<WindowName, String> {
 }
 
 pub fn run(a: DetectArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()])?;
+    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
     let opts = DetectOptions {
         window_len: a.window_len,
         window: a.window.0,

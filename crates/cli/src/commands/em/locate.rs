@@ -49,7 +49,10 @@ pub struct LocateArgs {
 }
 
 pub fn run(a: LocateArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()])?;
+    crate::output::check_files(
+        [a.out.as_path()],
+        &[a.input.as_path(), a.calibration.as_path()],
+    )?;
     let text = std::fs::read_to_string(&a.calibration)
         .map_err(|e| aeromag::Error::read(&a.calibration, e))?;
     let file = CalibrationFile::from_json(&text)
