@@ -65,6 +65,13 @@ use realfft::RealFftPlanner;
 /// Segments with fewer positioned samples than this get no gradient.
 pub const MIN_PROFILE_SAMPLES: usize = 64;
 
+/// Resampled points per positioned sample beyond which a segment gets no
+/// gradient: its median step is far below its mean step, the positions
+/// jittering in place for most of it. Found by fuzzing: a line whose first
+/// 70 % of positions alternated between two adjacent latitudes (a median
+/// step of 10⁻⁹ m) asked for 5·10¹³ bytes and aborted the process.
+pub const MAX_RESAMPLE_FACTOR: usize = 4;
+
 /// The profile operator `S = F⁻¹[|κ_s| B̂]` (nT/m) along each track segment
 /// of `tracks.value`, one value per row; NaN off lines, on short segments
 /// and at rows without a position (module docs).
@@ -106,6 +113,11 @@ pub fn profile_gradient(tracks: &SurveyTracks, cfg: &TrackConfig) -> Result<Vec<
         let ds = steps[steps.len() / 2];
         let values: Vec<f64> = rows.iter().map(|&i| tracks.value[i]).collect();
         let total = *s.last().unwrap_or(&0.0);
+        // A segment whose median step is far below its mean (positions
+        // jittering in place for most of it) is no profile to resample.
+        if !(total / ds <= (MAX_RESAMPLE_FACTOR * rows.len()) as f64) {
+            continue;
+        }
         let m = (total / ds).floor() as usize + 1;
         let grid: Vec<f64> = (0..m).map(|j| j as f64 * ds).collect();
         let mut u: Vec<f64> = grid.iter().map(|&x| interp(&s, &values, x)).collect();
@@ -258,6 +270,23 @@ mod tests {
         assert!(bias < 0.02, "bias {bias} of the peak");
         // Far from the source the operator gives ~0, not the trend's slope.
         assert!(g[n / 2].is_finite() && g[n / 2] > 0.9 * peak);
+    }
+
+    #[test]
+    fn a_profile_jittering_in_place_gets_nan_not_a_huge_resampling() {
+        // 70 % of the rows alternate between two adjacent latitudes, then
+        // the line advances 7 m per row.
+        let n = 1000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * 0.1).collect();
+        let lat: Vec<f64> = (0..n)
+            .map(|i| match i {
+                i if i < 700 && i % 2 == 0 => 50.0,
+                i if i < 700 => f64::from_bits(50.0f64.to_bits() + 1),
+                i => 50.0 + (i - 699) as f64 * 6.3e-5,
+            })
+            .collect();
+        let g = gradient_of(&time, &lat, &vec![10.0; n], &vec![1.0; n], &vec![5.0e4; n]);
+        assert!(g.iter().all(|v| v.is_nan()));
     }
 
     #[test]
