@@ -65,6 +65,7 @@ class Flight:
         vector: Optional[str] = None,
         lines: _Labels = None,
         time_range: Optional[Tuple[float, float]] = None,
+        copy: bool = True,
     ) -> "Flight": ...
     @staticmethod
     def from_pandas(
@@ -74,6 +75,7 @@ class Flight:
         vector: Optional[str] = None,
         lines: _Labels = None,
         time_range: Optional[Tuple[float, float]] = None,
+        copy: bool = True,
     ) -> "Flight": ...
     def to_dict(self) -> Dict[str, np.ndarray]: ...
     def to_csv(self, path: str) -> None: ...

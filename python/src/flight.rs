@@ -72,6 +72,121 @@ impl NumpyBuffer {
     }
 }
 
+/// Canonical columns that hold numbers (every one but `line`).
+const NUMERIC_CANONICAL: [&str; 16] = [
+    "time", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "mag", "flux_x",
+    "flux_y", "flux_z", "diurnal", "igrf",
+];
+
+/// One column of `Flight.from_dict`: numbers as float64 (copied unless
+/// `copy` is false and the array is contiguous float64; a masked array's
+/// masked values NaN; an object array of numbers and `None` as numbers,
+/// `None` NaN), text arrays as text (`None` as an empty, missing cell).
+fn column_from_py(
+    np: &Bound<'_, PyModule>,
+    name: &str,
+    v: &Bound<'_, PyAny>,
+    copy: bool,
+) -> PyResult<ColumnData> {
+    let one_d = |a: &Bound<'_, PyAny>| -> PyResult<()> {
+        if a.getattr("ndim")?.extract::<usize>()? != 1 {
+            return Err(bad_argument(format!(
+                "column '{name}' must be one-dimensional"
+            )));
+        }
+        Ok(())
+    };
+    let ma = np.getattr("ma")?;
+    let masked = ma.call_method1("isMaskedArray", (v,))?.extract::<bool>()?;
+    let mut arr = if masked {
+        // Masked values are missing: filled with NaN (numbers) once the
+        // array is float64.
+        let kind: String = v.getattr("dtype")?.getattr("kind")?.extract()?;
+        if !matches!(kind.as_str(), "f" | "i" | "u" | "b") {
+            return Err(bad_argument(format!(
+                "column '{name}' is a masked array of NumPy dtype kind '{kind}'; give numbers"
+            )));
+        }
+        let f = v.call_method1("astype", ("float64",))?;
+        ma.call_method1("filled", (f, f64::NAN))?
+    } else {
+        np.call_method1("asarray", (v,))?
+    };
+    let mut kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    if kind == "O" {
+        one_d(&arr)?;
+        // Numbers and None only: a number column (pandas gives object
+        // arrays for numbers with None).
+        let items: Vec<Bound<'_, PyAny>> = arr
+            .call_method0("tolist")?
+            .try_iter()?
+            .collect::<PyResult<_>>()?;
+        let numeric = items.iter().all(|x| {
+            x.is_none()
+                || (!x.is_instance_of::<pyo3::types::PyString>()
+                    && !x.is_instance_of::<pyo3::types::PyBytes>()
+                    && x.extract::<f64>().is_ok())
+        });
+        if numeric && !items.is_empty() {
+            let values: Vec<f64> = items
+                .iter()
+                .map(|x| {
+                    if x.is_none() {
+                        Ok(f64::NAN)
+                    } else {
+                        x.extract::<f64>()
+                    }
+                })
+                .collect::<PyResult<_>>()?;
+            arr = np.call_method1("asarray", (values,))?;
+            kind = "f".into();
+        }
+    }
+    Ok(match kind.as_str() {
+        "f" | "i" | "u" | "b" => {
+            let a = np
+                .call_method1("ascontiguousarray", (&arr, "float64"))?
+                .cast_into::<PyArray1<f64>>()
+                .map_err(|_| bad_argument(format!("column '{name}' must be one-dimensional")))?;
+            let values = if copy {
+                Values::Owned(a.readonly().as_slice()?.to_vec())
+            } else {
+                NumpyBuffer::share(a)?
+            };
+            let nan = aeromag::io::nan_count(&values);
+            ColumnData::Numeric {
+                values,
+                missing: Missing {
+                    nan,
+                    ..Missing::default()
+                },
+            }
+        }
+        "U" | "S" | "O" => {
+            one_d(&arr)?;
+            let text: Vec<String> = arr
+                .call_method0("tolist")?
+                .try_iter()?
+                .map(|x| {
+                    x.and_then(|x| {
+                        if x.is_none() {
+                            Ok(String::new())
+                        } else {
+                            x.str().map(|s| s.to_string())
+                        }
+                    })
+                })
+                .collect::<PyResult<_>>()?;
+            ColumnData::Text(text)
+        }
+        other => {
+            return Err(bad_argument(format!(
+                "column '{name}' has NumPy dtype kind '{other}'; give numbers or text"
+            )));
+        }
+    })
+}
+
 /// How to read: the `--columns`, `--mag`, `--vector`, `--lines` and
 /// `--time-range` choices of the CLI, parsed by the same library calls.
 pub fn read_options(
@@ -170,13 +285,18 @@ impl PyFlight {
     /// columns (str arrays or lists) kept as text. The same mapping,
     /// selection and checks as a file.
     ///
-    /// One-dimensional contiguous float64 arrays are not copied: the flight
-    /// reads them in place (other numeric arrays are converted once). Do not
-    /// change them while an aeromag call runs on the flight; aeromag itself
-    /// never writes them (a unit conversion or row selection works on its
-    /// own copy).
+    /// The arrays are copied (`copy=True`), so that changing them
+    /// afterwards changes nothing in the flight, whose checks (time going
+    /// forward, finite values, …) were made on what it holds. With
+    /// `copy=False` one-dimensional contiguous float64 arrays are read in
+    /// place (no copy, for large flights): the caller must then not change
+    /// them while the flight is in use — a changed array is read as it is,
+    /// without those checks. aeromag itself never writes them. Object
+    /// arrays of numbers and `None` are numbers (`None` missing); a masked
+    /// array's masked values are missing.
     #[staticmethod]
-    #[pyo3(signature = (data, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+    #[pyo3(signature = (data, columns=None, mag=None, vector=None, lines=None, time_range=None, copy=true))]
+    #[allow(clippy::too_many_arguments)]
     fn from_dict(
         py: Python<'_>,
         data: &Bound<'_, PyDict>,
@@ -185,6 +305,7 @@ impl PyFlight {
         vector: Option<String>,
         lines: Option<Bound<'_, PyAny>>,
         time_range: Option<(f64, f64)>,
+        copy: bool,
     ) -> PyResult<PyFlight> {
         let opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
         let np = py.import("numpy")?;
@@ -193,45 +314,7 @@ impl PyFlight {
             let name: String = k
                 .extract()
                 .map_err(|_| bad_argument(format!("column names must be str, got {k}")))?;
-            let arr = np.call_method1("asarray", (&v,))?;
-            let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
-            let col = match kind.as_str() {
-                "f" | "i" | "u" | "b" => {
-                    let a = np
-                        .call_method1("ascontiguousarray", (&arr, "float64"))?
-                        .cast_into::<PyArray1<f64>>()
-                        .map_err(|_| {
-                            bad_argument(format!("column '{name}' must be one-dimensional"))
-                        })?;
-                    let values = NumpyBuffer::share(a)?;
-                    let nan = aeromag::io::nan_count(&values);
-                    ColumnData::Numeric {
-                        values,
-                        missing: Missing {
-                            nan,
-                            ..Missing::default()
-                        },
-                    }
-                }
-                "U" | "S" | "O" => {
-                    if arr.getattr("ndim")?.extract::<usize>()? != 1 {
-                        return Err(bad_argument(format!(
-                            "column '{name}' must be one-dimensional"
-                        )));
-                    }
-                    let text: Vec<String> = arr
-                        .call_method0("tolist")?
-                        .try_iter()?
-                        .map(|x| x.and_then(|x| x.str().map(|s| s.to_string())))
-                        .collect::<PyResult<_>>()?;
-                    ColumnData::Text(text)
-                }
-                other => {
-                    return Err(bad_argument(format!(
-                        "column '{name}' has NumPy dtype kind '{other}'; give numbers or text"
-                    )));
-                }
-            };
+            let col = column_from_py(&np, &name, &v, copy)?;
             cols.push((name, col));
         }
         let flight = py
@@ -241,13 +324,28 @@ impl PyFlight {
                     .and_then(Flight::from_table)
             })
             .py_err()?;
+        // A number column given as text (an object or str array) was found
+        // only by the first call that used it.
+        for name in NUMERIC_CANONICAL {
+            if let Some(text) = flight.text_column(name) {
+                let first = text.iter().position(|t| t.trim().parse::<f64>().is_err());
+                return Err(bad_argument(format!(
+                    "column '{name}' holds text{}: give numbers (NaN or None for missing values)",
+                    first.map_or(String::new(), |r| format!(
+                        " ({} at row {r})",
+                        aeromag::core::error::shown_text(&text[r])
+                    ))
+                )));
+            }
+        }
         Ok(PyFlight::new(flight))
     }
 
     /// A flight from a pandas DataFrame, its columns named as in the files
-    /// (`Flight.from_dict` of its columns).
+    /// (`Flight.from_dict` of its columns, `copy` as there).
     #[staticmethod]
-    #[pyo3(signature = (df, columns=None, mag=None, vector=None, lines=None, time_range=None))]
+    #[pyo3(signature = (df, columns=None, mag=None, vector=None, lines=None, time_range=None, copy=true))]
+    #[allow(clippy::too_many_arguments)]
     fn from_pandas(
         py: Python<'_>,
         df: &Bound<'_, PyAny>,
@@ -256,14 +354,23 @@ impl PyFlight {
         vector: Option<String>,
         lines: Option<Bound<'_, PyAny>>,
         time_range: Option<(f64, f64)>,
+        copy: bool,
     ) -> PyResult<PyFlight> {
         let data = PyDict::new(py);
-        for name in df.getattr("columns")?.try_iter()? {
+        let names = df.getattr("columns").map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "from_pandas takes a pandas DataFrame, got {}",
+                df.get_type()
+                    .name()
+                    .map_or("an object".into(), |n| n.to_string())
+            ))
+        })?;
+        for name in names.try_iter()? {
             let name = name?;
             let values = df.get_item(&name)?.call_method0("to_numpy")?;
             data.set_item(name.str()?, values)?;
         }
-        Self::from_dict(py, &data, columns, mag, vector, lines, time_range)
+        Self::from_dict(py, &data, columns, mag, vector, lines, time_range, copy)
     }
 
     /// Every column as a dict of NumPy arrays (file names).

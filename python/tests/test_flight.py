@@ -84,10 +84,19 @@ def test_from_dict_maps_file_names_and_checks():
     # conversion works on a copy, never on the caller's array.
     assert np.allclose(f["time"], t) and np.allclose(f["lat"], 45.0)
     assert np.allclose(data["ins_lat"], np.radians(45.0))
-    # float64 arrays are read in place, not copied: the flight sees a change
-    # made to the caller's array afterwards (what "no copy" means).
+    # The arrays are copied: a change to the caller's array afterwards does
+    # not reach the flight, whose checks were made on what it holds (found
+    # by fuzzing: time edited to run backwards after the flight was built
+    # made level panic and microlevel hang).
     data["mag_1_uc"][3] = 50001.0
-    assert f["mag"][3] == 50001.0
+    data["tt"][5] = -1.0
+    assert f["mag"][3] == 50000.0 and f["time"][5] == 0.5
+    data["tt"][5] = 0.5
+    # copy=False reads float64 arrays in place (large flights): the flight
+    # sees the change.
+    h = aeromag.Flight.from_dict(data, copy=False)
+    data["mag_1_uc"][3] = 50002.0
+    assert h["mag"][3] == 50002.0
     data["mag_1_uc"][3] = 50000.0
     g = aeromag.Flight.from_dict(data, lines=[1002])
     assert len(g) == 100
@@ -99,6 +108,35 @@ def test_from_dict_maps_file_names_and_checks():
     assert e.value.row == 1
     with pytest.raises(aeromag.BadInputError):
         aeromag.Flight.from_dict({"a": np.zeros(3), "b": np.zeros(4)})
+
+
+def test_from_dict_numbers_with_none_masks_and_text():
+    n = 50
+    t = np.arange(n) * 0.1
+    mag = np.full(n, 50000.0)
+    # Numbers with None (an object array, as pandas gives them): numbers,
+    # None missing; it became the text "None" and the flight was built.
+    with_none = [50000.0] * n
+    with_none[7] = None
+    f = aeromag.Flight.from_dict({"time": t, "mag": np.array(with_none, dtype=object)})
+    assert np.isnan(f["mag"][7]) and f["mag"][8] == 50000.0
+    # A masked array's masked values are missing (the mask was dropped).
+    m = np.ma.masked_array(mag, mask=np.arange(n) == 3)
+    f = aeromag.Flight.from_dict({"time": t, "mag": m})
+    assert np.isnan(f["mag"][3]) and f["mag"][4] == 50000.0
+    # A number column given as text is bad input at once, naming it.
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.Flight.from_dict({"time": t.astype(str), "mag": mag})
+    assert "'time'" in str(e.value) and "text" in str(e.value)
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.Flight.from_dict({"time": t, "mag": np.array(["50000"] * (n - 1) + ["x"])})
+    assert "'mag'" in str(e.value) and "row 49" in str(e.value)
+    # Text line labels stay text, None an empty (missing) label.
+    labels = np.array(["L1"] * (n - 1) + [None], dtype=object)
+    f = aeromag.Flight.from_dict({"time": t, "mag": mag, "line": labels})
+    assert f["line"][0] == "L1"
+    with pytest.raises(TypeError):
+        aeromag.Flight.from_pandas(3)
 
 
 def test_pandas_round_trip(cal):
