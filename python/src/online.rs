@@ -54,6 +54,15 @@ impl PyOnline {
         Ok(Some(d))
     }
 
+    /// When adapting, the samples not learnt from as outliers (their
+    /// innovation beyond 100 standard deviations; they are compensated with
+    /// the coefficients of the time); `None` with the model's fixed
+    /// coefficients.
+    #[getter]
+    fn outliers(&self) -> Option<u64> {
+        self.online.outliers()
+    }
+
     /// The extra channels a sample carries, in order (the model's current
     /// channels, e.g. `cur_strb`).
     #[getter]

@@ -128,24 +128,13 @@ impl WarningKind {
 /// total channel mapped as a component gives tens of per cent or more.
 pub const VECTOR_SCALAR_TOLERANCE: f64 = 0.10;
 
-/// The largest magnetic reading taken as one, nT (1 mT): Earth's field is
-/// below 70 000 nT and an aircraft's at its sensors a few thousand; a value
-/// beyond is a corrupted cell or a numeric dummy (−1e32), which would
-/// otherwise run through every computation (a flux component of 1e300 gave
-/// its neighbours an interference of 10²⁹⁵ nT, flagged compensated).
-pub const MAX_FIELD_NT: f64 = 1e6;
-
-/// The largest height taken as one, m (1000 km, twice a magnetic satellite's
-/// orbit): a value beyond is a corrupted cell or a numeric dummy, whose
-/// height difference at a crossover made levelling's normal matrix
-/// overflow (a singular system blamed on the fit).
-pub const MAX_ALT_M: f64 = 1e6;
+pub use aeromag_core::field::{MAX_ALT_M, MAX_FIELD_NT};
 
 /// The largest median ground speed taken as a flight's, m/s: an airliner
 /// cruises at 250 m/s and a fast jet at 700; above, the time is in
 /// minutes or hours (a 60 m/s survey with its time in minutes moves at
 /// 3 600 m/s), and [`check_units`] warns.
-pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = 1000.0;
+pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = aeromag_core::field::MAX_GROUND_SPEED_M_S;
 
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);

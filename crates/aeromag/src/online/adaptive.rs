@@ -9,7 +9,9 @@ use aeromag_compensation::kalman::NoiseModel;
 use aeromag_compensation::kalman::online::{OnlineKalman, OnlineKalmanSettings};
 use aeromag_compensation::model_file::{KalmanSettings, MethodSettings};
 use aeromag_compensation::tolles_lawson::adaptive::{AdaptiveTl, CoefficientEstimator, Navigation};
-use aeromag_compensation::tolles_lawson::online::{OnlineOutput, OnlineSample, OnlineTl};
+use aeromag_compensation::tolles_lawson::online::{
+    OnlineOutput, OnlineSample, OnlineTl, SampleStatus,
+};
 use aeromag_compensation::tolles_lawson::rls::{Rls, RlsSettings};
 use serde::{Deserialize, Serialize};
 
@@ -75,10 +77,28 @@ pub enum OnlineEngine {
 
 impl OnlineEngine {
     /// Compensate one sample (the navigation is used only when adapting).
+    /// An interference beyond any magnetic field
+    /// ([`aeromag_io::MAX_FIELD_NT`]: a model file that does not belong to
+    /// the data) is no compensated value: the sample is `Missing`.
     pub fn push(&mut self, sample: &OnlineSample, nav: Navigation) -> OnlineOutput {
-        match self {
+        let o = match self {
             OnlineEngine::Fixed(o) => o.push(sample),
             OnlineEngine::Adaptive(a) => a.push(sample, nav),
+        };
+        // NaN too: neither is a compensated value.
+        if o.status.is_compensated() && !(o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT) {
+            OnlineOutput::not(SampleStatus::Missing)
+        } else {
+            o
+        }
+    }
+
+    /// When adapting, the samples not learnt from as outliers
+    /// ([`aeromag_compensation::tolles_lawson::adaptive::OUTLIER_NIS`]).
+    pub fn outliers(&self) -> Option<u64> {
+        match self {
+            OnlineEngine::Fixed(_) => None,
+            OnlineEngine::Adaptive(a) => Some(a.outliers()),
         }
     }
 
@@ -206,6 +226,7 @@ impl CausalTl {
             snapshots,
             mean_nis: tl.mean_nis(),
             failed_updates: tl.failed_updates(),
+            outliers: tl.outliers(),
         })
     }
 }
@@ -236,4 +257,7 @@ pub struct AdaptedFlight {
     pub mean_nis: Option<f64>,
     /// Samples the estimator could not learn from (numerically).
     pub failed_updates: u64,
+    /// Samples not learnt from as outliers
+    /// ([`aeromag_compensation::tolles_lawson::adaptive::OUTLIER_NIS`]).
+    pub outliers: u64,
 }

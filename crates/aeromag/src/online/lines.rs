@@ -300,16 +300,11 @@ impl LineCompensator {
                         alt_m: alt,
                     },
                 );
-                let flag = StreamFlag::from(o.status);
-                // NaN too: neither is a compensated value.
-                let within_any_field = o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT;
-                if matches!(flag, StreamFlag::Compensated | StreamFlag::Started)
-                    && !within_any_field
-                {
-                    (f64::NAN, f64::NAN, StreamFlag::Missing)
-                } else {
-                    (o.interference_nt, o.compensated_nt, flag)
-                }
+                (
+                    o.interference_nt,
+                    o.compensated_nt,
+                    StreamFlag::from(o.status),
+                )
             }
         };
         self.counts.add(flag);
@@ -403,6 +398,12 @@ impl LineCompensator {
     /// order) when adapting, `None` with the model's fixed coefficients.
     pub fn coefficients(&self) -> Option<(&[f64], Vec<f64>)> {
         self.engine.coefficients()
+    }
+
+    /// When adapting, the samples not learnt from as outliers
+    /// ([`OnlineEngine::outliers`]).
+    pub fn outliers(&self) -> Option<u64> {
+        self.engine.outliers()
     }
 }
 
@@ -556,6 +557,13 @@ impl LineStream {
         self.comp
             .as_ref()
             .map_or(self.before, |c| self.before.plus(c.counts()))
+    }
+
+    /// When adapting, the samples not learnt from as outliers
+    /// ([`OnlineEngine::outliers`]; `None` otherwise, or before the first
+    /// header).
+    pub fn outliers(&self) -> Option<u64> {
+        self.comp.as_ref().and_then(|c| c.outliers())
     }
 
     /// When adapting: each coefficient's name, current value and standard

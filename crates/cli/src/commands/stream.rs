@@ -141,6 +141,12 @@ fn print_coefficients(stream: &LineStream) {
             eprintln!("  {name:<8} {v} ± {s:.3e}");
         }
     }
+    if let Some(n) = stream.outliers().filter(|&n| n > 0) {
+        eprintln!(
+            "warning: {n} sample(s) not learnt from: their innovation was beyond 100 standard deviations \
+             (an outlying reading; they were compensated with the coefficients of the time)"
+        );
+    }
 }
 
 /// Serve one TCP connection after another, for ever (Ctrl-C ends it).

@@ -161,6 +161,23 @@ impl JointFilter {
         dz_m: f64,
         y_nt: f64,
     ) -> Result<Innovation> {
+        self.step_gated(d_m, dt_s, h1, dz_m, y_nt, f64::INFINITY)
+            .map(|(nu, _)| nu)
+    }
+
+    /// [`Self::step_timed`], the update left out when the normalised
+    /// innovation squared `ν²/σ²` exceeds `gate_nis` (an outlier: the
+    /// estimate is only predicted). Returns the innovation and whether it
+    /// was used.
+    pub fn step_gated(
+        &mut self,
+        d_m: f64,
+        dt_s: f64,
+        h1: &[f64],
+        dz_m: f64,
+        y_nt: f64,
+        gate_nis: f64,
+    ) -> Result<(Innovation, bool)> {
         if h1.len() != self.m {
             return Err(CompError::data(format!(
                 "design row of length {} for {} coefficients",
@@ -194,9 +211,14 @@ impl JointFilter {
         self.h[B_H] = 1.0;
         self.h[self.b_z] = dz_m;
         self.h[self.x2_dim..].copy_from_slice(h1);
-        self.filter
-            .update(&self.h, y_nt, self.noise.r_nt2)
-            .map_err(est)
+        let r = self.noise.r_nt2;
+        if gate_nis.is_finite() {
+            let nu = self.filter.innovation(&self.h, y_nt, r).map_err(est)?;
+            if !(nu.value * nu.value <= gate_nis * nu.variance) {
+                return Ok((nu, false));
+            }
+        }
+        Ok((self.filter.update(&self.h, y_nt, r).map_err(est)?, true))
     }
 
     /// The current coefficient estimate `X1`.

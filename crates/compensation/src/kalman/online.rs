@@ -54,7 +54,7 @@ use super::anomaly_model::{NoiseModel, X2Prior};
 use super::joint_filter::JointFilter;
 use crate::error::{CompError, Result};
 use crate::tolles_lawson::Design;
-use crate::tolles_lawson::adaptive::{AdaptiveStep, CoefficientEstimator};
+use crate::tolles_lawson::adaptive::{AdaptiveStep, CoefficientEstimator, OUTLIER_NIS, Update};
 use crate::tolles_lawson::terms::Column;
 use serde::{Deserialize, Serialize};
 
@@ -228,7 +228,7 @@ impl CoefficientEstimator for OnlineKalman {
         self.filter.start_run()
     }
 
-    fn update(&mut self, step: &AdaptiveStep) -> Result<()> {
+    fn update(&mut self, step: &AdaptiveStep) -> Result<Update> {
         for (r, &k) in self.row.iter_mut().zip(&self.order) {
             *r = step.row[k];
         }
@@ -243,15 +243,23 @@ impl CoefficientEstimator for OnlineKalman {
             }
             (_, false) => 0.0,
         };
-        let nu =
-            self.filter
-                .step_timed(step.along_track_m, step.dt_s, &self.row, dz_m, y - y_ref)?;
+        let (nu, used) = self.filter.step_gated(
+            step.along_track_m,
+            step.dt_s,
+            &self.row,
+            dz_m,
+            y - y_ref,
+            OUTLIER_NIS,
+        )?;
+        if !used {
+            return Ok(Update::Outlier);
+        }
         let z = nu.normalized();
         self.nis = (self.nis.0 + z * z, self.nis.1 + 1);
         for (j, &k) in self.order.iter().enumerate() {
             self.coef[k] = self.filter.coefficients()[j];
         }
-        Ok(())
+        Ok(Update::Learnt)
     }
 
     fn needs_speed(&self) -> bool {

@@ -32,6 +32,7 @@ use super::design::TotalField;
 use super::online::{AXES, OnlineOutput, OnlineRows, OnlineSample, SampleStatus, dot};
 use super::{Design, Magnitude};
 use crate::error::{CompError, Result};
+use aeromag_core::field::{MAX_ALT_M, MAX_GROUND_SPEED_M_S};
 
 /// What an estimator gets for one sample.
 #[derive(Debug, Clone, Copy)]
@@ -49,6 +50,28 @@ pub struct AdaptiveStep<'a> {
     pub alt_m: f64,
 }
 
+/// The normalised innovation squared `ν²/σ²` beyond which a sample is an
+/// outlier that an estimator does not learn from (it is still
+/// compensated): 100 standard deviations, far beyond any innovation of a
+/// valid sample (the simulated flights' largest are below 10 σ). Found by
+/// fuzzing: one `mag` of 900 000 nT (below [`MAX_FIELD_NT`]) or 0 made the
+/// Kalman filter's `mag_comp` −555 000 nT on the next samples and moved a
+/// coefficient from −22 to 48 290, all flagged compensated; RLS was 500–1400
+/// nT off afterwards.
+///
+/// [`MAX_FIELD_NT`]: aeromag_core::field::MAX_FIELD_NT
+pub const OUTLIER_NIS: f64 = 1e4;
+
+/// What an estimator did with a sample ([`CoefficientEstimator::update`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Update {
+    /// The sample updated the estimate.
+    Learnt,
+    /// Its innovation was beyond [`OUTLIER_NIS`]: the estimate is unchanged
+    /// (the Kalman filter's prediction to the sample's time is kept).
+    Outlier,
+}
+
 /// An estimator of the coefficients, updated one sample at a time.
 pub trait CoefficientEstimator: std::fmt::Debug + Send + Sync {
     /// The current estimate, column order.
@@ -58,8 +81,9 @@ pub trait CoefficientEstimator: std::fmt::Debug + Send + Sync {
     /// A new run starts with the next sample (after a gap or an unusable
     /// sample): the field may have jumped.
     fn start_run(&mut self) -> Result<()>;
-    /// Update with one sample. On error the estimate is unchanged.
-    fn update(&mut self, step: &AdaptiveStep) -> Result<()>;
+    /// Update with one sample, unless its innovation is beyond
+    /// [`OUTLIER_NIS`]. On error the estimate is unchanged.
+    fn update(&mut self, step: &AdaptiveStep) -> Result<Update>;
     /// The mean normalised innovation squared `ν²/σ²` over the updates so
     /// far, when the estimator predicts its innovations' variance (≈ 1
     /// when its model fits the data; ≫ 1: the field or the reading varies
@@ -107,6 +131,7 @@ pub struct AdaptiveTl {
     /// The time of the last sample learnt from in this run, s.
     last_learnt_s: f64,
     failed_updates: u64,
+    outliers: u64,
 }
 
 impl AdaptiveTl {
@@ -137,6 +162,7 @@ impl AdaptiveTl {
             pending_start: true,
             last_learnt_s: f64::NAN,
             failed_updates: 0,
+            outliers: 0,
         })
     }
 
@@ -169,6 +195,12 @@ impl AdaptiveTl {
     /// compensated, the coefficients kept.
     pub fn failed_updates(&self) -> u64 {
         self.failed_updates
+    }
+
+    /// Samples not learnt from as outliers ([`OUTLIER_NIS`]): compensated
+    /// with the coefficients they found.
+    pub fn outliers(&self) -> u64 {
+        self.outliers
     }
 
     /// Compensate one sample with the current coefficients, then update
@@ -209,7 +241,14 @@ impl AdaptiveTl {
         if status == SampleStatus::Started {
             self.pending_start = true;
         }
-        let speed_known = nav.speed_m_s.is_finite() && nav.speed_m_s >= 0.0;
+        // A speed or an altitude beyond any aircraft's is a corrupted value
+        // (a speed of 1e308 made the coefficients NaN): unknown.
+        let speed_known = (0.0..=MAX_GROUND_SPEED_M_S).contains(&nav.speed_m_s);
+        let alt_m = if nav.alt_m.abs() <= MAX_ALT_M {
+            nav.alt_m
+        } else {
+            f64::NAN
+        };
         if speed_known || !self.estimator.needs_speed() {
             let dt_s = if self.pending_start {
                 0.0
@@ -226,13 +265,15 @@ impl AdaptiveTl {
                 } else {
                     f64::NAN
                 },
-                alt_m: nav.alt_m,
+                alt_m,
             };
-            if started && self.estimator.update(&step).is_ok() {
-                self.pending_start = false;
-                self.last_learnt_s = s.time_s;
-            } else {
-                self.failed_updates += 1;
+            match started.then(|| self.estimator.update(&step)) {
+                Some(Ok(Update::Learnt)) => {
+                    self.pending_start = false;
+                    self.last_learnt_s = s.time_s;
+                }
+                Some(Ok(Update::Outlier)) => self.outliers += 1,
+                _ => self.failed_updates += 1,
             }
         }
         OnlineOutput::compensated(s.mag_nt, interference_nt, status)
@@ -257,7 +298,8 @@ mod tests {
     /// after the other) with known coefficients (`p3,i5`), the estimators
     /// started from wrong ones: they learn them, under both magnitudes;
     /// without the ground speed the Kalman filter learns nothing and RLS
-    /// (which does not need it) still learns.
+    /// (which does not need it) still learns. Dropout readings and corrupt
+    /// navigation values leave what they learn as it is.
     #[test]
     fn the_estimators_learn_wrong_starting_coefficients() {
         let terms = TermSet::parse("p3,i5").unwrap();
@@ -286,25 +328,48 @@ mod tests {
                 .sqrt()
         };
         let e0 = err(&start);
+        // With `glitches`, two readings are dropout values (900 000 nT, 0)
+        // and one speed and one altitude are 1e308 (found by fuzzing: each
+        // turned the coefficients into NaN or thousands of nT off).
+        let run_with =
+            |design: &Design, est: Box<dyn CoefficientEstimator>, speed: f64, glitches: bool| {
+                let mut tl = AdaptiveTl::new(design, 0.15, est).unwrap();
+                for k in 0..n {
+                    let glitch = glitches && [1000, 4000, 2000, 3000].contains(&k);
+                    let out = tl.push(
+                        &OnlineSample {
+                            time_s: t[k],
+                            flux_nt: [f[0][k], f[1][k], f[2][k]],
+                            mag_nt: match k {
+                                1000 if glitch => 900_000.0,
+                                4000 if glitch => 0.0,
+                                _ => m[k],
+                            },
+                            channels: &[],
+                        },
+                        Navigation {
+                            speed_m_s: if glitch && k == 2000 { 1e308 } else { speed },
+                            alt_m: if glitch && k == 3000 { 1e308 } else { f64::NAN },
+                        },
+                    );
+                    assert!(out.status.is_compensated());
+                }
+                assert_eq!(tl.failed_updates(), 0);
+                let learning = speed.is_finite() || !tl.estimator.needs_speed();
+                let outliers = if glitches && learning { 2 } else { 0 };
+                assert_eq!(tl.outliers(), outliers, "no valid sample is an outlier");
+                (err(tl.coefficients()), tl.coefficient_std(), tl.mean_nis())
+            };
         let run = |design: &Design, est: Box<dyn CoefficientEstimator>, speed: f64| {
-            let mut tl = AdaptiveTl::new(design, 0.15, est).unwrap();
-            for k in 0..n {
-                let out = tl.push(
-                    &OnlineSample {
-                        time_s: t[k],
-                        flux_nt: [f[0][k], f[1][k], f[2][k]],
-                        mag_nt: m[k],
-                        channels: &[],
-                    },
-                    Navigation {
-                        speed_m_s: speed,
-                        alt_m: f64::NAN,
-                    },
-                );
-                assert!(out.status.is_compensated());
-            }
-            assert_eq!(tl.failed_updates(), 0);
-            (err(tl.coefficients()), tl.coefficient_std(), tl.mean_nis())
+            let clean = run_with(design, est.clone(), speed, false);
+            let glitched = run_with(design, est, speed, true);
+            assert!(
+                glitched.0 <= 1.2 * clean.0 && glitched.2.is_none_or(|v| v.is_finite()),
+                "glitches: {} against {}",
+                glitched.0,
+                clean.0
+            );
+            clean
         };
         let std = [5.0; 8];
         for magnitude in [Magnitude::FirstOrder, Magnitude::Exact] {

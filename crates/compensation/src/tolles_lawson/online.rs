@@ -47,6 +47,7 @@ use super::design::{Lags, TotalField};
 use super::terms::backward_difference;
 use super::{Design, Magnitude};
 use crate::error::{CompError, Result};
+use aeromag_core::field::MAX_FIELD_NT;
 
 /// One sample of a stream: time (s), the vector magnetometer (body frame,
 /// nT), the scalar reading (nT) and the extra regressors' channels in the
@@ -72,8 +73,9 @@ pub enum SampleStatus {
     /// a gap or a sample that could not be used): derivative 0, the lags
     /// restarted.
     Started,
-    /// Not compensated: an input is missing (not finite) or the field is
-    /// all zero. The run ends.
+    /// Not compensated: an input is missing (not finite), `mag` or a
+    /// `flux` component is beyond any magnetic field
+    /// ([`MAX_FIELD_NT`]), or the field is all zero. The run ends.
     Missing,
     /// Not compensated: its time does not increase. The state is kept.
     TimeBackwards,
@@ -179,9 +181,12 @@ impl OnlineRows {
         {
             return SampleStatus::TimeBackwards;
         }
+        // A reading beyond any magnetic field is a corrupted value, as a
+        // missing one (1e308 ran through an adaptive compensator's state).
+        let field = |v: &f64| v.abs() <= MAX_FIELD_NT;
         let usable = s.time_s.is_finite()
-            && s.mag_nt.is_finite()
-            && s.flux_nt.iter().all(|v| v.is_finite())
+            && field(&s.mag_nt)
+            && s.flux_nt.iter().all(field)
             && s.channels.len() == self.extra.len()
             && s.channels.iter().all(|v| v.is_finite())
             && s.flux_nt.iter().any(|v| *v != 0.0);
@@ -349,7 +354,7 @@ impl OnlineTl {
 
 impl OnlineOutput {
     /// A compensated sample: reading `mag_nt` minus `interference_nt`.
-    pub(crate) fn compensated(mag_nt: f64, interference_nt: f64, status: SampleStatus) -> Self {
+    pub fn compensated(mag_nt: f64, interference_nt: f64, status: SampleStatus) -> Self {
         Self {
             interference_nt,
             compensated_nt: mag_nt - interference_nt,
@@ -358,7 +363,7 @@ impl OnlineOutput {
     }
 
     /// The output of a sample that was not compensated.
-    pub(crate) fn not(status: SampleStatus) -> Self {
+    pub fn not(status: SampleStatus) -> Self {
         Self {
             interference_nt: f64::NAN,
             compensated_nt: f64::NAN,
@@ -518,5 +523,29 @@ mod tests {
             channels: &[1.0],
         });
         assert_eq!(out.status, SampleStatus::Missing);
+        // A reading beyond any magnetic field is a corrupted value: missing
+        // (flux of 1e308 gave an interference of 0 flagged compensated, and
+        // NaN afterwards).
+        let b = [20_000.0, 1_000.0, 45_000.0];
+        for (k, (flux_nt, mag_nt)) in [
+            (b, 49_300.0),
+            (b, 1e308),
+            ([1e308, 1e308, 1e308], 49_300.0),
+            (b, -2e6),
+            (b, 49_300.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let out = o.push(&OnlineSample {
+                time_s: 1.0 + 0.1 * k as f64,
+                flux_nt,
+                mag_nt,
+                channels: &[],
+            });
+            let usable = mag_nt.abs() < 1e6 && flux_nt[0] < 1e6;
+            assert_eq!(out.status.is_compensated(), usable, "{k}");
+            assert_eq!(out.interference_nt.is_finite(), usable, "{k}");
+        }
     }
 }

@@ -20,7 +20,7 @@
 //! the Kalman filter; this one shows what it avoids. The offset's variance
 //! is reset at every run start (the field jumps across a gap).
 
-use super::adaptive::{AdaptiveStep, CoefficientEstimator};
+use super::adaptive::{AdaptiveStep, CoefficientEstimator, OUTLIER_NIS, Update};
 use crate::error::{CompError, Result};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -146,7 +146,7 @@ impl CoefficientEstimator for Rls {
         Ok(())
     }
 
-    fn update(&mut self, step: &AdaptiveStep) -> Result<()> {
+    fn update(&mut self, step: &AdaptiveStep) -> Result<Update> {
         let m = self.m();
         if step.row.len() != m || !step.y_nt.is_finite() || step.dt_s.is_nan() || step.dt_s < 0.0 {
             return Err(CompError::data(format!(
@@ -158,10 +158,11 @@ impl CoefficientEstimator for Rls {
         }
         let mut y = step.y_nt;
         if self.settings.differenced {
-            let Some((row0, y0)) = self.prev.replace((step.row.to_vec(), step.y_nt)) else {
-                return Ok(());
+            let Some((row0, y0)) = &self.prev else {
+                self.prev = Some((step.row.to_vec(), step.y_nt));
+                return Ok(Update::Learnt);
             };
-            for ((h, r), r0) in self.h.iter_mut().zip(step.row).zip(&row0) {
+            for ((h, r), r0) in self.h.iter_mut().zip(step.row).zip(row0) {
                 *h = r - r0;
             }
             self.h[m] = 0.0;
@@ -178,12 +179,20 @@ impl CoefficientEstimator for Rls {
             )));
         }
         let e = y - self.h.dot(&self.theta);
+        // An outlier is left out, and so is its row as the next difference's
+        // start.
+        if !(e * e <= OUTLIER_NIS * alpha) {
+            return Ok(Update::Outlier);
+        }
+        if self.settings.differenced {
+            self.prev = Some((step.row.to_vec(), step.y_nt));
+        }
         self.theta.axpy(e / alpha, &self.ph, 1.0);
         // P ← (P − Ph (Ph)ᵀ / α) / λ, symmetric by construction.
         let lambda = (-step.dt_s / self.settings.memory_s).exp();
         self.p.ger(-1.0 / alpha, &self.ph, &self.ph, 1.0);
         self.p /= lambda;
-        Ok(())
+        Ok(Update::Learnt)
     }
 
     fn boxed_clone(&self) -> Box<dyn CoefficientEstimator> {

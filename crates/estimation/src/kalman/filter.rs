@@ -174,6 +174,27 @@ impl SqrtKalmanFilter {
         )
     }
 
+    /// The innovation that [`update`](Self::update) with row `h`, value
+    /// `y` and noise variance `r` would have, `ν = y − hᵀx`,
+    /// `σ² = |Sᵀh|² + r`, without updating: for a caller that leaves out an
+    /// outlier before it enters the estimate.
+    pub fn innovation(&self, h: &[f64], y: f64, r: f64) -> Result<Innovation> {
+        let n = self.dim();
+        if h.len() != n {
+            return Err(EstError::Dimension("measurement row length".into()));
+        }
+        let mut variance = r;
+        for j in 0..n {
+            let f: f64 = (0..=j).map(|i| self.s[(i, j)] * h[i]).sum();
+            variance += f * f;
+        }
+        let predicted: f64 = h.iter().zip(self.x.iter()).map(|(a, b)| a * b).sum();
+        Ok(Innovation {
+            value: y - predicted,
+            variance,
+        })
+    }
+
     /// The Kalman gain `P⁻h/α` of the last [`update`](Self::update).
     pub fn last_gain(&self) -> &[f64] {
         &self.gain
