@@ -96,6 +96,11 @@ const NOT_REFERENCES: [&str; 6] = [
     "flux_z",
 ];
 
+/// Canonical columns that are no magnetic field, so no reference.
+const NOT_FIELDS: [&str; 11] = [
+    "time", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "line",
+];
+
 /// The sum of the named reference channels of `flight` (zeros if none),
 /// nT. With a lever arm, the `igrf` channel is moved from the navigation
 /// point to the sensor (needs `lat`, `lon`, `alt`, `roll`, `pitch`, `yaw`;
@@ -110,6 +115,26 @@ pub fn reference_sum(
             "reference channel `{c}` is a magnetometer reading or its compensation, not a \
              reference: a reference is a field the aircraft does not make (igrf, diurnal, a base \
              station's record)"
+        )));
+    }
+    if let Some(c) = cols.iter().find(|c| NOT_FIELDS.contains(&c.as_str())) {
+        return Err(Error::bad_input(format!(
+            "reference channel `{c}` is not a magnetic field (nT): a reference is a field the \
+             aircraft does not make (igrf, diurnal, a base station's record)"
+        )));
+    }
+    // Each channel named is subtracted once per naming: found by fuzzing,
+    // `diurnal,diurnal` moved the fitted p_z from −12.9 to −15.1 nT silently.
+    if let Some((k, c)) = cols
+        .iter()
+        .enumerate()
+        .find(|(k, c)| cols[..*k].contains(c))
+    {
+        return Err(Error::bad_input(format!(
+            "reference channel `{c}` is named twice (channels {} and {} of the list): each is \
+             subtracted once",
+            cols.iter().position(|x| x == c).map_or(0, |p| p + 1),
+            k + 1
         )));
     }
     let mut r = vec![0.0; flight.n_rows()];
@@ -168,6 +193,16 @@ mod tests {
         for c in ["mag", "mag_comp"] {
             let e = reference_sum(&f, &["diurnal".into(), c.into()], None).unwrap_err();
             assert!(e.is_bad_input() && e.to_string().contains(c), "{e}");
+        }
+        // Neither is a column that is no field, nor one named twice (it was
+        // subtracted twice).
+        for (cols, needle) in [
+            (vec!["time"], "not a magnetic field"),
+            (vec!["diurnal", "diurnal"], "named twice (channels 1 and 2"),
+        ] {
+            let cols: Vec<String> = cols.into_iter().map(String::from).collect();
+            let e = reference_sum(&f, &cols, None).unwrap_err();
+            assert!(e.is_bad_input() && e.to_string().contains(needle), "{e}");
         }
     }
 }
