@@ -164,6 +164,25 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
         let e = LineCompensator::new(&model, header, &opts).unwrap_err();
         assert!(e.is_bad_input() && e.to_string().contains(says), "{e}");
     }
+    // A column map naming a column the stream lacks fell back on `mag`
+    // (a typo switched sensors); one column in two roles flagged every line
+    // malformed without a reason.
+    for (map, says) in [
+        ("mag=mag_3", "\"mag_3\", which the stream does not have"),
+        ("mag=flux_x", "both `mag` and `flux_x`"),
+        ("time=mag", "both `time` and `mag`"),
+    ] {
+        let opts = StreamOptions {
+            columns: aeromag::ColumnMap::parse(map).unwrap(),
+            ..StreamOptions::default()
+        };
+        let e =
+            LineCompensator::new(&model, "time,flux_x,flux_y,flux_z,mag,mag_2", &opts).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains(says),
+            "{map}: {e}"
+        );
+    }
     let wide: Vec<String> = (0..1_000_000).map(|k| format!("c{k}")).collect();
     let wide = wide.join(",");
     let e = LineCompensator::new(&model, &wide, &opts).unwrap_err();

@@ -523,6 +523,19 @@ fn several_sensors_with_current_terms() {
         comp.to_str().unwrap(),
     ]);
     assert_code(&o, 0);
+    // `stream` takes one sensor: it said the model was not written by
+    // `aeromag calibrate`.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_aeromag"))
+        .args(["stream", "--model", m.to_str().unwrap()])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("stream compensates one sensor"),
+        "{}",
+        stderr(&o)
+    );
     // `calibrate --compensated` wrote the same file from its one reading.
     assert_eq!(
         std::fs::read(&comp).unwrap(),

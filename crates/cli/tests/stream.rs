@@ -300,6 +300,24 @@ fn stream_and_causal_errors_exit_2() {
     ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("--causal"), "{}", stderr(&o));
+    // An estimator's flag with the other estimator was ignored silently.
+    let m = model.to_str().unwrap();
+    for (args, says) in [
+        (
+            ["--adapt", "rls", "--permanent-drift", "5"],
+            "--permanent-drift applies to --adapt kalman only",
+        ),
+        (
+            ["--adapt", "kalman", "--memory", "900"],
+            "--memory applies to --adapt rls only",
+        ),
+    ] {
+        let mut all = vec!["stream", "--model", m];
+        all.extend(args);
+        let o = aeromag(&all);
+        assert_code(&o, 2);
+        assert!(stderr(&o).contains(says), "{}", stderr(&o));
+    }
 }
 
 /// At real-time pace (one line, then its answer, then the next), every

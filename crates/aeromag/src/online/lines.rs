@@ -183,6 +183,18 @@ impl LineCompensator {
                 listed(&names)
             )));
         }
+        // A mapping onto a column the stream lacks (a typo) fell back on
+        // the canonical column silently, switching sensors.
+        for (canonical, name) in opts.columns.pairs() {
+            if !names.iter().any(|h| h.eq_ignore_ascii_case(name)) {
+                return Err(Error::bad_input(format!(
+                    "the column map sends `{canonical}` to column {:?}, which the stream does not have; \
+                     its columns: {}",
+                    clipped(name),
+                    listed(&names)
+                )));
+            }
+        }
         let lookup = |canonical: &str| -> Option<usize> {
             let by = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
             opts.columns
@@ -241,6 +253,22 @@ impl LineCompensator {
             count: names.len(),
             last: 0,
         };
+        // One stream column in two roles (`--columns mag=flux_x`): every
+        // line was flagged malformed without a reason.
+        let roles: Vec<(&str, usize)> = [("time", fields.time), ("mag", fields.mag)]
+            .into_iter()
+            .chain(["flux_x", "flux_y", "flux_z"].into_iter().zip(fields.flux))
+            .collect();
+        for (k, (a, i)) in roles.iter().enumerate() {
+            if let Some((b, _)) = roles[..k].iter().find(|(_, j)| j == i) {
+                return Err(Error::bad_input(format!(
+                    "the stream column {:?} would be read as both `{b}` and `{a}`; its columns: {} \
+                     (map each with --columns {a}=NAME)",
+                    clipped(names[*i]),
+                    listed(&names)
+                )));
+            }
+        }
         let mut fields = fields;
         fields.last = [fields.time, fields.mag]
             .into_iter()

@@ -19,10 +19,11 @@ use std::path::PathBuf;
 /// names the columns. Each line is written back, flushed, with
 /// `mag_interf` and `mag_comp` (nT) and `comp_flag`: 0 compensated,
 /// 1 missing value (or an interference beyond any magnetic field, 10⁶ nT),
-/// 2 compensated after a gap (run restarted), 3 time going back (ignored),
-/// 4 malformed line (or a `mag`/`flux_*` value beyond 10⁶ nT). Bad lines
-/// never stop the stream; the counts go to standard error when a stream
-/// ends. Comment
+/// 2 compensated after a gap (run restarted), 3 time going back (ignored;
+/// after 10 such lines in a row that advance together, the stream runs on
+/// their clock), 4 malformed line (or a `mag`/`flux_*` value beyond 10⁶
+/// nT). Bad lines never stop the stream; the counts go to standard error
+/// when a stream ends. Comment
 /// lines (`#` first, as in a CSV file: a simulated file's `# units:`
 /// lines) are written back as they are, in their place, and so are blank
 /// lines before the header.
@@ -85,6 +86,38 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    // The estimators' own flags with the other estimator were ignored
+    // without a word (`--adapt rls --permanent-drift 5`).
+    let given = |flag: &'static str, set: bool| set.then_some(flag);
+    let misplaced = match a.adapt {
+        Some(Adapt::Rls) => [
+            given("--speed", a.speed.is_some()),
+            given("--permanent-drift", a.permanent_drift.is_some()),
+            given("--field-q1", a.field_q1.is_some()),
+        ]
+        .into_iter()
+        .flatten()
+        .next()
+        .map(|f| (f, "kalman")),
+        Some(Adapt::Kalman) => given("--memory", a.memory.is_some()).map(|f| (f, "rls")),
+        None => None,
+    };
+    if let Some((flag, method)) = misplaced {
+        anyhow::bail!(aeromag::Error::bad_input(format!(
+            "{flag} applies to --adapt {method} only"
+        )));
+    }
+    // A multi-sensor model was refused as "not a `tolles-lawson` model
+    // (written by `aeromag calibrate`)", which it was.
+    if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
+    {
+        anyhow::bail!(aeromag::Error::bad_file(
+            a.model.display().to_string(),
+            "a model of several sensors (`calibrate --mag A,B`): stream compensates one sensor; \
+             fit its model alone (`calibrate --mag A`), or compensate the recorded flight with \
+             `aeromag compensate --causal`"
+        ));
+    }
     let model = TlModel::read(&a.model)?;
     let opts = StreamOptions {
         columns: match &a.columns {
@@ -105,7 +138,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let stdin = std::io::stdin().lock();
     let stdout = std::io::stdout().lock();
-    let result = stream.serve(stdin, stdout, "standard input");
+    // The connection is named for its input; a failed write is on the
+    // output ("cannot write 'standard input'" said otherwise).
+    let result = stream
+        .serve(stdin, stdout, "standard input")
+        .map_err(|e| match e {
+            aeromag::Error::Write { source, .. } => aeromag::Error::Write {
+                path: "standard output".into(),
+                source,
+            },
+            e => e,
+        });
     eprintln!("{}", stream.counts());
     print_coefficients(&stream);
     Ok(result?)
