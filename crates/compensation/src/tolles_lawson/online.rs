@@ -77,7 +77,8 @@ pub enum SampleStatus {
     /// `flux` component is beyond any magnetic field
     /// ([`MAX_FIELD_NT`]), or the field is all zero. The run ends.
     Missing,
-    /// Not compensated: its time does not increase. The state is kept.
+    /// Not compensated: its time does not increase. The state is kept
+    /// (until [`RESYNC_SAMPLES`] samples in a row go back together).
     TimeBackwards,
 }
 
@@ -98,6 +99,14 @@ pub struct OnlineOutput {
     /// What happened.
     pub status: SampleStatus,
 }
+
+/// Samples in a row whose time goes back from the last increasing time,
+/// each advancing on the one before within a run's step, after which the
+/// stream takes their clock (the last of them starts a run; the others
+/// stay [`SampleStatus::TimeBackwards`]). Found by fuzzing: one time of
+/// 1e308 or 99 999, or a seconds-of-day clock wrapping at midnight, made
+/// every later sample "time going back" for the rest of the stream.
+pub const RESYNC_SAMPLES: usize = 10;
 
 /// The last sample of the current run.
 #[derive(Debug, Clone, Copy)]
@@ -122,6 +131,10 @@ pub struct OnlineRows {
     last: Option<Last>,
     /// The last increasing time stamp seen.
     last_time_s: Option<f64>,
+    /// The samples in a row whose time went back, each advancing on the
+    /// one before by at most `max_step_s`: the last one's time and how
+    /// many ([`RESYNC_SAMPLES`]).
+    back: Option<(f64, usize)>,
     /// The current sample's inputs: field, derivative, lagged derivatives,
     /// extra channels `[x, L_τ[x]]`.
     b: [f64; 3],
@@ -152,6 +165,7 @@ impl OnlineRows {
             max_step_s,
             last: None,
             last_time_s: None,
+            back: None,
         })
     }
 
@@ -179,7 +193,22 @@ impl OnlineRows {
             && s.time_s.is_finite()
             && s.time_s <= t0
         {
-            return SampleStatus::TimeBackwards;
+            // Samples going back that run on among themselves: after
+            // RESYNC_SAMPLES of them the stream's clock is theirs (the
+            // time before was a spike, or the clock wrapped at midnight).
+            let count = match self.back {
+                Some((b, k)) if s.time_s > b && s.time_s - b <= self.max_step_s => k + 1,
+                _ => 1,
+            };
+            if count < RESYNC_SAMPLES {
+                self.back = Some((s.time_s, count));
+                return SampleStatus::TimeBackwards;
+            }
+            self.back = None;
+            self.last = None;
+            self.last_time_s = None;
+        } else {
+            self.back = None;
         }
         // A reading beyond any magnetic field is a corrupted value, as a
         // missing one (1e308 ran through an adaptive compensator's state).
@@ -255,6 +284,7 @@ impl OnlineRows {
     pub fn reset(&mut self) {
         self.last = None;
         self.last_time_s = None;
+        self.back = None;
         self.lags = Lags::new(&self.design.terms);
     }
 }
@@ -506,6 +536,33 @@ mod tests {
             }
             let b = dirty.push(&sample(k, t[k]));
             assert_eq!(a, b, "row {k}");
+        }
+        // One time far ahead (a corrupted cell): the samples after it go
+        // back, and after RESYNC_SAMPLES of them the stream runs on its
+        // clock again; so it does when the clock jumps back for good.
+        for jump in [1e308, -86_400.0] {
+            let mut o = OnlineTl::new(&design, &coef, 0.15).unwrap();
+            let mut statuses = Vec::new();
+            for k in 0..n {
+                let time_s = match (k, jump > 0.0) {
+                    (50, true) => jump,
+                    (k, false) if k >= 50 => t[k] + jump,
+                    _ => t[k],
+                };
+                statuses.push(o.push(&sample(k, time_s)).status);
+            }
+            let back = statuses
+                .iter()
+                .filter(|s| **s == SampleStatus::TimeBackwards)
+                .count();
+            assert_eq!(back, RESYNC_SAMPLES - 1, "{jump}");
+            let resync = if jump > 0.0 { 51 } else { 50 } + RESYNC_SAMPLES - 1;
+            assert_eq!(statuses[resync], SampleStatus::Started, "{jump}");
+            assert!(
+                statuses[resync + 1..]
+                    .iter()
+                    .all(|s| *s == SampleStatus::Compensated)
+            );
         }
     }
 
