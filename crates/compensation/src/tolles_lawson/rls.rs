@@ -81,21 +81,33 @@ impl Rls {
     /// (NaN: unknown, the floor is used). Bad settings are
     /// [`CompError::InvalidSetting`].
     pub fn new(coef: &[f64], coef_std: &[f64], settings: RlsSettings) -> Result<Self> {
-        if settings.memory_s.is_nan() || settings.memory_s < MIN_MEMORY_S {
+        let shown = aeromag_core::error::shown;
+        if !(settings.memory_s >= MIN_MEMORY_S && settings.memory_s.is_finite()) {
             return Err(CompError::setting(format!(
-                "recursive least squares: a memory of {} s is too short: at least {MIN_MEMORY_S} s",
-                aeromag_core::error::shown(settings.memory_s)
+                "recursive least squares: a memory of {} s (--memory): it must be finite and at least \
+                 {MIN_MEMORY_S} s",
+                shown(settings.memory_s)
             )));
         }
         let ok = |v: f64| v > 0.0 && v.is_finite();
-        if !(ok(settings.memory_s)
-            && ok(settings.noise_nt2)
-            && ok(settings.offset_std_nt)
-            && ok(settings.coef_std_floor))
-            || coef_std.len() != coef.len()
-        {
+        for (name, v) in [
+            ("noise variance (nT²)", settings.noise_nt2),
+            ("offset standard deviation (nT)", settings.offset_std_nt),
+            (
+                "coefficient standard deviation floor",
+                settings.coef_std_floor,
+            ),
+        ] {
+            if !ok(v) {
+                return Err(CompError::setting(format!(
+                    "recursive least squares: a {name} of {} must be finite and > 0",
+                    shown(v)
+                )));
+            }
+        }
+        if coef_std.len() != coef.len() {
             return Err(CompError::setting(format!(
-                "recursive least squares: {settings:?} (every value finite and > 0), {} coefficients, {} standard deviations",
+                "recursive least squares: {} coefficients but {} standard deviations",
                 coef.len(),
                 coef_std.len()
             )));
