@@ -417,3 +417,31 @@ fn time_in_minutes_is_a_named_warning() {
     ]);
     assert!(check_units(&still).unwrap().is_empty());
 }
+
+/// Found by fuzzing: two rows 1e-9 s apart in a 10 Hz flight were taken,
+/// and `compensate` wrote an interference of −177 747 nT as compensated.
+#[test]
+fn a_time_step_far_below_the_median_is_refused_naming_the_rows() {
+    let table = |t: Vec<f64>| {
+        let mut tb = FlightTable::new();
+        tb.add_column("time", t).unwrap();
+        tb
+    };
+    let mut t: Vec<f64> = (0..100).map(|k| k as f64 * 0.1).collect();
+    // Jitter of a few per cent and a gap pass.
+    t[50] += 0.004;
+    for v in &mut t[80..] {
+        *v += 3.0;
+    }
+    check_time(&table(t.clone())).unwrap();
+    for dt in [1e-9, 1e-6, 5e-4] {
+        let mut g = t.clone();
+        g[10] = g[9] + dt;
+        let e = check_time(&table(g)).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            e.is_bad_input() && msg.contains("data row 11") && msg.contains("median step (0.1"),
+            "{msg}"
+        );
+    }
+}
