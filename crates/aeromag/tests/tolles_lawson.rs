@@ -174,6 +174,46 @@ fn an_interference_beyond_any_field_is_bad_input_naming_its_row() {
     }
 }
 
+/// Found by fuzzing: a flight whose time is in milliseconds was compensated
+/// without a word (the eddy-current derivatives a thousandth of the
+/// calibration's, `mag_comp` up to 0.30 nT off), batch and causal alike.
+#[test]
+fn a_flight_timed_in_other_units_than_the_calibration_is_bad_input() {
+    let cal = calibration(5);
+    let model = classical_model(&cal);
+    let mut t = FlightTable::new();
+    for c in cal.table().columns() {
+        let v = c.values().unwrap();
+        let v = if c.name() == "time" {
+            v.iter().map(|x| x * 1e3).collect()
+        } else {
+            v.to_vec()
+        };
+        t.add_column(c.name(), v).unwrap();
+    }
+    let ms = Flight::from_table(t).unwrap();
+    let causal = aeromag::online::CausalTl::new(&model, None).unwrap();
+    for e in [
+        model.compensate(&ms).unwrap_err(),
+        causal.compensate(&ms).unwrap_err(),
+    ] {
+        let msg = e.to_string();
+        assert!(
+            e.is_bad_input() && msg.contains("milliseconds") && msg.contains("1000 times longer"),
+            "{msg}"
+        );
+    }
+    // A tenth of the calibration's rate passes.
+    let every_tenth: Vec<usize> = (0..cal.n_rows()).step_by(10).collect();
+    let mut t = FlightTable::new();
+    for c in cal.table().columns() {
+        let v = c.values().unwrap();
+        t.add_column(c.name(), every_tenth.iter().map(|&k| v[k]).collect())
+            .unwrap();
+    }
+    assert!(model.compensate(&Flight::from_table(t).unwrap()).is_ok());
+}
+
 /// The rows `rows` of every column of `f`, as a flight.
 fn rows_of(f: &FlightTable, rows: std::ops::Range<usize>) -> Flight {
     let mut t = FlightTable::new();

@@ -104,6 +104,7 @@ impl CausalTl {
     /// The interference (nT) at the sensor `sensor` of `flight` under the
     /// causal convention, NaN outside the runs.
     pub fn interference_at(&self, flight: &Flight, sensor: &SensorColumns) -> Result<Vec<f64>> {
+        crate::tolles_lawson::check_time_unit(&self.model, flight)?;
         let design = self.model.design.causal();
         let cols =
             TlInputs::of_sensor(flight, sensor)?.with_extras(flight, design.terms.extras())?;

@@ -30,7 +30,8 @@ mod settings;
 pub use calibrate::{
     CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, SECOND_ORDER_NOTE_NT, calibrate,
 };
-pub use compensate::{InterferenceParts, TL_OUTPUT, second_order_range_nt};
+pub(crate) use compensate::check_time_unit;
+pub use compensate::{InterferenceParts, MAX_STEP_RATIO, TL_OUTPUT, second_order_range_nt};
 pub use contributions::{Contributions, PartsRms};
 pub(crate) use kalman::ground_speed;
 pub use kalman::{KALMAN_SERIES, KalmanOptions, KalmanOutcome, KalmanSeriesColumns};
