@@ -235,7 +235,7 @@ impl Compensated {
         let flags = self.flags();
         table.add_column(self.output.interference, self.interference_nt)?;
         table.add_column(COMPENSATED, self.compensated_nt)?;
-        table.add_column(self.output.flag, flags)?;
+        table.add_integer_column(self.output.flag, flags)?;
         Ok(())
     }
 

@@ -142,7 +142,7 @@ impl Levelled {
             &self.output_column(),
             self.levelling.levelled.value_nt.clone(),
         )?;
-        table.add_column(LEVEL_FLAG, self.flags())?;
+        table.add_integer_column(LEVEL_FLAG, self.flags())?;
         Ok(())
     }
 

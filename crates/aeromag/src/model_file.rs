@@ -27,7 +27,7 @@ pub trait ModelFile: Sized {
     /// not a model of this kind).
     fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+        let text = read_text_file(path)?;
         Self::parse(&text, &path.display().to_string())
     }
 
@@ -39,12 +39,38 @@ pub trait ModelFile: Sized {
     }
 }
 
+/// The largest model, settings or scenario file read, bytes (64 MiB): the
+/// largest model files are tens of kilobytes. Found by fuzzing:
+/// `--model /dev/zero` grew to a gigabyte before running out of memory.
+pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
+
+/// The text of a model, settings or scenario file: bad input when it
+/// cannot be read, is not UTF-8 or is larger than [`MAX_TEXT_FILE_BYTES`].
+pub fn read_text_file(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
+    let mut text = String::new();
+    file.take(MAX_TEXT_FILE_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(|e| Error::read(path, e))?;
+    if text.len() as u64 > MAX_TEXT_FILE_BYTES {
+        return Err(Error::bad_file(
+            path.display().to_string(),
+            format!(
+                "larger than {} MiB: not a model, settings or scenario file",
+                MAX_TEXT_FILE_BYTES >> 20
+            ),
+        ));
+    }
+    Ok(text)
+}
+
 /// The `kind` of the model file at `path` (`tolles-lawson`,
 /// `tolles-lawson-sensors`, `rotor`, …), to choose how to read it; bad
 /// input when it cannot be read or is not a model file.
 pub fn kind_of(path: impl AsRef<Path>) -> Result<String> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = read_text_file(path)?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
         Error::bad_file(
             path.display().to_string(),
@@ -147,6 +173,22 @@ mod tests {
         let e = write_atomically(&d.path().join("no/such/m.json"), b"x").unwrap_err();
         assert!(!e.is_bad_input());
         assert!(e.to_string().contains("no/such/m.json"), "{e}");
+    }
+
+    /// `--model /dev/zero` grew to a gigabyte before running out of memory.
+    #[cfg(unix)]
+    #[test]
+    fn an_endless_file_is_bad_input_after_the_limit() {
+        let e = TlModel::read("/dev/zero").unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("larger than 64 MiB"),
+            "{e}"
+        );
+        let e = kind_of("/dev/zero").unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("larger than 64 MiB"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -301,6 +301,17 @@ impl FlightTable {
         })
     }
 
+    /// Adds a numeric column of whole numbers (flags, counts), written
+    /// without `.0` (`0`, `1`; non-whole values keep their decimals);
+    /// errors as [`FlightTable::add_column`].
+    pub fn add_integer_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        self.add_column(name, values)?;
+        if let Some(c) = self.columns.last_mut() {
+            c.integer_text = true;
+        }
+        Ok(())
+    }
+
     /// Adds a text column (errors as [`FlightTable::add_column`]).
     pub fn add_text_column(&mut self, name: &str, values: Vec<String>) -> Result<()> {
         self.push_column(Column {

@@ -63,7 +63,7 @@ pub fn read_detected(path: &Path) -> Result<Vec<FieldEpoch>> {
 /// instrument constants).
 pub fn read_system(path: &Path) -> Result<EmSystem> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = crate::model_file::read_text_file(path)?;
     let s: EmSystem = serde_json::from_str(&text)
         .map_err(|e| Error::bad_file(&file, format!("not an EM system description: {e}")))?;
     s.validate()

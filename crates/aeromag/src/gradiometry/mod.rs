@@ -42,7 +42,7 @@ pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
     match path {
         None => Ok(GradiometerConfig::default()),
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| Error::read(p, e))?;
+            let text = crate::model_file::read_text_file(p)?;
             let bad =
                 |e: &dyn std::fmt::Display| Error::bad_file(p.display().to_string(), e.to_string());
             let cfg = GradiometerConfig::from_toml(&text).map_err(|e| bad(&e))?;
@@ -592,7 +592,7 @@ impl Track {
         let mut t = FlightTable::new();
         t.add_column("time", time.to_vec())?;
         let flag = |v: &[bool]| v.iter().map(|&b| f64::from(u8::from(b))).collect();
-        t.add_column("detected", flag(&self.detected))?;
+        t.add_integer_column("detected", flag(&self.detected))?;
         const N: [&str; 6] = ["x_m", "y_m", "z_m", "mx_am2", "my_am2", "mz_am2"];
         for (prefix, rows) in [("", &self.x), ("sd_", &self.sd), ("mu_", &self.mu)] {
             for (k, n) in N.iter().enumerate() {
@@ -606,7 +606,7 @@ impl Track {
         }
         t.add_column("iterations", self.iterations.clone())?;
         t.add_column("residual_nt", self.residual_nt.clone())?;
-        t.add_column("converged", flag(&self.converged))?;
+        t.add_integer_column("converged", flag(&self.converged))?;
         Ok(t)
     }
 }
