@@ -26,7 +26,7 @@ for methods that failed, ``OSError`` for outputs that could not be written.
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -292,6 +292,19 @@ def locate_em(
     return _aeromag.locate_em(detected, calibration, half_space=half_space, progress=progress_callback(progress))
 
 
+def _labels(x: Any) -> Optional[List[str]]:
+    """Line labels from a label, a comma-separated text or a sequence
+    (``"2001"`` is one label, not the characters 2, 0, 0, 1)."""
+    if x is None:
+        return None
+    if isinstance(x, (str, bytes)):
+        text = x.decode() if isinstance(x, bytes) else x
+        return [t.strip() for t in text.split(",") if t.strip()]
+    if isinstance(x, (int, float)):
+        return [str(x)]
+    return [str(t) for t in x]
+
+
 def level(
     flight: Flight,
     value: Optional[str] = None,
@@ -333,7 +346,7 @@ def level(
         no_robust=no_robust,
         ridge_lambda=ridge_lambda,
         reference=reference,
-        ties=None if ties is None else [str(t) for t in ties],
+        ties=_labels(ties),
         progress=progress_callback(progress),
     )
 

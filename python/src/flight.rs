@@ -271,10 +271,25 @@ pub fn read_flight(
     fields: Option<Vec<String>>,
 ) -> PyResult<PyFlight> {
     let mut opts = python_read_options(columns.as_ref(), mag, vector, lines.as_ref(), time_range)?;
-    if let Some(names) = fields {
-        opts.fields = aeromag::Fields::Only(names);
+    if let Some(names) = &fields {
+        opts.fields = aeromag::Fields::Only(names.clone());
     }
     let flight = py.detach(|| Flight::read_with(&path, &opts)).py_err()?;
+    // A field asked for that the file lacks (a typo) gave a flight without
+    // it and no word.
+    // (A pattern, `true_*`, may match nothing.)
+    if let Some(missing) = fields.iter().flatten().find(|n| {
+        let t = flight.table();
+        !n.contains(['*', '?'])
+            && t.get(n).is_none()
+            && !t.column_names().iter().any(|c| c.eq_ignore_ascii_case(n))
+    }) {
+        return Err(bad_argument(format!(
+            "fields: '{}' has no field '{missing}'; its fields: {}",
+            path.display(),
+            flight.table().present_columns()
+        )));
+    }
     Ok(PyFlight::new(flight))
 }
 

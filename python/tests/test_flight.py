@@ -166,3 +166,12 @@ def test_simulate_with_config_and_truth():
     np.testing.assert_array_equal(f["mag"], g["mag"])  # seeded: identical
     with pytest.raises(aeromag.BadInputError, match="unknown scenario"):
         aeromag.simulate("nosuch")
+
+
+def test_a_field_asked_for_that_the_file_lacks_is_bad_input(cal_csv):
+    # A typo gave a flight of `time` alone, without a word.
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.read_flight(cal_csv, fields=["mag", "nosuch"])
+    assert "nosuch" in str(e.value)
+    f = aeromag.read_flight(cal_csv, fields=["MAG"])
+    assert "mag" in f.columns

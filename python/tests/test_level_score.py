@@ -61,3 +61,12 @@ def test_observability_of_a_single_heading(cal):
     for name in o["undetermined"]:
         assert effect[name] > effect_full[name] and (effect[name] >= 1.0 or
                                                      next(c["mu"] for c in o["coefficients"] if c["name"] == name) > 0.9)
+
+
+def test_tie_labels_given_as_text_are_labels_not_characters():
+    # `ties="2001"` was split into the labels 2, 0, 0, 1.
+    assert aeromag._labels("2001") == ["2001"]
+    assert aeromag._labels("T1, T2") == ["T1", "T2"]
+    assert aeromag._labels(2001) == ["2001"]
+    assert aeromag._labels(["T1", 2]) == ["T1", "2"]
+    assert aeromag._labels(None) is None
