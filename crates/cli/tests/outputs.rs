@@ -184,6 +184,10 @@ fn outputs_never_replace_inputs_devices_or_links() {
     );
     let written = std::fs::read(&target).unwrap();
     assert!(written.starts_with(b"time,") || written.starts_with(b"#"));
+    // comp_flag as the help documents it: 0 or 1, not 0.0.
+    let text = String::from_utf8(written.clone()).unwrap();
+    let row = text.lines().filter(|l| !l.starts_with('#')).nth(1).unwrap();
+    assert!(row.ends_with(",0") || row.ends_with(",1"), "{row}");
     // A FIFO: written through, and still a FIFO afterwards.
     let fifo = d.join("fifo");
     let c = std::ffi::CString::new(s(&fifo)).unwrap();
