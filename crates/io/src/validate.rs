@@ -202,7 +202,7 @@ fn check_time_steps(table: &FlightTable, t: &[f64]) -> Result<()> {
     let step = |i: usize| t[i] - t[i - 1];
     let shortest = (1..n).map(step).fold(f64::INFINITY, f64::min);
     let mean = (t[n - 1] - t[0]) / (n - 1) as f64;
-    if !(shortest < MIN_TIME_STEP_FRACTION * mean) {
+    if shortest >= MIN_TIME_STEP_FRACTION * mean {
         return Ok(());
     }
     let mut steps: Vec<f64> = (1..n).map(step).collect();

@@ -86,7 +86,8 @@ impl OnlineEngine {
             OnlineEngine::Adaptive(a) => a.push(sample, nav),
         };
         // NaN too: neither is a compensated value.
-        if o.status.is_compensated() && !(o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT) {
+        let within_any_field = o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT;
+        if o.status.is_compensated() && !within_any_field {
             OnlineOutput::not(SampleStatus::Missing)
         } else {
             o

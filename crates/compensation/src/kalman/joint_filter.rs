@@ -214,7 +214,9 @@ impl JointFilter {
         let r = self.noise.r_nt2;
         if gate_nis.is_finite() {
             let nu = self.filter.innovation(&self.h, y_nt, r).map_err(est)?;
-            if !(nu.value * nu.value <= gate_nis * nu.variance) {
+            // NaN too: no innovation to learn from.
+            let within = nu.value * nu.value <= gate_nis * nu.variance;
+            if !within {
                 return Ok((nu, false));
             }
         }

@@ -115,7 +115,8 @@ pub fn profile_gradient(tracks: &SurveyTracks, cfg: &TrackConfig) -> Result<Vec<
         let total = *s.last().unwrap_or(&0.0);
         // A segment whose median step is far below its mean (positions
         // jittering in place for most of it) is no profile to resample.
-        if !(total / ds <= (MAX_RESAMPLE_FACTOR * rows.len()) as f64) {
+        let resamplable = total / ds <= (MAX_RESAMPLE_FACTOR * rows.len()) as f64;
+        if !resamplable {
             continue;
         }
         let m = (total / ds).floor() as usize + 1;

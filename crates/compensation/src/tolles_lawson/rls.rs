@@ -193,7 +193,8 @@ impl CoefficientEstimator for Rls {
         let e = y - self.h.dot(&self.theta);
         // An outlier is left out, and so is its row as the next difference's
         // start.
-        if !(e * e <= OUTLIER_NIS * alpha) {
+        let within = e * e <= OUTLIER_NIS * alpha;
+        if !within {
             return Ok(Update::Outlier);
         }
         if self.settings.differenced {
