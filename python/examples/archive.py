@@ -44,14 +44,19 @@ def simulated_archive(folder, n=4):
     return paths
 
 
-def main():
-    if len(sys.argv) > 1:
-        paths = sorted(glob.glob(os.path.join(sys.argv[1], "*.csv")) + glob.glob(os.path.join(sys.argv[1], "*.h5")))
-    else:
-        paths = simulated_archive(tempfile.mkdtemp(prefix="aeromag-archive-"))
+def report(paths):
     for r in aeromag.batch(process_flight, paths, processes=2):
         ir = "n/a" if r["ir"] is None else f"{r['ir']:.1f}"
         print(f"{r['flight']}: {r['rows']} rows, fit residual {r['residual_nt']:.4f} nT, IR {ir}")
+
+
+def main():
+    if len(sys.argv) > 1:
+        report(sorted(glob.glob(os.path.join(sys.argv[1], "*.csv")) + glob.glob(os.path.join(sys.argv[1], "*.h5"))))
+        return
+    # A simulated archive in a temporary folder, removed afterwards.
+    with tempfile.TemporaryDirectory(prefix="aeromag-archive-") as folder:
+        report(simulated_archive(folder))
 
 
 if __name__ == "__main__":

@@ -22,9 +22,14 @@ from archive import process_flight, simulated_archive
 
 def main():
     if len(sys.argv) > 1:
-        paths = sorted(glob.glob(os.path.join(sys.argv[1], "*.csv")))
-    else:
-        paths = simulated_archive(tempfile.mkdtemp(prefix="aeromag-archive-"))
+        run(sorted(glob.glob(os.path.join(sys.argv[1], "*.csv"))))
+        return
+    # A simulated archive in a temporary folder, removed afterwards.
+    with tempfile.TemporaryDirectory(prefix="aeromag-archive-") as folder:
+        run(simulated_archive(folder))
+
+
+def run(paths):
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, Client(
         cluster
     ) as client:

@@ -251,11 +251,28 @@ impl Write for Output {
 mod tests {
     use super::*;
 
-    fn dir(name: &str) -> PathBuf {
+    /// A fresh folder of the test's own, removed when the test ends (they
+    /// were left in the system's temporary folder, three per run).
+    struct Dir(PathBuf);
+
+    impl std::ops::Deref for Dir {
+        type Target = Path;
+        fn deref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    impl Drop for Dir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn dir(name: &str) -> Dir {
         let d = std::env::temp_dir().join(format!("aeromag-atomic-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
-        d
+        Dir(d)
     }
 
     fn entries(d: &Path) -> Vec<String> {
@@ -290,7 +307,7 @@ mod tests {
         .unwrap();
         assert!(std::fs::read(&p).unwrap() == bytes);
         assert_eq!(entries(&d), ["big.bin"]);
-        std::fs::remove_dir_all(&d).unwrap();
+        std::fs::remove_dir_all(&*d).unwrap();
     }
 
     #[test]
