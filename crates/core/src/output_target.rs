@@ -41,6 +41,15 @@ pub enum OutputTarget {
 /// (a dangling link names the file to create). Errors: a link loop or
 /// chain longer than [`MAX_LINKS`], and the errors of reading the links.
 pub fn output_target(path: &Path) -> std::io::Result<OutputTarget> {
+    // What the path opens, links followed by the system: `/dev/stdout`
+    // reaches a pipe through `/proc/self/fd/1`, a link whose text
+    // (`pipe:[…]`) names no file.
+    if let Ok(m) = std::fs::metadata(path) {
+        let kind = m.file_type();
+        if !kind.is_file() && !kind.is_dir() {
+            return Ok(OutputTarget::Stream(path.to_path_buf()));
+        }
+    }
     let mut p = path.to_path_buf();
     for _ in 0..MAX_LINKS {
         let meta = match std::fs::symlink_metadata(&p) {
@@ -126,7 +135,7 @@ mod tests {
         std::os::unix::fs::symlink("loop1", d.join("loop2")).unwrap();
         let e = output_target(&d.join("loop1")).unwrap_err();
         assert!(e.to_string().contains("loop1"), "{e}");
-        // Devices and links to them are streams.
+        // Devices and links to them are streams, opened by the name given.
         assert_eq!(
             output_target(Path::new("/dev/null")).unwrap(),
             OutputTarget::Stream("/dev/null".into())
@@ -134,8 +143,20 @@ mod tests {
         std::os::unix::fs::symlink("/dev/null", d.join("null")).unwrap();
         assert_eq!(
             output_target(&d.join("null")).unwrap(),
-            OutputTarget::Stream("/dev/null".into())
+            OutputTarget::Stream(d.join("null"))
         );
+        // A pipe reached through /proc's fd links (what /dev/stdout is when
+        // the output is piped): a stream.
+        let (r, w) = std::io::pipe().unwrap();
+        let fd = std::os::fd::AsRawFd::as_raw_fd(&w);
+        let via_proc = PathBuf::from(format!("/proc/self/fd/{fd}"));
+        if via_proc.exists() {
+            assert_eq!(
+                output_target(&via_proc).unwrap(),
+                OutputTarget::Stream(via_proc.clone())
+            );
+        }
+        drop((r, w));
         assert!(same_file(&d.join("l2"), &file));
         assert!(!same_file(&d.join("new.csv"), &file));
         std::fs::remove_dir_all(&d).unwrap();
