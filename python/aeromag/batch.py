@@ -38,6 +38,9 @@ def batch(
     """
     if errors not in ("raise", "return"):
         raise ValueError("errors must be 'raise' or 'return'")
+    if processes is not None and (isinstance(processes, bool) or not isinstance(processes, int) or processes < 1):
+        # -3 ran with one process without a word.
+        raise ValueError(f"processes must be a whole number of at least 1, got {processes!r}")
     items = list(items)
     n = processes or os.cpu_count() or 1
     from .tolles_lawson import progress_callback

@@ -42,9 +42,10 @@ pub fn igrf<'py>(
         return Err(bad_argument("lat, lon, alt and time must have one length"));
     }
     for (i, ((&la, &lo), &al)) in lat.iter().zip(lon).zip(alt).enumerate() {
-        if la.is_nan() || la.abs() > 90.0 || !lo.is_finite() || !(-1.0e4..=1.0e6).contains(&al) {
+        let lon_ok = lo.abs() <= aeromag::core::field::MAX_LON_DEG;
+        if la.is_nan() || la.abs() > 90.0 || !lon_ok || !(-1.0e4..=1.0e6).contains(&al) {
             return Err(bad_argument(format!(
-                "point {i}: lat {la}° (−90…90), lon {lo}° (finite), alt {al} m (−10 km … 1000 km)"
+                "point {i}: lat {la}° (−90…90), lon {lo}° (−360…360), alt {al} m (−10 km … 1000 km)"
             )));
         }
     }

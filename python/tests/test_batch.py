@@ -18,6 +18,10 @@ def test_results_in_order_and_errors():
     assert isinstance(out[1], aeromag.BadInputError) and out[1].file == "flight_3.csv"
     with pytest.raises(aeromag.BadInputError, match="three"):
         aeromag.batch(square_or_fail, [1, 3], processes=2)
+    # processes=-3 ran with one process without a word.
+    for bad in (-3, 0, 1.5, True):
+        with pytest.raises(ValueError, match="processes"):
+            aeromag.batch(square_or_fail, [1], processes=bad)
     seen = []
     aeromag.batch(square_or_fail, [1, 2], processes=1, progress=lambda s, d, t: seen.append((d, t)))
     assert seen[-1] == (2, 2)

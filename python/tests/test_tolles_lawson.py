@@ -146,3 +146,6 @@ def test_igrf_against_the_cli(cli):
         assert abs(f[k][0] - ref[k]) < 1e-9 * max(1.0, abs(ref[k])), k
     with pytest.raises(aeromag.BadInputError):
         aeromag.igrf(95.0, 0.0)
+    # A longitude of 1e300 was taken (any finite value was).
+    with pytest.raises(aeromag.BadInputError, match="−360…360"):
+        aeromag.igrf(45.0, 1e300)

@@ -32,10 +32,7 @@ pub struct Args {
     json: bool,
 }
 
-/// The largest |--lon| taken, degrees: as in a flight file's `lon` column
-/// (`aeromag_io::check_units`); 1e308 was taken and printed with 309
-/// digits, its sine and cosine meaningless.
-pub const MAX_LON_DEG: f64 = 360.0;
+use aeromag_core::field::MAX_LON_DEG;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     if !a.lat.is_finite() || a.lat.abs() > 90.0 {

@@ -17,6 +17,12 @@ pub const MAX_FIELD_NT: f64 = 1e6;
 /// overflow (a singular system blamed on the fit).
 pub const MAX_ALT_M: f64 = 1e6;
 
+/// The largest |longitude| taken, degrees (east or west of Greenwich, or
+/// 0–360): 1e308 was taken by `aeromag igrf` and printed with 309 digits,
+/// and by Python's `igrf` (any finite value), its sine and cosine
+/// meaningless.
+pub const MAX_LON_DEG: f64 = 360.0;
+
 /// The largest ground speed taken as one, m/s: an airliner cruises at
 /// 250 m/s and a fast jet at 700; beyond, the value is a corrupted cell or
 /// the time is not in seconds (one speed of 1e308 turned an adaptive
