@@ -69,6 +69,18 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// A figure in a message: four decimals, or three significant digits in
+/// exponent form below 10⁻³ and from 10⁶ (a phase in radians turns at
+/// 4.8·10⁻⁵ Hz, which [`shown`] wrote with 20 digits; a time step of
+/// 10⁻⁹ s was `9.999999717180685e-10`).
+pub fn figure(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.2e}")
+    } else {
+        fixed(x, 4)
+    }
+}
+
 /// Characters of a text [`shown_text`] keeps.
 pub const SHOWN_TEXT_CHARS: usize = 40;
 

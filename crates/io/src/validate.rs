@@ -37,7 +37,7 @@ use serde::Serialize;
 use crate::columns::MAGNETIC_COLUMNS;
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
-use aeromag_core::error::shown;
+use aeromag_core::error::{figure, shown};
 
 /// Columns in which an infinite value is an error ([`check_units`]): the
 /// canonical navigation, attitude, field and line columns, whose
@@ -206,18 +206,10 @@ fn check_time_steps(table: &FlightTable, t: &[f64]) -> Result<()> {
         return Ok(());
     }
     let mut steps: Vec<f64> = (1..n).map(step).collect();
-    let mid = steps.len() / 2;
-    let median = *steps.select_nth_unstable_by(mid, f64::total_cmp).1;
-    let limit = MIN_TIME_STEP_FRACTION * median;
-    // Steps of seconds to decimals in four places, shorter ones in
-    // exponent form (1.00e-9, not 9.999999717180685e-10).
-    let brief = |x: f64| {
-        if x >= 1e-3 {
-            shown((x * 1e4).round() / 1e4)
-        } else {
-            format!("{x:.2e}")
-        }
+    let Some(median) = median_in_place(&mut steps) else {
+        return Ok(());
     };
+    let limit = MIN_TIME_STEP_FRACTION * median;
     match (1..n).find(|&i| step(i) < limit) {
         None => Ok(()),
         Some(i) => Err(IoError::Units {
@@ -228,11 +220,11 @@ fn check_time_steps(table: &FlightTable, t: &[f64]) -> Result<()> {
                  a duplicated or corrupted time? (the eddy-current terms divide by the step)",
                 data_row(table, i),
                 shown(t[i]),
-                brief(step(i)),
+                figure(step(i)),
                 data_row(table, i - 1),
                 shown(t[i - 1]),
                 shown(100.0 * MIN_TIME_STEP_FRACTION),
-                brief(median)
+                figure(median)
             ),
         }),
     }

@@ -3,7 +3,7 @@
 //! revolution) and the slowly varying angles tracked with the parameters
 //! fixed.
 
-use super::columns::{RotorColumns, check_rotor_speed, figure, mean_rotor_hz};
+use super::columns::{RotorColumns, check_rotor_speed, mean_rotor_hz};
 use crate::compensate::{Compensator, OutputColumns};
 use crate::error::{InFile, Result};
 use crate::flight::Flight;
@@ -13,7 +13,7 @@ use aeromag_compensation::rotor::{
     FlapAngles, RotorInput, SlowAngleOptions, TailRotor, align_phase_offset, estimate_phase,
     regressors, rotor_speed, track_slow_angles, unwrap_deg,
 };
-use aeromag_core::error::shown;
+use aeromag_core::error::{figure, shown};
 use nalgebra::Vector3;
 use std::ops::Range;
 

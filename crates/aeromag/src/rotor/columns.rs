@@ -10,7 +10,7 @@ use crate::flight::{Flight, GAP_FACTOR, SegmentRule, finite_segments};
 use crate::observer::Note;
 use aeromag_compensation::rotor::{RotorFitOptions, TailRotor};
 use aeromag_compensation::tolles_lawson::segments::median_step;
-use aeromag_core::error::{fixed, shown};
+use aeromag_core::error::{figure, fixed, shown};
 use nalgebra::Vector3;
 use std::ops::Range;
 
@@ -368,17 +368,6 @@ const MAX_FILL_S: f64 = 0.1;
 /// alternating 0.0105 and 0.0095 s (taken as 95.2 Hz, the rotor at 4.60
 /// Hz instead of 4.83).
 pub const MAX_STEP_DEVIATION: f64 = 0.02;
-
-/// A figure in a message: four decimals, or three significant digits in
-/// exponent form below 10⁻³ and from 10⁶ (a phase in radians turns at
-/// 4.8·10⁻⁵ Hz, which `shown` wrote with 20 digits).
-pub(super) fn figure(x: f64) -> String {
-    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
-        format!("{x:.2e}")
-    } else {
-        fixed(x, 4)
-    }
-}
 
 /// The mean rotor frequency (Hz) of the rotor speeds `omega_rad_s`.
 pub(super) fn mean_rotor_hz(omega_rad_s: &[f64]) -> f64 {

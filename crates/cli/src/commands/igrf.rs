@@ -2,6 +2,7 @@
 
 use crate::exit::bad_input;
 use aeromag_core::error::shown;
+use aeromag_core::field::MAX_LON_DEG;
 use aeromag_core::field::igrf::igrf_geodetic;
 use aeromag_core::frames::Geodetic;
 use aeromag_core::time::Date;
@@ -31,8 +32,6 @@ pub struct Args {
     #[arg(long)]
     json: bool,
 }
-
-use aeromag_core::field::MAX_LON_DEG;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     if !a.lat.is_finite() || a.lat.abs() > 90.0 {
