@@ -181,7 +181,16 @@ def simulate(
     text = None
     if config is not None:
         path = os.fspath(config)
-        text = open(path, encoding="utf-8").read() if os.path.isfile(path) else str(config)
+        if os.path.isfile(path):
+            text = open(path, encoding="utf-8").read()
+        elif isinstance(config, str) and ("\n" in config or "=" in config or not config.strip()):
+            text = config
+        else:
+            # A path that names no file was parsed as TOML text ("expected
+            # `.`, `=`"): say which file is missing.
+            raise BadInputError(
+                f"config: no file {path!r} (config is a scenario file's path or its TOML text)"
+            )
     return _aeromag.simulate(scenario, seed=seed, config=text)
 
 

@@ -46,6 +46,12 @@ def test_flags_and_bad_arguments(model, survey_csv, cli, tmp_path):
     i, c, f = oc.push(0.2, b, float("nan"))
     assert f == 1 and np.isnan(i) and np.isnan(c)
     assert oc.push(5.0, b, 49_300.0)[2] == 2
+    # A dropout value or a reading in tesla is no reading: not compensated
+    # (a mag of 0 was compensated to about 20 nT and flagged 0).
+    for t, flux, mag in [(5.1, b, 0.0), (5.2, b, 4.93e-5), (5.3, tuple(v * 1e-9 for v in b), 49_300.0)]:
+        i, c, f = oc.push(t, flux, mag)
+        assert f == 1 and np.isnan(c), (t, i, c, f)
+    assert oc.push(5.4, b, 49_300.0)[2] == 2
     with pytest.raises(aeromag.BadInputError, match="channels"):
         oc.push(6.0, b, 49_300.0, [1.0])
     with pytest.raises(aeromag.BadInputError, match="one length"):

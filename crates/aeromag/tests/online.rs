@@ -260,6 +260,85 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
         (c.lines, c.compensated, c.restarts, c.malformed),
         (10, 5, 2, 3)
     );
+    // Why, for the user: malformed lines gave no reason.
+    let m = &lc.issues().malformed;
+    assert_eq!(m.count, 3);
+    assert_eq!(
+        m.first,
+        Some((3, "4 cells where the header has 5".to_string()))
+    );
+    let w: Vec<String> = lc
+        .issues()
+        .warnings()
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    assert_eq!(
+        w,
+        ["warning: 3 lines malformed (the first: data line 3: 4 cells where the header has 5)"]
+    );
+    let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
+    lc.line("0.0,20000,x,45000,49300", &mut out);
+    assert_eq!(
+        lc.issues().malformed.first,
+        Some((1, "column \"flux_y\": \"x\" is not a number".to_string()))
+    );
+}
+
+/// A `mag` below any reading of Earth's field (a dropout value 0, a
+/// negated reading, tesla) or a vector magnetometer in tesla was
+/// compensated and flagged 0 (`mag` 0 gave `mag_comp` 20.5 nT): flagged 1,
+/// its values empty, counted with the first line named; the run restarts
+/// after it.
+#[test]
+fn readings_below_earths_field_are_not_compensated_and_named() {
+    let model = model();
+    let header = "time,flux_x,flux_y,flux_z,mag";
+    let lines = [
+        "0.0,20000,1000,45000,49300",
+        "0.1,20001,1001,45001,0",
+        "0.2,20001,1001,45001,4.9301e-5",
+        "0.3,20002,1002,45002,-49302",
+        "0.4,2.0003e-5,1.003e-6,4.5003e-5,49303",
+        "0.5,20003,1003,45003,999.9",
+        "0.6,20003,1003,45003,1000",
+        "0.7,20003,1003,45003,49303",
+    ];
+    let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
+    let mut out = String::new();
+    let flags: Vec<StreamFlag> = lines.iter().map(|l| lc.line(l, &mut out)).collect();
+    use StreamFlag::*;
+    assert_eq!(
+        flags,
+        [
+            Started,
+            Missing,
+            Missing,
+            Missing,
+            Missing,
+            Missing,
+            Started,
+            Compensated
+        ]
+    );
+    for (k, line) in lines.iter().enumerate().take(6).skip(1) {
+        assert_eq!(out.lines().nth(k).unwrap(), format!("{line},,,1"));
+    }
+    let i = &lc.issues().not_reading;
+    assert_eq!(i.count, 5);
+    assert_eq!(i.first, Some((2, "mag = 0 nT".to_string())));
+    let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
+    lc.line(lines[2], &mut out);
+    lc.line(lines[4], &mut out);
+    assert_eq!(
+        lc.issues().not_reading.first,
+        Some((1, "mag = 4.930e-5 nT".to_string()))
+    );
+    let w = lc.issues().warnings()[0].to_string();
+    assert!(
+        w.starts_with("warning: 2 lines with a reading below 1000 nT") && w.contains("tesla"),
+        "{w}"
+    );
 }
 
 /// A `mag` or `flux_*` value beyond any magnetic field (10⁶ nT) is a
@@ -288,6 +367,13 @@ fn readings_and_interference_beyond_any_field_are_not_written_as_compensated() {
         out.lines().nth(1).unwrap().ends_with("2e6,45001,49301,,,4"),
         "{out}"
     );
+    assert_eq!(
+        lc.issues().malformed.first,
+        Some((
+            2,
+            "column \"flux_y\": 2000000 is beyond any magnetic field (1000000 nT)".to_string()
+        ))
+    );
 
     let mut corrupt = model.clone();
     corrupt.coefficients[0].value = 1e300;
@@ -297,6 +383,10 @@ fn readings_and_interference_beyond_any_field_are_not_written_as_compensated() {
     assert_eq!(flags, [Missing]);
     assert_eq!(out, format!("{},,,1\n", lines[0]));
     assert_eq!(lc.counts().missing, 1);
+    assert_eq!(lc.issues().beyond_field.first, Some((1, String::new())));
+    assert!(lc.issues().warnings()[0].to_string().contains(
+        "beyond any magnetic field (the first: data line 1): the model file does not fit"
+    ));
 }
 
 /// A line longer than the limit is flagged malformed and skipped to its
@@ -368,6 +458,21 @@ fn comment_lines_are_written_back_in_their_place() {
     // A connection of comments alone writes them back and has no header.
     let (got, n, _) = serve("# nothing yet\n");
     assert_eq!((got, n), (vec!["# nothing yet".to_string()], 0));
+    // As a file reader reads them: a byte-order mark before the header, a
+    // blank line among the data and a quoted number (the header was not
+    // found; the blank line and the quoted cell were malformed lines).
+    let quoted = data[2].replace("49302", "\"49302\"");
+    let (got, n, bad) = serve(&format!(
+        "\u{feff}{header}\n{}\n \r\n{quoted}\n",
+        data[..2].join("\n")
+    ));
+    assert_eq!((n, bad), (3, 0), "{got:?}");
+    let want: Vec<String> = plain[..3]
+        .iter()
+        .cloned()
+        .chain([" ".to_string(), plain[3].replace("49302", "\"49302\"")])
+        .collect();
+    assert_eq!(got, want);
 }
 
 /// A multi-sensor model under the causal convention (`compensate --causal`

@@ -430,11 +430,26 @@ fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
     assert!(out.interference_nt[250].is_nan() && out.interference_nt[251].is_finite());
     // One sample of 0 nT (a logger's dummy): the fit's residual was 362 nT
     // instead of 0.07, and a good model's interference wrong by up to 230
-    // nT over 5 s. The spike is bridged (a warning) and left in the output.
+    // nT over 5 s. Such a value is no reading and is refused on reading
+    // (`MIN_READING_NT`); a spike that is still a reading (20 000 nT among
+    // 53 000) is bridged (a warning) and left in the output.
+    let mut t = FlightTable::new();
+    for c in other.columns() {
+        let mut v = c.values().unwrap().to_vec();
+        if c.name() == "mag" {
+            v[5000] = 0.0;
+        }
+        t.add_column(c.name(), v).unwrap();
+    }
+    let e = Flight::from_table(t).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("0 nT at data row 5001"),
+        "{e}"
+    );
     let spiked = |f: &Flight| {
         edited(f, |n, v| {
             if n == "mag" {
-                v[5000] = 0.0;
+                v[5000] = 20_000.0;
             }
         })
     };

@@ -124,6 +124,37 @@ fn a_pipe_gives_the_causal_batch_values_and_flags_bad_lines() {
         err.contains("6003 lines: 6000 compensated (0 runs restarted), 0 with missing values, 1 with time going back, 2 malformed"),
         "{err}"
     );
+    // Why, with the first line of each kind (no reason was given).
+    assert!(
+        err.contains("warning: 2 lines malformed (the first: data line 102: column \"time\": \"garbage\" is not a number)"),
+        "{err}"
+    );
+}
+
+/// A stream whose `mag` is in tesla was compensated to tens of nT and
+/// flagged 0: every line flagged 1, and standard error says why.
+#[test]
+fn a_stream_in_tesla_is_not_compensated_and_says_why() {
+    let d = tempfile::tempdir().unwrap();
+    let (model, lines, _) = setup(d.path());
+    let mag = lines[0].split(',').position(|n| n == "mag").unwrap();
+    let mut input = vec![lines[0].clone()];
+    for l in &lines[1..101] {
+        let mut cells: Vec<String> = l.split(',').map(str::to_string).collect();
+        cells[mag] = format!("{:e}", cells[mag].parse::<f64>().unwrap() * 1e-9);
+        input.push(cells.join(","));
+    }
+    let (out, err) = through_pipe(&model, &[], &input);
+    assert!(out[1..].iter().all(|l| flag(l) == "1"), "{}", out[1]);
+    assert!(
+        err.contains("100 lines: 0 compensated (0 runs restarted), 100 with missing values"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: 100 lines with a reading below 1000 nT, no reading of Earth's field (the first: data line 1: mag = ")
+            && err.contains("not tesla"),
+        "{err}"
+    );
 }
 
 /// A file as `aeromag simulate` writes it, its `#` lines first, streams as

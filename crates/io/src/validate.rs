@@ -15,6 +15,7 @@
 //! | columns | error | warning |
 //! |---|---|---|
 //! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
+//! | `mag` | when its median \|B\| is within 15 000–75 000 nT (a total field): any value below [`MIN_READING_NT`] (a dropout value, a negated reading), naming the first row | — |
 //! | `mag`, `igrf`, `flux_x/y/z`, `diurnal` | once the units pass: any \|value\| > [`MAX_FIELD_NT`] (a corrupted cell, a numeric dummy such as −1e32), naming the first row | — |
 //! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 15 000–75 000 nT; median relative difference from `mag` above 10 % (`vector-vs-scalar`) |
 //! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
@@ -128,7 +129,7 @@ impl WarningKind {
 /// total channel mapped as a component gives tens of per cent or more.
 pub const VECTOR_SCALAR_TOLERANCE: f64 = 0.10;
 
-pub use aeromag_core::field::{MAX_ALT_M, MAX_FIELD_NT};
+pub use aeromag_core::field::{MAX_ALT_M, MAX_FIELD_NT, MIN_READING_NT};
 
 /// The largest median ground speed taken as a flight's, m/s: an airliner
 /// cruises at 250 m/s and a fast jet at 700; above, the time is in
@@ -299,6 +300,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
             ctx.within_field(name, max)?;
         }
     }
+    ctx.readings("mag", stats.mag, stats.mag_min)?;
     for (name, c) in ["flux_x", "flux_y", "flux_z", "diurnal"]
         .into_iter()
         .zip(stats.components)
@@ -383,6 +385,8 @@ struct Stats {
     igrf: Option<f64>,
     /// Maximum |value| of `mag` and of `igrf`.
     mag_max: Option<f64>,
+    /// Smallest value of `mag`.
+    mag_min: Option<f64>,
     igrf_max: Option<f64>,
     /// Maximum and median |value| of `flux_x`, `flux_y`, `flux_z`, `diurnal`.
     components: [(Option<f64>, Option<f64>); 4],
@@ -433,6 +437,11 @@ impl Stats {
                     .map(|v| Box::new(move || max_abs(v)) as Job<'_>),
             );
         }
+        jobs.push(
+            table
+                .column("mag")
+                .map(|v| Box::new(move || min_value(v)) as Job<'_>),
+        );
         let v = crate::parts::each_on_cores(&jobs, |job| job.as_ref().and_then(|f| f()));
         Self {
             mag: v[0],
@@ -442,6 +451,7 @@ impl Stats {
             alt: v[12],
             mag_max: v[13],
             igrf_max: v[14],
+            mag_min: v[15],
         }
     }
 }
@@ -531,6 +541,40 @@ impl Ctx<'_> {
                 ));
         }
         Ok(())
+    }
+
+    /// A total-field reading (a column whose median `median_abs` is within
+    /// [`EARTH_FIELD_NT`]) has no value below [`MIN_READING_NT`] (`min`:
+    /// its smallest), or bad input naming the first row that has one: a
+    /// dropout value (0, −99999), a negated reading. A column of an anomaly
+    /// or another unit is not tested (its median is warned about).
+    fn readings(&self, name: &str, median_abs: Option<f64>, min: Option<f64>) -> Result<()> {
+        let total_field = median_abs.is_some_and(|m| m >= EARTH_FIELD_NT.0);
+        if !total_field || min.is_none_or(|m| m >= MIN_READING_NT) {
+            return Ok(());
+        }
+        let Some((i, v)) = self
+            .table
+            .column(name)
+            .and_then(|c| first_where(c, |v| v < MIN_READING_NT))
+        else {
+            return Ok(());
+        };
+        let what = if v < 0.0 {
+            "a total field is never negative: a negated column, or a number standing for a missing value?"
+        } else {
+            "a dropout value, or a number standing for a missing value?"
+        };
+        Err(self.units(
+            name,
+            format!(
+                "{} nT at {} is no reading of Earth's total field (at least {} nT; the column's median is {:.0} nT): {what} leave the cell empty (`*` in an XYZ file) for a missing value",
+                shown(v),
+                data_row(self.table, i),
+                shown(MIN_READING_NT),
+                median_abs.unwrap_or(f64::NAN)
+            ),
+        ))
     }
 
     /// No `|value|` of `name` above [`MAX_FIELD_NT`] (`max`: its largest),
@@ -742,20 +786,33 @@ fn first_where(v: &[f64], pred: impl Fn(f64) -> bool) -> Option<(usize, f64)> {
 /// long column in parts on the cores ([`crate::parts`]), the parts'
 /// maxima then compared: the same value either way.
 fn max_abs(v: &[f64]) -> Option<f64> {
-    crate::parts::on_parts(v, max_abs_serial)
+    max_key(v, f64::abs)
+}
+
+/// The smallest finite value of `v` (`None` when there is none), as
+/// [`max_abs`].
+fn min_value(v: &[f64]) -> Option<f64> {
+    max_key(v, |x| -x).map(|m| -m)
+}
+
+/// The largest `key(x)` over the finite values `x` of `v`, in parts on the
+/// cores.
+fn max_key(v: &[f64], key: impl Fn(f64) -> f64 + Sync + Copy) -> Option<f64> {
+    crate::parts::on_parts(v, |part| max_key_serial(part, key))
         .into_iter()
         .flatten()
         .reduce(f64::max)
 }
 
-/// [`max_abs`] in one pass on the calling thread.
-fn max_abs_serial(v: &[f64]) -> Option<f64> {
+/// [`max_key`] in one pass on the calling thread.
+#[inline(always)]
+fn max_key_serial(v: &[f64], key: impl Fn(f64) -> f64) -> Option<f64> {
     // Four independent running maxima with selects (no NaN-aware `max`,
     // no branch), so the pass over a long column vectorises; a non-finite
-    // value counts as −∞, below every finite |value|.
+    // value counts as −∞, below every finite key.
     let lane = |x: f64| {
         if x.is_finite() {
-            x.abs()
+            key(x)
         } else {
             f64::NEG_INFINITY
         }
@@ -943,9 +1000,13 @@ mod tests {
             v[at] = -1e6;
             v[(at + 1) % n] = f64::INFINITY;
             assert_eq!(max_abs(&v), Some(1e6));
-            assert_eq!(max_abs(&v), max_abs_serial(&v));
+            assert_eq!(max_abs(&v), max_key_serial(&v, f64::abs));
+            assert_eq!(min_value(&v), Some(-1e6));
+            v[at] = 1e6;
+            assert_eq!(min_value(&v), Some(-500.0));
         }
         assert_eq!(max_abs(&vec![f64::NAN; n]), None);
+        assert_eq!(min_value(&vec![f64::NAN; n]), None);
     }
 
     #[test]

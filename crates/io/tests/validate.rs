@@ -217,11 +217,64 @@ fn a_reading_beyond_any_field_names_its_row() {
         let e = check_units(&table(&[(name, v)])).unwrap_err();
         assert_mentions(&e.to_string(), &[&format!("'{name}'"), "data row 7"]);
     }
-    // At the limit, and a picotesla file's median first.
-    let t = table(&[("mag", vec![53_000.0, -1e6, 53_000.0])]);
+    // At the limit (a total field's limit: a negative one is no reading,
+    // below), and a picotesla file's median first.
+    let t = table(&[("mag", vec![53_000.0, 1e6, 53_000.0])]);
+    assert!(check_units(&t).is_ok());
+    let t = table(&[("diurnal", vec![3.0, -1e6, 4.0])]);
     assert!(check_units(&t).is_ok());
     let t = table(&[("mag", vec![5.3e7, 5.3e7, 5.3e7])]);
     assert_mentions(&check_units(&t).unwrap_err().to_string(), &["picotesla"]);
+}
+
+/// A dropout value (0, −99999) or a negated reading in a total-field
+/// `mag` was compensated as a reading (0 gave `mag_comp` 20.5 nT, flagged
+/// compensated) and went into fits: bad input naming the first row. An
+/// anomaly column (its median outside Earth's field, warned about) is not
+/// tested.
+#[test]
+fn a_total_field_below_any_reading_names_its_first_row() {
+    let fx = Fixtures::new();
+    let t = fx
+        .read(
+            "drop.csv",
+            "time,mag\n0,53000\n0.1,53001\n0.2,0\n0.3,53002\n0.4,-99999\n",
+        )
+        .unwrap();
+    let e = check_units(&t).unwrap_err();
+    assert!(matches!(e, IoError::Units { .. }), "{e:?}");
+    assert_mentions(
+        &e.to_string(),
+        &[
+            "drop.csv",
+            "'mag'",
+            "0 nT at data row 3 (line 4)",
+            "at least 1000 nT",
+            "median is 53001 nT",
+            "dropout",
+            "empty",
+        ],
+    );
+    let e = check_units(&table(&[("mag", vec![-53_000.0; 5])])).unwrap_err();
+    assert_mentions(&e.to_string(), &["-53000 nT at data row 1", "negated"]);
+    // 999.99 is below, 1000 is a reading (of a total field whose median
+    // is Earth's); an anomaly column holds small and negative values.
+    let mut v = vec![53_000.0; 9];
+    v[4] = 999.99;
+    assert_mentions(
+        &check_units(&table(&[("mag", v.clone())]))
+            .unwrap_err()
+            .to_string(),
+        &["999.99 nT at data row 5"],
+    );
+    v[4] = 1000.0;
+    assert!(check_units(&table(&[("mag", v)])).is_ok());
+    let anomaly = table(&[("mag", vec![-120.0, 0.0, 35.5, 12.0, 800.0])]);
+    let w = check_units(&anomaly).unwrap();
+    assert!(
+        w.len() == 1 && w[0].kind == WarningKind::FieldRange,
+        "{w:?}"
+    );
 }
 
 #[test]

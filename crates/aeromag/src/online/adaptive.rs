@@ -81,6 +81,12 @@ impl OnlineEngine {
     /// ([`aeromag_io::MAX_FIELD_NT`]: a model file that does not belong to
     /// the data) is no compensated value: the sample is `Missing`.
     pub fn push(&mut self, sample: &OnlineSample, nav: Navigation) -> OnlineOutput {
+        self.push_told(sample, nav).0
+    }
+
+    /// [`OnlineEngine::push`], and whether the sample is `Missing` because
+    /// its interference was beyond any magnetic field (for a message).
+    pub fn push_told(&mut self, sample: &OnlineSample, nav: Navigation) -> (OnlineOutput, bool) {
         let o = match self {
             OnlineEngine::Fixed(o) => o.push(sample),
             OnlineEngine::Adaptive(a) => a.push(sample, nav),
@@ -88,9 +94,9 @@ impl OnlineEngine {
         // NaN too: neither is a compensated value.
         let within_any_field = o.interference_nt.abs() <= aeromag_io::MAX_FIELD_NT;
         if o.status.is_compensated() && !within_any_field {
-            OnlineOutput::not(SampleStatus::Missing)
+            (OnlineOutput::not(SampleStatus::Missing), true)
         } else {
-            o
+            (o, false)
         }
     }
 

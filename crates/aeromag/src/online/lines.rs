@@ -4,6 +4,7 @@
 use super::CausalTl;
 use super::adaptive::{Adapt, AdaptOptions, OnlineEngine};
 use crate::error::{Error, Result};
+use crate::observer::Note;
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::adaptive::Navigation;
 use aeromag_compensation::tolles_lawson::online::{OnlineSample, SampleStatus};
@@ -104,6 +105,100 @@ impl std::fmt::Display for StreamCounts {
     }
 }
 
+/// Lines of one kind that a stream could not compensate: how many, and
+/// the first (its data line, counted from 1 since the header, and what
+/// was wrong with it).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LineIssue {
+    /// Lines of this kind.
+    pub count: u64,
+    /// The first one: data line and detail (empty when the kind says it
+    /// all).
+    pub first: Option<(u64, String)>,
+}
+
+impl LineIssue {
+    fn add(&mut self, line: u64, detail: String) {
+        self.count += 1;
+        if self.first.is_none() {
+            self.first = Some((line, detail));
+        }
+    }
+
+    /// `self` and then `later` (a later connection's).
+    fn then(&self, later: &LineIssue) -> LineIssue {
+        LineIssue {
+            count: self.count + later.count,
+            first: self.first.clone().or_else(|| later.first.clone()),
+        }
+    }
+
+    /// `N line(s) … (the first: data line L, detail)`, `None` without lines.
+    fn told(&self, what: &str, then: &str) -> Option<Note> {
+        let (line, detail) = self.first.as_ref()?;
+        let detail = if detail.is_empty() {
+            String::new()
+        } else {
+            format!(": {detail}")
+        };
+        Some(Note::warning(format!(
+            "{} {} {what} (the first: data line {line}{detail}){then}",
+            self.count,
+            if self.count == 1 { "line" } else { "lines" },
+        )))
+    }
+}
+
+/// Why lines of a stream were not compensated, for the user (the flags
+/// say which lines; these say why): malformed lines (flag 4), readings
+/// below a reading of Earth's field and interference beyond any field
+/// (both flag 1).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StreamIssues {
+    /// Malformed lines (flag 4): a wrong number of cells, text where a
+    /// number is needed, a value beyond any magnetic field, a line too
+    /// long.
+    pub malformed: LineIssue,
+    /// Lines whose `mag` or vector magnitude is below
+    /// [`aeromag_core::field::MIN_READING_NT`] (flag 1).
+    pub not_reading: LineIssue,
+    /// Lines whose modelled interference is beyond any magnetic field
+    /// (flag 1; a model file that does not fit the stream).
+    pub beyond_field: LineIssue,
+}
+
+impl StreamIssues {
+    /// `self` and then `later` (a later connection's).
+    fn then(&self, later: &StreamIssues) -> StreamIssues {
+        StreamIssues {
+            malformed: self.malformed.then(&later.malformed),
+            not_reading: self.not_reading.then(&later.not_reading),
+            beyond_field: self.beyond_field.then(&later.beyond_field),
+        }
+    }
+
+    /// One warning per kind of line seen, with its first line.
+    pub fn warnings(&self) -> Vec<Note> {
+        [
+            self.malformed.told("malformed", ""),
+            self.not_reading.told(
+                &format!(
+                    "with a reading below {} nT, no reading of Earth's field",
+                    aeromag_core::error::shown(aeromag_core::field::MIN_READING_NT)
+                ),
+                ": a dropout value, a negated reading, or another unit (the stream wants nT, not tesla, gauss or µT)? not compensated (comp_flag 1)",
+            ),
+            self.beyond_field.told(
+                "whose modelled interference is beyond any magnetic field",
+                ": the model file does not fit this stream (an edited coefficient, another aircraft's model?); not compensated (comp_flag 1)",
+            ),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+}
+
 /// How a stream's columns are found.
 #[derive(Debug, Clone, Default)]
 pub struct StreamOptions {
@@ -145,7 +240,10 @@ pub struct LineCompensator {
     speed_m_s: f64,
     fields: Fields,
     header: String,
+    /// The header's names, trimmed (for messages).
+    names: Vec<String>,
     counts: StreamCounts,
+    issues: StreamIssues,
     channels: Vec<f64>,
     /// `vn`, `ve`, `alt` of the current line (NaN when absent).
     nav: [f64; 3],
@@ -163,6 +261,9 @@ impl LineCompensator {
     /// [`StreamOptions::speed_m_s`].
     pub fn new(model: &TlModel, header: &str, opts: &StreamOptions) -> Result<Self> {
         let causal = CausalTl::new(model, opts.sample_rate_hz)?;
+        // A byte-order mark (a file saved by a Windows editor) is no part
+        // of the first name: `time` was not found.
+        let header = header.strip_prefix('\u{feff}').unwrap_or(header);
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
         if let Some(c) = header.chars().find(|c| c.is_control() && *c != '\t') {
             return Err(Error::bad_input(format!(
@@ -291,7 +392,9 @@ impl LineCompensator {
             speed_m_s,
             fields,
             header: normalised(header),
+            names: names.iter().map(|n| n.to_string()).collect(),
             counts: StreamCounts::default(),
+            issues: StreamIssues::default(),
         })
     }
 
@@ -303,31 +406,48 @@ impl LineCompensator {
     /// Compensate one data line (without its line end) and append it to
     /// `out` with the three values and a newline. Numbers are written as
     /// the CSV writer writes them (shortest round trip; missing as an empty
-    /// cell).
+    /// cell). A line not compensated for a reason the user must see is
+    /// counted in [`LineCompensator::issues`].
     pub fn line(&mut self, line: &str, out: &mut String) -> StreamFlag {
         let line = line.trim_end_matches(['\r', '\n']);
+        let at = self.counts.lines + 1;
         let (interf, comp, flag) = match self.parse(line) {
-            None => (f64::NAN, f64::NAN, StreamFlag::Malformed),
-            Some((time_s, flux_nt, mag_nt)) => {
+            Err(why) => {
+                self.issues.malformed.add(at, why);
+                (f64::NAN, f64::NAN, StreamFlag::Malformed)
+            }
+            Ok((time_s, flux_nt, mag_nt)) => {
                 let sample = OnlineSample {
                     time_s,
                     flux_nt,
                     mag_nt,
                     channels: &self.channels,
                 };
+                if let Some((what, v)) = sample.below_reading() {
+                    // 5.3e-5 (tesla), not 0.00005310232207072217.
+                    let v = if v == 0.0 || v.abs() >= 1e-3 {
+                        aeromag_core::error::shown(v)
+                    } else {
+                        format!("{v:.3e}")
+                    };
+                    self.issues.not_reading.add(at, format!("{what} = {v} nT"));
+                }
                 let [vn, ve, alt] = self.nav;
                 let speed_m_s = if self.fields.nav[0].is_some() && self.fields.nav[1].is_some() {
                     vn.hypot(ve)
                 } else {
                     self.speed_m_s
                 };
-                let o = self.engine.push(
+                let (o, beyond) = self.engine.push_told(
                     &sample,
                     Navigation {
                         speed_m_s,
                         alt_m: alt,
                     },
                 );
+                if beyond {
+                    self.issues.beyond_field.add(at, String::new());
+                }
                 (
                     o.interference_nt,
                     o.compensated_nt,
@@ -353,16 +473,26 @@ impl LineCompensator {
     /// A line too long to read: flagged malformed, written as an empty
     /// line with the three values.
     fn malformed(&mut self, out: &mut String) {
+        let at = self.counts.lines + 1;
+        self.issues
+            .malformed
+            .add(at, format!("longer than {} bytes", MAX_STREAM_LINE_BYTES));
         self.counts.add(StreamFlag::Malformed);
         out.push_str(",,,4\n");
     }
 
-    /// The inputs of a line (channels into `self.channels`), `None` when
-    /// the line is malformed. Empty cells and `NaN` are missing values.
-    fn parse(&mut self, line: &str) -> Option<(f64, [f64; 3], f64)> {
+    /// The lines not compensated for a reason the user must see, so far.
+    pub fn issues(&self) -> &StreamIssues {
+        &self.issues
+    }
+
+    /// The inputs of a line (channels into `self.channels`), or why the
+    /// line is malformed. Empty cells and `NaN` are missing values.
+    fn parse(&mut self, line: &str) -> std::result::Result<(f64, [f64; 3], f64), String> {
         let f = &self.fields;
-        let (mut time, mut flux, mut mag) = (None, [None; 3], None);
-        let mut cell = |k: usize, text: &str| -> Option<()> {
+        let names = &self.names;
+        let (mut time, mut flux, mut mag) = (f64::NAN, [f64::NAN; 3], f64::NAN);
+        let mut cell = |k: usize, text: &str| -> std::result::Result<(), String> {
             let slot = if k == f.time {
                 &mut time
             } else if k == f.mag {
@@ -370,45 +500,59 @@ impl LineCompensator {
             } else if let Some(a) = f.flux.iter().position(|&i| i == k) {
                 &mut flux[a]
             } else if let Some(c) = f.channels.iter().position(|&i| i == k) {
-                self.channels[c] = number(text)?;
-                return Some(());
+                &mut self.channels[c]
             } else if let Some(c) = f.nav.iter().position(|&i| i == Some(k)) {
-                self.nav[c] = number(text)?;
-                return Some(());
+                &mut self.nav[c]
             } else {
-                return Some(());
+                return Ok(());
             };
-            *slot = Some(number(text)?);
-            Some(())
+            *slot = number(text).ok_or_else(|| {
+                format!(
+                    "column {:?}: {} is not a number",
+                    clipped(&names[k]),
+                    aeromag_core::error::shown_text(text)
+                )
+            })?;
+            Ok(())
         };
         // The cells up to the last input, then only the commas counted.
         let bytes = line.as_bytes();
         let (mut start, mut k) = (0, 0);
         let mut commas = memchr::memchr_iter(b',', bytes);
+        let cells = |n: usize| format!("{n} cells where the header has {}", f.count);
         while k < f.last {
             let end = commas.next().unwrap_or(bytes.len());
             cell(k, &line[start..end.min(bytes.len())])?;
             if end >= bytes.len() {
-                return None;
+                return Err(cells(k + 1));
             }
             (start, k) = (end + 1, k + 1);
         }
         let rest = &bytes[start..];
         let end = memchr::memchr(b',', rest).map_or(bytes.len(), |i| start + i);
         cell(k, &line[start..end])?;
-        if k + 1 + memchr::memchr_iter(b',', &bytes[end.min(bytes.len())..]).count() != f.count {
-            return None;
+        let n = k + 1 + memchr::memchr_iter(b',', &bytes[end.min(bytes.len())..]).count();
+        if n != f.count {
+            return Err(cells(n));
         }
-        let (flux, mag) = ([flux[0]?, flux[1]?, flux[2]?], mag?);
         // Beyond any magnetic field: a corrupted cell (NaN is missing).
-        if flux
-            .iter()
-            .chain([&mag])
-            .any(|v| v.abs() > aeromag_io::MAX_FIELD_NT)
-        {
-            return None;
+        let beyond = [
+            (f.mag, mag),
+            (f.flux[0], flux[0]),
+            (f.flux[1], flux[1]),
+            (f.flux[2], flux[2]),
+        ]
+        .into_iter()
+        .find(|(_, v)| v.abs() > aeromag_io::MAX_FIELD_NT);
+        if let Some((k, v)) = beyond {
+            return Err(format!(
+                "column {:?}: {} is beyond any magnetic field ({} nT)",
+                clipped(&names[k]),
+                aeromag_core::error::shown(v),
+                aeromag_core::error::shown(aeromag_io::MAX_FIELD_NT)
+            ));
         }
-        Some((time?, flux, mag))
+        Ok((time, flux, mag))
     }
 
     /// What became of the lines so far.
@@ -461,6 +605,7 @@ pub struct LineStream {
     columns_in: Option<String>,
     comp: Option<LineCompensator>,
     before: StreamCounts,
+    issues_before: StreamIssues,
 }
 
 impl LineStream {
@@ -477,6 +622,7 @@ impl LineStream {
             columns_in: columns_in.map(str::to_string),
             comp,
             before: StreamCounts::default(),
+            issues_before: StreamIssues::default(),
         })
     }
 
@@ -528,6 +674,7 @@ impl LineStream {
                 let next = LineCompensator::new(&self.model, header, &self.opts)?;
                 if let Some(old) = self.comp.replace(next) {
                     self.before = self.before.plus(old.counts());
+                    self.issues_before = self.issues_before.then(old.issues());
                 }
             }
         }
@@ -567,8 +714,9 @@ impl LineStream {
             }
             if buf.len() > MAX_STREAM_LINE_BYTES {
                 comp.malformed(&mut out);
-            } else if is_comment(&buf) {
-                // A comment, written back as it is.
+            } else if is_comment(&buf) || buf.iter().all(u8::is_ascii_whitespace) {
+                // A comment or a blank line (which a file reader skips),
+                // written back as it is; no data line.
                 out.push_str(String::from_utf8_lossy(&buf).trim_end_matches(['\r', '\n']));
                 out.push('\n');
             } else {
@@ -585,6 +733,15 @@ impl LineStream {
         self.comp
             .as_ref()
             .map_or(self.before, |c| self.before.plus(c.counts()))
+    }
+
+    /// Why lines were not compensated so far, over every connection (data
+    /// lines are counted from each header that changed the columns).
+    pub fn issues(&self) -> StreamIssues {
+        self.comp.as_ref().map_or_else(
+            || self.issues_before.clone(),
+            |c| self.issues_before.then(c.issues()),
+        )
     }
 
     /// When adapting, the samples not learnt from as outliers
@@ -645,6 +802,12 @@ fn write_flushed(output: &mut impl std::io::Write, text: &str, peer: &str) -> Re
 /// `None` (a malformed line).
 fn number(cell: &str) -> Option<f64> {
     let c = cell.trim();
+    // Quoted, as a CSV writer may quote any cell (`"49302"`), and as the
+    // file reader takes it.
+    let c = c
+        .strip_prefix('"')
+        .and_then(|c| c.strip_suffix('"'))
+        .map_or(c, str::trim);
     if c.is_empty() {
         Some(f64::NAN)
     } else {
@@ -674,9 +837,11 @@ fn listed(names: &[&str]) -> String {
     shown.join(", ")
 }
 
-/// A header's names, trimmed, joined by commas.
+/// A header's names, trimmed, joined by commas (a byte-order mark dropped).
 fn normalised(header: &str) -> String {
     header
+        .strip_prefix('\u{feff}')
+        .unwrap_or(header)
         .split(',')
         .map(str::trim)
         .collect::<Vec<_>>()

@@ -41,6 +41,6 @@ pub use aeromag_compensation::tolles_lawson::online::{
 pub use aeromag_compensation::tolles_lawson::rls::RlsSettings;
 pub use causal::{CausalSensors, CausalTl};
 pub use lines::{
-    LineCompensator, LineStream, MAX_STREAM_LINE_BYTES, STREAM_OUTPUT, StreamCounts, StreamFlag,
-    StreamOptions,
+    LineCompensator, LineIssue, LineStream, MAX_STREAM_LINE_BYTES, STREAM_OUTPUT, StreamCounts,
+    StreamFlag, StreamIssues, StreamOptions,
 };

@@ -150,6 +150,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             e => e,
         });
     eprintln!("{}", stream.counts());
+    print_issues(&stream);
     print_coefficients(&stream);
     Ok(result?)
 }
@@ -167,6 +168,14 @@ fn adapt_options(a: &Args) -> AdaptOptions {
         o.rls.memory_s = m;
     }
     o
+}
+
+/// Why lines were not compensated, on standard error (each kind's count
+/// and first line).
+fn print_issues(stream: &LineStream) {
+    for w in stream.issues().warnings() {
+        eprintln!("{w}");
+    }
 }
 
 /// The adapted coefficients on standard error (nothing without --adapt).
@@ -217,6 +226,7 @@ fn serve_tcp(stream: &mut LineStream, addr: &str) -> anyhow::Result<()> {
             let _ = (&conn).write_all(format!("# error: {e}\n").as_bytes());
         }
         eprintln!("{peer} disconnected; so far {}", stream.counts());
+        print_issues(stream);
         print_coefficients(stream);
     }
     Ok(())

@@ -47,7 +47,7 @@ use super::design::{Lags, TotalField};
 use super::terms::backward_difference;
 use super::{Design, Magnitude};
 use crate::error::{CompError, Result};
-use aeromag_core::field::MAX_FIELD_NT;
+use aeromag_core::field::{MAX_FIELD_NT, MIN_READING_NT};
 
 /// One sample of a stream: time (s), the vector magnetometer (body frame,
 /// nT), the scalar reading (nT) and the extra regressors' channels in the
@@ -64,6 +64,34 @@ pub struct OnlineSample<'a> {
     pub channels: &'a [f64],
 }
 
+impl OnlineSample<'_> {
+    /// Whether `mag` and the vector magnetometer are readings of a
+    /// magnetic field: finite, within ±[`MAX_FIELD_NT`] (beyond is a
+    /// corrupted value: 1e308 ran through an adaptive compensator's state)
+    /// and not [below a reading](Self::below_reading).
+    pub fn readings_usable(&self) -> bool {
+        let field = |v: &f64| v.abs() <= MAX_FIELD_NT;
+        field(&self.mag_nt) && self.flux_nt.iter().all(field) && self.below_reading().is_none()
+    }
+
+    /// `("mag", mag)` when the scalar reading is below [`MIN_READING_NT`],
+    /// else `("|flux|", magnitude)` when the vector magnetometer's
+    /// magnitude is (all zero included): a dropout value, a negated
+    /// reading or another unit (tesla, gauss, µT), no reading of Earth's
+    /// field. `None` otherwise (NaN included).
+    pub fn below_reading(&self) -> Option<(&'static str, f64)> {
+        let [x, y, z] = self.flux_nt;
+        let norm = (x * x + y * y + z * z).sqrt();
+        if self.mag_nt < MIN_READING_NT {
+            Some(("mag", self.mag_nt))
+        } else if norm < MIN_READING_NT {
+            Some(("|flux|", norm))
+        } else {
+            None
+        }
+    }
+}
+
 /// What happened to a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SampleStatus {
@@ -75,7 +103,9 @@ pub enum SampleStatus {
     Started,
     /// Not compensated: an input is missing (not finite), `mag` or a
     /// `flux` component is beyond any magnetic field
-    /// ([`MAX_FIELD_NT`]), or the field is all zero. The run ends.
+    /// ([`MAX_FIELD_NT`]), or `mag` or the vector magnetometer's magnitude
+    /// is below a reading of Earth's field ([`MIN_READING_NT`]: a dropout
+    /// value such as 0, another unit). The run ends.
     Missing,
     /// Not compensated: its time does not increase. The state is kept
     /// (until [`RESYNC_SAMPLES`] samples in a row go back together).
@@ -210,15 +240,10 @@ impl OnlineRows {
         } else {
             self.back = None;
         }
-        // A reading beyond any magnetic field is a corrupted value, as a
-        // missing one (1e308 ran through an adaptive compensator's state).
-        let field = |v: &f64| v.abs() <= MAX_FIELD_NT;
         let usable = s.time_s.is_finite()
-            && field(&s.mag_nt)
-            && s.flux_nt.iter().all(field)
+            && s.readings_usable()
             && s.channels.len() == self.extra.len()
-            && s.channels.iter().all(|v| v.is_finite())
-            && s.flux_nt.iter().any(|v| *v != 0.0);
+            && s.channels.iter().all(|v| v.is_finite());
         if s.time_s.is_finite() {
             self.last_time_s = Some(s.time_s);
         }

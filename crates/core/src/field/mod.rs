@@ -11,6 +11,15 @@ pub mod igrf;
 /// mag of 1e308 turned an adaptive compensator's coefficients into NaN).
 pub const MAX_FIELD_NT: f64 = 1e6;
 
+/// The smallest total-field reading taken as one, nT: Earth's field is
+/// above 22 000 nT everywhere (15 000 nT with room for the strongest
+/// anomalies at survey heights), and survey magnetometers read from 10 000
+/// or 15 000 nT up; a `mag` below, or a vector magnetometer's magnitude
+/// below, is a dropout value (0, −1, −99999), a negated reading or another
+/// unit (tesla, gauss, µT). A `mag` of 0 was compensated to 20.5 nT and
+/// flagged compensated, in files and on `aeromag stream`.
+pub const MIN_READING_NT: f64 = 1_000.0;
+
 /// The largest height taken as one, m (1000 km, twice a magnetic satellite's
 /// orbit): a value beyond is a corrupted cell or a numeric dummy, whose
 /// height difference at a crossover made levelling's normal matrix
