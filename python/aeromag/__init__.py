@@ -131,6 +131,21 @@ def decimal_year(date: str) -> float:
     return _aeromag.decimal_year(date)
 
 
+def _real_array(name: str, value: Any) -> np.ndarray:
+    """``value`` as float64, a TypeError naming ``name`` for None (read as
+    NaN: "lat NaN°") or complex values (their imaginary part was dropped
+    with NumPy's warning only)."""
+    if value is None:
+        raise TypeError(f"{name} must be a number or an array of numbers, not None")
+    a = np.asarray(value)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real numbers, not complex")
+    try:
+        return a.astype(np.float64)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name} must be numbers: {e}") from None
+
+
 def igrf(
     lat: Any, lon: Any, alt: Any = 0.0, time: Union[str, float, Any] = "2025-01-01"
 ) -> Dict[str, np.ndarray]:
@@ -147,10 +162,7 @@ def igrf(
     if isinstance(time, str):
         time = decimal_year(time)
     la, lo, al, ti = np.broadcast_arrays(
-        np.asarray(lat, dtype=np.float64),
-        np.asarray(lon, dtype=np.float64),
-        np.asarray(alt, dtype=np.float64),
-        np.asarray(time, dtype=np.float64),
+        *(_real_array(n, v) for n, v in (("lat", lat), ("lon", lon), ("alt", alt), ("time", time)))
     )
     shape = la.shape
     flat = [np.ascontiguousarray(a).reshape(-1) for a in (la, lo, al, ti)]

@@ -6,7 +6,7 @@
 //! (`to_dict`), parsed from that same file text, so Python and CLI numbers
 //! are the same bits.
 
-use crate::errors::{IntoPy, bad_argument};
+use crate::errors::{IntoPy, bad_argument, whole_opt};
 use crate::progress::PyProgress;
 use aeromag::Note;
 use aeromag::core::filter::Window;
@@ -116,7 +116,7 @@ impl PyEmDetection {
 pub fn detect_em(
     py: Python<'_>,
     raw: PathBuf,
-    window_len: Option<usize>,
+    window_len: Option<Bound<'_, PyAny>>,
     window: &str,
     pilot: bool,
     system: Option<PathBuf>,
@@ -124,7 +124,7 @@ pub fn detect_em(
 ) -> PyResult<PyEmDetection> {
     let defaults = DetectOptions::default();
     let opts = DetectOptions {
-        window_len: window_len.unwrap_or(defaults.window_len),
+        window_len: whole_opt("window_len", window_len.as_ref())?.unwrap_or(defaults.window_len),
         window: match window {
             "blackman-harris" => Window::BlackmanHarris,
             "nuttall" => Window::Nuttall,
@@ -309,15 +309,18 @@ pub fn locate_em(
 /// Simulate an EM positioning flight into the folder `out` (the files of
 /// `aeromag em simulate`); returns their paths and counts.
 #[pyfunction]
-#[pyo3(signature = (out, config=None, seed=None, known_positions=aeromag::em::DEFAULT_KNOWN),
+#[pyo3(signature = (out, config=None, seed=None, known_positions=None),
        text_signature = "(out, config=None, seed=None, known_positions=8)")]
 pub fn simulate_em<'py>(
     py: Python<'py>,
     out: PathBuf,
     config: Option<PathBuf>,
-    seed: Option<u64>,
-    known_positions: usize,
+    seed: Option<Bound<'py, PyAny>>,
+    known_positions: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let seed: Option<u64> = whole_opt("seed", seed.as_ref())?;
+    let known_positions: usize = whole_opt("known_positions", known_positions.as_ref())?
+        .unwrap_or(aeromag::em::DEFAULT_KNOWN);
     let text = config
         .as_deref()
         .map(|p| std::fs::read_to_string(p).map_err(|e| aeromag::Error::read(p, e)))

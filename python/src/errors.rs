@@ -15,7 +15,12 @@ pub fn to_py(e: aeromag::Error) -> PyErr {
 }
 
 fn exception(py: Python<'_>, e: &aeromag::Error) -> PyResult<PyErr> {
-    let message = e.to_string();
+    // The row selection's messages name the CLI's options; here they are
+    // keyword arguments ("--lines: no row has the line label …").
+    let message = e
+        .to_string()
+        .replace("--lines: ", "lines: ")
+        .replace("--time-range: ", "time_range: ");
     if let aeromag::Error::Write { .. } = e {
         return Ok(PyOSError::new_err(message));
     }
@@ -41,6 +46,37 @@ impl<T, E: Into<aeromag::Error>> IntoPy<T> for Result<T, E> {
     fn py_err(self) -> PyResult<T> {
         self.map_err(|e| to_py(e.into()))
     }
+}
+
+/// A whole-number argument `name` as `T`: a negative or too large one is
+/// bad input naming it, a non-integer a TypeError naming it (PyO3's
+/// `OverflowError: can't convert negative int to unsigned` named none).
+pub fn whole<T: TryFrom<u128>>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<T> {
+    let i: i128 = v.extract().map_err(|_| {
+        let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{name} must be a whole number, got {shown}"
+        ))
+    })?;
+    if i < 0 {
+        return Err(bad_argument(format!(
+            "{name} must not be negative, got {i}"
+        )));
+    }
+    u128::try_from(i)
+        .ok()
+        .and_then(|u| T::try_from(u).ok())
+        .ok_or_else(|| bad_argument(format!("{name}: {i} is too large")))
+}
+
+/// [`whole`] of an optional argument.
+pub fn whole_opt<T: TryFrom<u128>>(
+    name: &str,
+    v: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<T>> {
+    v.filter(|v| !v.is_none())
+        .map(|v| whole(name, v))
+        .transpose()
 }
 
 /// A bad-input error about an argument (a keyword option).

@@ -219,6 +219,12 @@ fn comma_list(v: Option<&Bound<'_, PyAny>>) -> PyResult<Option<String>> {
         .try_iter()?
         .map(|x| x.and_then(|x| x.str().map(|s| s.to_string())))
         .collect::<PyResult<_>>()?;
+    if parts.is_empty() {
+        // "--lines: '' has an empty label".
+        return Err(bad_argument(
+            "lines: an empty list selects no line (None keeps every row)",
+        ));
+    }
     Ok(Some(parts.join(",")))
 }
 

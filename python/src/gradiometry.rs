@@ -1,7 +1,7 @@
 //! Dipole estimation from gradiometer passes (`aeromag dipole locate`,
 //! `aeromag dipole crlb`, `aeromag simulate gradiometer`).
 
-use crate::errors::IntoPy;
+use crate::errors::{IntoPy, whole_opt};
 use crate::flight::PyFlight;
 use aeromag::Flight;
 use aeromag::gradiometry::{
@@ -27,9 +27,10 @@ pub fn locate_dipole(
     layout: Option<&str>,
     baseline_m: Option<f64>,
     noise_nt: Option<f64>,
-    passes: Option<usize>,
+    passes: Option<Bound<'_, PyAny>>,
     multistart: Option<bool>,
 ) -> PyResult<PyFlight> {
+    let passes: Option<usize> = whole_opt("passes", passes.as_ref())?;
     let mut cfg = read_config(config.as_deref()).py_err()?;
     LocateSettings {
         gradiometer: gradiometer
@@ -75,8 +76,9 @@ pub fn dipole_crlb(py: Python<'_>, config: Option<PathBuf>) -> PyResult<String> 
 pub fn simulate_gradiometer(
     py: Python<'_>,
     config: Option<PathBuf>,
-    seed: Option<u64>,
+    seed: Option<Bound<'_, PyAny>>,
 ) -> PyResult<PyFlight> {
+    let seed: Option<u64> = whole_opt("seed", seed.as_ref())?;
     let mut cfg = read_config(config.as_deref()).py_err()?;
     if let Some(s) = seed {
         cfg.seed = s;

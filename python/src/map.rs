@@ -1,7 +1,7 @@
 //! From lines to the map (`aeromag grid`, `aeromag microlevel`,
 //! `aeromag derive`): grids as NumPy arrays with their coordinates and CRS.
 
-use crate::errors::{IntoPy, bad_argument};
+use crate::errors::{IntoPy, bad_argument, whole_opt};
 use crate::flight::PyFlight;
 use crate::progress::PyProgress;
 use aeromag::Flight;
@@ -172,7 +172,8 @@ impl PyGrid {
 /// Grid a column of a survey (the keywords are `aeromag grid`'s flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, tension=0.25, method="min-curvature", blanking=None,
-    utm_zone=None, lever_arm=None, extent=None, max_sweeps=500, convergence=None, progress=None))]
+    utm_zone=None, lever_arm=None, extent=None, max_sweeps=None, convergence=None, progress=None),
+    text_signature = "(flight, column=None, cell=None, tension=0.25, method='min-curvature', blanking=None, utm_zone=None, lever_arm=None, extent=None, max_sweeps=500, convergence=None, progress=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn grid_flight(
     py: Python<'_>,
@@ -185,7 +186,7 @@ pub fn grid_flight(
     utm_zone: Option<&str>,
     lever_arm: Option<[f64; 3]>,
     extent: Option<[f64; 4]>,
-    max_sweeps: usize,
+    max_sweeps: Option<Bound<'_, PyAny>>,
     convergence: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyGrid> {
@@ -213,7 +214,8 @@ pub fn grid_flight(
         method,
         min_curvature: MinCurvature {
             tension,
-            max_iterations: max_sweeps,
+            max_iterations: whole_opt("max_sweeps", max_sweeps.as_ref())?
+                .unwrap_or(MinCurvature::default().max_iterations),
             convergence,
             ..MinCurvature::default()
         },
@@ -347,7 +349,8 @@ impl PyMicrolevelled {
 /// flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0,
-    tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=500, convergence=None, progress=None))]
+    tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=None, convergence=None, progress=None),
+    text_signature = "(flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0, tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=500, convergence=None, progress=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn microlevel(
     py: Python<'_>,
@@ -360,7 +363,7 @@ pub fn microlevel(
     tension: f64,
     utm_zone: Option<&str>,
     lever_arm: Option<[f64; 3]>,
-    max_sweeps: usize,
+    max_sweeps: Option<Bound<'_, PyAny>>,
     convergence: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyMicrolevelled> {
@@ -374,7 +377,8 @@ pub fn microlevel(
         cosine_power,
         min_curvature: MinCurvature {
             tension,
-            max_iterations: max_sweeps,
+            max_iterations: whole_opt("max_sweeps", max_sweeps.as_ref())?
+                .unwrap_or(MinCurvature::default().max_iterations),
             convergence,
             ..MinCurvature::default()
         },

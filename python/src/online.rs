@@ -8,7 +8,7 @@ use aeromag::TlModel;
 use aeromag::online::{
     Adapt, AdaptOptions, CausalTl, Navigation, OnlineEngine, OnlineSample, StreamFlag,
 };
-use numpy::{PyArray1, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -121,14 +121,14 @@ impl PyOnline {
     fn push_block<'py>(
         &mut self,
         py: Python<'py>,
-        time: PyReadonlyArray1<'py, f64>,
-        flux_x: PyReadonlyArray1<'py, f64>,
-        flux_y: PyReadonlyArray1<'py, f64>,
-        flux_z: PyReadonlyArray1<'py, f64>,
-        mag: PyReadonlyArray1<'py, f64>,
+        time: &Bound<'py, PyAny>,
+        flux_x: &Bound<'py, PyAny>,
+        flux_y: &Bound<'py, PyAny>,
+        flux_z: &Bound<'py, PyAny>,
+        mag: &Bound<'py, PyAny>,
         channels: Option<&Bound<'py, PyAny>>,
-        speed: Option<PyReadonlyArray1<'py, f64>>,
-        alt: Option<PyReadonlyArray1<'py, f64>>,
+        speed: Option<&Bound<'py, PyAny>>,
+        alt: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let chans: Vec<PyReadonlyArray1<'py, f64>> = match channels {
             None => Vec::new(),
@@ -137,23 +137,46 @@ impl PyOnline {
                     .channels
                     .iter()
                     .map(|n| {
-                        d.get_item(n)?
-                            .ok_or_else(|| bad_argument(format!("channels has no `{n}`")))?
-                            .extract()
+                        let a = d
+                            .get_item(n)?
+                            .ok_or_else(|| bad_argument(format!("channels has no `{n}`")))?;
+                        float_array(&format!("channels[{n:?}]"), &a)
                     })
                     .collect::<PyResult<_>>()?,
-                Err(_) => c.extract()?,
+                Err(_) => c
+                    .try_iter()?
+                    .enumerate()
+                    .map(|(k, a)| float_array(&format!("channels[{k}]"), &a?))
+                    .collect::<PyResult<_>>()?,
             },
         };
         self.check_channels(chans.len())?;
-        let cols = [&time, &flux_x, &flux_y, &flux_z, &mag].map(|a| a.as_slice());
-        let cols: Vec<&[f64]> = cols.into_iter().collect::<Result<_, _>>()?;
+        let cols = [
+            ("time", time),
+            ("flux_x", flux_x),
+            ("flux_y", flux_y),
+            ("flux_z", flux_z),
+            ("mag", mag),
+        ]
+        .map(|(name, a)| float_array(name, a));
+        let cols: Vec<PyReadonlyArray1<'py, f64>> = cols.into_iter().collect::<PyResult<_>>()?;
+        let nav = [("speed", speed), ("alt", alt)].map(|(name, a)| {
+            a.filter(|a| !a.is_none())
+                .map(|a| float_array(name, a))
+                .transpose()
+        });
+        let nav: Vec<Option<PyReadonlyArray1<'py, f64>>> =
+            nav.into_iter().collect::<PyResult<_>>()?;
+        let cols: Vec<&[f64]> = cols
+            .iter()
+            .map(|a| a.as_slice())
+            .collect::<Result<_, _>>()?;
         let ch: Vec<&[f64]> = chans
             .iter()
             .map(|a| a.as_slice())
             .collect::<Result<_, _>>()?;
-        let nav: Vec<Option<&[f64]>> = [&speed, &alt]
-            .into_iter()
+        let nav: Vec<Option<&[f64]>> = nav
+            .iter()
             .map(|a| a.as_ref().map(|a| a.as_slice()).transpose())
             .collect::<Result<_, _>>()?;
         let n = cols[0].len();
@@ -214,6 +237,30 @@ impl PyOnline {
             self.channels, self.max_step_s
         )
     }
+}
+
+/// `value` as a contiguous one-dimensional float64 array (a view when it
+/// is one already): a strided slice, integers, a list or a pandas Series
+/// are taken (a strided or integer array was "not contiguous" or "cannot
+/// be converted to 'PyArray<T, D>'"); complex values, text or another
+/// shape are a TypeError naming `name`.
+fn float_array<'py>(name: &str, value: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray1<'py, f64>> {
+    let np = value.py().import("numpy")?;
+    let wrong = |what: String| pyo3::exceptions::PyTypeError::new_err(format!("{name} {what}"));
+    let arr = np
+        .call_method1("asarray", (value,))
+        .map_err(|e| wrong(format!("must be an array of numbers: {e}")))?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u" | "b") {
+        return Err(wrong(format!(
+            "must be an array of real numbers, not of NumPy dtype kind '{kind}'"
+        )));
+    }
+    let a = np.call_method1("ascontiguousarray", (&arr, "float64"))?;
+    let a = a
+        .cast_into::<PyArray1<f64>>()
+        .map_err(|_| wrong("must be one-dimensional".to_string()))?;
+    Ok(a.readonly())
 }
 
 impl PyOnline {

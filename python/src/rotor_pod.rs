@@ -2,7 +2,7 @@
 //! `aeromag pod fit|apply`): fitted on a flight, they apply themselves to
 //! flights like the Tolles-Lawson model.
 
-use crate::errors::{IntoPy, bad_argument};
+use crate::errors::{IntoPy, bad_argument, whole_opt};
 use crate::flight::PyFlight;
 use crate::progress::PyProgress;
 use aeromag::pod::{PodModelFile, PodSetup, apply_pod, fit_pod as lib_fit_pod};
@@ -149,7 +149,7 @@ pub fn fit_rotor(
     hub_m: Option<[f64; 3]>,
     sensor_m: Option<[f64; 3]>,
     blade_span_m: Option<[f64; 2]>,
-    blades: Option<usize>,
+    blades: Option<Bound<'_, PyAny>>,
     coning_deg: Option<f64>,
     tilt_lon_deg: Option<f64>,
     phase_column: Option<String>,
@@ -161,7 +161,7 @@ pub fn fit_rotor(
     tail_spin_axis: Option<[f64; 3]>,
     tail_zero_azimuth: Option<[f64; 3]>,
     tail_blade_span_m: Option<[f64; 2]>,
-    tail_blades: Option<usize>,
+    tail_blades: Option<Bound<'_, PyAny>>,
     gear_ratio: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyModel> {
@@ -184,7 +184,7 @@ pub fn fit_rotor(
         hub_m,
         sensor_m,
         blade_span_m,
-        blades,
+        blades: whole_opt("blades", blades.as_ref())?,
         coning_deg,
         tilt_lon_deg,
         phase_column,
@@ -196,7 +196,7 @@ pub fn fit_rotor(
         tail_spin_axis,
         tail_zero_azimuth,
         tail_blade_span_m,
-        tail_blades,
+        tail_blades: whole_opt("tail_blades", tail_blades.as_ref())?,
         gear_ratio,
     })
     .py_err()?;

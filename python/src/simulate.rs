@@ -1,6 +1,6 @@
 //! The physical simulator (`aeromag simulate`): flights with truth.
 
-use crate::errors::{IntoPy, bad_argument};
+use crate::errors::{IntoPy, bad_argument, whole_opt};
 use crate::flight::PyFlight;
 use aeromag::sim::ScenarioKind;
 use aeromag::simulate::simulate_flight;
@@ -14,9 +14,10 @@ use pyo3::prelude::*;
 pub fn simulate(
     py: Python<'_>,
     scenario: &str,
-    seed: Option<u64>,
+    seed: Option<Bound<'_, PyAny>>,
     config: Option<String>,
 ) -> PyResult<PyFlight> {
+    let seed: Option<u64> = whole_opt("seed", seed.as_ref())?;
     let wanted = scenario.replace('-', "_");
     let kind = ScenarioKind::ALL
         .into_iter()

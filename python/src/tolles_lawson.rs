@@ -3,7 +3,7 @@
 //! calls [`calibrate`] with its keyword options, which are turned into the
 //! library's [`CalibrateSettings`] as the CLI's flags are.
 
-use crate::errors::{IntoPy, bad_argument};
+use crate::errors::{IntoPy, bad_argument, whole};
 use crate::flight::PyFlight;
 use crate::progress::PyProgress;
 use aeromag::compensation::kalman::NoiseModel;
@@ -100,7 +100,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                     r_nt2: q[2],
                 });
             }
-            "field_order" => s.field_order = Some(v.extract()?),
+            "field_order" => s.field_order = Some(whole("field_order", &v)?),
             "series" => s.series = v.extract()?,
             "terms" => s.terms = Some(TermSet::parse(&text()?).py_err()?),
             "extra" => s.extra = ExtraRequest::parse_list(&text()?).py_err()?,

@@ -59,3 +59,44 @@ def test_unwritable_output_is_oserror(tmp_path):
     (tmp_path / "a_file").write_text("")
     with pytest.raises(OSError):
         tl.save(tmp_path / "a_file" / "m.json")
+
+
+def test_arguments_are_named_in_their_errors(tmp_path):
+    """Found by fuzzing the API: errors that named no argument, named the
+    CLI's option, or misread the argument."""
+    cal = aeromag.simulate("calibration", seed=1)
+    # A negative count was PyO3's "can't convert negative int to unsigned".
+    for call, name in [
+        (lambda: aeromag.simulate("calibration", seed=-1), "seed"),
+        (lambda: aeromag.grid_flight(cal, max_sweeps=-1), "max_sweeps"),
+        (lambda: aeromag.TollesLawson(method="kalman", field_order=-1).fit(cal), "field_order"),
+        (lambda: aeromag.simulate_em(str(tmp_path / "em"), known_positions=-1), "known_positions"),
+        (lambda: aeromag.simulate_gradiometer(seed=-2), "seed"),
+    ]:
+        with pytest.raises(aeromag.BadInputError, match=f"{name} must not be negative, got -"):
+            call()
+    with pytest.raises(TypeError, match="seed must be a whole number, got 1.5"):
+        aeromag.simulate("calibration", seed=1.5)
+    with pytest.raises(aeromag.BadInputError, match="seed: 18446744073709551616 is too large"):
+        aeromag.simulate("calibration", seed=2**64)
+    # NumPy's integers are whole numbers.
+    assert np.array_equal(aeromag.simulate("calibration", seed=np.int64(1)).to_dict()["mag"], cal.to_dict()["mag"])
+    # A path that names no file was parsed as TOML text.
+    with pytest.raises(aeromag.BadInputError, match="config: no file '/nonexistent/my.toml'"):
+        aeromag.simulate("calibration", config="/nonexistent/my.toml")
+    # A NaN lever arm was "longer than 1000 m".
+    with pytest.raises(aeromag.BadInputError, match="finite number of metres"):
+        aeromag.TollesLawson(lever_arm=(float("nan"), 0, 0)).fit(cal)
+    # The row selection said "--lines: '' has an empty label".
+    with pytest.raises(aeromag.BadInputError, match="lines: an empty list selects no line"):
+        aeromag.Flight.from_dict({"time": [0.0, 1.0], "line": [1.0, 1.0]}, lines=[])
+    with pytest.raises(aeromag.BadInputError, match=" lines: no row has the line label '7'") as e:
+        aeromag.Flight.from_dict({"time": [0.0, 1.0], "line": [1.0, 1.0]}, lines=[7])
+    assert "--" not in str(e.value)
+    with pytest.raises(aeromag.BadInputError, match="^time_range: start 2 is after end 1"):
+        aeromag.Flight.from_dict({"time": [0.0, 1.0]}, time_range=(2.0, 1.0))
+    # A TIFF header and junk: "failed to fill whole buffer".
+    junk = tmp_path / "g.tif"
+    junk.write_bytes(b"II*\x00junk")
+    with pytest.raises(aeromag.BadInputError, match="truncated or damaged"):
+        aeromag.read_grid(junk)

@@ -29,6 +29,19 @@ def test_push_and_push_block_equal_the_causal_batch(model, survey_csv):
     assert comp.tobytes() == batch.tobytes()
     flags = np.concatenate([o["comp_flag"] for o in out])
     assert flags[0] == 2 and (flags[1:] == 0).all()
+    # A strided view, lists and a column of integers are arrays of numbers
+    # ("not contiguous", "cannot be converted to 'PyArray<T, D>'" before).
+    wide = np.zeros((n, 2))
+    wide[:, 0] = cols[0][:n]
+    again = aeromag.OnlineCompensator(model).push_block(
+        wide[:, 0], *(list(c[:n]) for c in cols[1:4]), np.round(cols[4][:n]).astype(np.int64)
+    )
+    want = aeromag.OnlineCompensator(model).push_block(cols[0][:n], *(c[:n] for c in cols[1:4]), np.round(cols[4][:n]))
+    assert again["mag_comp"].tobytes() == want["mag_comp"].tobytes()
+    with pytest.raises(TypeError, match="^mag must be an array of real numbers"):
+        block.push_block(*(c[:3] for c in cols[:4]), cols[4][:3] + 0j)
+    with pytest.raises(TypeError, match="^flux_y must be one-dimensional"):
+        block.push_block(cols[0][:3], cols[1][:3], np.zeros((3, 2)), cols[3][:3], cols[4][:3])
     # The causal convention costs almost nothing against the batch path.
     line = survey["line"] > 0
     truth = survey["true_external"]

@@ -149,3 +149,11 @@ def test_igrf_against_the_cli(cli):
     # A longitude of 1e300 was taken (any finite value was).
     with pytest.raises(aeromag.BadInputError, match="−360…360"):
         aeromag.igrf(45.0, 1e300)
+    # None was read as NaN ("lat NaN°"), a complex latitude lost its
+    # imaginary part with NumPy's warning only.
+    with pytest.raises(TypeError, match="lat must be a number"):
+        aeromag.igrf(None, 0.0)
+    with pytest.raises(TypeError, match="time must be a number"):
+        aeromag.igrf(0.0, 0.0, 0.0, None)
+    with pytest.raises(TypeError, match="lat must be real"):
+        aeromag.igrf(np.array([50 + 5j]), 0.0)

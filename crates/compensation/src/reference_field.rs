@@ -39,6 +39,12 @@ pub fn check_lever_arm(arm_m: [f64; 3]) -> Result<()> {
         return Ok(());
     }
     let shown = arm_m.map(aeromag_core::error::shown).join(", ");
+    // A NaN component was "longer than 1000 m".
+    if arm_m.iter().any(|v| !v.is_finite()) {
+        return Err(CompError::setting(format!(
+            "lever arm ({shown}) m: every component must be a finite number of metres (body frame X,Y,Z)"
+        )));
+    }
     Err(CompError::setting(format!(
         "lever arm ({shown}) m is longer than {MAX_LEVER_ARM_M} m: no sensor is that far from the navigation point (metres expected, body frame X,Y,Z)"
     )))
@@ -141,10 +147,17 @@ mod tests {
     fn lever_arms_beyond_a_kilometre_or_not_finite_are_refused() {
         assert!(check_lever_arm([-9.5, 0.0, -0.6]).is_ok());
         assert!(check_lever_arm([0.0, 0.0, 1000.0]).is_ok());
-        for arm in [[1e300, 0.0, 0.0], [0.0, 600.0, 900.0], [f64::NAN, 0.0, 0.0]] {
+        for (arm, says) in [
+            ([1e300, 0.0, 0.0], "longer than 1000 m"),
+            ([0.0, 600.0, 900.0], "longer than 1000 m"),
+            ([f64::NAN, 0.0, 0.0], "must be a finite number"),
+            ([0.0, f64::INFINITY, 0.0], "must be a finite number"),
+        ] {
             let e = check_lever_arm(arm).unwrap_err();
             assert!(
-                e.is_bad_input() && e.to_string().contains("lever arm"),
+                e.is_bad_input()
+                    && e.to_string().contains("lever arm")
+                    && e.to_string().contains(says),
                 "{e}"
             );
         }

@@ -22,8 +22,10 @@ pub const MAX_GROUND_SPEED_M_S: f64 = 1000.0;
 pub enum StreamFlag {
     /// 0: compensated.
     Compensated = 0,
-    /// 1: not compensated, an input is missing (empty, `NaN`) or the field
-    /// is all zero, or the interference the model gives is beyond any
+    /// 1: not compensated, an input is missing (empty, `NaN`), `mag` or
+    /// the vector magnitude is below a reading of Earth's field
+    /// ([`aeromag_core::field::MIN_READING_NT`]: a dropout value such as 0,
+    /// tesla), or the interference the model gives is beyond any
     /// magnetic field ([`aeromag_io::MAX_FIELD_NT`]: a model file that does
     /// not fit, or a time step too short for the derivative); its values
     /// are left empty.

@@ -18,15 +18,17 @@ use std::path::PathBuf;
 /// The first line is the header (the column names) unless --columns-in
 /// names the columns. Each line is written back, flushed, with
 /// `mag_interf` and `mag_comp` (nT) and `comp_flag`: 0 compensated,
-/// 1 missing value (or an interference beyond any magnetic field, 10⁶ nT),
+/// 1 missing value (or a `mag` or vector magnitude below 1000 nT, no
+/// reading of Earth's field: a dropout value or another unit; or an
+/// interference beyond any magnetic field, 10⁶ nT),
 /// 2 compensated after a gap (run restarted), 3 time going back (ignored;
 /// after 10 such lines in a row that advance together, the stream runs on
 /// their clock), 4 malformed line (or a `mag`/`flux_*` value beyond 10⁶
 /// nT). Bad lines never stop the stream; the counts go to standard error
-/// when a stream ends. Comment
-/// lines (`#` first, as in a CSV file: a simulated file's `# units:`
-/// lines) are written back as they are, in their place, and so are blank
-/// lines before the header.
+/// when a stream ends, with the first line of each kind not compensated
+/// and why. Comment lines (`#` first, as in a CSV file: a simulated
+/// file's `# units:` lines) and blank lines are written back as they are,
+/// in their place.
 ///
 /// With --adapt the coefficients start at the model's and are updated by
 /// every compensated sample, after it is compensated: `kalman`, the

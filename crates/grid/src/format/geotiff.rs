@@ -212,12 +212,23 @@ fn encode<W: Write + Seek>(w: &mut W, grid: &Grid) -> std::result::Result<(), Ti
     image.finish()
 }
 
+/// A TIFF decoder's error in words: the file ending inside a structure
+/// said "failed to fill whole buffer".
+fn tiff_reason(e: TiffError) -> String {
+    match e {
+        TiffError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file ends inside the TIFF structure (truncated or damaged)".to_string()
+        }
+        e => e.to_string(),
+    }
+}
+
 /// Reads a GeoTIFF (module docs for what is accepted). The name and unit
 /// come from `GDAL_METADATA` (else the file stem and no unit), the CRS
 /// from `ProjectedCSTypeGeoKey` when it is a WGS 84 / UTM code.
 pub fn read(path: &Path) -> Result<Grid> {
     let file = File::open(path).map_err(|e| read_error(path, e))?;
-    let err = |e: TiffError| read_error(path, e);
+    let err = |e: TiffError| read_error(path, tiff_reason(e));
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(err)?
         .with_limits(Limits::unlimited());
@@ -534,5 +545,21 @@ mod tests {
             e.contains("big.tif") && e.contains("15800 × 15800") && e.contains("but the file has"),
             "{e}"
         );
+        // A TIFF header and then junk, and a file cut in its tags: said
+        // "failed to fill whole buffer".
+        for (name, b) in [
+            ("junk.tif", b"II*\x00junk".to_vec()),
+            ("cut.tif", bytes[..bytes.len().min(40)].to_vec()),
+        ] {
+            let p = dir.path().join(name);
+            std::fs::write(&p, &b).unwrap();
+            let e = read(&p).unwrap_err();
+            assert!(e.is_bad_input());
+            let e = e.to_string();
+            assert!(
+                e.contains(name) && e.contains("truncated or damaged"),
+                "{e}"
+            );
+        }
     }
 }
