@@ -441,6 +441,22 @@ impl CsvSource {
         }
         self.last = self.rec.len().saturating_sub(1);
         self.crlf = self.rec.get(self.last).is_some_and(|f| f.ends_with(b"\r"));
+        // A `\r` inside the header record other than a CRLF end: the file
+        // ends its lines in `\r` alone and was read as one line.
+        let inner_cr = self.rec.iter().enumerate().any(|(k, f)| {
+            let f = if self.crlf && k == self.last {
+                f.strip_suffix(b"\r").unwrap_or(f)
+            } else {
+                f
+            };
+            f.contains(&b'\r')
+        });
+        if inner_cr {
+            return Err(IoError::CrLineEnds {
+                file: self.file.clone(),
+                line: self.line,
+            });
+        }
         self.rec
             .iter()
             .map(|f| {

@@ -93,6 +93,17 @@ pub enum IoError {
         /// What is too large, with the limit.
         what: String,
     },
+    /// The lines end in `\r` alone (a classic Mac OS text file): the whole
+    /// file read as one header line ("column name '0.0' appears twice").
+    #[error(
+        "'{file}' line {line}: the lines end in \\r alone (a classic Mac OS text file); convert the line ends to \\n or \\r\\n"
+    )]
+    CrLineEnds {
+        /// File as given.
+        file: String,
+        /// The header's line.
+        line: u64,
+    },
     /// A column name appears twice in the header.
     #[error(
         "'{file}' line {line}: column name '{column}' appears twice in the header (columns {first} and {second}, counted from 1)"
@@ -375,6 +386,7 @@ impl IoError {
             | Unsupported { file, .. } => at.file = Some(file.clone()),
             Read { file, line, .. }
             | Binary { file, line, .. }
+            | CrLineEnds { file, line }
             | WrongDelimiter { file, line, .. }
             | TooLarge { file, line, .. }
             | XyzHeader { file, line, .. } => {

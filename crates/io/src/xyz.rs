@@ -408,6 +408,14 @@ impl TokenSource {
         if self.buf.len() as u64 > MAX_LINE_BYTES {
             return Err(line_too_long(&self.file, self.line));
         }
+        // The first line holding a `\r`: the lines end in `\r` alone and
+        // the whole file is one line ("a header but no data rows").
+        if self.line == 1 && memchr::memchr(b'\r', &self.buf).is_some() {
+            return Err(IoError::CrLineEnds {
+                file: self.file.clone(),
+                line: 1,
+            });
+        }
         Ok(true)
     }
 

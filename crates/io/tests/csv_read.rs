@@ -42,6 +42,29 @@ fn crlf_bom_and_no_trailing_newline() {
     assert_eq!(t.line_of_row(2), Some(4));
 }
 
+/// Lines ending in `\r` alone (a classic Mac OS file) were read as one
+/// header line: "column name '0.0' appears twice", or an XYZ file's "a
+/// header but no data rows".
+#[test]
+fn cr_only_line_ends_are_named() {
+    let fx = Fixtures::new();
+    for (name, text) in [
+        ("mac.csv", "time,mag\r0,53000\r0.1,53001\r"),
+        (
+            "mac.xyz",
+            "/ survey\rTIME MAG LINE\r0 53000 1\r0.1 53001 1\r",
+        ),
+    ] {
+        let e = fx.read(name, text).unwrap_err();
+        assert!(matches!(e, IoError::CrLineEnds { line: 1, .. }), "{e:?}");
+        assert!(e.is_bad_input());
+        assert_mentions(&e.to_string(), &[name, "line 1", "\\r alone"]);
+    }
+    // A CRLF file with a quoted header name still reads.
+    let t = fx.read("q.csv", "time,\"mag\"\r\n0,53000\r\n").unwrap();
+    assert_eq!(t.column_names(), vec!["time", "mag"]);
+}
+
 #[test]
 fn comments_anywhere_and_blank_lines_keep_line_numbers() {
     let fx = Fixtures::new();
