@@ -9,6 +9,7 @@
 //! assert_eq!(known_field("ins_lat").unwrap().unit, "rad"); // not degrees
 //! assert_eq!(known_field("CUR_ACHi").unwrap().unit, "A");
 //! assert_eq!(known_field("PITOT_P").unwrap().unit, "kPa");
+//! assert_eq!(known_field("rotor_phase").unwrap().unit, "deg");
 //! assert!(known_field("MY_CHANNEL").is_none());
 //! ```
 
@@ -48,6 +49,11 @@ const EXACT: &[(&str, KnownField)] = &[
     ("line", f("—", "line label")),
     ("diurnal", f("nT", "base station (diurnal variation)")),
     ("igrf", f("nT", "main field (IGRF)")),
+    // the rotor and pod models' channels (an HDF5 `units` attribute of
+    // `rad` on them is refused, not read as degrees)
+    ("rotor_phase", f("deg", "rotor phase of blade 0, [0, 360)")),
+    ("cable_inclination", f("deg", "tow cable inclination below the horizontal")),
+    ("cable_azimuth", f("deg", "tow cable azimuth from magnetic north, [0, 360)")),
     // SGL HDF5 layout
     ("tt", f("s", "seconds past midnight UTC")),
     ("flight", f("—", "flight number")),
