@@ -303,11 +303,13 @@ fn readings_below_earths_field_are_not_compensated_and_named() {
         "0.5,20003,1003,45003,999.9",
         "0.6,20003,1003,45003,1000",
         "0.7,20003,1003,45003,49303",
+        "0.6,20003,1003,45003,0",
     ];
     let mut lc = LineCompensator::new(&model, header, &StreamOptions::default()).unwrap();
     let mut out = String::new();
     let flags: Vec<StreamFlag> = lines.iter().map(|l| lc.line(l, &mut out)).collect();
     use StreamFlag::*;
+    // (The last goes back in time: flagged 3, not counted as no reading.)
     assert_eq!(
         flags,
         [
@@ -318,7 +320,8 @@ fn readings_below_earths_field_are_not_compensated_and_named() {
             Missing,
             Missing,
             Started,
-            Compensated
+            Compensated,
+            TimeBackwards
         ]
     );
     for (k, line) in lines.iter().enumerate().take(6).skip(1) {

@@ -52,8 +52,14 @@ const EXACT: &[(&str, KnownField)] = &[
     // the rotor and pod models' channels (an HDF5 `units` attribute of
     // `rad` on them is refused, not read as degrees)
     ("rotor_phase", f("deg", "rotor phase of blade 0, [0, 360)")),
-    ("cable_inclination", f("deg", "tow cable inclination below the horizontal")),
-    ("cable_azimuth", f("deg", "tow cable azimuth from magnetic north, [0, 360)")),
+    (
+        "cable_inclination",
+        f("deg", "tow cable inclination below the horizontal"),
+    ),
+    (
+        "cable_azimuth",
+        f("deg", "tow cable azimuth from magnetic north, [0, 360)"),
+    ),
     // SGL HDF5 layout
     ("tt", f("s", "seconds past midnight UTC")),
     ("flight", f("—", "flight number")),

@@ -425,15 +425,6 @@ impl LineCompensator {
                     mag_nt,
                     channels: &self.channels,
                 };
-                if let Some((what, v)) = sample.below_reading() {
-                    // 5.3e-5 (tesla), not 0.00005310232207072217.
-                    let v = if v == 0.0 || v.abs() >= 1e-3 {
-                        aeromag_core::error::shown(v)
-                    } else {
-                        format!("{v:.3e}")
-                    };
-                    self.issues.not_reading.add(at, format!("{what} = {v} nT"));
-                }
                 let [vn, ve, alt] = self.nav;
                 let speed_m_s = if self.fields.nav[0].is_some() && self.fields.nav[1].is_some() {
                     vn.hypot(ve)
@@ -449,6 +440,17 @@ impl LineCompensator {
                 );
                 if beyond {
                     self.issues.beyond_field.add(at, String::new());
+                }
+                if o.status == SampleStatus::Missing
+                    && let Some((what, v)) = sample.below_reading()
+                {
+                    // 5.3e-5 (tesla), not 0.00005310232207072217.
+                    let v = if v == 0.0 || v.abs() >= 1e-3 {
+                        aeromag_core::error::shown(v)
+                    } else {
+                        format!("{v:.3e}")
+                    };
+                    self.issues.not_reading.add(at, format!("{what} = {v} nT"));
                 }
                 (
                     o.interference_nt,
