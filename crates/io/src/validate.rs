@@ -15,7 +15,7 @@
 //! | columns | error | warning |
 //! |---|---|---|
 //! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
-//! | `mag` | when its median \|B\| is within 15 000–75 000 nT (a total field): any value below [`MIN_READING_NT`] (a dropout value, a negated reading), naming the first row | — |
+//! | `mag` | when its median \|B\| is at least 15 000 nT (a total field, not an anomaly): any value below [`MIN_READING_NT`] (a dropout value, a negated reading), naming the first row | — |
 //! | `mag`, `igrf`, `flux_x/y/z`, `diurnal` | once the units pass: any \|value\| > [`MAX_FIELD_NT`] (a corrupted cell, a numeric dummy such as −1e32), naming the first row | — |
 //! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 15 000–75 000 nT; median relative difference from `mag` above 10 % (`vector-vs-scalar`) |
 //! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
@@ -543,8 +543,8 @@ impl Ctx<'_> {
         Ok(())
     }
 
-    /// A total-field reading (a column whose median `median_abs` is within
-    /// [`EARTH_FIELD_NT`]) has no value below [`MIN_READING_NT`] (`min`:
+    /// A total-field reading (a column whose median `median_abs` is at
+    /// least [`EARTH_FIELD_NT`]'s lower end) has no value below [`MIN_READING_NT`] (`min`:
     /// its smallest), or bad input naming the first row that has one: a
     /// dropout value (0, −99999), a negated reading. A column of an anomaly
     /// or another unit is not tested (its median is warned about).
