@@ -258,6 +258,27 @@ pub fn level(
             flight.require("alt")?,
         ),
     };
+    // Rows off the track (a GPS dropout written as 0, 0) made crossovers
+    // of their own: 10 on a survey, a line shifted by 55 nT. They are left
+    // out as `grid` and `microlevel` leave them out.
+    let time = flight.require("time")?;
+    let off_track = aeromag_io::position_glitches(time, lat, lon);
+    let on_track_positions = (!off_track.is_empty()).then(|| {
+        let mut la = lat.to_vec();
+        let mut lo = lon.to_vec();
+        for &k in &off_track {
+            la[k] = f64::NAN;
+            lo[k] = f64::NAN;
+        }
+        (la, lo)
+    });
+    if let Some(w) = crate::map::survey::off_track_warning(flight, &off_track) {
+        notes.warn(w);
+    }
+    let (lat, lon) = match &on_track_positions {
+        Some((la, lo)) => (la.as_slice(), lo.as_slice()),
+        None => (lat, lon),
+    };
     let reference_columns = opts.reference.resolve(flight)?;
     let sum = reference_sum(flight, &reference_columns, None)?;
     let value = reduced(flight.require(&value_column)?, &sum);
@@ -275,7 +296,7 @@ pub fn level(
         .transpose()?;
     let lines = LineLabels::of(flight, &opts.ties)?;
     let tracks = SurveyTracks {
-        time: flight.require("time")?,
+        time,
         lat,
         lon,
         alt,

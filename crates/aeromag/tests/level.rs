@@ -284,3 +284,46 @@ fn a_file_that_marks_no_tie_levels_as_plain_labels_and_given_ties_count() {
     let k = both.labels.iter().position(|l| l == "1001").unwrap();
     assert!(both.ties.as_ref().unwrap()[k] && !marked.ties.as_ref().unwrap()[k]);
 }
+
+/// A GPS dropout written as latitude and longitude 0 (a row of a line,
+/// mid-survey) made crossovers of its own (10 on a survey, one line
+/// shifted by 55 nT) while `grid` and `microlevel` left it out: `level`
+/// leaves it out too, with the `[position-glitch]` warning, and levels as
+/// without it.
+#[test]
+fn a_gps_dropout_row_makes_no_crossover() {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
+    let opts = LevelOptions::default();
+    let clean = level(&survey, &opts, &mut Silent).unwrap();
+    let row = survey.n_rows() / 3;
+    let dropout = edited(&survey, &|t: &mut FlightTable| {
+        let mut fresh = FlightTable::new();
+        for c in t.columns() {
+            let mut v = c.values().unwrap().to_vec();
+            if matches!(c.name(), "lat" | "lon") {
+                v[row] = 0.0;
+            }
+            fresh.add_column(c.name(), v).unwrap();
+        }
+        *t = fresh;
+    });
+    let lev = level(&dropout, &opts, &mut Silent).unwrap();
+    assert!(
+        lev.notes.iter().any(|n| n.is_warning()
+            && n.message.contains("1 row is off the track")
+            && n.message.contains(&format!("data row {}", row + 1))
+            && n.message.contains("[position-glitch]")),
+        "{:?}",
+        lev.notes
+    );
+    let (a, b) = (&clean.levelling, &lev.levelling);
+    assert_eq!(a.crossovers.crossovers.len(), b.crossovers.crossovers.len());
+    for (la, lb) in a.fit.lines.iter().zip(&b.fit.lines) {
+        assert!(
+            (la.offset_nt - lb.offset_nt).abs() < 0.05,
+            "{} against {}",
+            la.offset_nt,
+            lb.offset_nt
+        );
+    }
+}

@@ -214,6 +214,117 @@ fn a_flight_timed_in_other_units_than_the_calibration_is_bad_input() {
     assert!(model.compensate(&Flight::from_table(t).unwrap()).is_ok());
 }
 
+/// `f` with column `name` replaced by `edit` of it.
+fn edited(f: &Flight, name: &str, edit: impl Fn(&[f64]) -> Vec<f64>) -> Flight {
+    let mut t = FlightTable::new();
+    for c in f.table().columns() {
+        let v = c.values().unwrap();
+        let v = if c.name() == name {
+            edit(v)
+        } else {
+            v.to_vec()
+        };
+        t.add_column(c.name(), v).unwrap();
+    }
+    Flight::from_table(t).unwrap()
+}
+
+/// Found by fuzzing `calibrate` (each fitted with exit 0 a model that
+/// removed nothing or less, or failed as "singular system" / "invalid
+/// argument `low_hz`"): a stuck magnetometer, a dead fluxgate axis, a time
+/// in milliseconds, a truth column as an input, the reading as its own
+/// reference, a lever arm with nothing to move, LS settings with the
+/// Kalman method. Each is bad input saying what is wrong.
+#[test]
+fn hostile_calibration_flights_and_settings_are_refused() {
+    let cal = calibration(1);
+    let ls = CalibrateOptions {
+        eddy_lag: EddyLag::None,
+        ..CalibrateOptions::default()
+    };
+    let refused = |f: &Flight, opts: &CalibrateOptions, says: &str| {
+        let e = calibrate(f, opts, &mut Silent).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains(says),
+            "{says}: {e}"
+        );
+        e
+    };
+    let stuck = edited(&cal, "mag", |v| vec![53_100.0; v.len()]);
+    let e = refused(&stuck, &ls, "holds one value, 53100 nT, on every row");
+    assert_eq!(e.location().column.as_deref(), Some("mag"));
+    let dead = edited(&cal, "flux_y", |v| vec![0.0; v.len()]);
+    for opts in [&ls, &CalibrateOptions::kalman()] {
+        let e = refused(&dead, opts, "holds one value, 0 nT");
+        assert_eq!(e.location().column.as_deref(), Some("flux_y"));
+    }
+    let ms = edited(&cal, "time", |v| v.iter().map(|t| t * 1e3).collect());
+    for opts in [&ls, &CalibrateOptions::kalman()] {
+        refused(&ms, opts, "median time step is 100.0000 s (0.0100 Hz)");
+    }
+    let half = edited(&cal, "time", |v| v.iter().map(|t| t * 10.0).collect());
+    refused(
+        &half,
+        &ls,
+        "needs a sampling rate above 1.8 Hz, and segment",
+    );
+    // Truth never goes in: as an extra regressor, a reference channel, a
+    // sensor.
+    for opts in [
+        CalibrateOptions {
+            extra: aeromag::compensation::tolles_lawson::ExtraRequest::parse_list("true_interf")
+                .unwrap(),
+            extra_selection: aeromag::ExtraSelection::All,
+            ..ls.clone()
+        },
+        CalibrateOptions {
+            reference: "true_external".parse().unwrap(),
+            ..ls.clone()
+        },
+        CalibrateOptions {
+            sensor: SensorColumns {
+                mag: "true_external".into(),
+                ..SensorColumns::default()
+            },
+            ..ls.clone()
+        },
+    ] {
+        refused(&cal, &opts, "is a simulation truth column");
+    }
+    // `mag` read from `igrf` with the automatic references.
+    let own = CalibrateOptions {
+        sensor: SensorColumns {
+            mag: "igrf".into(),
+            ..SensorColumns::default()
+        },
+        ..ls.clone()
+    };
+    refused(
+        &cal,
+        &own,
+        "reference channel `igrf` is the scalar reading itself",
+    );
+    let lever = CalibrateOptions {
+        reference: "none".parse().unwrap(),
+        lever_arm: Some(aeromag::LeverArm {
+            arm_m: [10.0, 0.0, 0.0],
+            decimal_year: 2025.0,
+        }),
+        ..ls.clone()
+    };
+    refused(&cal, &lever, "the LS fit would not use it");
+    let band = aeromag::CalibrateSettings {
+        method: aeromag::Method::Kalman,
+        band_hz: Some(Some((0.2, 0.5))),
+        ..Default::default()
+    };
+    let e = band.options().unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("band (--band)"),
+        "{e}"
+    );
+}
+
 /// The rows `rows` of every column of `f`, as a flight.
 fn rows_of(f: &FlightTable, rows: std::ops::Range<usize>) -> Flight {
     let mut t = FlightTable::new();

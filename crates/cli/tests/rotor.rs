@@ -129,8 +129,11 @@ fn rotor_fit_needs_the_geometry_and_apply_keeps_every_row() {
         args.extend(extra);
         let o = fit(&args);
         assert_code(&o, 2);
+        // Refused on reading, for every command.
         assert!(
-            stderr(&o).contains("`true_flux_x` (as flux_x) is a simulation truth column"),
+            stderr(&o).contains(
+                "column 'true_flux_x' cannot be read as `flux_x`: it is simulation truth"
+            ),
             "{}",
             stderr(&o)
         );

@@ -259,6 +259,42 @@ impl std::str::FromStr for ColumnMap {
     }
 }
 
+/// The user's and the sensors' mappings `out` play measured roles only: a
+/// `true_…` column mapped onto a measured role (`--columns mag=true_external`
+/// was fitted; estimators never read truth), or a canonical column mapped
+/// onto another role while it keeps its own (`--columns flux_x=flux_y`:
+/// `flux_y` read as both) is bad input. Swapping two columns
+/// (`flux_x=flux_y,flux_y=flux_x`) is a mapping of each.
+fn check_roles(file: &str, map: &ColumnMap, out: &[MappedColumn]) -> Result<()> {
+    let err = |m: &MappedColumn, reason: String| IoError::MappedColumnRole {
+        file: file.to_string(),
+        canonical: m.canonical.clone(),
+        file_column: m.file_column.clone(),
+        reason,
+    };
+    for m in out {
+        if is_truth_column(&m.file_column) && !is_truth_column(&m.canonical) {
+            return Err(err(
+                m,
+                "it is simulation truth, which aeromag's estimators and models never read; map a measured column".into(),
+            ));
+        }
+        let keeps_own = is_canonical(&m.file_column)
+            && m.file_column != m.canonical
+            && map.get(&m.file_column).is_none();
+        if keeps_own {
+            return Err(err(
+                m,
+                format!(
+                    "it is read as `{}` too (one column in two roles); map `{}` elsewhere as well to swap them",
+                    m.file_column, m.file_column
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Resolves the aliases for a file with the given header: the user's map
 /// first (every mapped file column must exist), then, if `preset` is on, the
 /// MagNav preset for canonical names that are neither in the header nor mapped.
@@ -294,6 +330,7 @@ pub(crate) fn resolve(
         });
     }
     sensors.resolve(file, header, map, &mut out)?;
+    check_roles(file, map, &out)?;
     if !preset {
         return Ok(out);
     }

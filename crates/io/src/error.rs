@@ -198,6 +198,21 @@ pub enum IoError {
         /// Comma-separated list of the columns present.
         present: String,
     },
+    /// A column mapped (`--columns`, `--mag`, `--vector`) onto an input
+    /// role it cannot play: a simulation truth column (estimators never
+    /// read truth), or a column that keeps its own canonical role too
+    /// (`--columns flux_x=flux_y` read one axis twice: "singular system").
+    #[error("'{file}': column '{file_column}' cannot be read as `{canonical}`: {reason}")]
+    MappedColumnRole {
+        /// File as given.
+        file: String,
+        /// The role it was mapped onto.
+        canonical: String,
+        /// The file's column.
+        file_column: String,
+        /// Why not.
+        reason: String,
+    },
     /// An HDF5 file that cannot be read (not HDF5, damaged, a field of an
     /// unsupported type).
     #[error("'{file}'{}: {message}", dataset.as_ref().map(|d| format!(", dataset '{d}'")).unwrap_or_default())]
@@ -428,6 +443,9 @@ impl IoError {
                 at.column = Some(column.clone());
             }
             MappedColumnAbsent {
+                file, file_column, ..
+            }
+            | MappedColumnRole {
                 file, file_column, ..
             } => {
                 at.file = Some(file.clone());

@@ -175,6 +175,29 @@ impl Flight {
         }
     }
 
+    /// The column `name` as a model's or an estimator's input: as
+    /// [`FlightTable::require`], and bad input when it is (or is mapped
+    /// onto) a simulation truth column (`true_…`), which they never read
+    /// (`calibrate --extra true_interf` fitted the truth; `--columns` and
+    /// the sensor choices are checked on reading).
+    pub fn measured(&self, name: &str) -> Result<&[f64]> {
+        let column = self.resolve(name).unwrap_or(name);
+        if aeromag_io::is_truth_column(column) {
+            return Err(Error::bad_file(
+                self.label(),
+                format!(
+                    "`{column}`{} is a simulation truth column; models and estimators never read truth",
+                    if column == name {
+                        String::new()
+                    } else {
+                        format!(" (as {name})")
+                    }
+                ),
+            ));
+        }
+        Ok(self.require(name)?)
+    }
+
     /// A numeric column whose every value must be finite: bad input naming
     /// the first cell that is not a number (the reader keeps such a column
     /// as text) or that is missing, NaN or infinite.

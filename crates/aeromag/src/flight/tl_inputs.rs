@@ -146,11 +146,11 @@ impl<'a> TlInputs<'a> {
         Ok(Self {
             time: flight.require("time")?,
             flux: [
-                flight.require(&sensor.flux[0])?,
-                flight.require(&sensor.flux[1])?,
-                flight.require(&sensor.flux[2])?,
+                flight.measured(&sensor.flux[0])?,
+                flight.measured(&sensor.flux[1])?,
+                flight.measured(&sensor.flux[2])?,
             ],
-            mag: flight.require(&sensor.mag)?,
+            mag: flight.measured(&sensor.mag)?,
             line: flight.column("line"),
             channels: Vec::new(),
             flight: Some(flight),
@@ -162,8 +162,8 @@ impl<'a> TlInputs<'a> {
     pub fn with_extras(self, flight: &'a Flight, extras: &[ExtraTerm]) -> Result<Self> {
         let channels = extras
             .iter()
-            .map(|x| flight.require(&x.channel))
-            .collect::<std::result::Result<_, _>>()?;
+            .map(|x| flight.measured(&x.channel))
+            .collect::<Result<_>>()?;
         Ok(Self { channels, ..self })
     }
 

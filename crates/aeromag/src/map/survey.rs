@@ -128,39 +128,7 @@ impl ProjectedSurvey {
     /// none): how many, and the first few with their file rows, lines and
     /// positions, named `[position-glitch]`.
     pub fn off_track_warning(&self, flight: &Flight) -> Option<String> {
-        const SHOWN: usize = 5;
-        let n = self.off_track.len();
-        if n == 0 {
-            return None;
-        }
-        let (lat, lon) = (flight.column("lat"), flight.column("lon"));
-        let rows: Vec<String> = self.off_track[..n.min(SHOWN)]
-            .iter()
-            .map(|&k| {
-                let line = flight
-                    .line_of_row(k)
-                    .map_or(String::new(), |l| format!(" (line {l})"));
-                let at = |c: Option<&[f64]>| shown(c.map_or(f64::NAN, |c| c[k]));
-                format!(
-                    "data row {}{line}: lat {}, lon {}",
-                    flight.file_row(k) + 1,
-                    at(lat),
-                    at(lon)
-                )
-            })
-            .collect();
-        let more = if n > SHOWN {
-            format!(" and {} more", n - SHOWN)
-        } else {
-            String::new()
-        };
-        Some(format!(
-            "{n} {} off the track (the position jumps away and back faster than {} m/s: a GPS dropout or a corrupted cell?) and {} left out: {}{more} [position-glitch]",
-            if n == 1 { "row is" } else { "rows are" },
-            crate::flight::MAX_GROUND_SPEED_M_S,
-            if n == 1 { "is" } else { "are" },
-            rows.join("; ")
-        ))
+        off_track_warning(flight, &self.off_track)
     }
 
     /// Whether row `k` is survey data: on a line when there are lines
@@ -168,6 +136,47 @@ impl ProjectedSurvey {
     pub fn on_line(&self, k: usize) -> bool {
         self.line_ids.as_ref().is_none_or(|ids| ids[k] != 0.0)
     }
+}
+
+/// The warning for the rows `off_track` (ascending, 0-based) of `flight`
+/// whose position is off the track (`None` when there are none): how
+/// many, and the first few with their file rows, lines and positions,
+/// named `[position-glitch]`; `grid`, `microlevel` and `level` leave them
+/// out.
+pub(crate) fn off_track_warning(flight: &Flight, off_track: &[usize]) -> Option<String> {
+    const SHOWN: usize = 5;
+    let n = off_track.len();
+    if n == 0 {
+        return None;
+    }
+    let (lat, lon) = (flight.column("lat"), flight.column("lon"));
+    let rows: Vec<String> = off_track[..n.min(SHOWN)]
+        .iter()
+        .map(|&k| {
+            let line = flight
+                .line_of_row(k)
+                .map_or(String::new(), |l| format!(" (line {l})"));
+            let at = |c: Option<&[f64]>| shown(c.map_or(f64::NAN, |c| c[k]));
+            format!(
+                "data row {}{line}: lat {}, lon {}",
+                flight.file_row(k) + 1,
+                at(lat),
+                at(lon)
+            )
+        })
+        .collect();
+    let more = if n > SHOWN {
+        format!(" and {} more", n - SHOWN)
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{n} {} off the track (the position jumps away and back faster than {} m/s: a GPS dropout or a corrupted cell?) and {} left out: {}{more} [position-glitch]",
+        if n == 1 { "row is" } else { "rows are" },
+        crate::flight::MAX_GROUND_SPEED_M_S,
+        if n == 1 { "is" } else { "are" },
+        rows.join("; ")
+    ))
 }
 
 impl LineGeometry {

@@ -352,7 +352,7 @@ pub fn oracle(
             ..Default::default()
         },
         eddy_lag: EddyLag::Fixed(terms.eddy_lags_s().to_vec()),
-        reference: ReferenceChannels::Columns(vec![format!("true_external_{idx}")]),
+        reference: ReferenceChannels::None,
         extra_selection: ExtraSelection::All,
         // As the reference-sensor mode fits: the lagged terms run through
         // the line changes as the compensation applies them (fitted line by
@@ -361,7 +361,16 @@ pub fn oracle(
         split_lines: false,
         ..CalibrateOptions::default()
     };
-    let fit = calibrate(survey, &opts, &mut crate::observer::Silent)?.model;
+    // The true external field subtracted as a series (truth columns are
+    // refused as reference channels).
+    let truth = survey.require(&format!("true_external_{idx}"))?;
+    let fit = crate::tolles_lawson::calibrate_against(
+        survey,
+        &opts,
+        truth,
+        &mut crate::observer::Silent,
+    )?
+    .model;
     line_error_rms(survey, &compensated(survey, s, fit)?, idx)
 }
 

@@ -27,6 +27,7 @@ mod observability;
 mod sensors;
 mod settings;
 
+pub(crate) use calibrate::calibrate_against;
 pub use calibrate::{
     CalibrateOptions, Calibration, EddyLag, ExtraSelection, Method, SECOND_ORDER_NOTE_NT, calibrate,
 };

@@ -98,6 +98,20 @@ impl CalibrateSettings {
                     return Err(Error::bad_input(format!("{name} needs method kalman")));
                 }
             }
+        } else {
+            // The band-pass LS settings were ignored by the Kalman method
+            // without a word (the same coefficients with `--band 0.2,0.5`).
+            for (given, name) in [
+                (self.ridge_lambda.is_some(), "ridge_lambda (--lambda)"),
+                (self.band_hz.is_some(), "band (--band)"),
+                (self.trim.is_some(), "trim (--trim)"),
+            ] {
+                if given {
+                    return Err(Error::bad_input(format!(
+                        "{name} is a setting of the band-pass LS method; the Kalman method does not filter"
+                    )));
+                }
+            }
         }
         if let Some(l) = self.ridge_lambda
             && !(l.is_finite() && l >= 0.0)

@@ -5,7 +5,6 @@ use crate::args::{self, Band, parsed};
 use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::compensation::kalman::{NoiseModel, q1_unit};
-use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
 use aeromag::compensation::tolles_lawson::{Convention, Design, ExtraRequest, Magnitude, TermSet};
 use aeromag::{
     CalibrateOptions, CalibrateSettings, EddyLag, ExtraSelection, Method, ReferenceChannels,
@@ -144,15 +143,17 @@ pub struct Args {
     /// (MagNav.jl create_TL_A: per-sample central difference).
     #[arg(long, value_enum, ignore_case = true, default_value_t = Design::default().convention)]
     convention: Convention,
-    /// Ridge parameter λ ≥ 0.
-    #[arg(long, value_parser = args::non_negative, default_value_t = LsConfig::default().lambda)]
-    lambda: f64,
-    /// Pass band LO,HI in Hz, or `none` to fit unfiltered data.
-    #[arg(long, value_name = "LO,HI|none", default_value_t = Band(LsConfig::default().band_hz))]
-    band: Band,
-    /// Samples trimmed at each end of each filtered leg.
-    #[arg(long, default_value_t = LsConfig::default().trim)]
-    trim: usize,
+    /// Ridge parameter λ ≥ 0 (LS method) [default: 0].
+    #[arg(long, value_parser = args::non_negative)]
+    lambda: Option<f64>,
+    /// Pass band LO,HI in Hz, or `none` to fit unfiltered data (LS method)
+    /// [default: 0.1,0.9].
+    #[arg(long, value_name = "LO,HI|none")]
+    band: Option<Band>,
+    /// Samples trimmed at each end of each filtered leg (LS method)
+    /// [default: 20].
+    #[arg(long)]
+    trim: Option<usize>,
     /// Scale of the induced and eddy columns, nT.
     #[arg(long, value_parser = args::positive, default_value_t = Design::default().bt_scale_nt)]
     bt_scale: f64,
@@ -212,9 +213,9 @@ fn options(a: &Args) -> anyhow::Result<CalibrateOptions> {
         method: a.method,
         terms: Some(a.terms.clone()),
         convention: Some(a.convention),
-        ridge_lambda: Some(a.lambda),
-        band_hz: Some(a.band.0),
-        trim: Some(a.trim),
+        ridge_lambda: a.lambda,
+        band_hz: a.band.as_ref().map(|b| b.0),
+        trim: a.trim,
         bt_scale_nt: Some(a.bt_scale),
         no_split_lines: a.no_split_lines,
         reference: a.reference.clone(),
@@ -410,4 +411,33 @@ fn run_sensors(a: &Args, opts: &CalibrateOptions) -> anyhow::Result<()> {
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aeromag::compensation::tolles_lawson::fit_ls::LsConfig;
+
+    /// The LS settings are options (so that the Kalman method can refuse
+    /// them when given); the defaults their help states are the library's.
+    #[test]
+    fn stated_ls_defaults_are_the_librarys() {
+        let cmd = <Args as clap::Args>::augment_args(clap::Command::new("calibrate"));
+        let help = |id: &str| {
+            cmd.get_arguments()
+                .find(|a| a.get_id() == id)
+                .and_then(|a| a.get_help())
+                .map(|h| h.to_string())
+                .unwrap()
+        };
+        let ls = LsConfig::default();
+        for (id, value) in [
+            ("lambda", ls.lambda.to_string()),
+            ("band", Band(ls.band_hz).to_string()),
+            ("trim", ls.trim.to_string()),
+        ] {
+            let h = help(id);
+            assert!(h.contains(&format!("[default: {value}]")), "{id}: {h}");
+        }
+    }
 }

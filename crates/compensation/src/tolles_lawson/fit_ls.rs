@@ -364,6 +364,25 @@ fn segment_filter(
             "segment {k} ({n} samples) has no valid time step; skipped"
         )));
     }
+    // The band's high edge at or above the flight's Nyquist frequency:
+    // the filter design said "invalid argument `high_hz`".
+    // (`0.5 / 0.1` is 5.000000000000001: an edge at Nyquist within
+    // round-off is at it.)
+    if let Some((lo, hi)) = cfg.band_hz
+        && hi * dt >= 0.5 * (1.0 - 1e-9)
+    {
+        let shown = aeromag_core::error::shown;
+        return Err(CompError::setting(format!(
+            "pass band {}–{} Hz needs a sampling rate above {} Hz, and segment {k} is sampled at {} \
+             Hz (median step {} s): lower the band's high edge (--band; the default is 0.1–0.9 Hz), \
+             or is the time not in seconds?",
+            shown(lo),
+            shown(hi),
+            shown(2.0 * hi),
+            shown((1e3 / dt).round() / 1e3),
+            aeromag_core::error::figure(dt)
+        )));
+    }
     let sos = match cfg.band_hz {
         Some((lo, hi)) => Some(butter(
             cfg.filter_order,
@@ -400,6 +419,10 @@ fn segment_filter(
     }
     Ok(Ok((dt, sos)))
 }
+
+/// Skipped segments named one by one in a fit's warnings; more are
+/// counted in one more warning.
+pub const LISTED_SKIPS: usize = 3;
 
 /// Which of `segments` a fit under `cfg` uses (the others are too short to
 /// filter and trim with its number of columns, or have no time step).
@@ -648,9 +671,13 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
         Ok(Ok((dt, blocks)))
     };
     // The segments' products added in segment order.
+    let mut skipped_samples = 0;
     for_each_segment_on_cores(segments, products, |k, d| {
         match d? {
-            Err(w) => warnings.push(w),
+            Err(w) => {
+                skipped_samples += segments[k].time.len();
+                warnings.push(w);
+            }
             Ok((dt, blocks)) => {
                 for p in &blocks {
                     ne.add_products(p)
@@ -672,6 +699,16 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
         return Err(CompError::data(format!(
             "no segment is long enough to fit{why}"
         )));
+    }
+    // A flight whose second part is at another rate gave a warning per
+    // one-sample segment (1 610 lines) and no total.
+    if warnings.len() > LISTED_SKIPS {
+        let all: usize = segments.iter().map(|s| s.time.len()).sum();
+        let n = warnings.len();
+        warnings.truncate(LISTED_SKIPS);
+        warnings.push(format!(
+            "{n} segments skipped in all ({skipped_samples} of {all} samples), the first {LISTED_SKIPS} above"
+        ));
     }
     let independent_fraction = match cfg.band_hz {
         Some((lo, hi)) => {
