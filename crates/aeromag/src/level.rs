@@ -281,12 +281,18 @@ pub fn level(
     };
     let reference_columns = opts.reference.resolve(flight)?;
     let sum = reference_sum(flight, &reference_columns, None)?;
-    let value = reduced(flight.require(&value_column)?, &sum);
+    let value = reduced(flight.field_values(&value_column)?, &sum);
     let rate_column = match &opts.rate_of {
         Some(c) => c.clone(),
         None if flight.column("mag").is_some() => "mag".into(),
         None => value_column.clone(),
     };
+    // `--rate-of time` failed as a "singular system" (exit 1).
+    if crate::flight::NOT_FIELDS.contains(&rate_column.as_str()) {
+        return Err(Error::bad_input(format!(
+            "the rate of `{rate_column}` is no d|B0|/dt: give a magnetic column (the reading as recorded, `mag` by default)"
+        )));
+    }
     // The column as recorded (the sensor lags the reference fields too);
     // not needed, and its gaps not imposed, without the k term.
     let sensed = opts

@@ -327,3 +327,45 @@ fn a_gps_dropout_row_makes_no_crossover() {
         );
     }
 }
+
+/// Found by fuzzing the survey chain: an `inf` or 1e300 in the levelled
+/// column was levelled into `inf` with exit 0 (and dropped from a grid
+/// without a word), a `mag_comp` in tesla was levelled as nT, and `--rate-of
+/// time` failed as a singular system: each is bad input saying what is
+/// wrong.
+#[test]
+fn a_levelled_column_that_is_no_field_in_nt_is_refused() {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
+    let row = survey.n_rows() / 2;
+    let opts = LevelOptions::default();
+    let bad = |f: &Flight, says: &str| {
+        let e = level(f, &opts, &mut Silent).unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains(says), "{e}");
+        e
+    };
+    for v in [f64::INFINITY, 1e300] {
+        // The canonical `mag` is checked on reading; `mag_comp` was not.
+        let f = edited(&survey, &|t: &mut FlightTable| {
+            let mut comp = t.column("mag").unwrap().to_vec();
+            comp[row] = v;
+            t.add_column("mag_comp", comp).unwrap();
+        });
+        let e = bad(&f, "is no magnetic field value in nT");
+        assert_eq!(e.location().row, Some(row));
+        assert_eq!(e.location().column.as_deref(), Some("mag_comp"));
+    }
+    let tesla = edited(&survey, &|t: &mut FlightTable| {
+        let mag = t.column("mag").unwrap().iter().map(|v| v * 1e-9).collect();
+        t.add_column("mag_comp", mag).unwrap();
+    });
+    bad(&tesla, "tesla?");
+    let rate = LevelOptions {
+        rate_of: Some("time".into()),
+        ..LevelOptions::default()
+    };
+    let e = level(&survey, &rate, &mut Silent).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("the rate of `time`"),
+        "{e}"
+    );
+}

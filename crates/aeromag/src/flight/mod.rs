@@ -24,6 +24,7 @@ mod tl_inputs;
 pub use aeromag_compensation::reference_field::LeverArm;
 pub use aeromag_io::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub use line_labels::LineLabels;
+pub(crate) use reference::NOT_FIELDS;
 pub(crate) use reference::reduced;
 pub use reference::{ReferenceChannels, reference_sum};
 pub use segments::{GAP_FACTOR, SegmentRule, Segments, finite_segments};
@@ -196,6 +197,48 @@ impl Flight {
             ));
         }
         Ok(self.require(name)?)
+    }
+
+    /// The magnetic column `name` that a survey command levels or grids
+    /// (`mag_comp`, `mag_level`, a column chosen with --value/--column):
+    /// bad input naming the first row where a value is infinite or beyond
+    /// any magnetic field ([`aeromag_io::MAX_FIELD_NT`]: `inf` and 1e300
+    /// were levelled into `inf` and dropped from a grid without a word),
+    /// or when every value is below 10⁻³ in magnitude (tesla: the unit
+    /// checks test `mag` and the reference columns, not a compensated or
+    /// levelled column). Missing values (NaN) pass.
+    pub fn field_values(&self, name: &str) -> Result<&[f64]> {
+        let v = self.require(name)?;
+        if let Some(k) = v
+            .iter()
+            .position(|x| x.is_infinite() || x.abs() > aeromag_io::MAX_FIELD_NT)
+        {
+            return Err(self.bad_value(
+                k,
+                self.resolve(name).unwrap_or(name),
+                format!(
+                    "{} is no magnetic field value in nT (at most {} in magnitude): a corrupted cell? leave a missing value's cell empty",
+                    aeromag_core::error::shown(v[k]),
+                    aeromag_core::error::shown(aeromag_io::MAX_FIELD_NT)
+                ),
+            ));
+        }
+        let max = v
+            .iter()
+            .filter(|x| x.is_finite())
+            .fold(f64::NEG_INFINITY, |m, x| m.max(x.abs()));
+        if max > 0.0 && max < 1e-3 {
+            return Err(Error::BadInput {
+                file: Some(self.label()),
+                line: None,
+                row: None,
+                column: Some(self.resolve(name).unwrap_or(name).to_string()),
+                reason: format!(
+                    "every value is below 1e-3 in magnitude (largest {max:.3e}): tesla? the values must be in nT (multiply by 1e9)"
+                ),
+            });
+        }
+        Ok(v)
     }
 
     /// A numeric column whose every value must be finite: bad input naming

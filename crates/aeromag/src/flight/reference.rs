@@ -97,7 +97,7 @@ const NOT_REFERENCES: [&str; 6] = [
 ];
 
 /// Canonical columns that are no magnetic field, so no reference.
-const NOT_FIELDS: [&str; 11] = [
+pub(crate) const NOT_FIELDS: [&str; 11] = [
     "time", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "line",
 ];
 

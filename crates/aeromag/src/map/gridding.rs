@@ -141,7 +141,23 @@ pub(crate) fn grid_flight_finest(
                 )
             })?,
     };
-    let values = flight.require(&column)?;
+    // A magnetic column is checked as one (tesla, 1e300); any other (a
+    // height, a time) only for infinities, which a grid dropped silently.
+    let magnetic =
+        column.starts_with("mag") || aeromag_io::MAGNETIC_COLUMNS.contains(&column.as_str());
+    let values = if magnetic {
+        flight.field_values(&column)?
+    } else {
+        let v = flight.require(&column)?;
+        if let Some(k) = v.iter().position(|x| x.is_infinite()) {
+            return Err(flight.bad_value(
+                k,
+                flight.resolve(&column).unwrap_or(&column),
+                "the value is infinite: a corrupted cell? leave a missing value's cell empty",
+            ));
+        }
+        v
+    };
     notes.stage("projecting");
     let survey = ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m)?;
     if let Some(w) = survey.off_track_warning(flight) {

@@ -214,7 +214,7 @@ pub fn microlevel(
     notes.stage("correcting the lines");
     let survey = &gridded.survey;
     let ids = survey.line_ids.as_deref().unwrap_or(&[]);
-    let value = flight.require(&column)?;
+    let value = flight.field_values(&column)?;
     let n = value.len();
     // Per row on a line: the corrugation there (NaN outside the grid).
     let sampled: Vec<f64> = (0..n)
