@@ -29,7 +29,9 @@
 //!
 //! Reading ([`read`]) accepts a single-band north-up GeoTIFF of square
 //! pixels with a tie point and a pixel scale, of either raster type (a
-//! PixelIsPoint tie point is a node), of any sample type.
+//! PixelIsPoint tie point is a node), of any sample type, whose strips or
+//! tiles hold the image its header declares (an uncompressed strip
+//! exactly its rows × `ImageWidth` samples).
 
 use std::fs::File;
 use std::io::{self, BufReader, Seek, Write};
@@ -223,6 +225,105 @@ fn tiff_reason(e: TiffError) -> String {
     }
 }
 
+/// Checks, before the decoder reads them, that the strips (or tiles) hold
+/// the image the header declares: each lies inside the file, and when
+/// uncompressed each holds exactly its rows of `nx` samples of `bits` bits
+/// (`StripByteCounts`), the last strip at least its rows and at most a
+/// full strip (some writers pad it), a tile exactly `TileWidth ×
+/// TileLength` samples. The decoder reads an uncompressed strip from its
+/// offset for as many bytes as the declared width and rows need, whatever
+/// its byte count: an `ImageWidth` one larger than the data (a corrupt
+/// tag) read on past the strip into the file's metadata, every row
+/// shifted by one more pixel, and `derive` wrote that skewed grid.
+/// (Compressed chunks are bounded by their byte counts in the decoder: a
+/// short one is an error there.)
+fn check_chunks<R: std::io::Read + Seek>(
+    dec: &mut Decoder<R>,
+    path: &Path,
+    (nx, ny): (u32, u32),
+    bits: u8,
+    compressed: bool,
+    file_len: u64,
+) -> Result<()> {
+    let err = |e: TiffError| read_error(path, tiff_reason(e));
+    let tiled = dec.find_tag(Tag::TileOffsets).map_err(err)?.is_some();
+    let (kind, offsets_tag, counts_tag) = if tiled {
+        ("tile", Tag::TileOffsets, Tag::TileByteCounts)
+    } else {
+        ("strip", Tag::StripOffsets, Tag::StripByteCounts)
+    };
+    let offsets = dec.get_tag_u64_vec(offsets_tag).map_err(err)?;
+    let counts = dec.get_tag_u64_vec(counts_tag).map_err(err)?;
+    if offsets.len() != counts.len() {
+        return Err(read_error(
+            path,
+            format!(
+                "{} {kind} offsets but {} {kind} byte counts",
+                offsets.len(),
+                counts.len()
+            ),
+        ));
+    }
+    let row_bytes = |width: u64| width.saturating_mul(u64::from(bits)).div_ceil(8);
+    // Rows of a strip (or a tile's size); saturating products, as the
+    // tags of a corrupt file may be up to 2³² each.
+    let (rows_per_chunk, width) = if tiled {
+        let mut tile = |t: Tag| dec.find_tag_unsigned::<u64>(t).map_err(err);
+        (
+            tile(Tag::TileLength)?.unwrap_or(0),
+            tile(Tag::TileWidth)?.unwrap_or(0),
+        )
+    } else {
+        let rows = dec
+            .find_tag_unsigned::<u64>(Tag::RowsPerStrip)
+            .map_err(err)?
+            .unwrap_or(u64::from(ny));
+        (rows.clamp(1, u64::from(ny)), u64::from(nx))
+    };
+    let n = offsets.len();
+    for (k, (&offset, &count)) in offsets.iter().zip(&counts).enumerate() {
+        if offset.checked_add(count).is_none_or(|end| end > file_len) {
+            return Err(read_error(
+                path,
+                format!(
+                    "{kind} {} of {n} ({count} bytes at byte {offset}) ends past the end of \
+                     the file ({file_len} bytes): truncated or damaged",
+                    k + 1
+                ),
+            ));
+        }
+        if compressed {
+            continue;
+        }
+        let full = rows_per_chunk.saturating_mul(row_bytes(width));
+        let (least, most) = if tiled {
+            (full, full)
+        } else {
+            let first_row = (k as u64).saturating_mul(rows_per_chunk);
+            let rows = rows_per_chunk.min(u64::from(ny).saturating_sub(first_row));
+            let least = rows * row_bytes(width);
+            (least, if k + 1 == n { full } else { least })
+        };
+        if !(least..=most).contains(&count) {
+            let need = if least == most {
+                format!("{least}")
+            } else {
+                format!("{least} to {most}")
+            };
+            return Err(read_error(
+                path,
+                format!(
+                    "{kind} {} of {n} holds {count} bytes, but the header's {nx} × {ny} \
+                     pixels of {bits} bits (ImageWidth × ImageLength) need {need}: the image \
+                     size does not match its data (a damaged header)",
+                    k + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads a GeoTIFF (module docs for what is accepted). The name and unit
 /// come from `GDAL_METADATA` (else the file stem and no unit), the CRS
 /// from `ProjectedCSTypeGeoKey` when it is a WGS 84 / UTM code.
@@ -292,6 +393,8 @@ pub fn read(path: &Path) -> Result<Grid> {
         if compressed { bytes / 4096.0 } else { bytes },
         file_len,
     )?;
+    let bits = dec.colortype().map_err(err)?.bit_depth();
+    check_chunks(&mut dec, path, (nx, ny), bits, compressed, file_len)?;
     let nodata: Option<f64> = dec
         .find_tag(Tag::GdalNodata)
         .map_err(err)?
@@ -561,5 +664,68 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// An `ImageWidth` (or `ImageLength`) that does not match the strip:
+    /// one more column than the data was read on past the strip into the
+    /// file's metadata, a skewed grid and exit 0 (finding 19); one fewer
+    /// read a grid sheared the other way. Both are refused naming the
+    /// file and the sizes; the same in a file of many strips.
+    #[test]
+    fn an_image_size_that_does_not_match_the_strips_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.tif");
+        write_grid(&path, &sample_grid()).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        // 5 × 4 float32: one strip of 80 bytes.
+        for (tag, value, need) in [
+            (256, 6, "need 96"),
+            (256, 4, "need 64"),
+            (257, 5, "need 100"),
+            (257, 3, "need 60"),
+        ] {
+            let bad = dir.path().join(format!("w{tag}_{value}.tif"));
+            std::fs::write(&bad, patched_tag(&bytes, tag, value)).unwrap();
+            let e = read(&bad).unwrap_err();
+            assert!(e.is_bad_input());
+            let e = e.to_string();
+            assert!(
+                e.contains(&format!("w{tag}_{value}.tif"))
+                    && e.contains("strip 1 of 1 holds 80 bytes")
+                    && e.contains(need),
+                "{e}"
+            );
+        }
+        // 300 × 900 rows in strips of 834 rows: a width of 299 is
+        // refused at the first strip.
+        let mut grid = Grid::blank(
+            GridGeometry {
+                x0: 0.0,
+                y0: 0.0,
+                cell: 1.0,
+                nx: 300,
+                ny: 900,
+            },
+            "z",
+            "",
+        );
+        grid.values.fill(1.0);
+        let big = dir.path().join("big.tif");
+        write_grid(&big, &grid).unwrap();
+        let bytes = std::fs::read(&big).unwrap();
+        std::fs::write(&big, patched_tag(&bytes, 256, 299)).unwrap();
+        let e = read(&big).unwrap_err().to_string();
+        assert!(
+            e.contains("strip 1 of 2 holds 1000800 bytes") && e.contains("need 997464"),
+            "{e}"
+        );
+        // A strip whose byte count runs past the end of the file.
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, patched_tag(&bytes, 279, 100_000)).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("strip 1 of 1 (100000 bytes at byte") && e.contains("ends past the end"),
+            "{e}"
+        );
     }
 }
