@@ -23,6 +23,12 @@
 //! line (GDAL and ArcGIS read both flavours); when it is not, an old
 //! `<stem>.prj` (describing the file being replaced) is removed.
 //!
+//! The coordinates must be metres: a `.prj` declaring a geographic system
+//! (`GEOGCS`, longitude and latitude in degrees) or a projected one in
+//! another unit (`UNIT["US survey foot",0.3048006096]`) is refused, naming
+//! the file; a `.prj` this crate cannot read is taken as metres, as one
+//! that is absent.
+//!
 //! Reading accepts `xllcorner`/`yllcorner` too (the node then half a cell
 //! in), any order of header lines, keywords in any case and an absent
 //! `NODATA_value`. A value `nan` is a blank node too (as GDAL reads it).
@@ -37,8 +43,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::{
-    NODATA, check_declared_size, check_grid, check_values, checked_geometry, crs_from_wkt, crs_wkt,
-    read_error, stem, write_atomic,
+    CoordinateUnit, NODATA, check_declared_size, check_grid, check_values, checked_geometry,
+    crs_from_wkt, crs_wkt, not_metres, read_error, stem, wkt_unit, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -177,6 +183,17 @@ pub fn read(path: &Path) -> Result<Grid> {
             ny: ny.ok_or_else(|| missing("nrows"))?,
         },
     )?;
+    // The .prj first: a grid in degrees is refused whatever its values.
+    let prj = path.with_extension("prj");
+    let mut crs = None;
+    if prj.is_file() {
+        let wkt = fs::read_to_string(&prj).map_err(|e| read_error(&prj, e))?;
+        if let Some(unit) = wkt_unit(&wkt).filter(|u| *u != CoordinateUnit::Metre) {
+            let by = format!("its .prj ({})", prj.display());
+            return Err(not_metres(path, &by, &unit));
+        }
+        crs = crs_from_wkt(wkt.trim());
+    }
     // Each value takes at least one character and a separator (the last
     // none): check before allocating what the header declares.
     check_declared_size(path, geometry.nx, geometry.ny, 2.0, text.len() as u64 + 1)?;
@@ -214,11 +231,7 @@ pub fn read(path: &Path) -> Result<Grid> {
             format!("more than {} values", geometry.len()),
         ));
     }
-    let prj = path.with_extension("prj");
-    if prj.is_file() {
-        let wkt = fs::read_to_string(&prj).map_err(|e| read_error(&prj, e))?;
-        grid.crs = crs_from_wkt(wkt.trim());
-    }
+    grid.crs = crs;
     Ok(grid)
 }
 
@@ -451,5 +464,46 @@ mod tests {
         fs::write(&path, format!("ncols {garbage}\n")).unwrap();
         let e = read(&path).unwrap_err().to_string();
         assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
+    }
+
+    /// A grid whose .prj declares a geographic system (a 0.001° cell) was
+    /// differentiated as if the cell were 0.001 m, 10⁵ times too large
+    /// (finding 08); one in feet 3.3 times. Both are now refused naming
+    /// the grid and its .prj; an unreadable .prj is taken as metres.
+    #[test]
+    fn a_prj_not_in_metres_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("ll.asc");
+        let mut grid = sample_grid();
+        grid.crs = None;
+        write_grid(&path, &grid).unwrap();
+        let prj = dir.path().join("ll.prj");
+        for (wkt, what) in [
+            (
+                "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,\
+                 298.257223563]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]]\n",
+                "a geographic coordinate system (longitude and latitude in degrees)",
+            ),
+            (
+                "PROJCS[\"NAD83 / Texas Central (ftUS)\",GEOGCS[\"NAD83\",\
+                 UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Lambert_Conformal_Conic_2SP\"],\
+                 UNIT[\"US survey foot\",0.3048006096012192],AUTHORITY[\"EPSG\",\"2277\"]]",
+                "coordinates in \"US survey foot\" (0.3048006096012192 m)",
+            ),
+        ] {
+            fs::write(&prj, wkt).unwrap();
+            let e = read_grid(&path).unwrap_err();
+            assert!(e.is_bad_input());
+            let e = e.to_string();
+            assert!(
+                e.starts_with(&format!("reading '{}': its .prj", path.display()))
+                    && e.contains("ll.prj")
+                    && e.contains(what)
+                    && e.contains("must be in a projected coordinate system in metres"),
+                "{e}"
+            );
+        }
+        fs::write(&prj, "not a WKT").unwrap();
+        assert_same_grid(&grid, &read_grid(&path).unwrap());
     }
 }

@@ -28,7 +28,9 @@
 //! system in metres) and the citation says so.
 //!
 //! Reading ([`read`]) accepts a single-band north-up GeoTIFF of square
-//! pixels with a tie point and a pixel scale, of either raster type (a
+//! pixels in metres (a geographic model type, `GTModelTypeGeoKey` = 2, or
+//! a `ProjLinearUnitsGeoKey` of feet, miles or kilometres is refused)
+//! with a tie point and a pixel scale, of either raster type (a
 //! PixelIsPoint tie point is a node), of any sample type, whose strips or
 //! tiles hold the image its header declares (an uncompressed strip
 //! exactly its rows × `ImageWidth` samples).
@@ -43,8 +45,8 @@ use tiff::tags::Tag;
 use tiff::{ColorType, TiffError};
 
 use super::{
-    NODATA, check_declared_size, check_grid, check_values, checked_geometry, crs_from_epsg,
-    label_from_file, read_error, stem, write_atomic,
+    CoordinateUnit, NODATA, check_declared_size, check_grid, check_values, checked_geometry,
+    crs_from_epsg, label_from_file, not_metres, read_error, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -59,12 +61,24 @@ mod key {
     pub const PROJ_LINEAR_UNITS: u16 = 3076;
     /// `ModelTypeProjected`.
     pub const PROJECTED: u16 = 1;
+    /// `ModelTypeGeographic`: longitude and latitude, degrees.
+    pub const GEOGRAPHIC: u16 = 2;
     /// `RasterPixelIsArea`.
     pub const PIXEL_IS_AREA: u16 = 1;
     /// `RasterPixelIsPoint`.
     pub const PIXEL_IS_POINT: u16 = 2;
     /// `Linear_Meter`.
     pub const METRE: u16 = 9001;
+    /// EPSG linear units a `ProjLinearUnitsGeoKey` may name, and their
+    /// length in metres (EPSG dataset; other codes are left as metres).
+    pub const LINEAR_UNITS: [(u16, &str, f64); 6] = [
+        (METRE, "metre", 1.0),
+        (9002, "foot", 0.3048),
+        (9003, "US survey foot", 1200.0 / 3937.0),
+        (9030, "nautical mile", 1852.0),
+        (9035, "statute mile", 1609.344),
+        (9036, "kilometre", 1000.0),
+    ];
 }
 
 /// The `GDAL_METADATA` tag (XML), not named by the `tiff` crate.
@@ -360,6 +374,19 @@ pub fn read(path: &Path) -> Result<Grid> {
             .find(|k| k[0] == id && k[1] == 0)
             .map(|k| k[3])
     };
+    // Coordinates in metres only (module docs).
+    if geokey(key::MODEL_TYPE) == Some(key::GEOGRAPHIC) {
+        let by = "its GTModelTypeGeoKey (2, geographic)";
+        return Err(not_metres(path, by, &CoordinateUnit::Degree));
+    }
+    if let Some(code) = geokey(key::PROJ_LINEAR_UNITS)
+        && let Some((_, name, metres)) = key::LINEAR_UNITS.iter().find(|u| u.0 == code)
+        && code != key::METRE
+    {
+        let by = format!("its ProjLinearUnitsGeoKey ({code})");
+        let unit = CoordinateUnit::Other(name.to_string(), *metres);
+        return Err(not_metres(path, &by, &unit));
+    }
     let point = geokey(key::RASTER_TYPE) == Some(key::PIXEL_IS_POINT);
     // The node of pixel (0, 0): the tie point's pixel (i, j) at (x, y).
     let shift = if point { 0.0 } else { 0.5 };
@@ -727,5 +754,46 @@ mod tests {
             e.contains("strip 1 of 1 (100000 bytes at byte") && e.contains("ends past the end"),
             "{e}"
         );
+    }
+
+    /// A GeoTIFF of a geographic model (degrees) or in feet was read as
+    /// metres (finding 08): now refused naming the file and the key.
+    #[test]
+    fn a_geotiff_not_in_metres_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.tif");
+        write_grid(&path, &sample_grid()).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let key = |k: [u16; 4]| k.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
+        for (from, to, named, what) in [
+            (
+                [1024, 0, 1, 1],
+                [1024, 0, 1, 2],
+                "GTModelTypeGeoKey (2, geographic)",
+                "a geographic coordinate system",
+            ),
+            (
+                [3076, 0, 1, 9001],
+                [3076, 0, 1, 9003],
+                "ProjLinearUnitsGeoKey (9003)",
+                "coordinates in \"US survey foot\" (0.3048006096012192 m)",
+            ),
+        ] {
+            let (from, to) = (key(from), key(to));
+            let at = bytes.windows(8).position(|w| w == from).unwrap();
+            let mut b = bytes.clone();
+            b[at..at + 8].copy_from_slice(&to);
+            let bad = dir.path().join("bad.tif");
+            std::fs::write(&bad, &b).unwrap();
+            let e = read(&bad).unwrap_err();
+            assert!(e.is_bad_input());
+            let e = e.to_string();
+            assert!(
+                e.contains("bad.tif")
+                    && e.contains(&format!("its {named} declares {what}"))
+                    && e.contains("in metres (e.g. UTM)"),
+                "{e}"
+            );
+        }
     }
 }

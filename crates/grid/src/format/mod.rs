@@ -40,7 +40,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use crate::error::{GridError, Result};
 use crate::grid::{Grid, GridGeometry, MAX_CELL, MAX_COORDINATE, MAX_NODES, MAX_VALUE, MIN_CELL};
 use crate::projection::{Crs, UtmZone};
-use aeromag_core::error::shown;
+use aeromag_core::error::{shown, shown_text};
 use aeromag_core::output_target::{OutputTarget, output_target};
 
 /// The value blank nodes take in the GeoTIFF (`GDAL_NODATA` tag) and ESRI
@@ -424,6 +424,169 @@ pub(crate) fn crs_from_wkt(wkt: &str) -> Option<Crs> {
     None
 }
 
+/// What a grid file says of the unit of its `x`, `y` coordinates. Every
+/// computation on a grid (the spectral products' wavenumbers, distances,
+/// continuation heights) takes the cell in metres: a geographic grid's
+/// 0.001° cell read as 0.001 m gave a vertical derivative 10⁵ times too
+/// large.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum CoordinateUnit {
+    /// Metres (or the file does not say: as before, taken as metres).
+    Metre,
+    /// Longitude and latitude: a geographic coordinate system.
+    Degree,
+    /// Another linear unit: its name and its length in metres.
+    Other(String, f64),
+}
+
+/// One element of a WKT: its keyword and what its brackets hold, quoted
+/// strings and numbers as text, nested elements as such.
+#[derive(Debug)]
+struct WktNode {
+    keyword: String,
+    texts: Vec<String>,
+    children: Vec<WktNode>,
+}
+
+/// Most nested brackets of a WKT read ([`parse_wkt`]): a real one has
+/// about 5; a corrupt `.prj` of a million `[` must not overflow the stack.
+const MAX_WKT_DEPTH: usize = 64;
+
+/// The WKT element starting at `s[*pos..]` (WKT 1 or 2, OGC or ESRI);
+/// `None` when it is not well formed.
+fn parse_wkt(s: &[u8], pos: &mut usize, depth: usize) -> Option<WktNode> {
+    if depth > MAX_WKT_DEPTH {
+        return None;
+    }
+    let skip = |pos: &mut usize| {
+        while s.get(*pos).is_some_and(u8::is_ascii_whitespace) {
+            *pos += 1;
+        }
+    };
+    skip(pos);
+    let start = *pos;
+    while s
+        .get(*pos)
+        .is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_')
+    {
+        *pos += 1;
+    }
+    let keyword = String::from_utf8_lossy(&s[start..*pos]).to_ascii_uppercase();
+    skip(pos);
+    let mut node = WktNode {
+        keyword,
+        texts: vec![],
+        children: vec![],
+    };
+    if !matches!(s.get(*pos), Some(b'[' | b'(')) {
+        return None;
+    }
+    *pos += 1;
+    loop {
+        skip(pos);
+        match s.get(*pos)? {
+            b']' | b')' => {
+                *pos += 1;
+                return Some(node);
+            }
+            b',' => *pos += 1,
+            b'"' => {
+                let end = *pos + 1 + s[*pos + 1..].iter().position(|&c| c == b'"')?;
+                node.texts
+                    .push(String::from_utf8_lossy(&s[*pos + 1..end]).into_owned());
+                *pos = end + 1;
+            }
+            _ => {
+                let start = *pos;
+                while s
+                    .get(*pos)
+                    .is_some_and(|&c| !matches!(c, b',' | b'[' | b'(' | b']' | b')'))
+                {
+                    *pos += 1;
+                }
+                if matches!(s.get(*pos), Some(b'[' | b'(')) {
+                    *pos = start;
+                    node.children.push(parse_wkt(s, pos, depth + 1)?);
+                } else {
+                    node.texts
+                        .push(String::from_utf8_lossy(&s[start..*pos]).trim().to_string());
+                }
+            }
+        }
+    }
+}
+
+/// The unit of the coordinates a WKT (a `.prj`, a netCDF `crs_wkt`)
+/// declares: [`CoordinateUnit::Degree`] for a geographic system
+/// (`GEOGCS`, `GEOGCRS`, an ellipsoidal `GEODCRS`), the linear unit of a
+/// projected one (`PROJCS`'s own `UNIT`, `PROJCRS`'s `LENGTHUNIT` of its
+/// axes), metre when its length is 1 m. `None` for a WKT this crate cannot
+/// read (left as before: metres).
+pub(crate) fn wkt_unit(wkt: &str) -> Option<CoordinateUnit> {
+    let root = parse_wkt(wkt.trim().as_bytes(), &mut 0, 0)?;
+    fn child<'a>(n: &'a WktNode, keys: &[&str]) -> Option<&'a WktNode> {
+        n.children
+            .iter()
+            .find(|c| keys.contains(&c.keyword.as_str()))
+    }
+    match root.keyword.as_str() {
+        "GEOGCS" | "GEOGCRS" | "GEOGRAPHICCRS" => Some(CoordinateUnit::Degree),
+        "GEODCRS" | "GEODETICCRS"
+            if child(&root, &["CS"]).is_some_and(|cs| {
+                cs.texts
+                    .first()
+                    .is_some_and(|t| t.eq_ignore_ascii_case("ellipsoidal"))
+            }) =>
+        {
+            Some(CoordinateUnit::Degree)
+        }
+        "PROJCS" | "PROJCRS" | "PROJECTEDCRS" => {
+            let keys = ["UNIT", "LENGTHUNIT"];
+            let unit = child(&root, &keys).or_else(|| {
+                root.children
+                    .iter()
+                    .filter(|c| c.keyword == "AXIS")
+                    .find_map(|a| child(a, &keys))
+            })?;
+            let name = unit.texts.first()?.clone();
+            let metres: f64 = unit.texts.get(1)?.parse().ok()?;
+            if !(metres.is_finite() && metres > 0.0) {
+                return None;
+            }
+            Some(if (metres - 1.0).abs() <= 1e-9 {
+                CoordinateUnit::Metre
+            } else {
+                CoordinateUnit::Other(name, metres)
+            })
+        }
+        _ => None,
+    }
+}
+
+/// The error of a grid whose coordinates are declared in another unit
+/// than metres, `by` saying where (e.g. "its .prj"), `unit` what it says.
+pub(crate) fn not_metres(path: &Path, by: &str, unit: &CoordinateUnit) -> GridError {
+    read_error(path, not_metres_reason(by, unit))
+}
+
+/// The reason of [`not_metres`], without the file.
+pub(crate) fn not_metres_reason(by: &str, unit: &CoordinateUnit) -> String {
+    let what = match unit {
+        CoordinateUnit::Degree => {
+            "a geographic coordinate system (longitude and latitude in degrees)".to_string()
+        }
+        CoordinateUnit::Other(name, metres) => {
+            format!("coordinates in {} ({} m)", shown_text(name), shown(*metres))
+        }
+        CoordinateUnit::Metre => "coordinates in metres".to_string(),
+    };
+    format!(
+        "{by} declares {what}: grids must be in a projected coordinate system in metres \
+         (e.g. UTM), as cell sizes, derivatives and heights are computed in metres; \
+         project the grid first (e.g. gdalwarp -t_srs EPSG:32637)"
+    )
+}
+
 /// The file stem, for the name of a grid whose file does not carry one
 /// ([`label_from_file`]).
 pub(crate) fn stem(path: &Path) -> String {
@@ -717,6 +880,50 @@ mod tests {
             }))
         );
         assert_eq!(crs_from_epsg(32661), None);
+    }
+
+    /// The coordinate unit a WKT declares: degrees for a geographic
+    /// system (WKT 1 and 2), the projected system's own linear unit (not
+    /// its geographic base's degrees), `None` for what cannot be read.
+    #[test]
+    fn wkt_units_are_read_from_the_right_element() {
+        assert_eq!(wkt_unit(&crs_wkt(&ZONE_37N)), Some(CoordinateUnit::Metre));
+        assert_eq!(
+            wkt_unit(
+                "PROJCS[\"WGS_1984_UTM_Zone_37N\",GEOGCS[\"GCS_WGS_1984\",UNIT[\"Degree\",0.017]],UNIT[\"Meter\",1.0]]"
+            ),
+            Some(CoordinateUnit::Metre)
+        );
+        for geographic in [
+            "GEOGCS[\"WGS 84\",UNIT[\"degree\",0.0174532925199433]]",
+            " geogcs [\"GCS_WGS_1984\"]",
+            "GEOGCRS[\"WGS 84\",CS[ellipsoidal,2],ID[\"EPSG\",4326]]",
+            "GEODCRS[\"WGS 84\",CS[ellipsoidal,2]]",
+        ] {
+            assert_eq!(
+                wkt_unit(geographic),
+                Some(CoordinateUnit::Degree),
+                "{geographic}"
+            );
+        }
+        assert_eq!(
+            wkt_unit(
+                "PROJCRS[\"x\",BASEGEOGCRS[\"y\",ANGLEUNIT[\"degree\",0.017]],\
+                 CONVERSION[\"z\",PARAMETER[\"False easting\",0,LENGTHUNIT[\"metre\",1]]],\
+                 CS[Cartesian,2],AXIS[\"easting\",east,LENGTHUNIT[\"foot\",0.3048]]]"
+            ),
+            Some(CoordinateUnit::Other("foot".into(), 0.3048))
+        );
+        for unreadable in [
+            "",
+            "junk",
+            "GEODCRS[\"x\",CS[Cartesian,3]]",
+            "PROJCS[\"x\",UNIT[\"m\",zero]]",
+            "PROJCS[\"unclosed\",UNIT[\"metre\",1]",
+            &"PROJCS[".repeat(100_000),
+        ] {
+            assert_eq!(wkt_unit(unreadable), None, "{unreadable:.40}");
+        }
     }
 
     /// `gdalinfo -json` on the three formats: origin and pixel size of

@@ -35,15 +35,20 @@
 //! and equal spacing, `y` ascending or descending; it applies `_FillValue`
 //! / `missing_value`, `scale_factor` and `add_offset`, and takes the CRS
 //! from the grid-mapping variable (`epsg_code`, else the WKT of
-//! `crs_wkt`/`spatial_ref`).
+//! `crs_wkt`/`spatial_ref`). The coordinates must be metres, or
+//! kilometres (`units = "km"`, converted to metres: the grid read, and any
+//! grid written from it, is in metres); coordinates in degrees
+//! (`degrees_east`/`degrees_north`, a `latitude_longitude` grid mapping, a
+//! geographic WKT) are refused. `units` this crate does not
+//! know are taken as metres.
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::Path;
 
 use super::{
-    check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt, crs_wkt,
-    label_from_file, read_error, write_atomic,
+    CoordinateUnit, check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt,
+    crs_wkt, label_from_file, not_metres_reason, read_error, wkt_unit, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -582,6 +587,55 @@ fn regular(values: &[f64], name: &str) -> Parse<(f64, Option<f64>)> {
     Ok((first, Some(step)))
 }
 
+/// Metres in a kilometre, the one other unit of coordinates read.
+const METRES_PER_KM: f64 = 1000.0;
+
+/// The values of coordinate variable `v` in metres, by its `units` (and
+/// `standard_name`): metres (`m`, `metre(s)`, `meter(s)`), no unit, or one
+/// this crate does not know are taken as they are; kilometres (`km`,
+/// `kilometre(s)`, `kilometer(s)`, as GMT grids in km have) are converted
+/// to metres and rounded to the micrometre (the decimal error of a km
+/// value in float64, ~10⁻¹⁰ m, must not make the cell 100.00000000000001
+/// m); degrees (`degrees_east`, `degrees_north`, `degree`, `deg`; without
+/// units, a `standard_name` of `longitude` or `latitude`) are refused: every
+/// computation on a grid takes its cell in metres, and a 0.001° cell read
+/// as 0.001 m gave a vertical derivative 10⁵ times too large.
+fn in_metres(mut values: Vec<f64>, v: &Variable) -> Parse<Vec<f64>> {
+    let attribute = |name: &str| match v.attribute(name) {
+        Some(Value::Text(s)) => s.trim().to_string(),
+        _ => String::new(),
+    };
+    let (raw, standard) = (attribute("units"), attribute("standard_name"));
+    let units = raw.to_ascii_lowercase();
+    let by = if units.starts_with("degree") || units == "deg" {
+        format!(
+            "the units attribute of {} ({})",
+            shown_text(&v.name),
+            shown_text(&raw)
+        )
+    } else if units.is_empty() && (standard == "longitude" || standard == "latitude") {
+        format!(
+            "the standard_name of {} ({})",
+            shown_text(&v.name),
+            shown_text(&standard)
+        )
+    } else {
+        String::new()
+    };
+    if !by.is_empty() {
+        return Err(not_metres_reason(&by, &CoordinateUnit::Degree));
+    }
+    if matches!(
+        units.as_str(),
+        "km" | "kilometre" | "kilometres" | "kilometer" | "kilometers"
+    ) {
+        for x in &mut values {
+            *x = (*x * METRES_PER_KM * 1e6).round() / 1e6;
+        }
+    }
+    Ok(values)
+}
+
 /// Reads a netCDF classic grid (module docs for what is accepted).
 pub fn read(path: &Path) -> Result<Grid> {
     let bytes = fs::read(path).map_err(|e| read_error(path, e))?;
@@ -603,8 +657,27 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         return Err(format!("{} is text", shown_text(&z.name)));
     }
     let (ydim, xdim) = (z.dims[0], z.dims[1]);
-    let xs = h.data(bytes, h.coordinate(xdim)?)?;
-    let ys = h.data(bytes, h.coordinate(ydim)?)?;
+    let text = |v: &Variable, name: &str| match v.attribute(name) {
+        Some(Value::Text(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let mapping = text(z, "grid_mapping").and_then(|m| h.vars.iter().find(|v| v.name == m));
+    if let Some(m) = mapping {
+        if text(m, "grid_mapping_name").as_deref() == Some("latitude_longitude") {
+            let by = "its grid mapping (latitude_longitude)";
+            return Err(not_metres_reason(by, &CoordinateUnit::Degree));
+        }
+        let wkt = text(m, "crs_wkt").or_else(|| text(m, "spatial_ref"));
+        if let Some(unit) = wkt
+            .and_then(|w| wkt_unit(&w))
+            .filter(|u| *u != CoordinateUnit::Metre)
+        {
+            return Err(not_metres_reason("its grid mapping's WKT", &unit));
+        }
+    }
+    let (x_var, y_var) = (h.coordinate(xdim)?, h.coordinate(ydim)?);
+    let xs = in_metres(h.data(bytes, x_var)?, x_var)?;
+    let ys = in_metres(h.data(bytes, y_var)?, y_var)?;
     let (x0, dx) = regular(&xs, &h.dims[xdim].0)?;
     let (y_first, dy) = regular(&ys, &h.dims[ydim].0)?;
     let cell = match (dx, dy) {
@@ -648,22 +721,16 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
     if !south_first {
         values = values.chunks_exact(nx).rev().flatten().copied().collect();
     }
-    let text = |v: &Variable, name: &str| match v.attribute(name) {
-        Some(Value::Text(s)) => Some(s.clone()),
-        _ => None,
-    };
-    let crs = text(z, "grid_mapping")
-        .and_then(|m| h.vars.iter().find(|v| v.name == m))
-        .and_then(|m| {
-            let epsg = m
-                .attribute("epsg_code")
-                .and_then(|v| v.numbers().first().copied());
-            epsg.and_then(|c| crs_from_epsg(c as u32)).or_else(|| {
-                text(m, "crs_wkt")
-                    .or_else(|| text(m, "spatial_ref"))
-                    .and_then(|w| crs_from_wkt(&w))
-            })
-        });
+    let crs = mapping.and_then(|m| {
+        let epsg = m
+            .attribute("epsg_code")
+            .and_then(|v| v.numbers().first().copied());
+        epsg.and_then(|c| crs_from_epsg(c as u32)).or_else(|| {
+            text(m, "crs_wkt")
+                .or_else(|| text(m, "spatial_ref"))
+                .and_then(|w| crs_from_wkt(&w))
+        })
+    });
     let grid = Grid {
         geometry,
         values,
@@ -868,5 +935,118 @@ mod tests {
         let e = read(&path).unwrap_err().to_string();
         assert!(e.contains("g.nc"), "{e}");
         assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
+    }
+
+    /// A CDF-1 file of 3 × 2 nodes, x 437.1–437.3 and y 6206.4–6206.5,
+    /// whose `x` and `y` have the `units` given (none when empty) and `y`
+    /// the `standard_name` given (none when empty).
+    fn grid_with_units(x_units: &str, y_units: &str, y_standard: &str) -> Vec<u8> {
+        let text = |name: &str, u: &str| match u {
+            "" => vec![],
+            u => vec![(name.to_string(), Value::text(u))],
+        };
+        let dims = [("x", 3usize), ("y", 2usize)];
+        let mut vars = vec![
+            Variable {
+                name: "x".into(),
+                dims: vec![0],
+                attributes: text("units", x_units),
+                nc_type: NcType::Double,
+                begin: 0,
+            },
+            Variable {
+                name: "y".into(),
+                dims: vec![1],
+                attributes: [text("units", y_units), text("standard_name", y_standard)].concat(),
+                nc_type: NcType::Double,
+                begin: 0,
+            },
+            Variable {
+                name: "z".into(),
+                dims: vec![1, 0],
+                attributes: vec![],
+                nc_type: NcType::Float,
+                begin: 0,
+            },
+        ];
+        let mut b = layout(false, &dims, &vec![], &mut vars);
+        for v in [437.1f64, 437.2, 437.3, 6206.4, 6206.5] {
+            b.extend_from_slice(&v.to_be_bytes());
+        }
+        for z in [1f32, 2.0, 3.0, 4.0, 5.0, 6.0] {
+            b.extend_from_slice(&z.to_be_bytes());
+        }
+        b
+    }
+
+    /// x/y in degrees (`degrees_east`, `degrees_north`) were read as
+    /// metres: a 0.001° cell as 0.001 m, a vertical derivative 10⁵ times
+    /// too large (finding 08). Now refused naming the variable and its
+    /// unit; kilometres (read as metres, 1000 times off) are converted to
+    /// metres exactly; metres and unknown units are read as before.
+    #[test]
+    fn coordinates_in_degrees_are_refused_and_kilometres_converted() {
+        for (x, y, standard, named) in [
+            (
+                "degrees_east",
+                "degrees_north",
+                "",
+                "the units attribute of \"x\" (\"degrees_east\")",
+            ),
+            (
+                "m",
+                "degree_N",
+                "",
+                "the units attribute of \"y\" (\"degree_N\")",
+            ),
+            (
+                "Degrees",
+                "",
+                "",
+                "the units attribute of \"x\" (\"Degrees\")",
+            ),
+            (
+                "",
+                "",
+                "latitude",
+                "the standard_name of \"y\" (\"latitude\")",
+            ),
+        ] {
+            let e = read_bytes(&grid_with_units(x, y, standard)).unwrap_err();
+            assert!(
+                e.starts_with(&format!("{named} declares a geographic coordinate system"))
+                    && e.contains("must be in a projected coordinate system in metres"),
+                "{e}"
+            );
+        }
+        for (x, y) in [("km", "km"), ("kilometres", " KM ")] {
+            let (geometry, _) = read_bytes(&grid_with_units(x, y, "")).unwrap();
+            assert_eq!(
+                geometry,
+                GridGeometry {
+                    x0: 437_100.0,
+                    y0: 6_206_400.0,
+                    cell: 100.0,
+                    nx: 3,
+                    ny: 2
+                },
+                "{x}, {y}"
+            );
+        }
+        for (x, y, standard) in [
+            ("m", "m", ""),
+            ("", "", ""),
+            ("metre", "furlongs", ""),
+            ("", "m", "latitude"),
+        ] {
+            let (geometry, _) = read_bytes(&grid_with_units(x, y, standard)).unwrap();
+            assert_eq!((geometry.x0, geometry.y0), (437.1, 6206.4), "{x}, {y}");
+        }
+        // The file is named.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("deg.nc");
+        fs::write(&path, grid_with_units("degrees_east", "degrees_north", "")).unwrap();
+        let e = read_grid(&path).unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains("deg.nc"), "{e}");
     }
 }
