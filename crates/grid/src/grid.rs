@@ -263,8 +263,27 @@ impl Grid {
     }
 
     /// `self − other` node by node (blank where either is blank); the two
-    /// grids must have the same geometry.
+    /// grids must have the same geometry and, when both record one, the
+    /// same coordinate system: equal node coordinates in two UTM zones are
+    /// places some 400 km apart (two grids of one survey pattern in zones
+    /// 37N and 38N were differenced node by node). A grid without a CRS
+    /// (an ESRI ASCII grid without its `.prj`, a `.prj` this crate cannot
+    /// read) is taken to be in the other's, the usual case of a sidecar
+    /// left behind: its coordinates still have to match node for node, and
+    /// the difference carries the CRS that is known.
     pub fn difference(&self, other: &Grid) -> Result<Grid> {
+        if let (Some(a), Some(b)) = (self.crs, other.crs)
+            && a != b
+        {
+            return Err(GridError::Unusable(format!(
+                "the grids' coordinate systems differ: {} (EPSG:{}) against {} (EPSG:{}); \
+                 their nodes are not the same places",
+                a.name(),
+                a.epsg(),
+                b.name(),
+                b.epsg()
+            )));
+        }
         if self.geometry != other.geometry {
             return Err(GridError::Unusable(format!(
                 "the grids' nodes differ: {} against {}",
@@ -292,6 +311,7 @@ impl Grid {
         }
         Ok(Grid {
             values,
+            crs: self.crs.or(other.crs),
             name: format!("{} - {}", self.name, other.name),
             ..self.clone()
         })
@@ -385,5 +405,38 @@ mod tests {
         assert_eq!(d.values[0], 0.0);
         assert_eq!(d.values[2], 0.0);
         assert!(d.values[1].is_nan() && d.values[3].is_nan());
+    }
+
+    /// Grids of equal nodes in UTM zones 37N and 38N were differenced node
+    /// by node (finding 12); now refused, naming both zones. A grid without
+    /// a CRS is differenced with one that has one, and the result keeps
+    /// the known CRS.
+    #[test]
+    fn grids_in_different_coordinate_systems_are_not_differenced() {
+        use crate::projection::UtmZone;
+        let geometry = GridGeometry::covering(437_100.0, 437_200.0, 0.0, 100.0, 100.0).unwrap();
+        let zone = |number| {
+            Some(Crs::Utm(UtmZone {
+                number,
+                north: true,
+            }))
+        };
+        let mut a = Grid::blank(geometry, "a", "nT");
+        a.values.fill(2.0);
+        a.crs = zone(37);
+        let mut b = a.clone();
+        b.crs = zone(38);
+        let e = a.difference(&b).unwrap_err();
+        assert!(e.is_bad_input());
+        assert_eq!(
+            e.to_string(),
+            "the grids' coordinate systems differ: WGS 84 / UTM zone 37N (EPSG:32637) \
+             against WGS 84 / UTM zone 38N (EPSG:32638); their nodes are not the same places"
+        );
+        b.crs = None;
+        assert_eq!(a.difference(&b).unwrap().crs, zone(37));
+        assert_eq!(b.difference(&a).unwrap().crs, zone(37));
+        b.crs = zone(37);
+        assert_eq!(a.difference(&b).unwrap().values, vec![0.0; 4]);
     }
 }
