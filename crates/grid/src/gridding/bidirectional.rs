@@ -10,12 +10,16 @@
 //! lines (rotated by their direction) and has the output's cell; the
 //! output nodes are its bilinear interpolation. Nodes beyond the outermost
 //! lines of a row, beyond a line's ends, or across a gap of more than
-//! `max_gap_cells` cells along a line are blank. This is the classical
+//! `max_gap_cells` cells along a line are blank; when the samples along
+//! the lines are farther apart than that (median gap), or no node is left
+//! with a value, it is an error naming the smallest cell that bridges
+//! them, not a grid of blanks. This is the classical
 //! method for line data (Geosoft's bi-directional gridding); it keeps the
 //! along-line resolution that minimum curvature smooths.
 
 use crate::error::{GridError, Result};
 use crate::grid::GridGeometry;
+use aeromag_core::error::shown;
 
 /// Settings of bi-directional gridding.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,6 +98,32 @@ impl Bidirectional {
             vmin = vmin.min(s[0].0);
             vmax = vmax.max(s[s.len() - 1].0);
         }
+        // Most gaps must be bridged, or (nearly) every node is blank: a
+        // 5 m cell on a 2 Hz survey (35 m between samples, 20 m bridged)
+        // wrote an all-blank grid with exit 0.
+        let mut gaps: Vec<f64> = lines
+            .values()
+            .flat_map(|s| s.windows(2).map(|w| w[1].0 - w[0].0))
+            .filter(|&g| g > 0.0)
+            .collect();
+        let max_gap = self.max_gap_cells * cell;
+        if !gaps.is_empty() {
+            let mid = gaps.len() / 2;
+            let (_, &mut median, _) = gaps.select_nth_unstable_by(mid, f64::total_cmp);
+            if median > max_gap {
+                return Err(GridError::Data(format!(
+                    "bi-directional gridding bridges gaps along a line of at most {} cells \
+                     ({} m at a {} m cell), but the samples along the lines are {} m apart \
+                     (median), so nearly every node would be blank: choose a cell of at \
+                     least {} m",
+                    shown(self.max_gap_cells),
+                    shown(max_gap),
+                    shown(cell),
+                    shown((median * 10.0).round() / 10.0),
+                    shown((median / self.max_gap_cells * 10.0).ceil() / 10.0)
+                )));
+            }
+        }
         let v0 = (vmin / cell).floor() * cell;
         let rows = ((vmax - v0) / cell).floor() as usize + 1;
         if rows.saturating_mul(lines.len()) > crate::grid::MAX_NODES {
@@ -102,7 +132,6 @@ impl Bidirectional {
             ));
         }
         // Per row, the lines' (u, z) at it.
-        let max_gap = self.max_gap_cells * cell;
         let mut at_rows: Vec<Vec<(f64, f64)>> = vec![Vec::new(); rows];
         for s in lines.values() {
             let mut k = 0;
@@ -181,6 +210,12 @@ impl Bidirectional {
                 out[geometry.index(i, j)] = (1.0 - dv) * ((1.0 - du) * w(a, b) + du * w(a + 1, b))
                     + dv * ((1.0 - du) * w(a, b + 1) + du * w(a + 1, b + 1));
             }
+        }
+        if out.iter().all(|v| v.is_nan()) {
+            return Err(GridError::Data(format!(
+                "bi-directional gridding left every node blank: no node of the grid \
+                 ({geometry}) lies between the outermost lines and within the lines' ends"
+            )));
         }
         Ok(out)
     }
@@ -367,5 +402,49 @@ mod tests {
             )
             .is_err()
         );
+    }
+
+    /// Samples 35 m apart along the lines (2 Hz at 70 m/s) gridded at a
+    /// 5 m cell: with 4 cells (20 m) bridged, every node was blank and
+    /// the grid written with exit 0 (finding 07). Now an error naming the
+    /// cell that works, 8.8 m; at 9 m the grid has values.
+    #[test]
+    fn a_cell_too_small_for_the_sample_spacing_is_an_error_not_a_blank_grid() {
+        let (mut x, mut y, mut z, mut id) = (vec![], vec![], vec![], vec![]);
+        for l in 0..6 {
+            for k in 0..40 {
+                x.push(l as f64 * 500.0);
+                y.push(k as f64 * 35.0);
+                z.push(50_000.0 + x[x.len() - 1] * 0.01);
+                id.push(l);
+            }
+        }
+        let points = LinePoints {
+            x: &x,
+            y: &y,
+            z: &z,
+            line: &id,
+        };
+        let b = Bidirectional {
+            direction_deg: 0.0,
+            max_gap_cells: 4.0,
+        };
+        for cell in [1.0, 5.0, 8.0] {
+            let g = GridGeometry::covering(0.0, 2500.0, 0.0, 1365.0, cell).unwrap();
+            let e = b.grid(points, g).unwrap_err();
+            assert!(e.is_bad_input());
+            let m = e.to_string();
+            assert!(
+                m.contains("35 m apart (median)") && m.contains("choose a cell of at least 8.8 m"),
+                "{m}"
+            );
+        }
+        let g = GridGeometry::covering(0.0, 2500.0, 0.0, 1365.0, 9.0).unwrap();
+        let out = b.grid(points, g).unwrap();
+        assert!(out.iter().filter(|v| v.is_finite()).count() > g.len() / 2);
+        // A grid beside the lines: every node blank, an error.
+        let away = GridGeometry::covering(5000.0, 6000.0, 0.0, 1000.0, 50.0).unwrap();
+        let m = b.grid(points, away).unwrap_err().to_string();
+        assert!(m.contains("left every node blank"), "{m}");
     }
 }
