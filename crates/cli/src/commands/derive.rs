@@ -18,7 +18,11 @@ use std::path::PathBuf;
 /// nodes are blank; an infinite value or one beyond float32's range
 /// (±3.4e38: every grid format stores float32, and no field or gradient
 /// comes near it) is an error naming its row (from the north) and column; the cell size must be 1e-6 to 1e6 m, node coordinates within
-/// ±1e9 m, and the header may not declare more nodes than the file holds.
+/// ±1e9 m, and the header may not declare more nodes than the file holds
+/// (a GeoTIFF's strips must hold exactly the image its header declares).
+/// Coordinates must be metres of a projected system (e.g. UTM): a grid
+/// whose .prj, GeoTIFF keys or netCDF units declare degrees (a geographic
+/// system) or feet is refused; netCDF coordinates in km are converted to m.
 ///
 /// Examples:
 ///   aeromag derive --input mag.tif --vertical-derivative --out fvd.tif
@@ -43,8 +47,9 @@ pub struct Args {
     /// the grid's mean).
     #[arg(long, value_name = "M", group = "product", value_parser = crate::args::non_negative)]
     upward: Option<f64>,
-    /// The input minus this grid (the same nodes; at least one node set
-    /// in both).
+    /// The input minus this grid (the same nodes in the same coordinate
+    /// system, e.g. UTM zone, when both files record one; at least one
+    /// node set in both).
     #[arg(long, value_name = "GRID", group = "product")]
     minus: Option<PathBuf>,
 }
