@@ -69,7 +69,8 @@ pub struct SurveyGrid {
     pub survey: ProjectedSurvey,
     /// The blanking distance used, m.
     pub blanking_m: f64,
-    /// Nodes blanked.
+    /// Nodes left blank: beyond the blanking distance, or without a value
+    /// from the method.
     pub blanked_nodes: usize,
     /// Rows gridded (on a line, finite position and value).
     pub rows_used: usize,
