@@ -125,6 +125,16 @@ fn check_range(t: &Flight, name: &str, v: &[f64], lo: f64, hi: f64) -> Result<()
 /// ones (for a lazy read, [`Fields::canonical_and`](aeromag_io::Fields::canonical_and)).
 pub const POD_COLUMNS: [&str; 2] = ["cable_inclination", "cable_azimuth"];
 
+/// Directions of learning headings a pod fit needs, at least
+/// [`MIN_HEADING_SEPARATION_DEG`] apart: the attitude-dependent terms are
+/// determined only by headings around the compass (the seed's learning set
+/// has eight, 45° apart), as a Tolles-Lawson box needs four.
+pub const MIN_LEARNING_DIRECTIONS: usize = 4;
+
+/// Smallest angle between two learning headings counted as two directions,
+/// degrees.
+pub const MIN_HEADING_SEPARATION_DEG: f64 = 30.0;
+
 /// Split `t` into headings and build the model inputs of each with the
 /// pod trajectory of `method`. Returns the headings and the sample rate.
 fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Heading>, f64)> {
@@ -299,6 +309,35 @@ pub fn fit_pod(
         return Err(Error::bad_file(
             t.file_label(),
             format!("no heading of ≥ {MIN_HEADING_S} s without gaps or missing values"),
+        ));
+    }
+    // One heading (or 10 s of one) was fitted to 63 coefficients without
+    // a word, and the model applied to the other headings gave an
+    // "interference" of ±295 000 nT, flagged compensated.
+    let mut directions: Vec<f64> = Vec::new();
+    for h in &hs {
+        let apart = |d: &f64| {
+            let a = (h.heading_deg - d).rem_euclid(360.0);
+            a.min(360.0 - a) >= MIN_HEADING_SEPARATION_DEG
+        };
+        if directions.iter().all(apart) {
+            directions.push(h.heading_deg);
+        }
+    }
+    if directions.len() < MIN_LEARNING_DIRECTIONS {
+        let flown: Vec<String> = hs
+            .iter()
+            .map(|h| format!("{:.0}°", h.heading_deg))
+            .collect();
+        return Err(Error::bad_file(
+            t.file_label(),
+            format!(
+                "the pod model needs learning headings in at least {MIN_LEARNING_DIRECTIONS} directions \
+                 {MIN_HEADING_SEPARATION_DEG}° or more apart (a box: 0, 90, 180, 270°) to be \
+                 determined; the rows fitted hold {} heading(s): {}",
+                hs.len(),
+                flown.join(", ")
+            ),
         ));
     }
     let data: Vec<PodHeading> = hs.iter().map(|h| h.data.clone()).collect();

@@ -182,3 +182,49 @@ fn the_two_step_solve_works_from_the_equator_to_the_pole() {
     }
     assert_eq!(s.rate_test_inclination_0, s.rate_test_by_inclination[0].1);
 }
+
+/// Found by fuzzing: one learning heading (or 10 s of one) was fitted to
+/// the 63-coefficient array without a word, and the model applied to the
+/// other headings gave an "interference" of ±295 000 nT flagged
+/// compensated. A fit needs headings in four directions; the seed's two
+/// boxes (eight) and one box (four, 90° apart) fit.
+#[test]
+fn a_learning_flight_of_fewer_than_four_directions_is_refused() {
+    let learn = simulate_flight(ScenarioKind::Pod, None, None).unwrap();
+    let s = setup(40.0, [0.0, 0.0, 1.2], 45.0);
+    let headings = |keep: &[f64]| -> Flight {
+        let line = learn.require("line").unwrap();
+        let labels: Vec<f64> = {
+            let mut l: Vec<f64> = line.to_vec();
+            l.dedup();
+            l
+        };
+        let rows: Vec<usize> = (0..learn.n_rows())
+            .filter(|&k| keep.iter().any(|&i| line[k] == labels[i as usize]))
+            .collect();
+        let mut t = aeromag::FlightTable::new();
+        for c in learn.table().columns() {
+            let v = c.values().unwrap();
+            t.add_column(c.name(), rows.iter().map(|&k| v[k]).collect())
+                .unwrap();
+        }
+        Flight::from_table(t).unwrap()
+    };
+    // The learning set is 0, 90, 180, 270, 45, 135, 225, 315°.
+    for keep in [&[0.0][..], &[0.0, 4.0], &[0.0, 4.0, 1.0]] {
+        let e = fit_pod(&headings(keep), &s, PodMethod::DipoleArray, None).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("at least 4 directions"),
+            "{keep:?}: {e}"
+        );
+    }
+    assert!(
+        fit_pod(
+            &headings(&[0.0, 1.0, 2.0, 3.0]),
+            &s,
+            PodMethod::DipoleArray,
+            None
+        )
+        .is_ok()
+    );
+}
