@@ -167,9 +167,25 @@ class TollesLawson:
         sig = inspect.signature(cls.__init__)
         return [p for p in sig.parameters if p != "self"]
 
+    @classmethod
+    def _defaults(cls) -> Dict[str, Any]:
+        return {k: p.default for k, p in inspect.signature(cls.__init__).parameters.items() if k != "self"}
+
     def get_params(self, deep: bool = True) -> Dict[str, Any]:
         """The keyword options, as given."""
         return {k: getattr(self, k) for k in self._param_names()}
+
+    def _settings(self) -> Dict[str, Any]:
+        """The options the library is given: with ``method="kalman"`` the
+        band-pass LS settings are left out at their defaults (changed, the
+        library refuses them: the Kalman method does not filter)."""
+        params = self.get_params()
+        if params.get("method") == "kalman":
+            defaults = self._defaults()
+            for k in ("ridge_lambda", "band", "trim"):
+                if params[k] == defaults[k]:
+                    del params[k]
+        return params
 
     def set_params(self, **params: Any) -> "TollesLawson":
         """Set keyword options; returns the estimator."""
@@ -181,9 +197,7 @@ class TollesLawson:
         return self
 
     def __repr__(self) -> str:
-        defaults = {
-            k: p.default for k, p in inspect.signature(type(self).__init__).parameters.items() if k != "self"
-        }
+        defaults = self._defaults()
         changed = [f"{k}={v!r}" for k, v in self.get_params().items() if v != defaults[k]]
         return f"TollesLawson({', '.join(changed)})"
 
@@ -197,7 +211,7 @@ class TollesLawson:
         signature); ``progress``: a callable ``(stage, done, total)``, a
         tqdm bar, or True. The GIL is released while fitting.
         """
-        model = _aeromag.calibrate(as_flight(flight), self.get_params(), progress_callback(progress))
+        model = _aeromag.calibrate(as_flight(flight), self._settings(), progress_callback(progress))
         self._set_fitted(model)
         return self
 
@@ -266,7 +280,7 @@ def calibrate_sensors(
     ``model.apply(flight)`` the flight with them, ``model.score(flight)``
     the figures of ``aeromag report`` for it.
     """
-    params = TollesLawson(**options).get_params()
+    params = TollesLawson(**options)._settings()
     names = [m.strip() for m in mag.split(",")] if isinstance(mag, str) else list(mag)
     vectors = [v.strip() for v in vector.split(",")] if isinstance(vector, str) else vector
     return _aeromag.calibrate_sensors(

@@ -38,6 +38,7 @@ def test_missing_file_and_bad_options(tmp_path):
         dict(ridge_lambda=-1.0),
         dict(field_order=3),  # needs method kalman
         dict(eddy_lag="soon"),
+        dict(method="kalman", band=(0.2, 0.5)),  # was ignored: the Kalman method does not filter
     ]:
         with pytest.raises(aeromag.BadInputError):
             aeromag.TollesLawson(**bad).fit(cal)

@@ -59,13 +59,18 @@ def test_only_the_fields_asked_for(cal_csv):
     assert "mag_2_uc" in g.unread_columns
 
 
-def test_time_range_and_column_map(cal_csv):
+def test_time_range_and_column_map(cal_csv, tmp_path):
     f = aeromag.read_flight(cal_csv)
     t0 = f["time"][0]
     g = aeromag.read_flight(cal_csv, time_range=(t0, t0 + 10.0))
     assert np.all((g["time"] >= t0) & (g["time"] <= t0 + 10.0)) and len(g) > 10
-    h = aeromag.read_flight(cal_csv, columns={"mag": "true_interf"})
-    assert np.array_equal(h["mag"], f["true_interf"])
+    p = tmp_path / "my.csv"
+    p.write_text("time,my_mag\n" + "".join(f"{float(t)!r},{float(m)!r}\n" for t, m in zip(f["time"][:50], f["mag"][:50])))
+    h = aeromag.read_flight(p, columns={"mag": "my_mag"})
+    assert np.array_equal(h["mag"], f["mag"][:50])
+    # Truth never plays a measured role.
+    with pytest.raises(aeromag.BadInputError, match="simulation truth"):
+        aeromag.read_flight(cal_csv, columns={"mag": "true_interf"})
 
 
 def test_from_dict_maps_file_names_and_checks():
