@@ -74,13 +74,21 @@ impl Geodetic {
 
     /// Local flat-earth offsets (north, east, down) in metres of `other`
     /// relative to `self`, using the ellipsoid's radii of curvature at `self`.
-    /// Accurate to better than 0.1 % over survey blocks of tens of km.
+    /// Accurate to better than 0.1 % over survey blocks of tens of km. The
+    /// longitude difference is the shorter way round: a survey across the
+    /// antimeridian (179.9° and −179.9°) is 0.2° wide, not 359.8° (levelling
+    /// formed crossovers 22 000 km apart).
     pub fn ned_offset_to(&self, other: &Geodetic) -> [f64; 3] {
         let (rm, rn) = self.radii_of_curvature();
         let dn = (other.lat_deg - self.lat_deg).to_radians() * (rm + self.alt_m);
-        let de = (other.lon_deg - self.lon_deg).to_radians()
-            * (rn + self.alt_m)
-            * self.lat_deg.to_radians().cos();
+        // Wrapped only beyond ±180°, so that every other difference keeps
+        // its bits.
+        let dlon = match other.lon_deg - self.lon_deg {
+            d if d > 180.0 => d - 360.0,
+            d if d < -180.0 => d + 360.0,
+            d => d,
+        };
+        let de = dlon.to_radians() * (rn + self.alt_m) * self.lat_deg.to_radians().cos();
         [dn, de, self.alt_m - other.alt_m]
     }
 
@@ -106,6 +114,21 @@ impl Geodetic {
 
 #[cfg(test)]
 mod tests {
+    /// Across the antimeridian the east offset is the short way round, and
+    /// the same as between 19.9° and 20.1°.
+    #[test]
+    fn offsets_across_the_antimeridian_are_the_short_way_round() {
+        let at = |lon: f64| super::Geodetic::new(-17.0, lon, 0.0);
+        let across = at(179.9).ned_offset_to(&at(-179.9));
+        let plain = at(19.9).ned_offset_to(&at(20.1));
+        assert!(
+            (across[1] - plain[1]).abs() < 1e-6,
+            "{across:?} vs {plain:?}"
+        );
+        let back = at(-179.9).ned_offset_to(&at(179.9));
+        assert!((back[1] + plain[1]).abs() < 1e-6, "{back:?}");
+    }
+
     use super::*;
     use approx::assert_relative_eq;
 
