@@ -160,6 +160,18 @@ impl Flight {
         self.bad_at(row, Some(column.to_string()), reason.into())
     }
 
+    /// A bad-input error about the column `name` (canonical or the file's;
+    /// named as the file spells it) as a whole, no one row to blame.
+    pub fn bad_column(&self, name: &str, reason: impl Into<String>) -> Error {
+        Error::BadInput {
+            file: Some(self.label()),
+            line: None,
+            row: None,
+            column: Some(self.resolve(name).unwrap_or(name).to_string()),
+            reason: reason.into(),
+        }
+    }
+
     /// A bad-input error at `row` (0-based) of this flight as a whole (no
     /// one column to blame), with the file's line when it is known.
     pub fn bad_row(&self, row: usize, reason: impl Into<String>) -> Error {
@@ -228,15 +240,12 @@ impl Flight {
             .filter(|x| x.is_finite())
             .fold(f64::NEG_INFINITY, |m, x| m.max(x.abs()));
         if max > 0.0 && max < 1e-3 {
-            return Err(Error::BadInput {
-                file: Some(self.label()),
-                line: None,
-                row: None,
-                column: Some(self.resolve(name).unwrap_or(name).to_string()),
-                reason: format!(
+            return Err(self.bad_column(
+                name,
+                format!(
                     "every value is below 1e-3 in magnitude (largest {max:.3e}): tesla? the values must be in nT (multiply by 1e9)"
                 ),
-            });
+            ));
         }
         Ok(v)
     }

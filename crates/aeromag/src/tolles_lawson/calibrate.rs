@@ -509,17 +509,14 @@ fn check_sensors_vary(flight: &Flight, inputs: &TlInputs, sensor: &SensorColumns
         if let Some(first) = finite.next()
             && finite.all(|x| x == first)
         {
-            return Err(Error::BadInput {
-                file: Some(flight.label()),
-                line: None,
-                row: None,
-                column: Some(flight.resolve(name).unwrap_or(name).to_string()),
-                reason: format!(
+            return Err(flight.bad_column(
+                name,
+                format!(
                     "holds one value, {} nT, on every row: a stuck or dead sensor, or a wrong \
                      column; there is nothing to fit",
                     aeromag_core::error::shown(*first)
                 ),
-            });
+            ));
         }
     }
     Ok(())
