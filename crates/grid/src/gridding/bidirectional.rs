@@ -108,8 +108,7 @@ impl Bidirectional {
             .collect();
         let max_gap = self.max_gap_cells * cell;
         if !gaps.is_empty() {
-            let mid = gaps.len() / 2;
-            let (_, &mut median, _) = gaps.select_nth_unstable_by(mid, f64::total_cmp);
+            let median = crate::median(&mut gaps);
             if median > max_gap {
                 return Err(GridError::Data(format!(
                     "bi-directional gridding bridges gaps along a line of at most {} cells \

@@ -63,6 +63,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{GridError, Result};
+use crate::median;
 
 /// WGS 84 semi-major axis, metres.
 const WGS84_A_M: f64 = 6_378_137.0;
@@ -283,18 +284,6 @@ fn wrap_deg(lon: f64) -> f64 {
         lon
     } else {
         (lon + 180.0).rem_euclid(360.0) - 180.0
-    }
-}
-
-/// Median of a non-empty slice (sorted in place); mean of the two middle
-/// values for an even count.
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_unstable_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
     }
 }
 
