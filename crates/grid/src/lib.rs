@@ -27,7 +27,7 @@ pub use error::{GridError, Result};
 /// middle values for an even count. Serves the UTM zone of a survey's
 /// points and bi-directional gridding's sample spacing.
 pub(crate) fn median(v: &mut [f64]) -> f64 {
-    let (m, even) = (v.len() / 2, v.len() % 2 == 0);
+    let (m, even) = (v.len() / 2, v.len().is_multiple_of(2));
     let (below, &mut hi, _) = v.select_nth_unstable_by(m, f64::total_cmp);
     if even {
         let lo = below.iter().copied().fold(f64::NEG_INFINITY, f64::max);
