@@ -59,6 +59,18 @@ def test_only_the_fields_asked_for(cal_csv):
     assert "mag_2_uc" in g.unread_columns
 
 
+def test_line_labels_of_one_number_in_two_texts_stay_two_lines(tmp_path):
+    # Geosoft's LINE.VERSION: 1003.1 and 1003.10 are two lines, read as
+    # written; without such a pair the labels stay numbers.
+    p = tmp_path / "versions.csv"
+    p.write_text("time,line\n0,1003.1\n1,1003.1\n2,0\n3,1003.10\n")
+    f = aeromag.read_flight(p)
+    assert list(f["line"]) == ["1003.1", "1003.1", "0", "1003.10"]
+    assert len(aeromag.read_flight(p, lines="1003.10")) == 1
+    p.write_text("time,line\n0,1003.1\n1,1003.2\n")
+    assert aeromag.read_flight(p)["line"].dtype == np.float64
+
+
 def test_time_range_and_column_map(cal_csv, tmp_path):
     f = aeromag.read_flight(cal_csv)
     t0 = f["time"][0]

@@ -301,6 +301,15 @@ pub fn level(
         .then(|| flight.require(&rate_column))
         .transpose()?;
     let lines = LineLabels::of(flight, &opts.ties)?;
+    for w in [
+        lines.missing_warning(flight),
+        lines.repeated_warning(flight),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        notes.warn(w);
+    }
     let tracks = SurveyTracks {
         time,
         lat,

@@ -157,7 +157,7 @@ fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Head
     let fs = t.sample_rate_hz()?;
     let min_len = (MIN_HEADING_S * fs).ceil() as usize;
     let rule = SegmentRule::default().min_len(min_len);
-    let segs = finite_segments(time, t.column("line"), &cols, &rule).1.kept;
+    let segs = finite_segments(time, t.line_numbers(), &cols, &rule).1.kept;
     let cable = Cable {
         length_m: setup.cable_length_m,
         attach_m: setup.attach_m,

@@ -14,6 +14,11 @@
 //! second pass over those rows only (usually none: a text column such as a
 //! flight id already fails on the first row).
 //!
+//! The `line` column is read as numbers while its labels are numbers, but
+//! when two of its labels differ as text and not as numbers (`1003.1` and
+//! `1003.10`: [`crate::label_texts`]) it is read again as text, whole, by
+//! the same second pass.
+//!
 //! A column that [`Fields::Only`](crate::Fields::Only) does not ask for
 //! is skipped: its cells are not parsed or checked, it holds no memory,
 //! and the table leaves it out ([`FlightTable::unread_columns`] names it).
@@ -39,6 +44,7 @@ use crate::ReadOptions;
 use crate::cell::{Cell, CellError, check_text, parse_cell};
 use crate::columns::{MappedColumn, must_be_numeric, resolve};
 use crate::error::{IoError, Result};
+use crate::label_texts::{LabelClash, LabelTexts};
 use crate::table::{ColumnData, FlightTable, Missing};
 use crate::wanted::wanted_fields;
 
@@ -142,6 +148,13 @@ pub(crate) struct TableBuilder {
     n_rows: usize,
     row_lines: Vec<(usize, u64)>,
     last_line: u64,
+    /// The read column whose role is `line`, if any: its labels' texts
+    /// are kept while it is numeric ([`crate::label_texts`]).
+    label_column: Option<usize>,
+    /// The texts of that column's cells read by [`Self::push_row`].
+    label_texts: LabelTexts,
+    /// Whether two of its texts (from either reader) give one number.
+    label_clash: LabelClash,
 }
 
 impl TableBuilder {
@@ -203,7 +216,12 @@ impl TableBuilder {
             })
             .collect();
         let numeric_only = names.iter().map(|n| must_be_numeric(&role_of(n))).collect();
-        let cols = wanted_fields(&names, &aliases, opts)
+        let wanted = wanted_fields(&names, &aliases, opts);
+        let label_column = names
+            .iter()
+            .zip(&wanted)
+            .position(|(n, &read)| read && role_of(n) == "line");
+        let cols = wanted
             .into_iter()
             .map(|wanted| match wanted {
                 true => ColState::Numeric {
@@ -229,7 +247,16 @@ impl TableBuilder {
             n_rows: 0,
             row_lines: Vec::new(),
             last_line: 0,
+            label_column,
+            label_texts: LabelTexts::default(),
+            label_clash: LabelClash::default(),
         })
+    }
+
+    /// The read column whose role is `line` (its labels' texts are kept
+    /// while it is read as numbers: [`crate::label_texts`]).
+    pub(crate) fn label_column(&self) -> Option<usize> {
+        self.label_column
     }
 
     /// Column names after de-duplication checks (header order).
@@ -272,11 +299,17 @@ impl TableBuilder {
                 } => match parse_cell(bytes) {
                     Ok(Cell::Value(v)) => {
                         *integers = *integers && is_integer_text(bytes);
-                        values.push(v)
+                        values.push(v);
+                        if self.label_column == Some(i) {
+                            self.label_texts.note(bytes, v);
+                        }
                     }
                     Ok(Cell::Missing(kind)) => {
                         values.push(f64::NAN);
                         missing.count(kind);
+                        if self.label_column == Some(i) {
+                            self.label_texts.note(bytes, f64::NAN);
+                        }
                     }
                     Err(CellError::NotNumber) if !self.numeric_only[i] => {
                         // First text cell of a free column: it becomes a text column.
@@ -341,6 +374,7 @@ impl TableBuilder {
         if part.rows == 0 {
             return true;
         }
+        self.label_clash.add_all(&part.labels);
         for (i, col) in self.cols.iter_mut().enumerate() {
             if let ColState::Numeric {
                 values,
@@ -408,8 +442,23 @@ impl TableBuilder {
             aliases,
             n_rows,
             row_lines,
+            label_column,
+            label_texts,
+            mut label_clash,
             ..
         } = self;
+        // Two texts of one number in the `line` column (`1003.1` and
+        // `1003.10`): the column is read again as text, whole.
+        label_clash.add_all(&label_texts);
+        if let Some(c) = label_column
+            && label_clash.clash
+            && matches!(cols[c], ColState::Numeric { .. })
+        {
+            cols[c] = ColState::Text {
+                values: Vec::new(),
+                from_row: n_rows,
+            };
+        }
         let pending: Vec<(usize, usize)> = cols
             .iter()
             .enumerate()

@@ -36,9 +36,10 @@ use std::sync::Mutex;
 use crate::builder::{TableBuilder, is_integer_text};
 use crate::cell::{Cell, EXACT_POWERS_OF_TEN, MissingKind, parse_cell, plain_decimal_prefix};
 use crate::error::{IoError, Result};
+use crate::label_texts::LabelTexts;
 use crate::ordered::{in_order, lock};
 use crate::table::Missing;
-use crate::xyz::{Dialect, Kind, line_kind};
+use crate::xyz::{Dialect, Kind, line_kind, record_text};
 
 /// Bytes per piece (about; a piece ends at a line end).
 pub(crate) const PIECE_BYTES: usize = 512 << 10;
@@ -68,6 +69,9 @@ pub(crate) struct Shape<'a> {
     /// whitespace table, an ASCII space other than a blank is not clean:
     /// the general reader splits it its own way.
     pub wanted: Option<&'a [bool]>,
+    /// The `line` column, whose cells' texts are kept
+    /// ([`CleanRows::labels`], [`crate::label_texts`]).
+    pub label: Option<usize>,
 }
 
 /// Whether field `i` of `shape` is read.
@@ -111,8 +115,10 @@ pub(crate) struct CleanRows {
     /// Whether the piece stopped at a line that is not clean.
     pub stopped: bool,
     /// The Geosoft `Line`/`Tie` records read: `(rows before it in the
-    /// piece, its number, whether a tie)`.
-    pub records: Vec<(usize, f64, bool)>,
+    /// piece, its number, whether a tie, its number as written)`.
+    pub records: Vec<(usize, f64, bool, Vec<u8>)>,
+    /// The texts of the `line` column's cells ([`Shape::label`]).
+    pub labels: LabelTexts,
 }
 
 impl CleanRows {
@@ -134,6 +140,7 @@ impl CleanRows {
         self.bytes = 0;
         self.stopped = false;
         self.records.clear();
+        self.labels.clear();
     }
 
     /// Counts a row (its values already pushed) on `line` of the piece.
@@ -159,9 +166,23 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape<'_>, out: &mut CleanRows) {
     while pos < piece.len() {
         // Most lines: plain decimals and the line end, in one pass.
         let row = if shape.whitespace.is_some() {
-            whitespace_row(piece, pos, shape, &mut out.values, &mut out.integers)
+            whitespace_row(
+                piece,
+                pos,
+                shape,
+                &mut out.values,
+                &mut out.integers,
+                &mut out.labels,
+            )
         } else {
-            plain_row(piece, pos, shape, &mut out.values, &mut out.integers)
+            plain_row(
+                piece,
+                pos,
+                shape,
+                &mut out.values,
+                &mut out.integers,
+                &mut out.labels,
+            )
         };
         if let Some(end) = row {
             out.row_on(line);
@@ -185,7 +206,8 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape<'_>, out: &mut CleanRows) {
             match line_kind(dialect, t) {
                 Some(Kind::Data) => false,
                 Some(Kind::Record { number, tie }) => {
-                    out.records.push((out.rows, number, tie));
+                    let text = record_text(t).to_vec();
+                    out.records.push((out.rows, number, tie, text));
                     true
                 }
                 Some(Kind::Blank | Kind::Comment) => true,
@@ -206,6 +228,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape<'_>, out: &mut CleanRows) {
                     shape,
                     &mut out.values,
                     &mut out.integers,
+                    &mut out.labels,
                     &mut missing,
                 )
             } else {
@@ -216,6 +239,7 @@ pub(crate) fn parse_piece(piece: &[u8], shape: Shape<'_>, out: &mut CleanRows) {
                         shape,
                         &mut out.values,
                         &mut out.integers,
+                        &mut out.labels,
                         &mut missing,
                     )
             };
@@ -252,6 +276,7 @@ fn plain_row(
     shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
+    labels: &mut LabelTexts,
 ) -> Option<usize> {
     let last = shape.n_fields.saturating_sub(1);
     let mut p = start;
@@ -260,6 +285,9 @@ fn plain_row(
             let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
             column.push(v);
             *integer &= is_integer;
+            if shape.label == Some(i) {
+                labels.note(&piece[p..p + len], v);
+            }
             p + len
         } else {
             unread_field_end(piece, p, shape.delimiter)
@@ -296,6 +324,7 @@ fn whitespace_row(
     shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
+    labels: &mut LabelTexts,
 ) -> Option<usize> {
     let blank = |p: usize| matches!(piece.get(p), Some(b' ' | b'\t'));
     let mut p = start;
@@ -308,6 +337,9 @@ fn whitespace_row(
             let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
             column.push(v);
             *integer &= is_integer;
+            if shape.label == Some(i) {
+                labels.note(&piece[p..p + len], v);
+            }
             p += len;
         } else {
             // An unread field: its bytes up to any ASCII space (one other
@@ -351,6 +383,7 @@ fn whitespace_clean_row(
     shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
+    labels: &mut LabelTexts,
     missing: &mut Vec<(usize, MissingKind)>,
 ) -> bool {
     missing.clear();
@@ -370,6 +403,9 @@ fn whitespace_clean_row(
         }
         if read(&shape, i) && !push_cell(f, i, column, integers, missing) {
             return false;
+        }
+        if shape.label == Some(i) {
+            labels.note(f, column.last().copied().unwrap_or(f64::NAN));
         }
     }
     fields.next().is_none() // else a long row
@@ -393,6 +429,7 @@ fn clean_row(
     shape: Shape<'_>,
     values: &mut [Vec<f64>],
     integers: &mut [bool],
+    labels: &mut LabelTexts,
     missing: &mut Vec<(usize, MissingKind)>,
 ) -> bool {
     missing.clear();
@@ -414,6 +451,9 @@ fn clean_row(
             if end_ok {
                 column.push(v);
                 integers[i] &= integer;
+                if shape.label == Some(i) {
+                    labels.note(&piece[start..end], v);
+                }
                 start = end + 1;
                 continue;
             }
@@ -438,6 +478,9 @@ fn clean_row(
         };
         if wanted && !push_cell(f, i, column, integers, missing) {
             return false;
+        }
+        if wanted && shape.label == Some(i) {
+            labels.note(f, column.last().copied().unwrap_or(f64::NAN));
         }
         start += len + 1;
     }
@@ -861,6 +904,7 @@ mod tests {
         crlf: false,
         whitespace: None,
         wanted: None,
+        label: None,
     };
 
     fn parsed(piece: &[u8], shape: Shape) -> CleanRows {

@@ -123,6 +123,7 @@ fn read_csv_with(
         crlf: src.crlf,
         whitespace: None,
         wanted: wanted.as_deref(),
+        label: builder.label_column(),
     };
     // Clean rows on all cores first; the general reader from the first
     // line that is not clean (module docs of csv_clean).
@@ -613,6 +614,70 @@ mod tests {
                 threads,
                 piece,
             )?;
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// Line labels are names (`crate::label_texts`): a `line` column
+        /// stays numeric unless two of its labels differ as text and not as
+        /// numbers, and then holds every label as written; the fast path
+        /// reads it as the general reader does, in any piece size.
+        #[test]
+        fn line_labels_of_one_number_in_two_texts_stay_two_lines(
+            labels in proptest::collection::vec(
+                prop::sample::select(vec![
+                    "1003", "1003.0", "01003", "1003.1", "1003.10", " 1003.1", "7", "0", "0.0",
+                    "", "NaN", "*", "1e3", "1000",
+                ]),
+                1..12,
+            ),
+            run in 1usize..30,
+            threads in 1usize..4,
+            piece in 8usize..300,
+        ) {
+            let mut text = String::from("time,line,mag\n");
+            let mut row = 0;
+            for l in &labels {
+                for _ in 0..run {
+                    text.push_str(&format!("{row}.5,{l},5{row}.25\n"));
+                    row += 1;
+                }
+            }
+            let opts = ReadOptions::default();
+            csv_clean::check::reads_as_the_general_reader(
+                text.as_bytes(),
+                |path, clean| read_csv_with(path, &opts, clean),
+                threads,
+                piece,
+            )?;
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("l.csv");
+            std::fs::write(&path, &text).unwrap();
+            let t = read_csv(&path, &opts).unwrap();
+            let value = |l: &str| l.trim().parse::<f64>().ok().filter(|v| *v != 0.0 && !v.is_nan());
+            let mut by_value: Vec<(f64, &str)> = Vec::new();
+            let mut clash = false;
+            for l in &labels {
+                if let Some(v) = value(l) {
+                    match by_value.iter().find(|(x, _)| *x == v) {
+                        Some((_, first)) => clash |= first.trim() != l.trim(),
+                        None => by_value.push((v, l)),
+                    }
+                }
+            }
+            match t.text_column("line") {
+                Some(cells) => {
+                    prop_assert!(clash, "read as text without a clash: {labels:?}");
+                    let written: Vec<&str> = labels
+                        .iter()
+                        .flat_map(|l| std::iter::repeat_n(*l, run))
+                        .collect();
+                    prop_assert_eq!(cells, &written);
+                }
+                None => prop_assert!(!clash, "clash read as numbers: {:?}", labels),
+            }
         }
     }
 

@@ -43,6 +43,7 @@ pub mod derive;
 mod error;
 mod fields;
 mod hdf5;
+mod label_texts;
 mod number_text;
 mod ordered;
 mod parts;

@@ -11,7 +11,9 @@
 //! (`L1020`, `T901`, any case) and as numbers where it is numeric: `1003.01`
 //! selects the rows whose value is the number 1003.01, and a label with
 //! leading letters (`L1020`) selects 1020 in a numeric column (the Geosoft
-//! XYZ reader keeps the number of a `Line L1020` record).
+//! XYZ reader keeps the number of a `Line L1020` record). A `line` column
+//! whose labels differ as text but not as numbers (`1003.1` and `1003.10`)
+//! is read as text, so `--lines 1003.1` selects that line only.
 //!
 //! The rows kept keep their file line numbers, so messages still name the
 //! file's lines; data rows are counted within the selection.
@@ -215,7 +217,7 @@ impl<'a> LineLabels<'a> {
                 LineLabels::Numeric(v) => v[i].to_string(),
                 LineLabels::Text(t) => t[i].trim().to_string(),
             };
-            if s.is_empty() || seen.contains(&s) {
+            if no_line_label(&s) || seen.contains(&s) {
                 continue;
             }
             if seen.len() == max {
@@ -242,6 +244,17 @@ pub fn label_number(label: &str) -> Option<f64> {
     digits.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
+/// Whether a text label says no line at all: a missing marker as the
+/// readers know them (empty, `NaN`, Geosoft's `*`) or the number 0 (turns
+/// and transits, spec `data-formats.md`).
+pub fn no_line_label(label: &str) -> bool {
+    match crate::cell::parse_cell(label.as_bytes()) {
+        Ok(crate::cell::Cell::Missing(_)) => true,
+        Ok(crate::cell::Cell::Value(v)) => v == 0.0,
+        Err(_) => false,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +266,16 @@ mod tests {
         t.add_column("line", vec![1002.01, 1002.02, 1002.02, f64::NAN, 1003.01])
             .unwrap();
         t
+    }
+
+    #[test]
+    fn missing_and_zero_labels_are_no_line() {
+        for t in ["", " ", "NaN", "nan", "*", "0", "0.0", "-0"] {
+            assert!(no_line_label(t), "{t:?}");
+        }
+        for t in ["1003", "L0", "T901", "1003.10", "x"] {
+            assert!(!no_line_label(t), "{t:?}");
+        }
     }
 
     #[test]

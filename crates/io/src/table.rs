@@ -218,6 +218,46 @@ impl FlightTable {
         self.get(name).and_then(Column::values)
     }
 
+    /// The `line` column (alias resolved) as numbers, whatever its form: a
+    /// numeric column as it is; a text column (`L1020`, `T901`, or number
+    /// labels kept as text because two of them give one number, `1003.1`
+    /// and `1003.10`: see the readers) numbered by label, each distinct
+    /// label (trimmed, any case) 1, 2, … in order of first appearance, 0
+    /// for no line ([`crate::select::no_line_label`]: the number 0) and NaN
+    /// for a missing label. What splits a flight at line changes and tells
+    /// rows on a line; `None` without a `line` column.
+    pub fn line_numbers(&self) -> Option<std::borrow::Cow<'_, [f64]>> {
+        let column = self.get("line")?;
+        if let Some(v) = column.values() {
+            return Some(std::borrow::Cow::Borrowed(v));
+        }
+        let text = column.text()?;
+        let mut ids: std::collections::HashMap<String, f64> = std::collections::HashMap::new();
+        let mut previous: Option<(&str, f64)> = None;
+        let numbers = text
+            .iter()
+            .map(|t| {
+                let t = t.trim();
+                match previous {
+                    Some((p, id)) if p == t => id,
+                    _ => {
+                        let id = if crate::select::no_line_label(t) {
+                            // `0`: no line; empty, `NaN`, `*`: missing.
+                            let zero = t.parse::<f64>().is_ok_and(|v| v == 0.0);
+                            if zero { 0.0 } else { f64::NAN }
+                        } else {
+                            let next = ids.len() as f64 + 1.0;
+                            *ids.entry(t.to_ascii_lowercase()).or_insert(next)
+                        };
+                        previous = Some((t, id));
+                        id
+                    }
+                }
+            })
+            .collect();
+        Some(std::borrow::Cow::Owned(numbers))
+    }
+
     /// Text values of column `name` (alias resolved); `None` if absent or numeric.
     pub fn text_column(&self, name: &str) -> Option<&[String]> {
         self.get(name).and_then(Column::text)
@@ -548,6 +588,26 @@ impl FlightTable {
 mod tests {
     use super::*;
     use crate::columns::MapOrigin;
+
+    #[test]
+    fn text_line_labels_are_numbered_in_order_of_appearance() {
+        let mut t = FlightTable::new();
+        let labels = [
+            "L2", "L2", "l2", "", "0", "T9", "NaN", "*", "1003.10", "1003.1", "T9",
+        ];
+        t.add_text_column("line", labels.iter().map(|s| s.to_string()).collect())
+            .unwrap();
+        let n = t.line_numbers().unwrap();
+        let shown: Vec<String> = n.iter().map(|v| v.to_string()).collect();
+        assert_eq!(
+            shown,
+            ["1", "1", "1", "NaN", "0", "2", "NaN", "NaN", "3", "4", "2"]
+        );
+        let mut numeric = FlightTable::new();
+        numeric.add_column("line", vec![1003.1, 0.0]).unwrap();
+        assert_eq!(&*numeric.line_numbers().unwrap(), &[1003.1, 0.0]);
+        assert!(FlightTable::new().line_numbers().is_none());
+    }
 
     #[test]
     fn add_and_access_columns() {

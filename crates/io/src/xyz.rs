@@ -61,6 +61,7 @@ use crate::builder::{
 };
 use crate::csv_clean::{self, Resume, Shape, push_clean_rows};
 use crate::error::{IoError, Result};
+use crate::label_texts::LabelClash;
 use crate::read_ahead::push_rows;
 use crate::sniff::{BOM, read_prefix};
 use crate::table::FlightTable;
@@ -114,6 +115,7 @@ fn read_tokens(
                 crlf: false,
                 whitespace: Some(dialect),
                 wanted: wanted.as_deref(),
+                label: builder.label_column(),
             };
             let stop = push_clean_rows(
                 &mut builder,
@@ -143,7 +145,10 @@ fn read_tokens(
                 name.to_string()
             }
         };
-        table.add_column(&free("line"), std::mem::take(&mut src.line_values))?;
+        match src.take_line_column() {
+            Ok(numbers) => table.add_column(&free("line"), numbers)?,
+            Err(text) => table.add_text_column(&free("line"), text)?,
+        }
         table.add_column(&free("line_type"), std::mem::take(&mut src.line_types))?;
     }
     Ok(table)
@@ -188,6 +193,11 @@ struct TokenSource {
     any_record: bool,
     line_values: Vec<f64>,
     line_types: Vec<f64>,
+    /// `(rows before it, its number as written)` of each record, for the
+    /// `line` column as text when two records' numbers clash
+    /// ([`crate::label_texts`]: `Line 1003.1` and `Line 1003.10`).
+    record_texts: Vec<(usize, Vec<u8>)>,
+    record_clash: LabelClash,
 }
 
 impl TokenSource {
@@ -229,6 +239,8 @@ impl TokenSource {
             any_record: false,
             line_values: Vec::new(),
             line_types: Vec::new(),
+            record_texts: Vec::new(),
+            record_clash: LabelClash::default(),
         })
     }
 
@@ -241,14 +253,14 @@ impl TokenSource {
         }
         let mut records = piece.records.iter().peekable();
         for row in 0..piece.rows {
-            while let Some(&(_, number, tie)) = records.next_if(|r| r.0 <= row) {
-                self.set_record(number, tie);
+            while let Some((_, number, tie, text)) = records.next_if(|r| r.0 <= row) {
+                self.set_record(*number, *tie, text);
             }
             self.line_values.push(self.current_line);
             self.line_types.push(self.current_type);
         }
-        for &(_, number, tie) in records {
-            self.set_record(number, tie);
+        for (_, number, tie, text) in records {
+            self.set_record(*number, *tie, text);
         }
     }
 
@@ -291,7 +303,10 @@ impl TokenSource {
                         last_comment = Some(self.line);
                     }
                 }
-                Kind::Record { number, tie } => self.set_record(number, tie),
+                Kind::Record { number, tie } => {
+                    let text = record_text(&self.buf).to_vec();
+                    self.set_record(number, tie, &text)
+                }
                 Kind::Data => break,
             }
         }
@@ -430,10 +445,35 @@ impl TokenSource {
         })
     }
 
-    fn set_record(&mut self, number: f64, tie: bool) {
+    /// A `Line`/`Tie` record of number `number`, written `text`.
+    fn set_record(&mut self, number: f64, tie: bool, text: &[u8]) {
         self.current_line = number;
         self.current_type = if tie { 1.0 } else { 0.0 };
         self.any_record = true;
+        if number != 0.0 {
+            self.record_clash.add(text, number);
+        }
+        self.record_texts
+            .push((self.line_values.len(), text.to_vec()));
+    }
+
+    /// The `line` column of the records: their numbers, or their texts
+    /// when two texts give one number (NaN, resp. empty, before the first).
+    fn take_line_column(&mut self) -> std::result::Result<Vec<f64>, Vec<String>> {
+        let values = std::mem::take(&mut self.line_values);
+        if !self.record_clash.clash {
+            return Ok(values);
+        }
+        let mut text = Vec::with_capacity(values.len());
+        let mut runs = self.record_texts.iter().peekable();
+        let mut current = String::new();
+        for row in 0..values.len() {
+            while let Some((_, t)) = runs.next_if(|r| r.0 <= row) {
+                current = String::from_utf8_lossy(t).into_owned();
+            }
+            text.push(current.clone());
+        }
+        Err(text)
     }
 
     fn tokenize(&mut self) {
@@ -490,7 +530,10 @@ impl RowSource for TokenSource {
             }
             match self.classify()? {
                 Kind::Blank | Kind::Comment => {}
-                Kind::Record { number, tie } => self.set_record(number, tie),
+                Kind::Record { number, tie } => {
+                    let text = record_text(&self.buf).to_vec();
+                    self.set_record(number, tie, &text)
+                }
                 Kind::Data => {
                     self.tokenize();
                     self.accept_row()?;
@@ -551,9 +594,20 @@ fn geosoft_kind(t: &[u8]) -> Option<Kind> {
     Some(Kind::Record { number, tie })
 }
 
-/// The number of a `Line`/`Tie` record word: leading letters dropped, then
-/// the leading digits and dots (`L1010` → 1010, `1010.1` → 1010.1, `10:2` → 10).
-fn record_number(word: &[u8]) -> Option<f64> {
+/// The number of a `Line`/`Tie` record as written (`Line L1003.10` →
+/// `1003.10`; see [`record_number`]), of a line [`line_kind`] found a
+/// record (empty otherwise).
+pub(crate) fn record_text(line: &[u8]) -> &[u8] {
+    let word = line
+        .split(|b| b.is_ascii_whitespace())
+        .filter(|w| !w.is_empty())
+        .nth(1)
+        .unwrap_or_default();
+    record_digits(word).unwrap_or_default()
+}
+
+/// The digits and dots of a record word after its leading letters.
+fn record_digits(word: &[u8]) -> Option<&[u8]> {
     let digits = word.trim_ascii_start();
     let start = digits.iter().position(|b| !b.is_ascii_alphabetic())?;
     let rest = &digits[start..];
@@ -561,7 +615,13 @@ fn record_number(word: &[u8]) -> Option<f64> {
         .iter()
         .position(|b| !(b.is_ascii_digit() || *b == b'.'))
         .unwrap_or(rest.len());
-    std::str::from_utf8(&rest[..end]).ok()?.parse().ok()
+    Some(&rest[..end])
+}
+
+/// The number of a `Line`/`Tie` record word: leading letters dropped, then
+/// the leading digits and dots (`L1010` → 1010, `1010.1` → 1010.1, `10:2` → 10).
+fn record_number(word: &[u8]) -> Option<f64> {
+    std::str::from_utf8(record_digits(word)?).ok()?.parse().ok()
 }
 
 #[cfg(test)]
@@ -747,6 +807,53 @@ mod tests {
 
         /// Records between rows label the rows after them, read by the
         /// fast path (with pieces that end between a record and its rows).
+        /// Two records whose numbers differ as text only (`Line 1003.1`,
+        /// `Line L1003.10`: Geosoft line 1003, versions 1 and 10) label two
+        /// lines: the `line` column then holds each record's number as
+        /// written, in either reader.
+        #[test]
+        fn records_of_one_number_in_two_texts_stay_two_lines() {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("v.xyz");
+            let mut text = String::from("/ time mag\n  0.0  53000.5\n");
+            for (k, record) in ["Line 1003.1", "Tie T901", "Line L1003.10", "Line 1003.1"]
+                .iter()
+                .enumerate()
+            {
+                text.push_str(record);
+                text.push('\n');
+                for i in 0..700 {
+                    text.push_str(&format!("  {k}{i:04}.5  53{i:03}.5\n"));
+                }
+            }
+            std::fs::write(&path, &text).unwrap();
+            let opts = ReadOptions::default();
+            let fast = read_tokens(&path, &opts, Dialect::Geosoft, Some((2, 1000))).unwrap();
+            let line = fast.text_column("line").unwrap();
+            assert_eq!(
+                (
+                    &*line[0],
+                    &*line[1],
+                    &*line[701],
+                    &*line[1401],
+                    &*line[2101],
+                    &*line[2800]
+                ),
+                ("", "1003.1", "901", "1003.10", "1003.1", "1003.1")
+            );
+            assert_eq!(
+                format!("{fast:?}"),
+                format!(
+                    "{:?}",
+                    read_tokens(&path, &opts, Dialect::Geosoft, None).unwrap()
+                )
+            );
+            // Without the clash the numbers stay numbers.
+            std::fs::write(&path, text.replace("L1003.10", "1004")).unwrap();
+            let numbers = read_tokens(&path, &opts, Dialect::Geosoft, Some((2, 1000))).unwrap();
+            assert_eq!(numbers.column("line").unwrap()[1401], 1004.0);
+        }
+
         #[test]
         fn records_label_the_rows_after_them() {
             let dir = tempfile::tempdir().unwrap();

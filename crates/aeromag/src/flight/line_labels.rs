@@ -16,8 +16,12 @@
 //! When it is known, crossovers are formed only between a line and a tie;
 //! otherwise between any two lines that cross.
 //!
-//! Rows with no label (missing, empty text, or the number 0: turns and
-//! transits) are on no line.
+//! Rows with no label (missing, empty text, `NaN`, `*`, or the number 0:
+//! turns and transits) are on no line.
+//!
+//! Labels are names: `1003.1` and `1003.10` (Geosoft line 1003, versions 1
+//! and 10) are two lines, as the readers keep them (a `line` column with
+//! such a pair is read as text).
 
 use std::collections::HashMap;
 
@@ -37,6 +41,14 @@ pub struct LineLabels {
     pub numbers: Option<Vec<f64>>,
     /// Per id, whether it is a tie line; `None` when not known.
     pub ties: Option<Vec<bool>>,
+    /// Rows whose label is missing (empty, `NaN`, `*`; not the 0 of a
+    /// turn), and the first of them: on no line, which a file seldom means
+    /// ([`LineLabels::missing_warning`]).
+    pub missing: (usize, Option<usize>),
+    /// Labels flown in more than one pass (their rows interrupted by
+    /// another line's): `(id, passes, first row of the second pass)`
+    /// ([`LineLabels::repeated_warning`]).
+    pub repeated: Vec<(i64, usize, usize)>,
 }
 
 impl LineLabels {
@@ -55,8 +67,10 @@ impl LineLabels {
             (Some(v), _) => v
                 .iter()
                 .map(|&x| {
-                    if x.is_nan() || x == 0.0 {
+                    if x.is_nan() {
                         String::new()
+                    } else if x == 0.0 {
+                        "0".to_string()
                     } else {
                         shown(x)
                     }
@@ -69,15 +83,21 @@ impl LineLabels {
         // Label (lower case) → index in `labels`: one lookup per run of
         // equal labels, however many lines the file has.
         let mut index: HashMap<String, usize> = HashMap::new();
-        let mut previous: Option<(&str, Option<usize>)> = None;
+        let mut previous: Option<(&str, Option<usize>, bool)> = None;
         let mut ids = Vec::with_capacity(text.len());
         let mut kind_of_row: Vec<Option<usize>> = Vec::with_capacity(text.len());
-        for t in &text {
-            let kind = match previous {
-                Some((p, kind)) if p == t => kind,
+        let mut missing = (0, None);
+        // Per label: its passes and the first row of its second; the label
+        // of the last row on a line.
+        let mut passes: Vec<(usize, usize)> = Vec::new();
+        let mut last_on_line: Option<usize> = None;
+        for (row, t) in text.iter().enumerate() {
+            let (kind, is_missing) = match previous {
+                Some((p, kind, m)) if p == t => (kind, m),
                 _ => {
-                    // A text column's `0`, `0.0`, `-0`: the number 0, no line.
-                    let kind = if t.is_empty() || t.parse::<f64>() == Ok(0.0) {
+                    // A text column's `0`, `0.0`, `-0` (the number 0) or a
+                    // missing marker (empty, `NaN`, `*`): no line.
+                    let kind = if aeromag_io::select::no_line_label(t) {
                         None
                     } else {
                         let n = labels.len();
@@ -87,10 +107,29 @@ impl LineLabels {
                         }
                         Some(k)
                     };
-                    previous = Some((t, kind));
-                    kind
+                    let m = kind.is_none() && !t.parse::<f64>().is_ok_and(|v| v == 0.0);
+                    previous = Some((t, kind, m));
+                    (kind, m)
                 }
             };
+            if is_missing {
+                missing.0 += 1;
+                missing.1.get_or_insert(row);
+            }
+            if let Some(k) = kind
+                && last_on_line != Some(k)
+            {
+                if k == passes.len() {
+                    passes.push((1, 0));
+                } else {
+                    let (n, second) = &mut passes[k];
+                    *n += 1;
+                    if *n == 2 {
+                        *second = row;
+                    }
+                }
+                last_on_line = Some(k);
+            }
             ids.push(kind.map_or(0.0, |k| (k + 1) as f64));
             kind_of_row.push(kind);
         }
@@ -136,10 +175,14 @@ impl LineLabels {
         } else {
             let mut tie = marked.unwrap_or_else(|| vec![false; labels.len()]);
             for t in ties {
+                // The label as written; else as a number (`901` for `T901`),
+                // unless labels differ as text only (`1003.1`, `1003.10`).
+                let as_text = labels.iter().any(|l| l.eq_ignore_ascii_case(t));
                 let hit = labels.iter().enumerate().filter(|(_, l)| {
                     l.eq_ignore_ascii_case(t)
-                        || aeromag_io::label_number(t)
-                            .is_some_and(|x| aeromag_io::label_number(l) == Some(x))
+                        || (!as_text
+                            && aeromag_io::label_number(t)
+                                .is_some_and(|x| aeromag_io::label_number(l) == Some(x)))
                 });
                 let mut any = false;
                 for (k, _) in hit {
@@ -155,12 +198,73 @@ impl LineLabels {
             }
             Some(tie)
         };
+        let repeated = passes
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.0 > 1)
+            .map(|(k, &(n, second))| (k as i64 + 1, n, second))
+            .collect();
         Ok(LineLabels {
             ids,
             labels,
             numbers,
             ties,
+            missing,
+            repeated,
         })
+    }
+
+    /// The warning for labels flown in more than one pass (`None` when
+    /// there are none), named `[line-repeated]`: levelling gives all the
+    /// rows of a label one offset, so a re-flight under the label of the
+    /// first flight would keep its own level error. A pass ends where
+    /// another line's rows begin (turns, labelled 0, and rows without a
+    /// label do not end it).
+    pub fn repeated_warning(&self, flight: &Flight) -> Option<String> {
+        const SHOWN: usize = 5;
+        let first = self.repeated.first()?;
+        let n = self.repeated.len();
+        let listed: Vec<String> = self.repeated[..n.min(SHOWN)]
+            .iter()
+            .map(|&(id, passes, second)| {
+                format!(
+                    "{} ({passes} passes, the second from data row {})",
+                    self.label(id).unwrap_or_default(),
+                    flight.file_row(second) + 1
+                )
+            })
+            .collect();
+        let more = if n > SHOWN {
+            format!(" and {} more", n - SHOWN)
+        } else {
+            String::new()
+        };
+        let example = self.label(first.0).unwrap_or_default();
+        Some(format!(
+            "{} of '{}' {} flown in separate passes, another line's rows between them: {}{more}; each label gets one offset, so a re-flight keeps its own level error: label it apart ({example}.01, as Geosoft's LINE.VERSION) [line-repeated]",
+            if n == 1 { "a line" } else { "lines" },
+            flight.label(),
+            if n == 1 { "is" } else { "are" },
+            listed.join(", "),
+        ))
+    }
+
+    /// The warning for rows whose label is missing (`None` when there are
+    /// none), named `[line-missing]`: levelling and gridding leave them
+    /// out as they leave turns out, so a line whose labels were lost
+    /// would go unlevelled and ungridded without a word.
+    pub fn missing_warning(&self, flight: &Flight) -> Option<String> {
+        let (n, first) = self.missing;
+        let first = first?;
+        Some(format!(
+            "{n} {} of '{}' {} no line label (empty, NaN or *; the first at data row {}): {} on no line, as turns are, and left out; label {} (0 for turns) [line-missing]",
+            if n == 1 { "row" } else { "rows" },
+            flight.label(),
+            if n == 1 { "has" } else { "have" },
+            flight.file_row(first) + 1,
+            if n == 1 { "it is" } else { "they are" },
+            if n == 1 { "it" } else { "them" },
+        ))
     }
 
     /// Which crossings levelling uses: line with tie when the ties are
@@ -223,6 +327,64 @@ mod tests {
         let l = LineLabels::of(&f, &[]).unwrap();
         assert_eq!(l.labels, vec!["1001.0", "abc"]);
         assert_eq!(l.ids, vec![0.0, 1.0, 1.0, 0.0, 2.0, 0.0, 0.0]);
+        assert_eq!(l.missing, (1, Some(6)));
+        let numeric = LineLabels::of(&flight(Ok(vec![0.0, 7.0, f64::NAN, f64::NAN])), &[]).unwrap();
+        assert_eq!(numeric.missing, (2, Some(2)));
+        let none = LineLabels::of(&flight(Ok(vec![0.0, 7.0, -0.0])), &[]).unwrap();
+        assert_eq!(none.missing_warning(&flight(Ok(vec![0.0]))), None);
+    }
+
+    /// Labels that are one number in two texts, read from a file: two
+    /// lines (they were one, levelled with one offset), `--ties` picks the
+    /// one written so, and missing markers are no line.
+    #[test]
+    fn one_number_in_two_texts_is_two_lines() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("v.csv");
+        let mut text = String::from("time,line\n");
+        for (k, l) in ["1003.1", "1003.1", "NaN", "1003.10", "*", "901", "0"]
+            .iter()
+            .enumerate()
+        {
+            text.push_str(&format!("{k},{l}\n"));
+        }
+        std::fs::write(&path, text).unwrap();
+        let f = Flight::read(&path).unwrap();
+        let l = LineLabels::of(&f, &["1003.1".to_string()]).unwrap();
+        assert_eq!(l.labels, vec!["1003.1", "1003.10", "901"]);
+        assert_eq!(l.ids, vec![1.0, 1.0, 0.0, 2.0, 0.0, 3.0, 0.0]);
+        assert_eq!(l.ties, Some(vec![true, false, false]));
+        // `NaN` and `*` are missing labels, the `0` a turn.
+        assert_eq!(l.missing, (2, Some(2)));
+        let w = l.missing_warning(&f).unwrap();
+        assert!(w.contains("2 rows of") && w.contains("data row 3"), "{w}");
+        assert!(w.ends_with("[line-missing]"), "{w}");
+        // A label given as a number still finds its text (`901`, `T901`).
+        let by_number = LineLabels::of(&f, &["T901".to_string()]).unwrap();
+        assert_eq!(by_number.ties, Some(vec![false, false, true]));
+    }
+
+    /// A label whose rows another line's interrupt is flown twice (the
+    /// re-flight kept the first flight's level error, silently); turns
+    /// (0) and rows without a label between its rows do not part it.
+    #[test]
+    fn a_label_flown_twice_is_named() {
+        let once = flight(Ok(vec![7.0, 7.0, 0.0, 7.0, f64::NAN, 7.0, 8.0, 8.0]));
+        let l = LineLabels::of(&once, &[]).unwrap();
+        assert!(l.repeated.is_empty());
+        assert_eq!(l.repeated_warning(&once), None);
+        let twice = flight(Ok(vec![7.0, 7.0, 0.0, 8.0, 8.0, 0.0, 7.0, 9.0, 8.0, 7.0]));
+        let l = LineLabels::of(&twice, &[]).unwrap();
+        assert_eq!(l.repeated, vec![(1, 3, 6), (2, 2, 8)]);
+        let w = l.repeated_warning(&twice).unwrap();
+        assert!(
+            w.contains("7 (3 passes, the second from data row 7), 8 (2 passes"),
+            "{w}"
+        );
+        assert!(
+            w.ends_with("(7.01, as Geosoft's LINE.VERSION) [line-repeated]"),
+            "{w}"
+        );
     }
 
     /// A label near f64's limit is named in exponent form (it was written

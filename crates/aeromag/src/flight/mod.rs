@@ -59,6 +59,9 @@ pub struct Flight {
     /// The median time step, s, once worked out ([`Flight::median_step_s`];
     /// the checked columns never change).
     median_step: std::sync::OnceLock<f64>,
+    /// A text `line` column numbered by label, once worked out
+    /// ([`Flight::line_numbers`]).
+    text_line_numbers: std::sync::OnceLock<Option<Vec<f64>>>,
 }
 
 impl Flight {
@@ -98,6 +101,7 @@ impl Flight {
             table,
             warnings,
             median_step: Default::default(),
+            text_line_numbers: Default::default(),
         })
     }
 
@@ -108,7 +112,22 @@ impl Flight {
             table,
             warnings: Vec::new(),
             median_step: Default::default(),
+            text_line_numbers: Default::default(),
         }
+    }
+
+    /// The `line` column as numbers, text labels (`L1020`, `T901`,
+    /// `1003.1` beside `1003.10`) numbered by label
+    /// ([`FlightTable::line_numbers`]): what splits the flight at line
+    /// changes and tells the rows on a line (not 0). `None` without a
+    /// `line` column.
+    pub fn line_numbers(&self) -> Option<&[f64]> {
+        if let Some(v) = self.table.column("line") {
+            return Some(v);
+        }
+        self.text_line_numbers
+            .get_or_init(|| self.table.line_numbers().map(std::borrow::Cow::into_owned))
+            .as_deref()
     }
 
     /// The table.

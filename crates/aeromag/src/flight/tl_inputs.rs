@@ -7,8 +7,8 @@ use aeromag_compensation::tolles_lawson::design::Channels;
 use aeromag_compensation::tolles_lawson::fit_ls::Segment;
 use aeromag_compensation::tolles_lawson::segments::median_step;
 
-/// `time` (s), `flux_x/y/z` (nT, body frame), `mag` (nT), `line` (when
-/// numeric) and the channels of the extra regressors of a flight: what the
+/// `time` (s), `flux_x/y/z` (nT, body frame), `mag` (nT), `line`
+/// ([`Flight::line_numbers`]) and the channels of the extra regressors of a flight: what the
 /// Tolles-Lawson model reads.
 #[derive(Debug, Clone)]
 pub struct TlInputs<'a> {
@@ -151,7 +151,7 @@ impl<'a> TlInputs<'a> {
                 flight.measured(&sensor.flux[2])?,
             ],
             mag: flight.measured(&sensor.mag)?,
-            line: flight.column("line"),
+            line: flight.line_numbers(),
             channels: Vec::new(),
             flight: Some(flight),
         })
@@ -315,6 +315,47 @@ mod tests {
             inputs.segments(&SegmentRule::default()).kept,
             vec![0..180, 181..250, 250..300, 300..400]
         );
+    }
+
+    /// Text line labels (`L7`, `L8`: the labels `--lines` shows) split
+    /// the flight into legs as numbers do; before, a text `line` column
+    /// was not seen and the flight was one leg.
+    #[test]
+    fn text_line_labels_split_legs_as_numbers_do() {
+        let n = 400;
+        let columns = |line: std::result::Result<Vec<f64>, Vec<String>>| {
+            let mut t = FlightTable::new();
+            t.add_column("time", (0..n).map(|k| k as f64 * 0.1).collect())
+                .unwrap();
+            match line {
+                Ok(v) => t.add_column("line", v).unwrap(),
+                Err(s) => t.add_text_column("line", s).unwrap(),
+            }
+            t.add_column("mag", vec![50_000.0; n]).unwrap();
+            for (c, v) in [("flux_x", 2e4), ("flux_y", 1e3), ("flux_z", 4.5e4)] {
+                t.add_column(c, vec![v; n]).unwrap();
+            }
+            Flight::from_table(t).unwrap()
+        };
+        let at = |k: usize| {
+            if k < 150 {
+                7
+            } else if k < 300 {
+                8
+            } else {
+                7
+            }
+        };
+        let numbers = columns(Ok((0..n).map(|k| at(k) as f64).collect()));
+        let text = columns(Err((0..n).map(|k| format!("L{}", at(k))).collect()));
+        let legs = |f: &Flight| {
+            TlInputs::of_sensor(f, &SensorColumns::default())
+                .unwrap()
+                .segments(&SegmentRule::default())
+                .kept
+        };
+        assert_eq!(legs(&text), vec![0..150, 150..300, 300..400]);
+        assert_eq!(legs(&text), legs(&numbers));
     }
 
     #[test]

@@ -164,6 +164,9 @@ pub(crate) fn grid_flight_finest(
     if let Some(w) = survey.off_track_warning(flight) {
         notes.warn(w);
     }
+    if let Some(w) = &survey.missing_labels {
+        notes.warn(w.clone());
+    }
     let cell = match (opts.geometry.map(|g| g.cell).or(opts.cell_m), &survey.lines) {
         (Some(c), Some(l)) if finest.is_some_and(|f| c < f * l.spacing_m) => {
             let f = finest.unwrap_or_default();

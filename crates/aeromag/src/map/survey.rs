@@ -37,6 +37,9 @@ pub struct ProjectedSurvey {
     /// Per row the id of its line (0: on no line), when the flight has a
     /// `line` column.
     pub line_ids: Option<Vec<f64>>,
+    /// The warning for rows without a line label
+    /// ([`LineLabels::missing_warning`]).
+    pub missing_labels: Option<String>,
     /// The lines' geometry, when there are lines.
     pub lines: Option<LineGeometry>,
 }
@@ -107,10 +110,12 @@ impl ProjectedSurvey {
             x.push(e);
             y.push(n);
         }
-        let line_ids = match flight.get("line") {
-            Some(_) => Some(LineLabels::of(flight, &[])?.ids),
-            None => None,
-        };
+        let labels = flight
+            .get("line")
+            .map(|_| LineLabels::of(flight, &[]))
+            .transpose()?;
+        let missing_labels = labels.as_ref().and_then(|l| l.missing_warning(flight));
+        let line_ids = labels.map(|l| l.ids);
         let lines = line_ids
             .as_deref()
             .and_then(|ids| LineGeometry::of(&x, &y, ids));
@@ -120,6 +125,7 @@ impl ProjectedSurvey {
             y,
             off_track,
             line_ids,
+            missing_labels,
             lines,
         })
     }

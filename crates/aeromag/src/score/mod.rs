@@ -141,7 +141,7 @@ fn segments(t: &Flight, mag: &[f64], comp: &[f64]) -> Result<Vec<Range<usize>>> 
         .collect();
     Ok(SegmentRule::default()
         .min_len(2)
-        .split(time, t.column("line"), &usable)
+        .split(time, t.line_numbers(), &usable)
         .kept)
 }
 
@@ -221,7 +221,7 @@ pub fn score_series(
         }
     }
     let (mut residual_rms_nt, mut lines, mut noise_floor_nt) = (None, Vec::new(), None);
-    let on_line: Vec<Range<usize>> = match t.column("line") {
+    let on_line: Vec<Range<usize>> = match t.line_numbers() {
         Some(l) => segs.iter().filter(|r| l[r.start] != 0.0).cloned().collect(),
         None => segs.clone(),
     };

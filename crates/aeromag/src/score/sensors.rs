@@ -471,7 +471,7 @@ impl SensorsFigures {
 /// gaps, on survey lines (`line` ≠ 0) when the flight has them.
 fn scored_segments(t: &Flight, s: &SensorSeries) -> Result<Vec<Range<usize>>> {
     let segs = super::segments(t, s.mag, s.comp)?;
-    Ok(match t.column("line") {
+    Ok(match t.line_numbers() {
         Some(l) => segs.into_iter().filter(|r| l[r.start] != 0.0).collect(),
         None => segs,
     })

@@ -1,0 +1,118 @@
+//! The texts of a `line` column read as numbers, kept while it is read.
+//!
+//! Line labels are names, even when they are written as numbers: Geosoft's
+//! `LINE.VERSION` labels make `1003.1` (version 1) and `1003.10` (version
+//! 10) two lines, and a contractor's `01003` need not be the `1003` of
+//! another export. Read as numbers, such pairs would become one line, and
+//! levelling would give two tracks one offset without a word. So while a
+//! `line` column is read as numbers, the reader notes each distinct text
+//! of its cells with the value it reads ([`LabelTexts`]), and when two
+//! texts give one value ([`LabelClash`]) the column is read as text
+//! instead (the table then holds the labels exactly as written).
+//!
+//! The cost is one comparison of the cell with the previous row's per row
+//! (a line's rows repeat its label) and a hash lookup when the label
+//! changes.
+
+use std::collections::HashMap;
+
+/// The distinct texts of a label column's cells, with their values.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct LabelTexts {
+    /// The previous cell, untrimmed (most rows repeat it).
+    last: Vec<u8>,
+    /// Each distinct text (trimmed) of a cell holding a number other than 0.
+    seen: HashMap<Vec<u8>, f64>,
+}
+
+impl LabelTexts {
+    /// Notes the cell `bytes` read as `value` (NaN: missing; 0: no line).
+    #[inline]
+    pub(crate) fn note(&mut self, bytes: &[u8], value: f64) {
+        if bytes == self.last.as_slice() {
+            return;
+        }
+        self.last.clear();
+        self.last.extend_from_slice(bytes);
+        if value.is_nan() || value == 0.0 {
+            return;
+        }
+        let text = bytes.trim_ascii();
+        if !self.seen.contains_key(text) {
+            self.seen.insert(text.to_vec(), value);
+        }
+    }
+
+    /// Forgets every text (a buffer reused for the next piece of rows).
+    pub(crate) fn clear(&mut self) {
+        self.last.clear();
+        self.seen.clear();
+    }
+
+    /// The distinct texts and their values, in no particular order.
+    pub(crate) fn texts(&self) -> impl Iterator<Item = (&[u8], f64)> {
+        self.seen.iter().map(|(t, v)| (t.as_slice(), *v))
+    }
+}
+
+/// Across the whole read: the first text of each value, and whether two
+/// texts of one value were found.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct LabelClash {
+    by_value: HashMap<u64, Vec<u8>>,
+    /// Two texts of one value (`1003.1`, `1003.10`) were found.
+    pub clash: bool,
+}
+
+impl LabelClash {
+    /// Adds the text `text` of the value `value` (not NaN, not 0).
+    pub(crate) fn add(&mut self, text: &[u8], value: f64) {
+        if self.clash {
+            return;
+        }
+        match self.by_value.get(&value.to_bits()) {
+            Some(first) => self.clash = first.as_slice() != text,
+            None => {
+                self.by_value.insert(value.to_bits(), text.to_vec());
+            }
+        }
+    }
+
+    /// Adds every text of `texts`.
+    pub(crate) fn add_all(&mut self, texts: &LabelTexts) {
+        for (t, v) in texts.texts() {
+            self.add(t, v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn clash_of(cells: &[&str]) -> bool {
+        let mut texts = LabelTexts::default();
+        for c in cells {
+            let v = crate::cell::parse_cell(c.as_bytes()).map_or(f64::NAN, |c| match c {
+                crate::cell::Cell::Value(v) => v,
+                crate::cell::Cell::Missing(_) => f64::NAN,
+            });
+            texts.note(c.as_bytes(), v);
+        }
+        let mut clash = LabelClash::default();
+        clash.add_all(&texts);
+        clash.clash
+    }
+
+    #[test]
+    fn two_texts_of_one_number_clash() {
+        assert!(clash_of(&["1003.1", "1003.1", "1003.10"]));
+        assert!(clash_of(&["1003", "1003.0"]));
+        assert!(clash_of(&["01003", " 1003"]));
+        assert!(!clash_of(&["1003.1", "1004.1", "1003.1"]));
+        // Spaces around a label are not part of it.
+        assert!(!clash_of(&["1003", " 1003 ", "1003"]));
+        // Missing and zero labels (turns) are no line at all.
+        assert!(!clash_of(&["0", "0.0", "-0", "", "NaN", "*", "7"]));
+    }
+}
