@@ -278,6 +278,8 @@ fn plain_row(
     integers: &mut [bool],
     labels: &mut LabelTexts,
 ) -> Option<usize> {
+    // The label column's index (none: past every field).
+    let label = shape.label.unwrap_or(usize::MAX);
     let last = shape.n_fields.saturating_sub(1);
     let mut p = start;
     for (i, (column, integer)) in values.iter_mut().zip(integers.iter_mut()).enumerate() {
@@ -285,8 +287,8 @@ fn plain_row(
             let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
             column.push(v);
             *integer &= is_integer;
-            if shape.label == Some(i) {
-                labels.note(&piece[p..p + len], v);
+            if i == label {
+                labels.note_at(piece, p, len, v);
             }
             p + len
         } else {
@@ -326,6 +328,8 @@ fn whitespace_row(
     integers: &mut [bool],
     labels: &mut LabelTexts,
 ) -> Option<usize> {
+    // The label column's index (none: past every field).
+    let label = shape.label.unwrap_or(usize::MAX);
     let blank = |p: usize| matches!(piece.get(p), Some(b' ' | b'\t'));
     let mut p = start;
     while blank(p) {
@@ -337,8 +341,8 @@ fn whitespace_row(
             let (v, is_integer, len) = plain_decimal_field(piece, p, piece.len())?;
             column.push(v);
             *integer &= is_integer;
-            if shape.label == Some(i) {
-                labels.note(&piece[p..p + len], v);
+            if i == label {
+                labels.note_at(piece, p, len, v);
             }
             p += len;
         } else {
@@ -386,6 +390,8 @@ fn whitespace_clean_row(
     labels: &mut LabelTexts,
     missing: &mut Vec<(usize, MissingKind)>,
 ) -> bool {
+    // The label column's index (none: past every field).
+    let label = shape.label.unwrap_or(usize::MAX);
     missing.clear();
     let mut line = line;
     while let [rest @ .., b'\r'] = line {
@@ -404,7 +410,7 @@ fn whitespace_clean_row(
         if read(&shape, i) && !push_cell(f, i, column, integers, missing) {
             return false;
         }
-        if shape.label == Some(i) {
+        if i == label {
             labels.note(f, column.last().copied().unwrap_or(f64::NAN));
         }
     }
@@ -432,6 +438,8 @@ fn clean_row(
     labels: &mut LabelTexts,
     missing: &mut Vec<(usize, MissingKind)>,
 ) -> bool {
+    // The label column's index (none: past every field).
+    let label = shape.label.unwrap_or(usize::MAX);
     missing.clear();
     let last = shape.n_fields.saturating_sub(1);
     let mut start = line.start;
@@ -451,8 +459,8 @@ fn clean_row(
             if end_ok {
                 column.push(v);
                 integers[i] &= integer;
-                if shape.label == Some(i) {
-                    labels.note(&piece[start..end], v);
+                if i == label {
+                    labels.note_at(piece, start, end - start, v);
                 }
                 start = end + 1;
                 continue;
@@ -479,7 +487,7 @@ fn clean_row(
         if wanted && !push_cell(f, i, column, integers, missing) {
             return false;
         }
-        if wanted && shape.label == Some(i) {
+        if wanted && i == label {
             labels.note(f, column.last().copied().unwrap_or(f64::NAN));
         }
         start += len + 1;

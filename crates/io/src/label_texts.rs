@@ -17,23 +17,70 @@
 use std::collections::HashMap;
 
 /// The distinct texts of a label column's cells, with their values.
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Clone)]
 pub(crate) struct LabelTexts {
-    /// The previous cell, untrimmed (most rows repeat it).
+    /// The previous cell when it was up to 8 bytes long and read by
+    /// [`Self::note_at`]: its bytes in a word (little-endian, zero above
+    /// its length) and its length; `usize::MAX` otherwise.
+    last_word: (u64, usize),
+    /// The previous cell, untrimmed, when [`Self::note`] read it.
     last: Vec<u8>,
     /// Each distinct text (trimmed) of a cell holding a number other than 0.
     seen: HashMap<Vec<u8>, f64>,
 }
 
+impl Default for LabelTexts {
+    fn default() -> Self {
+        Self {
+            last_word: (0, usize::MAX),
+            last: Vec::new(),
+            seen: HashMap::new(),
+        }
+    }
+}
+
 impl LabelTexts {
+    /// [`Self::note`] of the cell `text[p..p + len]`, without a call to
+    /// `memcmp` for the short labels of most files (up to 8 bytes, with 8
+    /// bytes of `text` to load at `p`): the fast path's per-row cost.
+    #[inline(always)]
+    pub(crate) fn note_at(&mut self, text: &[u8], p: usize, len: usize, value: f64) {
+        if len <= 8
+            && let Some(bytes) = text.get(p..p + 8)
+        {
+            let mask = if len == 8 {
+                u64::MAX
+            } else {
+                (1u64 << (8 * len)) - 1
+            };
+            let word = u64::from_le_bytes(bytes.try_into().unwrap_or_default()) & mask;
+            if (word, len) == self.last_word {
+                return;
+            }
+            self.last_word = (word, len);
+            self.last.clear();
+            self.changed(&text[p..p + len], value);
+        } else {
+            self.note(&text[p..p + len], value);
+        }
+    }
+
     /// Notes the cell `bytes` read as `value` (NaN: missing; 0: no line).
     #[inline]
     pub(crate) fn note(&mut self, bytes: &[u8], value: f64) {
-        if bytes == self.last.as_slice() {
+        if bytes == self.last.as_slice() && self.last_word.1 == usize::MAX {
             return;
         }
         self.last.clear();
         self.last.extend_from_slice(bytes);
+        self.last_word = (0, usize::MAX);
+        self.changed(bytes, value);
+    }
+
+    /// A cell unlike the previous one.
+    #[cold]
+    #[inline(never)]
+    fn changed(&mut self, bytes: &[u8], value: f64) {
         if value.is_nan() || value == 0.0 {
             return;
         }
@@ -46,6 +93,7 @@ impl LabelTexts {
     /// Forgets every text (a buffer reused for the next piece of rows).
     pub(crate) fn clear(&mut self) {
         self.last.clear();
+        self.last_word = (0, usize::MAX);
         self.seen.clear();
     }
 
