@@ -14,7 +14,7 @@
 //!
 //! | columns | error | warning |
 //! |---|---|---|
-//! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
+//! | `mag`, `igrf` | median \|B\| < 1 (tesla 1e-6–1e-3, gauss 0.05–1, else "wrong units") or > 1e6 (pT?); median \|B\| in [`EARTH_FIELD_UT`] (microtesla; for `mag` only when every value lies within half and twice the median, as a total field does and an anomaly does not) | median \|B\| outside 15 000–75 000 nT (`field-range`) |
 //! | `mag` | when its median \|B\| is at least 15 000 nT (a total field, not an anomaly): any value below [`MIN_READING_NT`] (a dropout value, a negated reading), naming the first row | — |
 //! | `mag`, `igrf`, `flux_x/y/z`, `diurnal` | once the units pass: any \|value\| > [`MAX_FIELD_NT`] (a corrupted cell, a numeric dummy such as −1e32), naming the first row | — |
 //! | `flux_x/y/z` | one component: max \|B\| < 1e-3 or median \|B\| > 1e6; all three: median of the vector magnitude as for `mag` | magnitude outside 15 000–75 000 nT; median relative difference from `mag` above 10 % (`vector-vs-scalar`) |
@@ -139,6 +139,11 @@ pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = aeromag_core::field::MAX_GROUND_SPE
 
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
+
+/// Earth's total field in microtesla ([`EARTH_FIELD_NT`] / 1000): a total
+/// field whose median lies here is in µT, 1000 times too small for nT (a
+/// fit on it gave a model with exit 0).
+pub const EARTH_FIELD_UT: (f64, f64) = (15.0, 75.0);
 
 /// Checks that `time` exists, has no missing value and strictly increases.
 ///
@@ -296,7 +301,8 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
         ("igrf", stats.igrf, stats.igrf_max),
     ] {
         if table.column(name).is_some() {
-            ctx.total_field(name, m, &mut warnings)?;
+            let range = (name == "mag").then_some((stats.mag_min, stats.mag_max));
+            ctx.total_field(name, m, range, &mut warnings)?;
             ctx.within_field(name, max)?;
         }
     }
@@ -311,7 +317,7 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
         }
     }
     if let Some((norm, vs_mag)) = stats.vector {
-        ctx.total_field("flux_x/flux_y/flux_z", norm, &mut warnings)?;
+        ctx.total_field("flux_x/flux_y/flux_z", norm, None, &mut warnings)?;
         if let Some(d) = vs_mag
             && d.abs() > VECTOR_SCALAR_TOLERANCE
         {
@@ -487,9 +493,30 @@ impl Ctx<'_> {
     }
 
     /// A total-field magnitude (nT): errors for tesla/gauss/pT-like medians, warning outside Earth's range.
-    fn total_field(&self, name: &str, median_abs: Option<f64>, w: &mut Vec<Warning>) -> Result<()> {
+    /// `range`: the column's smallest and largest value when it could be
+    /// an anomaly rather than a total field (`mag`), `None` for a column
+    /// that is a total field whatever its values (`igrf`, the vector
+    /// magnitude).
+    fn total_field(
+        &self,
+        name: &str,
+        median_abs: Option<f64>,
+        range: Option<(Option<f64>, Option<f64>)>,
+        w: &mut Vec<Warning>,
+    ) -> Result<()> {
         let Some(m) = median_abs else { return Ok(()) };
         let fix = "expected nT";
+        // A total field varies by a few per cent; an anomaly of this median
+        // would be all of one sign and within a factor of 2 of it.
+        let total = range.is_none_or(|(lo, hi)| {
+            lo.is_some_and(|lo| lo >= m / 2.0) && hi.is_some_and(|hi| hi <= 2.0 * m)
+        });
+        if (EARTH_FIELD_UT.0..=EARTH_FIELD_UT.1).contains(&m) && total {
+            return Err(self.units(
+                name,
+                format!("median |value| = {} looks like microtesla (Earth's field is 22 to 67 µT), {fix} (multiply by 1000)", shown(m)),
+            ));
+        }
         if m < 1.0 {
             let guess = if (1e-6..1e-3).contains(&m) {
                 format!(

@@ -115,6 +115,37 @@ fn tesla_gauss_and_picotesla_are_errors() {
     );
 }
 
+/// A total field in microtesla (53.1 for 53 100 nT) was a warning only,
+/// and `calibrate` fitted it with exit 0; an anomaly of that median, with
+/// values of both signs or spread beyond a factor 2, is still a warning.
+#[test]
+fn microtesla_is_an_error_an_anomaly_a_warning() {
+    let ut = table(&[("mag", vec![53.06, 53.1, 53.62, f64::NAN])]);
+    let e = check_units(&ut).unwrap_err();
+    assert!(matches!(e, IoError::Units { .. }), "{e:?}");
+    assert_mentions(&e.to_string(), &["'mag'", "microtesla", "multiply by 1000"]);
+    let igrf = table(&[("igrf", vec![48.0, 48.1])]);
+    assert_mentions(
+        &check_units(&igrf).unwrap_err().to_string(),
+        &["'igrf'", "microtesla"],
+    );
+    let flux = table(&[
+        ("flux_x", vec![14.0, 14.1]),
+        ("flux_y", vec![3.7, 3.6]),
+        ("flux_z", vec![51.1, 51.2]),
+    ]);
+    assert_mentions(
+        &check_units(&flux).unwrap_err().to_string(),
+        &["flux_x/flux_y/flux_z", "microtesla"],
+    );
+    for anomaly in [vec![53.0, -20.0, 60.0], vec![53.0, 20.0, 160.0]] {
+        let t = table(&[("mag", anomaly)]);
+        let w = check_units(&t).unwrap();
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert_eq!(w[0].kind, WarningKind::FieldRange);
+    }
+}
+
 #[test]
 fn flux_components_and_diurnal_in_tesla() {
     let t = table(&[
