@@ -266,6 +266,10 @@ fn model_and_argument_errors_exit_2() {
             "--kalman-noise",
             "1e-15,1e-15,0",
         ],
+        // Empty values (an unset shell variable) were taken as `none`.
+        vec!["calibrate", "--input", p, "--model", m, "--eddy-lag="],
+        vec!["calibrate", "--input", p, "--model", m, "--reference="],
+        vec!["calibrate", "--input", p, "--model", m, "--reference=,"],
         vec!["calibrate", "--input", p, "--model", m, "--series", "s.csv"],
         vec![
             "calibrate",

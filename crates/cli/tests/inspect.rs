@@ -35,6 +35,25 @@ fn summarises_a_good_file() {
     assert!(!s.contains("off the track"), "{s}");
 }
 
+/// A file of one row has a time but no sampling (it said the file had
+/// no `time` column); a file without one still says so.
+#[test]
+fn one_row_has_a_time_but_no_sampling() {
+    let d = tempfile::tempdir().unwrap();
+    let one: String = GOOD.lines().take(2).map(|l| format!("{l}\n")).collect();
+    let p = write(&d, "one.csv", one.as_bytes());
+    let o = aeromag(&["inspect", "--input", p.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(
+        s.contains("time     0.000 s (one time only: no sampling interval)"),
+        "{s}"
+    );
+    let p = write(&d, "untimed.csv", b"mag\n52000.1\n");
+    let s = stdout(&aeromag(&["inspect", "--input", p.to_str().unwrap()]));
+    assert!(s.contains("no `time` column"), "{s}");
+}
+
 /// A row whose latitude reads 0 among rows at 45° N is named as off the
 /// track, in the text and in the JSON.
 #[test]

@@ -17,6 +17,8 @@ use std::str::FromStr;
 /// use aeromag::ReferenceChannels;
 /// assert_eq!("auto".parse::<ReferenceChannels>()?, ReferenceChannels::Auto);
 /// assert_eq!("none".parse::<ReferenceChannels>()?, ReferenceChannels::None);
+/// assert!("".parse::<ReferenceChannels>().is_err());
+/// assert!(" , ".parse::<ReferenceChannels>().is_err());
 /// assert_eq!(
 ///     "diurnal, igrf".parse::<ReferenceChannels>()?,
 ///     ReferenceChannels::Columns(vec!["diurnal".into(), "igrf".into()])
@@ -59,17 +61,26 @@ impl ReferenceChannels {
 
 impl FromStr for ReferenceChannels {
     type Err = Error;
-    /// `auto`, `none` (or empty) or a comma-separated list of columns.
+    /// `auto`, `none` or a comma-separated list of columns. Empty (or
+    /// only commas) is bad input: an unset shell variable
+    /// (`--reference=$REF`) meant `none`.
     fn from_str(s: &str) -> Result<Self> {
         Ok(match s.trim() {
             "auto" => ReferenceChannels::Auto,
-            "none" | "" => ReferenceChannels::None,
-            list => ReferenceChannels::Columns(
-                list.split(',')
+            "none" => ReferenceChannels::None,
+            list => {
+                let columns: Vec<String> = list
+                    .split(',')
                     .map(|c| c.trim().to_string())
                     .filter(|c| !c.is_empty())
-                    .collect(),
-            ),
+                    .collect();
+                if columns.is_empty() {
+                    return Err(Error::bad_input(format!(
+                        "reference `{s}` names no column: give auto, none or columns such as diurnal,igrf"
+                    )));
+                }
+                ReferenceChannels::Columns(columns)
+            }
         })
     }
 }

@@ -70,6 +70,7 @@ impl FromStr for Method {
 /// assert_eq!("auto".parse::<EddyLag>()?, EddyLag::Auto);
 /// assert_eq!("0.3,0.8".parse::<EddyLag>()?, EddyLag::Fixed(vec![0.3, 0.8]));
 /// assert!("-1".parse::<EddyLag>().is_err());
+/// assert!("".parse::<EddyLag>().is_err());
 /// # Ok::<(), aeromag::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -98,11 +99,15 @@ impl EddyLag {
 
 impl FromStr for EddyLag {
     type Err = Error;
-    /// `auto`, `none` (or empty) or lags in seconds such as `0.3,0.8`.
+    /// `auto`, `none` or lags in seconds such as `0.3,0.8`. Empty is bad
+    /// input (an unset shell variable, `--eddy-lag=$LAG`, meant `none`).
     fn from_str(s: &str) -> Result<Self> {
         match s.trim() {
             "auto" => Ok(EddyLag::Auto),
-            "none" | "" => Ok(EddyLag::None),
+            "none" => Ok(EddyLag::None),
+            "" => Err(Error::bad_input(
+                "eddy lag is empty: give auto, none or lags in seconds such as 0.3,0.8",
+            )),
             list => list
                 .split(',')
                 .map(|t| match t.trim().parse::<f64>() {
@@ -674,6 +679,9 @@ fn fit_ls_segments(
     let fit = fit_band_pass_ls(segments, cfg).in_file(&label)?;
     for w in &fit.warnings {
         notes.warn(w.clone());
+    }
+    for n in &fit.notes {
+        notes.note(n.clone());
     }
     second_order_note(&cfg.design, &fit.coef, segments, notes);
     let model = TlModel {

@@ -295,6 +295,9 @@ pub(super) fn fit_kalman_flight(
     for w in &fit.warnings {
         notes.warn(w.clone());
     }
+    for n in &fit.notes {
+        notes.note(n.clone());
+    }
     let mut model = fit.to_model(&cfg);
     model.columns = model_columns(
         flight,

@@ -85,10 +85,23 @@ pub fn render(s: &Summary) -> String {
             }
         }
     } else {
-        let _ = writeln!(
-            o,
-            "time     no `time` column (map one with --columns time=NAME)"
-        );
+        // A `time` column with fewer than two finite times has no sampling.
+        let time = s
+            .columns
+            .iter()
+            .find(|c| c.name == "time" || c.canonical.as_deref() == Some("time"));
+        let _ = match time.map(|c| (c.min, c.max)) {
+            Some((Some(t0), Some(t1))) if t0 == t1 => writeln!(
+                o,
+                "time     {} s (one time only: no sampling interval)",
+                fixed(t0, 3)
+            ),
+            Some(_) => writeln!(o, "time     no finite time: no sampling interval"),
+            None => writeln!(
+                o,
+                "time     no `time` column (map one with --columns time=NAME)"
+            ),
+        };
     }
     if let Some(lines) = &s.lines {
         let shown: Vec<String> = lines

@@ -226,26 +226,43 @@ impl NoiseModel {
     /// innovation variance of 10³⁰⁸ nT², or one below rounding).
     pub fn check(&self, order: usize) -> Result<()> {
         let d = Self::calibration_default_for(order);
-        let near = |v: f64, default: f64| (0.0..=default * 10f64.powf(NOISE_DECADES)).contains(&v);
+        let top = 10f64.powf(NOISE_DECADES);
+        let near = |v: f64, default: f64| (0.0..=default * top).contains(&v);
         let (lo, hi) = R_RANGE_NT2;
-        if near(self.q1, d.q1)
-            && near(self.q2_nt2_per_m5, d.q2_nt2_per_m5)
-            && (lo..=hi).contains(&self.r_nt2)
-        {
+        // The values out of range, each with its own range: the message
+        // listed every range, and `0,0,0` read as refused for q1 (it was r).
+        let mut out = Vec::new();
+        if !near(self.q1, d.q1) {
+            out.push(format!(
+                "q1 = {:e} must be from 0 to 10^{NOISE_DECADES} times its default {:.2e} {}",
+                self.q1,
+                d.q1,
+                q1_unit(order)
+            ));
+        }
+        if !near(self.q2_nt2_per_m5, d.q2_nt2_per_m5) {
+            out.push(format!(
+                "q2 = {:e} must be from 0 to 10^{NOISE_DECADES} times its default {:.0e} nT²/m⁵",
+                self.q2_nt2_per_m5, d.q2_nt2_per_m5
+            ));
+        }
+        if !(lo..=hi).contains(&self.r_nt2) {
+            out.push(format!(
+                "r = {:e} must be from {lo:e} to {hi:e} nT² ({:e} to {} nT RMS)",
+                self.r_nt2,
+                lo.sqrt(),
+                hi.sqrt()
+            ));
+        }
+        if out.is_empty() {
             return Ok(());
         }
         Err(CompError::setting(format!(
-            "Kalman noise {:e},{:e},{:e}: q1 must be from 0 to 10^{NOISE_DECADES} times its default \
-             {:.2e} {}, q2 from 0 to 10^{NOISE_DECADES} times {:.0e} nT²/m⁵, and r from {lo:e} to \
-             {hi:e} nT² ({:e} to {} nT RMS)",
+            "Kalman noise {:e},{:e},{:e}: {}",
             self.q1,
             self.q2_nt2_per_m5,
             self.r_nt2,
-            d.q1,
-            q1_unit(order),
-            d.q2_nt2_per_m5,
-            lo.sqrt(),
-            hi.sqrt(),
+            out.join("; ")
         )))
     }
 
@@ -636,6 +653,12 @@ mod tests {
                 let e = bad.unwrap_err();
                 assert!(e.is_bad_input() && e.to_string().len() < 400, "{e}");
             }
+            // The message names the value out of range, and only that one
+            // (`0,0,0` read as q1 refused; it was r).
+            let e = at(0.0, 0.0, 0.0).unwrap_err().to_string();
+            assert!(e.contains("r = 0e0 must be") && !e.contains("q1 ="), "{e}");
+            let e = at(-1.0, 0.0, d.r_nt2).unwrap_err().to_string();
+            assert!(e.contains("q1 = -1e0 must be") && !e.contains("r ="), "{e}");
         }
     }
 

@@ -193,6 +193,8 @@ pub struct KalmanFit {
     pub segments_used: usize,
     /// Warnings for the user.
     pub warnings: Vec<String>,
+    /// Notes for the user ([`LsFit::notes`]).
+    pub notes: Vec<String>,
     /// Per-segment series (empty without [`KalmanConfig::compute_series`]).
     pub series: Vec<KalmanSeries>,
 }
@@ -258,11 +260,15 @@ pub fn fit_kalman_exact(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Resul
         }
     }
     fit.tuning = tuning;
-    fit.warnings.push(if converged {
-        format!("exact magnitude: Gauss–Newton converged in {steps} steps")
+    if converged {
+        fit.notes.push(format!(
+            "exact magnitude: Gauss–Newton converged in {steps} steps"
+        ));
     } else {
-        format!("exact magnitude: Gauss–Newton did not converge in {steps} steps")
-    });
+        fit.warnings.push(format!(
+            "exact magnitude: Gauss–Newton did not converge in {steps} steps"
+        ));
+    }
     Ok(fit)
 }
 
@@ -526,6 +532,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
             s.len()
         },
         warnings,
+        notes: Vec::new(),
         series,
     })
 }
@@ -1020,6 +1027,7 @@ impl KalmanFit {
             effective_dof: self.rows as f64,
             segments_used: self.segments_used,
             warnings: self.warnings.clone(),
+            notes: self.notes.clone(),
         }
     }
 

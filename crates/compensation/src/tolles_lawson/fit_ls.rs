@@ -160,6 +160,9 @@ pub struct LsFit {
     /// Warnings for the user (ill-conditioning, poorly determined terms,
     /// segments too short to filter).
     pub warnings: Vec<String>,
+    /// Notes for the user: how the fit went where nothing is wrong (the
+    /// exact magnitude's Gauss–Newton steps).
+    pub notes: Vec<String>,
 }
 
 /// Relative accuracy to which block-wise filtering reproduces whole-segment
@@ -596,11 +599,15 @@ pub fn fit_exact_magnitude(segments: &[Segment], cfg: &LsConfig) -> Result<LsFit
             break;
         }
     }
-    fit.warnings.push(if converged {
-        format!("exact magnitude: Gauss–Newton converged in {steps} steps")
+    if converged {
+        fit.notes.push(format!(
+            "exact magnitude: Gauss–Newton converged in {steps} steps"
+        ));
     } else {
-        format!("exact magnitude: Gauss–Newton did not converge in {steps} steps")
-    });
+        fit.warnings.push(format!(
+            "exact magnitude: Gauss–Newton did not converge in {steps} steps"
+        ));
+    }
     Ok(fit)
 }
 
@@ -768,6 +775,7 @@ pub(crate) fn solve_accumulated(
         segments_used: used,
         names,
         warnings,
+        notes: Vec::new(),
     })
 }
 
