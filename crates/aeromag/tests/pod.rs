@@ -165,6 +165,42 @@ fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_
     );
 }
 
+/// Cable angles in radians were taken as degrees, with exit 0: a fit on
+/// them learnt 2–30 % (99 % in degrees), and a good model applied to them
+/// made the data worse. Both now refuse them, naming the column; the
+/// degrees still pass.
+#[test]
+fn cable_angles_in_radians_are_bad_input() {
+    let (learn, test) = pair("", "[30.0, 120.0]");
+    let s = setup(40.0, [0.0, 0.0, 1.2], 45.0);
+    let model = fit_pod(&learn, &s, PodMethod::DipoleArray, None).unwrap();
+    let radians = |f: &Flight, col: &str| {
+        let mut t = f.table().clone();
+        let x: Vec<f64> = t
+            .require(col)
+            .unwrap()
+            .iter()
+            .map(|d| d.to_radians())
+            .collect();
+        t.set_column(col, x).unwrap();
+        Flight::from_table(t).unwrap()
+    };
+    for col in ["cable_inclination", "cable_azimuth"] {
+        let e = fit_pod(&radians(&learn, col), &s, PodMethod::DipoleArray, None).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        assert!(
+            e.to_string().contains(col) && e.to_string().contains("radians?"),
+            "{e}"
+        );
+    }
+    let e = apply_pod(&model, &radians(&test, "cable_inclination")).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("radians?"),
+        "{e}"
+    );
+    assert!(apply_pod(&model, &test).is_ok());
+}
+
 /// Issue 23, seed 002 near the magnetic equator: the two-step solve with
 /// the axes reordered (the component of U of largest magnitude
 /// eliminated) works at every inclination, 0° included, where eliminating
