@@ -137,6 +137,18 @@ pub use aeromag_core::field::{MAX_ALT_M, MAX_FIELD_NT, MIN_READING_NT};
 /// 3 600 m/s), and [`check_units`] warns.
 pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = aeromag_core::field::MAX_GROUND_SPEED_M_S;
 
+/// Below this median ground speed (m/s), a platform that moves at least
+/// [`MIN_MOVING_STEP_M`] between rows has its time in milliseconds: a
+/// 2 Hz survey at 70 m/s with its time in ms moves at 0.07 m/s, 35 m per
+/// row (levelling then fitted k = 505 s for 0.505 s). A base station does
+/// not move; a boat or a walker moving 5 m per row at under 1 m/s samples
+/// every 5 s or more.
+pub const MIN_MOVING_SPEED_M_S: f64 = 1.0;
+
+/// The median distance between rows (m) from which [`MIN_MOVING_SPEED_M_S`]
+/// applies.
+pub const MIN_MOVING_STEP_M: f64 = 5.0;
+
 /// Earth's total field, nT: a `mag` median outside is warned about.
 pub const EARTH_FIELD_NT: (f64, f64) = (15_000.0, 75_000.0);
 
@@ -629,7 +641,9 @@ impl Ctx<'_> {
     /// The [`WarningKind::TimeUnit`] rule: the median ground speed between
     /// consecutive rows ([`MEDIAN_SAMPLES`] pairs at most; equirectangular
     /// distance on a 6 371 km sphere, degrees) above
-    /// [`MAX_MEDIAN_GROUND_SPEED_M_S`].
+    /// [`MAX_MEDIAN_GROUND_SPEED_M_S`], or below [`MIN_MOVING_SPEED_M_S`]
+    /// while the median distance between rows is at least
+    /// [`MIN_MOVING_STEP_M`] (time in milliseconds).
     fn ground_speed(&self, lat: &[f64], lon: &[f64], w: &mut Vec<Warning>) {
         let Some(t) = self.table.column("time") else {
             return;
@@ -647,6 +661,26 @@ impl Ctx<'_> {
         let Some(v) = median(t.len().saturating_sub(1), speed) else {
             return;
         };
+        let distance = |i: usize| speed(i) * (t[i + 1] - t[i]);
+        let step = |i: usize| t[i + 1] - t[i];
+        let pairs = t.len().saturating_sub(1);
+        if v < MIN_MOVING_SPEED_M_S
+            && let (Some(d), Some(dt)) = (median(pairs, distance), median(pairs, step))
+            && d >= MIN_MOVING_STEP_M
+        {
+            w.push(self.warn(
+                WarningKind::TimeUnit,
+                "time",
+                None,
+                format!(
+                    "the platform moves a median {} m from row to row but a row comes every {} s \
+                     ({} m/s): time in milliseconds? expected seconds",
+                    shown((d * 10.0).round() / 10.0),
+                    shown(dt),
+                    shown((v * 1000.0).round() / 1000.0)
+                ),
+            ));
+        }
         if v > MAX_MEDIAN_GROUND_SPEED_M_S {
             w.push(self.warn(
                 WarningKind::TimeUnit,

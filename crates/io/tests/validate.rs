@@ -500,6 +500,21 @@ fn time_in_minutes_is_a_named_warning() {
         ("lon", vec![38.0; n]),
     ]);
     assert!(check_units(&still).unwrap().is_empty());
+    // Time in milliseconds: 6 m a row, a row every 100 "s" (0.06 m/s).
+    let w = check_units(&flight(1000.0)).unwrap();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(w[0].kind, WarningKind::TimeUnit);
+    assert!(w[0].message.contains("milliseconds"), "{}", w[0]);
+    // A boat at 2 m/s logging every 10 s (20 m a row) is no warning.
+    let boat = table(&[
+        ("time", (0..n).map(|k| k as f64 * 10.0).collect()),
+        (
+            "lat",
+            (0..n).map(|k| 56.0 + k as f64 * 20.0 / 111_195.0).collect(),
+        ),
+        ("lon", vec![38.0; n]),
+    ]);
+    assert!(check_units(&boat).unwrap().is_empty());
 }
 
 /// Found by fuzzing: two rows 1e-9 s apart in a 10 Hz flight were taken,
