@@ -99,6 +99,24 @@ fn a_position_glitch_is_left_out_with_a_warning() {
     assert!(b < 1.05 * a, "misfit {b} against {a} without the glitch");
 }
 
+/// A zone given far from the data names the longitude and the option
+/// (it blamed the column `lat`).
+#[test]
+fn a_zone_far_from_the_data_names_lon_and_the_option() {
+    let flight = survey(
+        "[pattern]\nline_count = 6\nline_length_m = 4000.0\ntie_count = 2\n",
+        12,
+    );
+    let far: aeromag_grid::projection::UtmZone = "1N".parse().unwrap();
+    let e = aeromag::map::ProjectedSurvey::of(&flight, Some(far), None).unwrap_err();
+    let m = e.to_string();
+    assert!(e.is_bad_input(), "{m}");
+    assert!(
+        m.contains("column 'lon'") && m.contains("--utm-zone"),
+        "{m}"
+    );
+}
+
 /// The glitch warning names a position in exponent form when it would be
 /// long: a latitude of 1e-320 (a corrupted cell) was written with 320
 /// digits, five times in one `microlevel` warning.
@@ -149,6 +167,9 @@ fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
     let mut table = flight.into_table();
     table.add_column("smooth", smooth.clone()).unwrap();
     table.add_column("lev", noisy.clone()).unwrap();
+    table
+        .add_column("flat", vec![53_000.0; line.len()])
+        .unwrap();
     let flight = Flight::from_table(table).unwrap();
     let m = microlevel(
         &flight,
@@ -188,6 +209,23 @@ fn microlevelling_removes_line_to_line_offsets_from_a_smooth_field() {
         (0..line.len())
             .filter(|&k| line[k] == 0.0)
             .all(|k| m.correction[k] == 0.0)
+    );
+    // A constant column's crossover differences do not rise: 0 before,
+    // 2.3e-12 nT after (gridding round-off) was warned of as a rise "from
+    // 0.000 to 0.000 nT".
+    let flat = microlevel(
+        &flight,
+        &MicrolevelOptions {
+            column: Some("flat".into()),
+            ..MicrolevelOptions::default()
+        },
+        &mut Silent,
+    )
+    .unwrap();
+    assert!(
+        flat.notes.iter().all(|n| !n.message.contains("raises")),
+        "{:?}",
+        flat.notes
     );
 }
 

@@ -244,8 +244,11 @@ pub fn microlevel(
     let max = on_line.iter().fold(0.0f64, |m, c| m.max(c.abs()));
     let values: Vec<f64> = value.iter().zip(&correction).map(|(v, c)| v + c).collect();
     let crossover_rms_nt = crossover_check(flight, value, &correction)?;
+    // A rise below the printed resolution is none (a constant column gave
+    // "raises … from 0.000 to 0.000 nT").
+    const RESOLUTION_NT: f64 = 1e-3;
     if let Some((before, after)) = crossover_rms_nt
-        && after > 1.5 * before
+        && after > 1.5 * before + RESOLUTION_NT
     {
         notes.warn(format!(
             "micro-levelling raises the crossover differences from {before:.3} to {after:.3} nT RMS: \

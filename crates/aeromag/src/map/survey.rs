@@ -82,6 +82,7 @@ impl ProjectedSurvey {
             .column("time")
             .map_or_else(Vec::new, |t| position_glitches(t, lat, lon));
         let on_track = |k: usize| off_track.binary_search(&k).is_err();
+        let zone_given = zone.is_some();
         let zone = match zone {
             Some(z) => Ok(z),
             None if off_track.is_empty() => UtmZone::for_points(lat, lon),
@@ -104,9 +105,20 @@ impl ProjectedSurvey {
                 y.push(f64::NAN);
                 continue;
             }
-            let (e, n) = utm
-                .forward(la, lo)
-                .map_err(|e| flight.bad_value(k, "lat", e.to_string()))?;
+            let (e, n) = utm.forward(la, lo).map_err(|e| {
+                // Within UTM's latitudes the longitude is refused: far from
+                // the zone, which a zone given by `--utm-zone` explains.
+                use aeromag_grid::projection::utm::{FORWARD_LAT_MAX_DEG, FORWARD_LAT_MIN_DEG};
+                let column = match (FORWARD_LAT_MIN_DEG..=FORWARD_LAT_MAX_DEG).contains(&la) {
+                    true => "lon",
+                    false => "lat",
+                };
+                let given = match (zone_given, column) {
+                    (true, "lon") => " (the zone given with --utm-zone is not the data's: leave it out to take theirs)",
+                    _ => "",
+                };
+                flight.bad_value(k, column, format!("{e}{given}"))
+            })?;
             x.push(e);
             y.push(n);
         }

@@ -344,10 +344,31 @@ pub fn fit_levelling(crossovers: &[Crossover], cfg: &LevellingConfig) -> Result<
     };
     let p_eff = p - free_modes;
     if crossovers.len() <= p_eff {
+        // Only the parameters this fit has, and only the advice it can take
+        // (`--tie-only` was told to drop k, which it does not fit).
+        let mut fitted = vec!["offsets"];
+        let mut fewer = Vec::new();
+        if cfg.drift {
+            fitted.push("drifts");
+            fewer.push("no drift");
+        }
+        if cfg.estimate_k {
+            fitted.insert(0, "k");
+            fewer.push("no k");
+        }
+        if alt_used {
+            fitted.push("altitude term");
+            fewer.push("no altitude term");
+        }
+        let advice = if fewer.is_empty() {
+            "fly more ties".to_string()
+        } else {
+            format!("fit fewer ({}) or fly more ties", fewer.join(", "))
+        };
         return Err(bad(format!(
-            "{} crossovers cannot determine {p_eff} parameters (k, offsets{}): fit fewer (no drift, no k, no altitude term) or fly more ties",
+            "{} crossovers cannot determine {p_eff} parameters ({}) with a residual to spare: {advice}",
             crossovers.len(),
-            if cfg.drift { ", drifts" } else { "" }
+            fitted.join(", "),
         )));
     }
 
@@ -939,6 +960,25 @@ pub(crate) mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("cannot determine"), "{e}");
+        assert!(
+            e.to_string().contains("(k, offsets, drifts)")
+                && e.to_string().contains("fit fewer (no drift, no k)"),
+            "{e}"
+        );
+        // Offsets alone (`--tie-only`): neither k nor drift to drop.
+        let e = fit_levelling(
+            &x[..2],
+            &LevellingConfig {
+                estimate_k: false,
+                ..Default::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("(offsets)") && e.ends_with(": fly more ties"),
+            "{e}"
+        );
         // The same rate at both sides of every crossover (`--rate-of
         // time`): the lag's column is zero, the system singular — a failed
         // fit, not bad input (it exited 2).

@@ -115,37 +115,52 @@ fn push_f32(s: &mut String, v: f64) {
 /// file stem and the unit empty (the format carries neither).
 pub fn read(path: &Path) -> Result<Grid> {
     let text = fs::read_to_string(path).map_err(|e| read_error(path, e))?;
-    let mut tokens = text.split_ascii_whitespace().peekable();
     let (mut nx, mut ny, mut x, mut y, mut cell, mut nodata) = (None, None, None, None, None, None);
     let mut corner = (false, false);
-    while let Some(key) = tokens.peek() {
-        // The header ends at the first number.
+    // The header: one `keyword value` per line, up to the first line that
+    // starts with a number (read by lines: a keyword without its value took
+    // the first grid value as its own, and the error blamed the data).
+    let mut data_start = text.len();
+    let mut offset = 0;
+    for (k, line) in text.split_inclusive('\n').enumerate() {
+        let line_no = k + 1;
+        let mut words = line.split_ascii_whitespace();
+        let Some(key) = words.next() else {
+            offset += line.len();
+            continue;
+        };
         if key.parse::<f64>().is_ok() {
+            data_start = offset;
             break;
         }
-        let key = tokens.next().unwrap().to_ascii_lowercase();
-        let value = tokens
+        offset += line.len();
+        let (word, key) = (key, key.to_ascii_lowercase());
+        let at = |what: String| read_error(path, format!("line {line_no}: {what}"));
+        let value = words
             .next()
-            .ok_or_else(|| read_error(path, format!("no value after {}", shown_text(&key))))?;
+            .ok_or_else(|| at(format!("{} has no value", shown_text(word))))?;
         let number = || -> Result<f64> {
             value.parse::<f64>().map_err(|_| {
-                read_error(
-                    path,
-                    format!(
-                        "{} is not a number: {}",
-                        shown_text(&key),
-                        shown_text(value)
-                    ),
-                )
+                at(format!(
+                    "{} is not a number: {}",
+                    shown_text(word),
+                    shown_text(value)
+                ))
             })
         };
         let count = || -> Result<usize> {
-            value.parse::<usize>().map_err(|_| {
-                read_error(
-                    path,
-                    format!("{} is not a count: {}", shown_text(&key), shown_text(value)),
-                )
-            })
+            match value.parse::<usize>() {
+                Ok(0) => Err(at(format!(
+                    "{} is 0: a grid has at least one",
+                    shown_text(word)
+                ))),
+                Ok(n) => Ok(n),
+                Err(_) => Err(at(format!(
+                    "{} is not a count: {}",
+                    shown_text(word),
+                    shown_text(value)
+                ))),
+            }
         };
         match key.as_str() {
             "ncols" => nx = Some(count()?),
@@ -162,14 +177,17 @@ pub fn read(path: &Path) -> Result<Grid> {
             }
             "cellsize" => cell = Some(number()?),
             "nodata_value" => nodata = Some(number()?),
-            _ => {
-                return Err(read_error(
-                    path,
-                    format!("unknown header keyword {}", shown_text(&key)),
-                ));
-            }
+            _ => return Err(at(format!("unknown header keyword {}", shown_text(word)))),
+        }
+        if let Some(extra) = words.next() {
+            return Err(at(format!(
+                "{} has more than one value: {}",
+                shown_text(word),
+                shown_text(extra)
+            )));
         }
     }
+    let mut tokens = text[data_start..].split_ascii_whitespace();
     let missing = |k: &str| read_error(path, format!("no '{k}' in the header"));
     let cell = cell.ok_or_else(|| missing("cellsize"))?;
     let half = |c: bool| if c { cell / 2.0 } else { 0.0 };
@@ -313,6 +331,25 @@ mod tests {
         assert!(read(&path).is_err());
         fs::write(&path, "ncols 2\nnrows 1\nxllcenter 0\ncellsize 1\n1 2\n").unwrap();
         assert!(read(&path).unwrap_err().to_string().contains("yllcenter"));
+        // Header errors name the keyword and its line: a keyword without
+        // its value took the first grid value ("4 values, expected 5"),
+        // and ncols 0 read as a size limit.
+        for (header, says) in [
+            ("NODATA_value\n", "line 6: \"NODATA_value\" has no value"),
+            ("ncols 0\n", "line 6: \"ncols\" is 0"),
+            (
+                "cellsize 1 2\n",
+                "line 6: \"cellsize\" has more than one value",
+            ),
+        ] {
+            fs::write(
+                &path,
+                format!("ncols 2\nnrows 1\nxllcenter 0\nyllcenter 0\ncellsize 1\n{header}1 2\n"),
+            )
+            .unwrap();
+            let e = read(&path).unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
     }
 
     /// The file `name` in `dir` with a 3 × 3 header of cell `cell` and the

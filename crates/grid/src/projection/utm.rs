@@ -81,9 +81,9 @@ const ZONE_LAT_MIN_DEG: f64 = -80.0;
 /// Northern limit of the UTM zones (zone choice), degrees.
 const ZONE_LAT_MAX_DEG: f64 = 84.0;
 /// Southern limit of [`Utm::forward`] (the zones overlap UPS by 30′), degrees.
-const FORWARD_LAT_MIN_DEG: f64 = -80.5;
+pub const FORWARD_LAT_MIN_DEG: f64 = -80.5;
 /// Northern limit of [`Utm::forward`], degrees.
-const FORWARD_LAT_MAX_DEG: f64 = 84.5;
+pub const FORWARD_LAT_MAX_DEG: f64 = 84.5;
 /// Largest longitude difference from the central meridian that
 /// [`Utm::forward`] accepts, degrees.
 const FORWARD_MAX_DLON_DEG: f64 = 30.0;
