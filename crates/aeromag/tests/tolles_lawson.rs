@@ -418,6 +418,41 @@ fn a_single_heading_without_manoeuvres_does_not_determine_the_model() {
     }
 }
 
+/// The straight legs of a box (every heading, no manoeuvre) fitted
+/// without a word, with coefficients 17 stated σ from the whole box's:
+/// now a `[few-manoeuvres]` warning names the still axes; the whole box
+/// has none.
+#[test]
+fn straight_legs_without_manoeuvres_are_warned_about() {
+    let cal = calibration(6);
+    let (line, man) = (
+        cal.require("line").unwrap(),
+        cal.require("manoeuvre").unwrap(),
+    );
+    let keep: Vec<usize> = (0..cal.n_rows())
+        .filter(|&i| line[i] != 0.0 && man[i] == 0.0)
+        .collect();
+    let mut t = FlightTable::new();
+    for c in cal.columns() {
+        let v = c.values().unwrap();
+        t.add_column(c.name(), keep.iter().map(|&i| v[i]).collect())
+            .unwrap();
+    }
+    let straight = Flight::from_table(t).unwrap();
+    let warned = |f: &Flight| {
+        let fit = calibrate(f, &CalibrateOptions::default(), &mut Silent).unwrap();
+        fit.notes
+            .iter()
+            .filter(|n| n.is_warning() && n.message.contains("[few-manoeuvres]"))
+            .map(|n| n.message.clone())
+            .collect::<Vec<_>>()
+    };
+    let w = warned(&straight);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("barely manoeuvres"), "{w:?}");
+    assert!(warned(&cal).is_empty());
+}
+
 /// A noise-free turning flight in a constant field fitted without a
 /// band-pass: the induced diagonal equals the bias column times |B|/bt_scale,
 /// the normal equations are singular, and that is a failed fit, not bad

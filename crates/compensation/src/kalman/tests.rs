@@ -613,7 +613,7 @@ fn kalman_exact_magnitude_fits_what_the_projection_cannot() {
         "first order {first_err} nT, exact {gn_err} nT, {:?}",
         gn.warnings
     );
-    assert_exact_beats_first_order(first_err, gn_err, &gn.warnings);
+    assert_exact_beats_first_order(first_err, gn_err, &gn.notes, &gn.warnings);
     // Every coefficient within 4 of its standard deviations of the truth.
     for (k, ((a, c), s)) in gn.coef.iter().zip(&coef).zip(&gn.std).enumerate() {
         assert!(
