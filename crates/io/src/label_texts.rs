@@ -16,6 +16,12 @@
 
 use std::collections::HashMap;
 
+/// Distinct labels kept, per piece and in all: a survey has hundreds or
+/// thousands of lines, and a column with a new label on every row (a
+/// fiducial mapped as `line`) would otherwise keep 10⁷ texts. Beyond, the
+/// texts are not compared (a clash among the later labels goes unseen).
+pub(crate) const MAX_LABELS: usize = 1 << 16;
+
 /// The distinct texts of a label column's cells, with their values.
 #[derive(Debug, Clone)]
 pub(crate) struct LabelTexts {
@@ -85,7 +91,7 @@ impl LabelTexts {
             return;
         }
         let text = bytes.trim_ascii();
-        if !self.seen.contains_key(text) {
+        if self.seen.len() < MAX_LABELS && !self.seen.contains_key(text) {
             self.seen.insert(text.to_vec(), value);
         }
     }
@@ -120,9 +126,10 @@ impl LabelClash {
         }
         match self.by_value.get(&value.to_bits()) {
             Some(first) => self.clash = first.as_slice() != text,
-            None => {
+            None if self.by_value.len() < MAX_LABELS => {
                 self.by_value.insert(value.to_bits(), text.to_vec());
             }
+            None => {}
         }
     }
 
@@ -162,5 +169,19 @@ mod tests {
         assert!(!clash_of(&["1003", " 1003 ", "1003"]));
         // Missing and zero labels (turns) are no line at all.
         assert!(!clash_of(&["0", "0.0", "-0", "", "NaN", "*", "7"]));
+    }
+
+    /// A new label on every row keeps at most MAX_LABELS texts.
+    #[test]
+    fn distinct_labels_kept_are_bounded() {
+        let mut texts = LabelTexts::default();
+        let mut clash = LabelClash::default();
+        for k in 1..=(3 * MAX_LABELS) {
+            texts.note(k.to_string().as_bytes(), k as f64);
+        }
+        clash.add_all(&texts);
+        assert_eq!(texts.seen.len(), MAX_LABELS);
+        assert_eq!(clash.by_value.len(), MAX_LABELS);
+        assert!(!clash.clash);
     }
 }

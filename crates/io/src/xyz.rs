@@ -198,6 +198,9 @@ struct TokenSource {
     /// ([`crate::label_texts`]: `Line 1003.1` and `Line 1003.10`).
     record_texts: Vec<(usize, Vec<u8>)>,
     record_clash: LabelClash,
+    /// More records than [`crate::label_texts::MAX_LABELS`] came without a
+    /// clash: texts no longer kept, the numbers stay.
+    records_untracked: bool,
 }
 
 impl TokenSource {
@@ -241,6 +244,7 @@ impl TokenSource {
             line_types: Vec::new(),
             record_texts: Vec::new(),
             record_clash: LabelClash::default(),
+            records_untracked: false,
         })
     }
 
@@ -450,6 +454,15 @@ impl TokenSource {
         self.current_line = number;
         self.current_type = if tie { 1.0 } else { 0.0 };
         self.any_record = true;
+        // A record on every row of a hostile file: beyond MAX_LABELS
+        // records without a clash, their texts are no longer kept.
+        if self.record_texts.len() >= crate::label_texts::MAX_LABELS && !self.record_clash.clash {
+            self.records_untracked = true;
+            self.record_texts = Vec::new();
+        }
+        if self.records_untracked {
+            return;
+        }
         if number != 0.0 {
             self.record_clash.add(text, number);
         }
@@ -461,7 +474,7 @@ impl TokenSource {
     /// when two texts give one number (NaN, resp. empty, before the first).
     fn take_line_column(&mut self) -> std::result::Result<Vec<f64>, Vec<String>> {
         let values = std::mem::take(&mut self.line_values);
-        if !self.record_clash.clash {
+        if !self.record_clash.clash || self.records_untracked {
             return Ok(values);
         }
         let mut text = Vec::with_capacity(values.len());
