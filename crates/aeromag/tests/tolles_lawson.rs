@@ -76,6 +76,21 @@ fn eddy_lags_are_chosen_when_significant_and_recorded() {
         "{sel:?}"
     );
     assert_eq!(sel.taus_s, m.design.terms.eddy_lags_s());
+    // The note says which rows its residuals are over: the search's, no
+    // more than the fit's (on short legs fewer; the figures disagreed with
+    // the fit's without a word).
+    assert!(
+        sel.rows > 0 && sel.rows <= m.fit.rows,
+        "{} of {}",
+        sel.rows,
+        m.fit.rows
+    );
+    let over = format!("over the {} rows every candidate lag can use", sel.rows);
+    assert!(
+        fit.notes.iter().any(|n| n.message.contains(&over)),
+        "{:?}",
+        fit.notes
+    );
     // `none`: the classical 16 terms, with a larger residual.
     let classical = classical_model(&cal);
     assert_eq!(classical.coefficients.len(), 16);

@@ -151,9 +151,11 @@ pub(super) fn choose_terms(
             if sel.taus_s.is_empty() {
                 notes.note("eddy-current lags: no lag is significant; classical eddy terms kept");
             } else {
+                // The search's rows, which on short legs are fewer than the
+                // fit's: the residuals differed from the fit's without a word.
                 notes.note(format!(
-                    "eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS",
-                    sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt
+                    "eddy-current lags τ = {:?} s chosen (likelihood-ratio test): band-passed residual {:.4} → {:.4} nT RMS over the {} rows every candidate lag can use",
+                    sel.taus_s, sel.base_residual_rms_nt, sel.residual_rms_nt, sel.rows
                 ));
             }
             (with(&sel.taus_s)?, Some(sel))

@@ -125,6 +125,11 @@ pub struct LagSelection {
     pub residual_rms_nt: f64,
     /// Every candidate scored, in the order tried.
     pub candidates: Vec<LagCandidate>,
+    /// Rows the residuals are over: those every candidate can use (a leg's
+    /// first rows lack the history of the longest lag), fewer than the
+    /// final fit's on short legs (0 in model files written before it).
+    #[serde(default)]
+    pub rows: usize,
 }
 
 fn rss(f: &LsFit) -> f64 {
@@ -547,6 +552,7 @@ fn select_lags(
         base_residual_rms_nt: base.residual_rms_nt,
         residual_rms_nt: current.residual_rms_nt,
         candidates,
+        rows: base.rows,
     })
 }
 
