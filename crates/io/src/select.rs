@@ -255,6 +255,15 @@ pub fn no_line_label(label: &str) -> bool {
     }
 }
 
+/// Whether a text label is missing (empty, `NaN`, `*`): no line, as a
+/// turn's 0 is, but seldom what a file means ([`no_line_label`]).
+pub fn missing_label(label: &str) -> bool {
+    matches!(
+        crate::cell::parse_cell(label.as_bytes()),
+        Ok(crate::cell::Cell::Missing(_))
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,6 +284,15 @@ mod tests {
         }
         for t in ["1003", "L0", "T901", "1003.10", "x"] {
             assert!(!no_line_label(t), "{t:?}");
+        }
+        for (t, missing) in [
+            ("", true),
+            ("NaN", true),
+            ("*", true),
+            ("0", false),
+            ("7", false),
+        ] {
+            assert_eq!(missing_label(t), missing, "{t:?}");
         }
     }
 

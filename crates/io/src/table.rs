@@ -241,10 +241,11 @@ impl FlightTable {
                 match previous {
                     Some((p, id)) if p == t => id,
                     _ => {
-                        let id = if crate::select::no_line_label(t) {
-                            // `0`: no line; empty, `NaN`, `*`: missing.
-                            let zero = t.parse::<f64>().is_ok_and(|v| v == 0.0);
-                            if zero { 0.0 } else { f64::NAN }
+                        // Empty, `NaN`, `*`: missing; `0`: no line.
+                        let id = if crate::select::missing_label(t) {
+                            f64::NAN
+                        } else if crate::select::no_line_label(t) {
+                            0.0
                         } else {
                             let next = ids.len() as f64 + 1.0;
                             *ids.entry(t.to_ascii_lowercase()).or_insert(next)

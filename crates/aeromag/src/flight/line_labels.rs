@@ -107,7 +107,7 @@ impl LineLabels {
                         }
                         Some(k)
                     };
-                    let m = kind.is_none() && !t.parse::<f64>().is_ok_and(|v| v == 0.0);
+                    let m = kind.is_none() && aeromag_io::select::missing_label(t);
                     previous = Some((t, kind, m));
                     (kind, m)
                 }
