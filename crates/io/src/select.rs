@@ -255,6 +255,43 @@ pub fn no_line_label(label: &str) -> bool {
     }
 }
 
+/// Text line labels numbered: per label (trimmed), NaN when missing
+/// ([`missing_label`]), 0 for no line (the number 0, [`no_line_label`]),
+/// else `k` for the `k`-th distinct label (any case, 1-based, in order of
+/// first appearance); and the distinct labels as first written. One map
+/// lookup per run of equal labels, however many lines the file has.
+pub fn number_labels<'a>(labels: impl IntoIterator<Item = &'a str>) -> (Vec<f64>, Vec<String>) {
+    let mut distinct: Vec<String> = Vec::new();
+    let mut index: std::collections::HashMap<String, f64> = std::collections::HashMap::new();
+    let mut previous: Option<(&str, f64)> = None;
+    let ids = labels
+        .into_iter()
+        .map(|t| {
+            let t = t.trim();
+            match previous {
+                Some((p, id)) if p == t => id,
+                _ => {
+                    let id = if missing_label(t) {
+                        f64::NAN
+                    } else if no_line_label(t) {
+                        0.0
+                    } else {
+                        let next = distinct.len() as f64 + 1.0;
+                        let id = *index.entry(t.to_ascii_lowercase()).or_insert(next);
+                        if id == next {
+                            distinct.push(t.to_string());
+                        }
+                        id
+                    };
+                    previous = Some((t, id));
+                    id
+                }
+            }
+        })
+        .collect();
+    (ids, distinct)
+}
+
 /// Whether a text label is missing (empty, `NaN`, `*`): no line, as a
 /// turn's 0 is, but seldom what a file means ([`no_line_label`]).
 pub fn missing_label(label: &str) -> bool {

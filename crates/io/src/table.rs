@@ -223,8 +223,8 @@ impl FlightTable {
     /// labels kept as text because two of them give one number, `1003.1`
     /// and `1003.10`: see the readers) numbered by label, each distinct
     /// label (trimmed, any case) 1, 2, … in order of first appearance, 0
-    /// for no line ([`crate::select::no_line_label`]: the number 0) and NaN
-    /// for a missing label. What splits a flight at line changes and tells
+    /// for no line (the number 0) and NaN for a missing label
+    /// ([`crate::select::number_labels`]). What splits a flight at line changes and tells
     /// rows on a line; `None` without a `line` column.
     pub fn line_numbers(&self) -> Option<std::borrow::Cow<'_, [f64]>> {
         let column = self.get("line")?;
@@ -232,31 +232,8 @@ impl FlightTable {
             return Some(std::borrow::Cow::Borrowed(v));
         }
         let text = column.text()?;
-        let mut ids: std::collections::HashMap<String, f64> = std::collections::HashMap::new();
-        let mut previous: Option<(&str, f64)> = None;
-        let numbers = text
-            .iter()
-            .map(|t| {
-                let t = t.trim();
-                match previous {
-                    Some((p, id)) if p == t => id,
-                    _ => {
-                        // Empty, `NaN`, `*`: missing; `0`: no line.
-                        let id = if crate::select::missing_label(t) {
-                            f64::NAN
-                        } else if crate::select::no_line_label(t) {
-                            0.0
-                        } else {
-                            let next = ids.len() as f64 + 1.0;
-                            *ids.entry(t.to_ascii_lowercase()).or_insert(next)
-                        };
-                        previous = Some((t, id));
-                        id
-                    }
-                }
-            })
-            .collect();
-        Some(std::borrow::Cow::Owned(numbers))
+        let (ids, _) = crate::select::number_labels(text.iter().map(String::as_str));
+        Some(std::borrow::Cow::Owned(ids))
     }
 
     /// Text values of column `name` (alias resolved); `None` if absent or numeric.

@@ -23,8 +23,6 @@
 //! and 10) are two lines, as the readers keep them (a `line` column with
 //! such a pair is read as text).
 
-use std::collections::HashMap;
-
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use aeromag_compensation::levelling::Pairing;
@@ -63,56 +61,34 @@ impl LineLabels {
                 "has no `line` column (map one with --columns line=NAME)",
             )
         })?;
-        let text: Vec<String> = match (column.values(), column.text()) {
-            (Some(v), _) => v
-                .iter()
-                .map(|&x| {
-                    if x.is_nan() {
-                        String::new()
-                    } else if x == 0.0 {
-                        "0".to_string()
-                    } else {
-                        shown(x)
-                    }
-                })
-                .collect(),
-            (None, Some(t)) => t.iter().map(|s| s.trim().to_string()).collect(),
+        // Per row the label's number (NaN missing, 0 no line, k the k-th
+        // distinct label), and the labels; a number as it is shown.
+        let number_labels = aeromag_io::select::number_labels;
+        let (numbered, labels) = match (column.values(), column.text()) {
+            (Some(v), _) => {
+                let text: Vec<String> = v
+                    .iter()
+                    .map(|&x| match x {
+                        x if x.is_nan() => String::new(),
+                        0.0 => "0".to_string(),
+                        x => shown(x),
+                    })
+                    .collect();
+                number_labels(text.iter().map(String::as_str))
+            }
+            (None, Some(t)) => number_labels(t.iter().map(String::as_str)),
             (None, None) => unreachable!("a column is numeric or text"),
         };
-        let mut labels: Vec<String> = Vec::new();
-        // Label (lower case) → index in `labels`: one lookup per run of
-        // equal labels, however many lines the file has.
-        let mut index: HashMap<String, usize> = HashMap::new();
-        let mut previous: Option<(&str, Option<usize>, bool)> = None;
-        let mut ids = Vec::with_capacity(text.len());
-        let mut kind_of_row: Vec<Option<usize>> = Vec::with_capacity(text.len());
+        let mut ids = Vec::with_capacity(numbered.len());
+        let mut kind_of_row: Vec<Option<usize>> = Vec::with_capacity(numbered.len());
         let mut missing = (0, None);
         // Per label: its passes and the first row of its second; the label
         // of the last row on a line.
         let mut passes: Vec<(usize, usize)> = Vec::new();
         let mut last_on_line: Option<usize> = None;
-        for (row, t) in text.iter().enumerate() {
-            let (kind, is_missing) = match previous {
-                Some((p, kind, m)) if p == t => (kind, m),
-                _ => {
-                    // A text column's `0`, `0.0`, `-0` (the number 0) or a
-                    // missing marker (empty, `NaN`, `*`): no line.
-                    let kind = if aeromag_io::select::no_line_label(t) {
-                        None
-                    } else {
-                        let n = labels.len();
-                        let k = *index.entry(t.to_ascii_lowercase()).or_insert(n);
-                        if k == n {
-                            labels.push(t.clone());
-                        }
-                        Some(k)
-                    };
-                    let m = kind.is_none() && aeromag_io::select::missing_label(t);
-                    previous = Some((t, kind, m));
-                    (kind, m)
-                }
-            };
-            if is_missing {
+        for (row, &id) in numbered.iter().enumerate() {
+            let kind = (id > 0.0).then(|| id as usize - 1);
+            if id.is_nan() {
                 missing.0 += 1;
                 missing.1.get_or_insert(row);
             }
