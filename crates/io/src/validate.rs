@@ -649,23 +649,22 @@ impl Ctx<'_> {
             return;
         };
         const EARTH_RADIUS_M: f64 = 6_371_000.0;
-        let speed = |i: usize| {
-            let (dt, dlat) = (t[i + 1] - t[i], (lat[i + 1] - lat[i]).to_radians());
+        let step = |i: usize| t[i + 1] - t[i];
+        let distance = |i: usize| {
+            let dlat = (lat[i + 1] - lat[i]).to_radians();
             let dlon = (lon[i + 1] - lon[i]).to_radians() * lat[i].to_radians().cos();
-            if dt > 0.0 {
-                EARTH_RADIUS_M * dlat.hypot(dlon) / dt
-            } else {
-                f64::NAN
-            }
+            EARTH_RADIUS_M * dlat.hypot(dlon)
         };
-        let Some(v) = median(t.len().saturating_sub(1), speed) else {
+        // Over steps forward in time only (NaN is left out of a median).
+        let forward = |i: usize, v: f64| if step(i) > 0.0 { v } else { f64::NAN };
+        let speed = |i: usize| forward(i, distance(i) / step(i));
+        let moved = |i: usize| forward(i, distance(i));
+        let pairs = t.len().saturating_sub(1);
+        let Some(v) = median(pairs, speed) else {
             return;
         };
-        let distance = |i: usize| speed(i) * (t[i + 1] - t[i]);
-        let step = |i: usize| t[i + 1] - t[i];
-        let pairs = t.len().saturating_sub(1);
         if v < MIN_MOVING_SPEED_M_S
-            && let (Some(d), Some(dt)) = (median(pairs, distance), median(pairs, step))
+            && let (Some(d), Some(dt)) = (median(pairs, moved), median(pairs, step))
             && d >= MIN_MOVING_STEP_M
         {
             w.push(self.warn(
