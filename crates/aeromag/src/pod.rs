@@ -138,13 +138,7 @@ fn check_cable_degrees(t: &Flight, ci: &[f64], ca: &[f64], yaw: &[f64]) -> Resul
     };
     let two_pi = std::f64::consts::TAU;
     let radians = |name: &str, what: String| {
-        Err(Error::bad_file(
-            t.file_label(),
-            format!(
-                "column '{}': {what}: radians? expected degrees",
-                t.resolve(name).unwrap_or(name)
-            ),
-        ))
+        Err(t.bad_column(name, format!("{what}: radians? expected degrees")))
     };
     if let Some((_, hi)) = span(ci)
         && hi <= std::f64::consts::FRAC_PI_2
