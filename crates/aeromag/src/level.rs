@@ -149,13 +149,17 @@ impl Levelled {
     /// The crossover table: one row per crossover with both lines,
     /// position, times, altitudes, values, `d|B0|/dt`, profile gradients,
     /// the difference, what the fitted model leaves of it and its weight
-    /// (units in the column names).
+    /// (units in the column names). The lines are `line_a` and `line_b`,
+    /// numbers when the labels are, text when a label's later pass is
+    /// named (`1003 (pass 2)`).
     pub fn crossover_table(&self) -> Result<FlightTable> {
         let xs = &self.levelling.crossovers.crossovers;
         let fit = &self.levelling.fit;
         let col = |f: &dyn Fn(&Crossover) -> f64| -> Vec<f64> { xs.iter().map(f).collect() };
         let mut t = FlightTable::new();
-        if self.lines.numbers.is_some() {
+        // The labels as numbers, unless a label flown twice needs its
+        // passes named (`1003 (pass 2)`).
+        if self.lines.numbers.is_some() && self.lines.repeated.is_empty() {
             t.add_column("line_a", col(&|x| self.lines.number(x.a.label)))?;
             t.add_column("line_b", col(&|x| self.lines.number(x.b.label)))?;
         } else {

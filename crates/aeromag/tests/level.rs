@@ -369,3 +369,69 @@ fn a_levelled_column_that_is_no_field_in_nt_is_refused() {
         "{e}"
     );
 }
+
+/// Found by fuzzing the survey chain: a line flown again under its first
+/// label, after the other lines, with a level error of 50 nT, was levelled
+/// with the first pass's offset, and the 50 nT stayed in the levelled
+/// column with exit 0. Each pass is now a line of its own, named in the
+/// `[line-repeated]` warning: the re-flight is levelled to the first
+/// flight's level.
+#[test]
+fn a_label_flown_twice_is_levelled_per_pass() {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(3)).unwrap();
+    let line = survey.column("line").unwrap();
+    let label = 1003.0;
+    let rows: Vec<usize> = (0..line.len()).filter(|&i| line[i] == label).collect();
+    assert!(rows.len() > 100, "{} rows on line 1003", rows.len());
+    let time = survey.column("time").unwrap();
+    let shift_s = time[time.len() - 1] - time[rows[0]] + 100.0;
+    let again = edited(&survey, &|t: &mut FlightTable| {
+        typed_ties(t);
+        let mut fresh = FlightTable::new();
+        for c in t.columns() {
+            let mut v = c.values().unwrap().to_vec();
+            let extra = rows.iter().map(|&i| match c.name() {
+                "time" => v[i] + shift_s,
+                "mag" => v[i] + 50.0,
+                _ => v[i],
+            });
+            let extra: Vec<f64> = extra.collect();
+            v.extend(extra);
+            fresh.add_column(c.name(), v).unwrap();
+        }
+        *t = fresh;
+    });
+    let lev = level(&again, &LevelOptions::default(), &mut Silent).unwrap();
+    let pass_two = lev.lines.labels.iter().position(|l| l == "1003 (pass 2)");
+    let pass_two = pass_two.expect("the second pass is a line") as i64 + 1;
+    assert!(
+        lev.notes.iter().any(|n| n.is_warning()
+            && n.message
+                .contains("1003 (2 passes, the second from data row")
+            && n.message.contains("'1003 (pass 2)'")
+            && n.message.ends_with("[line-repeated]")),
+        "{:?}",
+        lev.notes
+    );
+    let table = lev.crossover_table().unwrap();
+    let named = |c: &str| table.get(c).unwrap().text().unwrap().to_vec();
+    assert!(
+        named("line_a")
+            .iter()
+            .chain(&named("line_b"))
+            .any(|l| l == "1003 (pass 2)")
+    );
+    let fit = &lev.levelling.fit;
+    let second = fit.lines.iter().find(|l| l.label == pass_two).unwrap();
+    assert!(second.crossovers >= 3, "{} crossovers", second.crossovers);
+    // The two passes, row for row, after levelling: the 50 nT are gone.
+    let out = &lev.levelling.levelled.value_nt;
+    let n = survey.n_rows();
+    let mean = rows
+        .iter()
+        .enumerate()
+        .map(|(j, &i)| out[n + j] - out[i])
+        .sum::<f64>()
+        / rows.len() as f64;
+    assert!(mean.abs() < 1.0, "the re-flight is {mean} nT off the first");
+}

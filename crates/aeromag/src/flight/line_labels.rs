@@ -19,6 +19,11 @@
 //! Rows with no label (missing, empty text, `NaN`, `*`, or the number 0:
 //! turns and transits) are on no line.
 //!
+//! A label flown in separate passes (another line's rows between them: a
+//! re-flight exported under the first flight's label) is one line per
+//! pass, `1003`, `1003 (pass 2)`, …: each pass has its own level error,
+//! and with one offset for the label a re-flight kept its own.
+//!
 //! Labels are names: `1003.1` and `1003.10` (Geosoft line 1003, versions 1
 //! and 10) are two lines, as the readers keep them (a `line` column with
 //! such a pair is read as text).
@@ -31,11 +36,15 @@ use aeromag_core::error::shown;
 /// Ids (1, 2, …, in order of first appearance) of a flight's line labels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineLabels {
-    /// Per row: the id of its label, `0.0` for rows on no line.
+    /// Per row: the id of its line, `0.0` for rows on no line. The labels
+    /// have ids 1, 2, … in order of first appearance; the later passes of a
+    /// label flown more than once follow, in order of their start.
     pub ids: Vec<f64>,
-    /// The label of id `k` at index `k − 1`, as text (`1003.01`, `L1020`).
+    /// The label of id `k` at index `k − 1`, as text (`1003.01`, `L1020`;
+    /// a later pass `1003.01 (pass 2)`).
     pub labels: Vec<String>,
-    /// The label of id `k` as a number, when the `line` column is numeric.
+    /// The label of id `k` as a number, when the `line` column is numeric
+    /// (a later pass has its label's).
     pub numbers: Option<Vec<f64>>,
     /// Per id, whether it is a tie line; `None` when not known.
     pub ties: Option<Vec<bool>>,
@@ -44,8 +53,8 @@ pub struct LineLabels {
     /// ([`LineLabels::missing_warning`]).
     pub missing: (usize, Option<usize>),
     /// Labels flown in more than one pass (their rows interrupted by
-    /// another line's): `(id, passes, first row of the second pass)`
-    /// ([`LineLabels::repeated_warning`]).
+    /// another line's): `(id of the first pass, passes, first row of the
+    /// second pass)` ([`LineLabels::repeated_warning`]).
     pub repeated: Vec<(i64, usize, usize)>,
 }
 
@@ -83,9 +92,11 @@ impl LineLabels {
         let mut kind_of_row: Vec<Option<usize>> = Vec::with_capacity(numbered.len());
         let mut missing = (0, None);
         // Per label: its passes and the first row of its second; the label
-        // of the last row on a line.
+        // of the last row on a line; the later passes, each `(label, pass,
+        // first row)`, in order of their start.
         let mut passes: Vec<(usize, usize)> = Vec::new();
         let mut last_on_line: Option<usize> = None;
+        let mut later_passes: Vec<(usize, usize, usize)> = Vec::new();
         for (row, &id) in numbered.iter().enumerate() {
             let kind = (id > 0.0).then(|| id as usize - 1);
             if id.is_nan() {
@@ -103,10 +114,19 @@ impl LineLabels {
                     if *n == 2 {
                         *second = row;
                     }
+                    later_passes.push((k, *n, row));
                 }
                 last_on_line = Some(k);
             }
-            ids.push(kind.map_or(0.0, |k| (k + 1) as f64));
+            // A later pass of label `k` is the line of its own appended
+            // below; the id is set there.
+            let pass_id = match (kind, later_passes.last()) {
+                (Some(k), Some(&(l, _, _))) if l == k && passes[k].0 > 1 => {
+                    (labels.len() + later_passes.len()) as f64
+                }
+                _ => kind.map_or(0.0, |k| (k + 1) as f64),
+            };
+            ids.push(pass_id);
             kind_of_row.push(kind);
         }
         let numbers: Option<Vec<f64>> = column
@@ -180,6 +200,19 @@ impl LineLabels {
             .filter(|(_, p)| p.0 > 1)
             .map(|(k, &(n, second))| (k as i64 + 1, n, second))
             .collect();
+        // Each later pass is a line of its own, of its label's kind.
+        let mut labels = labels;
+        let mut numbers = numbers;
+        let mut ties = ties;
+        for &(k, pass, _) in &later_passes {
+            labels.push(format!("{} (pass {pass})", labels[k]));
+            if let Some(n) = &mut numbers {
+                n.push(n[k]);
+            }
+            if let Some(t) = &mut ties {
+                t.push(t[k]);
+            }
+        }
         Ok(LineLabels {
             ids,
             labels,
@@ -191,9 +224,8 @@ impl LineLabels {
     }
 
     /// The warning for labels flown in more than one pass (`None` when
-    /// there are none), named `[line-repeated]`: levelling gives all the
-    /// rows of a label one offset, so a re-flight under the label of the
-    /// first flight would keep its own level error. A pass ends where
+    /// there are none), named `[line-repeated]`: each pass is a line of its
+    /// own (`7 (pass 2)`), which the file may not mean. A pass ends where
     /// another line's rows begin (turns, labelled 0, and rows without a
     /// label do not end it).
     pub fn repeated_warning(&self, flight: &Flight) -> Option<String> {
@@ -217,7 +249,7 @@ impl LineLabels {
         };
         let example = self.label(first.0).unwrap_or_default();
         Some(format!(
-            "{} of '{}' {} flown in separate passes, another line's rows between them: {}{more}; each label gets one offset, so a re-flight keeps its own level error: label it apart ({example}.01, as Geosoft's LINE.VERSION) [line-repeated]",
+            "{} of '{}' {} flown in separate passes, another line's rows between them: {}{more}; each pass is taken as a line of its own ('{example} (pass 2)'), as a re-flight has its own level error: label re-flights apart ({example}.01, as Geosoft's LINE.VERSION) to name them [line-repeated]",
             if n == 1 { "a line" } else { "lines" },
             flight.label(),
             if n == 1 { "is" } else { "are" },
@@ -341,10 +373,11 @@ mod tests {
     }
 
     /// A label whose rows another line's interrupt is flown twice (the
-    /// re-flight kept the first flight's level error, silently); turns
-    /// (0) and rows without a label between its rows do not part it.
+    /// re-flight kept the first flight's level error, silently): each pass
+    /// is a line, and the warning names them; turns (0) and rows without a
+    /// label between its rows do not part it.
     #[test]
-    fn a_label_flown_twice_is_named() {
+    fn a_label_flown_twice_is_named_and_parted() {
         let once = flight(Ok(vec![7.0, 7.0, 0.0, 7.0, f64::NAN, 7.0, 8.0, 8.0]));
         let l = LineLabels::of(&once, &[]).unwrap();
         assert!(l.repeated.is_empty());
@@ -352,15 +385,29 @@ mod tests {
         let twice = flight(Ok(vec![7.0, 7.0, 0.0, 8.0, 8.0, 0.0, 7.0, 9.0, 8.0, 7.0]));
         let l = LineLabels::of(&twice, &[]).unwrap();
         assert_eq!(l.repeated, vec![(1, 3, 6), (2, 2, 8)]);
+        // Each later pass is a line of its own, after the labels.
+        assert_eq!(
+            l.ids,
+            vec![1.0, 1.0, 0.0, 2.0, 2.0, 0.0, 4.0, 3.0, 5.0, 6.0]
+        );
+        assert_eq!(
+            l.labels,
+            ["7", "8", "9", "7 (pass 2)", "8 (pass 2)", "7 (pass 3)"]
+        );
+        assert_eq!(l.numbers, Some(vec![7.0, 8.0, 9.0, 7.0, 8.0, 7.0]));
         let w = l.repeated_warning(&twice).unwrap();
         assert!(
             w.contains("7 (3 passes, the second from data row 7), 8 (2 passes"),
             "{w}"
         );
         assert!(
-            w.ends_with("(7.01, as Geosoft's LINE.VERSION) [line-repeated]"),
+            w.contains("a line of its own ('7 (pass 2)')")
+                && w.ends_with("(7.01, as Geosoft's LINE.VERSION) to name them [line-repeated]"),
             "{w}"
         );
+        // A pass of a tie is a tie.
+        let tie = LineLabels::of(&twice, &["8".to_string()]).unwrap();
+        assert_eq!(tie.ties, Some(vec![false, true, false, false, true, false]));
     }
 
     /// A label near f64's limit is named in exponent form (it was written
@@ -376,7 +423,7 @@ mod tests {
 
     /// Labels are found by a map, not by a search of all labels per row:
     /// 200 000 rows with a label each took 42 s in `aeromag level`. Case
-    /// does not make a new label.
+    /// does not make a new label: `l7` at the end is `L7`'s second pass.
     #[test]
     fn many_labels_in_one_pass() {
         let n = 200_000;
@@ -385,8 +432,9 @@ mod tests {
         s.push("l7");
         let t0 = std::time::Instant::now();
         let l = LineLabels::of(&flight(Err(s)), &[]).unwrap();
-        assert_eq!(l.labels.len(), n);
-        assert_eq!(l.ids[n], 8.0);
+        assert_eq!(l.labels.len(), n + 1);
+        assert_eq!(l.ids[n], (n + 1) as f64);
+        assert_eq!(l.label(l.ids[n] as i64), Some("L7 (pass 2)"));
         assert!(t0.elapsed().as_secs_f64() < 10.0, "{:?}", t0.elapsed());
     }
 }

@@ -5,7 +5,7 @@ use crate::args;
 use crate::input::InputArgs;
 use crate::progress::Bars;
 use aeromag::ReferenceChannels;
-use aeromag::compensation::levelling::{HUBER_K, LevellingConfig};
+use aeromag::compensation::levelling::{HUBER_K, LevellingConfig, LineLevel};
 use aeromag::level::{LevelFitChoices, LevelOptions, level};
 use std::path::PathBuf;
 
@@ -16,7 +16,10 @@ use std::path::PathBuf;
 /// (and with --drift a linear drift) is fitted jointly with `k` of the
 /// survey-altitude `k·d|B0|/dt` term (the field's rate along the track
 /// times the scalar channel's lag), the altitude term and robust weights.
-/// It prints the crossovers' differences before and after and `k`.
+/// It prints the crossovers' differences before and after and `k`. A
+/// label flown in two passes (another line's rows between them: a
+/// re-flight under the first flight's label) is levelled per pass,
+/// `1003 (pass 2)`, with the warning [line-repeated].
 ///
 /// Examples:
 ///   aeromag level -i survey_comp.csv --out levelled.csv
@@ -176,14 +179,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         );
     }
+    // Labels such as `L1020.01 (pass 2)` widen the first column.
+    let label = |l: &LineLevel| lev.lines.label(l.label).unwrap_or("?");
+    let w = f
+        .lines
+        .iter()
+        .map(|l| label(l).chars().count())
+        .fold(10, usize::max);
     println!(
-        "{:>10} {:>11} {:>12} {:>10}",
+        "{:>w$} {:>11} {:>12} {:>10}",
         "line", "crossovers", "offset (nT)", "std (nT)"
     );
     for l in &f.lines {
         println!(
-            "{:>10} {:>11} {:>12.4} {:>10.4}",
-            lev.lines.label(l.label).unwrap_or("?"),
+            "{:>w$} {:>11} {:>12.4} {:>10.4}",
+            label(l),
             l.crossovers,
             l.offset_nt,
             l.offset_std_nt
