@@ -176,6 +176,28 @@ pub(crate) fn check_grid(grid: &Grid) -> Result<()> {
     Ok(())
 }
 
+/// A magnetic-field unit other than nT (`T`, `mT`, `µT`, `pT`, their
+/// names, `gamma`), alone or per length (`T/m`), as a grid file may
+/// declare it (a netCDF variable's `units`): the factor that takes its
+/// values to nT and the unit then (`nT`, `nT/m`). `None` for nT and for
+/// any other unit. A CF file in SI units holds a field of 5·10⁻⁵ T, which
+/// was carried as such and printed as 0.0000.
+pub(crate) fn in_nanotesla(unit: &str) -> Option<(f64, String)> {
+    let (base, per) = match unit.trim().split_once('/') {
+        Some((b, p)) => (b.trim(), format!("/{}", p.trim())),
+        None => (unit.trim(), String::new()),
+    };
+    let factor = match base {
+        "T" | "tesla" | "Tesla" => 1e9,
+        "mT" | "millitesla" => 1e6,
+        "uT" | "µT" | "μT" | "microtesla" => 1e3,
+        "pT" | "picotesla" => 1e-3,
+        "gamma" | "gammas" => 1.0,
+        _ => return None,
+    };
+    Some((factor, format!("nT{per}")))
+}
+
 /// Most characters of a grid's name or unit read from a file: the longest
 /// this crate writes (a column name and two products, "mag_comp_level
 /// continued up 200 m vertical derivative") is about 60.

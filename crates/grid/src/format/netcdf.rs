@@ -40,7 +40,9 @@
 //! grid written from it, is in metres); coordinates in degrees
 //! (`degrees_east`/`degrees_north`, a `latitude_longitude` grid mapping, a
 //! geographic WKT) are refused. `units` this crate does not
-//! know are taken as metres.
+//! know are taken as metres. Values in a magnetic-field unit other than nT
+//! (`units = "T"`, as CF's SI units have it, `µT`, `pT`, `T/m`, …) are
+//! taken to nT (`nT`, `nT/m`).
 
 use std::fs;
 use std::io::{self, Write};
@@ -48,7 +50,7 @@ use std::path::Path;
 
 use super::{
     CoordinateUnit, check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt,
-    crs_wkt, label_from_file, not_metres_reason, read_error, wkt_unit, write_atomic,
+    crs_wkt, in_nanotesla, label_from_file, not_metres_reason, read_error, wkt_unit, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -731,12 +733,19 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
                 .and_then(|w| crs_from_wkt(&w))
         })
     });
+    // A field in tesla (CF's SI units) is taken to nT, as every command
+    // works in nT.
+    let mut unit = text(z, "units").unwrap_or_default();
+    if let Some((factor, nt)) = in_nanotesla(&unit) {
+        values.iter_mut().for_each(|v| *v *= factor);
+        unit = nt;
+    }
     let grid = Grid {
         geometry,
         values,
         crs,
         name: label_from_file(&text(z, "long_name").unwrap_or_else(|| z.name.clone())),
-        unit: label_from_file(&text(z, "units").unwrap_or_default()),
+        unit: label_from_file(&unit),
     };
     Ok((geometry, grid))
 }
@@ -935,6 +944,41 @@ mod tests {
         let e = read(&path).unwrap_err().to_string();
         assert!(e.contains("g.nc"), "{e}");
         assert!(!e.chars().any(|c| c.is_control()) && e.len() < 200, "{e}");
+    }
+
+    /// A field in tesla (CF's SI units; finding 08's `unitsT.nc`) was
+    /// carried in tesla, its vertical derivative printed as 0.0000 T/m:
+    /// it is read in nT, and so is a gradient in T/m; nT and other units
+    /// (metres of a DEM) are read as written.
+    #[test]
+    fn a_field_in_tesla_is_read_in_nanotesla() {
+        let dir = tempfile::tempdir().unwrap();
+        let nt = sample_grid();
+        for (unit, factor, read_as) in [
+            ("T", 1e-9, "nT"),
+            ("µT", 1e-3, "nT"),
+            ("pT", 1e3, "nT"),
+            ("T/m", 1e-9, "nT/m"),
+            ("gamma", 1.0, "nT"),
+            ("nT", 1.0, "nT"),
+            ("m", 1.0, "m"),
+        ] {
+            let mut g = nt.clone();
+            g.unit = unit.into();
+            g.values.iter_mut().for_each(|v| *v *= factor);
+            let path = dir.path().join("t.nc");
+            write_grid(&path, &g).unwrap();
+            let back = read_grid(&path).unwrap();
+            assert_eq!(back.unit, read_as, "{unit}");
+            assert_eq!(back.geometry, nt.geometry);
+            // float32 in the file: within two of its roundings.
+            for (k, (x, y)) in nt.values.iter().zip(&back.values).enumerate() {
+                assert!(
+                    (x.is_nan() && y.is_nan()) || (x - y).abs() <= 2.4e-7 * x.abs(),
+                    "{unit} node {k}: {x} read as {y}"
+                );
+            }
+        }
     }
 
     /// A CDF-1 file of 3 × 2 nodes, x 437.1–437.3 and y 6206.4–6206.5,
