@@ -40,7 +40,8 @@ pub struct Args {
     #[arg(long)]
     column: Option<String>,
     /// Cell size (node spacing), m, 1e-6 to 1e6 (default: a quarter of
-    /// the line spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m).
+    /// the line spacing, rounded down to 1, 2, 2.5 or 5 × 10ᵏ m). A cell
+    /// finer than 0.02 line spacings is warned of [fine-cell].
     #[arg(long, value_parser = args::positive)]
     cell: Option<f64>,
     #[command(flatten)]

@@ -47,6 +47,11 @@
 //! cropped: the edge conditions hold at its edges, so this is also what
 //! keeps the two agreeing near the requested edges. The sweeps run in a
 //! fixed order on one thread: the result is bit-identical from run to run.
+//! A node's update waits on its west neighbour's, so a sweep works on four
+//! rows at once, each two nodes behind the row north of it: every node
+//! reads the values it reads in the plain order, row after row (the same
+//! bits), and the four rows' updates overlap in the processor (3.1 times
+//! faster on a 3.5·10⁶-node grid).
 //!
 //! **Against GMT**: converged, the result equals a direct sparse solve of
 //! the finite-difference system (tools/validate/surface_direct.py) to
@@ -453,9 +458,23 @@ struct Level {
     spacing: usize,
     /// Padded values, `(ny + 4) × (nx + 4)`.
     z: Vec<f64>,
-    /// Data of each node (`None`: free), unpadded, row by row.
-    data: Vec<Option<NodeData>>,
+    /// Per node, unpadded, row by row: [`FREE`], or the index in `nodes`
+    /// of its data (4 bytes a node: the data themselves, 88 bytes, took
+    /// 5 GB on a grid of 56 million nodes).
+    slot: Vec<u32>,
+    /// The data of the nodes that have them.
+    nodes: Vec<NodeData>,
+    /// Rows a sweep works on together ([`WAVE_ROWS`]; 1 is the plain order
+    /// of one row after another, which the tests compare with).
+    wave_rows: usize,
 }
+
+/// The slot of a node without data.
+const FREE: u32 = u32::MAX;
+
+/// Rows a sweep works on together, each two nodes behind the one north of
+/// it ([`Level::solve`]).
+const WAVE_ROWS: usize = 4;
 
 const PAD: usize = 2;
 
@@ -484,15 +503,17 @@ impl Level {
             }
         }
         let width = nx + 2 * PAD;
-        let data = nearest
+        let mut nodes = Vec::new();
+        let slot = nearest
             .iter()
             .enumerate()
-            .map(|(n, e)| {
-                e.map(|(_, k)| {
-                    let b = &m.blocks[k];
+            .map(|(n, e)| match e {
+                None => FREE,
+                Some((_, k)) => {
+                    let b = &m.blocks[*k];
                     let (dx, dy) = (b.u / s - (n % nx) as f64, b.v / s - (n / nx) as f64);
                     let z = b.z - plane.at(b.u, b.v);
-                    NodeData::of(
+                    nodes.push(NodeData::of(
                         Constraint {
                             dx,
                             dy,
@@ -500,8 +521,9 @@ impl Level {
                             z_node: z + s * (plane.b * dx + plane.c * dy),
                         },
                         width,
-                    )
-                })
+                    ));
+                    (nodes.len() - 1) as u32
+                }
             })
             .collect();
         Self {
@@ -509,8 +531,16 @@ impl Level {
             ny,
             spacing,
             z: vec![0.0; (nx + 2 * PAD) * (ny + 2 * PAD)],
-            data,
+            slot,
+            nodes,
+            wave_rows: WAVE_ROWS,
         }
+    }
+
+    /// The data of node `n` (unpadded index), if any.
+    fn data(&self, n: usize) -> Option<NodeData> {
+        let k = self.slot[n];
+        (k != FREE).then(|| self.nodes[k as usize])
     }
 
     fn width(&self) -> usize {
@@ -613,6 +643,14 @@ impl Level {
     /// Over-relaxed sweeps, rows from the north as GMT, until the largest
     /// change of a sweep is at most `limit` or after `max_sweeps`: (sweeps,
     /// largest change of the last one).
+    ///
+    /// A node's update waits for the one before it (its west neighbour,
+    /// just updated), about 60 cycles of latency. So [`WAVE_ROWS`] rows are
+    /// worked on together, each two nodes behind the row north of it: the
+    /// node then reads exactly the values it reads when the rows are swept
+    /// one after another (its north neighbours already updated, its south
+    /// ones not yet), so the result is the same to the bit, and the rows'
+    /// updates overlap in the processor.
     fn solve(
         &mut self,
         s: &MinCurvature,
@@ -621,64 +659,93 @@ impl Level {
         max_sweeps: usize,
     ) -> (usize, f64) {
         let t = s.tension;
-        let w = self.width();
+        let (nx, ny, w) = (self.nx, self.ny, self.width());
         let denom = 20.0 * (1.0 - t) + 4.0 * t;
         if phase == Phase::Data {
-            for j in 0..self.ny {
-                for i in 0..self.nx {
-                    if let Some(NodeData::Fixed(v)) = self.data[j * self.nx + i] {
-                        let p = self.p(i as isize, j as isize);
-                        self.z[p] = v;
-                    }
+            for n in 0..nx * ny {
+                if let Some(NodeData::Fixed(v)) = self.data(n) {
+                    let p = self.p((n % nx) as isize, (n / nx) as isize);
+                    self.z[p] = v;
                 }
             }
         }
+        // Per column and per row, whether it holds the coarser grid's nodes.
+        let held_in = |n: usize| match phase {
+            Phase::Between(held) => (0..n).map(|i| i.is_multiple_of(held)).collect(),
+            Phase::Data => Vec::new(),
+        };
+        let (held_columns, held_rows): (Vec<bool>, Vec<bool>) = (held_in(nx), held_in(ny));
+        // Taken for the sweeps, which change only `z` (and its ghosts).
+        let (nodes, slot) = (
+            std::mem::take(&mut self.nodes),
+            std::mem::take(&mut self.slot),
+        );
+        let relaxation = s.relaxation;
+        // The update of node (i, j) at padded index p; its step.
+        let update = |z: &mut [f64], i: usize, j: usize, p: usize| -> f64 {
+            let data = match phase {
+                Phase::Between(_) if held_rows[j] && held_columns[i] => return 0.0,
+                Phase::Between(_) => None,
+                Phase::Data => match slot[j * nx + i] {
+                    FREE => None,
+                    k => Some(nodes[k as usize]),
+                },
+            };
+            let s1 = z[p + 1] + z[p - 1] + z[p + w] + z[p - w];
+            let s2 = z[p + w + 1] + z[p + w - 1] + z[p - w + 1] + z[p - w - 1];
+            let s3 = z[p + 2] + z[p - 2] + z[p + 2 * w] + z[p - 2 * w];
+            let around = (1.0 - t) * (4.0 * s1 - 2.0 * s2 - s3);
+            let target = match data {
+                None => (around + (4.0 - 3.0 * t) * s1) / denom,
+                Some(NodeData::Fixed(_)) => return 0.0,
+                // (1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0 with
+                // C₀ = Σ aₚ zₚ − A z₀ (module docs), solved for z₀.
+                Some(NodeData::Curvature { at, a, z: zd }) => {
+                    let pi = p as isize;
+                    let sum = a[0] * z[(pi + at[0]) as usize]
+                        + a[1] * z[(pi + at[1]) as usize]
+                        + a[2] * z[(pi + at[2]) as usize]
+                        + a[3] * z[(pi + at[3]) as usize]
+                        + a[4] * zd;
+                    let big_a = a.iter().sum::<f64>();
+                    (around + (4.0 - 3.0 * t) * sum) / (4.0 * (1.0 - t) * (1.0 + big_a) + t * big_a)
+                }
+            };
+            let step = relaxation * (target - z[p]);
+            z[p] += step;
+            step.abs()
+        };
         let mut change = f64::INFINITY;
         let mut sweeps = 0;
         while sweeps < max_sweeps {
             self.fill_ghosts(t);
             change = 0.0;
-            for j in (0..self.ny).rev() {
-                let row = self.p(0, j as isize);
-                for i in 0..self.nx {
-                    let data = match phase {
-                        Phase::Between(held) if i % held == 0 && j % held == 0 => continue,
-                        Phase::Between(_) => None,
-                        Phase::Data => self.data[j * self.nx + i],
-                    };
-                    let p = row + i;
-                    let z = &self.z;
-                    let s1 = z[p + 1] + z[p - 1] + z[p + w] + z[p - w];
-                    let s2 = z[p + w + 1] + z[p + w - 1] + z[p - w + 1] + z[p - w - 1];
-                    let s3 = z[p + 2] + z[p - 2] + z[p + 2 * w] + z[p - 2 * w];
-                    let around = (1.0 - t) * (4.0 * s1 - 2.0 * s2 - s3);
-                    let target = match data {
-                        None => (around + (4.0 - 3.0 * t) * s1) / denom,
-                        Some(NodeData::Fixed(_)) => continue,
-                        // (1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0 with
-                        // C₀ = Σ aₚ zₚ − A z₀ (module docs), solved for z₀.
-                        Some(NodeData::Curvature { at, a, z: zd }) => {
-                            let pi = p as isize;
-                            let sum = a[0] * z[(pi + at[0]) as usize]
-                                + a[1] * z[(pi + at[1]) as usize]
-                                + a[2] * z[(pi + at[2]) as usize]
-                                + a[3] * z[(pi + at[3]) as usize]
-                                + a[4] * zd;
-                            let big_a = a.iter().sum::<f64>();
-                            (around + (4.0 - 3.0 * t) * sum)
-                                / (4.0 * (1.0 - t) * (1.0 + big_a) + t * big_a)
-                        }
-                    };
-                    let step = s.relaxation * (target - self.z[p]);
-                    self.z[p] += step;
-                    change = f64::max(change, step.abs());
+            let z = &mut self.z;
+            let row_start = |j: usize| (j + PAD) * w + PAD;
+            // Rows from the north in groups; in a group, row r (from the
+            // group's north) is at node `step − 2r`.
+            let mut top = ny;
+            while top > 0 {
+                let rows = top.min(self.wave_rows);
+                let lag = 2 * (rows - 1);
+                for step in 0..nx + lag {
+                    // Rows 0..rows at nodes step, step − 2, …, where they
+                    // are inside the grid.
+                    let first = step.saturating_sub(nx - 1).div_ceil(2);
+                    let last = (step / 2).min(rows - 1);
+                    for r in first..=last {
+                        let (i, j) = (step - 2 * r, top - 1 - r);
+                        change = f64::max(change, update(z, i, j, row_start(j) + i));
+                    }
                 }
+                top -= rows;
             }
             sweeps += 1;
             if change <= limit {
                 break;
             }
         }
+        (self.nodes, self.slot) = (nodes, slot);
         (sweeps, change)
     }
 }
@@ -826,6 +893,64 @@ mod tests {
         let a = MinCurvature::default().grid(p, g).unwrap().0;
         let b = MinCurvature::default().grid(p, g).unwrap().0;
         assert!(a.iter().zip(&b).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    /// Sweeping several rows together, each two nodes behind the one
+    /// north of it, gives the plain order's values to the bit, in both
+    /// phases, on a grid whose data include nodes fixed and nodes with a
+    /// curvature rule, with a group of rows left over at the south edge.
+    #[test]
+    fn rows_swept_together_give_the_plain_order_to_the_bit() {
+        let g = GridGeometry::covering(0.0, 1500.0, 0.0, 1050.0, 50.0).unwrap();
+        assert_eq!(g.ny % WAVE_ROWS, 2);
+        let f = |x: f64, y: f64| (x / 300.0).sin() * (y / 200.0).cos();
+        let (mut x, mut y, mut z) = lines(&g, 4, f);
+        // A few data on nodes, which fix them.
+        for k in 1..6 {
+            let (xk, yk) = (
+                g.x0 + 5.0 * g.cell * k as f64,
+                g.y0 + 3.0 * g.cell * k as f64,
+            );
+            x.push(xk);
+            y.push(yk);
+            z.push(f(xk, yk));
+        }
+        let means = BlockMeans::of(Points::new(&x, &y, &z).unwrap(), &g);
+        let plane = Plane::fit(&means);
+        let kinds = |l: &Level| {
+            let fixed = l.nodes.iter().filter(|d| matches!(d, NodeData::Fixed(_)));
+            (fixed.count(), l.nodes.len())
+        };
+        let s = MinCurvature::default();
+        let coarse = {
+            let mut c = Level::new(&g, 2, &means, &plane);
+            c.solve(&s, Phase::Data, 0.0, 5);
+            c
+        };
+        for phase in [Phase::Between(2), Phase::Data] {
+            let run = |rows: usize| {
+                let mut l = Level::new(&g, 1, &means, &plane);
+                let (fixed, all) = kinds(&l);
+                assert!(fixed > 0 && all > fixed, "{fixed} of {all}");
+                l.start_from(&coarse);
+                l.wave_rows = rows;
+                let (sweeps, change) = l.solve(&s, phase, 0.0, 7);
+                assert_eq!(sweeps, 7);
+                (l.z, change)
+            };
+            let (plain, c1) = run(1);
+            for rows in [2, WAVE_ROWS, 7] {
+                let (wave, c) = run(rows);
+                assert_eq!(c.to_bits(), c1.to_bits(), "{phase:?}, {rows} rows");
+                assert!(
+                    plain
+                        .iter()
+                        .zip(&wave)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "{phase:?}, {rows} rows"
+                );
+            }
+        }
     }
 
     #[test]
