@@ -397,11 +397,8 @@ mod tests {
 
     #[test]
     fn apply_keeps_file_lines() {
-        let mut t = crate::read_csv(
-            &write("time,line\n0,1\n1,2\n2,2\n3,1\n"),
-            &crate::ReadOptions::default(),
-        )
-        .unwrap();
+        let (_dir, path) = write("time,line\n0,1\n1,2\n2,2\n3,1\n");
+        let mut t = crate::read_csv(&path, &crate::ReadOptions::default()).unwrap();
         RowSelection::parse(Some("1"), None)
             .unwrap()
             .apply(&mut t)
@@ -416,9 +413,8 @@ mod tests {
     /// the selection, also after two selections.
     #[test]
     fn messages_count_data_rows_of_the_file() {
-        let mut t = crate::read_csv(
-            &write(
-                "time,line,lat
+        let (_dir, path) = write(
+            "time,line,lat
 0,1,45
 1,2,45
 2,2,45
@@ -426,10 +422,8 @@ mod tests {
 4,1,45
 5,1,145
 ",
-            ),
-            &crate::ReadOptions::default(),
-        )
-        .unwrap();
+        );
+        let mut t = crate::read_csv(&path, &crate::ReadOptions::default()).unwrap();
         RowSelection::parse(Some("1"), None)
             .unwrap()
             .apply(&mut t)
@@ -451,14 +445,13 @@ mod tests {
         );
     }
 
-    fn write(text: &str) -> std::path::PathBuf {
-        // One folder per call: tests may run as threads of one process.
-        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-        let k = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("aeromag-select-{}-{k}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("t.csv");
+    /// `text` in a file of a folder removed when the returned guard drops
+    /// (the folders of a counter under the system's temporary folder were
+    /// left behind by every run).
+    fn write(text: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.csv");
         std::fs::write(&p, text).unwrap();
-        p
+        (dir, p)
     }
 }
