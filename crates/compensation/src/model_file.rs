@@ -277,11 +277,26 @@ impl TlModel {
         let expect = m.design.column_names();
         let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
         if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
+            // The first difference, not both lists (2 KB for 43 terms).
+            let k = (0..expect.len().max(got.len()))
+                .find(|&k| expect.get(k).map(String::as_str) != got.get(k).copied())
+                .unwrap_or_default();
+            let named = |name: Option<&str>| name.map_or("none".to_string(), |n| format!("`{n}`"));
+            let lags = match m.design.terms.eddy_lags_s().len() {
+                0 => String::new(),
+                1 => " with 1 eddy lag".to_string(),
+                n => format!(" with {n} eddy lags"),
+            };
             return Err(model_error(
                 origin,
                 format!(
-                    "coefficient names {got:?} do not match terms `{}` ({expect:?})",
-                    m.design.terms
+                    "its terms `{}`{lags} take {} coefficients and it names {}: coefficient {} is {} where the terms have {}",
+                    m.design.terms,
+                    expect.len(),
+                    got.len(),
+                    k + 1,
+                    named(got.get(k).copied()),
+                    named(expect.get(k).map(String::as_str)),
                 ),
             ));
         }
@@ -592,7 +607,30 @@ mod tests {
         assert!(e.to_string().contains("m.json") && e.to_string().contains("other/9"));
         let mut m = sample();
         m.coefficients[0].name = "q".into();
-        assert!(TlModel::from_json(&serde_json::to_string(&m).unwrap(), "m.json").is_err());
+        let e = TlModel::from_json(&serde_json::to_string(&m).unwrap(), "m.json").unwrap_err();
+        assert!(
+            e.to_string()
+                .ends_with("coefficient 1 is `q` where the terms have `p_x`"),
+            "{e}"
+        );
         assert!(TlModel::from_json("{", "m.json").is_err());
+        // One coefficient too many: the counts and the first difference,
+        // not both lists (a lag-count mismatch listed 2 KB of names).
+        let mut m = sample();
+        let mut extra = m.coefficients[0].clone();
+        extra.name = "l2_xx".into();
+        m.coefficients.push(extra);
+        let e = TlModel::from_json(&serde_json::to_string(&m).unwrap(), "m.json")
+            .unwrap_err()
+            .to_string();
+        let n = m.coefficients.len();
+        assert!(
+            e.contains(&format!("take {} coefficients and it names {n}", n - 1))
+                && e.ends_with(&format!(
+                    "coefficient {n} is `l2_xx` where the terms have none"
+                )),
+            "{e}"
+        );
+        assert!(e.len() < 200, "{e}");
     }
 }
