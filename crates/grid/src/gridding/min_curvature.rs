@@ -45,13 +45,18 @@
 //! sweeps ×), as GMT. As GMT does by default, the solve runs on the
 //! slightly larger grid whose dimensions have more common factors and is
 //! cropped: the edge conditions hold at its edges, so this is also what
-//! keeps the two agreeing near the requested edges. The sweeps run in a
-//! fixed order on one thread: the result is bit-identical from run to run.
-//! A node's update waits on its west neighbour's, so a sweep works on four
-//! rows at once, each two nodes behind the row north of it: every node
-//! reads the values it reads in the plain order, row after row (the same
-//! bits), and the four rows' updates overlap in the processor (3.1 times
-//! faster on a 3.5·10⁶-node grid).
+//! keeps the two agreeing near the requested edges.
+//!
+//! **Order**: every node reads the values it reads in the plain
+//! Gauss–Seidel order, row after row from the north, so the result is the
+//! same bits from run to run and for any number of threads. A node's update
+//! waits on its west neighbour's (about 60 cycles), so a sweep works on
+//! groups of four rows, each row two nodes behind the one north of it, and
+//! the four rows' updates overlap in the processor; on grids of 2¹⁷ nodes
+//! or more the groups are shared among up to four threads as a pipeline,
+//! each group two nodes behind the last row of the group north of it. On a
+//! 1738 × 2039-node grid (a 2 m cell on a small survey): 40.5 s with the
+//! former row-after-row sweep, 10.8 s in groups on one thread, 6.9 s on two.
 //!
 //! **Against GMT**: converged, the result equals a direct sparse solve of
 //! the finite-difference system (tools/validate/surface_direct.py) to
@@ -64,6 +69,7 @@ use super::good_size::{Enlargement, enlargement, strides};
 use super::points::{BlockMeans, Points};
 use crate::error::{GridError, Result};
 use crate::grid::GridGeometry;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Settings of minimum-curvature gridding (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -467,6 +473,8 @@ struct Level {
     /// Rows a sweep works on together ([`WAVE_ROWS`]; 1 is the plain order
     /// of one row after another, which the tests compare with).
     wave_rows: usize,
+    /// Threads of a sweep; `None`: chosen by the grid's size.
+    threads: Option<usize>,
 }
 
 /// The slot of a node without data.
@@ -534,6 +542,7 @@ impl Level {
             slot,
             nodes,
             wave_rows: WAVE_ROWS,
+            threads: None,
         }
     }
 
@@ -680,66 +689,65 @@ impl Level {
             std::mem::take(&mut self.nodes),
             std::mem::take(&mut self.slot),
         );
-        let relaxation = s.relaxation;
-        // The update of node (i, j) at padded index p; its step.
-        let update = |z: &mut [f64], i: usize, j: usize, p: usize| -> f64 {
-            let data = match phase {
-                Phase::Between(_) if held_rows[j] && held_columns[i] => return 0.0,
-                Phase::Between(_) => None,
-                Phase::Data => match slot[j * nx + i] {
-                    FREE => None,
-                    k => Some(nodes[k as usize]),
-                },
-            };
-            let s1 = z[p + 1] + z[p - 1] + z[p + w] + z[p - w];
-            let s2 = z[p + w + 1] + z[p + w - 1] + z[p - w + 1] + z[p - w - 1];
-            let s3 = z[p + 2] + z[p - 2] + z[p + 2 * w] + z[p - 2 * w];
-            let around = (1.0 - t) * (4.0 * s1 - 2.0 * s2 - s3);
-            let target = match data {
-                None => (around + (4.0 - 3.0 * t) * s1) / denom,
-                Some(NodeData::Fixed(_)) => return 0.0,
-                // (1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0 with
-                // C₀ = Σ aₚ zₚ − A z₀ (module docs), solved for z₀.
-                Some(NodeData::Curvature { at, a, z: zd }) => {
-                    let pi = p as isize;
-                    let sum = a[0] * z[(pi + at[0]) as usize]
-                        + a[1] * z[(pi + at[1]) as usize]
-                        + a[2] * z[(pi + at[2]) as usize]
-                        + a[3] * z[(pi + at[3]) as usize]
-                        + a[4] * zd;
-                    let big_a = a.iter().sum::<f64>();
-                    (around + (4.0 - 3.0 * t) * sum) / (4.0 * (1.0 - t) * (1.0 + big_a) + t * big_a)
-                }
-            };
-            let step = relaxation * (target - z[p]);
-            z[p] += step;
-            step.abs()
+        let sweep = Sweep {
+            phase,
+            t,
+            relaxation: s.relaxation,
+            denom,
+            nx,
+            w,
+            held_rows: &held_rows,
+            held_columns: &held_columns,
+            slot: &slot,
+            nodes: &nodes,
         };
+        // Groups of rows from the north: (top row + 1, rows).
+        let mut groups = Vec::new();
+        let mut top = ny;
+        while top > 0 {
+            let rows = top.min(self.wave_rows);
+            groups.push((top, rows));
+            top -= rows;
+        }
+        let threads = match self.threads {
+            Some(n) => n,
+            None if nx * ny >= THREADED_NODES && nx >= 64 => {
+                aeromag_core::parallel::threads().min(MAX_SWEEP_THREADS)
+            }
+            None => 1,
+        }
+        .clamp(1, groups.len());
+        let done: Vec<AtomicUsize> = groups.iter().map(|_| AtomicUsize::new(0)).collect();
         let mut change = f64::INFINITY;
         let mut sweeps = 0;
         while sweeps < max_sweeps {
             self.fill_ghosts(t);
-            change = 0.0;
-            let z = &mut self.z;
-            let row_start = |j: usize| (j + PAD) * w + PAD;
-            // Rows from the north in groups; in a group, row r (from the
-            // group's north) is at node `step − 2r`.
-            let mut top = ny;
-            while top > 0 {
-                let rows = top.min(self.wave_rows);
-                let lag = 2 * (rows - 1);
-                for step in 0..nx + lag {
-                    // Rows 0..rows at nodes step, step − 2, …, where they
-                    // are inside the grid.
-                    let first = step.saturating_sub(nx - 1).div_ceil(2);
-                    let last = (step / 2).min(rows - 1);
-                    for r in first..=last {
-                        let (i, j) = (step - 2 * r, top - 1 - r);
-                        change = f64::max(change, update(z, i, j, row_start(j) + i));
-                    }
+            let z = Padded(self.z.as_mut_ptr());
+            done.iter().for_each(|d| d.store(0, Ordering::Relaxed));
+            // Thread k sweeps groups k, k + threads, …; its largest change.
+            let part = |k: usize| -> f64 {
+                let z = &z;
+                let mut change = 0.0f64;
+                for g in (k..groups.len()).step_by(threads) {
+                    let before = g.checked_sub(1).map(|h| (&done[h], groups[h].1));
+                    // SAFETY: `z` is the padded grid, each node written by
+                    // the one thread sweeping its group; see `Sweep::group`.
+                    change = change.max(unsafe { sweep.group(z, groups[g], before, &done[g]) });
                 }
-                top -= rows;
-            }
+                change
+            };
+            change = if threads == 1 {
+                part(0)
+            } else {
+                std::thread::scope(|scope| {
+                    let others: Vec<_> =
+                        (1..threads).map(|k| scope.spawn(move || part(k))).collect();
+                    others
+                        .into_iter()
+                        .map(|h| h.join().expect("a sweep thread panicked"))
+                        .fold(part(0), f64::max)
+                })
+            };
             sweeps += 1;
             if change <= limit {
                 break;
@@ -747,6 +755,143 @@ impl Level {
         }
         (self.nodes, self.slot) = (nodes, slot);
         (sweeps, change)
+    }
+}
+
+/// Nodes from which a sweep's rows are shared among threads.
+const THREADED_NODES: usize = 1 << 17;
+
+/// Most threads a sweep takes: the groups of rows form a pipeline, each
+/// waiting on the one north of it.
+const MAX_SWEEP_THREADS: usize = 4;
+
+/// Completed steps a group publishes at once.
+const PUBLISH_EVERY: usize = 16;
+
+/// The padded values of a level, written by the threads of a sweep.
+#[derive(Clone, Copy)]
+struct Padded(*mut f64);
+
+// SAFETY: the threads of a sweep write disjoint rows (their groups) and read
+// another thread's rows only as the progress counters allow
+// (`Sweep::group`).
+unsafe impl Send for Padded {}
+unsafe impl Sync for Padded {}
+
+/// What one sweep of a level needs to update its nodes.
+struct Sweep<'a> {
+    phase: Phase,
+    t: f64,
+    relaxation: f64,
+    denom: f64,
+    nx: usize,
+    /// Padded row width.
+    w: usize,
+    held_rows: &'a [bool],
+    held_columns: &'a [bool],
+    slot: &'a [u32],
+    nodes: &'a [NodeData],
+}
+
+impl Sweep<'_> {
+    /// Update node (i, j) at padded index `p`; the size of its step.
+    ///
+    /// # Safety
+    /// `z` is the padded grid of this level and (i, j) a node of it (so
+    /// `p ± 2w ± 2` lie inside), and no other thread writes the nodes it
+    /// reads meanwhile.
+    #[inline(always)]
+    unsafe fn update(&self, z: Padded, i: usize, j: usize, p: usize) -> f64 {
+        let (t, w) = (self.t, self.w);
+        let data = match self.phase {
+            Phase::Between(_) if self.held_rows[j] && self.held_columns[i] => return 0.0,
+            Phase::Between(_) => None,
+            Phase::Data => match self.slot[j * self.nx + i] {
+                FREE => None,
+                k => Some(self.nodes[k as usize]),
+            },
+        };
+        // SAFETY: as the caller promises.
+        let at = |q: usize| unsafe { *z.0.add(q) };
+        let s1 = at(p + 1) + at(p - 1) + at(p + w) + at(p - w);
+        let s2 = at(p + w + 1) + at(p + w - 1) + at(p - w + 1) + at(p - w - 1);
+        let s3 = at(p + 2) + at(p - 2) + at(p + 2 * w) + at(p - 2 * w);
+        let around = (1.0 - t) * (4.0 * s1 - 2.0 * s2 - s3);
+        let target = match data {
+            None => (around + (4.0 - 3.0 * t) * s1) / self.denom,
+            Some(NodeData::Fixed(_)) => return 0.0,
+            // (1 − T)(Σₖ Cₖ − 4 C₀) − T C₀ = 0 with
+            // C₀ = Σ aₚ zₚ − A z₀ (module docs), solved for z₀.
+            Some(NodeData::Curvature { at: o, a, z: zd }) => {
+                let q = |k: usize| at(p.wrapping_add_signed(o[k]));
+                let sum = a[0] * q(0) + a[1] * q(1) + a[2] * q(2) + a[3] * q(3) + a[4] * zd;
+                let big_a = a.iter().sum::<f64>();
+                (around + (4.0 - 3.0 * t) * sum) / (4.0 * (1.0 - t) * (1.0 + big_a) + t * big_a)
+            }
+        };
+        let step = self.relaxation * (target - at(p));
+        // SAFETY: as the caller promises.
+        unsafe { *z.0.add(p) += step };
+        step.abs()
+    }
+
+    /// Sweep the group of `rows` rows below row `top` (exclusive), row r
+    /// (from the group's north) at node `step − 2r`, publishing its
+    /// completed steps in `done`; `before` is the group north of it (its
+    /// counter and rows), on another thread. Its largest step.
+    ///
+    /// The group's first row at node i reads the row north of it at
+    /// i + 1, which that group's last row updates at its step
+    /// i + 1 + 2 (rows − 1): so the group waits until the one before has
+    /// completed step i + 2·rows. The group before reads this group's rows
+    /// only at nodes this group reaches later (the same two-node lag), so
+    /// every node reads the values of the plain order, row after row.
+    ///
+    /// # Safety
+    /// `z` is the padded grid; every group is swept by one thread, after
+    /// `done` of every group was reset to 0.
+    unsafe fn group(
+        &self,
+        z: &Padded,
+        (top, rows): (usize, usize),
+        before: Option<(&AtomicUsize, usize)>,
+        done: &AtomicUsize,
+    ) -> f64 {
+        let nx = self.nx;
+        let lag = 2 * (rows - 1);
+        let row_start = |j: usize| (j + PAD) * self.w + PAD;
+        let mut change = 0.0f64;
+        let mut known = 0;
+        for step in 0..nx + lag {
+            if let Some((counter, rows_before)) = before {
+                let need = (step + 2 * rows_before).min(nx + 2 * (rows_before - 1));
+                let mut spins = 0u32;
+                while known < need {
+                    known = counter.load(Ordering::Acquire);
+                    if known < need {
+                        spins += 1;
+                        if spins < 1 << 10 {
+                            std::hint::spin_loop();
+                        } else {
+                            std::thread::yield_now();
+                        }
+                    }
+                }
+            }
+            // Rows 0..rows at nodes step, step − 2, …, inside the grid.
+            let first = step.saturating_sub(nx - 1).div_ceil(2);
+            let last = (step / 2).min(rows - 1);
+            for r in first..=last {
+                let (i, j) = (step - 2 * r, top - 1 - r);
+                // SAFETY: (i, j) is a node; see above for the threads.
+                change = change.max(unsafe { self.update(*z, i, j, row_start(j) + i) });
+            }
+            if (step + 1).is_multiple_of(PUBLISH_EVERY) {
+                done.store(step + 1, Ordering::Release);
+            }
+        }
+        done.store(nx + lag, Ordering::Release);
+        change
     }
 }
 
@@ -896,7 +1041,8 @@ mod tests {
     }
 
     /// Sweeping several rows together, each two nodes behind the one
-    /// north of it, gives the plain order's values to the bit, in both
+    /// north of it, on one thread or with the groups of rows shared among
+    /// threads, gives the plain order's values to the bit, in both
     /// phases, on a grid whose data include nodes fixed and nodes with a
     /// curvature rule, with a group of rows left over at the south edge.
     #[test]
@@ -928,26 +1074,36 @@ mod tests {
             c
         };
         for phase in [Phase::Between(2), Phase::Data] {
-            let run = |rows: usize| {
+            let run = |rows: usize, threads: usize| {
                 let mut l = Level::new(&g, 1, &means, &plane);
                 let (fixed, all) = kinds(&l);
                 assert!(fixed > 0 && all > fixed, "{fixed} of {all}");
                 l.start_from(&coarse);
                 l.wave_rows = rows;
+                l.threads = Some(threads);
                 let (sweeps, change) = l.solve(&s, phase, 0.0, 7);
                 assert_eq!(sweeps, 7);
                 (l.z, change)
             };
-            let (plain, c1) = run(1);
-            for rows in [2, WAVE_ROWS, 7] {
-                let (wave, c) = run(rows);
-                assert_eq!(c.to_bits(), c1.to_bits(), "{phase:?}, {rows} rows");
+            let (plain, c1) = run(1, 1);
+            for (rows, threads) in [
+                (2, 1),
+                (WAVE_ROWS, 1),
+                (7, 1),
+                (1, 2),
+                (WAVE_ROWS, 2),
+                (WAVE_ROWS, 3),
+                (2, 4),
+            ] {
+                let (wave, c) = run(rows, threads);
+                let case = format!("{phase:?}, {rows} rows, {threads} threads");
+                assert_eq!(c.to_bits(), c1.to_bits(), "{case}");
                 assert!(
                     plain
                         .iter()
                         .zip(&wave)
                         .all(|(a, b)| a.to_bits() == b.to_bits()),
-                    "{phase:?}, {rows} rows"
+                    "{case}"
                 );
             }
         }
