@@ -622,3 +622,58 @@ fn adaptive_stream_equals_the_adaptive_flight_bit_for_bit() {
         );
     }
 }
+
+/// Found by fuzzing the stream: `--adapt kalman --speed 0` on an aircraft
+/// flying 70 m/s drifted its coefficients about 50 nT, silently. With
+/// positions in the stream, each 10 s stretch whose path gives a ground
+/// speed far from `--speed` is counted and named in a warning; the right
+/// speed is not.
+#[test]
+fn a_speed_the_positions_disagree_with_is_warned_of() {
+    use aeromag::online::Adapt;
+    let model = model();
+    let dir = tempfile::tempdir().unwrap();
+    let (path, lines) = survey_csv(dir.path());
+    let flight = Flight::read(&path).unwrap();
+    let (vn, ve) = (flight.require("vn").unwrap(), flight.require("ve").unwrap());
+    let mut speeds: Vec<f64> = (0..5000).map(|k| vn[k].hypot(ve[k])).collect();
+    speeds.sort_by(f64::total_cmp);
+    let flown = speeds[2500];
+    assert!(flown > 30.0, "{flown} m/s");
+    // The velocity columns hidden: the speed is `--speed`'s.
+    let header = lines[0]
+        .replace(",vn,", ",v_north,")
+        .replace(",ve,", ",v_east,");
+    assert_ne!(header, lines[0]);
+    let run = |speed: f64| {
+        let opts = StreamOptions {
+            adapt: Some(Adapt::Kalman),
+            speed_m_s: Some(speed),
+            ..StreamOptions::default()
+        };
+        let mut lc = LineCompensator::new(&model, &header, &opts).unwrap();
+        let mut out = String::new();
+        for l in &lines[1..5001] {
+            lc.line(l, &mut out);
+        }
+        lc.issues().clone()
+    };
+    assert_eq!(run(flown).speed.count, 0);
+    let issues = run(0.0);
+    // 500 s of lines: about 50 stretches, every one moving.
+    assert!(issues.speed.count >= 40, "{:?}", issues.speed);
+    let warned: Vec<String> = issues
+        .warnings()
+        .iter()
+        .map(|n| n.message.clone())
+        .filter(|m| m.contains("--speed"))
+        .collect();
+    assert_eq!(warned.len(), 1, "{warned:?}");
+    assert!(
+        warned[0]
+            .contains("ending 10 s stretches whose positions give a ground speed far from --speed")
+            && warned[0].contains("against --speed 0)"),
+        "{}",
+        warned[0]
+    );
+}

@@ -145,6 +145,16 @@ pub const MAX_MEDIAN_GROUND_SPEED_M_S: f64 = aeromag_core::field::MAX_GROUND_SPE
 /// every 5 s or more.
 pub const MIN_MOVING_SPEED_M_S: f64 = 1.0;
 
+/// The distance between two nearby positions `[lat, lon]` (degrees), m:
+/// equirectangular on a 6 371 km sphere, at the first one's latitude (for
+/// the step between consecutive samples, not for long distances).
+pub fn step_distance_m(a: [f64; 2], b: [f64; 2]) -> f64 {
+    const EARTH_RADIUS_M: f64 = 6_371_000.0;
+    let dlat = (b[0] - a[0]).to_radians();
+    let dlon = (b[1] - a[1]).to_radians() * a[0].to_radians().cos();
+    EARTH_RADIUS_M * dlat.hypot(dlon)
+}
+
 /// The median distance between rows (m) from which [`MIN_MOVING_SPEED_M_S`]
 /// applies.
 pub const MIN_MOVING_STEP_M: f64 = 5.0;
@@ -648,13 +658,8 @@ impl Ctx<'_> {
         let Some(t) = self.table.column("time") else {
             return;
         };
-        const EARTH_RADIUS_M: f64 = 6_371_000.0;
         let step = |i: usize| t[i + 1] - t[i];
-        let distance = |i: usize| {
-            let dlat = (lat[i + 1] - lat[i]).to_radians();
-            let dlon = (lon[i + 1] - lon[i]).to_radians() * lat[i].to_radians().cos();
-            EARTH_RADIUS_M * dlat.hypot(dlon)
-        };
+        let distance = |i: usize| step_distance_m([lat[i], lon[i]], [lat[i + 1], lon[i + 1]]);
         // Over steps forward in time only (NaN is left out of a median).
         let forward = |i: usize, v: f64| if step(i) > 0.0 { v } else { f64::NAN };
         let speed = |i: usize| forward(i, distance(i) / step(i));

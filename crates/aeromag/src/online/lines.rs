@@ -8,6 +8,7 @@ use crate::observer::Note;
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::adaptive::Navigation;
 use aeromag_compensation::tolles_lawson::online::{OnlineSample, SampleStatus};
+use aeromag_core::error::shown;
 use aeromag_io::ColumnMap;
 
 /// The columns a stream's lines gain.
@@ -16,6 +17,55 @@ pub const STREAM_OUTPUT: [&str; 3] = ["mag_interf", "mag_comp", "comp_flag"];
 /// The largest ground speed `--speed` may give, m/s: three times a jet
 /// survey's; beyond it the along-track field model's arithmetic fails.
 pub const MAX_GROUND_SPEED_M_S: f64 = 1000.0;
+
+/// The stretch of a stream, s, over which its positions' ground speed is
+/// measured against `--speed` ([`StreamIssues::speed`]): long enough that
+/// the position noise of a GNSS receiver (metres) is a small part of the
+/// path (hundreds of metres at survey speeds).
+pub const SPEED_STRETCH_S: f64 = 10.0;
+
+/// The longest time step, s, within a stretch of [`SPEED_STRETCH_S`]: a
+/// gap restarts the stretch (the path across it is unknown).
+pub const SPEED_STRETCH_GAP_S: f64 = 2.0;
+
+/// Whether a ground speed measured from positions, `measured_m_s`,
+/// disagrees with the one given, `given_m_s`: by more than 5 m/s and by
+/// more than half the larger of the two (0 given at 70 m/s does; 60 given
+/// at 70 does not).
+pub fn speed_disagrees(measured_m_s: f64, given_m_s: f64) -> bool {
+    (measured_m_s - given_m_s).abs() > f64::max(5.0, 0.5 * measured_m_s.max(given_m_s))
+}
+
+/// The ground speed a stream's positions give over stretches of
+/// [`SPEED_STRETCH_S`] (path length over time).
+#[derive(Debug, Clone, Default)]
+struct SpeedCheck {
+    /// The stretch's start time, s, and its path so far, m.
+    start_s: f64,
+    path_m: f64,
+    /// The last line's time, s, and position `[lat, lon]`, degrees.
+    last: Option<(f64, [f64; 2])>,
+}
+
+impl SpeedCheck {
+    /// Take a line's time and position; the stretch's speed, m/s, and
+    /// length, s, when it is complete (a new one then starts).
+    fn push(&mut self, time_s: f64, position: [f64; 2]) -> Option<(f64, f64)> {
+        match self.last {
+            Some((t, p)) if time_s > t && time_s - t <= SPEED_STRETCH_GAP_S => {
+                self.path_m += aeromag_io::step_distance_m(p, position);
+            }
+            _ => (self.start_s, self.path_m) = (time_s, 0.0),
+        }
+        self.last = Some((time_s, position));
+        let span = time_s - self.start_s;
+        (span >= SPEED_STRETCH_S).then(|| {
+            let v = self.path_m / span;
+            (self.start_s, self.path_m) = (time_s, 0.0);
+            (v, span)
+        })
+    }
+}
 
 /// `comp_flag` of an output line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -167,6 +217,10 @@ pub struct StreamIssues {
     /// Lines whose modelled interference is beyond any magnetic field
     /// (flag 1; a model file that does not fit the stream).
     pub beyond_field: LineIssue,
+    /// Lines ending a stretch of [`SPEED_STRETCH_S`] whose positions give a
+    /// ground speed far from `--speed` ([`speed_disagrees`]; the Kalman
+    /// filter's field model then runs along the track at the wrong pace).
+    pub speed: LineIssue,
 }
 
 impl StreamIssues {
@@ -176,6 +230,7 @@ impl StreamIssues {
             malformed: self.malformed.then(&later.malformed),
             not_reading: self.not_reading.then(&later.not_reading),
             beyond_field: self.beyond_field.then(&later.beyond_field),
+            speed: self.speed.then(&later.speed),
         }
     }
 
@@ -193,6 +248,10 @@ impl StreamIssues {
             self.beyond_field.told(
                 "whose modelled interference is beyond any magnetic field",
                 ": the model file does not fit this stream (an edited coefficient, another aircraft's model?); not compensated (comp_flag 1)",
+            ),
+            self.speed.told(
+                &format!("ending {} s stretches whose positions give a ground speed far from --speed", shown(SPEED_STRETCH_S)),
+                ": the adaptive Kalman filter's field model runs along the track at the speed given; give the stream's ground speed (--speed) or map its velocity (--columns vn=NAME,ve=NAME)",
             ),
         ]
         .into_iter()
@@ -226,8 +285,8 @@ struct Fields {
     flux: [usize; 3],
     mag: usize,
     channels: Vec<usize>,
-    /// `vn`, `ve`, `alt` (adaptive mode, when present).
-    nav: [Option<usize>; 3],
+    /// `vn`, `ve`, `alt`, `lat`, `lon` (adaptive mode, when present).
+    nav: [Option<usize>; 5],
     /// The last input's position.
     last: usize,
     /// Cells per line.
@@ -247,8 +306,11 @@ pub struct LineCompensator {
     counts: StreamCounts,
     issues: StreamIssues,
     channels: Vec<f64>,
-    /// `vn`, `ve`, `alt` of the current line (NaN when absent).
-    nav: [f64; 3],
+    /// `vn`, `ve`, `alt`, `lat`, `lon` of the current line (NaN when
+    /// absent).
+    nav: [f64; 5],
+    /// The positions' ground speed, when the speed is `--speed`'s.
+    speed_check: SpeedCheck,
 }
 
 impl LineCompensator {
@@ -319,10 +381,15 @@ impl LineCompensator {
                     ))
                 })
         };
-        let nav = match opts.adapt {
-            Some(_) => ["vn", "ve", "alt"].map(lookup),
-            None => [None; 3],
+        let mut nav = match opts.adapt {
+            Some(_) => ["vn", "ve", "alt", "lat", "lon"].map(lookup),
+            None => [None; 5],
         };
+        // The position is read only to check `--speed` (the Kalman filter
+        // without `vn`, `ve`).
+        if opts.adapt != Some(Adapt::Kalman) || (nav[0].is_some() && nav[1].is_some()) {
+            (nav[3], nav[4]) = (None, None);
+        }
         let speed_m_s = match opts.speed_m_s {
             Some(v) if !(0.0..=MAX_GROUND_SPEED_M_S).contains(&v) => {
                 return Err(Error::bad_input(format!(
@@ -389,7 +456,8 @@ impl LineCompensator {
         }
         Ok(Self {
             channels: vec![0.0; fields.channels.len()],
-            nav: [f64::NAN; 3],
+            nav: [f64::NAN; 5],
+            speed_check: SpeedCheck::default(),
             engine,
             speed_m_s,
             fields,
@@ -425,10 +493,27 @@ impl LineCompensator {
                     mag_nt,
                     channels: &self.channels,
                 };
-                let [vn, ve, alt] = self.nav;
+                let [vn, ve, alt, lat, lon] = self.nav;
                 let speed_m_s = if self.fields.nav[0].is_some() && self.fields.nav[1].is_some() {
                     vn.hypot(ve)
                 } else {
+                    // `--speed`, against the positions when there are any.
+                    if !self.speed_m_s.is_nan()
+                        && lat.is_finite()
+                        && lon.is_finite()
+                        && let Some((v, span)) = self.speed_check.push(time_s, [lat, lon])
+                        && speed_disagrees(v, self.speed_m_s)
+                    {
+                        self.issues.speed.add(
+                            at,
+                            format!(
+                                "{} m/s over {} s against --speed {}",
+                                shown((v * 10.0).round() / 10.0),
+                                shown((span * 10.0).round() / 10.0),
+                                shown(self.speed_m_s)
+                            ),
+                        );
+                    }
                     self.speed_m_s
                 };
                 let (o, beyond) = self.engine.push_told(

@@ -70,7 +70,8 @@ pub struct Args {
     #[arg(long, value_name = "METHOD")]
     adapt: Option<Adapt>,
     /// Ground speed, m/s, when the stream has no vn, ve columns (--adapt
-    /// kalman; at most 1000).
+    /// kalman; at most 1000). With lat, lon in the stream, 10 s stretches
+    /// whose path gives a speed far from it are warned of.
     #[arg(long, value_name = "M/S", requires = "adapt")]
     speed: Option<f64>,
     /// Random-walk intensity of the permanent coefficients, nT/√h
