@@ -231,10 +231,17 @@ impl Compensator for RotorModelFile {
             observer.note(&n);
         }
         let mut out = vec![f64::NAN; flight.n_rows()];
-        for r in cols.usable_stretches(flight, fs)? {
-            let t = track_segment(self, &cols, &r, fs, &flight.label()).in_file(&flight.label())?;
-            let p = t.predict(self, fs)?;
-            out[r].copy_from_slice(&p);
+        // Each stretch alone, the stretches on the cores; the first failure
+        // in their order reported.
+        let stretches = cols.usable_stretches(flight, fs)?;
+        let label = flight.label();
+        let threads = aeromag_core::parallel::threads();
+        let predicted = aeromag_core::parallel::parallel_map(stretches.len(), threads, |i| {
+            let t = track_segment(self, &cols, &stretches[i], fs, &label).in_file(&label)?;
+            t.predict(self, fs)
+        });
+        for (r, p) in stretches.into_iter().zip(predicted) {
+            out[r].copy_from_slice(&p?);
         }
         // A bridged row keeps its stretch whole, but its interference is
         // given only where its own readings are.

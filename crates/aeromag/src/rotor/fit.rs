@@ -596,13 +596,14 @@ pub fn fit_rotor(
     // angles tracked as `rotor apply` would.
     if segs.len() > 1 {
         for _ in 0..REFINE_ITERATIONS {
-            let tracked = segs
-                .iter()
-                .map(|s| track_segment(&model, &cols, s, fs, &file))
-                .collect::<Result<Vec<_>>>()?;
-            let regs: Vec<Vec<Vec<f64>>> = tracked
-                .iter()
-                .map(|t| t.columns(&model, fs))
+            // Each stretch tracked alone: the stretches on the cores, the
+            // first failure in their order reported.
+            let threads = aeromag_core::parallel::threads();
+            let regs: Vec<Vec<Vec<f64>>> =
+                aeromag_core::parallel::parallel_map(segs.len(), threads, |i| {
+                    track_segment(&model, &cols, &segs[i], fs, &file)?.columns(&model, fs)
+                })
+                .into_iter()
                 .collect::<Result<_>>()?;
             let records: Vec<(&[Vec<f64>], &[f64])> = regs
                 .iter()

@@ -85,6 +85,10 @@ impl RotorInput<'_> {
     }
 }
 
+/// Rows of the regressors computed together on one core (a part's columns
+/// stay near the caches).
+const ROWS_PER_PART: usize = 4096;
+
 /// Regressor columns (nT per unit of each parameter; blade-major order,
 /// within a blade: hard along, soft along, eddy, then for
 /// [`BladeTerms::Full`] hard lead, hard up, soft lead, soft up).
@@ -102,41 +106,57 @@ pub fn regressors(
     let hub_from_body = geom.body_from_hub()?.transpose();
     let a = hub_from_body * geom.sensor_from_hub();
     let mut cols = vec![vec![0.0; n]; nb * pb];
-    for k in 0..n {
-        let b = hub_from_body * input.b_body_nt[k] * 1e-9;
-        let bn = b.norm();
-        if !(bn.is_finite() && bn > 0.0) {
-            return Err(CompError::data(format!(
-                "rotor input: field at sample {k} is zero or not finite"
-            )));
-        }
-        let e = b / bn;
-        let w = Vector3::new(0.0, 0.0, input.omega_rad_s[k]);
-        let wb = w.cross(&b);
-        for j in 0..nb {
-            let psi = input.phase_rad[k] + std::f64::consts::TAU * j as f64 / nb as f64;
-            let r = blade_axes(psi, input.angles_at(k));
-            let (rp, el, eu) = (
-                r.column(0).into_owned(),
-                r.column(1).into_owned(),
-                r.column(2).into_owned(),
-            );
-            let g = dipole_integral(&a, &rp, geom.root_m, geom.tip_m)
-                .map_err(|_| on_blade_line(geom, j, k, psi))?
-                .transpose()
-                * e
-                * 1e9;
-            let c = j * pb;
-            cols[c][k] = g.dot(&rp);
-            cols[c + 1][k] = g.dot(&rp) * rp.dot(&b) / MU0;
-            cols[c + 2][k] = g.dot(&wb);
-            if terms == BladeTerms::Full {
-                cols[c + 3][k] = g.dot(&el);
-                cols[c + 4][k] = g.dot(&eu);
-                cols[c + 5][k] = g.dot(&el) * el.dot(&b) / MU0;
-                cols[c + 6][k] = g.dot(&eu) * eu.dot(&b) / MU0;
+    // Rows are independent: parts of them on the cores, each part's first
+    // failure kept, the earliest of all reported (as one pass would).
+    let failures = std::sync::Mutex::new(Vec::new());
+    let mut outs: Vec<&mut [f64]> = cols.iter_mut().map(|c| c.as_mut_slice()).collect();
+    let threads = aeromag_core::parallel::threads();
+    aeromag_core::parallel::for_each_rows_mut(&mut outs, threads, ROWS_PER_PART, |start, parts| {
+        for (i, k) in (start..start + parts[0].len()).enumerate() {
+            let b = hub_from_body * input.b_body_nt[k] * 1e-9;
+            let bn = b.norm();
+            if !(bn.is_finite() && bn > 0.0) {
+                let e = CompError::data(format!(
+                    "rotor input: field at sample {k} is zero or not finite"
+                ));
+                failures.lock().expect("no panic holds it").push((k, e));
+                return;
+            }
+            let e = b / bn;
+            let w = Vector3::new(0.0, 0.0, input.omega_rad_s[k]);
+            let wb = w.cross(&b);
+            for j in 0..nb {
+                let psi = input.phase_rad[k] + std::f64::consts::TAU * j as f64 / nb as f64;
+                let r = blade_axes(psi, input.angles_at(k));
+                let (rp, el, eu) = (
+                    r.column(0).into_owned(),
+                    r.column(1).into_owned(),
+                    r.column(2).into_owned(),
+                );
+                let g = match dipole_integral(&a, &rp, geom.root_m, geom.tip_m) {
+                    Ok(g) => g.transpose() * e * 1e9,
+                    Err(_) => {
+                        let e = on_blade_line(geom, j, k, psi);
+                        failures.lock().expect("no panic holds it").push((k, e));
+                        return;
+                    }
+                };
+                let c = j * pb;
+                parts[c][i] = g.dot(&rp);
+                parts[c + 1][i] = g.dot(&rp) * rp.dot(&b) / MU0;
+                parts[c + 2][i] = g.dot(&wb);
+                if terms == BladeTerms::Full {
+                    parts[c + 3][i] = g.dot(&el);
+                    parts[c + 4][i] = g.dot(&eu);
+                    parts[c + 5][i] = g.dot(&el) * el.dot(&b) / MU0;
+                    parts[c + 6][i] = g.dot(&eu) * eu.dot(&b) / MU0;
+                }
             }
         }
+    });
+    let failures = failures.into_inner().expect("no panic holds it");
+    if let Some((_, e)) = failures.into_iter().min_by_key(|(k, _)| *k) {
+        return Err(e);
     }
     Ok(cols)
 }
@@ -332,5 +352,52 @@ mod tests {
         let mut off = geom.clone();
         off.sensor_m[2] = -2.0;
         assert!(regressors(&off, BladeTerms::Simplified, &input).is_ok());
+    }
+
+    /// The rows are computed in parts on the cores: the same columns as
+    /// row by row, and of two bad samples in different parts the earlier
+    /// is named, as one pass names it.
+    #[test]
+    fn rows_in_parts_give_the_columns_and_the_first_failure_of_one_pass() {
+        let geom = RotorGeometry::main_rotor([0.0, 0.0, -2.6], [5.0, 0.0, -2.0], 0.8, 7.5, 4);
+        let n = 3 * ROWS_PER_PART + 17;
+        let mut b: Vec<Vector3<f64>> = (0..n)
+            .map(|k| Vector3::new(20_000.0 + k as f64, -3_000.0, 45_000.0))
+            .collect();
+        let phase: Vec<f64> = (0..n).map(|k| 0.3 * k as f64).collect();
+        let nominal = [FlapAngles {
+            coning_rad: 0.05,
+            tilt_lon_rad: 0.01,
+            tilt_lat_rad: -0.02,
+        }];
+        let input = |b: &[Vector3<f64>]| -> Result<Vec<Vec<f64>>> {
+            let inp = RotorInput {
+                b_body_nt: b,
+                phase_rad: &phase,
+                omega_rad_s: &vec![30.0; n],
+                angles: &nominal,
+            };
+            regressors(&geom, BladeTerms::Full, &inp)
+        };
+        let all = input(&b).unwrap();
+        for k in [0, ROWS_PER_PART + 3, n - 1] {
+            let one = RotorInput {
+                b_body_nt: &b[k..=k],
+                phase_rad: &phase[k..=k],
+                omega_rad_s: &[30.0],
+                angles: &nominal,
+            };
+            let row = regressors(&geom, BladeTerms::Full, &one).unwrap();
+            for (c, r) in all.iter().zip(&row) {
+                assert_eq!(c[k].to_bits(), r[0].to_bits(), "row {k}");
+            }
+        }
+        b[n - 5] = Vector3::zeros();
+        b[ROWS_PER_PART + 1] = Vector3::new(f64::NAN, 0.0, 0.0);
+        let e = input(&b).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("field at sample {} is zero", ROWS_PER_PART + 1)),
+            "{e}"
+        );
     }
 }
