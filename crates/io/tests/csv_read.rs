@@ -60,6 +60,21 @@ fn cr_only_line_ends_are_named() {
         assert!(e.is_bad_input());
         assert_mentions(&e.to_string(), &[name, "line 1", "\\r alone"]);
     }
+    // A long one is named so too, not "the header has 360019 columns".
+    let rows = "0.1,53001\r".repeat(60_000);
+    for (name, text) in [
+        ("long_mac.csv", format!("time,mag\r{rows}")),
+        (
+            "long_mac.xyz",
+            format!("TIME MAG\r{}", rows.replace(',', " ")),
+        ),
+    ] {
+        let e = fx.read(name, &text).unwrap_err();
+        assert!(
+            matches!(e, IoError::CrLineEnds { line: 1, .. }),
+            "{name}: {e:?}"
+        );
+    }
     // A CRLF file with a quoted header name still reads.
     let t = fx.read("q.csv", "time,\"mag\"\r\n0,53000\r\n").unwrap();
     assert_eq!(t.column_names(), vec!["time", "mag"]);
