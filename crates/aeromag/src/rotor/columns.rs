@@ -172,9 +172,31 @@ impl<'a> RotorColumns<'a> {
         let mag = without(self.mag, &mag_spikes);
         // A glitch of the phase channel (a corrupted cell) stands out of
         // its unwrapped line by up to 180°.
-        let phase_spikes = self
-            .phase
-            .map_or_else(Vec::new, |p| spikes(&unwrapped_deg(p), PHASE_GLITCH_DEG));
+        // A block of samples offset from the rest (a step and a step back)
+        // is off the level most samples keep.
+        // Levels are sorted out between time gaps (the phase across one is
+        // unknown: each stretch is tracked alone).
+        let phase_spikes = self.phase.map_or_else(Vec::new, |p| {
+            let u = unwrapped_deg(p);
+            let mut at = spikes(&u, PHASE_GLITCH_DEG);
+            let dt = median_step(self.time);
+            let mut start = 0;
+            for k in 1..=u.len() {
+                // A step beyond the gap rule, or not a number, parts them.
+                let regular = |k: usize| (self.time[k] - self.time[k - 1]) <= dt * GAP_FACTOR;
+                if k == u.len() || !regular(k) {
+                    at.extend(
+                        off_level(&u[start..k], PHASE_GLITCH_DEG)
+                            .iter()
+                            .map(|i| i + start),
+                    );
+                    start = k;
+                }
+            }
+            at.sort_unstable();
+            at.dedup();
+            at
+        });
         let phase = self.phase.map(|p| without(p, &phase_spikes));
         let columns: Vec<Vec<f64>> = raw
             .iter()
@@ -260,12 +282,13 @@ impl Bridged {
         if let Some(&first) = self.phase_spikes.first() {
             let n = self.phase_spikes.len();
             notes.push(Note::warning(format!(
-                "{}: {n} {} of the rotor phase {} from the line of {} neighbours by more than \
-                 {PHASE_GLITCH_DEG}° (glitches; the first at data row {}): bridged {purpose}",
+                "{}: {n} {} of the rotor phase {} from the line of the other samples by more \
+                 than {PHASE_GLITCH_DEG}° (glitches, or blocks stepped away and back; the first \
+                 at data row {}): bridged {purpose} where at most {MAX_FILL_S} s long, left out \
+                 otherwise",
                 flight.label(),
                 if n == 1 { "sample" } else { "samples" },
                 if n == 1 { "jumps" } else { "jump" },
-                if n == 1 { "its" } else { "their" },
                 flight.file_row(first) + 1,
             )));
         }
@@ -305,6 +328,83 @@ fn unwrapped_deg(p: &[f64]) -> Vec<f64> {
     }
     out
 }
+
+/// The samples of an unwrapped phase `u` (deg) off the level most of its
+/// samples keep, by more than `step` (deg, wrapped to ±180°): a block of
+/// samples stepped away and back (+90° on 100 rows made the fitted mean
+/// coning 0.3° instead of 3.9°, the two steps alone taken as glitches).
+///
+/// Each step from the last present sample is compared with the median
+/// step of its block of [`LEVEL_BLOCK`] steps (the rotor's speed, which
+/// changes slowly); a step off it by more than `step` changes the level by
+/// its excess. The reference level is the one the most samples keep.
+fn off_level(u: &[f64], step: f64) -> Vec<usize> {
+    // (row, step from the last present sample, rows since it).
+    let mut steps: Vec<(usize, f64, f64)> = Vec::new();
+    let mut last: Option<usize> = None;
+    for (k, &x) in u.iter().enumerate() {
+        if !x.is_finite() {
+            continue;
+        }
+        if let Some(j) = last {
+            steps.push((k, x - u[j], (k - j) as f64));
+        }
+        last = Some(k);
+    }
+    // Per block of steps, the median step per row.
+    let typical: Vec<f64> = steps
+        .chunks(LEVEL_BLOCK)
+        .map(|b| {
+            let mut v: Vec<f64> = b.iter().map(|(_, d, n)| d / n).collect();
+            let mid = v.len() / 2;
+            *v.select_nth_unstable_by(mid, f64::total_cmp).1
+        })
+        .collect();
+    let wrapped = |x: f64| (x + 180.0).rem_euclid(360.0) - 180.0;
+    // The level from each row on: (first row, level), a new one at each step.
+    let mut levels: Vec<(usize, f64)> = vec![(0, 0.0)];
+    let mut level = 0.0;
+    for (i, &(k, d, n)) in steps.iter().enumerate() {
+        let excess = d - typical[i / LEVEL_BLOCK] * n;
+        if excess.abs() > step {
+            level += excess;
+            levels.push((k, level));
+        }
+    }
+    // One level; or a channel stepping all the time, which is no block
+    // offset (its spikes are found as such).
+    if levels.len() == 1 || levels.len() > MAX_LEVELS {
+        return Vec::new();
+    }
+    // Rows per level (levels within `step` of each other are one).
+    let span = |i: usize| levels.get(i + 1).map_or(u.len(), |l| l.0) - levels[i].0;
+    let held = |l: f64| -> usize {
+        (0..levels.len())
+            .filter(|&i| wrapped(levels[i].1 - l).abs() <= step)
+            .map(span)
+            .sum()
+    };
+    let reference = levels
+        .iter()
+        .map(|l| l.1)
+        .max_by_key(|&l| held(l))
+        .unwrap_or(0.0);
+    (0..levels.len())
+        .filter(|&i| wrapped(levels[i].1 - reference).abs() > step)
+        .flat_map(|i| levels[i].0..levels[i].0 + span(i))
+        .filter(|&k| u[k].is_finite())
+        .collect()
+}
+
+/// Steps of the phase whose median is the typical step of each
+/// ([`off_level`]): half a second at 128 Hz; a step's excess is then
+/// measured against the rotor's speed of that half second.
+const LEVEL_BLOCK: usize = 64;
+
+/// Most levels of the phase [`off_level`] sorts out (each is compared
+/// with each); a channel with more steps than this is not one offset by
+/// blocks.
+const MAX_LEVELS: usize = 1000;
 
 /// Spikes of `mag`: a sample whose second difference
 /// `m[k] − (m[k−1] + m[k+1])/2` exceeds this many times the flight's
