@@ -283,6 +283,16 @@ fn bad_streams_are_bad_input_and_bad_lines_are_flagged() {
         lc.issues().malformed.first,
         Some((1, "column \"flux_y\": \"x\" is not a number".to_string()))
     );
+    // A NUL byte, even in a cell the model does not use, makes the line
+    // malformed, as `compensate` refuses the file (the stream took it).
+    let mut lc =
+        LineCompensator::new(&model, &format!("{header},lat"), &StreamOptions::default()).unwrap();
+    let flag = lc.line("0.0,20000,0,45000,49300,56\u{0}.1", &mut out);
+    assert_eq!(flag, Malformed);
+    assert_eq!(
+        lc.issues().malformed.first,
+        Some((1, "column \"lat\": a NUL byte (binary data)".to_string()))
+    );
 }
 
 /// A `mag` below any reading of Earth's field (a dropout value 0, a

@@ -580,6 +580,15 @@ impl LineCompensator {
     fn parse(&mut self, line: &str) -> std::result::Result<(f64, [f64; 3], f64), String> {
         let f = &self.fields;
         let names = &self.names;
+        // Binary data in any cell, used or not (`compensate` refuses the
+        // file; the stream took the line and echoed the NUL).
+        if let Some(at) = memchr::memchr(0, line.as_bytes()) {
+            let k = memchr::memchr_iter(b',', &line.as_bytes()[..at]).count();
+            return Err(match names.get(k) {
+                Some(name) => format!("column {:?}: a NUL byte (binary data)", clipped(name)),
+                None => format!("a NUL byte (binary data) in cell {}", k + 1),
+            });
+        }
         let (mut time, mut flux, mut mag) = (f64::NAN, [f64::NAN; 3], f64::NAN);
         let mut cell = |k: usize, text: &str| -> std::result::Result<(), String> {
             let slot = if k == f.time {
