@@ -304,7 +304,7 @@ pub fn level(
         .estimate_k
         .then(|| flight.require(&rate_column))
         .transpose()?;
-    let lines = LineLabels::of(flight, &opts.ties)?;
+    let lines = LineLabels::per_pass(flight, &opts.ties)?;
     for w in [
         lines.missing_warning(flight),
         lines.repeated_warning(flight),

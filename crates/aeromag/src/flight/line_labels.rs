@@ -19,10 +19,11 @@
 //! Rows with no label (missing, empty text, `NaN`, `*`, or the number 0:
 //! turns and transits) are on no line.
 //!
-//! A label flown in separate passes (another line's rows between them: a
-//! re-flight exported under the first flight's label) is one line per
-//! pass, `1003`, `1003 (pass 2)`, …: each pass has its own level error,
-//! and with one offset for the label a re-flight kept its own.
+//! For levelling ([`LineLabels::per_pass`]), a label flown in separate
+//! passes (another line's rows between them: a re-flight exported under
+//! the first flight's label) is one line per pass, `1003`, `1003 (pass
+//! 2)`, …: each pass has its own level error, and with one offset for the
+//! label a re-flight kept its own.
 //!
 //! Labels are names: `1003.1` and `1003.10` (Geosoft line 1003, versions 1
 //! and 10) are two lines, as the readers keep them (a `line` column with
@@ -37,8 +38,9 @@ use aeromag_core::error::shown;
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineLabels {
     /// Per row: the id of its line, `0.0` for rows on no line. The labels
-    /// have ids 1, 2, … in order of first appearance; the later passes of a
-    /// label flown more than once follow, in order of their start.
+    /// have ids 1, 2, … in order of first appearance; per pass
+    /// ([`LineLabels::per_pass`]) the later passes of a label flown more
+    /// than once follow, in order of their start.
     pub ids: Vec<f64>,
     /// The label of id `k` at index `k − 1`, as text (`1003.01`, `L1020`;
     /// a later pass `1003.01 (pass 2)`).
@@ -63,7 +65,22 @@ impl LineLabels {
     /// declares tie lines (see the module docs for the order of the rules).
     /// Errors: no `line` column, a `ties` label that matches no line, or a
     /// `line_type` that is not 0 or 1.
+    ///
+    /// A label flown in separate passes is one line here (gridding and
+    /// micro-levelling see a track, and a line re-flown on the same track
+    /// must not halve the line spacing); [`LineLabels::per_pass`] parts it.
     pub fn of(flight: &Flight, ties: &[String]) -> Result<Self> {
+        Self::build(flight, ties, false)
+    }
+
+    /// [`LineLabels::of`] with each later pass of a label flown more than
+    /// once a line of its own (`1003 (pass 2)`), as levelling needs: each
+    /// pass has its own level error.
+    pub fn per_pass(flight: &Flight, ties: &[String]) -> Result<Self> {
+        Self::build(flight, ties, true)
+    }
+
+    fn build(flight: &Flight, ties: &[String], per_pass: bool) -> Result<Self> {
         let column = flight.get("line").ok_or_else(|| {
             Error::bad_file(
                 flight.label(),
@@ -121,7 +138,7 @@ impl LineLabels {
             // A later pass of label `k` is the line of its own appended
             // below; the id is set there.
             let pass_id = match (kind, later_passes.last()) {
-                (Some(k), Some(&(l, _, _))) if l == k && passes[k].0 > 1 => {
+                (Some(k), Some(&(l, _, _))) if per_pass && l == k && passes[k].0 > 1 => {
                     (labels.len() + later_passes.len()) as f64
                 }
                 _ => kind.map_or(0.0, |k| (k + 1) as f64),
@@ -204,7 +221,7 @@ impl LineLabels {
         let mut labels = labels;
         let mut numbers = numbers;
         let mut ties = ties;
-        for &(k, pass, _) in &later_passes {
+        for &(k, pass, _) in later_passes.iter().filter(|_| per_pass) {
             labels.push(format!("{} (pass {pass})", labels[k]));
             if let Some(n) = &mut numbers {
                 n.push(n[k]);
@@ -383,7 +400,12 @@ mod tests {
         assert!(l.repeated.is_empty());
         assert_eq!(l.repeated_warning(&once), None);
         let twice = flight(Ok(vec![7.0, 7.0, 0.0, 8.0, 8.0, 0.0, 7.0, 9.0, 8.0, 7.0]));
-        let l = LineLabels::of(&twice, &[]).unwrap();
+        // One line per label, as gridding sees them.
+        let whole = LineLabels::of(&twice, &[]).unwrap();
+        assert_eq!(whole.labels, ["7", "8", "9"]);
+        assert_eq!(whole.ids[9], 1.0);
+        assert_eq!(whole.repeated, vec![(1, 3, 6), (2, 2, 8)]);
+        let l = LineLabels::per_pass(&twice, &[]).unwrap();
         assert_eq!(l.repeated, vec![(1, 3, 6), (2, 2, 8)]);
         // Each later pass is a line of its own, after the labels.
         assert_eq!(
@@ -406,7 +428,7 @@ mod tests {
             "{w}"
         );
         // A pass of a tie is a tie.
-        let tie = LineLabels::of(&twice, &["8".to_string()]).unwrap();
+        let tie = LineLabels::per_pass(&twice, &["8".to_string()]).unwrap();
         assert_eq!(tie.ties, Some(vec![false, true, false, false, true, false]));
     }
 
@@ -431,7 +453,7 @@ mod tests {
         let mut s: Vec<&str> = v.iter().map(String::as_str).collect();
         s.push("l7");
         let t0 = std::time::Instant::now();
-        let l = LineLabels::of(&flight(Err(s)), &[]).unwrap();
+        let l = LineLabels::per_pass(&flight(Err(s)), &[]).unwrap();
         assert_eq!(l.labels.len(), n + 1);
         assert_eq!(l.ids[n], (n + 1) as f64);
         assert_eq!(l.label(l.ids[n] as i64), Some("L7 (pass 2)"));
