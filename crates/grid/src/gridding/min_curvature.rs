@@ -727,6 +727,14 @@ impl Level {
             // Thread k sweeps groups k, k + threads, …; its largest change.
             let part = |k: usize| -> f64 {
                 let z = &z;
+                // Should this thread panic, its groups are marked done, so
+                // that the others do not wait for them for ever (the panic
+                // then ends the sweep).
+                let _unblock = Unblock {
+                    done: &done,
+                    first: k,
+                    every: threads,
+                };
                 let mut change = 0.0f64;
                 for g in (k..groups.len()).step_by(threads) {
                     let before = g.checked_sub(1).map(|h| (&done[h], groups[h].1));
@@ -767,6 +775,24 @@ const MAX_SWEEP_THREADS: usize = 4;
 
 /// Completed steps a group publishes at once.
 const PUBLISH_EVERY: usize = 16;
+
+/// On a panic of a sweep's thread, its groups' counters set past any
+/// step (see `Level::solve`).
+struct Unblock<'a> {
+    done: &'a [AtomicUsize],
+    first: usize,
+    every: usize,
+}
+
+impl Drop for Unblock<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            for d in self.done.iter().skip(self.first).step_by(self.every) {
+                d.store(usize::MAX, Ordering::Release);
+            }
+        }
+    }
+}
 
 /// The padded values of a level, written by the threads of a sweep.
 #[derive(Clone, Copy)]
