@@ -171,19 +171,18 @@ impl<'a> RotorColumns<'a> {
         };
         let mag = without(self.mag, &mag_spikes);
         // A glitch of the phase channel (a corrupted cell) stands out of
-        // its unwrapped line by up to 180°.
-        // A block of samples offset from the rest (a step and a step back)
-        // is off the level most samples keep.
-        // Levels are sorted out between time gaps (the phase across one is
-        // unknown: each stretch is tracked alone).
+        // its unwrapped line by up to 180°; a block of samples offset from
+        // the rest (a step and a step back) is off the level most samples
+        // keep. Levels are sorted out between time gaps (a time step beyond
+        // the gap rule, or not a number): the phase across one is unknown,
+        // and each stretch is tracked alone.
+        let dt = median_step(self.time);
+        let regular = |k: usize| (self.time[k] - self.time[k - 1]) <= dt * GAP_FACTOR;
         let phase_spikes = self.phase.map_or_else(Vec::new, |p| {
             let u = unwrapped_deg(p);
             let mut at = spikes(&u, PHASE_GLITCH_DEG);
-            let dt = median_step(self.time);
             let mut start = 0;
             for k in 1..=u.len() {
-                // A step beyond the gap rule, or not a number, parts them.
-                let regular = |k: usize| (self.time[k] - self.time[k - 1]) <= dt * GAP_FACTOR;
                 if k == u.len() || !regular(k) {
                     at.extend(
                         off_level(&u[start..k], PHASE_GLITCH_DEG)
