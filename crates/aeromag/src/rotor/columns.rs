@@ -207,7 +207,7 @@ impl<'a> RotorColumns<'a> {
                     4 => phase.as_deref().unwrap_or(c),
                     _ => c,
                 };
-                bridge_dropouts(self.time, c, max_fill, period)
+                bridge_dropouts(self.time, dt, c, max_fill, period)
             })
             .collect();
         let rows = (0..self.time.len())
@@ -476,10 +476,15 @@ pub(super) fn mean_rotor_hz(omega_rad_s: &[f64]) -> f64 {
 /// Bridge runs of at most `max_len` non-finite values between finite ones
 /// by linear interpolation in time (`period`: interpolate the shortest way
 /// round, for a phase in degrees), when the time steps across the run are
-/// regular (no gap: [`GAP_FACTOR`]).
-fn bridge_dropouts(time: &[f64], x: &[f64], max_len: usize, period: Option<f64>) -> Vec<f64> {
+/// regular (no gap: [`GAP_FACTOR`] times `dt`, the median step, s).
+fn bridge_dropouts(
+    time: &[f64],
+    dt: f64,
+    x: &[f64],
+    max_len: usize,
+    period: Option<f64>,
+) -> Vec<f64> {
     let mut out = x.to_vec();
-    let dt = median_step(time);
     let n = x.len();
     let mut k = 0;
     while k < n {
@@ -585,7 +590,7 @@ mod tests {
         let t: Vec<f64> = (0..10).map(|k| k as f64 * 0.01).collect();
         let nan = f64::NAN;
         let x = [0.0, 1.0, nan, 3.0, nan, nan, nan, 7.0, 8.0, nan];
-        let y = bridge_dropouts(&t, &x, 2, None);
+        let y = bridge_dropouts(&t, median_step(&t), &x, 2, None);
         assert_eq!(y[2], 2.0);
         assert!(
             y[4].is_nan() && y[5].is_nan() && y[6].is_nan(),
@@ -593,10 +598,18 @@ mod tests {
         );
         assert!(y[9].is_nan(), "no value after the run");
         // A phase in degrees is interpolated the short way round 360°.
-        let p = bridge_dropouts(&t[..3], &[350.0, nan, 10.0], 1, Some(360.0));
+        let p = bridge_dropouts(
+            &t[..3],
+            median_step(&t[..3]),
+            &[350.0, nan, 10.0],
+            1,
+            Some(360.0),
+        );
         assert!((p[1] - 360.0).abs() < 1e-9, "{}", p[1]);
         // A time gap across the run: left alone.
         let tg = [0.0, 0.01, 0.02, 0.5, 0.51];
-        assert!(bridge_dropouts(&tg, &[0.0, 1.0, nan, 3.0, 4.0], 2, None)[2].is_nan());
+        assert!(
+            bridge_dropouts(&tg, median_step(&tg), &[0.0, 1.0, nan, 3.0, 4.0], 2, None)[2].is_nan()
+        );
     }
 }
