@@ -11,7 +11,7 @@ use aeromag_compensation::model_file::MODEL_FORMAT;
 use aeromag_compensation::rotor::blade::MAX_FLAP_RAD;
 use aeromag_compensation::rotor::linear::highpass;
 use aeromag_compensation::rotor::model_file::{PhaseSource, ROTOR_KIND, RotorModelFile, TailModel};
-use aeromag_compensation::rotor::tail::split;
+use aeromag_compensation::rotor::tail::{TailFit, split};
 use aeromag_compensation::rotor::{
     BladeTerms, FlapAngles, RotorFit, RotorFitOptions, RotorGeometry, RotorInput, SlowAngleFit,
     SlowAngleOptions, TailRotor, fit_records, fit_slow_angles, fit_with_tail, refine_phase_offset,
@@ -398,6 +398,29 @@ fn explained_warning(
     )))
 }
 
+/// The warning for a tail rotor left out of the model
+/// ([`TailFit::tail_is_seen`]).
+fn tail_unseen_warning(j: &TailFit) -> String {
+    let n = j.tail_prediction_nt.len().max(1) as f64;
+    let mean = j.tail_prediction_nt.iter().sum::<f64>() / n;
+    let std = (j
+        .tail_prediction_nt
+        .iter()
+        .map(|v| (v - mean).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    format!(
+        "the tail rotor is left out of the model: the sensor does not see it (its blade-passing part in the \
+         joint fit is {} nT RMS, below the fit's residual of {} nT), so its fitted parameters would be the \
+         main rotor's misfit, and its slow part (the rotation average, {} nT std here) an error in the \
+         compensated reading; the main rotor is fitted alone",
+        fixed(j.tail_highpassed_rms_nt, 4),
+        fixed(j.tail.residual_rms_nt, 4),
+        fixed(std, 3),
+    )
+}
+
 /// Options of the phase refinement of a phase estimated from the data:
 /// the tracked phase is biased by the heading-dependent phase of the
 /// harmonics, so it is refined jointly with the parameters (library docs of
@@ -530,11 +553,10 @@ pub fn fit_rotor(
         omega_rad_s: &omega,
         angles: &nominal,
     };
-    let (slow, tail) = match &opts.tail {
-        None => (
-            fit_slow_angles(geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &slow_opts)?,
-            None,
-        ),
+    // A tail rotor whose blade-passing signal the sensor does not see is
+    // left out (`TailFit::tail_is_seen`).
+    let joint = match &opts.tail {
+        None => None,
         Some(t) => {
             let j = fit_with_tail(
                 geom,
@@ -546,6 +568,20 @@ pub fn fit_rotor(
                 &fit_opts,
                 Some(&slow_opts),
             )?;
+            if j.tail_is_seen() {
+                Some((t, j))
+            } else {
+                notes.warn(tail_unseen_warning(&j));
+                None
+            }
+        }
+    };
+    let (slow, tail) = match joint {
+        None => (
+            fit_slow_angles(geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &slow_opts)?,
+            None,
+        ),
+        Some((t, j)) => {
             let angles = j.angles.unwrap_or_else(|| vec![opts.nominal_angles]);
             let slow = SlowAngleFit {
                 fit: j.main,

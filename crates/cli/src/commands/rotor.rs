@@ -76,7 +76,12 @@ struct StudyArgs {
 /// --tail-rotor adds a tail rotor geared to the main rotor (its phase is the
 /// main rotor's phase channel times the gear ratio plus an offset found in
 /// the fit), fitted jointly with it: where the sensor is near the tail
-/// (a tail-boom installation); at a nose boom its field is negligible.
+/// (a tail-boom installation); at a nose boom its field is negligible. A
+/// tail rotor whose blade-passing signal stays below the joint fit's
+/// residual is left out of the model, with a warning: its parameters would
+/// be fitted to the main rotor's misfit, and its slow part (the rotation
+/// average, which turns with the heading) would put tens of nT of error
+/// into the compensated reading.
 ///
 /// Example:
 ///   aeromag rotor fit --input heli.csv --model rotor.json --preset aeromag-sim-helicopter
