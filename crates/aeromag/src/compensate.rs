@@ -24,6 +24,9 @@ pub struct OutputColumns {
     pub flag: &'static str,
     /// Why a row can be left uncompensated, in words.
     pub why_missing: &'static str,
+    /// What may make this model's interference beyond any magnetic field
+    /// on a flight, in words (the end of that error's message).
+    pub why_beyond: &'static str,
 }
 
 /// The compensated reading, always this column.
@@ -66,7 +69,7 @@ pub trait Compensator {
     /// a model file that does not fit the flight).
     fn interference(&self, flight: &Flight) -> Result<Vec<f64>> {
         let v = self.interference_observed(flight, &mut Silent)?;
-        check_interference(flight, &v)?;
+        check_interference(flight, self.output(), &v)?;
         Ok(v)
     }
 
@@ -107,9 +110,18 @@ pub trait Compensator {
 /// (an edited or corrupted coefficient or `bt_scale`, another aircraft's
 /// terms); written out, it would pass for a compensated reading. NaN is a
 /// row the model could not be applied to, not an error.
-pub(crate) fn check_interference(flight: &Flight, interference_nt: &[f64]) -> Result<()> {
+pub(crate) fn check_interference(
+    flight: &Flight,
+    output: OutputColumns,
+    interference_nt: &[f64],
+) -> Result<()> {
     match interference_nt.iter().position(|v| beyond_any_field(*v)) {
-        Some(row) => Err(interference_error(flight, row, interference_nt[row])),
+        Some(row) => Err(interference_error(
+            flight,
+            output,
+            row,
+            interference_nt[row],
+        )),
         None => Ok(()),
     }
 }
@@ -119,12 +131,13 @@ fn beyond_any_field(v: f64) -> bool {
     v.abs() > aeromag_io::MAX_FIELD_NT
 }
 
-fn interference_error(flight: &Flight, row: usize, v: f64) -> Error {
+fn interference_error(flight: &Flight, output: OutputColumns, row: usize, v: f64) -> Error {
     flight.bad_row(
         row,
         format!(
-            "the model's interference here is {v:e} nT, beyond any magnetic field (at most {:e} nT in magnitude): the model file does not fit this flight (an edited or corrupted coefficient or bt_scale, or another aircraft's model?)",
-            aeromag_io::MAX_FIELD_NT
+            "the model's interference here is {v:e} nT, beyond any magnetic field (at most {:e} nT in magnitude): the model does not fit this flight ({})",
+            aeromag_io::MAX_FIELD_NT,
+            output.why_beyond
         ),
     )
 }
@@ -197,7 +210,12 @@ impl Compensated {
             .filter(|&row| row < n)
             .or(tail.map(|k| n + k));
         if let Some(row) = first {
-            return Err(interference_error(flight, row, interference_nt[row]));
+            return Err(interference_error(
+                flight,
+                output,
+                row,
+                interference_nt[row],
+            ));
         }
         let missing = missing.into_inner()
             + interference_nt[n..]
@@ -276,6 +294,7 @@ mod tests {
             interference: "mag_interf",
             flag: "comp_flag",
             why_missing: "test",
+            why_beyond: "test",
         };
         // Beyond any field (∞ included) in several parts: the first such
         // row is named, whichever part's thread finds its own first.

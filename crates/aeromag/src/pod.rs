@@ -53,6 +53,8 @@ pub const POD_OUTPUT: OutputColumns = OutputColumns {
     interference: "pod_interf",
     flag: "pod_flag",
     why_missing: "missing values or headings under 10 s",
+    why_beyond: "an edited or corrupted parameter, another pod's model, or the pod's columns \
+                 mapped wrongly?",
 };
 
 /// Names of the 43 small-signal parameters (`aeromag_compensation::pod::

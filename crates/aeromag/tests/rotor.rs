@@ -401,6 +401,20 @@ fn hostile_flights_are_refused_or_fail_instead_of_being_applied() {
         "{msg}"
     );
     assert!(!msg.contains("0000000"), "{msg}");
+    // A model whose interference is beyond any field on this flight: bad
+    // input naming the row, with the rotor model's likely causes (it named
+    // the Tolles-Lawson model's `bt_scale`).
+    let mut wild = fit.model.clone();
+    wild.model.params[0] *= 1e9;
+    let e = wild.compensate(&other).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        e.is_bad_input()
+            && msg.contains("beyond any magnetic field")
+            && msg.contains("another helicopter's model")
+            && !msg.contains("bt_scale"),
+        "{msg}"
+    );
     // Steps alternating ±5 %: refused, naming the row.
     let uneven = edited(&other, |n, v| {
         if n == "time" {

@@ -22,6 +22,9 @@ pub const ROTOR_OUTPUT: OutputColumns = OutputColumns {
     interference: "rotor_interf",
     flag: "rotor_flag",
     why_missing: "missing values or stretches under 10 s",
+    why_beyond: "an edited or corrupted parameter, another helicopter's model, or a sensor \
+                 beside a magnetised part, where the fluxgate's field direction is not the \
+                 sensor's?",
 };
 
 /// Phase (rad, unwrapped) and rotor speed (rad/s) of one segment: from the

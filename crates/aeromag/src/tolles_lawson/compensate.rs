@@ -13,6 +13,7 @@ pub const TL_OUTPUT: OutputColumns = OutputColumns {
     interference: "mag_interf",
     flag: "comp_flag",
     why_missing: "missing values",
+    why_beyond: "an edited or corrupted coefficient or bt_scale, or another aircraft's model?",
 };
 
 impl Compensator for TlModel {

@@ -321,7 +321,7 @@ impl SensorsCompensated {
                 flux: s.flux.clone(),
             };
             let interf = interference(k, &cols)?;
-            crate::compensate::check_interference(flight, &interf)?;
+            crate::compensate::check_interference(flight, super::TL_OUTPUT, &interf)?;
             let mag = flight.require(&s.mag)?;
             let comp = mag.iter().zip(&interf).map(|(m, i)| m - i).collect();
             sensors.push((s.name.clone(), interf, comp));
