@@ -1272,3 +1272,45 @@ fn a_long_flight_of_many_legs_calibrates_with_current_channels() {
     let tau = terms.extras()[1].lag_s.unwrap();
     assert!((tau - 0.4).abs() < 0.02, "{terms:?}");
 }
+
+/// The residual per line of a flight whose `line` column is text (`L1`,
+/// `L2`, …, `0` for the turns) is reported under those labels: every line was `0` in
+/// `report`'s table and figures before.
+#[test]
+fn the_residual_per_line_keeps_text_labels() {
+    let cal = simulate_flight(ScenarioKind::Calibration, None, Some(3)).unwrap();
+    let model = calibrate(&cal, &CalibrateOptions::default(), &mut Silent)
+        .unwrap()
+        .model;
+    let flight = model.compensate(&cal).unwrap().into_flight(cal).unwrap();
+    let numeric = aeromag::score::score(&flight, &[], None).unwrap();
+    let mut t = aeromag::FlightTable::new();
+    for c in flight.columns() {
+        match (c.name(), c.values()) {
+            ("line", Some(v)) => t
+                .add_text_column(
+                    "line",
+                    // 0 stays the turns' "no line".
+                    v.iter()
+                        .map(|&x| {
+                            if x == 0.0 {
+                                "0".into()
+                            } else {
+                                format!("L{x}")
+                            }
+                        })
+                        .collect(),
+                )
+                .unwrap(),
+            (name, Some(v)) => t.add_column(name, v.to_vec()).unwrap(),
+            _ => {}
+        }
+    }
+    let texts = aeromag::score::score(&Flight::from_table(t).unwrap(), &[], None).unwrap();
+    assert!(numeric.lines.len() > 1, "{:?}", numeric.lines);
+    assert_eq!(numeric.lines.len(), texts.lines.len());
+    for (a, b) in numeric.lines.iter().zip(&texts.lines) {
+        assert_eq!(b.line.to_string(), format!("L{}", a.line));
+        assert_eq!((a.samples, a.rms_nt), (b.samples, b.rms_nt));
+    }
+}

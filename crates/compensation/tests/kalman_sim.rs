@@ -45,7 +45,7 @@
 use aeromag_compensation::kalman::{
     KalmanConfig, KalmanFit, KalmanSegment, fit_kalman, ground_speed_from_velocity,
 };
-use aeromag_compensation::metrics::residual_by_line;
+use aeromag_compensation::metrics::{LineLabel, residual_by_line};
 use aeromag_compensation::tolles_lawson::Design;
 use aeromag_compensation::tolles_lawson::TermSet;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, LsFit, Segment, fit_band_pass_ls};
@@ -156,8 +156,9 @@ fn survey_error(survey: &Flight, coef: &[f64]) -> (f64, f64) {
     }
     let mag = col(s, "mag");
     let comp: Vec<f64> = (0..n).map(|i| mag[i] - model[i]).collect();
-    let (_, total) = residual_by_line(&comp, col(s, "true_external"), Some(line), &legs);
-    let (_, interf) = residual_by_line(col(s, "true_interf"), &model, Some(line), &legs);
+    let of = |i: usize| LineLabel::Number(line[i]);
+    let (_, total) = residual_by_line(&comp, col(s, "true_external"), &of, &legs);
+    let (_, interf) = residual_by_line(col(s, "true_interf"), &model, &of, &legs);
     (total, interf)
 }
 

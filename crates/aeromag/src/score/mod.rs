@@ -19,7 +19,7 @@ pub use sensors::{
 use crate::error::{Error, Result};
 use crate::flight::{Flight, LeverArm, SegmentRule, reduced, reference_sum};
 use aeromag_compensation::metrics::{
-    FomReport, LineResidual, ManeuverDetection, band_pass_segments, detect_maneuvers,
+    FomReport, LineLabel, LineResidual, ManeuverDetection, band_pass_segments, detect_maneuvers,
     figure_of_merit, improvement_ratio, residual_by_line,
 };
 use aeromag_compensation::tolles_lawson::segments::median_step;
@@ -225,15 +225,24 @@ pub fn score_series(
         Some(l) => segs.iter().filter(|r| l[r.start] != 0.0).cloned().collect(),
         None => segs.clone(),
     };
+    // A line by its first row's label: the number, or the text of a text
+    // column (every line was `0` in the table before).
+    let numbers = t.column("line");
+    let text = t.table().text_column("line");
+    let line_of = |i: usize| match (numbers, text) {
+        (Some(v), _) => LineLabel::Number(v[i]),
+        (None, Some(s)) => LineLabel::Text(s[i].trim().to_string()),
+        (None, None) => LineLabel::Number(0.0),
+    };
     let interference_rms_nt = match (s.truth.interf, s.interf) {
         (Some(truth), Some(model)) => {
-            let (_, pooled) = residual_by_line(model, truth, t.column("line"), &on_line);
+            let (_, pooled) = residual_by_line(model, truth, &line_of, &on_line);
             pooled.is_finite().then_some(pooled)
         }
         _ => None,
     };
     if let Some(truth) = s.truth.compensated() {
-        let (l, pooled) = residual_by_line(comp_raw, &truth, t.column("line"), &on_line);
+        let (l, pooled) = residual_by_line(comp_raw, &truth, &line_of, &on_line);
         residual_rms_nt = pooled.is_finite().then_some(pooled);
         lines = l;
     }

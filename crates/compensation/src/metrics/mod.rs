@@ -8,4 +8,4 @@ pub mod residual;
 pub use fom::{FomReport, FomWindow, figure_of_merit};
 pub use improvement::{band_pass_segments, improvement_ratio};
 pub use maneuvers::{Axis, Maneuver, ManeuverDetection, detect_maneuvers};
-pub use residual::{LineResidual, residual_by_line};
+pub use residual::{LineLabel, LineResidual, residual_by_line};

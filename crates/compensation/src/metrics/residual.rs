@@ -8,11 +8,33 @@
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
+/// A line's label: a number where the `line` column holds numbers, else
+/// its text (`L1020`, or number labels kept as text because two of them
+/// read as one number, `1003.1` and `1003.10`). Serialised as a JSON
+/// number or string.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum LineLabel {
+    /// A numeric label.
+    Number(f64),
+    /// A text label.
+    Text(String),
+}
+
+impl std::fmt::Display for LineLabel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Number(v) => write!(f, "{v}"),
+            Self::Text(s) => f.write_str(s),
+        }
+    }
+}
+
 /// Residual statistics of one line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LineResidual {
     /// Line label.
-    pub line: f64,
+    pub line: LineLabel,
     /// Samples used.
     pub samples: usize,
     /// Mean of the difference, nT.
@@ -22,12 +44,13 @@ pub struct LineResidual {
 }
 
 /// Per-line residual statistics of `value − reference` over the given
-/// segments (each segment belongs to one line, `line[start]`); non-finite
-/// samples are skipped. Returns the lines and the pooled RMS.
+/// segments (each segment belongs to one line, `line_of(start)`, the label
+/// of its first row); non-finite samples are skipped. Returns the lines and
+/// the pooled RMS.
 pub fn residual_by_line(
     value: &[f64],
     reference: &[f64],
-    line: Option<&[f64]>,
+    line_of: &dyn Fn(usize) -> LineLabel,
     segments: &[Range<usize>],
 ) -> (Vec<LineResidual>, f64) {
     let mut lines: Vec<LineResidual> = Vec::new();
@@ -46,7 +69,7 @@ pub fn residual_by_line(
         pooled2 += ss;
         pooled_n += d.len();
         lines.push(LineResidual {
-            line: line.map_or(0.0, |l| l[r.start]),
+            line: line_of(r.start),
             samples: d.len(),
             mean_nt: m,
             rms_nt: (ss / d.len() as f64).sqrt(),
@@ -77,8 +100,10 @@ mod tests {
             .collect();
         let r = vec![0.0; 20];
         let line: Vec<f64> = (0..20).map(|i| if i < 10 { 1.0 } else { 2.0 }).collect();
-        let (lines, pooled) = residual_by_line(&v, &r, Some(&line), &[0..10, 10..20]);
+        let of = |i: usize| LineLabel::Number(line[i]);
+        let (lines, pooled) = residual_by_line(&v, &r, &of, &[0..10, 10..20]);
         assert_eq!(lines.len(), 2);
+        assert_eq!(lines[1].line, LineLabel::Number(2.0));
         assert!((lines[0].rms_nt - 0.5).abs() < 1e-12 && (lines[1].rms_nt - 1.0).abs() < 1e-12);
         assert!((lines[0].mean_nt - 5.5).abs() < 1e-12);
         assert!((pooled - (0.625f64).sqrt()).abs() < 1e-12);
