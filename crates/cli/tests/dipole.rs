@@ -443,3 +443,33 @@ fn convergence_on_the_smallest_grids_and_threads_zero() {
     ]);
     assert_bad(&o, &["--threads 0"]);
 }
+
+/// The plain IEKF locks on a wrong solution on the default pass (180 m off,
+/// `converged` 1, σ about a metre): a warning now says its estimates are
+/// not to be trusted; the multi-start's are not warned of. Both print the
+/// mean normalised innovation and write it per epoch (`nis`).
+#[test]
+fn a_filter_locked_on_a_wrong_solution_is_warned_of() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(&d.path().join("sim"), None);
+    let out = d.path().join("est.csv");
+    let good = locate_with(&csv, &toml, &out, &[]);
+    assert_code(&good, 0);
+    assert!(
+        stdout(&good).contains("mean normalised innovation squared per contrast 0.9")
+            && !stderr(&good).contains("warning"),
+        "{}{}",
+        stdout(&good),
+        stderr(&good)
+    );
+    let header = std::fs::read_to_string(&out).unwrap();
+    assert!(header.lines().next().unwrap().ends_with(",converged,nis"));
+    let plain = locate_with(&csv, &toml, &out, &["--plain"]);
+    assert_code(&plain, 0);
+    assert!(
+        stderr(&plain).contains("warning: the filter's normalised innovations squared average")
+            && stderr(&plain).contains("not to be trusted"),
+        "{}",
+        stderr(&plain)
+    );
+}

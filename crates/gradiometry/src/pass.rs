@@ -64,6 +64,34 @@ pub struct PassStep<const N: usize> {
     pub converged: bool,
     /// `MeasureS` estimability per component.
     pub estimability: SVector<f64, N>,
+    /// The epoch's normalised innovation squared
+    /// `νᵀ (H P⁻ Hᵀ + σ² I)⁻¹ ν`, `ν = z − h(x⁻)` at the prior
+    /// ([`normalised_innovation`]): about `Z` on average when the filter's
+    /// covariance is honest.
+    pub nis: f64,
+}
+
+/// The normalised innovation squared of measurement `z` against `prior`
+/// (noise variance `sigma2`, nT²): `νᵀ (H P⁻ Hᵀ + σ² I)⁻¹ ν` with
+/// `ν = z − h(x⁻)` and `H = ∂h/∂x` at the prior's estimate. A filter whose
+/// covariance describes its errors gives `Z` on average (χ² with `Z`
+/// degrees of freedom); one locked on a wrong solution, or whose process
+/// noise is too small for how its state really moves, gives many times
+/// that. NaN when the innovation covariance is not invertible.
+pub fn normalised_innovation<const N: usize, const Z: usize, F: Forward<N, Z>>(
+    prior: &SrState<N>,
+    z: &SVector<f64, Z>,
+    model: &F,
+    sigma2: f64,
+) -> f64 {
+    let (hx, hj) = model.eval(&prior.x);
+    let nu = z - hx;
+    let hs = hj * prior.s;
+    let cov = hs * hs.transpose() + SMatrix::<f64, Z, Z>::identity() * sigma2;
+    match cov.cholesky() {
+        Some(c) => nu.dot(&c.solve(&nu)),
+        None => f64::NAN,
+    }
 }
 
 /// Run the filter from `initial` over `epochs`.
@@ -99,9 +127,30 @@ pub fn run_pass_with_extra_noise<const N: usize, const Z: usize, F: Forward<N, Z
             iterations: r.iterations,
             converged: r.converged,
             estimability: measure_s(&r.posterior, &blind),
+            nis: normalised_innovation(&prior, &e.z, &e.model, cfg.sigma_nt * cfg.sigma_nt),
         });
     }
     Ok(out)
+}
+
+/// The trajectory `x̄_j` of a final estimate `x_final` (the state at the
+/// last epoch) carried back through the inverse transitions,
+/// `x̄_{j−1} = F_j⁻¹ (x̄_j − u_j)` (module docs); the first epoch's
+/// transition is not used.
+pub fn carried_back<const N: usize, const Z: usize, F>(
+    x_final: &SVector<f64, N>,
+    epochs: &[PassEpoch<N, Z, F>],
+) -> Result<Vec<SVector<f64, N>>> {
+    let mut traj = vec![*x_final; epochs.len()];
+    for j in (1..epochs.len()).rev() {
+        let e = &epochs[j];
+        let finv = e
+            .transition
+            .try_inverse()
+            .ok_or(GradiometryError::Singular("transition"))?;
+        traj[j - 1] = finv * (traj[j] - e.offset);
+    }
+    Ok(traj)
 }
 
 /// [`run_pass_with_extra_noise`] (first pass, extra noise `first_extra_s_q`
@@ -125,16 +174,7 @@ pub fn run_pass_relinearised<const N: usize, const Z: usize, F: Forward<N, Z>>(
         let Some(last) = out.last() else {
             return Ok(out);
         };
-        // trajectory x̄_j, carried back from the final estimate
-        let mut traj = vec![last.posterior.x; epochs.len()];
-        for j in (1..epochs.len()).rev() {
-            let e = &epochs[j];
-            let finv = e
-                .transition
-                .try_inverse()
-                .ok_or(GradiometryError::Singular("transition"))?;
-            traj[j - 1] = finv * (traj[j] - e.offset);
-        }
+        let traj = carried_back(&last.posterior.x, epochs)?;
         let mut state = *initial;
         let mut blind = *initial;
         let mut next = Vec::with_capacity(epochs.len());
@@ -142,6 +182,7 @@ pub fn run_pass_relinearised<const N: usize, const Z: usize, F: Forward<N, Z>>(
             let mut prior = prognosis(&state, &e.transition, &e.s_q);
             prior.x += e.offset;
             blind = prognosis(&blind, &e.transition, &e.s_q);
+            let nis = normalised_innovation(&prior, &e.z, &e.model, sigma2);
             let (hx, hj) = e.model.eval(xl);
             state = update_linearised(&prior, &e.z, xl, &hx, &hj, sigma2)?;
             if !state.x.iter().all(|v| v.is_finite()) {
@@ -155,6 +196,7 @@ pub fn run_pass_relinearised<const N: usize, const Z: usize, F: Forward<N, Z>>(
                 iterations: 1,
                 converged: residual <= threshold,
                 estimability: measure_s(&state, &blind),
+                nis,
             });
         }
         let change = match (out.last(), next.last()) {

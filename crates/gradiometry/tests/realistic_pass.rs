@@ -36,6 +36,7 @@ fn init_step(s: &SrState<6>) -> PassStep<6> {
         iterations: 0,
         converged: false,
         estimability: SVector::repeat(1.0),
+        nis: f64::NAN,
     }
 }
 

@@ -526,6 +526,10 @@ pub struct Track {
     pub residual_nt: Vec<f64>,
     /// Whether the iteration converged.
     pub converged: Vec<bool>,
+    /// The epoch's normalised innovation squared over the number of
+    /// contrasts `Z` ([`aeromag_gradiometry::pass::normalised_innovation`]
+    /// / `Z`): about 1 on average when the filter's σ describe its errors.
+    pub nis: Vec<f64>,
 }
 
 impl Track {
@@ -559,6 +563,10 @@ impl Track {
                 .iter()
                 .map(|o| o.is_some_and(|l| l.step.converged))
                 .collect(),
+            nis: out
+                .iter()
+                .map(|o| o.map_or(f64::NAN, |l| l.step.nis / 9.0))
+                .collect(),
         }
     }
 
@@ -581,13 +589,38 @@ impl Track {
             iterations: out.iter().map(|l| l.step.iterations as f64).collect(),
             residual_nt: out.iter().map(|l| l.residual_nt).collect(),
             converged: out.iter().map(|l| l.step.converged).collect(),
+            nis: out.iter().map(|l| l.step.nis / 3.0).collect(),
         }
+    }
+
+    /// The mean of [`Track::nis`] over the epochs estimated (from the
+    /// detection on): about 1 when the filter's covariance describes its
+    /// errors; `None` when nothing was estimated.
+    pub fn mean_nis(&self) -> Option<f64> {
+        let v: Vec<f64> = self.nis.iter().copied().filter(|v| v.is_finite()).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    }
+
+    /// A warning when the filter's innovations are beyond what its
+    /// covariance allows ([`Track::mean_nis`] above [`MAX_MEAN_NIS`]): its
+    /// estimates and their σ are then not to be trusted.
+    pub fn inconsistency_warning(&self) -> Option<String> {
+        let m = self.mean_nis()?;
+        (m > MAX_MEAN_NIS).then(|| {
+            format!(
+                "the filter's normalised innovations squared average {m:.1} per contrast, where a filter \
+                 whose σ describe its errors averages about 1 (above {MAX_MEAN_NIS} here): the estimates \
+                 and their σ are not to be trusted. A filter locked on a wrong solution (--plain from \
+                 the half-space away from the object?), sensor columns swapped or mis-mapped, or quiet \
+                 epochs (estimator.quiet_epochs) that are not quiet?"
+            )
+        })
     }
 
     /// The estimates as a table: `time, detected, x_m, y_m, z_m, mx_am2,
     /// my_am2, mz_am2`, their standard deviations `sd_…`, the estimability
     /// measures `mu_…` (μ = σ⁺/σ⁰, 0 = determined), `iterations,
-    /// residual_nt, converged`.
+    /// residual_nt, converged, nis` ([`Track::nis`]).
     pub fn to_table(&self, time: &[f64]) -> Result<FlightTable> {
         let mut t = FlightTable::new();
         t.add_column("time", time.to_vec())?;
@@ -607,9 +640,21 @@ impl Track {
         t.add_column("iterations", self.iterations.clone())?;
         t.add_column("residual_nt", self.residual_nt.clone())?;
         t.add_integer_column("converged", flag(&self.converged))?;
+        t.add_column("nis", self.nis.clone())?;
         Ok(t)
     }
 }
+
+/// The largest mean normalised innovation squared per contrast
+/// ([`Track::mean_nis`]) of a track whose filter is taken as consistent.
+/// An honest filter gives 1 (the mean of χ²/Z over a pass of n epochs has
+/// a standard deviation of √(2/(Z n)), 0.03 over the default pass).
+/// Measured (default scenario): correct passes 0.93–0.99 (tensor
+/// gradiometer, seeds 1–6, stationary and mobile), 0.82–0.85 (scalar);
+/// the plain IEKF locked 180 m from the object 3709, sensor 1's and
+/// sensor 2's columns swapped 3509, a file starting with the object near
+/// (its quiet epochs not quiet) 176, `quiet_epochs = 0` 419.
+pub const MAX_MEAN_NIS: f64 = 3.0;
 
 /// Locate the object over a pass with the configured estimator (the
 /// square-root IEKF: detection, multi-start or the seed's plain IEKF,

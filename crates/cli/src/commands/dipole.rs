@@ -230,6 +230,14 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
                 "final moment (A·m²)   {:9.2} {:9.2} {:9.2}  σ {:.3e} {:.3e} {:.3e}",
                 x[3], x[4], x[5], sd[3], sd[4], sd[5]
             );
+            if let Some(m) = track.mean_nis() {
+                println!(
+                    "mean normalised innovation squared per contrast {m:.2} (about 1 when the σ describe the errors)"
+                );
+            }
+            if let Some(w) = track.inconsistency_warning() {
+                eprintln!("warning: {w}");
+            }
         }
     }
     println!("estimates written to {}", a.out.display());
