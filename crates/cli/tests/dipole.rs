@@ -464,6 +464,13 @@ fn a_filter_locked_on_a_wrong_solution_is_warned_of() {
     );
     let header = std::fs::read_to_string(&out).unwrap();
     assert!(header.lines().next().unwrap().ends_with(",converged,nis"));
+    // The scenario file named as the output: refused, the file kept (it
+    // was replaced by the estimates).
+    let before = std::fs::read(&toml).unwrap();
+    let o = locate_with(&csv, &toml, &toml, &[]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("is also an input"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&toml).unwrap(), before);
     let plain = locate_with(&csv, &toml, &out, &["--plain"]);
     assert_code(&plain, 0);
     assert!(

@@ -14,7 +14,7 @@ use aeromag::gradiometry::{
 };
 use aeromag::report::{Report, ReportSection, Table};
 use aeromag_gradiometry::convergence::ConvergenceCase;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Magnetic dipole (object) parameters from tensor or scalar gradiometer
 /// differences with a square-root iterated EKF (seed 004).
@@ -178,7 +178,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 fn locate(a: LocateArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
+    // The scenario file is an input too (`--config X --out X` replaced it
+    // with the estimates).
+    let inputs: Vec<&Path> = std::iter::once(a.input.as_path())
+        .chain(a.config.as_deref())
+        .collect();
+    crate::output::check_files([a.out.as_path()], &inputs)?;
     let mut cfg = read_config(a.config.as_deref())?;
     let settings = LocateSettings {
         gradiometer: a
