@@ -165,6 +165,19 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     }
 }
 
+/// A pass of 320 s: the object's heading passes 360° and is written so
+/// (unwrapped); the pass is read and located (it was refused: "360.05 is
+/// not an angle").
+#[test]
+fn a_long_pass_with_the_heading_past_a_turn_is_located() {
+    let mut cfg = GradiometerConfig::default();
+    cfg.trajectory.epochs = 3200;
+    let (track, truth) = simulate_and_locate(&cfg);
+    let yaw = truth.require("obj_yaw").unwrap();
+    assert!(yaw.iter().any(|&y| y > 360.0));
+    assert!(track.detected.iter().any(|&d| d));
+}
+
 #[test]
 fn the_study_meets_the_issue_figures() {
     let out = GradiometryStudy.run(StudySize::Full, &mut Silent).unwrap();

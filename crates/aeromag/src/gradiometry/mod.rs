@@ -427,6 +427,10 @@ pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
             ),
         ));
     }
+    // Headings may be recorded unwrapped (an object turning for minutes
+    // passes 360°: the simulator's own longer passes were refused); the
+    // motion model takes their steps modulo a turn.
+    let unwrapped = (-1e6, 1e6);
     let (lat, lon) = (
         within("lat", (-90.0, 90.0), "a latitude, deg")?,
         within("lon", angle, "a longitude, deg")?,
@@ -440,14 +444,14 @@ pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
     let att = [
         within("roll", angle, "an angle, deg")?,
         within("pitch", angle, "an angle, deg")?,
-        within("yaw", angle, "an angle, deg")?,
+        within("yaw", unwrapped, "a heading, deg")?,
     ];
     let obj = [
         within("obj_north_m", local, local_what)?,
         within("obj_east_m", local, local_what)?,
         within("obj_down_m", local, local_what)?,
     ];
-    let obj_yaw = within("obj_yaw", angle, "an angle, deg")?;
+    let obj_yaw = within("obj_yaw", unwrapped, "a heading, deg")?;
     let names = sensor_columns(cfg.system.gradiometer);
     let field = (-aeromag_io::MAX_FIELD_NT, aeromag_io::MAX_FIELD_NT);
     let readings = names
