@@ -1314,3 +1314,76 @@ fn the_residual_per_line_keeps_text_labels() {
         assert_eq!((a.samples, a.rms_nt), (b.samples, b.rms_nt));
     }
 }
+
+/// A compensated flight whose columns are not what they say is bad input
+/// naming the row and column: `mag_comp` beyond any field (a report gave
+/// an improvement ratio of 0.000), in µT (a residual of −53 046 nT), or not
+/// `mag − mag_interf` (`mag_interf` in pT, `mag` and `mag_comp` swapped),
+/// all reported without a word before.
+#[test]
+fn a_compensated_flight_whose_columns_disagree_is_not_scored() {
+    let cal = simulate_flight(ScenarioKind::Calibration, None, Some(3)).unwrap();
+    let model = classical_model(&cal);
+    let flight = model.compensate(&cal).unwrap().into_flight(cal).unwrap();
+    assert!(aeromag::score::score(&flight, &[], None).is_ok());
+    let edited = |edit: &dyn Fn(&str, &mut Vec<f64>)| {
+        let mut t = FlightTable::new();
+        for c in flight.columns() {
+            if let Some(v) = c.values() {
+                let mut v = v.to_vec();
+                edit(c.name(), &mut v);
+                t.add_column(c.name(), v).unwrap();
+            }
+        }
+        Flight::from_table(t).unwrap()
+    };
+    let mag = flight.require("mag").unwrap().to_vec();
+    let comp = flight.require("mag_comp").unwrap().to_vec();
+    type Edit = Box<dyn Fn(&str, &mut Vec<f64>)>;
+    let cases: [(&str, Edit, &str); 4] = [
+        (
+            "beyond",
+            Box::new(|n, v| {
+                if n == "mag_comp" {
+                    v[100] = 1e300;
+                }
+            }),
+            "beyond any magnetic field",
+        ),
+        (
+            "µT",
+            Box::new(|n, v| {
+                if n == "mag_comp" {
+                    v.iter_mut().for_each(|x| *x *= 1e-3);
+                }
+            }),
+            "another unit",
+        ),
+        (
+            "pT",
+            Box::new(|n, v| {
+                if n == "mag_interf" {
+                    v.iter_mut().for_each(|x| *x *= 1e3);
+                }
+            }),
+            "is not `mag` minus `mag_interf`",
+        ),
+        (
+            "swapped",
+            Box::new(move |n, v| match n {
+                "mag" => v.copy_from_slice(&comp),
+                "mag_comp" => v.copy_from_slice(&mag),
+                _ => {}
+            }),
+            "is not `mag` minus `mag_interf`",
+        ),
+    ];
+    for (what, edit, needle) in cases {
+        let e = aeromag::score::score(&edited(&*edit), &[], None).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            e.is_bad_input() && msg.contains(needle) && msg.contains("column 'mag_comp'"),
+            "{what}: {msg}"
+        );
+    }
+}

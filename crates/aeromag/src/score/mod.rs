@@ -23,6 +23,7 @@ use aeromag_compensation::metrics::{
     figure_of_merit, improvement_ratio, residual_by_line,
 };
 use aeromag_compensation::tolles_lawson::segments::median_step;
+use aeromag_core::error::{fixed, shown};
 use aeromag_core::filter::BandPass;
 use serde::Serialize;
 use std::ops::Range;
@@ -105,7 +106,7 @@ impl<'a> SensorSeries<'a> {
     /// `mag_comp`, and `mag_interf`, `true_external`, `true_lag`,
     /// `true_interf`, `true_mag_noise` when present.
     pub fn of(t: &'a Flight) -> Result<Self> {
-        Ok(Self {
+        Self {
             mag: t.require("mag")?,
             comp: t.require("mag_comp")?,
             interf: t.column("mag_interf"),
@@ -115,8 +116,110 @@ impl<'a> SensorSeries<'a> {
                 interf: t.column("true_interf"),
                 noise: t.column("true_mag_noise"),
             },
-        })
+        }
+        .checked(t, ["mag", "mag_comp", "mag_interf"])
     }
+
+    /// The series, once its compensated reading and interference (columns
+    /// `names`: reading, compensated, interference) are checked to be what
+    /// they say, as bad input naming the row and column: within any
+    /// magnetic field ([`aeromag_io::MAX_FIELD_NT`]); the compensated
+    /// reading a total field like the reading (their median difference
+    /// below [`MAX_INTERFERENCE_SHARE`] of the reading's median); and, with
+    /// the interference, the reading minus it (to
+    /// [`CONSISTENCY_TOLERANCE_NT`] or 10⁻⁹ of the reading). A report of
+    /// `1e300` in `mag_comp` gave an improvement ratio of 0.000, one in µT
+    /// a residual of −53 046 nT, and `mag_interf` ×1000 or `mag` and
+    /// `mag_comp` swapped were scored, all without a word.
+    pub(crate) fn checked(self, t: &Flight, names: [&str; 3]) -> Result<Self> {
+        let [mag_name, comp_name, interf_name] = names;
+        let columns =
+            std::iter::once((comp_name, self.comp)).chain(self.interf.map(|v| (interf_name, v)));
+        for (name, v) in columns {
+            if let Some(row) = v.iter().position(|x| x.abs() > aeromag_io::MAX_FIELD_NT) {
+                return Err(t.bad_value(
+                    row,
+                    name,
+                    format!(
+                        "{} nT is beyond any magnetic field (at most {} nT in magnitude)",
+                        shown(v[row]),
+                        shown(aeromag_io::MAX_FIELD_NT)
+                    ),
+                ));
+            }
+        }
+        let both: Vec<(f64, f64)> = self
+            .mag
+            .iter()
+            .zip(self.comp)
+            .filter(|(m, c)| m.is_finite() && c.is_finite())
+            .map(|(&m, &c)| (m, c))
+            .collect();
+        if !both.is_empty() {
+            let mut field: Vec<f64> = both.iter().map(|(m, _)| m.abs()).collect();
+            let mut diff: Vec<f64> = both.iter().map(|(m, c)| (m - c).abs()).collect();
+            let (field, diff) = (median_of(&mut field), median_of(&mut diff));
+            if diff > MAX_INTERFERENCE_SHARE * field {
+                return Err(t.bad_column(
+                    comp_name,
+                    format!(
+                        "the compensated reading differs from `{mag_name}` by a median of {} nT, {} % of \
+                         the field ({} nT): no aircraft's interference is that large; is it in another \
+                         unit (µT, pT?) or another column?",
+                        fixed(diff, 1),
+                        fixed(100.0 * diff / field, 1),
+                        fixed(field, 1)
+                    ),
+                ));
+            }
+        }
+        if let Some(interf) = self.interf {
+            let off = |i: usize| {
+                let (m, c, f) = (self.mag[i], self.comp[i], interf[i]);
+                let tol = CONSISTENCY_TOLERANCE_NT.max(1e-9 * m.abs());
+                m.is_finite() && c.is_finite() && f.is_finite() && (m - f - c).abs() > tol
+            };
+            if let Some(row) =
+                (0..self.mag.len().min(self.comp.len()).min(interf.len())).find(|&i| off(i))
+            {
+                return Err(t.bad_value(
+                    row,
+                    comp_name,
+                    format!(
+                        "{} nT is not `{mag_name}` minus `{interf_name}` ({} − {} = {} nT): columns \
+                         swapped, another unit, or edited after compensation? (drop `{interf_name}` to \
+                         report the compensated reading alone)",
+                        shown(self.comp[row]),
+                        shown(self.mag[row]),
+                        shown(interf[row]),
+                        shown(self.mag[row] - interf[row])
+                    ),
+                ));
+            }
+        }
+        Ok(self)
+    }
+}
+
+/// The largest median difference between a flight's reading and its
+/// compensated reading, as a share of the reading's median, that
+/// [`SensorSeries::checked`] takes for aircraft interference: half the
+/// field. Fixed-wing interference is tens to thousands of nT against a
+/// field of 20 000–65 000 nT; a compensated reading in µT differs by 99.9 %.
+pub const MAX_INTERFERENCE_SHARE: f64 = 0.5;
+
+/// How far the compensated reading may differ from the reading minus the
+/// interference, nT ([`SensorSeries::checked`]): files written by another
+/// tool with three decimals round each by 0.0005 nT.
+pub const CONSISTENCY_TOLERANCE_NT: f64 = 0.01;
+
+/// The median of `v` (reordered), NaN when empty.
+fn median_of(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let k = v.len() / 2;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
 impl SensorTruth<'_> {

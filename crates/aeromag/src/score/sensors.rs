@@ -319,12 +319,14 @@ fn columns_of(s: &SensorModel) -> SensorColumns {
 
 /// The scored series of the sensor `s` of the compensated flight `t`.
 fn series_of<'a>(t: &'a Flight, s: &SensorModel) -> Result<SensorSeries<'a>> {
-    Ok(SensorSeries {
+    let (comp, interf) = (format!("{}_comp", s.name), format!("{}_interf", s.name));
+    SensorSeries {
         mag: t.require(&s.mag)?,
-        comp: t.require(&format!("{}_comp", s.name))?,
-        interf: Some(t.require(&format!("{}_interf", s.name))?),
+        comp: t.require(&comp)?,
+        interf: Some(t.require(&interf)?),
         truth: truth_of(t, &s.name),
-    })
+    }
+    .checked(t, [&s.mag, &comp, &interf])
 }
 
 impl SensorsFigures {
