@@ -447,9 +447,10 @@ fn convergence_on_the_smallest_grids_and_threads_zero() {
 /// The plain IEKF locks on a wrong solution on the default pass (180 m off,
 /// `converged` 1, σ about a metre): a warning now says its estimates are
 /// not to be trusted; the multi-start's are not warned of. Both print the
-/// mean normalised innovation and write it per epoch (`nis`).
+/// mean normalised innovation and write it per epoch (`nis`). The scenario
+/// file as the output, and readings in µT, are refused.
 #[test]
-fn a_filter_locked_on_a_wrong_solution_is_warned_of() {
+fn a_wrong_lock_is_warned_of_and_wrong_units_or_paths_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let (csv, toml) = simulate_into(&d.path().join("sim"), None);
     let out = d.path().join("est.csv");
@@ -471,6 +472,34 @@ fn a_filter_locked_on_a_wrong_solution_is_warned_of() {
     assert_code(&o, 2);
     assert!(stderr(&o).contains("is also an input"), "{}", stderr(&o));
     assert_eq!(std::fs::read(&toml).unwrap(), before);
+    // Sensor 2's readings in µT: bad input naming its columns (it read as
+    // a pass where the object was not detected, exit 0).
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let micro: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            let f: Vec<String> = l
+                .split(',')
+                .zip(&header)
+                .map(|(v, h)| match (i, h.starts_with("b2_")) {
+                    (1.., true) => (v.parse::<f64>().unwrap() * 1e-3).to_string(),
+                    _ => v.to_string(),
+                })
+                .collect();
+            f.join(",") + "\n"
+        })
+        .collect();
+    let micro_csv = d.path().join("micro.csv");
+    std::fs::write(&micro_csv, micro).unwrap();
+    let o = locate_with(&micro_csv, &toml, &out, &[]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("sensor 2 (b2_x, b2_y, b2_z) reads a median field of"),
+        "{}",
+        stderr(&o)
+    );
     let plain = locate_with(&csv, &toml, &out, &["--plain"]);
     assert_code(&plain, 0);
     assert!(

@@ -504,11 +504,73 @@ pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
             object_yaw_rad: f.object_yaw_rad,
         });
     }
+    check_reading_units(t, cfg, &names, &epochs)?;
     Ok(MeasuredPass {
         epochs,
         positions_m: positions,
     })
 }
+
+/// The readings of each sensor in nT: the median magnitude of its
+/// readings over the pass within a factor [`FIELD_UNIT_FACTOR`] of the
+/// IGRF's at the pass, else bad input naming its columns. Readings in µT
+/// (53 for 53 000 nT) were read as a pass on which the object was not
+/// detected, exit 0.
+fn check_reading_units(
+    t: &Flight,
+    cfg: &GradiometerConfig,
+    names: &[String],
+    epochs: &[Epoch],
+) -> Result<()> {
+    let median = |mut v: Vec<f64>| {
+        let k = v.len() / 2;
+        v.select_nth_unstable_by(k, f64::total_cmp);
+        v[k]
+    };
+    if epochs.is_empty() {
+        return Ok(());
+    }
+    let igrf = median(
+        epochs
+            .iter()
+            .map(|e| e.background.field_nt.norm())
+            .collect(),
+    );
+    for i in 0..4 {
+        let (columns, reading): (Vec<&str>, Vec<f64>) = match cfg.system.gradiometer {
+            Gradiometer::Tensor => (
+                names[3 * i..3 * i + 3].iter().map(String::as_str).collect(),
+                epochs.iter().map(|e| e.vector_nt[i].norm()).collect(),
+            ),
+            Gradiometer::Scalar => (
+                vec![names[i].as_str()],
+                epochs.iter().map(|e| e.scalar_nt[i].abs()).collect(),
+            ),
+        };
+        let m = median(reading);
+        if !(igrf / FIELD_UNIT_FACTOR..=igrf * FIELD_UNIT_FACTOR).contains(&m) {
+            return Err(t.bad_column(
+                columns[0],
+                format!(
+                    "sensor {} ({}) reads a median field of {} nT where the IGRF at the pass gives {} nT: \
+                     another unit (µT, pT?) or another channel? expected nT",
+                    i + 1,
+                    columns.join(", "),
+                    aeromag_core::error::fixed(m, 3),
+                    aeromag_core::error::fixed(igrf, 1)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// How far (a factor either way) the median field a gradiometer's sensor
+/// reads over a pass may lie from the IGRF's before its unit is taken to
+/// be wrong: the object adds hundreds of nT near the closest approach and
+/// the variations a few nT, on a field of 20 000–65 000 nT; a unit off by
+/// 1000 is a factor of 1000.
+pub const FIELD_UNIT_FACTOR: f64 = 2.0;
 
 /// Per-epoch estimates over a pass: rows of 6 values in state order `x, y,
 /// z` (m, body frame, object relative to the gradiometer centre), `mx, my,
