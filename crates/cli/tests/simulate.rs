@@ -193,3 +193,28 @@ fn an_out_that_is_no_folder_and_an_unwritable_seed_are_bad_input() {
     assert!(stderr(&o).contains("must be < 2^63"), "{}", stderr(&o));
     assert!(!out.join("em.toml").exists());
 }
+
+/// A folder in the place of the truth file: nothing is written (the flight
+/// and scenario of the new seed were written beside the old truth).
+#[test]
+fn a_run_that_cannot_write_every_file_writes_none() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out");
+    let o = aeromag(&["simulate", "pod", "--out", out.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let csv = std::fs::read(out.join("pod.csv")).unwrap();
+    let truth = out.join("pod.truth.json");
+    std::fs::remove_file(&truth).unwrap();
+    std::fs::create_dir(&truth).unwrap();
+    let o = aeromag(&[
+        "simulate",
+        "pod",
+        "--seed",
+        "9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.code() != Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pod.truth.json"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(out.join("pod.csv")).unwrap(), csv);
+}

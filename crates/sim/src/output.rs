@@ -160,7 +160,12 @@ impl Simulation {
                 source: e,
             }
         };
-        // Each file through a temporary renamed when complete.
+        // All three checked before any is written (a folder in the place
+        // of the truth file left a new flight beside the old truth), then
+        // each file through a temporary renamed when complete.
+        for p in [&files.csv, &files.scenario, &files.truth] {
+            aeromag_io::atomic::check_writable(p).map_err(werr(p))?;
+        }
         let mut failure: Option<SimError> = None;
         aeromag_io::atomic::write_atomically(&files.csv, |w| {
             self.write_csv(w).map_err(|e| {
