@@ -39,9 +39,22 @@ pub struct InputArgs {
 }
 
 /// Read and check a file of another kind than a flight (a gradiometer
-/// pass) with the default options; its warnings go to stderr.
-pub fn load(path: &std::path::Path) -> anyhow::Result<Flight> {
-    let flight = Flight::read(path)?;
+/// pass), the fields `names` alone (the others are delimited but not
+/// parsed: a truth column's text cell no longer stops a command that does
+/// not read it), with the default options; its warnings go to stderr.
+pub fn load_only(path: &std::path::Path, names: Vec<String>) -> anyhow::Result<Flight> {
+    read_checked(
+        path,
+        &ReadOptions {
+            fields: Fields::Only(names),
+            ..ReadOptions::default()
+        },
+    )
+}
+
+/// Read and check `path` with `opts`; its warnings go to stderr.
+fn read_checked(path: &std::path::Path, opts: &ReadOptions) -> anyhow::Result<Flight> {
+    let flight = Flight::read_with(path, opts)?;
     for w in flight.warnings() {
         eprintln!("{w}");
     }
@@ -115,10 +128,6 @@ impl InputArgs {
             fields,
             ..self.read_options()?
         };
-        let flight = Flight::read_with(&self.input, &opts)?;
-        for w in flight.warnings() {
-            eprintln!("{w}");
-        }
-        Ok(flight)
+        read_checked(&self.input, &opts)
     }
 }

@@ -448,7 +448,8 @@ fn convergence_on_the_smallest_grids_and_threads_zero() {
 /// `converged` 1, σ about a metre): a warning now says its estimates are
 /// not to be trusted; the multi-start's are not warned of. Both print the
 /// mean normalised innovation and write it per epoch (`nis`). The scenario
-/// file as the output, and readings in µT, are refused.
+/// file as the output, and readings in µT, are refused; a truth column is
+/// not read.
 #[test]
 fn a_wrong_lock_is_warned_of_and_wrong_units_or_paths_are_refused() {
     let d = tempfile::tempdir().unwrap();
@@ -500,6 +501,11 @@ fn a_wrong_lock_is_warned_of_and_wrong_units_or_paths_are_refused() {
         "{}",
         stderr(&o)
     );
+    // A text cell in a truth column, which locate never reads: located
+    // (it was parsed, and refused).
+    let truth_text = d.path().join("truth_text.csv");
+    std::fs::write(&truth_text, edited(&text, "true_x_m", 5, "abc")).unwrap();
+    assert_code(&locate_with(&truth_text, &toml, &out, &[]), 0);
     let plain = locate_with(&csv, &toml, &out, &["--plain"]);
     assert_code(&plain, 0);
     assert!(

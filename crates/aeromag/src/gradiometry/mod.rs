@@ -312,6 +312,33 @@ pub fn sensor_columns(g: Gradiometer) -> Vec<String> {
     }
 }
 
+/// The columns [`read_pass`] reads: `time`, the system's `lat, lon, alt,
+/// north_m, east_m, down_m, roll, pitch, yaw`, the object's known track
+/// `obj_north_m, obj_east_m, obj_down_m, obj_yaw` and the readings
+/// ([`sensor_columns`]); never the truth ([`TRUTH`]).
+pub fn pass_columns(g: Gradiometer) -> Vec<String> {
+    [
+        "time",
+        "lat",
+        "lon",
+        "alt",
+        "north_m",
+        "east_m",
+        "down_m",
+        "roll",
+        "pitch",
+        "yaw",
+        "obj_north_m",
+        "obj_east_m",
+        "obj_down_m",
+        "obj_yaw",
+    ]
+    .into_iter()
+    .map(String::from)
+    .chain(sensor_columns(g))
+    .collect()
+}
+
 /// The simulated pass as a table (one row per epoch): `time`; system
 /// `lat, lon, alt`, `north_m, east_m, down_m`, `roll, pitch, yaw` (deg); the
 /// object's known track `obj_north_m, obj_east_m, obj_down_m, obj_yaw`

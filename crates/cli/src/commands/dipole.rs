@@ -9,8 +9,8 @@
 use crate::exit::bad_input;
 use aeromag::core::parallel::MAX_THREADS;
 use aeromag::gradiometry::{
-    LocateSettings, STATE_NAMES, both_maps, locate_pass, map_figures, parse_name, read_config,
-    read_pass,
+    LocateSettings, STATE_NAMES, both_maps, locate_pass, map_figures, parse_name, pass_columns,
+    read_config, read_pass,
 };
 use aeromag::report::{Report, ReportSection, Table};
 use aeromag_gradiometry::convergence::ConvergenceCase;
@@ -206,7 +206,7 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
         },
     };
     settings.apply(&mut cfg)?;
-    let table = crate::input::load(&a.input)?;
+    let table = crate::input::load_only(&a.input, pass_columns(cfg.system.gradiometer))?;
     let pass = read_pass(&table, &cfg)?;
     let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
     let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();
