@@ -515,3 +515,30 @@ fn a_wrong_lock_is_warned_of_and_wrong_units_or_paths_are_refused() {
         stderr(&plain)
     );
 }
+
+/// A pass with 10 s missing at the closest approach: the object is not
+/// detected, and a warning names the gap (it said nothing of it).
+#[test]
+fn a_time_gap_in_the_pass_is_warned_of() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(&d.path().join("sim"), None);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let gapped: String = text
+        .lines()
+        .enumerate()
+        .filter(|(i, _)| !(250..350).contains(i))
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    let f = d.path().join("gap.csv");
+    std::fs::write(&f, gapped).unwrap();
+    let o = locate_with(&f, &toml, &d.path().join("est.csv"), &[]);
+    assert_code(&o, 0);
+    assert!(
+        stderr(&o).contains("1 time gap(s) in the pass")
+            && stderr(&o).contains("before data row 250"),
+        "{}",
+        stderr(&o)
+    );
+    let o = locate_with(&csv, &toml, &d.path().join("est.csv"), &[]);
+    assert!(!stderr(&o).contains("gap"), "{}", stderr(&o));
+}

@@ -14,6 +14,7 @@ pub use aeromag_gradiometry::{
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
+use crate::observer::Note;
 use aeromag_core::error::shown;
 use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
@@ -395,6 +396,52 @@ pub struct MeasuredPass {
     pub epochs: Vec<Epoch>,
     /// The object's known position, body frame, m.
     pub positions_m: Vec<Vector3<f64>>,
+    /// Warnings about the pass as read (time gaps).
+    pub notes: Vec<Note>,
+}
+
+/// A step between epochs this many times the median step is a gap in the
+/// pass, warned of: the object may pass unseen in it (a 10 s gap at the
+/// closest approach gave "object not detected", exit 0, without a word).
+pub const GAP_STEPS: f64 = 3.0;
+
+/// The warning for the time gaps of a pass (steps above [`GAP_STEPS`] times
+/// the median step), naming the first and the longest; none without gaps.
+fn gap_warning(t: &Flight, time: &[f64]) -> Option<Note> {
+    let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return None;
+    }
+    let k = steps.len() / 2;
+    let median = *steps.clone().select_nth_unstable_by(k, f64::total_cmp).1;
+    steps.iter_mut().for_each(|s| *s = s.max(0.0));
+    let gaps: Vec<usize> = (0..steps.len())
+        .filter(|&j| steps[j] > GAP_STEPS * median)
+        .collect();
+    let first = *gaps.first()?;
+    let longest = *gaps
+        .iter()
+        .max_by(|&&a, &&b| steps[a].total_cmp(&steps[b]))?;
+    let fig = aeromag_core::error::figure;
+    let longest = if gaps.len() > 1 {
+        format!(
+            ", the longest {} s before data row {}",
+            fig(steps[longest]),
+            t.file_row(longest + 1) + 1
+        )
+    } else {
+        String::new()
+    };
+    Some(Note::warning(format!(
+        "{}: {} time gap(s) in the pass (steps over {GAP_STEPS} times the median {} s), the first {} s \
+         before data row {}{longest}: the object may have passed unseen there; the filter bridges \
+         them with its motion model",
+        t.label(),
+        gaps.len(),
+        fig(median),
+        fig(steps[first]),
+        t.file_row(first + 1) + 1,
+    )))
 }
 
 /// Extent of a pass's local frame, m (positions `north_m`, `obj_north_m`,
@@ -535,6 +582,7 @@ pub fn read_pass(t: &Flight, cfg: &GradiometerConfig) -> Result<MeasuredPass> {
     Ok(MeasuredPass {
         epochs,
         positions_m: positions,
+        notes: gap_warning(t, time).into_iter().collect(),
     })
 }
 

@@ -208,6 +208,9 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
     settings.apply(&mut cfg)?;
     let table = crate::input::load_only(&a.input, pass_columns(cfg.system.gradiometer))?;
     let pass = read_pass(&table, &cfg)?;
+    for n in &pass.notes {
+        eprintln!("{n}");
+    }
     let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
     let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();
     aeromag::io::write_csv(&track.to_table(&time)?, &a.out)?;
