@@ -77,8 +77,15 @@ pub struct SimulateArgs {
 /// settings come from the scenario file (the one `simulate` writes) and the
 /// flags. Writes EST.csv: `time, detected, x_m, y_m, z_m, mx_am2, my_am2,
 /// mz_am2` (body frame), their standard deviations `sd_…`, `iterations,
-/// residual_nt, converged` and the estimability measures `mu_…`
-/// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior).
+/// residual_nt, converged`, the estimability measures `mu_…`
+/// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior)
+/// and `nis`, the epoch's normalised innovation squared per contrast
+/// (about 1 on average when the σ describe the errors). A mean `nis` above
+/// 3 is warned of: the filter is locked on a wrong solution or its inputs
+/// are not what they say (swapped sensors, quiet epochs that are not
+/// quiet), and its estimates and σ are not to be trusted. Readings whose
+/// median field is not the IGRF's within a factor 2 are refused (another
+/// unit), and time gaps in the pass are warned of.
 /// The scalar gradiometer does not estimate the position (it is known from
 /// the tracks): its `sd_x_m … mu_z` cells are empty and the summary says
 /// "σ not estimated".
