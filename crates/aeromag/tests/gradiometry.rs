@@ -260,6 +260,16 @@ fn non_finite_and_overflowing_scenario_values_are_bad_input() {
     let e = aeromag::gradiometry::simulate_pass(&cfg).unwrap_err();
     assert!(e.is_bad_input(), "{e}");
     assert!(e.to_string().contains("too large for the simulator"), "{e}");
+    // A moment of 1e300 A·m² gives finite readings beyond any field: the
+    // simulated pass is one the reader refuses, so it is not written (it
+    // was, with exit 0).
+    let cfg = GradiometerConfig::from_toml("[object]\npermanent_moment_am2 = [1e300, 0.0, 0.0]\n")
+        .unwrap();
+    let e = aeromag::gradiometry::simulate_pass(&cfg).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("refuses") && e.to_string().contains("b1_x"),
+        "{e}"
+    );
 
     let e = aeromag::em::parse_config(Some("range_period_s = nan\n"), "em.toml").unwrap_err();
     assert!(e.is_bad_input(), "{e}");

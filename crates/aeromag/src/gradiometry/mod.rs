@@ -165,6 +165,19 @@ pub fn simulate_pass(cfg: &GradiometerConfig) -> Result<FlightTable> {
             )));
         }
     }
+    // The pass must be one the reader takes (readings beyond any field, a
+    // speed of 3·10⁸ m/s, a longitude of 400° were written with exit 0 and
+    // refused by `dipole locate`).
+    let mut measured = FlightTable::new();
+    measured.set_source("simulated pass");
+    for name in pass_columns(cfg.system.gradiometer) {
+        measured.add_column(&name, table.require(&name)?.to_vec())?;
+    }
+    read_pass(&Flight::from_table(measured)?, cfg).map_err(|e| {
+        Error::bad_input(format!(
+            "scenario: the simulated pass is one `dipole locate` refuses: {e}"
+        ))
+    })?;
     Ok(table)
 }
 
