@@ -100,9 +100,22 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
             system.frequencies_hz, system.pilot_offset_hz
         ));
     }
+    // Less than one bin apart, a pilot and its working tone fall in the
+    // same bin of an N-sample block: no window separates them (N = 1600
+    // gave ranges of 5·10¹⁰ m). From 1 to 4 bins they are inside the
+    // window's main lobe and leak (N = 4000 and 12000: position errors of
+    // 50 m and 10 m, which locate's residual test fails).
+    let min_n = (4.0 * fs / system.pilot_offset_hz).ceil();
+    if pilot_bins < 1.0 - 1e-9 {
+        return Err(Error::bad_input(format!(
+            "window length {n} ({} s of '{file}'): the pilot offset {} Hz is {pilot_bins:.2} bins f_s/N, so the pilots fall in their working tones' bins and cannot be resolved; use N ≥ {min_n} (4 bins)",
+            aeromag_core::error::figure(n as f64 / fs),
+            system.pilot_offset_hz
+        )));
+    }
     if pilot_bins < 4.0 - 1e-9 {
         notes.warn(format!(
-            "pilot offset {} Hz is {pilot_bins:.2} bins (< 4): the pilots leak into the working detector",
+            "window length N = {n} samples: pilot offset {} Hz is {pilot_bins:.2} bins (< 4): the pilots leak into the working detector; use N ≥ {min_n}",
             system.pilot_offset_hz
         ));
     }

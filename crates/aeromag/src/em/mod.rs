@@ -15,7 +15,7 @@ mod simulate;
 pub use aeromag_em::{EmError, calibration, detection, positioning, sim, study};
 pub use calibrate::{EmCalibration, calibrate, known_points};
 pub use detect::{DetectOptions, Detection, detect};
-pub use locate::{Located, Pose, Poses, locate};
+pub use locate::{Located, MAX_RESIDUAL_REL, Pose, Poses, locate};
 pub use simulate::{DEFAULT_KNOWN, SimulatedEm, command_default, parse_config, simulate_to_dir};
 
 use crate::error::{Error, Result};

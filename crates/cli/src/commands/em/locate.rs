@@ -30,6 +30,11 @@ use std::path::PathBuf;
 ///   field components); hemisphere_by_continuity (0/1); status (0 located,
 ///   1 failed: pose columns empty).
 ///
+/// An epoch whose residual_rel exceeds 1e-3 (15× the largest of 2560
+/// simulated epochs) is not explained by the dipoles at one pose and is
+/// failed, with a warning; when no epoch is located the command fails
+/// (exit 1) and writes nothing.
+///
 /// Example:
 ///   aeromag em locate --input em/detected.csv --calibration em/cal.json --out em/poses.csv
 #[derive(Debug, clap::Args)]
@@ -58,7 +63,14 @@ pub fn run(a: LocateArgs) -> anyhow::Result<()> {
     let file = CalibrationFile::from_json(&text)
         .map_err(|e| bad_input!("'{}': {e}", a.calibration.display()))?;
     let epochs = read_detected(&a.input)?;
-    let poses = locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new())?;
+    let poses =
+        locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new()).map_err(|e| {
+            anyhow::Error::new(e).context(format!(
+                "locating '{}' with '{}' failed",
+                a.input.display(),
+                a.calibration.display()
+            ))
+        })?;
     aeromag::io::atomic::write_file(&a.out, poses.to_csv())
         .map_err(|e| aeromag::Error::write(&a.out, e))?;
     println!(
