@@ -821,3 +821,78 @@ fn epochs_the_dipoles_do_not_explain_are_failed() {
         &["window length 1600", "0.40 bins", "N ≥ 16000", "em.raw"],
     );
 }
+
+/// KNOWN positions in km gave |S| = 1.7 and negated moments a 175°
+/// "small rotation" Q, both written to the calibration file with exit 0.
+/// They are bad input naming the likely causes.
+#[test]
+fn implausible_calibration_corrections_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&[
+            "em",
+            "detect",
+            "--input",
+            s(&sim.join("em.raw")),
+            "--out",
+            s(&det),
+        ]),
+        0,
+    );
+    let (known, system) = (sim.join("em.known.csv"), sim.join("em.system.json"));
+    let calibrate = |known: &Path, system: &Path| {
+        vec![
+            "em".to_string(),
+            "calibrate".into(),
+            "--input".into(),
+            s(&det).into(),
+            "--known".into(),
+            s(known).into(),
+            "--system".into(),
+            s(system).into(),
+            "--out".into(),
+            s(&d.join("cal.json")).into(),
+        ]
+    };
+    fn strs(v: &[String]) -> Vec<&str> {
+        v.iter().map(String::as_str).collect()
+    }
+    assert_code(&aeromag(&strs(&calibrate(&known, &system))), 0);
+    // Positions in km.
+    let text = std::fs::read_to_string(&known).unwrap();
+    let mut km = String::new();
+    for (i, l) in text.lines().enumerate() {
+        let mut v: Vec<String> = l.split(',').map(String::from).collect();
+        if i > 0 {
+            for c in &mut v[1..4] {
+                *c = (c.parse::<f64>().unwrap() / 1000.0).to_string();
+            }
+        }
+        km += &(v.join(",") + "\n");
+    }
+    let known_km = d.join("known_km.csv");
+    std::fs::write(&known_km, km).unwrap();
+    bad(
+        &strs(&calibrate(&known_km, &system)),
+        &["known_km.csv", "|S| = ", "exceeds 0.5", "not in metres"],
+    );
+    // Moments of the wrong sign.
+    let mut sys: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&system).unwrap()).unwrap();
+    for m in sys["moments_am2"].as_array_mut().unwrap() {
+        *m = serde_json::json!(-m.as_f64().unwrap());
+    }
+    let neg = d.join("sys_neg.json");
+    std::fs::write(&neg, sys.to_string()).unwrap();
+    bad(
+        &strs(&calibrate(&known, &neg)),
+        &[
+            "sys_neg.json",
+            "attitude correction Q turns by",
+            "wrong sign",
+        ],
+    );
+}

@@ -178,6 +178,11 @@ pub struct EmCalibration {
 /// epochs whose position `known` gives (≥ 2); (3) attitude, from the
 /// epoch(s) whose attitude it gives. `system` gives the nominal moments;
 /// the sign of r is taken from the half-space.
+///
+/// Errors (bad input) when the fitted `|S|` or `Q` exceeds
+/// [`MAX_TRANSMITTER_S`](aeromag_em::calibration::MAX_TRANSMITTER_S) or
+/// [`MAX_ATTITUDE_Q_DEG`](aeromag_em::calibration::MAX_ATTITUDE_Q_DEG):
+/// such corrections come from wrong units, swapped channels or signs.
 pub fn calibrate(
     epochs: &[FieldEpoch],
     known: &KnownPoints,
@@ -193,6 +198,11 @@ pub fn calibrate(
     let data: Vec<_> = epochs.iter().map(|e| e.h).collect();
     let m = system.moments_am2;
     let cal = Calibration::fit(&data, known, &m, &Hemisphere::new(half_space.normal()))?;
+    if let Some(what) = cal.implausible() {
+        return Err(Error::bad_input(format!(
+            "the calibration corrects small mounting and transmitter errors, but {what}"
+        )));
+    }
     let before: Vec<f64> = data
         .iter()
         .flat_map(|e| aeromag_em::calibration::uncalibrated(e, &cal.polarisation.phase_rad).1)
