@@ -101,16 +101,29 @@ impl Calibration {
     /// the finiteness is checked elsewhere).
     pub fn implausible(&self) -> Option<String> {
         let mut out = Vec::new();
-        let s = self.transmitter_s.norm();
+        // The norm scaled by the largest entry: |S| of 1e300 entries stays finite.
+        let big = self.transmitter_s.amax();
+        let s = if big > 0.0 {
+            big * (self.transmitter_s / big).norm()
+        } else {
+            big
+        };
         if s > MAX_TRANSMITTER_S {
             let g = (Matrix3::identity() + self.transmitter_s)
                 .determinant()
                 .abs()
                 .cbrt();
+            let scale = if g.is_finite() {
+                format!(
+                    " (it scales the moments by about {})",
+                    aeromag_core::error::figure(g)
+                )
+            } else {
+                String::new()
+            };
             out.push(format!(
-                "transmitter distortion |S| = {} exceeds {MAX_TRANSMITTER_S} (it scales the moments by about {}): KNOWN positions not in metres (km, cm, ft?), moments in the wrong unit (×1000?), or swapped channels",
+                "transmitter distortion |S| = {} exceeds {MAX_TRANSMITTER_S}{scale}: KNOWN positions not in metres (km, cm, ft?), moments in the wrong unit (×1000?), or swapped channels",
                 aeromag_core::error::figure(s),
-                aeromag_core::error::figure(g)
             ));
         }
         let q = crate::positioning::rotation_angle_between(&self.attitude_q, &Matrix3::identity())
