@@ -896,3 +896,68 @@ fn implausible_calibration_corrections_are_bad_input() {
         ],
     );
 }
+
+/// A system or calibration JSON saved with a UTF-8 byte-order mark was
+/// refused ("expected value at line 1 column 1") though the CSV files
+/// accept one; it is skipped and gives the same results.
+#[test]
+fn json_files_with_a_byte_order_mark_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&[
+            "em",
+            "detect",
+            "--input",
+            s(&sim.join("em.raw")),
+            "--out",
+            s(&det),
+        ]),
+        0,
+    );
+    let bom = |p: &Path| {
+        let out = p.with_extension("bom.json");
+        let mut bytes = b"\xEF\xBB\xBF".to_vec();
+        bytes.extend(std::fs::read(p).unwrap());
+        std::fs::write(&out, bytes).unwrap();
+        out
+    };
+    let known = sim.join("em.known.csv");
+    let chain = |system: &Path, tag: &str, bom_cal: bool| {
+        let cal = d.join(format!("cal_{tag}.json"));
+        let o = aeromag(&[
+            "em",
+            "calibrate",
+            "--input",
+            s(&det),
+            "--known",
+            s(&known),
+            "--system",
+            s(system),
+            "--out",
+            s(&cal),
+        ]);
+        assert_code(&o, 0);
+        let cal = if bom_cal { bom(&cal) } else { cal };
+        let poses = d.join(format!("poses_{tag}.csv"));
+        let o = aeromag(&[
+            "em",
+            "locate",
+            "--input",
+            s(&det),
+            "--calibration",
+            s(&cal),
+            "--out",
+            s(&poses),
+        ]);
+        assert_code(&o, 0);
+        (std::fs::read(&cal).unwrap(), std::fs::read(&poses).unwrap())
+    };
+    let (cal_plain, poses_plain) = chain(&sim.join("em.system.json"), "plain", false);
+    let (cal_bom, poses_bom) = chain(&bom(&sim.join("em.system.json")), "bom", true);
+    assert_eq!(&cal_bom[..3], b"\xEF\xBB\xBF");
+    assert_eq!(cal_bom[3..], cal_plain[..]);
+    assert_eq!(poses_bom, poses_plain);
+}

@@ -1,12 +1,14 @@
 //! Reading the files of the EM chain with file, line, row and column in
 //! every error: detected-vector CSV, KNOWN CSV (through aeromag-io's
-//! reader), the system JSON and the raw record (read in place from a
+//! reader), the system and calibration JSON (a leading UTF-8 BOM is
+//! skipped, as in the CSV files) and the raw record (read in place from a
 //! memory map when its samples are aligned and complete, else streamed in
 //! chunks).
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use aeromag_core::error::shown;
+use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::detection::{EmSystem, FieldEpoch};
 use aeromag_em::sim::{RawReader, field_epoch_from_values, value_columns};
 use aeromag_io::{ReadOptions, read_table};
@@ -69,6 +71,14 @@ pub fn read_system(path: &Path) -> Result<EmSystem> {
     s.validate()
         .map_err(|e| Error::bad_file(&file, e.to_string()))?;
     Ok(s)
+}
+
+/// Read and check a calibration file (`em calibrate`'s JSON,
+/// [`CalibrationFile::from_json`]), naming the file in its errors.
+pub fn read_calibration(path: &Path) -> Result<CalibrationFile> {
+    let text = crate::model_file::read_text_file(path)?;
+    CalibrationFile::from_json(&text)
+        .map_err(|e| Error::bad_file(path.display().to_string(), e.to_string()))
 }
 
 /// ADC rates a raw record may have, Hz: 1 Hz to 100 MHz (the working

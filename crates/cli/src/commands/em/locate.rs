@@ -2,10 +2,8 @@
 //! [`aeromag::em::locate`]).
 
 use super::HalfSpaceArg;
-use crate::exit::bad_input;
 use crate::progress::Bars;
-use aeromag::em::calibration::CalibrationFile;
-use aeromag::em::files::read_detected;
+use aeromag::em::files::{read_calibration, read_detected};
 use aeromag::em::locate;
 use std::path::PathBuf;
 
@@ -58,10 +56,7 @@ pub fn run(a: LocateArgs) -> anyhow::Result<()> {
         [a.out.as_path()],
         &[a.input.as_path(), a.calibration.as_path()],
     )?;
-    let text = std::fs::read_to_string(&a.calibration)
-        .map_err(|e| aeromag::Error::read(&a.calibration, e))?;
-    let file = CalibrationFile::from_json(&text)
-        .map_err(|e| bad_input!("'{}': {e}", a.calibration.display()))?;
+    let file = read_calibration(&a.calibration)?;
     let epochs = read_detected(&a.input)?;
     let poses =
         locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new()).map_err(|e| {
