@@ -822,7 +822,7 @@ fn epochs_the_dipoles_do_not_explain_are_failed() {
     );
 }
 
-/// KNOWN positions in km gave |S| = 1.7 and negated moments a 175°
+/// KNOWN positions in ft gave |S| = 64 and negated moments a 175°
 /// "small rotation" Q, both written to the calibration file with exit 0.
 /// They are bad input naming the likely causes.
 #[test]
@@ -861,23 +861,23 @@ fn implausible_calibration_corrections_are_bad_input() {
         v.iter().map(String::as_str).collect()
     }
     assert_code(&aeromag(&strs(&calibrate(&known, &system))), 0);
-    // Positions in km.
+    // Positions in ft (those in km are out of the KNOWN range already).
     let text = std::fs::read_to_string(&known).unwrap();
-    let mut km = String::new();
+    let mut ft = String::new();
     for (i, l) in text.lines().enumerate() {
         let mut v: Vec<String> = l.split(',').map(String::from).collect();
         if i > 0 {
             for c in &mut v[1..4] {
-                *c = (c.parse::<f64>().unwrap() / 1000.0).to_string();
+                *c = (c.parse::<f64>().unwrap() * 3.28084).to_string();
             }
         }
-        km += &(v.join(",") + "\n");
+        ft += &(v.join(",") + "\n");
     }
-    let known_km = d.join("known_km.csv");
-    std::fs::write(&known_km, km).unwrap();
+    let known_ft = d.join("known_ft.csv");
+    std::fs::write(&known_ft, ft).unwrap();
     bad(
-        &strs(&calibrate(&known_km, &system)),
-        &["known_km.csv", "|S| = ", "exceeds 0.5", "not in metres"],
+        &strs(&calibrate(&known_ft, &system)),
+        &["known_ft.csv", "|S| = ", "exceeds 0.5", "not in metres"],
     );
     // Moments of the wrong sign.
     let mut sys: serde_json::Value =
@@ -960,4 +960,110 @@ fn json_files_with_a_byte_order_mark_are_read() {
     assert_eq!(&cal_bom[..3], b"\xEF\xBB\xBF");
     assert_eq!(cal_bom[3..], cal_plain[..]);
     assert_eq!(poses_bom, poses_plain);
+}
+
+/// A KNOWN position at the transmitter (0,0,0) or at 1e300 m, or a
+/// detected field of 1e300 T, failed in stage 2 with "singular matrix"
+/// (exit 1, no row named). They are bad input at their file, row and column.
+#[test]
+fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&[
+            "em",
+            "detect",
+            "--input",
+            s(&sim.join("em.raw")),
+            "--out",
+            s(&det),
+        ]),
+        0,
+    );
+    let (known, system) = (sim.join("em.known.csv"), sim.join("em.system.json"));
+    let out = d.join("cal.json");
+    // Replace data row `row` (0-based) column `col` of a CSV by `v`.
+    let edit = |p: &Path, name: &str, row: usize, cols: &[&str], v: &str| {
+        let text = std::fs::read_to_string(p).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        let header: Vec<&str> = lines[0].split(',').collect();
+        let at: Vec<usize> = cols
+            .iter()
+            .map(|c| header.iter().position(|h| h == c).unwrap())
+            .collect();
+        let mut f: Vec<String> = lines[row + 1].split(',').map(String::from).collect();
+        for &j in &at {
+            f[j] = v.to_string();
+        }
+        lines[row + 1] = f.join(",");
+        let o = d.join(name);
+        std::fs::write(&o, lines.join("\n") + "\n").unwrap();
+        o
+    };
+    let k0 = edit(&known, "k0.csv", 2, &["x_m", "y_m", "z_m"], "0");
+    bad(
+        &[
+            "em",
+            "calibrate",
+            "--input",
+            s(&det),
+            "--known",
+            s(&k0),
+            "--system",
+            s(&system),
+            "--out",
+            s(&out),
+        ],
+        &[
+            "k0.csv",
+            "line 4 (data row 3)",
+            "column 'x_m'",
+            "0 m from the transmitter",
+        ],
+    );
+    let kh = edit(&known, "kh.csv", 4, &["y_m"], "1e300");
+    bad(
+        &[
+            "em",
+            "calibrate",
+            "--input",
+            s(&det),
+            "--known",
+            s(&kh),
+            "--system",
+            s(&system),
+            "--out",
+            s(&out),
+        ],
+        &[
+            "kh.csv",
+            "line 6 (data row 5)",
+            "column 'y_m'",
+            "expected 1 … 10000 m",
+        ],
+    );
+    let dh = edit(&det, "dh.csv", 5, &["h2_z_im_t"], "1e300");
+    bad(
+        &[
+            "em",
+            "calibrate",
+            "--input",
+            s(&dh),
+            "--known",
+            s(&known),
+            "--system",
+            s(&system),
+            "--out",
+            s(&out),
+        ],
+        &[
+            "dh.csv",
+            "line 7 (data row 6)",
+            "column 'h2_z_im_t'",
+            "1e300 T",
+        ],
+    );
+    assert!(!out.exists());
 }

@@ -6,7 +6,7 @@
 //! | column | meaning |
 //! |---|---|
 //! | `time_s` | time of the point, s; within half an epoch spacing of a detected epoch's `time_s` |
-//! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty) |
+//! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty), 1 m to 10 km from the transmitter ([`KNOWN_RANGE_M`]) |
 //! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg, each within ±360 (all three, or all three empty; the columns may be omitted) |
 //!
 //! A row gives a position, an attitude or both.
@@ -26,6 +26,14 @@ use nalgebra::Vector3;
 /// either way (the rotation is the same modulo 360°; beyond that a value
 /// is a corrupted cell, not an angle).
 pub const MAX_ANGLE_DEG: f64 = 360.0;
+
+/// Range of a known position from the transmitter, m: a bird is towed
+/// tens to hundreds of metres behind (the simulated scenario 30–100 m).
+/// Below 1 m the point is the transmitter itself, where the dipole model
+/// has no meaning (0,0,0 made stage 2 singular); beyond 10 km the
+/// transmitter's field (≈ 4·10⁻¹⁵ T) is below any receiver's noise (1e300
+/// also made stage 2 singular).
+pub const KNOWN_RANGE_M: (f64, f64) = (1.0, 1e4);
 
 /// The known points of a KNOWN.csv table (module docs) against the
 /// detected epochs' times: each row's time must fall within half an epoch
@@ -120,6 +128,31 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                         shown(v[j])
                     ),
                 ));
+            }
+            if g[0] == "x_m" {
+                // Scaled by the largest component: 1e300 does not overflow.
+                let j = (1..3).fold(0, |a, b| if v[b].abs() > v[a].abs() { b } else { a });
+                let big = v[j].abs();
+                let range = if big > 0.0 {
+                    big * Vector3::new(v[0] / big, v[1] / big, v[2] / big).norm()
+                } else {
+                    0.0
+                };
+                if !(KNOWN_RANGE_M.0..=KNOWN_RANGE_M.1).contains(&range) {
+                    return Err(t.bad_value(
+                        row,
+                        g[j],
+                        format!(
+                            "position {}, {}, {} m is {} m from the transmitter, expected {} … {} m (a towed bird; positions in metres)",
+                            shown(v[0]),
+                            shown(v[1]),
+                            shown(v[2]),
+                            shown(range),
+                            KNOWN_RANGE_M.0,
+                            KNOWN_RANGE_M.1
+                        ),
+                    ));
+                }
             }
             any = true;
             if g[0] == "x_m" {
