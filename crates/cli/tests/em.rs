@@ -1067,3 +1067,47 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
     );
     assert!(!out.exists());
 }
+
+/// An all-zero record gave "invalid data: pilot not detected on channel
+/// 0", naming neither the file nor the cause; a channel silent for one
+/// detector block the same. Both name the file, channel and frames.
+#[test]
+fn a_record_without_signal_is_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let bytes = std::fs::read(sim.join("em.raw")).unwrap();
+    let body = 12 + u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    let zero = |name: &str, frames: std::ops::Range<usize>, channels: &[usize]| {
+        let mut b = bytes.clone();
+        for k in frames {
+            for &c in channels {
+                let at = body + 4 * (3 * k + c);
+                b[at..at + 4].copy_from_slice(&0f32.to_le_bytes());
+            }
+        }
+        let p = d.join(name);
+        std::fs::write(&p, b).unwrap();
+        p
+    };
+    let all = zero("allzero.raw", 0..128_000, &[0, 1, 2]);
+    let out = d.join("det.csv");
+    bad(
+        &["em", "detect", "--input", s(&all), "--out", s(&out)],
+        &[
+            "allzero.raw",
+            "channel 0 is 0 in every sample of frames 0 … 127999",
+            "carries no signal",
+        ],
+    );
+    let block = zero("block.raw", 16_000..32_000, &[1]);
+    bad(
+        &["em", "detect", "--input", s(&block), "--out", s(&out)],
+        &[
+            "block.raw",
+            "channel 1 is 0 in every sample of frames 16000 … 31999",
+            "no signal in that detector block",
+        ],
+    );
+    assert!(!out.exists());
+}

@@ -128,7 +128,10 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
     let chunk = n * (1usize << 18).div_ceil(n);
     let mut epochs = Vec::new();
     source.for_each_chunk(path, chunk, |first, samples| {
-        epochs.extend(chain.process(samples, first)?);
+        let got = chain
+            .process(samples, first)
+            .map_err(|e| silent_channel(&file, first, n, samples, e))?;
+        epochs.extend(got);
         Ok(())
     })?;
     let ratios: Vec<f64> = epochs
@@ -142,4 +145,44 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         polarization_ratio_rms: rms(&ratios),
         notes: notes.into_notes(),
     })
+}
+
+/// The error of detecting a chunk of `samples` (interleaved, 3 channels,
+/// absolute first frame `first`, detector blocks of `n` frames) in `file`:
+/// when a channel is 0 in every sample of the chunk or of a block, the
+/// record carries no signal there, which is what the pilot's "not
+/// detected" meant (an all-zero record gave "invalid data: pilot not
+/// detected on channel 0" without the file).
+fn silent_channel(
+    file: &str,
+    first: u64,
+    n: usize,
+    samples: &[f32],
+    e: aeromag_em::EmError,
+) -> Error {
+    let frames = samples.len() / 3;
+    let silent = |a: usize, b: usize, c: usize| (a..b).all(|k| samples[3 * k + c] == 0.0);
+    if let Some(c) = (0..3).find(|&c| silent(0, frames, c)) {
+        return Error::bad_file(
+            file,
+            format!(
+                "channel {c} is 0 in every sample of frames {first} … {}: the record carries no signal ({e})",
+                first + frames as u64 - 1
+            ),
+        );
+    }
+    for a in (0..frames).step_by(n.max(1)) {
+        let b = (a + n).min(frames);
+        if let Some(c) = (0..3).find(|&c| silent(a, b, c)) {
+            return Error::bad_file(
+                file,
+                format!(
+                    "channel {c} is 0 in every sample of frames {} … {}: no signal in that detector block ({e})",
+                    first + a as u64,
+                    first + b as u64 - 1
+                ),
+            );
+        }
+    }
+    Err::<(), _>(e).in_file(file).unwrap_err()
 }
