@@ -1111,3 +1111,50 @@ fn a_record_without_signal_is_named_as_such() {
     );
     assert!(!out.exists());
 }
+
+/// `detect --system` with the frequencies swapped (or in kHz) was used
+/// as given: the fields went to the wrong dipoles (exit 0). The system
+/// must agree with the record's header on the tones.
+#[test]
+fn detect_system_must_agree_with_the_records_tones() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let raw = sim.join("em.raw");
+    let system = sim.join("em.system.json");
+    let out = d.join("det.csv");
+    let o = aeromag(&[
+        "em",
+        "detect",
+        "--input",
+        s(&raw),
+        "--out",
+        s(&out),
+        "--system",
+        s(&system),
+    ]);
+    assert_code(&o, 0);
+    let mut sys: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&system).unwrap()).unwrap();
+    sys["frequencies_hz"] = serde_json::json!([2075.0, 1025.0, 3125.0]);
+    let swapped = d.join("swapped.json");
+    std::fs::write(&swapped, sys.to_string()).unwrap();
+    bad(
+        &[
+            "em",
+            "detect",
+            "--input",
+            s(&raw),
+            "--out",
+            s(&d.join("x.csv")),
+            "--system",
+            s(&swapped),
+        ],
+        &[
+            "em.raw",
+            "[2075.0, 1025.0, 3125.0]",
+            "[1025.0, 2075.0, 3125.0]",
+            "swapped",
+        ],
+    );
+}

@@ -83,6 +83,28 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
     let source = RawSource::open(path)?;
     let header = source.header().clone();
     let system = opts.system.clone().unwrap_or(header.system.clone());
+    // The tones are where the transmitter put them when the record was
+    // made: a system given in place of the header's (for its bench
+    // constants) must agree on them. Swapped frequencies assigned the
+    // fields to the wrong dipoles (every epoch mirrored, exit 0).
+    if opts.system.is_some() {
+        let h = &header.system;
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        let agree = (0..3).all(|i| same(system.frequencies_hz[i], h.frequencies_hz[i]))
+            && same(system.pilot_offset_hz, h.pilot_offset_hz);
+        if !agree {
+            return Err(Error::bad_file(
+                file.clone(),
+                format!(
+                    "the system given has frequencies {:?} Hz and pilot offset {} Hz, but the record was made at {:?} Hz and {} Hz (its header's system): a system of another record, or frequencies swapped or in kHz",
+                    system.frequencies_hz,
+                    system.pilot_offset_hz,
+                    h.frequencies_hz,
+                    h.pilot_offset_hz
+                ),
+            ));
+        }
+    }
     let fs = header.sample_rate_hz;
     let n = opts.window_len;
     if n < 8 || header.frames < n as u64 {
