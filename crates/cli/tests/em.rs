@@ -1158,3 +1158,83 @@ fn detect_system_must_agree_with_the_records_tones() {
         ],
     );
 }
+
+/// Detected times in ms put all 8 KNOWN rows within half an epoch of one
+/// epoch and calibrate used that epoch 8 times (exit 0). Two positions
+/// (or attitudes) on one epoch are bad input naming both rows.
+#[test]
+fn two_known_rows_on_one_epoch_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let det = d.join("det.csv");
+    assert_code(
+        &aeromag(&[
+            "em",
+            "detect",
+            "--input",
+            s(&sim.join("em.raw")),
+            "--out",
+            s(&det),
+        ]),
+        0,
+    );
+    let text = std::fs::read_to_string(sim.join("em.known.csv")).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    // Row 3's time moved onto row 2's epoch (+1 ms).
+    let t2: f64 = lines[2].split(',').next().unwrap().parse().unwrap();
+    let moved = format!("{}{}", t2 + 0.001, &lines[3][lines[3].find(',').unwrap()..]);
+    lines[3] = &moved;
+    let known = d.join("known_dup.csv");
+    std::fs::write(&known, lines.join("\n") + "\n").unwrap();
+    bad(
+        &[
+            "em",
+            "calibrate",
+            "--input",
+            s(&det),
+            "--known",
+            s(&known),
+            "--system",
+            s(&sim.join("em.system.json")),
+            "--out",
+            s(&d.join("cal.json")),
+        ],
+        &[
+            "known_dup.csv",
+            "line 4 (data row 3)",
+            "column 'time_s'",
+            "position data row 2 already gives",
+        ],
+    );
+    // A position and an attitude on one epoch from two rows are fine.
+    let orig: Vec<&str> = text.lines().collect();
+    let first: Vec<&str> = orig[1].split(',').collect();
+    let split = format!(
+        "{}\n{},{},{},{},,,\n{},,,,{},{},{}\n{}\n",
+        orig[0],
+        first[0],
+        first[1],
+        first[2],
+        first[3],
+        first[0],
+        first[4],
+        first[5],
+        first[6],
+        orig[2..].join("\n")
+    );
+    std::fs::write(&known, split).unwrap();
+    let o = aeromag(&[
+        "em",
+        "calibrate",
+        "--input",
+        s(&det),
+        "--known",
+        s(&known),
+        "--system",
+        s(&sim.join("em.system.json")),
+        "--out",
+        s(&d.join("cal.json")),
+    ]);
+    assert_code(&o, 0);
+}

@@ -9,7 +9,8 @@
 //! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty), 1 m to 10 km from the transmitter ([`KNOWN_RANGE_M`]) |
 //! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg, each within ±360 (all three, or all three empty; the columns may be omitted) |
 //!
-//! A row gives a position, an attitude or both.
+//! A row gives a position, an attitude or both; each detected epoch takes
+//! at most one position and one attitude.
 
 use super::HalfSpace;
 use crate::error::{Error, Result};
@@ -65,6 +66,10 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
         f64::INFINITY
     };
     let mut known = KnownPoints::default();
+    // The row that gave each epoch's position and attitude: two rows on one
+    // epoch (times in ms against seconds, a time column shifted) counted
+    // one epoch several times.
+    let mut given_at: Vec<[Option<usize>; 2]> = vec![[None, None]; epochs.len()];
     for row in 0..t.n_rows() {
         let tk = time[row];
         let k = epochs.partition_point(|e| e.time_s < tk);
@@ -154,6 +159,21 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                     ));
                 }
             }
+            let kind = usize::from(g[0] != "x_m");
+            if let Some(prev) = given_at[epoch][kind] {
+                return Err(t.bad_value(
+                    row,
+                    "time_s",
+                    format!(
+                        "{} s falls on the detected epoch at {} s, whose {} data row {} already gives: each epoch takes one (times in another unit than the detected file's?)",
+                        shown(tk),
+                        shown(epochs[epoch].time_s),
+                        ["position", "attitude"][kind],
+                        prev + 1
+                    ),
+                ));
+            }
+            given_at[epoch][kind] = Some(row);
             any = true;
             if g[0] == "x_m" {
                 known
