@@ -44,8 +44,11 @@ pub trait ModelFile: Sized {
 /// `--model /dev/zero` grew to a gigabyte before running out of memory.
 pub const MAX_TEXT_FILE_BYTES: u64 = 64 << 20;
 
-/// The text of a model, settings or scenario file: bad input when it
-/// cannot be read, is not UTF-8 or is larger than [`MAX_TEXT_FILE_BYTES`].
+/// The text of a model, settings, scenario, EM system or EM calibration
+/// file, without a leading UTF-8 byte-order mark (editors on Windows write
+/// one; the CSV reader skips it too, and serde_json refused it: "expected
+/// value at line 1 column 1"): bad input when it cannot be read, is not
+/// UTF-8 or is larger than [`MAX_TEXT_FILE_BYTES`].
 pub fn read_text_file(path: &Path) -> Result<String> {
     use std::io::Read;
     let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
@@ -61,6 +64,9 @@ pub fn read_text_file(path: &Path) -> Result<String> {
                 MAX_TEXT_FILE_BYTES >> 20
             ),
         ));
+    }
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
     }
     Ok(text)
 }

@@ -27,6 +27,13 @@ pub enum EmError {
         /// What is wrong.
         reason: String,
     },
+    /// A method ran on valid input but gave no usable result (e.g. no epoch
+    /// located) (a failure, not bad input).
+    #[error("{what}")]
+    Failed {
+        /// What failed, with the figures and likely causes.
+        what: String,
+    },
     /// An error from the core crate (filters, windows).
     #[error(transparent)]
     Core(#[from] aeromag_core::CoreError),
@@ -38,7 +45,7 @@ impl EmError {
     pub fn is_bad_input(&self) -> bool {
         match self {
             EmError::InvalidArgument { .. } | EmError::InvalidData { .. } => true,
-            EmError::Singular { .. } => false,
+            EmError::Singular { .. } | EmError::Failed { .. } => false,
             EmError::Core(e) => e.is_bad_input(),
         }
     }
@@ -53,5 +60,6 @@ mod tests {
         assert!(EmError::InvalidArgument { reason: "x".into() }.is_bad_input());
         assert!(EmError::InvalidData { reason: "x".into() }.is_bad_input());
         assert!(!EmError::Singular { what: "M".into() }.is_bad_input());
+        assert!(!EmError::Failed { what: "M".into() }.is_bad_input());
     }
 }

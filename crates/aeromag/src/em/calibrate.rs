@@ -6,10 +6,11 @@
 //! | column | meaning |
 //! |---|---|
 //! | `time_s` | time of the point, s; within half an epoch spacing of a detected epoch's `time_s` |
-//! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty) |
+//! | `x_m, y_m, z_m` | receiver position in the transmitter frame, m (all three, or all three empty), 1 m to 10 km from the transmitter ([`KNOWN_RANGE_M`]) |
 //! | `roll_deg, pitch_deg, yaw_deg` | receiver attitude relative to the transmitter frame, Z-Y-X, deg, each within ±360 (all three, or all three empty; the columns may be omitted) |
 //!
-//! A row gives a position, an attitude or both.
+//! A row gives a position, an attitude or both; each detected epoch takes
+//! at most one position and one attitude.
 
 use super::HalfSpace;
 use crate::error::{Error, Result};
@@ -26,6 +27,14 @@ use nalgebra::Vector3;
 /// either way (the rotation is the same modulo 360°; beyond that a value
 /// is a corrupted cell, not an angle).
 pub const MAX_ANGLE_DEG: f64 = 360.0;
+
+/// Range of a known position from the transmitter, m: a bird is towed
+/// tens to hundreds of metres behind (the simulated scenario 30–100 m).
+/// Below 1 m the point is the transmitter itself, where the dipole model
+/// has no meaning (0,0,0 made stage 2 singular); beyond 10 km the
+/// transmitter's field (≈ 4·10⁻¹⁵ T) is below any receiver's noise (1e300
+/// also made stage 2 singular).
+pub const KNOWN_RANGE_M: (f64, f64) = (1.0, 1e4);
 
 /// The known points of a KNOWN.csv table (module docs) against the
 /// detected epochs' times: each row's time must fall within half an epoch
@@ -57,6 +66,10 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
         f64::INFINITY
     };
     let mut known = KnownPoints::default();
+    // The row that gave each epoch's position and attitude: two rows on one
+    // epoch (times in ms against seconds, a time column shifted) counted
+    // one epoch several times.
+    let mut given_at: Vec<[Option<usize>; 2]> = vec![[None, None]; epochs.len()];
     for row in 0..t.n_rows() {
         let tk = time[row];
         let k = epochs.partition_point(|e| e.time_s < tk);
@@ -121,6 +134,46 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                     ),
                 ));
             }
+            if g[0] == "x_m" {
+                // Scaled by the largest component: 1e300 does not overflow.
+                let j = (1..3).fold(0, |a, b| if v[b].abs() > v[a].abs() { b } else { a });
+                let big = v[j].abs();
+                let range = if big > 0.0 {
+                    big * Vector3::new(v[0] / big, v[1] / big, v[2] / big).norm()
+                } else {
+                    0.0
+                };
+                if !(KNOWN_RANGE_M.0..=KNOWN_RANGE_M.1).contains(&range) {
+                    return Err(t.bad_value(
+                        row,
+                        g[j],
+                        format!(
+                            "position {}, {}, {} m is {} m from the transmitter, expected {} … {} m (a towed bird; positions in metres)",
+                            shown(v[0]),
+                            shown(v[1]),
+                            shown(v[2]),
+                            shown(range),
+                            KNOWN_RANGE_M.0,
+                            KNOWN_RANGE_M.1
+                        ),
+                    ));
+                }
+            }
+            let kind = usize::from(g[0] != "x_m");
+            if let Some(prev) = given_at[epoch][kind] {
+                return Err(t.bad_value(
+                    row,
+                    "time_s",
+                    format!(
+                        "{} s falls on the detected epoch at {} s, whose {} data row {} already gives: each epoch takes one (times in another unit than the detected file's?)",
+                        shown(tk),
+                        shown(epochs[epoch].time_s),
+                        ["position", "attitude"][kind],
+                        prev + 1
+                    ),
+                ));
+            }
+            given_at[epoch][kind] = Some(row);
             any = true;
             if g[0] == "x_m" {
                 known
@@ -178,6 +231,11 @@ pub struct EmCalibration {
 /// epochs whose position `known` gives (≥ 2); (3) attitude, from the
 /// epoch(s) whose attitude it gives. `system` gives the nominal moments;
 /// the sign of r is taken from the half-space.
+///
+/// Errors (bad input) when the fitted `|S|` or `Q` exceeds
+/// [`MAX_TRANSMITTER_S`](aeromag_em::calibration::MAX_TRANSMITTER_S) or
+/// [`MAX_ATTITUDE_Q_DEG`](aeromag_em::calibration::MAX_ATTITUDE_Q_DEG):
+/// such corrections come from wrong units, swapped channels or signs.
 pub fn calibrate(
     epochs: &[FieldEpoch],
     known: &KnownPoints,
@@ -193,6 +251,11 @@ pub fn calibrate(
     let data: Vec<_> = epochs.iter().map(|e| e.h).collect();
     let m = system.moments_am2;
     let cal = Calibration::fit(&data, known, &m, &Hemisphere::new(half_space.normal()))?;
+    if let Some(what) = cal.implausible() {
+        return Err(Error::bad_input(format!(
+            "the calibration corrects small mounting and transmitter errors, but {what}"
+        )));
+    }
     let before: Vec<f64> = data
         .iter()
         .flat_map(|e| aeromag_em::calibration::uncalibrated(e, &cal.polarisation.phase_rad).1)

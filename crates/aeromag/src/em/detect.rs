@@ -83,6 +83,28 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
     let source = RawSource::open(path)?;
     let header = source.header().clone();
     let system = opts.system.clone().unwrap_or(header.system.clone());
+    // The tones are where the transmitter put them when the record was
+    // made: a system given in place of the header's (for its bench
+    // constants) must agree on them. Swapped frequencies assigned the
+    // fields to the wrong dipoles (every epoch mirrored, exit 0).
+    if opts.system.is_some() {
+        let h = &header.system;
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        let agree = (0..3).all(|i| same(system.frequencies_hz[i], h.frequencies_hz[i]))
+            && same(system.pilot_offset_hz, h.pilot_offset_hz);
+        if !agree {
+            return Err(Error::bad_file(
+                file.clone(),
+                format!(
+                    "the system given has frequencies {:?} Hz and pilot offset {} Hz, but the record was made at {:?} Hz and {} Hz (its header's system): a system of another record, or frequencies swapped or in kHz",
+                    system.frequencies_hz,
+                    system.pilot_offset_hz,
+                    h.frequencies_hz,
+                    h.pilot_offset_hz
+                ),
+            ));
+        }
+    }
     let fs = header.sample_rate_hz;
     let n = opts.window_len;
     if n < 8 || header.frames < n as u64 {
@@ -100,9 +122,22 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
             system.frequencies_hz, system.pilot_offset_hz
         ));
     }
+    // Less than one bin apart, a pilot and its working tone fall in the
+    // same bin of an N-sample block: no window separates them (N = 1600
+    // gave ranges of 5·10¹⁰ m). From 1 to 4 bins they are inside the
+    // window's main lobe and leak (N = 4000 and 12000: position errors of
+    // 50 m and 10 m, which locate's residual test fails).
+    let min_n = (4.0 * fs / system.pilot_offset_hz).ceil();
+    if pilot_bins < 1.0 - 1e-9 {
+        return Err(Error::bad_input(format!(
+            "window length {n} ({} s of '{file}'): the pilot offset {} Hz is {pilot_bins:.2} bins f_s/N, so the pilots fall in their working tones' bins and cannot be resolved; use N ≥ {min_n} (4 bins)",
+            aeromag_core::error::figure(n as f64 / fs),
+            system.pilot_offset_hz
+        )));
+    }
     if pilot_bins < 4.0 - 1e-9 {
         notes.warn(format!(
-            "pilot offset {} Hz is {pilot_bins:.2} bins (< 4): the pilots leak into the working detector",
+            "window length N = {n} samples: pilot offset {} Hz is {pilot_bins:.2} bins (< 4): the pilots leak into the working detector; use N ≥ {min_n}",
             system.pilot_offset_hz
         ));
     }
@@ -115,7 +150,10 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
     let chunk = n * (1usize << 18).div_ceil(n);
     let mut epochs = Vec::new();
     source.for_each_chunk(path, chunk, |first, samples| {
-        epochs.extend(chain.process(samples, first)?);
+        let got = chain
+            .process(samples, first)
+            .map_err(|e| silent_channel(&file, first, n, samples, e))?;
+        epochs.extend(got);
         Ok(())
     })?;
     let ratios: Vec<f64> = epochs
@@ -129,4 +167,44 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         polarization_ratio_rms: rms(&ratios),
         notes: notes.into_notes(),
     })
+}
+
+/// The error of detecting a chunk of `samples` (interleaved, 3 channels,
+/// absolute first frame `first`, detector blocks of `n` frames) in `file`:
+/// when a channel is 0 in every sample of the chunk or of a block, the
+/// record carries no signal there, which is what the pilot's "not
+/// detected" meant (an all-zero record gave "invalid data: pilot not
+/// detected on channel 0" without the file).
+fn silent_channel(
+    file: &str,
+    first: u64,
+    n: usize,
+    samples: &[f32],
+    e: aeromag_em::EmError,
+) -> Error {
+    let frames = samples.len() / 3;
+    let silent = |a: usize, b: usize, c: usize| (a..b).all(|k| samples[3 * k + c] == 0.0);
+    if let Some(c) = (0..3).find(|&c| silent(0, frames, c)) {
+        return Error::bad_file(
+            file,
+            format!(
+                "channel {c} is 0 in every sample of frames {first} … {}: the record carries no signal ({e})",
+                first + frames as u64 - 1
+            ),
+        );
+    }
+    for a in (0..frames).step_by(n.max(1)) {
+        let b = (a + n).min(frames);
+        if let Some(c) = (0..3).find(|&c| silent(a, b, c)) {
+            return Error::bad_file(
+                file,
+                format!(
+                    "channel {c} is 0 in every sample of frames {} … {}: no signal in that detector block ({e})",
+                    first + a as u64,
+                    first + b as u64 - 1
+                ),
+            );
+        }
+    }
+    Err::<(), _>(e).in_file(file).unwrap_err()
 }

@@ -1,12 +1,14 @@
 //! Reading the files of the EM chain with file, line, row and column in
 //! every error: detected-vector CSV, KNOWN CSV (through aeromag-io's
-//! reader), the system JSON and the raw record (read in place from a
+//! reader), the system and calibration JSON (a leading UTF-8 BOM is
+//! skipped, as in the CSV files) and the raw record (read in place from a
 //! memory map when its samples are aligned and complete, else streamed in
 //! chunks).
 
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use aeromag_core::error::shown;
+use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::detection::{EmSystem, FieldEpoch};
 use aeromag_em::sim::{RawReader, field_epoch_from_values, value_columns};
 use aeromag_io::{ReadOptions, read_table};
@@ -40,14 +42,35 @@ fn increasing_time(t: &Flight, name: &str, time: &[f64]) -> Result<()> {
     Ok(())
 }
 
+/// The largest detected field component read, T: the 2·10⁴ A·m² dipoles
+/// of the simulated transmitter give 4 mT at 1 m (the default record's
+/// fields are ~10⁻⁸ T); 1e300 T gave a "singular matrix" failure.
+pub const MAX_FIELD_T: f64 = 1.0;
+
 /// The epochs of a detected-vector CSV ([`super::detect`]'s output,
-/// `aeromag em detect`): every value a finite number, time increasing.
+/// `aeromag em detect`): every value a finite number, field components
+/// within ±[`MAX_FIELD_T`], time increasing.
 pub fn read_detected(path: &Path) -> Result<Vec<FieldEpoch>> {
     let t = load_table(path)?;
     let time = t.finite("time_s")?;
     increasing_time(&t, "time_s", time)?;
     let names = value_columns();
     let cols: Vec<&[f64]> = names.iter().map(|n| t.finite(n)).collect::<Result<_>>()?;
+    for (n, c) in names.iter().zip(&cols) {
+        if !(n.starts_with('h') && n.ends_with("_t")) {
+            continue;
+        }
+        if let Some(r) = c.iter().position(|v| v.abs() > MAX_FIELD_T) {
+            return Err(t.bad_value(
+                r,
+                n,
+                format!(
+                    "{} T is not a field the transmitter induces at the bird (|h| ≤ {MAX_FIELD_T} T)",
+                    shown(c[r])
+                ),
+            ));
+        }
+    }
     let mut row = vec![0.0; cols.len()];
     (0..t.n_rows())
         .map(|r| {
@@ -69,6 +92,14 @@ pub fn read_system(path: &Path) -> Result<EmSystem> {
     s.validate()
         .map_err(|e| Error::bad_file(&file, e.to_string()))?;
     Ok(s)
+}
+
+/// Read and check a calibration file (`em calibrate`'s JSON,
+/// [`CalibrationFile::from_json`]), naming the file in its errors.
+pub fn read_calibration(path: &Path) -> Result<CalibrationFile> {
+    let text = crate::model_file::read_text_file(path)?;
+    CalibrationFile::from_json(&text)
+        .map_err(|e| Error::bad_file(path.display().to_string(), e.to_string()))
 }
 
 /// ADC rates a raw record may have, Hz: 1 Hz to 100 MHz (the working

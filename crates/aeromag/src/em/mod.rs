@@ -13,9 +13,9 @@ mod locate;
 mod simulate;
 
 pub use aeromag_em::{EmError, calibration, detection, positioning, sim, study};
-pub use calibrate::{EmCalibration, calibrate, known_points};
+pub use calibrate::{EmCalibration, KNOWN_RANGE_M, calibrate, known_points};
 pub use detect::{DetectOptions, Detection, detect};
-pub use locate::{Located, Pose, Poses, locate};
+pub use locate::{Located, MAX_RESIDUAL_REL, Pose, Poses, locate};
 pub use simulate::{DEFAULT_KNOWN, SimulatedEm, command_default, parse_config, simulate_to_dir};
 
 use crate::error::{Error, Result};
@@ -37,7 +37,13 @@ use std::str::FromStr;
 pub struct HalfSpace(Vector3<f64>);
 
 impl HalfSpace {
-    /// The half-space of a non-zero, finite normal.
+    /// The half-space of a non-zero, finite normal; only its direction
+    /// matters. The normal is kept scaled by its largest component (which
+    /// becomes ±1, so `-1,0,1` is kept exactly): its length is then between
+    /// 1 and √3 and normalising it can neither overflow nor underflow. The
+    /// length of `-1e160,0,1e160` overflowed to ∞ (`-1e-200,0,1e-200`
+    /// underflowed to 0), `e·n/|n|` became 0 and every bird came out
+    /// mirrored.
     pub fn new(normal: Vector3<f64>) -> Result<Self> {
         if normal == Vector3::zeros() || !normal.iter().all(|v| v.is_finite()) {
             return Err(Error::bad_input(format!(
@@ -45,10 +51,10 @@ impl HalfSpace {
                 normal.x, normal.y, normal.z
             )));
         }
-        Ok(Self(normal))
+        Ok(Self(normal / normal.amax()))
     }
 
-    /// The normal.
+    /// The normal, scaled so that its largest component is ±1.
     pub fn normal(&self) -> Vector3<f64> {
         self.0
     }
@@ -81,5 +87,32 @@ impl FromStr for HalfSpace {
             )));
         };
         Self::new(Vector3::new(x, y, z))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `-1e160,0,1e160` is the direction of `-1,0,1`: its length overflowed
+    /// (that of `-1e-200,0,1e-200` underflowed) and every bird was mirrored.
+    #[test]
+    fn half_space_normals_of_any_scale_are_the_same_half_space() {
+        for s in [
+            "-1e160,0,1e160",
+            "-1e-200,0,1e-200",
+            "-1e308,0,1e308",
+            "-5e-324,0,5e-324",
+        ] {
+            let h: HalfSpace = s.parse().unwrap();
+            assert_eq!(h, HalfSpace::default(), "{s}");
+            assert_eq!(h.to_string(), "-1,0,1", "{s}");
+        }
+        let h: HalfSpace = "2,-3e200,1e-300".parse().unwrap();
+        let n = h.normal();
+        assert_eq!(n.amax(), 1.0);
+        assert!(n.norm().is_finite() && n.y == -1.0, "{n}");
+        assert!("0,0,0".parse::<HalfSpace>().is_err());
+        assert!("1,inf,0".parse::<HalfSpace>().is_err());
     }
 }

@@ -16,6 +16,7 @@ use super::Calibration;
 use crate::{EmError, Result};
 use aeromag_core::error::shown;
 use nalgebra::Matrix3;
+use std::f64::consts::PI;
 
 /// Value of the `format` field.
 pub const CALIBRATION_FORMAT: &str = "aeromag-em-calibration";
@@ -26,6 +27,11 @@ pub const CALIBRATION_VERSION: u32 = 1;
 /// rotation written by `calibrate` is orthonormal to rounding (~10⁻¹⁵);
 /// 10⁻⁶ leaves room for a hand-edited file with 7 significant digits.
 pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Largest entry of `S − Sᵀ` of a stored transmitter distortion: stage 2
+/// writes an exactly symmetric `S`; 10⁻⁶ leaves room for a hand-edited
+/// file with 7 significant digits.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-6;
 
 /// How many epochs and known points the stages were fitted from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -73,9 +79,14 @@ impl CalibrationFile {
         })
     }
 
-    /// Parse and check format, version and finiteness, and that
+    /// Parse and check format, version and finiteness, that
     /// `calibration.attitude_q` is a rotation (orthonormal within
-    /// [`ROTATION_TOLERANCE`], determinant +1).
+    /// [`ROTATION_TOLERANCE`], determinant +1), that
+    /// `calibration.transmitter_s` is symmetric (within
+    /// [`SYMMETRY_TOLERANCE`]), the phases within ±π, and that `|S|` and
+    /// `Q` are within [`MAX_TRANSMITTER_S`](super::MAX_TRANSMITTER_S) and
+    /// [`MAX_ATTITUDE_Q_DEG`](super::MAX_ATTITUDE_Q_DEG) (what `calibrate`
+    /// accepts: `S = −I` would make the effective moments singular).
     ///
     /// Errors ([`EmError::InvalidData`]) with serde's line and column for
     /// malformed JSON, or naming the offending field.
@@ -122,6 +133,35 @@ impl CalibrationFile {
                     shown(off),
                     shown(q.determinant())
                 ),
+            });
+        }
+        let st = &c.transmitter_s;
+        let asym = (st - st.transpose()).amax();
+        if asym > SYMMETRY_TOLERANCE {
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'calibration.transmitter_s' is not symmetric (S and Sᵀ differ by {}; \
+                     stage 2 fits a symmetric S, expected within {SYMMETRY_TOLERANCE})",
+                    shown(asym)
+                ),
+            });
+        }
+        if let Some(k) = c.polarisation.phase_rad.iter().position(|v| v.abs() > PI) {
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'calibration.polarisation.phase_rad[{k}]' is {} rad, expected -π…π",
+                    shown(c.polarisation.phase_rad[k])
+                ),
+            });
+        }
+        if let Some(what) = c.implausible() {
+            let field = if what.contains("|S|") {
+                "calibration.transmitter_s"
+            } else {
+                "calibration.attitude_q"
+            };
+            return Err(EmError::InvalidData {
+                reason: format!("field '{field}': {what}"),
             });
         }
         if f.moments_am2.determinant().abs() == 0.0 {
@@ -174,6 +214,38 @@ mod tests {
         mirror.calibration.attitude_q =
             Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, -1.0));
         assert!(err(&mirror.to_json().unwrap()).contains("attitude_q"));
+        // Found by fuzzing (findings/09): all were read and used.
+        let with_s = |s: Matrix3<f64>| {
+            let mut b = f.clone();
+            b.calibration.transmitter_s = s;
+            err(&b.to_json().unwrap())
+        };
+        let mut asym = Matrix3::zeros();
+        asym[(0, 1)] = 0.02;
+        let e = with_s(asym);
+        assert!(
+            e.contains("transmitter_s") && e.contains("not symmetric"),
+            "{e}"
+        );
+        for s in [-Matrix3::identity(), Matrix3::from_diagonal_element(1e300)] {
+            let e = with_s(s);
+            assert!(
+                e.contains("'calibration.transmitter_s'") && e.contains("exceeds 0.5"),
+                "{e}"
+            );
+        }
+        let mut phase = f.clone();
+        phase.calibration.polarisation.phase_rad[1] = 1e300;
+        let e = err(&phase.to_json().unwrap());
+        assert!(e.contains("phase_rad[1]") && e.contains("1e300"), "{e}");
+        let mut turned = f.clone();
+        turned.calibration.attitude_q =
+            nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 1.0).into_inner();
+        let e = err(&turned.to_json().unwrap());
+        assert!(
+            e.contains("'calibration.attitude_q'") && e.contains("57.3°"),
+            "{e}"
+        );
         let mut nan = f;
         nan.calibration.attitude_q[(0, 1)] = f64::NAN;
         // serde_json writes NaN as null, which does not parse as a number.

@@ -52,6 +52,23 @@ impl Default for Calibration {
     }
 }
 
+/// Largest plausible transmitter distortion `|S|` (Frobenius norm,
+/// dimensionless). Stage 2 corrects a transmitter whose effective moments
+/// differ from the nominal ones by a few per cent: the simulated scenario
+/// (`transmitter_distortion` 0.05, seeds 1–10, starts 0/150/300/450 s,
+/// 40 records) fits `|S|` from 0.030 to 0.060. The bound is 8× that.
+/// KNOWN positions in km, cm or ft, or moments ×1000, gave 1.7 to
+/// 2.8·10¹⁰; swapped channel names 1.14.
+pub const MAX_TRANSMITTER_S: f64 = 0.5;
+
+/// Largest plausible attitude correction `Q`, deg (rotation angle). Stage
+/// 3 corrects a small mounting error: on the same 40 simulated records
+/// the fitted `Q` turns by 0.003° to 0.051°; the bound is 100× that and
+/// above any mounting error of a bird (a few degrees). Swapped x/y
+/// channels gave 113.8° and 153°, moments of the wrong sign 175°, KNOWN
+/// attitudes in radians 10.7°.
+pub const MAX_ATTITUDE_Q_DEG: f64 = 5.0;
+
 /// One located epoch.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Located {
@@ -76,6 +93,47 @@ impl Calibration {
         serde_json::from_str(s).map_err(|e| EmError::InvalidData {
             reason: e.to_string(),
         })
+    }
+
+    /// The corrections beyond [`MAX_TRANSMITTER_S`] and
+    /// [`MAX_ATTITUDE_Q_DEG`], described with their likely causes, or
+    /// `None` when both are within the bounds (or not finite: `None` too,
+    /// the finiteness is checked elsewhere).
+    pub fn implausible(&self) -> Option<String> {
+        let mut out = Vec::new();
+        // The norm scaled by the largest entry: |S| of 1e300 entries stays finite.
+        let big = self.transmitter_s.amax();
+        let s = if big > 0.0 {
+            big * (self.transmitter_s / big).norm()
+        } else {
+            big
+        };
+        if s > MAX_TRANSMITTER_S {
+            let g = (Matrix3::identity() + self.transmitter_s)
+                .determinant()
+                .abs()
+                .cbrt();
+            let scale = if g.is_finite() {
+                format!(
+                    " (it scales the moments by about {})",
+                    aeromag_core::error::figure(g)
+                )
+            } else {
+                String::new()
+            };
+            out.push(format!(
+                "transmitter distortion |S| = {} exceeds {MAX_TRANSMITTER_S}{scale}: KNOWN positions not in metres (km, cm, ft?), moments in the wrong unit (×1000?), or swapped channels",
+                aeromag_core::error::figure(s),
+            ));
+        }
+        let q = crate::positioning::rotation_angle_between(&self.attitude_q, &Matrix3::identity())
+            .to_degrees();
+        if q > MAX_ATTITUDE_Q_DEG {
+            out.push(format!(
+                "attitude correction Q turns by {q:.1}°, beyond the {MAX_ATTITUDE_Q_DEG}° of a mounting error: swapped or mislabelled receiver channels, KNOWN attitudes in radians or another convention, or moments of the wrong sign"
+            ));
+        }
+        (!out.is_empty()).then(|| out.join("; "))
     }
 
     /// Effective moments `M' = (I + S) M` (A·m²).

@@ -161,3 +161,44 @@ fn bad_inputs_error() {
     assert!(fit_attitude_correction(&[], &[]).is_err());
     assert!(Calibration::from_json("{").is_err());
 }
+
+/// `|S|` of 1.14 to 2.8e10 and rotations `Q` of 113.8° to 175° (wrong
+/// units, swapped channels, negated moments) were accepted as "small"
+/// corrections; the simulated scenario's are below 0.061 and 0.051°.
+#[test]
+fn corrections_beyond_the_plausible_bounds_are_described() {
+    assert_eq!(Calibration::default().implausible(), None);
+    let small = Calibration {
+        transmitter_s: Matrix3::from_diagonal_element(0.06),
+        attitude_q: nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 0.05f64.to_radians())
+            .into_inner(),
+        ..Calibration::default()
+    };
+    assert_eq!(small.implausible(), None);
+    let km = Calibration {
+        transmitter_s: Matrix3::from_diagonal_element(-0.99),
+        ..Calibration::default()
+    };
+    let e = km.implausible().unwrap();
+    assert!(
+        e.contains("|S| = 1.7147") && e.contains("by about 0.0100"),
+        "{e}"
+    );
+    assert!(e.contains("metres") && !e.contains("attitude"), "{e}");
+    let turned = Calibration {
+        attitude_q: nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 113.8f64.to_radians())
+            .into_inner(),
+        ..Calibration::default()
+    };
+    let e = turned.implausible().unwrap();
+    assert!(
+        e.contains("113.8°") && e.contains("swapped") && !e.contains("|S|"),
+        "{e}"
+    );
+    let rad = Calibration {
+        attitude_q: nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 10.7f64.to_radians())
+            .into_inner(),
+        ..Calibration::default()
+    };
+    assert!(rad.implausible().unwrap().contains("radians"));
+}

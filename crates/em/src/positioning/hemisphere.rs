@@ -28,7 +28,16 @@ pub struct Hemisphere {
 impl Hemisphere {
     /// A prior half-space `e · normal > 0` with a continuity margin of 0.2
     /// (≈ 11.5° from the dividing plane).
+    /// The normal is kept scaled by its largest component (a zero or
+    /// non-finite normal is kept as given and decides nothing), so that its
+    /// length can neither overflow nor underflow.
     pub fn new(normal: Vector3<f64>) -> Self {
+        let m = normal.amax();
+        let normal = if m > 0.0 && m.is_finite() {
+            normal / m
+        } else {
+            normal
+        };
         Self {
             normal,
             margin: 0.2,
@@ -78,5 +87,20 @@ mod tests {
         assert!(h2.resolve(&e2).dot(&e2) < 0.0);
         assert!(h2.by_continuity);
         assert!(h2.resolve(&e).dot(&e) > 0.99 && !h2.by_continuity);
+    }
+
+    /// `|n|` of (−1e160, 0, 1e160) overflowed (of ±1e-200 underflowed), so
+    /// `e·n/|n|` was 0 and the half-space decided nothing: the direction
+    /// kept the eigenvector's arbitrary sign.
+    #[test]
+    fn extreme_normals_keep_their_direction() {
+        let e = Vector3::new(-0.8, 0.0, 0.6).normalize();
+        for s in [1e160, 1e-200, 1e300, 5e-324, 1.0] {
+            let mut h = Hemisphere::new(Vector3::new(-s, 0.0, s));
+            assert!(h.resolve(&(-e)).dot(&e) > 0.99, "scale {s}");
+            assert!(!h.by_continuity, "scale {s}");
+            let mut h = Hemisphere::new(Vector3::new(s, 0.0, -s));
+            assert!(h.resolve(&e).dot(&e) < -0.99, "scale {s}");
+        }
     }
 }

@@ -141,7 +141,8 @@ impl EmScenario {
     /// Draw the scenario from the configuration's seed.
     ///
     /// Errors ([`EmError::InvalidArgument`]) for non-positive rate, duration
-    /// or ranges, or frequencies (with pilots) outside `(0, f_s/2)`.
+    /// or ranges, negative or non-finite noise and interference levels, or
+    /// frequencies (with pilots) outside `(0, f_s/2)`.
     pub fn new(config: EmSimConfig) -> Result<Self> {
         let c = &config;
         if !(c.sample_rate_hz > 0.0
@@ -160,6 +161,24 @@ impl EmScenario {
                     aeromag_core::error::shown(c.sferic_rate_hz)
                 ),
             });
+        }
+        // The noise and interference levels are amplitudes: the noise is
+        // `coil_noise_v · N(0, 1)`, so a negative level (−1 V in a mutated
+        // scenario file) was taken as its magnitude and buried the signal
+        // under 1 V of broadband noise; 0 turns a source off.
+        for (name, v) in [
+            ("coil_noise_v", c.coil_noise_v),
+            ("power_line_v", c.power_line_v),
+            ("sferic_amplitude_v", c.sferic_amplitude_v),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(EmError::InvalidArgument {
+                    reason: format!(
+                        "{name} {} V must be finite and ≥ 0 (an amplitude; 0 turns it off)",
+                        aeromag_core::error::shown(v)
+                    ),
+                });
+            }
         }
         if c.mean_direction.norm() == 0.0 {
             return Err(EmError::InvalidArgument {

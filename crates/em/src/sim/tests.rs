@@ -220,3 +220,52 @@ fn flight_study_rejects_bad_sizes() {
     assert!(run_flight_study(&EmSimConfig::default(), &bad).is_err());
     assert!(epochs_at(&EmSimConfig::default(), &[], true).is_err());
 }
+
+/// A negative noise level was taken as its magnitude (`σ · N(0, 1)`):
+/// `coil_noise_v = −1` gave 0.89 V RMS above 10 kHz instead of the
+/// 0.3 mV of the sferics alone. It is refused; 0 adds no coil noise.
+#[test]
+fn noise_levels_must_be_non_negative_and_zero_adds_none() {
+    for (k, v) in [
+        (0, -1.0),
+        (0, f64::NAN),
+        (1, -1e-2),
+        (2, -5e-3),
+        (0, f64::INFINITY),
+    ] {
+        let mut cfg = EmSimConfig {
+            duration_s: 0.02,
+            ..EmSimConfig::default()
+        };
+        let name = ["coil_noise_v", "power_line_v", "sferic_amplitude_v"][k];
+        *[
+            &mut cfg.coil_noise_v,
+            &mut cfg.power_line_v,
+            &mut cfg.sferic_amplitude_v,
+        ][k] = v;
+        let err = EmScenario::new(cfg).unwrap_err();
+        assert!(
+            err.is_bad_input() && err.to_string().contains(name),
+            "{err}"
+        );
+    }
+    // Zero coil noise, no interference: the record is the signal alone, so
+    // a record with 1e-12 V of noise differs only by f32 rounding.
+    let quiet = |noise: f64| {
+        let cfg = EmSimConfig {
+            duration_s: 0.02,
+            coil_noise_v: noise,
+            power_line_v: 0.0,
+            sferic_rate_hz: 0.0,
+            ..EmSimConfig::default()
+        };
+        synthesize(&EmScenario::new(cfg).unwrap()).unwrap().samples
+    };
+    let (zero, tiny) = (quiet(0.0), quiet(1e-12));
+    let peak = zero.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    let diff = zero
+        .iter()
+        .zip(&tiny)
+        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    assert!(peak > 0.0 && diff <= peak * 1e-6, "peak {peak} diff {diff}");
+}

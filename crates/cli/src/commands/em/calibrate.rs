@@ -68,9 +68,10 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let known = known_points(&load_table(&a.known)?, &epochs)?;
     let cal = calibrate(&epochs, &known, &system, &a.half_space.half_space).map_err(|e| {
         anyhow::Error::new(e).context(format!(
-            "calibration from '{}' and '{}' failed",
+            "calibration from '{}', '{}' and '{}' failed",
             a.input.display(),
-            a.known.display()
+            a.known.display(),
+            a.system.display()
         ))
     })?;
     aeromag::io::atomic::write_file(&a.out, cal.file.to_json()?)

@@ -2,10 +2,8 @@
 //! [`aeromag::em::locate`]).
 
 use super::HalfSpaceArg;
-use crate::exit::bad_input;
 use crate::progress::Bars;
-use aeromag::em::calibration::CalibrationFile;
-use aeromag::em::files::read_detected;
+use aeromag::em::files::{read_calibration, read_detected};
 use aeromag::em::locate;
 use std::path::PathBuf;
 
@@ -30,6 +28,11 @@ use std::path::PathBuf;
 ///   field components); hemisphere_by_continuity (0/1); status (0 located,
 ///   1 failed: pose columns empty).
 ///
+/// An epoch whose residual_rel exceeds 1e-3 (15× the largest of 2560
+/// simulated epochs) is not explained by the dipoles at one pose and is
+/// failed, with a warning; when no epoch is located the command fails
+/// (exit 1) and writes nothing.
+///
 /// Example:
 ///   aeromag em locate --input em/detected.csv --calibration em/cal.json --out em/poses.csv
 #[derive(Debug, clap::Args)]
@@ -53,12 +56,16 @@ pub fn run(a: LocateArgs) -> anyhow::Result<()> {
         [a.out.as_path()],
         &[a.input.as_path(), a.calibration.as_path()],
     )?;
-    let text = std::fs::read_to_string(&a.calibration)
-        .map_err(|e| aeromag::Error::read(&a.calibration, e))?;
-    let file = CalibrationFile::from_json(&text)
-        .map_err(|e| bad_input!("'{}': {e}", a.calibration.display()))?;
+    let file = read_calibration(&a.calibration)?;
     let epochs = read_detected(&a.input)?;
-    let poses = locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new())?;
+    let poses =
+        locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new()).map_err(|e| {
+            anyhow::Error::new(e).context(format!(
+                "locating '{}' with '{}' failed",
+                a.input.display(),
+                a.calibration.display()
+            ))
+        })?;
     aeromag::io::atomic::write_file(&a.out, poses.to_csv())
         .map_err(|e| aeromag::Error::write(&a.out, e))?;
     println!(
