@@ -95,6 +95,41 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `em calibrate` of `input` with `known` and `system`, written to `out`.
+fn calibrate_args<'a>(
+    input: &'a Path,
+    known: &'a Path,
+    system: &'a Path,
+    out: &'a Path,
+) -> [&'a str; 10] {
+    [
+        "em",
+        "calibrate",
+        "--input",
+        s(input),
+        "--known",
+        s(known),
+        "--system",
+        s(system),
+        "--out",
+        s(out),
+    ]
+}
+
+/// `em locate` of `input` with `calibration`, written to `out`.
+fn locate_args<'a>(input: &'a Path, calibration: &'a Path, out: &'a Path) -> [&'a str; 8] {
+    [
+        "em",
+        "locate",
+        "--input",
+        s(input),
+        "--calibration",
+        s(calibration),
+        "--out",
+        s(out),
+    ]
+}
+
 /// Simulate into `dir/sim` with extra arguments; returns the folder.
 fn simulate(dir: &Path, extra: &[&str]) -> PathBuf {
     let sim = dir.join("sim");
@@ -153,16 +188,7 @@ fn em_file_chain_reaches_the_issue_figures_against_the_truth() {
         serde_json::from_str(&std::fs::read_to_string(&cal).unwrap()).unwrap();
     assert_eq!(c["format"], "aeromag-em-calibration");
     assert_eq!(c["version"], 1);
-    let o = aeromag(&[
-        "em",
-        "locate",
-        "--input",
-        s(&det),
-        "--calibration",
-        s(&cal),
-        "--out",
-        s(&poses),
-    ]);
+    let o = aeromag(&locate_args(&det, &cal, &poses));
     assert_code(&o, 0);
 
     let (th, truth) = read_csv(&sim.join("em.truth.csv"));
@@ -698,16 +724,7 @@ fn header_attitudes_and_rotations_out_of_range_are_bad_input_naming_the_field() 
         let p = d.join(format!("cal_{name}.json"));
         std::fs::write(&p, serde_json::to_string(&bad_cal).unwrap()).unwrap();
         short(
-            &[
-                "em",
-                "locate",
-                "--input",
-                s(&det),
-                "--calibration",
-                s(&p),
-                "--out",
-                s(&out),
-            ],
+            &locate_args(&det, &p, &out),
             &[&format!("cal_{name}.json"), "attitude_q", "not a rotation"],
         );
     }
@@ -942,16 +959,7 @@ fn json_files_with_a_byte_order_mark_are_read() {
         assert_code(&o, 0);
         let cal = if bom_cal { bom(&cal) } else { cal };
         let poses = d.join(format!("poses_{tag}.csv"));
-        let o = aeromag(&[
-            "em",
-            "locate",
-            "--input",
-            s(&det),
-            "--calibration",
-            s(&cal),
-            "--out",
-            s(&poses),
-        ]);
+        let o = aeromag(&locate_args(&det, &cal, &poses));
         assert_code(&o, 0);
         (std::fs::read(&cal).unwrap(), std::fs::read(&poses).unwrap())
     };
@@ -1004,18 +1012,7 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
     };
     let k0 = edit(&known, "k0.csv", 2, &["x_m", "y_m", "z_m"], "0");
     bad(
-        &[
-            "em",
-            "calibrate",
-            "--input",
-            s(&det),
-            "--known",
-            s(&k0),
-            "--system",
-            s(&system),
-            "--out",
-            s(&out),
-        ],
+        &calibrate_args(&det, &k0, &system, &out),
         &[
             "k0.csv",
             "line 4 (data row 3)",
@@ -1025,18 +1022,7 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
     );
     let kh = edit(&known, "kh.csv", 4, &["y_m"], "1e300");
     bad(
-        &[
-            "em",
-            "calibrate",
-            "--input",
-            s(&det),
-            "--known",
-            s(&kh),
-            "--system",
-            s(&system),
-            "--out",
-            s(&out),
-        ],
+        &calibrate_args(&det, &kh, &system, &out),
         &[
             "kh.csv",
             "line 6 (data row 5)",
@@ -1046,18 +1032,7 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
     );
     let dh = edit(&det, "dh.csv", 5, &["h2_z_im_t"], "1e300");
     bad(
-        &[
-            "em",
-            "calibrate",
-            "--input",
-            s(&dh),
-            "--known",
-            s(&known),
-            "--system",
-            s(&system),
-            "--out",
-            s(&out),
-        ],
+        &calibrate_args(&dh, &known, &system, &out),
         &[
             "dh.csv",
             "line 7 (data row 6)",
