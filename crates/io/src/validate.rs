@@ -430,7 +430,7 @@ impl Stats {
         type Job<'a> = Box<dyn Fn() -> Option<f64> + Sync + 'a>;
         let median_abs = |v: &'static str| -> Option<Job<'_>> {
             let v = table.column(v)?;
-            Some(Box::new(move || median(v.len(), |i| v[i].abs())))
+            Some(Box::new(move || sampled_median(v.len(), |i| v[i].abs())))
         };
         let flux: Option<[&[f64]; 3]> =
             match ["flux_x", "flux_y", "flux_z"].map(|n| table.column(n)) {
@@ -448,15 +448,18 @@ impl Stats {
             jobs.extend([max, median_abs(name)]);
         }
         jobs.push(
-            flux.map(|f| Box::new(move || median(table.n_rows(), |i| norm(f, i))) as Job<'_>),
+            flux.map(|f| {
+                Box::new(move || sampled_median(table.n_rows(), |i| norm(f, i))) as Job<'_>
+            }),
         );
         jobs.push(flux.zip(table.column("mag")).map(|(f, mag)| {
-            Box::new(move || median(table.n_rows(), |i| (norm(f, i) - mag[i]) / mag[i])) as Job<'_>
+            Box::new(move || sampled_median(table.n_rows(), |i| (norm(f, i) - mag[i]) / mag[i]))
+                as Job<'_>
         }));
         jobs.push(
             table
                 .column("alt")
-                .map(|alt| Box::new(move || median(alt.len(), |i| alt[i])) as Job<'_>),
+                .map(|alt| Box::new(move || sampled_median(alt.len(), |i| alt[i])) as Job<'_>),
         );
         for name in ["mag", "igrf"] {
             jobs.push(
@@ -665,11 +668,11 @@ impl Ctx<'_> {
         let speed = |i: usize| forward(i, distance(i) / step(i));
         let moved = |i: usize| forward(i, distance(i));
         let pairs = t.len().saturating_sub(1);
-        let Some(v) = median(pairs, speed) else {
+        let Some(v) = sampled_median(pairs, speed) else {
             return;
         };
         if v < MIN_MOVING_SPEED_M_S
-            && let (Some(d), Some(dt)) = (median(pairs, moved), median(pairs, step))
+            && let (Some(d), Some(dt)) = (sampled_median(pairs, moved), sampled_median(pairs, step))
             && d >= MIN_MOVING_STEP_M
         {
             w.push(self.warn(
@@ -903,7 +906,7 @@ fn max_key_serial(v: &[f64], key: impl Fn(f64) -> f64) -> Option<f64> {
 /// strided samples `value(0), value(s), value(2s), …` of `n` rows; `None`
 /// when there is none. Only the sampled rows are evaluated (a 10⁷-row
 /// column is neither copied nor passed over whole).
-pub(crate) fn median(n: usize, value: impl Fn(usize) -> f64) -> Option<f64> {
+pub fn sampled_median(n: usize, value: impl Fn(usize) -> f64) -> Option<f64> {
     let stride = n.div_ceil(MEDIAN_SAMPLES).max(1);
     let mut v: Vec<f64> = (0..n)
         .step_by(stride)
@@ -914,7 +917,7 @@ pub(crate) fn median(n: usize, value: impl Fn(usize) -> f64) -> Option<f64> {
 }
 
 /// Median of a vector of finite values (reorders it); mean of the two middle values for even lengths.
-pub(crate) fn median_in_place(v: &mut [f64]) -> Option<f64> {
+pub fn median_in_place(v: &mut [f64]) -> Option<f64> {
     if v.is_empty() {
         return None;
     }
@@ -1079,7 +1082,10 @@ mod tests {
         assert_eq!(median_in_place(&mut [3.0, 1.0, 2.0]), Some(2.0));
         assert_eq!(median_in_place(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.5));
         assert_eq!(median_in_place(&mut []), None);
-        assert_eq!(median(3, |i| [f64::NAN, 5.0, f64::INFINITY][i]), Some(5.0));
+        assert_eq!(
+            sampled_median(3, |i| [f64::NAN, 5.0, f64::INFINITY][i]),
+            Some(5.0)
+        );
     }
 
     #[test]

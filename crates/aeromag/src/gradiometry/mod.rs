@@ -421,13 +421,8 @@ pub const GAP_STEPS: f64 = 3.0;
 /// The warning for the time gaps of a pass (steps above [`GAP_STEPS`] times
 /// the median step), naming the first and the longest; none without gaps.
 fn gap_warning(t: &Flight, time: &[f64]) -> Option<Note> {
-    let mut steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return None;
-    }
-    let k = steps.len() / 2;
-    let median = *steps.clone().select_nth_unstable_by(k, f64::total_cmp).1;
-    steps.iter_mut().for_each(|s| *s = s.max(0.0));
+    let steps: Vec<f64> = time.windows(2).map(|w| w[1] - w[0]).collect();
+    let median = aeromag_compensation::tolles_lawson::segments::median_step(time);
     let gaps: Vec<usize> = (0..steps.len())
         .filter(|&j| steps[j] > GAP_STEPS * median)
         .collect();
@@ -610,11 +605,7 @@ fn check_reading_units(
     names: &[String],
     epochs: &[Epoch],
 ) -> Result<()> {
-    let median = |mut v: Vec<f64>| {
-        let k = v.len() / 2;
-        v.select_nth_unstable_by(k, f64::total_cmp);
-        v[k]
-    };
+    let median = |mut v: Vec<f64>| aeromag_io::median_in_place(&mut v).unwrap_or(f64::NAN);
     if epochs.is_empty() {
         return Ok(());
     }
@@ -751,8 +742,12 @@ impl Track {
     /// detection on): about 1 when the filter's covariance describes its
     /// errors; `None` when nothing was estimated.
     pub fn mean_nis(&self) -> Option<f64> {
-        let v: Vec<f64> = self.nis.iter().copied().filter(|v| v.is_finite()).collect();
-        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        let (sum, n) = self
+            .nis
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+        (n > 0).then(|| sum / n as f64)
     }
 
     /// A warning when the filter's innovations are beyond what its

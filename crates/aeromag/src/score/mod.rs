@@ -148,30 +148,31 @@ impl<'a> SensorSeries<'a> {
                 ));
             }
         }
-        let both: Vec<(f64, f64)> = self
-            .mag
-            .iter()
-            .zip(self.comp)
-            .filter(|(m, c)| m.is_finite() && c.is_finite())
-            .map(|(&m, &c)| (m, c))
-            .collect();
-        if !both.is_empty() {
-            let mut field: Vec<f64> = both.iter().map(|(m, _)| m.abs()).collect();
-            let mut diff: Vec<f64> = both.iter().map(|(m, c)| (m - c).abs()).collect();
-            let (field, diff) = (median_of(&mut field), median_of(&mut diff));
-            if diff > MAX_INTERFERENCE_SHARE * field {
-                return Err(t.bad_column(
-                    comp_name,
-                    format!(
-                        "the compensated reading differs from `{mag_name}` by a median of {} nT, {} % of \
-                         the field ({} nT): no aircraft's interference is that large; is it in another \
-                         unit (µT, pT?) or another column?",
-                        fixed(diff, 1),
-                        fixed(100.0 * diff / field, 1),
-                        fixed(field, 1)
-                    ),
-                ));
+        // Medians over evenly strided rows where both are finite (NaN
+        // elsewhere is left out).
+        let n = self.mag.len().min(self.comp.len());
+        let both = |f: fn(f64, f64) -> f64| {
+            move |i: usize| {
+                let (m, c) = (self.mag[i], self.comp[i]);
+                if c.is_finite() { f(m, c) } else { f64::NAN }
             }
+        };
+        let field = aeromag_io::sampled_median(n, both(|m, _| m.abs()));
+        let diff = aeromag_io::sampled_median(n, both(|m, c| (m - c).abs()));
+        if let (Some(field), Some(diff)) = (field, diff)
+            && diff > MAX_INTERFERENCE_SHARE * field
+        {
+            return Err(t.bad_column(
+                comp_name,
+                format!(
+                    "the compensated reading differs from `{mag_name}` by a median of {} nT, {} % of \
+                     the field ({} nT): no aircraft's interference is that large; is it in another \
+                     unit (µT, pT?) or another column?",
+                    fixed(diff, 1),
+                    fixed(100.0 * diff / field, 1),
+                    fixed(field, 1)
+                ),
+            ));
         }
         if let Some(interf) = self.interf {
             let off = |i: usize| {
@@ -212,15 +213,6 @@ pub const MAX_INTERFERENCE_SHARE: f64 = 0.5;
 /// interference, nT ([`SensorSeries::checked`]): files written by another
 /// tool with three decimals round each by 0.0005 nT.
 pub const CONSISTENCY_TOLERANCE_NT: f64 = 0.01;
-
-/// The median of `v` (reordered), NaN when empty.
-fn median_of(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let k = v.len() / 2;
-    *v.select_nth_unstable_by(k, f64::total_cmp).1
-}
 
 impl SensorTruth<'_> {
     /// What the compensated reading should be: the external field plus the
