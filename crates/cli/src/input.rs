@@ -41,15 +41,30 @@ pub struct InputArgs {
 /// Read and check a file of another kind than a flight (a gradiometer
 /// pass), the fields `names` alone (the others are delimited but not
 /// parsed: a truth column's text cell no longer stops a command that does
-/// not read it), with the default options; its warnings go to stderr.
-pub fn load_only(path: &std::path::Path, names: Vec<String>) -> anyhow::Result<Flight> {
+/// not read it), with the canonical names mapped by `columns` (a
+/// `--columns` text, as for flights) and otherwise the default options; its
+/// warnings go to stderr.
+pub fn load_only(
+    path: &std::path::Path,
+    names: Vec<String>,
+    columns: Option<&str>,
+) -> anyhow::Result<Flight> {
     read_checked(
         path,
         &ReadOptions {
             fields: Fields::Only(names),
+            columns: column_map(columns)?,
             ..ReadOptions::default()
         },
     )
+}
+
+/// The column map of a `--columns` text (none: the empty map).
+fn column_map(columns: Option<&str>) -> anyhow::Result<ColumnMap> {
+    Ok(match columns {
+        Some(m) => ColumnMap::parse(m)?,
+        None => ColumnMap::new(),
+    })
 }
 
 /// Read and check `path` with `opts`; its warnings go to stderr.
@@ -65,10 +80,7 @@ impl InputArgs {
     /// The library's reading options for these arguments.
     pub fn read_options(&self) -> anyhow::Result<ReadOptions> {
         Ok(ReadOptions {
-            columns: match &self.columns {
-                Some(m) => ColumnMap::parse(m)?,
-                None => ColumnMap::new(),
-            },
+            columns: column_map(self.columns.as_deref())?,
             // Several sensors are chosen per model, not at reading.
             sensors: if self.several_sensors() {
                 Sensors::default()

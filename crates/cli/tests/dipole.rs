@@ -197,6 +197,49 @@ fn scenario_file_round_trip_and_simulate_dispatch() {
     );
 }
 
+/// A pass whose heading column has another name: the missing-column
+/// message's `--columns yaw=NAME` works, and gives the estimates of the
+/// file with the canonical name.
+#[test]
+fn columns_map_the_navigation_names() {
+    let d = tempfile::tempdir().unwrap();
+    let (csv, toml) = simulate_into(&d.path().join("sim"), Some("[trajectory]\nepochs = 120\n"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let (header, rows) = text.split_once('\n').unwrap();
+    let renamed = d.path().join("heading.csv");
+    let header = header.replace(",yaw,", ",heading,");
+    std::fs::write(&renamed, format!("{header}\n{rows}")).unwrap();
+    let locate = |input: &Path, out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "dipole",
+            "locate",
+            "--input",
+            p(input),
+            "--config",
+            p(&toml),
+            "--out",
+            p(out),
+        ];
+        args.extend_from_slice(extra);
+        aeromag(&args)
+    };
+    let o = locate(&renamed, &d.path().join("no.csv"), &[]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("required column 'yaw' is missing")
+            && stderr(&o).contains("--columns yaw=NAME"),
+        "{}",
+        stderr(&o)
+    );
+    let (mapped, plain) = (d.path().join("mapped.csv"), d.path().join("plain.csv"));
+    assert_code(&locate(&renamed, &mapped, &["--columns", "yaw=heading"]), 0);
+    assert_code(&locate(&csv, &plain, &[]), 0);
+    assert_eq!(
+        std::fs::read(&mapped).unwrap(),
+        std::fs::read(&plain).unwrap()
+    );
+}
+
 #[test]
 fn bad_input_exits_2_naming_file_row_and_column() {
     let d = tempfile::tempdir().unwrap();

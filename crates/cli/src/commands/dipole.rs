@@ -97,6 +97,11 @@ struct LocateArgs {
     /// The pass (CSV as written by `aeromag dipole simulate`).
     #[arg(long, short = 'i', value_name = "FILE")]
     input: PathBuf,
+    /// Map the navigation's canonical column names onto the file's names,
+    /// e.g. `time=t,yaw=heading` (time, lat, lon, alt, roll, pitch, yaw;
+    /// the pass's other columns keep the names above).
+    #[arg(long, value_name = "MAP")]
+    columns: Option<String>,
     /// Scenario file (TOML): geometry, noise, estimator settings.
     #[arg(long, value_name = "FILE.toml")]
     config: Option<PathBuf>,
@@ -213,7 +218,11 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
         },
     };
     settings.apply(&mut cfg)?;
-    let table = crate::input::load_only(&a.input, pass_columns(cfg.system.gradiometer))?;
+    let table = crate::input::load_only(
+        &a.input,
+        pass_columns(cfg.system.gradiometer),
+        a.columns.as_deref(),
+    )?;
     let pass = read_pass(&table, &cfg)?;
     for n in &pass.notes {
         eprintln!("{n}");
