@@ -114,27 +114,32 @@ fn the_default_pass_is_tracked_without_the_truth() {
 /// warning, where the estimates are wrong but each epoch's residual is at
 /// the noise level. Before, the plain IEKF locked 180 m from the object and
 /// the pass with sensor 1's and sensor 2's columns swapped (48 m off) both
-/// ended with `converged` 1, σ of centimetres to a metre and no word.
+/// ended with `converged` 1, σ of centimetres to a metre and no word; the
+/// object's track in km (55 m off) is flagged too.
 #[test]
 fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     let cfg = GradiometerConfig::default();
     let sim = simulate(&cfg.scenario().unwrap()).unwrap();
     let table = pass_table(&cfg, &sim).unwrap();
-    let bare = |swap: bool| {
+    // "swap": b1_… ↔ b2_… (vector sensors 1 and 2); "km": the object's
+    // track in km
+    let bare = |edit: &str| {
         let mut t = FlightTable::new();
         for c in table.columns() {
             let name = c.name();
             if name.starts_with("true_") {
                 continue;
             }
-            // b1_… ↔ b2_… (vector sensors 1 and 2)
-            let renamed = match (swap, name.get(..3)) {
-                (true, Some("b1_")) => format!("b2_{}", &name[3..]),
-                (true, Some("b2_")) => format!("b1_{}", &name[3..]),
+            let renamed = match (edit, name.get(..3)) {
+                ("swap", Some("b1_")) => format!("b2_{}", &name[3..]),
+                ("swap", Some("b2_")) => format!("b1_{}", &name[3..]),
                 _ => name.to_string(),
             };
-            t.add_column(&renamed, c.values().unwrap().to_vec())
-                .unwrap();
+            let mut values = c.values().unwrap().to_vec();
+            if edit == "km" && name.starts_with("obj_") && name.ends_with("_m") {
+                values.iter_mut().for_each(|v| *v /= 1000.0);
+            }
+            t.add_column(&renamed, values).unwrap();
         }
         Flight::from_table(t).unwrap()
     };
@@ -142,16 +147,16 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
         let pass = read_pass(f, cfg).unwrap();
         locate_pass(cfg, &pass.epochs, &pass.positions_m).unwrap()
     };
-    let good = locate(&cfg, &bare(false));
+    let good = locate(&cfg, &bare(""));
     let m = good.mean_nis().unwrap();
     assert!((0.7..1.3).contains(&m), "default pass: mean NIS {m}");
     assert!(good.inconsistency_warning().is_none());
     let mut plain = cfg.clone();
     plain.estimator.multistart = false;
-    let swapped = locate(&cfg, &bare(true));
     for (what, track) in [
-        ("plain", locate(&plain, &bare(false))),
-        ("swapped", swapped),
+        ("plain", locate(&plain, &bare(""))),
+        ("swapped", locate(&cfg, &bare("swap"))),
+        ("track in km", locate(&cfg, &bare("km"))),
     ] {
         let m = track.mean_nis().unwrap();
         eprintln!("{what}: mean NIS per contrast {m:.1}");

@@ -760,8 +760,9 @@ impl Track {
                 "the filter's normalised innovations squared average {m:.1} per contrast, where a filter \
                  whose σ describe its errors averages about 1 (above {MAX_MEAN_NIS} here): the estimates \
                  and their σ are not to be trusted. A filter locked on a wrong solution (--plain from \
-                 the half-space away from the object?), sensor columns swapped or mis-mapped, or quiet \
-                 epochs (estimator.quiet_epochs) that are not quiet?"
+                 the half-space away from the object?), sensor columns swapped or mis-mapped, positions \
+                 (north_m …, obj_north_m …) in another unit than metres, or quiet epochs \
+                 (estimator.quiet_epochs) that are not quiet?"
             )
         })
     }
