@@ -161,6 +161,26 @@ fn scenario_files_round_trip_and_typos_are_errors() {
     ]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("sample_rate_hzz"), "{}", stderr(&o));
+    // A flight the readers would refuse (a sensor lag of 10⁹ s: `mag` of
+    // 5.4·10⁸ nT) is bad input naming the scenario file; nothing written.
+    let lag = d.path().join("lag.toml");
+    std::fs::write(&lag, "[pattern]\ncycles = 1\n[scalar]\nlag_s = 1e9\n").unwrap();
+    let lag_out = d.path().join("lag");
+    let o = aeromag(&[
+        "simulate",
+        "calibration",
+        "--config",
+        lag.to_str().unwrap(),
+        "--out",
+        lag_out.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("lag.toml") && stderr(&o).contains("readers would refuse"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!lag_out.join("calibration.csv").exists());
     assert_code(
         &aeromag(&["simulate", "spaceship", "--out", out.to_str().unwrap()]),
         2,

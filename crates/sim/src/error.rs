@@ -39,6 +39,15 @@ pub enum SimError {
         /// ` (time T s)` when the simulation has a time column.
         at: String,
     },
+    /// The scenario's flight would be refused by aeromag's readers (its
+    /// time or unit checks): values far beyond a real instrument's.
+    #[error(
+        "the scenario gives a flight aeromag's readers would refuse: {reason}; check the scenario's values (a sensor lag, speed or size far beyond a real one?)"
+    )]
+    Unreadable {
+        /// The readers' message.
+        reason: String,
+    },
     /// An error of the core library (IGRF date range, dates, …).
     #[error(transparent)]
     Core(#[from] aeromag_core::CoreError),
@@ -79,7 +88,8 @@ impl SimError {
             SimError::ConfigParse(_)
             | SimError::InvalidConfig { .. }
             | SimError::Trajectory(_)
-            | SimError::Overflow { .. } => true,
+            | SimError::Overflow { .. }
+            | SimError::Unreadable { .. } => true,
             SimError::Core(e) => e.is_bad_input(),
             SimError::Io(e) => e.is_bad_input(),
             SimError::Numerics(_) | SimError::Write { .. } | SimError::Serialize { .. } => false,

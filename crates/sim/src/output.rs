@@ -112,8 +112,30 @@ impl Simulation {
     /// Write the CSV text to `w`: `#` comment lines (scenario, seed, altitude
     /// reference, units), then the table by [`aeromag_io::write_csv_to`]
     /// (header row, shortest round-trip numbers).
-    pub fn write_csv<W: Write>(&self, mut w: W) -> Result<()> {
-        let table = self.to_flight_table()?;
+    pub fn write_csv<W: Write>(&self, w: W) -> Result<()> {
+        self.write_table_csv(&self.to_flight_table()?, w)
+    }
+
+    /// The flight as aeromag's readers would take it: `table`
+    /// ([`Simulation::to_flight_table`]) passes the time and unit checks a
+    /// file read back gets ([`aeromag_io::check_time`],
+    /// [`aeromag_io::check_units`]; their warnings are left to the reader),
+    /// else [`SimError::Unreadable`]. A scenario with values far beyond a
+    /// real instrument's (`scalar.lag_s = 1e9` wrote `mag` of 5.4·10⁸ nT)
+    /// is refused before anything is written.
+    pub fn check_readable(table: &aeromag_io::FlightTable) -> Result<()> {
+        let unreadable = |e: aeromag_io::IoError| SimError::Unreadable {
+            reason: e.to_string(),
+        };
+        if table.column("time").is_some() {
+            aeromag_io::check_time(table).map_err(unreadable)?;
+        }
+        aeromag_io::check_units(table).map_err(unreadable)?;
+        Ok(())
+    }
+
+    /// [`Simulation::write_csv`] of the table already made of it.
+    fn write_table_csv<W: Write>(&self, table: &aeromag_io::FlightTable, mut w: W) -> Result<()> {
         let werr = |e| SimError::Write {
             path: PathBuf::from("<csv stream>"),
             source: e,
@@ -137,17 +159,21 @@ impl Simulation {
             .map(|c| format!("{}[{}]", c.name, c.unit))
             .collect();
         writeln!(w, "# units: {}", units.join(" ")).map_err(werr)?;
-        aeromag_io::write_csv_to(&table, &mut w).map_err(werr)
+        aeromag_io::write_csv_to(table, &mut w).map_err(werr)
     }
 
     /// Write `<stem>.csv`, `<stem>.toml` and `<stem>.truth.json` into `dir`
-    /// (created if missing), `stem` being the scenario name.
+    /// (created if missing), `stem` being the scenario name; nothing when
+    /// the readers would refuse the flight ([`Simulation::check_readable`]).
     pub fn write_to_dir(&self, dir: &Path) -> Result<WrittenFiles> {
+        let stem = self.kind.name();
+        let mut table = self.to_flight_table()?;
+        table.set_source(format!("{stem}.csv"));
+        Self::check_readable(&table)?;
         std::fs::create_dir_all(dir).map_err(|e| SimError::Write {
             path: dir.to_path_buf(),
             source: e,
         })?;
-        let stem = self.kind.name();
         let files = WrittenFiles {
             csv: dir.join(format!("{stem}.csv")),
             scenario: dir.join(format!("{stem}.toml")),
@@ -168,7 +194,7 @@ impl Simulation {
         }
         let mut failure: Option<SimError> = None;
         aeromag_io::atomic::write_atomically(&files.csv, |w| {
-            self.write_csv(w).map_err(|e| {
+            self.write_table_csv(&table, w).map_err(|e| {
                 let io = std::io::Error::other(e.to_string());
                 failure = Some(e);
                 io

@@ -554,6 +554,37 @@ fn onboard_current_appears_in_its_channel_and_in_the_interference() {
     assert!(rms(&rec.iter().zip(tru).map(|(a, b)| a - b).collect::<Vec<_>>()) < 0.05);
 }
 
+/// A scenario whose flight the readers would refuse is refused before a
+/// file is written: a scalar sensor lag of 10⁹ s wrote `mag` of 5.4·10⁸ nT
+/// that `calibrate` then refused as picotesla.
+#[test]
+fn a_flight_the_readers_would_refuse_is_not_written() {
+    let s = simulate(
+        ScenarioKind::Calibration,
+        Some("[pattern]\ncycles = 1\n[scalar]\nlag_s = 1e9\n"),
+        Some(1),
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let e = s.write_to_dir(dir.path()).unwrap_err();
+    assert!(matches!(e, SimError::Unreadable { .. }), "{e}");
+    assert!(e.is_bad_input());
+    let text = e.to_string();
+    assert!(
+        text.contains("'calibration.csv': column 'mag'") && text.contains("far above"),
+        "{text}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // A real sensor's lag is written.
+    let s = simulate(
+        ScenarioKind::Calibration,
+        Some("[pattern]\ncycles = 1\n[scalar]\nlag_s = 0.2\n"),
+        Some(1),
+    )
+    .unwrap();
+    s.write_to_dir(dir.path()).unwrap();
+}
+
 #[test]
 fn files_are_written_and_documented() {
     let s = simulate(ScenarioKind::Calibration, None, Some(8)).unwrap();

@@ -81,13 +81,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None => None,
     };
     let spinner = crate::progress::spinner(&format!("simulating {kind}"));
-    let sim = simulate(kind, text.as_deref(), a.seed).map_err(|e| match &a.config {
-        Some(p) => anyhow::Error::new(e).context(format!("in '{}'", p.display())),
-        None => anyhow::Error::new(e),
-    })?;
+    // The scenario file named with its values' errors (a flight the
+    // readers would refuse is found at writing).
+    let in_config = |e: aeromag_sim::SimError| match &a.config {
+        Some(p) if e.is_bad_input() => {
+            anyhow::Error::new(e).context(format!("in '{}'", p.display()))
+        }
+        _ => anyhow::Error::new(e),
+    };
+    let sim = simulate(kind, text.as_deref(), a.seed).map_err(in_config)?;
     spinner.finish_and_clear();
-    let out = a.out.ok_or_else(|| bad_input!("--out DIR is required"))?;
-    let files = sim.write_to_dir(&out)?;
+    let out = a
+        .out
+        .as_ref()
+        .ok_or_else(|| bad_input!("--out DIR is required"))?;
+    let files = sim.write_to_dir(out).map_err(in_config)?;
     println!(
         "simulated {kind} (seed {}): {} rows × {} columns",
         sim.seed,
