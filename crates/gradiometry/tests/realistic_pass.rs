@@ -3,16 +3,18 @@
 //! object that yaws so its induced moment changes (the isotropic part is in
 //! the scalar system's model, the anisotropic residue is not).
 
+use aeromag_gradiometry::config::GradiometerConfig;
 use aeromag_gradiometry::convergence::multistart_epoch;
+use aeromag_gradiometry::forward::ScalarForward;
 use aeromag_gradiometry::geometry::{Geometry, Layout};
-use aeromag_gradiometry::locate::{DifferenceModel, LocateConfig, locate_scalar, total_moment};
+use aeromag_gradiometry::locate::{locate_scalar, total_moment};
 use aeromag_gradiometry::motion::MotionNoise;
-use aeromag_gradiometry::pass::{PassStep, run_pass};
+use aeromag_gradiometry::pass::{PassEpoch, PassStep, run_pass};
 use aeromag_gradiometry::sim::{
-    Processing, Scenario, SystemMotion, scalar_epochs, simulate, tensor_epochs,
+    Processing, Scenario, SimEpoch, SystemMotion, scalar_epochs, simulate, tensor_epochs,
 };
 use aeromag_gradiometry::sr_iekf::{IekfConfig, SrState};
-use nalgebra::{SVector, Vector3};
+use nalgebra::SVector;
 
 fn processing() -> Processing {
     Processing {
@@ -30,6 +32,22 @@ fn scenario(motion: SystemMotion, layout: Layout) -> Scenario {
     let mut s = Scenario::new(motion, Geometry::new(layout, 1.0).unwrap());
     s.epochs = 600; // 120 m pass: the first 5 s are ≥ 50 m away (quiet)
     s
+}
+
+/// The simulated pass and the scalar system's filter input at the true
+/// positions.
+fn scalar_pass(s: &Scenario) -> (Vec<SimEpoch>, Vec<PassEpoch<9, 3, ScalarForward>>) {
+    let sim = simulate(s).unwrap();
+    let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
+    let epochs = scalar_epochs(
+        &sim,
+        &s.geometry,
+        &pos,
+        &processing(),
+        s.scalar_sensor.noise_nt,
+    )
+    .unwrap();
+    (sim, epochs)
 }
 
 fn init_step(s: &SrState<6>) -> PassStep<6> {
@@ -88,16 +106,7 @@ fn tensor_filter_tracks_position_and_moment_over_realistic_passes() {
 fn scalar_filter_recovers_the_moment_over_a_realistic_pass() {
     for motion in [SystemMotion::Stationary, SystemMotion::Mobile] {
         let s = scenario(motion, Layout::Tetrahedron);
-        let sim = simulate(&s).unwrap();
-        let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
-        let epochs = scalar_epochs(
-            &sim,
-            &s.geometry,
-            &pos,
-            &processing(),
-            s.scalar_sensor.noise_nt,
-        )
-        .unwrap();
+        let (sim, epochs) = scalar_pass(&s);
         // total and induced moment, prior σ 3000 A·m²; the contrasts'
         // offset from the first epoch's process noise
         let mut sigma = SVector::<f64, 9>::repeat(3000.0);
@@ -131,19 +140,11 @@ fn scalar_filter_recovers_the_moment_over_a_realistic_pass() {
 /// epochs' components were beyond 3σ, with consistent innovations.
 #[test]
 fn scalar_moment_errors_are_consistent_with_their_sigma() {
-    let cfg = LocateConfig {
-        iekf: IekfConfig::new(0.02).unwrap(),
-        detection_factor: 30.0,
-        multistart: true,
-        initial_position_m: Vector3::new(10.0, 0.0, 0.0),
-        prior_sigma_position_m: 20.0,
-        prior_sigma_moment_am2: 3000.0,
-        window_epochs: 30,
-        passes: 1,
-        first_pass_extra_position_m: 0.3,
-        first_pass_extra_moment_am2: 30.0,
-        difference_model: DifferenceModel::Exact,
-    };
+    // the default estimator settings (those of `processing()`) for the
+    // scalar sensors' noise
+    let cfg = GradiometerConfig::default()
+        .locate_config(Some(0.02))
+        .unwrap();
     let (mut beyond, mut n) = (0usize, 0usize);
     for motion in [SystemMotion::Stationary, SystemMotion::Mobile] {
         for seed in 1..=4 {
@@ -151,16 +152,7 @@ fn scalar_moment_errors_are_consistent_with_their_sigma() {
                 seed,
                 ..scenario(motion, Layout::Tetrahedron)
             };
-            let sim = simulate(&s).unwrap();
-            let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
-            let epochs = scalar_epochs(
-                &sim,
-                &s.geometry,
-                &pos,
-                &processing(),
-                s.scalar_sensor.noise_nt,
-            )
-            .unwrap();
+            let (sim, epochs) = scalar_pass(&s);
             let out = locate_scalar(&epochs, &cfg).unwrap();
             for (e, l) in sim.iter().zip(&out) {
                 let err = l.step.posterior.x - e.true_moment_am2;
@@ -191,9 +183,8 @@ fn scalar_moment_errors_are_consistent_with_their_sigma() {
 #[test]
 fn scalar_offset_prior_follows_from_the_quiet_epochs() {
     let s = scenario(SystemMotion::Stationary, Layout::Tetrahedron);
-    let sim = simulate(&s).unwrap();
+    let (sim, epochs) = scalar_pass(&s);
     let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
-    let epochs = scalar_epochs(&sim, &s.geometry, &pos, &processing(), 0.02).unwrap();
     let b0 = epochs[0].s_q.fixed_rows::<3>(6).into_owned();
     // 1500 A·m² 50–60 m away: some 0.01–0.1 nT per contrast
     assert!(
