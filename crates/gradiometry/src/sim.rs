@@ -383,7 +383,8 @@ pub struct Processing {
     pub quiet_epochs: usize,
     /// Model noise of the motion model.
     pub noise: MotionNoise,
-    /// Characteristic moment for the induced term of `S_Q`, A·m².
+    /// Characteristic moment for the induced term of `S_Q` (and the scalar
+    /// system's offset prior, [`scalar_epochs`]), A·m².
     pub moment_scale_am2: f64,
 }
 
