@@ -198,8 +198,10 @@ impl Default for TrajectoryConfig {
 #[serde(deny_unknown_fields, default)]
 pub struct EstimatorConfig {
     /// Subtract the mean contrasts of the first epochs (object far away:
-    /// removes sensor biases and the Earth-gradient contrasts); 0 = use the
-    /// IGRF background in the model. Default 50.
+    /// removes sensor biases and the Earth-gradient contrasts; the scalar
+    /// system estimates what the object's own contrasts there leave as a
+    /// contrast offset, [`crate::sim::scalar_epochs`]); 0 = use the IGRF
+    /// background in the model. Default 50.
     pub quiet_epochs: usize,
     /// Position random walk of the motion model, m/√s. Default 0.02.
     pub position_random_walk_m_per_sqrt_s: f64,
@@ -207,7 +209,8 @@ pub struct EstimatorConfig {
     pub moment_random_walk_am2_per_sqrt_s: f64,
     /// Induced-moment coefficient κ of the moment noise, per rad. Default 1.
     pub induced_per_rad: f64,
-    /// Characteristic moment |M| for the induced term, A·m². Default 1500.
+    /// Characteristic moment |M| for the induced term (and, scalar system,
+    /// for the prior of the contrast offset), A·m². Default 1500.
     pub moment_scale_am2: f64,
     /// Detection threshold `k` (tensor): start at the first epoch with
     /// `‖z‖ > k σ √9`. Default 30.

@@ -31,7 +31,7 @@
 
 use crate::crlb::{crlb, efficiency};
 use crate::error::{GradiometryError, Result};
-use crate::forward::Forward;
+use crate::forward::{Forward, ScalarForward};
 use crate::geometry::{Geometry, Layout};
 use crate::locate::{DifferenceModel, LocateConfig, locate_scalar, locate_tensor};
 use crate::motion::MotionNoise;
@@ -171,15 +171,30 @@ pub fn tensor_pass_crlb(
     bound(&epochs, &truth, sigma_nt)
 }
 
-/// CRLB of `M` (A·m²)² at the last epoch of `sim` for the scalar system at
-/// the known (true) positions; otherwise as [`tensor_pass_crlb`].
+/// CRLB of the total moment `M` (A·m²)² at the last epoch of `sim` for
+/// the scalar system at the known (true) positions, the whole moment turning
+/// with the object (the estimator's permanent and induced parts cannot be
+/// told apart while the heading is constant, as in [`well_posed`]: their
+/// 6-state information is singular); otherwise as [`tensor_pass_crlb`].
 pub fn scalar_pass_crlb(
     sim: &[SimEpoch],
     geometry: &Geometry,
     sigma_nt: f64,
 ) -> Result<SMatrix<f64, 3, 3>> {
     let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
-    let epochs = scalar_epochs(sim, geometry, &pos, &deterministic_processing())?;
+    // The total moment's model: the permanent part's transition, exact for
+    // the sum while the object's heading is constant.
+    let epochs: Vec<PassEpoch<3, 3, ScalarForward>> =
+        scalar_epochs(sim, geometry, &pos, &deterministic_processing(), sigma_nt)?
+            .into_iter()
+            .map(|e| PassEpoch {
+                transition: e.transition.fixed_view::<3, 3>(0, 0).into_owned(),
+                offset: e.offset.fixed_rows::<3>(0).into_owned(),
+                s_q: e.s_q.fixed_rows::<3>(0).into_owned(),
+                model: e.model,
+                z: e.z,
+            })
+            .collect();
     let truth: Vec<_> = sim.iter().map(|e| e.true_moment_am2).collect();
     bound(&epochs, &truth, sigma_nt)
 }
@@ -219,7 +234,8 @@ fn trial_error<const N: usize>(
         }
         Gradiometer::Scalar => {
             let pos: Vec<_> = sim.iter().map(|e| e.true_position_m).collect();
-            let out = locate_scalar(&scalar_epochs(&sim, &s.geometry, &pos, processing)?, cfg)?;
+            let input = scalar_epochs(&sim, &s.geometry, &pos, processing, cfg.iekf.sigma_nt)?;
+            let out = locate_scalar(&input, cfg)?;
             let est = out
                 .last()
                 .ok_or(GradiometryError::NotFinite { name: "estimate" })?;

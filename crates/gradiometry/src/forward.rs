@@ -200,6 +200,21 @@ impl Forward<3, 3> for ScalarForward {
     }
 }
 
+/// The scalar system's filter state `(M, M_i, b)`: the total and the
+/// induced moment (A·m², [`crate::motion::motion_mv_induced`]) and a
+/// constant offset `b` of the three contrasts (nT, what the bias removal of
+/// [`crate::sim::scalar_epochs`] leaves): `h(M, M_i, b) = h(M) + b`,
+/// `∂h/∂(M, M_i, b) = [H, 0, I]` with `H = ∂h/∂M` of the 3-state model.
+impl Forward<9, 3> for ScalarForward {
+    fn eval(&self, x: &SVector<f64, 9>) -> (SVector<f64, 3>, SMatrix<f64, 3, 9>) {
+        let (z, h) = self.eval(&x.fixed_rows::<3>(0).into_owned());
+        let mut h9 = SMatrix::<f64, 3, 9>::zeros();
+        h9.fixed_columns_mut::<3>(0).copy_from(&h);
+        h9.fixed_columns_mut::<3>(6).fill_with_identity();
+        (z + x.fixed_rows::<3>(6), h9)
+    }
+}
+
 /// Central finite-difference Jacobian of a [`Forward`] with per-component
 /// steps `step` (the seed's `JacobianH`, eq. 11/26); used to check the
 /// analytic Jacobians.
@@ -263,6 +278,13 @@ mod tests {
         let hfd = jacobian_fd(&f, &x, &Vector3::repeat(1e-2));
         let rel = (h - hfd).norm() / h.norm();
         assert!(rel < 1e-7, "rel {rel:e}");
+        // total and induced moment and an offset: the total's model plus the offset
+        let x9 = SVector::<f64, 9>::from([100.0, -20.0, 30.0, 200.0, -100.0, 50.0, 0.1, -0.2, 0.3]);
+        let (z9, h9): (SVector<f64, 3>, _) = f.eval(&x9);
+        let m = Vector3::new(100.0, -20.0, 30.0);
+        assert!((z9 - f.eval(&m).0 - Vector3::new(0.1, -0.2, 0.3)).norm() < 1e-9);
+        let hfd9 = jacobian_fd(&f, &x9, &SVector::repeat(1e-2));
+        assert!((h9 - hfd9).norm() / h9.norm() < 1e-7);
     }
 
     #[test]

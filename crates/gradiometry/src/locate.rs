@@ -23,9 +23,16 @@
 //!    (the whole-pass maximum a posteriori estimate, efficient against the
 //!    Cramér–Rao bound). `MeasureS` is taken against that prior.
 //!
-//! **Scalar system** ([`locate_scalar`], state `M`, position known): the
-//! model is nearly linear in `M`; the filter runs over every epoch from a
-//! zero moment with σ `prior_sigma_moment_am2`.
+//! **Scalar system** ([`locate_scalar`], position known): the state is the
+//! total and the induced moment `(M, M_i)` of
+//! [`crate::motion::motion_mv_induced`] (A·m², body frame; the model is
+//! nearly linear in `M`) and the contrasts' offset `b` (nT) of
+//! [`crate::sim::scalar_epochs`]; the filter runs over every epoch from a
+//! zero moment, `M` and `M_i` independent with σ `prior_sigma_moment_am2`
+//! per component (the offset's prior is the first epoch's process noise).
+//! The output is the total moment `M` in the body frame with its σ: with a
+//! constant heading `M_i` is not observed and `M` is estimated as by a
+//! 3-state filter with the same prior.
 //!
 //! Each epoch's output carries the residual `‖z − h(x⁺)‖` (nT).
 //!
@@ -36,9 +43,10 @@
 
 use crate::convergence::candidate_starts;
 use crate::error::{GradiometryError, Result, positive};
+use crate::estimability::measure_s;
 use crate::forward::{Forward, ScalarForward, TensorForward};
 use crate::pass::{PassEpoch, PassStep, run_pass, run_pass_relinearised};
-use crate::sr_iekf::{IekfConfig, SrState, iterate_epoch};
+use crate::sr_iekf::{IekfConfig, SrState, iterate_epoch, prognosis};
 pub use crate::tensor_approx::DifferenceModel;
 use crate::tensor_approx::TensorApproxForward;
 use nalgebra::{SMatrix, SVector, Vector3};
@@ -266,23 +274,48 @@ fn locate_tensor_with<F: Forward<6, 9> + Clone>(
     Ok(out)
 }
 
-/// Scalar system over a pass (module docs); every epoch has an estimate.
+/// The total moment `M` (A·m²) of the scalar system's state `(M, M_i, b)`,
+/// with its covariance.
+pub fn total_moment(x: &SrState<9>) -> SrState<3> {
+    x.mapped(&SMatrix::<f64, 3, 9>::identity())
+}
+
+/// Scalar system over a pass (module docs): every epoch has an estimate of
+/// the total moment `M` (its `MeasureS` against the prior propagated
+/// without measurements; the first-pass extra noise on `M` only).
 pub fn locate_scalar(
-    epochs: &[PassEpoch<3, 3, ScalarForward>],
+    epochs: &[PassEpoch<9, 3, ScalarForward>],
     cfg: &LocateConfig,
 ) -> Result<Vec<Located<3>>> {
     cfg.validate()?;
+    let m = cfg.prior_sigma_moment_am2;
     let prior = SrState::diagonal(
-        Vector3::zeros(),
-        &Vector3::repeat(cfg.prior_sigma_moment_am2),
+        SVector::zeros(),
+        &SVector::<f64, 9>::from([m, m, m, m, m, m, 0.0, 0.0, 0.0]),
     );
-    let steps = run(
-        &prior,
-        epochs,
-        cfg,
-        Vector3::repeat(cfg.first_pass_extra_moment_am2),
-    )?;
-    Ok(with_residuals(epochs, steps))
+    let e = cfg.first_pass_extra_moment_am2;
+    let extra = SVector::<f64, 9>::from([e, e, e, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let steps = run(&prior, epochs, cfg, extra)?;
+    // The last (or only) pass ran with the epochs' own process noise.
+    let mut blind = prior;
+    Ok(with_residuals(epochs, steps)
+        .into_iter()
+        .zip(epochs)
+        .map(|(l, e)| {
+            blind = prognosis(&blind, &e.transition, &e.s_q);
+            let posterior = total_moment(&l.step.posterior);
+            Located {
+                step: PassStep {
+                    posterior,
+                    iterations: l.step.iterations,
+                    converged: l.step.converged,
+                    estimability: measure_s(&posterior, &total_moment(&blind)),
+                    nis: l.step.nis,
+                },
+                residual_nt: l.residual_nt,
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]

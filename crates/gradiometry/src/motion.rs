@@ -1,5 +1,7 @@
 //! Motion models `MotionMT` (tensor, state `(r, M)`) and `MotionMV` (scalar,
-//! state `M`) of seed `004_…` (eqs. 17–18, 29; spec `gradiometry.md`).
+//! state `M`) of seed `004_…` (eqs. 17–18, 29; spec `gradiometry.md`), and
+//! the scalar system's model with a separate induced moment
+//! ([`motion_mv_induced`], state `(M_p, M_i)`).
 //!
 //! With `r` the object's position relative to the measuring system and `M`
 //! its moment, both in the system's frame, the object's and the system's
@@ -18,6 +20,39 @@
 //! uncertainty as a random walk, m/√s) and
 //! `(σ_M + κ |ω_o| |M|) √Δt` for the moment, the term in `|ω_o|` standing
 //! for the induced part that changes with the object's orientation.
+//!
+//! **Permanent and induced moment** ([`motion_mv_induced`], the scalar
+//! system's estimator). Turning the whole moment with the object is wrong
+//! for its induced part: an object of susceptibility `K` (A·m²/nT, in its
+//! own axes) in the Earth's field `B_e` (nT, navigation frame) carries
+//!
+//! ```text
+//! M_n(t) = C_no(t) M_perm + C_no(t) K C_on(t) B_e
+//!        = C_no(t) M_perm + k̄ B_e + C_no(t) (K − k̄ I) C_on(t) B_e,
+//! ```
+//!
+//! the permanent moment turning with the heading, the isotropic part of the
+//! induced one (`k̄ = trace K / 3`) fixed with the Earth's field, and an
+//! anisotropic residue that changes with the heading. The model keeps the
+//! first two, as six states in the system frame: the total moment the
+//! sensors see and the induced part, `x = (M, M_i)` (A·m²; the permanent
+//! part is `M_p = M − M_i`). With `M_p` turning at `ω_o − ω_m` and `M_i`
+//! at `−ω_m` (fixed in the navigation frame):
+//!
+//! ```text
+//! M_j+1   = M_j + (ω_o − ω_m) × M_j Δt − ω_o × M_i,j Δt + q_M
+//! M_i,j+1 = M_i,j − ω_m × M_i,j Δt
+//! F = [[I + [(ω_o − ω_m)×]Δt, −[ω_o×]Δt], [0, I − [ω_m×]Δt]],   u = 0,
+//! σ(q_M) = (σ_M + κ |ω_o| |M|) √Δt,   σ(q_i) = 0,
+//! ```
+//!
+//! the process noise of `MotionMV` on the total only: the anisotropic
+//! residue, which changes only when the object turns, and the slow drift
+//! of the permanent moment change the moment the sensors see, while the
+//! isotropic induced moment is constant. At a constant heading (`ω_o = 0`)
+//! `M` moves as in `MotionMV` and `M_i` is not observed: the model is the
+//! 3-state one, and `M_i`'s prior keeps the problem well posed; when the
+//! object turns, the change of `M` tells the parts apart.
 
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::attitude::wrap_pi;
@@ -137,6 +172,27 @@ pub fn motion_mv(
     (f, Vector3::zeros(), Vector3::repeat(qm))
 }
 
+/// The model with the induced part (module docs): `(F, u = 0, S_Q)` of the
+/// 6 states `(M, M_i)`, total and induced moment, system frame, A·m²;
+/// `moment` is the characteristic moment `|M|` of the noise's induced term,
+/// A·m² (the noise is `MotionMV`'s, on `M` only).
+pub fn motion_mv_induced(
+    m: &Motion,
+    noise: &MotionNoise,
+    moment: &Vector3<f64>,
+) -> (SMatrix<f64, 6, 6>, SVector<f64, 6>, SVector<f64, 6>) {
+    let (fm, _, qm) = motion_mv(m, noise, moment);
+    let mut f = SMatrix::<f64, 6, 6>::zeros();
+    f.fixed_view_mut::<3, 3>(0, 0).copy_from(&fm);
+    f.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(-skew(&m.w_object) * m.dt_s));
+    f.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&(Matrix3::identity() - skew(&m.w_system) * m.dt_s));
+    let mut q = SVector::<f64, 6>::zeros();
+    q.fixed_rows_mut::<3>(0).copy_from(&qm);
+    (f, SVector::zeros(), q)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,6 +225,40 @@ mod tests {
         };
         let (_, _, q2) = motion_mt(&w, &noise, &Vector3::new(10.0, 0.0, 0.0));
         assert!((q2[3] - 2.0 * 0.5 * 10.0 * 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_permanent_moment_turns_with_the_object_and_the_induced_one_does_not() {
+        let noise = MotionNoise {
+            position_m_per_sqrt_s: 0.0,
+            moment_am2_per_sqrt_s: 2.0,
+            induced_per_rad: 1.0,
+        };
+        let m = Motion {
+            v_object: Vector3::zeros(),
+            v_system: Vector3::zeros(),
+            w_object: Vector3::new(0.0, 0.0, 0.1),
+            w_system: Vector3::zeros(),
+            dt_s: 0.01,
+        };
+        let scale = Vector3::new(1500.0, 0.0, 0.0);
+        let (f, u, q) = motion_mv_induced(&m, &noise, &scale);
+        // M_p = (100, 0, 0) turns by ω_o Δt = 1 mrad about down, M_i = (50, 0, 0) stays
+        let x = SVector::<f64, 6>::from([150.0, 0.0, 0.0, 50.0, 0.0, 0.0]);
+        let x1 = f * x + u;
+        assert!((x1[0] - 150.0).abs() < 1e-12 && (x1[1] - 0.1).abs() < 1e-12);
+        assert!(x1[3] == 50.0 && x1[4] == 0.0);
+        assert_eq!(q.fixed_rows::<3>(0), motion_mv(&m, &noise, &scale).2);
+        assert_eq!(q.fixed_rows::<3>(3).norm(), 0.0);
+        // a turning system sees both parts turn backwards alike
+        let turn = Motion {
+            w_object: Vector3::zeros(),
+            w_system: Vector3::new(0.0, 0.0, 0.1),
+            ..m
+        };
+        let (f, _, _) = motion_mv_induced(&turn, &noise, &scale);
+        let x1 = f * x;
+        assert!((x1[1] + 0.15).abs() < 1e-12 && (x1[4] + 0.05).abs() < 1e-12);
     }
 
     #[test]

@@ -5,7 +5,9 @@
 //!
 //! Epoch `j` carries the transition *into* it, `x_j = F_j x_{j−1} + u_j`
 //! with process-noise root `S_Q,j` (from [`crate::motion`]; use `F = I`,
-//! `u = 0`, `S_Q = 0` for the first epoch), its forward model (geometry,
+//! `u = 0`, `S_Q = 0` for the first epoch, or an `S_Q` there that widens
+//! the prior, as the scalar system's contrast offset of
+//! [`crate::sim::scalar_epochs`]), its forward model (geometry,
 //! background, known position for the scalar system) and its white
 //! contrasts `z_j` (nT).
 //!

@@ -22,7 +22,12 @@
 //!   part fixed in the object and an induced part with an anisotropic
 //!   susceptibility `K = diag(k_x, k_y, k_z)` (A·m²/nT) in the object's
 //!   axes, so `M` changes with the object's heading in a way the
-//!   estimator's rotation model does not describe exactly;
+//!   estimators' models do not describe exactly (the tensor system turns
+//!   the whole moment with the object; the scalar system separates a
+//!   permanent part turning with it and an induced part fixed with the
+//!   Earth's field, [`crate::motion::motion_mv_induced`], which leaves the
+//!   anisotropic residue `C_no (K − k̄ I) C_on B_e` out). The truth
+//!   columns hold the total `M`, body frame;
 //! - vector sensors (body frame): `C_bn (B_e + G_e C_nb δr_i + d + B_dip) +
 //!   b_i + n`, scalar sensors `|B_e + G_e C_nb δr_i + d + B_dip| + b_i + n`,
 //!   with a fixed bias `b_i ~ N(0, σ_b²)` per sensor and white noise
@@ -34,9 +39,9 @@
 
 use crate::decorrelate::{contrasts_scalar, contrasts_vector};
 use crate::error::{GradiometryError, Result, in_range, positive};
-use crate::forward::{Background, ScalarForward, TensorForward};
+use crate::forward::{Background, Forward, ScalarForward, TensorForward};
 use crate::geometry::Geometry;
-use crate::motion::{Motion, MotionNoise, motion_mt, motion_mv};
+use crate::motion::{Motion, MotionNoise, motion_mt, motion_mv_induced};
 use crate::pass::PassEpoch;
 use aeromag_core::NT_PER_T;
 use aeromag_core::field::dipole::dipole_field;
@@ -44,7 +49,7 @@ use aeromag_core::field::igrf::IgrfModel;
 use aeromag_core::frames::Attitude;
 use aeromag_core::frames::geodetic::Geodetic;
 use aeromag_core::random::{self, ChaCha8Rng, normal};
-use nalgebra::{Matrix3, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use rand::RngExt;
 use std::borrow::Borrow;
 
@@ -378,7 +383,8 @@ pub struct Processing {
     pub quiet_epochs: usize,
     /// Model noise of the motion model.
     pub noise: MotionNoise,
-    /// Characteristic moment for the induced term of `S_Q`, A·m².
+    /// Characteristic moment for the induced term of `S_Q` (and the scalar
+    /// system's offset prior, [`scalar_epochs`]), A·m².
     pub moment_scale_am2: f64,
 }
 
@@ -430,14 +436,33 @@ pub fn tensor_epochs<E: Borrow<Epoch>>(
         .collect()
 }
 
-/// Scalar-system filter input (state `M`, body frame), position known
-/// (`positions_m[j]`, e.g. the true or a navigated relative position).
+/// Scalar-system filter input, position known (`positions_m[j]`, e.g. the
+/// true or a navigated relative position): state `x = (M, M_i, b)`, the
+/// total moment the sensors see and its induced part in the body frame
+/// (A·m², moving as in [`motion_mv_induced`]) and a constant offset `b` of
+/// the three contrasts (nT, `F = I`, no process noise).
+///
+/// The offset is what the bias removal leaves: the mean of the first
+/// `Q = quiet_epochs` contrasts holds, besides the sensor biases, the
+/// object's own contrasts there, `z̄_Q = b_s + (1/Q) Σ_{q<Q} h_q(M_q) + v̄`,
+/// which at the scalar sensors' noise (0.02 nT against some 0.05 nT from
+/// 1500 A·m² at 50 m) biased every epoch by about 2σ. Its prior enters as
+/// the first epoch's process noise (the pass's prior covers the moment
+/// only): per contrast `k`,
+///
+/// ```text
+/// σ_b,k = √((|M| ‖row_k(H̄_Q)‖)² + σ²/Q),   H̄_Q = (1/Q) Σ_{q<Q} ∂h_q/∂M (M = 0),
+/// ```
+///
+/// `|M|` the characteristic moment `moment_scale_am2`, `σ` the sensor
+/// noise `noise_nt` (nT). Without bias removal (`Q = 0`) the offset is 0.
 pub fn scalar_epochs<E: Borrow<Epoch>>(
     sim: &[E],
     geometry: &Geometry,
     positions_m: &[Vector3<f64>],
     p: &Processing,
-) -> Result<Vec<PassEpoch<3, 3, ScalarForward>>> {
+    noise_nt: f64,
+) -> Result<Vec<PassEpoch<9, 3, ScalarForward>>> {
     if positions_m.len() != sim.len() {
         return Err(GradiometryError::LengthMismatch {
             what: "positions_m",
@@ -450,23 +475,27 @@ pub fn scalar_epochs<E: Borrow<Epoch>>(
         sim.iter().map(|e| contrasts_scalar(&e.borrow().scalar_nt)),
         q,
     );
-    Ok(sim
+    let mut epochs: Vec<PassEpoch<9, 3, ScalarForward>> = sim
         .iter()
         .zip(positions_m)
         .map(|(e, r)| {
             let e: &Epoch = e.borrow();
-            let (f, u, s_q) = motion_mv(
+            let (f6, _, q6) = motion_mv_induced(
                 &e.motion,
                 &p.noise,
                 &Vector3::new(p.moment_scale_am2, 0.0, 0.0),
             );
+            let mut transition = SMatrix::<f64, 9, 9>::identity();
+            transition.fixed_view_mut::<6, 6>(0, 0).copy_from(&f6);
+            let mut s_q = SVector::<f64, 9>::zeros();
+            s_q.fixed_rows_mut::<6>(0).copy_from(&q6);
             let mut background = e.background;
             if q > 0 {
                 background.gradient_nt_per_m = Matrix3::zeros();
             }
             PassEpoch {
-                transition: f,
-                offset: u,
+                transition,
+                offset: SVector::zeros(),
                 s_q,
                 model: ScalarForward {
                     geometry: *geometry,
@@ -476,7 +505,20 @@ pub fn scalar_epochs<E: Borrow<Epoch>>(
                 z: contrasts_scalar(&e.scalar_nt) - z0,
             }
         })
-        .collect())
+        .collect();
+    if q > 0 {
+        let h_mean = epochs[..q]
+            .iter()
+            .map(|e| Forward::<3, 3>::eval(&e.model, &Vector3::zeros()).1)
+            .sum::<Matrix3<f64>>()
+            / q as f64;
+        let noise2 = noise_nt * noise_nt / q as f64;
+        let sigma_b = Vector3::from_fn(|k, _| {
+            ((p.moment_scale_am2 * h_mean.row(k).norm()).powi(2) + noise2).sqrt()
+        });
+        epochs[0].s_q.fixed_rows_mut::<3>(6).copy_from(&sigma_b);
+    }
+    Ok(epochs)
 }
 
 #[cfg(test)]

@@ -64,10 +64,35 @@ impl<const N: usize> SrState<N> {
     pub fn sigma(&self) -> SVector<f64, N> {
         SVector::from_fn(|i, _| self.s.row(i).norm())
     }
+
+    /// The state of `y = T x` (`M ≤ N` components): estimate `T x` and
+    /// the upper-triangular root of `T S Sᵀ Tᵀ`, re-triangularised from the
+    /// wide factor `T S` ([`triangularize_upper`]).
+    pub fn mapped<const M: usize>(&self, t: &SMatrix<f64, M, N>) -> SrState<M> {
+        assert!(
+            M <= N && N <= MAX_STATES,
+            "a map to at most the {N} states of at most {MAX_STATES}"
+        );
+        let ts = t * self.s;
+        let mut buf = [0.0; MAX_STATES * MAX_STATES];
+        let a = &mut buf[..M * N];
+        for i in 0..M {
+            for j in 0..N {
+                a[i * N + j] = ts[(i, j)];
+            }
+        }
+        let mut work = [0.0; MAX_STATES];
+        triangularize_upper(a, M, N, &mut work[..N]);
+        SrState {
+            x: t * self.x,
+            s: SMatrix::from_fn(|i, j| a[i * N + N - M + j]),
+        }
+    }
 }
 
-/// Largest state dimension of the filter (position and moment: 6).
-const MAX_STATES: usize = 8;
+/// Largest state dimension of the filter (the scalar system's permanent and
+/// induced moment and contrast offset: 9).
+const MAX_STATES: usize = 9;
 
 /// `PrognosisFK`: `x⁻ = F x`, `S⁻ = tri([diag(s_q), F S])` (module docs).
 pub fn prognosis<const N: usize>(
@@ -293,6 +318,21 @@ mod tests {
             proptest::prop_assert!((st.s * st.s.transpose() - p_plus).norm() <= 1e-9 * (1.0 + p.norm()));
             proptest::prop_assert!((st.x - gain * nu).norm() <= 1e-9 * (1.0 + (gain * nu).norm()));
         }
+    }
+
+    #[test]
+    fn a_mapped_state_has_the_mapped_covariance() {
+        let s = SMatrix::<f64, 3, 3>::new(2.0, 0.5, -0.3, 0.0, 1.0, 0.2, 0.0, 0.0, 0.7);
+        let st = SrState {
+            x: SVector::<f64, 3>::new(1.0, 2.0, 3.0),
+            s,
+        };
+        let t = SMatrix::<f64, 2, 3>::new(1.0, 0.0, 1.0, 0.5, -1.0, 0.0);
+        let y = st.mapped(&t);
+        let p = t * s * s.transpose() * t.transpose();
+        assert!((y.s * y.s.transpose() - p).norm() < 1e-12);
+        assert!((y.x - t * st.x).norm() < 1e-15);
+        assert_eq!(y.s[(1, 0)], 0.0);
     }
 
     #[test]

@@ -852,7 +852,13 @@ pub fn locate_pass<E: Borrow<Epoch>>(
             Track::from_tensor(&out)
         }
         Gradiometer::Scalar => {
-            let input = scalar_epochs(epochs, &geometry, positions, &cfg.processing())?;
+            let input = scalar_epochs(
+                epochs,
+                &geometry,
+                positions,
+                &cfg.processing(),
+                lc.iekf.sigma_nt,
+            )?;
             Track::from_scalar(&locate_scalar(&input, &lc)?, positions)
         }
     })
