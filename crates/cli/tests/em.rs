@@ -1087,6 +1087,40 @@ fn a_record_without_signal_is_named_as_such() {
     assert!(!out.exists());
 }
 
+/// One 1000 V sample (finding 07) was detected as signal (calibration 2×
+/// instead of 1700×, exit 0 without a word): it is repaired and counted in
+/// a warning naming the file, frame, epoch time and channel.
+#[test]
+fn an_impulsive_spike_is_repaired_and_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let mut bytes = std::fs::read(sim.join("em.raw")).unwrap();
+    let body = 12 + u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    let at = body + 4 * (3 * 50_000 + 1);
+    bytes[at..at + 4].copy_from_slice(&1000f32.to_le_bytes());
+    let spiked = d.join("spike.raw");
+    std::fs::write(&spiked, bytes).unwrap();
+    let out = d.join("det.csv");
+    let o = aeromag(&["em", "detect", "--input", s(&spiked), "--out", s(&out)]);
+    assert_code(&o, 0);
+    let e = stderr(&o);
+    for f in [
+        "warning: ",
+        "spike.raw",
+        "1 impulsive spike(s) in 1 epoch(s) repaired",
+        "the first at frame 50000 (epoch at 0.559995 s), channel 1, 1000 V",
+    ] {
+        assert!(e.contains(f), "stderr lacks '{f}':\n{e}");
+    }
+    assert!(out.is_file());
+    let clean = d.join("clean.raw");
+    std::fs::copy(sim.join("em.raw"), &clean).unwrap();
+    let o = aeromag(&["em", "detect", "--input", s(&clean), "--out", s(&out)]);
+    assert_code(&o, 0);
+    assert!(!stderr(&o).contains("spike"), "{}", stderr(&o));
+}
+
 /// `detect --system` with the frequencies swapped (or in kHz) was used
 /// as given: the fields went to the wrong dipoles (exit 0). The system
 /// must agree with the record's header on the tones.
