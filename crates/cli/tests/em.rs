@@ -1121,6 +1121,68 @@ fn an_impulsive_spike_is_repaired_and_named_in_a_warning() {
     assert!(!stderr(&o).contains("spike"), "{}", stderr(&o));
 }
 
+/// `em simulate` wrote records `em detect` refused (a coil gain or moments
+/// of 0, a frequency twice, a start time the frame index cannot hold) and
+/// KNOWN files `em calibrate` refused: exit 2 naming the scenario file,
+/// the field and the accepted range, and no folder written.
+#[test]
+fn simulate_refuses_scenarios_whose_files_detect_or_calibrate_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("sim");
+    for (name, toml, fragments) in [
+        (
+            "gain.toml",
+            "coil_gain_v_per_t_s = 0.0",
+            &["field 'coil_gain_v_per_t_s' is 0, expected 0.000001…10000000000 V/(T/s)"][..],
+        ),
+        (
+            "moments.toml",
+            "moments_am2 = [0.0, 0, 0, 0, 0, 0, 0, 0, 0]",
+            &["field 'moments_am2' is singular"],
+        ),
+        (
+            "twice.toml",
+            "frequencies_hz = [1025.0, 1025.0, 3125.0]",
+            &["field 'frequencies_hz' holds 1025 Hz twice"],
+        ),
+        (
+            "pilot.toml",
+            "pilot_offset_hz = 0.0",
+            &["field 'pilot_offset_hz' is 0, expected 0.001…100000 Hz"],
+        ),
+        (
+            "early.toml",
+            "start_time_s = -100.0",
+            &["field 'start_time_s' is -100 s, expected 0 … "],
+        ),
+        (
+            "late.toml",
+            "start_time_s = 1e15",
+            &["field 'start_time_s' is 1000000000000000 s, expected 0 …"],
+        ),
+        (
+            "far.toml",
+            "range_min_m = 15000.0\nrange_max_m = 20000.0",
+            &[
+                "known position at 0.079995 s",
+                "'range_max_m'",
+                "expected 1 … 10000 m",
+            ],
+        ),
+    ] {
+        let cfg = d.join(name);
+        std::fs::write(&cfg, format!("duration_s = 1.28\n{toml}\n")).unwrap();
+        let mut want = vec![name];
+        want.extend_from_slice(fragments);
+        bad(
+            &["em", "simulate", "--config", s(&cfg), "--out", s(&out)],
+            &want,
+        );
+        assert!(!out.exists(), "{name}");
+    }
+}
+
 /// `detect --system` with the frequencies swapped (or in kHz) was used
 /// as given: the fields went to the wrong dipoles (exit 0). The system
 /// must agree with the record's header on the tones.
