@@ -38,6 +38,49 @@ fn em_study_writes_its_summary_report_and_calibration() {
     assert!(out.join("calibration.json").is_file());
 }
 
+/// `em study` into the folder of an earlier study wrote its four files
+/// one by one, seconds apart (SIGTERM left old and new files mixed, and a
+/// folder in place of index.html failed after the three others were
+/// replaced): with the last file unwritable, none of the earlier files is
+/// replaced.
+#[test]
+fn em_study_replaces_an_earlier_study_whole_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("em");
+    let o = aeromag(&["em", "study", "--quick", "--seed", "2", "--out", s(&out)]);
+    assert_code(&o, 0);
+    let names = ["summary.json", "calibration.json", "curves.json"];
+    let before: Vec<Vec<u8>> = names
+        .iter()
+        .map(|n| std::fs::read(out.join(n)).unwrap())
+        .collect();
+    std::fs::remove_file(out.join("index.html")).unwrap();
+    std::fs::create_dir(out.join("index.html")).unwrap();
+    let o = aeromag(&["em", "study", "--quick", "--seed", "1", "--out", s(&out)]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("index.html"), "{}", stderr(&o));
+    for (n, b) in names.iter().zip(&before) {
+        assert!(
+            std::fs::read(out.join(n)).unwrap() == *b,
+            "{n} was replaced"
+        );
+    }
+    let mut left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        [
+            "calibration.json",
+            "curves.json",
+            "index.html",
+            "summary.json"
+        ]
+    );
+}
+
 #[test]
 fn em_study_requires_out() {
     assert_code(&aeromag(&["em", "study"]), 2);
