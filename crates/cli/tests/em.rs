@@ -1182,7 +1182,9 @@ fn simulate_refuses_scenarios_whose_files_detect_or_calibrate_refuse() {
         (
             "moments.toml",
             "moments_am2 = [0.0, 0, 0, 0, 0, 0, 0, 0, 0]",
-            &["field 'moments_am2' is singular"],
+            &[
+                "field 'moments_am2' is singular, expected three linearly independent dipole moments",
+            ],
         ),
         (
             "twice.toml",

@@ -405,6 +405,9 @@ impl SyncDetector {
     /// Detect one block of one channel (`samples.len() == N`) whose first
     /// sample has absolute index `start_index`; one value per frequency.
     ///
+    /// The samples are taken as they are: impulsive spikes are repaired by
+    /// [`Self::detect_interleaved`], which owns a copy of each block.
+    ///
     /// Errors if the block length differs from the window length.
     pub fn detect_block(&self, samples: &[f32], start_index: u64) -> Result<Vec<Complex64>> {
         if samples.len() != self.config.window_len {
