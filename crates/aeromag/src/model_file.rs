@@ -136,6 +136,16 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     })
 }
 
+/// Write several files as one set ([`aeromag_io::atomic::write_files`]):
+/// every target checked first, all written to temporaries, then renamed one
+/// right after another, so an error or an interruption leaves either all
+/// the old files or all the new ones. `em study` wrote its four files one
+/// by one, seconds apart: SIGTERM left an earlier study's files mixed with
+/// the new ones.
+pub fn write_files(files: &[(&Path, &[u8])]) -> Result<()> {
+    aeromag_io::atomic::write_files(files).map_err(|(path, e)| Error::write(path, e))
+}
+
 /// Write `path` by streaming into a buffered temporary file in the same
 /// folder (`.NAME.PID.tmp`), renamed when `write` has succeeded and the
 /// buffer is flushed; on any failure the temporary file is removed, so an

@@ -38,6 +38,49 @@ fn em_study_writes_its_summary_report_and_calibration() {
     assert!(out.join("calibration.json").is_file());
 }
 
+/// `em study` into the folder of an earlier study wrote its four files
+/// one by one, seconds apart (SIGTERM left old and new files mixed, and a
+/// folder in place of index.html failed after the three others were
+/// replaced): with the last file unwritable, none of the earlier files is
+/// replaced.
+#[test]
+fn em_study_replaces_an_earlier_study_whole_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("em");
+    let o = aeromag(&["em", "study", "--quick", "--seed", "2", "--out", s(&out)]);
+    assert_code(&o, 0);
+    let names = ["summary.json", "calibration.json", "curves.json"];
+    let before: Vec<Vec<u8>> = names
+        .iter()
+        .map(|n| std::fs::read(out.join(n)).unwrap())
+        .collect();
+    std::fs::remove_file(out.join("index.html")).unwrap();
+    std::fs::create_dir(out.join("index.html")).unwrap();
+    let o = aeromag(&["em", "study", "--quick", "--seed", "1", "--out", s(&out)]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("index.html"), "{}", stderr(&o));
+    for (n, b) in names.iter().zip(&before) {
+        assert!(
+            std::fs::read(out.join(n)).unwrap() == *b,
+            "{n} was replaced"
+        );
+    }
+    let mut left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        [
+            "calibration.json",
+            "curves.json",
+            "index.html",
+            "summary.json"
+        ]
+    );
+}
+
 #[test]
 fn em_study_requires_out() {
     assert_code(&aeromag(&["em", "study"]), 2);
@@ -1085,6 +1128,104 @@ fn a_record_without_signal_is_named_as_such() {
         ],
     );
     assert!(!out.exists());
+}
+
+/// One 1000 V sample (finding 07) was detected as signal (calibration 2×
+/// instead of 1700×, exit 0 without a word): it is repaired and counted in
+/// a warning naming the file, frame, epoch time and channel.
+#[test]
+fn an_impulsive_spike_is_repaired_and_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sim = simulate_short(d);
+    let mut bytes = std::fs::read(sim.join("em.raw")).unwrap();
+    let body = 12 + u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;
+    let at = body + 4 * (3 * 50_000 + 1);
+    bytes[at..at + 4].copy_from_slice(&1000f32.to_le_bytes());
+    let spiked = d.join("spike.raw");
+    std::fs::write(&spiked, bytes).unwrap();
+    let out = d.join("det.csv");
+    let o = aeromag(&["em", "detect", "--input", s(&spiked), "--out", s(&out)]);
+    assert_code(&o, 0);
+    let e = stderr(&o);
+    for f in [
+        "warning: ",
+        "spike.raw",
+        "1 impulsive spike(s) in 1 epoch(s) repaired",
+        "the first at frame 50000 (epoch at 0.559995 s), channel 1, 1000 V",
+    ] {
+        assert!(e.contains(f), "stderr lacks '{f}':\n{e}");
+    }
+    assert!(out.is_file());
+    let clean = d.join("clean.raw");
+    std::fs::copy(sim.join("em.raw"), &clean).unwrap();
+    let o = aeromag(&["em", "detect", "--input", s(&clean), "--out", s(&out)]);
+    assert_code(&o, 0);
+    assert!(!stderr(&o).contains("spike"), "{}", stderr(&o));
+}
+
+/// `em simulate` wrote records `em detect` refused (a coil gain or moments
+/// of 0, a frequency twice, a start time the frame index cannot hold) and
+/// KNOWN files `em calibrate` refused: exit 2 naming the scenario file,
+/// the field and the accepted range, and no folder written.
+#[test]
+fn simulate_refuses_scenarios_whose_files_detect_or_calibrate_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("sim");
+    for (name, toml, fragments) in [
+        (
+            "gain.toml",
+            "coil_gain_v_per_t_s = 0.0",
+            &["field 'coil_gain_v_per_t_s' is 0, expected 0.000001…10000000000 V/(T/s)"][..],
+        ),
+        (
+            "moments.toml",
+            "moments_am2 = [0.0, 0, 0, 0, 0, 0, 0, 0, 0]",
+            &[
+                "field 'moments_am2' is singular, expected three linearly independent dipole moments",
+            ],
+        ),
+        (
+            "twice.toml",
+            "frequencies_hz = [1025.0, 1025.0, 3125.0]",
+            &["field 'frequencies_hz' holds 1025 Hz twice"],
+        ),
+        (
+            "pilot.toml",
+            "pilot_offset_hz = 0.0",
+            &["field 'pilot_offset_hz' is 0, expected 0.001…100000 Hz"],
+        ),
+        (
+            "early.toml",
+            "start_time_s = -100.0",
+            &["field 'start_time_s' is -100 s, expected 0 … "],
+        ),
+        (
+            "late.toml",
+            "start_time_s = 1e15",
+            &["field 'start_time_s' is 1000000000000000 s, expected 0 …"],
+        ),
+        (
+            "far.toml",
+            "range_min_m = 15000.0\nrange_max_m = 20000.0",
+            &[
+                "known position at 0.079995 s",
+                "'range_max_m'",
+                "expected 1 … 10000 m",
+            ],
+        ),
+    ] {
+        let cfg = d.join(name);
+        std::fs::write(&cfg, format!("duration_s = 1.28\n{toml}\n")).unwrap();
+        let mut want = vec![name];
+        want.extend_from_slice(fragments);
+        bad(
+            &["em", "simulate", "--config", s(&cfg), "--out", s(&out)],
+            &want,
+        );
+        assert!(!out.exists(), "{name}");
+    }
 }
 
 /// `detect --system` with the frequencies swapped (or in kHz) was used

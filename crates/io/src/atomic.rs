@@ -6,6 +6,8 @@
 //! - [`write_atomically`] / [`write_file`]: write through a temporary
 //!   `.NAME.PID.N.tmp` beside the target, then rename (atomic on one file
 //!   system); on any error the temporary is removed.
+//! - [`write_files`]: several files as a set: all written to temporaries
+//!   first, then renamed one right after another.
 //! - The temporaries being written are registered; [`remove_temporaries`]
 //!   deletes them (the command-line program calls it on SIGINT/SIGTERM
 //!   before exiting with 130/143).
@@ -75,44 +77,117 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<Output>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let interrupted = || {
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            Err(std::io::Error::new(
-                std::io::ErrorKind::Interrupted,
-                "interrupted",
-            ))
-        } else {
-            Ok(())
-        }
-    };
-    interrupted()?;
+    not_interrupted()?;
     let path = match output_target(path)? {
         // A device, FIFO or socket is written as it is: a rename would
         // replace it by a regular file.
-        OutputTarget::Stream(p) => {
-            let f = std::fs::OpenOptions::new().write(true).open(p)?;
-            let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
-            write(&mut w)?;
-            return w.flush();
-        }
+        OutputTarget::Stream(p) => return write_stream(&p, write),
         OutputTarget::File(p) => p,
     };
     let path = path.as_path();
     let tmp = temporary(path);
-    let result = File::create(&tmp).and_then(|f| {
-        let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
-        write(&mut w)?;
-        w.flush()?;
-        let f = w.into_inner().map_err(|e| e.into_error())?.file;
-        f.sync_all()?;
-        drop(f);
-        interrupted()?;
+    let result = write_temporary(&tmp, write).and_then(|()| {
+        not_interrupted()?;
         std::fs::rename(&tmp, path)
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     unregister(&tmp);
+    result
+}
+
+/// An error once [`remove_temporaries`] has run: no file is completed
+/// after it.
+fn not_interrupted() -> std::io::Result<()> {
+    if INTERRUPTED.load(Ordering::SeqCst) {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "interrupted",
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// Write a device, FIFO or socket `p` directly through `write`.
+fn write_stream(
+    p: &Path,
+    write: impl FnOnce(&mut BufWriter<Output>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let f = std::fs::OpenOptions::new().write(true).open(p)?;
+    let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
+    write(&mut w)?;
+    w.flush()
+}
+
+/// Create the temporary `tmp`, fill it through `write`, flush and sync it.
+fn write_temporary(
+    tmp: &Path,
+    write: impl FnOnce(&mut BufWriter<Output>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let f = File::create(tmp)?;
+    let mut w = BufWriter::with_capacity(1 << 20, Output::new(f));
+    write(&mut w)?;
+    w.flush()?;
+    let f = w.into_inner().map_err(|e| e.into_error())?.file;
+    f.sync_all()
+}
+
+/// Writes several files as one set: every target is checked first
+/// ([`check_writable`]: not a folder, its folder takes a file), then each
+/// is written to a registered temporary beside it (flushed and synced),
+/// and only when all are complete are the temporaries renamed over their
+/// targets, one right after another (microseconds apart, where writing
+/// them one by one left seconds between the first and the last). An error
+/// or an interruption ([`remove_temporaries`]) before the renames removes
+/// every temporary and leaves every target as it was; only a failure of a
+/// rename itself leaves the earlier targets replaced. Devices, FIFOs and
+/// sockets (`/dev/null`) are written directly, before the renames.
+///
+/// Errors name the path that failed.
+pub fn write_files(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
+    let at = |p: &Path| {
+        let p = p.to_path_buf();
+        move |e| (p, e)
+    };
+    for &(path, _) in files {
+        check_writable(path).map_err(at(path))?;
+    }
+    let mut staged: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
+    let mut stage = || -> Result<(), (PathBuf, std::io::Error)> {
+        for &(path, bytes) in files {
+            not_interrupted().map_err(at(path))?;
+            match output_target(path).map_err(at(path))? {
+                OutputTarget::Stream(p) => {
+                    write_stream(&p, |w| w.write_all(bytes)).map_err(at(path))?;
+                }
+                OutputTarget::File(target) => {
+                    let tmp = temporary(&target);
+                    staged.push((tmp.clone(), target));
+                    write_temporary(&tmp, |w| w.write_all(bytes)).map_err(at(path))?;
+                }
+            }
+        }
+        not_interrupted().map_err(at(files.last().map_or(Path::new("."), |f| f.0)))
+    };
+    let mut result = stage();
+    let mut renamed = 0;
+    if result.is_ok() {
+        for (tmp, target) in &staged {
+            if let Err(e) = std::fs::rename(tmp, target) {
+                result = Err((target.clone(), e));
+                break;
+            }
+            renamed += 1;
+        }
+    }
+    for (tmp, _) in &staged[renamed..] {
+        let _ = std::fs::remove_file(tmp);
+    }
+    for (tmp, _) in &staged {
+        unregister(tmp);
+    }
     result
 }
 
@@ -324,6 +399,45 @@ mod tests {
         assert_eq!(e.to_string(), "disk full");
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "old");
         assert_eq!(entries(&d), ["out.csv"]);
+    }
+
+    /// A set of files is replaced whole or not at all: with a folder in
+    /// place of the last file, none of the earlier ones is replaced and
+    /// no temporary is left (`em study` into a folder of an earlier study
+    /// left old and new files mixed when interrupted).
+    #[test]
+    fn a_set_of_files_is_replaced_whole_or_not_at_all() {
+        let _serial = serial();
+        let d = dir("set");
+        let names = ["a.json", "b.json", "c.html"];
+        let paths: Vec<PathBuf> = names.iter().map(|n| d.join(n)).collect();
+        let set = |text: &'static str| -> Vec<(&Path, &[u8])> {
+            paths
+                .iter()
+                .map(|p| (p.as_path(), text.as_bytes()))
+                .collect()
+        };
+        write_files(&set("old")).unwrap();
+        std::fs::remove_file(&paths[2]).unwrap();
+        std::fs::create_dir(&paths[2]).unwrap();
+        let (at, e) = write_files(&set("new")).unwrap_err();
+        assert_eq!(at, paths[2]);
+        assert_eq!(e.kind(), std::io::ErrorKind::IsADirectory, "{e}");
+        for p in &paths[..2] {
+            assert_eq!(
+                std::fs::read_to_string(p).unwrap(),
+                "old",
+                "{}",
+                p.display()
+            );
+        }
+        assert_eq!(entries(&d), names);
+        std::fs::remove_dir(&paths[2]).unwrap();
+        write_files(&set("new")).unwrap();
+        for p in &paths {
+            assert_eq!(std::fs::read_to_string(p).unwrap(), "new");
+        }
+        assert_eq!(entries(&d), names);
     }
 
     #[test]

@@ -36,6 +36,32 @@ pub const MAX_ANGLE_DEG: f64 = 360.0;
 /// also made stage 2 singular).
 pub const KNOWN_RANGE_M: (f64, f64) = (1.0, 1e4);
 
+/// A known position `p` (m, transmitter frame) within [`KNOWN_RANGE_M`] of
+/// the transmitter, or the message saying how far it is. [`known_points`]
+/// applies it to the KNOWN rows it reads and `em simulate` to the positions
+/// it writes.
+pub fn check_known_position(p: [f64; 3]) -> std::result::Result<(), String> {
+    // Scaled by the largest component: 1e300 does not overflow.
+    let big = p.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let range = if big > 0.0 {
+        big * Vector3::new(p[0] / big, p[1] / big, p[2] / big).norm()
+    } else {
+        0.0
+    };
+    if (KNOWN_RANGE_M.0..=KNOWN_RANGE_M.1).contains(&range) {
+        return Ok(());
+    }
+    Err(format!(
+        "position {}, {}, {} m is {} m from the transmitter, expected {} … {} m (a towed bird; positions in metres)",
+        shown(p[0]),
+        shown(p[1]),
+        shown(p[2]),
+        shown(range),
+        KNOWN_RANGE_M.0,
+        KNOWN_RANGE_M.1
+    ))
+}
+
 /// The known points of a KNOWN.csv table (module docs) against the
 /// detected epochs' times: each row's time must fall within half an epoch
 /// spacing of a detected epoch.
@@ -134,30 +160,12 @@ pub fn known_points(t: &Flight, epochs: &[FieldEpoch]) -> Result<KnownPoints> {
                     ),
                 ));
             }
-            if g[0] == "x_m" {
-                // Scaled by the largest component: 1e300 does not overflow.
+            if g[0] == "x_m"
+                && let Err(m) = check_known_position([v[0], v[1], v[2]])
+            {
+                // Named at the largest component.
                 let j = (1..3).fold(0, |a, b| if v[b].abs() > v[a].abs() { b } else { a });
-                let big = v[j].abs();
-                let range = if big > 0.0 {
-                    big * Vector3::new(v[0] / big, v[1] / big, v[2] / big).norm()
-                } else {
-                    0.0
-                };
-                if !(KNOWN_RANGE_M.0..=KNOWN_RANGE_M.1).contains(&range) {
-                    return Err(t.bad_value(
-                        row,
-                        g[j],
-                        format!(
-                            "position {}, {}, {} m is {} m from the transmitter, expected {} … {} m (a towed bird; positions in metres)",
-                            shown(v[0]),
-                            shown(v[1]),
-                            shown(v[2]),
-                            shown(range),
-                            KNOWN_RANGE_M.0,
-                            KNOWN_RANGE_M.1
-                        ),
-                    ));
-                }
+                return Err(t.bad_value(row, g[j], m));
             }
             let kind = usize::from(g[0] != "x_m");
             if let Some(prev) = given_at[epoch][kind] {

@@ -5,7 +5,9 @@ use super::files::RawSource;
 use crate::error::{Error, InFile, Result};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_core::filter::Window;
-use aeromag_em::detection::{EmSystem, FieldEpoch, major_axis};
+use aeromag_em::detection::{
+    EmSystem, FieldEpoch, SPIKE_THRESHOLD, Spike, block_centre_time_s, major_axis,
+};
 use aeromag_em::study::{STUDY_WINDOW_LEN, rms};
 use std::path::Path;
 
@@ -47,7 +49,10 @@ pub struct Detection {
     pub window_len: usize,
     /// RMS polarisation ratio (minor/major axis) before calibration.
     pub polarization_ratio_rms: f64,
-    /// Warnings about the frequency plan.
+    /// Impulsive spikes repaired before detection (epoch order; frames are
+    /// absolute sample indices); counted in a warning.
+    pub spikes: Vec<Spike>,
+    /// Warnings about the frequency plan and repaired spikes.
     pub notes: Vec<Note>,
 }
 
@@ -59,7 +64,10 @@ pub struct Detection {
 /// and the coil transfer −iωg, leaving the complex field of each dipole in
 /// receiver axes. With a 4-term window every tone on the bin grid f_s/N at
 /// least 4 bins from a detector is rejected exactly; a plan off the grid is
-/// a warning.
+/// a warning. Samples far outside their block's robust spread (impulsive
+/// spikes: sferics, ADC glitches) are repaired by interpolation before
+/// detection and counted in a warning naming the file, frame, epoch time
+/// and channel ([`aeromag_em::detection::impulse`]).
 ///
 /// ```
 /// use aeromag::em::files::{load_table, read_system};
@@ -149,13 +157,32 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
     // chunk, the default 10.24 s record in four. Mapped: in one piece.
     let chunk = n * (1usize << 18).div_ceil(n);
     let mut epochs = Vec::new();
+    let mut spikes = Vec::new();
     source.for_each_chunk(path, chunk, |first, samples| {
-        let got = chain
-            .process(samples, first)
+        let (got, found) = chain
+            .process_with_spikes(samples, first)
             .map_err(|e| silent_channel(&file, first, n, samples, e))?;
         epochs.extend(got);
+        spikes.extend(found);
         Ok(())
     })?;
+    if let Some(s) = spikes.first() {
+        // Frames of the file (as in the non-finite sample's message); the
+        // epoch time is that of the detected CSV's `time_s`.
+        let block_of = |s: &Spike| (s.frame - header.start_index) / n as u64;
+        let mut blocks: Vec<u64> = spikes.iter().map(block_of).collect();
+        blocks.dedup();
+        let largest = spikes.iter().map(|s| s.statistic).fold(0.0, f64::max);
+        notes.warn(format!(
+            "'{file}': {} impulsive spike(s) in {} epoch(s) repaired by interpolation before detection (samples more than {SPIKE_THRESHOLD} robust spreads from their block's centre; largest {largest:.1}): the first at frame {} (epoch at {} s), channel {}, {} V",
+            spikes.len(),
+            blocks.len(),
+            s.frame - header.start_index,
+            block_centre_time_s(header.start_index + block_of(s) * n as u64, n, fs),
+            s.channel,
+            s.value
+        ));
+    }
     let ratios: Vec<f64> = epochs
         .iter()
         .flat_map(|e| e.h.iter().map(|h| major_axis(h).ratio))
@@ -165,6 +192,7 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         sample_rate_hz: fs,
         window_len: n,
         polarization_ratio_rms: rms(&ratios),
+        spikes,
         notes: notes.into_notes(),
     })
 }

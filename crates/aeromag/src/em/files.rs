@@ -10,7 +10,7 @@ use crate::flight::Flight;
 use aeromag_core::error::shown;
 use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::detection::{EmSystem, FieldEpoch};
-use aeromag_em::sim::{RawReader, field_epoch_from_values, value_columns};
+use aeromag_em::sim::{RawHeader, RawReader, field_epoch_from_values, value_columns};
 use aeromag_io::{ReadOptions, read_table};
 use std::fs::File;
 use std::io::BufReader;
@@ -123,45 +123,45 @@ pub fn open_raw(path: &Path) -> Result<RawReader<BufReader<File>>> {
 fn raw_reader<R: std::io::Read>(path: &Path, source: R) -> Result<RawReader<R>> {
     let file = path.display().to_string();
     let r = RawReader::new(source).map_err(|e| Error::bad_file(&file, e.to_string()))?;
-    let h = r.header();
+    check_raw_header(r.header()).map_err(|m| Error::bad_file(&file, m))?;
+    Ok(r)
+}
+
+/// The checks every raw header passes, as a message naming the header
+/// field: 3 channels, sample rate within [`RAW_SAMPLE_RATE_RANGE_HZ`],
+/// frame indices up to [`MAX_FRAME_INDEX`], a valid system
+/// ([`EmSystem::validate`]). [`open_raw`] applies them to the records it
+/// reads and `em simulate` to the header it is about to write, so that it
+/// never writes a record `em detect` refuses.
+pub fn check_raw_header(h: &RawHeader) -> std::result::Result<(), String> {
     if h.channels != 3 {
-        return Err(Error::bad_file(
-            &file,
-            format!(
-                "header field 'channels' is {}, the EM receiver has 3",
-                h.channels
-            ),
+        return Err(format!(
+            "header field 'channels' is {}, the EM receiver has 3",
+            h.channels
         ));
     }
     let (lo, hi) = RAW_SAMPLE_RATE_RANGE_HZ;
     if !(lo..=hi).contains(&h.sample_rate_hz) {
-        return Err(Error::bad_file(
-            &file,
-            format!(
-                "header field 'sample_rate_hz' is {}, expected {}…{} Hz",
-                shown(h.sample_rate_hz),
-                shown(lo),
-                shown(hi)
-            ),
+        return Err(format!(
+            "header field 'sample_rate_hz' is {}, expected {}…{} Hz",
+            shown(h.sample_rate_hz),
+            shown(lo),
+            shown(hi)
         ));
     }
     if h.start_index
         .checked_add(h.frames)
         .is_none_or(|end| end > MAX_FRAME_INDEX)
     {
-        return Err(Error::bad_file(
-            &file,
-            format!(
-                "header fields 'start_index' {} + 'frames' {} exceed 2^53 = {MAX_FRAME_INDEX} \
-                 (frame indices beyond it have no exact time)",
-                h.start_index, h.frames
-            ),
+        return Err(format!(
+            "header fields 'start_index' {} + 'frames' {} exceed 2^53 = {MAX_FRAME_INDEX} \
+             (frame indices beyond it have no exact time)",
+            h.start_index, h.frames
         ));
     }
     h.system
         .validate()
-        .map_err(|e| Error::bad_file(&file, format!("header field 'system': {e}")))?;
-    Ok(r)
+        .map_err(|e| format!("header field 'system': {e}"))
 }
 
 /// Read the next chunk of at most `frames` frames into `out`; every sample

@@ -2,10 +2,14 @@
 //! instrument constants, the calibration information a crew would have, and
 //! the truth.
 
+use super::calibrate::check_known_position;
+use super::files::{MAX_FRAME_INDEX, check_raw_header};
 use crate::error::{Error, Result};
 use crate::model_file::{write_atomically, write_streamed};
 use aeromag_em::detection::block_centre_time_s;
-use aeromag_em::sim::{EmScenario, EmSimConfig, known_csv, synthesize, truth_csv, write_raw};
+use aeromag_em::sim::{
+    EmScenario, EmSimConfig, RawHeader, known_csv, synthesize, truth_csv, write_raw,
+};
 use aeromag_em::study::STUDY_WINDOW_LEN;
 use std::path::{Path, PathBuf};
 
@@ -95,6 +99,47 @@ pub fn simulate_to_dir(
             aeromag_core::error::shown(frames)
         )));
     }
+    // What `em detect` and `em calibrate` check on the files is checked
+    // here with their own checks, before anything is built or written: a
+    // coil gain or moments of 0, or a frequency given twice, were written
+    // to a record that `em detect` then refused (exit 0, then 2).
+    let max_start_s = (MAX_FRAME_INDEX as f64 - frames) / fs;
+    if !(0.0..=max_start_s).contains(&cfg.start_time_s) {
+        return Err(Error::bad_input(format!(
+            "field 'start_time_s' is {} s, expected 0 … {} s (the record's frame indices start_time_s × sample_rate_hz … + frames must lie within 0 … 2^53)",
+            aeromag_core::error::shown(cfg.start_time_s),
+            aeromag_core::error::shown(max_start_s.max(0.0))
+        )));
+    }
+    let header = RawHeader::new(
+        fs,
+        3,
+        frames as u64,
+        (cfg.start_time_s * fs).round() as u64,
+        sc.system(),
+    );
+    check_raw_header(&header)
+        .map_err(|m| Error::bad_input(format!("em detect would refuse the record: {m}")))?;
+    let start = header.start_index;
+    let blocks = header.frames as usize / STUDY_WINDOW_LEN;
+    let times: Vec<f64> = (0..blocks)
+        .map(|b| block_centre_time_s(start + (b * STUDY_WINDOW_LEN) as u64, STUDY_WINDOW_LEN, fs))
+        .collect();
+    if known_positions < 2 || known_positions > times.len() {
+        return Err(Error::bad_input(format!(
+            "{known_positions} known positions: need 2 ..= {} (the record has {} epochs of {STUDY_WINDOW_LEN} samples)",
+            times.len().max(2),
+            times.len()
+        )));
+    }
+    for &t in &times[..known_positions] {
+        let p = sc.pose_at(t).position_m;
+        check_known_position([p.x, p.y, p.z]).map_err(|m| {
+            Error::bad_input(format!(
+                "em calibrate would refuse the known position at {t} s (fields 'range_min_m', 'range_max_m', 'mean_direction', 'swing_amplitude_m'): {m}"
+            ))
+        })?;
+    }
     let rec = synthesize(&sc)?;
     // The simulator models nothing as missing: NaN or ∞ is an overflow of
     // the scenario's values (a rotation rate of −10³⁰⁸ °/s).
@@ -106,18 +151,7 @@ pub fn simulate_to_dir(
             k / 3 + 1
         )));
     }
-    let start = rec.header.start_index;
-    let blocks = rec.header.frames as usize / STUDY_WINDOW_LEN;
-    let times: Vec<f64> = (0..blocks)
-        .map(|b| block_centre_time_s(start + (b * STUDY_WINDOW_LEN) as u64, STUDY_WINDOW_LEN, fs))
-        .collect();
-    if known_positions < 2 || known_positions > times.len() {
-        return Err(Error::bad_input(format!(
-            "{known_positions} known positions: need 2 ..= {} (the record has {} epochs of {STUDY_WINDOW_LEN} samples)",
-            times.len().max(2),
-            times.len()
-        )));
-    }
+    debug_assert_eq!(rec.header, header);
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     let path = |n: &str| out.join(n);
     let files = SimulatedEm {
@@ -145,4 +179,80 @@ pub fn simulate_to_dir(
     })?;
     write_atomically(&files.scenario, scenario.as_bytes())?;
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Scenarios whose record `em detect` (or whose KNOWN file `em
+    /// calibrate`) refuses were simulated and written (exit 0): they are
+    /// bad input naming the field, and nothing is written.
+    #[test]
+    fn scenarios_detect_or_calibrate_would_refuse_are_bad_input() {
+        let dir =
+            std::env::temp_dir().join(format!("aeromag-em-sim-refuse-{}", std::process::id()));
+        let base = EmSimConfig {
+            duration_s: 0.32,
+            ..command_default()
+        };
+        let cases: [(EmSimConfig, &str); 7] = [
+            (
+                EmSimConfig {
+                    coil_gain_v_per_t_s: 0.0,
+                    ..base.clone()
+                },
+                "'coil_gain_v_per_t_s' is 0, expected",
+            ),
+            (
+                EmSimConfig {
+                    moments_am2: nalgebra::Matrix3::zeros(),
+                    ..base.clone()
+                },
+                "'moments_am2' is singular",
+            ),
+            (
+                EmSimConfig {
+                    frequencies_hz: [1025.0, 1025.0, 3125.0],
+                    ..base.clone()
+                },
+                "'frequencies_hz' holds 1025 Hz twice",
+            ),
+            (
+                EmSimConfig {
+                    pilot_offset_hz: 0.0,
+                    ..base.clone()
+                },
+                "'pilot_offset_hz' is 0, expected",
+            ),
+            (
+                EmSimConfig {
+                    start_time_s: -100.0,
+                    ..base.clone()
+                },
+                "'start_time_s' is -100 s, expected 0 …",
+            ),
+            (
+                EmSimConfig {
+                    start_time_s: 1e15,
+                    ..base.clone()
+                },
+                "'start_time_s' is 1000000000000000 s, expected 0 …",
+            ),
+            (
+                EmSimConfig {
+                    range_min_m: 15_000.0,
+                    range_max_m: 20_000.0,
+                    ..base.clone()
+                },
+                "expected 1 … 10000 m",
+            ),
+        ];
+        for (cfg, want) in cases {
+            let e = simulate_to_dir(&cfg, 2, &dir).unwrap_err();
+            assert!(e.is_bad_input(), "{e}");
+            assert!(e.to_string().contains(want), "{e}");
+            assert!(!dir.exists(), "{want}: wrote {}", dir.display());
+        }
+    }
 }

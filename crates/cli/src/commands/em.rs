@@ -91,8 +91,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
 }
 
+/// The files `em study` writes into its folder, as a set.
+const STUDY_FILES: [&str; 4] = [
+    "summary.json",
+    "calibration.json",
+    "curves.json",
+    "index.html",
+];
+
 fn study(a: StudyArgs) -> anyhow::Result<()> {
     crate::output::check_folder(&a.out)?;
+    let paths = STUDY_FILES.map(|n| a.out.join(n));
+    crate::output::check_files(paths.iter().map(|p| p.as_path()), &[])?;
     let mut run = EmStudy::default();
     run.config.seed = a.seed;
     let out = run.run(StudySize::quick_if(a.quick), &mut Bars::new())?;
@@ -110,17 +120,21 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
         s.polarization_ratio_before / s.polarization_ratio_after,
         s.ratio_without_pilot
     );
-    std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
-    let write = |name: &str, text: String| {
-        aeromag::io::atomic::write_file(&a.out.join(name), text)
-            .map_err(|e| aeromag::Error::write(a.out.join(name), e))
-    };
-    write(
-        "summary.json",
-        serde_json::to_string_pretty(&json!({ "em": out.summary() }))?,
-    )?;
-    write("calibration.json", s.calibration.to_json()?)?;
-    write("curves.json", serde_json::to_string_pretty(c)?)?;
+    // Everything computed first, then the four files written as a set: an
+    // interruption leaves an earlier study's files or the new ones.
+    let summary = serde_json::to_string_pretty(&json!({ "em": out.summary() }))?;
+    let calibration = s.calibration.to_json()?;
+    let curves = serde_json::to_string_pretty(c)?;
+    let mut r = Report::new("aeromag — EM relative positioning study");
+    out.section()?.append_to(&mut r);
+    let html = r.to_html();
+    let texts = [summary, calibration, curves, html];
+    let files: Vec<(&std::path::Path, &[u8])> = paths
+        .iter()
+        .zip(&texts)
+        .map(|(p, t)| (p.as_path(), t.as_bytes()))
+        .collect();
+    aeromag::model_file::write_files(&files)?;
     for p in c.versus_range.iter().chain(&c.versus_noise) {
         println!(
             "range {:>5.1} m, coil noise ×{:<6} SNR {:>5.1} dB: range {:.2e}, direction {:.4} deg, attitude {:.4} deg",
@@ -132,10 +146,6 @@ fn study(a: StudyArgs) -> anyhow::Result<()> {
             p.attitude_err_deg
         );
     }
-    let mut r = Report::new("aeromag — EM relative positioning study");
-    out.section()?.append_to(&mut r);
-    let path = a.out.join("index.html");
-    r.write_html(&path)?;
-    println!("report written to {}", path.display());
+    println!("report written to {}", paths[3].display());
     Ok(())
 }

@@ -13,7 +13,7 @@
 //! with `χ_i` the bench-measured cross-coupling, `g` the coil gain (V per
 //! T/s) and `P` the pilot field in bird axes (T).
 
-use super::{Complex64, PilotCorrection, SyncDetector};
+use super::{Complex64, PilotCorrection, Spike, SyncDetector};
 use crate::{EmError, Result};
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::TAU;
@@ -99,8 +99,24 @@ impl FieldChain {
     ///
     /// Errors from detection or from a vanishing pilot.
     pub fn process(&self, data: &[f32], start_index: u64) -> Result<Vec<FieldEpoch>> {
+        Ok(self.process_with_spikes(data, start_index)?.0)
+    }
+
+    /// [`Self::process`], with the impulsive spikes repaired before
+    /// detection ([`super::impulse`]) in time order.
+    ///
+    /// Errors from detection or from a vanishing pilot.
+    pub fn process_with_spikes(
+        &self,
+        data: &[f32],
+        start_index: u64,
+    ) -> Result<(Vec<FieldEpoch>, Vec<Spike>)> {
         let epochs = self.detector.detect_interleaved(data, 3, start_index)?;
-        epochs
+        let spikes = epochs
+            .iter()
+            .flat_map(|e| e.spikes.iter().copied())
+            .collect();
+        let fields = epochs
             .iter()
             .map(|e| {
                 let v = |k: usize| [e.values[k * 3], e.values[k * 3 + 1], e.values[k * 3 + 2]];
@@ -121,6 +137,7 @@ impl FieldChain {
                     xi,
                 })
             })
-            .collect()
+            .collect::<Result<_>>()?;
+        Ok((fields, spikes))
     }
 }

@@ -1,6 +1,8 @@
 //! Signal chain from induction-coil voltages to real field vectors (seed
 //! `001_…` part II, eqs. 2–4; spec `em-positioning.md`, "Signal chain").
 //!
+//! 0. [`impulse`]: impulsive samples far outside a block's robust spread
+//!    are repaired (and reported) before detection.
 //! 1. [`synchronous`]: FIR-weighted synchronous detection (eq. 2) of every
 //!    channel at every working and pilot frequency, with the detector's
 //!    frequency response (the seed's fig. 1).
@@ -22,12 +24,14 @@
 //! cross-talk exactly (both the `ω − ω'` and the image `ω + ω'` terms).
 
 pub mod chain;
+pub mod impulse;
 pub mod pilot;
 pub mod polarisation;
 pub mod synchronous;
 pub mod system;
 
 pub use chain::{FieldChain, FieldEpoch};
+pub use impulse::{SPIKE_THRESHOLD, Spike};
 pub use pilot::PilotCorrection;
 pub use polarisation::{PolarisationEllipse, major_axis};
 pub use synchronous::{DetectorConfig, Epoch, SyncDetector, block_centre_time_s};

@@ -30,6 +30,7 @@
 //! the block start. Three channels share each kernel load.
 
 use super::Complex64;
+use super::impulse::{self, Spike};
 use crate::{EmError, Result};
 use aeromag_core::filter::{Symmetry, Window};
 use std::f64::consts::TAU;
@@ -91,6 +92,9 @@ pub struct Epoch {
     pub centre_time_s: f64,
     /// `values[k * channels + c]`: frequency `k`, channel `c`, in input units.
     pub values: Vec<Complex64>,
+    /// Impulsive spikes repaired before detection ([`impulse`]), channel
+    /// by channel, each in frame order.
+    pub spikes: Vec<Spike>,
 }
 
 /// FIR-weighted synchronous detector with precomputed kernels.
@@ -101,6 +105,8 @@ pub struct SyncDetector {
     kernels_re: Vec<Vec<f32>>,
     kernels_im: Vec<Vec<f32>>,
     avx2: bool,
+    /// Sub-block length of the impulse test ([`impulse::sub_block_len`]).
+    spike_sub_len: usize,
 }
 
 const LANES: usize = 32;
@@ -307,12 +313,19 @@ impl SyncDetector {
         let avx2 = std::arch::is_x86_feature_detected!("avx2");
         #[cfg(not(target_arch = "x86_64"))]
         let avx2 = false;
+        let lowest = config
+            .frequencies_hz
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let spike_sub_len = impulse::sub_block_len(len, fs, lowest);
         Ok(Self {
             config,
             weights,
             kernels_re,
             kernels_im,
             avx2,
+            spike_sub_len,
         })
     }
 
@@ -392,6 +405,9 @@ impl SyncDetector {
     /// Detect one block of one channel (`samples.len() == N`) whose first
     /// sample has absolute index `start_index`; one value per frequency.
     ///
+    /// The samples are taken as they are: impulsive spikes are repaired by
+    /// [`Self::detect_interleaved`], which owns a copy of each block.
+    ///
     /// Errors if the block length differs from the window length.
     pub fn detect_block(&self, samples: &[f32], start_index: u64) -> Result<Vec<Complex64>> {
         if samples.len() != self.config.window_len {
@@ -418,7 +434,9 @@ impl SyncDetector {
 
     /// Detect every complete block of channel-interleaved samples
     /// (`data[i * channels + c]`), the first sample having absolute index
-    /// `start_index`. A trailing partial block is ignored.
+    /// `start_index`. A trailing partial block is ignored. Impulsive
+    /// samples of each channel are repaired first and reported in the
+    /// epoch ([`impulse`]).
     ///
     /// The blocks are independent: they are shared out over the available
     /// cores in contiguous runs, and the epochs come back in order, each
@@ -469,6 +487,11 @@ impl SyncDetector {
                     buf[c][i] = v;
                 }
             }
+            let first = start_index + (b * n) as u64;
+            let mut spikes = Vec::new();
+            for (c, ch) in buf.iter_mut().enumerate() {
+                impulse::repair(ch, self.spike_sub_len, first, c, &mut spikes);
+            }
             sums.iter_mut().for_each(|s| *s = (0.0, 0.0));
             // Tile over samples so that one tile of every kernel and channel
             // stays in L1 while all frequency × channel products are formed.
@@ -494,7 +517,6 @@ impl SyncDetector {
                     }
                 }
             }
-            let first = start_index + (b * n) as u64;
             let mut values = Vec::with_capacity(nf * channels);
             for (k, &f) in self.config.frequencies_hz.iter().enumerate() {
                 let rot = block_phase(f, fs, first);
@@ -509,6 +531,7 @@ impl SyncDetector {
                 start_index: first,
                 centre_time_s: centre,
                 values,
+                spikes,
             });
         }
         Ok(out)

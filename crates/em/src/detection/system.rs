@@ -128,7 +128,9 @@ impl EmSystem {
         let largest = self.moments_am2.amax();
         let m = self.moments_am2 / largest;
         if largest == 0.0 || m.determinant().abs() < 1e-12 * m.norm().powi(3) {
-            return bad("field 'moments_am2' is singular");
+            return bad(
+                "field 'moments_am2' is singular, expected three linearly independent dipole moments (|det| ≥ 1e-12 ‖M‖³, scaled by the largest entry)",
+            );
         }
         if self.chi.iter().any(|m| m.try_inverse().is_none()) {
             return bad("field 'chi' holds a singular matrix");
