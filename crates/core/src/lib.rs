@@ -23,6 +23,7 @@
 //! | [`spectrum`] | Welch power spectral density |
 //! | [`random`] | seeded random streams (ChaCha8, one stream per purpose) |
 //! | [`time`] | calendar dates and decimal years |
+//! | [`median`] | the median of a sample (one definition for every crate) |
 //! | [`quadrature`] | composite Simpson's rule (reference integrals in tests) |
 //! | [`simd`] | kernels compiled with and without AVX, chosen at run time |
 //! | [`output_target`] | where an output goes: a regular file (written atomically) or a device, FIFO or socket |
@@ -33,6 +34,7 @@ pub mod estimability;
 pub mod field;
 pub mod filter;
 pub mod frames;
+pub mod median;
 pub mod output_target;
 pub mod parallel;
 pub mod quadrature;

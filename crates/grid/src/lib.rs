@@ -23,27 +23,10 @@ pub mod projection;
 
 pub use error::{GridError, Result};
 
-/// Median of a non-empty slice (reordered in place); mean of the two
-/// middle values for an even count. Serves the UTM zone of a survey's
-/// points and bi-directional gridding's sample spacing.
+/// Median of a non-empty slice (reordered in place): the UTM zone of a
+/// survey's points and bi-directional gridding's sample spacing
+/// ([`aeromag_core::median::median_in_place`]; an empty slice gives NaN).
 pub(crate) fn median(v: &mut [f64]) -> f64 {
-    let (m, even) = (v.len() / 2, v.len().is_multiple_of(2));
-    let (below, &mut hi, _) = v.select_nth_unstable_by(m, f64::total_cmp);
-    if even {
-        let lo = below.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        0.5 * (lo + hi)
-    } else {
-        hi
-    }
+    aeromag_core::median::median_in_place(v).unwrap_or(f64::NAN)
 }
 pub use grid::{Grid, GridGeometry, GridStats};
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        assert_eq!(super::median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(super::median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert_eq!(super::median(&mut [7.0]), 7.0);
-    }
-}

@@ -916,19 +916,7 @@ pub fn sampled_median(n: usize, value: impl Fn(usize) -> f64) -> Option<f64> {
     median_in_place(&mut v)
 }
 
-/// Median of a vector of finite values (reorders it); mean of the two middle values for even lengths.
-pub fn median_in_place(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    let n = v.len();
-    let (_, &mut hi, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
-    if n % 2 == 1 {
-        return Some(hi);
-    }
-    let lo = v[..n / 2].iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    Some(0.5 * (lo + hi))
-}
+pub use aeromag_core::median::median_in_place;
 
 #[cfg(test)]
 mod tests {
@@ -1078,10 +1066,7 @@ mod tests {
     }
 
     #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median_in_place(&mut [3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median_in_place(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.5));
-        assert_eq!(median_in_place(&mut []), None);
+    fn sampled_median_skips_what_is_not_finite() {
         assert_eq!(
             sampled_median(3, |i| [f64::NAN, 5.0, f64::INFINITY][i]),
             Some(5.0)

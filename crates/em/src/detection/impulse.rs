@@ -16,11 +16,12 @@
 //! full swing of every tone); sub-block `j` has extremes `max_j`, `min_j`:
 //!
 //! ```text
-//! c = median_j (max_j + min_j)/2        robust centre, V
-//! s = median_j (max_j − min_j)/2        robust spread (half the typical peak-to-peak), V
+//! c = umed_j (max_j + min_j)/2          robust centre, V
+//! s = umed_j (max_j − min_j)/2          robust spread (half the typical peak-to-peak), V
 //! z[n] = |u[n] − c| / s                 impulse statistic
 //! ```
 //!
+//! (`umed`: the upper median, [`aeromag_core::median::upper_median_in_place`]),
 //! and a sample with `z > Z` ([`SPIKE_THRESHOLD`] = 6) is impulsive. A
 //! spike changes one sub-block's extremes, not the medians (at least three
 //! sub-blocks are required; shorter blocks are not tested). Measured on
@@ -49,6 +50,8 @@
 //! ≈ 0 (6·10⁻⁵ for Blackman–Harris). Longer runs are repaired alike, with an error growing as
 //! the square of their length; every repaired run is reported
 //! ([`Spike`]).
+
+use aeromag_core::median::upper_median_in_place;
 
 /// The impulse statistic above which a sample is repaired (see the module
 /// documentation for the measurements that set it).
@@ -88,12 +91,6 @@ pub fn sub_block_len(window_len: usize, sample_rate_hz: f64, lowest_hz: f64) -> 
     window_len.div_ceil(SUB_BLOCKS).max(period)
 }
 
-/// Upper median of `v` (reordered).
-fn upper_median(v: &mut [f64]) -> f64 {
-    let m = v.len() / 2;
-    *v.select_nth_unstable_by(m, f64::total_cmp).1
-}
-
 /// Robust centre `c` and spread `s` of `u` over sub-blocks of `sub_len`
 /// samples, `None` with fewer than three sub-blocks or no spread.
 fn centre_and_spread(u: &[f32], sub_len: usize) -> Option<(f64, f64)> {
@@ -108,8 +105,12 @@ fn centre_and_spread(u: &[f32], sub_len: usize) -> Option<(f64, f64)> {
             (0.5 * (hi + lo), 0.5 * (hi - lo))
         })
         .unzip();
-    let s = upper_median(&mut halves);
-    (s > 0.0).then(|| (upper_median(&mut mids), s))
+    // Three or more sub-blocks: neither median is empty.
+    let s = upper_median_in_place(&mut halves)?;
+    (s > 0.0)
+        .then(|| upper_median_in_place(&mut mids))
+        .flatten()
+        .map(|c| (c, s))
 }
 
 /// `(min, max)` of a non-empty slice (a loop without branches, which
