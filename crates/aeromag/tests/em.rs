@@ -80,7 +80,17 @@ fn the_file_chain_locates_the_bird_within_the_issue_figures() {
     );
     assert_eq!(err_range.len(), files.epochs - 8);
     assert!(r <= 1e-3 && a <= 0.1, "range {r}, direction {a}°");
-    // The opposite prior mirrors every position.
+    // The opposite prior mirrors every position, and calibrating with it
+    // is refused: the known positions lie on the other side.
+    let opposite: HalfSpace = "1,0,-1".parse().unwrap();
+    let e = calibrate(&det.epochs, &known, &system, &opposite).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    assert!(
+        e.to_string()
+            .contains("half-space opposite to --half-space=1,0,-1")
+            && e.to_string().contains("mean direction is -0.8"),
+        "{e}"
+    );
     let flipped = locate(
         &det.epochs,
         &cal.file,

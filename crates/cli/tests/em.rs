@@ -1083,6 +1083,15 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
             "1e300 T",
         ],
     );
+    // Known positions on the other side of --half-space: `em locate` would
+    // mirror the bird (84 m off with exit 0 for birds ahead of the
+    // transmitter and the default half-space).
+    let mut opposite = calibrate_args(&det, &known, &system, &out).to_vec();
+    opposite.push("--half-space=1,0,-1");
+    bad(
+        &opposite,
+        &["half-space opposite to --half-space=1,0,-1", "would mirror"],
+    );
     assert!(!out.exists());
 }
 

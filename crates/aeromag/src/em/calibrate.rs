@@ -234,6 +234,47 @@ pub struct EmCalibration {
     pub attitude_correction_deg: f64,
 }
 
+/// The known positions against the prior half-space: a known position
+/// whose direction `e` lies on the other side beyond the continuity margin
+/// (`e·n/|n| < −margin`, [`Hemisphere`]) is bad input, as `em locate` with
+/// this half-space would mirror every such bird to `−r`. A scenario's birds
+/// ahead of the transmitter (mean direction `1,0,0`) with the default
+/// `-1,0,1` were calibrated without a word and then located 84 m off.
+fn check_known_side(
+    epochs: &[FieldEpoch],
+    known: &KnownPoints,
+    hemisphere: &Hemisphere,
+    half_space: &HalfSpace,
+) -> Result<()> {
+    let n = hemisphere.normal.normalize();
+    let side = |r: &Vector3<f64>| r.normalize().dot(&n);
+    let Some(&(k, r)) = known
+        .positions
+        .iter()
+        .find(|(_, r)| side(r) < -hemisphere.margin)
+    else {
+        return Ok(());
+    };
+    let mean: Vector3<f64> = known.positions.iter().map(|(_, r)| r.normalize()).sum();
+    let hint = if mean.norm() > 0.0 {
+        let e = mean.normalize();
+        format!(
+            "; the known positions' mean direction is {:.2},{:.2},{:.2}: pass the bird's half-space as --half-space=NX,NY,NZ to both `em calibrate` and `em locate`",
+            e.x, e.y, e.z
+        )
+    } else {
+        String::new()
+    };
+    Err(Error::bad_input(format!(
+        "the known position at {} s ({}, {}, {} m from the transmitter) lies in the half-space opposite to --half-space={half_space} (its direction makes e·n = {:.2}): `em locate` would mirror the bird to −r{hint}",
+        shown(epochs.get(k).map_or(f64::NAN, |e| e.time_s)),
+        shown(r.x),
+        shown(r.y),
+        shown(r.z),
+        side(&r),
+    )))
+}
+
 /// Fit the three stages: (1) polarisation, from all epochs (no external
 /// data; ≥ 8 epochs at varied attitudes); (2) transmitter geometry, from the
 /// epochs whose position `known` gives (≥ 2); (3) attitude, from the
@@ -256,9 +297,11 @@ pub fn calibrate(
             epochs.len()
         )));
     }
+    let hemisphere = Hemisphere::new(half_space.normal());
+    check_known_side(epochs, known, &hemisphere, half_space)?;
     let data: Vec<_> = epochs.iter().map(|e| e.h).collect();
     let m = system.moments_am2;
-    let cal = Calibration::fit(&data, known, &m, &Hemisphere::new(half_space.normal()))?;
+    let cal = Calibration::fit(&data, known, &m, &hemisphere)?;
     if let Some(what) = cal.implausible() {
         return Err(Error::bad_input(format!(
             "the calibration corrects small mounting and transmitter errors, but {what}"

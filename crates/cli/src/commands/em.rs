@@ -70,7 +70,8 @@ struct StudyArgs {
 pub struct HalfSpaceArg {
     /// Prior half-space normal NX,NY,NZ (transmitter frame) for the ±r
     /// choice: the bird is where r·n > 0 (default: behind and below, x
-    /// forward, z down).
+    /// forward, z down). Give the same to `em calibrate` and `em locate`;
+    /// `em calibrate` refuses known positions on the other side.
     #[arg(
         long = "half-space",
         value_name = "NX,NY,NZ",
