@@ -45,6 +45,8 @@ fn the_file_chain_locates_the_bird_within_the_issue_figures() {
     assert!(cal.polarization_ratio_before >= 100.0 * cal.polarization_ratio_after);
     let poses = locate(&det.epochs, &cal.file, &half, &mut Silent).unwrap();
     assert_eq!(poses.failed(), 0);
+    assert!(poses.notes.is_empty(), "{:?}", poses.notes);
+    assert_eq!(cal.file.half_space, Some([-1.0, 0.0, 1.0]));
     // Score against the truth file, on the epochs the calibration was not given.
     let truth = load_table(&files.truth).unwrap();
     let c = |n: &str| truth.require(n).unwrap();
@@ -98,6 +100,15 @@ fn the_file_chain_locates_the_bird_within_the_issue_figures() {
         &mut Silent,
     )
     .unwrap();
+    // … and is warned of: the calibration was fitted with the other.
+    assert!(
+        flipped
+            .notes
+            .iter()
+            .any(|n| n.to_string().contains("fitted with --half-space=-1,0,1")),
+        "{:?}",
+        flipped.notes
+    );
     for (a, b) in poses.poses.iter().zip(&flipped.poses) {
         let (a, b) = (a.located.unwrap(), b.located.unwrap());
         for k in 0..3 {

@@ -323,7 +323,8 @@ pub fn calibrate(
             known_positions: known.positions.len(),
             known_attitudes: known.attitudes.len(),
         },
-    );
+    )
+    .with_half_space(half_space.normal().into());
     Ok(EmCalibration {
         polarization_ratio_before: rms(&before),
         polarization_ratio_after: rms(&after),

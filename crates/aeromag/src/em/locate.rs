@@ -7,6 +7,7 @@ use aeromag_em::EmError;
 use aeromag_em::calibration::CalibrationFile;
 use aeromag_em::detection::FieldEpoch;
 use aeromag_em::positioning::Hemisphere;
+use nalgebra::Vector3;
 use std::fmt::Write;
 
 /// The pose of one epoch (`None` fields when it could not be located).
@@ -138,6 +139,18 @@ pub fn locate(
     observer: &mut dyn Observer,
 ) -> Result<Poses> {
     let mut notes = Notes::new(observer);
+    if let Some(fitted) = file.half_space.map(Vector3::from)
+        && let Ok(fitted) = HalfSpace::new(fitted)
+        && fitted
+            .normal()
+            .normalize()
+            .dot(&half_space.normal().normalize())
+            < 1.0 - 1e-9
+    {
+        notes.warn(format!(
+            "the calibration was fitted with --half-space={fitted} (its known positions on that side) and the bird is located with --half-space={half_space}: a bird on the calibration's side but not on this one comes out mirrored to −r; give both commands the same half-space"
+        ));
+    }
     let mut hemi = Hemisphere::new(half_space.normal());
     let mut poses = Vec::with_capacity(epochs.len());
     let mut failed = 0usize;

@@ -6,8 +6,12 @@
 //! { "format": "aeromag-em-calibration", "version": 1,
 //!   "moments_am2": [9 numbers, column-major],
 //!   "calibration": { "polarisation": {...}, "transmitter_s": [...], "attitude_q": [...] },
-//!   "fit": { "epochs": 120, "known_positions": 8, "known_attitudes": 1 } }
+//!   "fit": { "epochs": 120, "known_positions": 8, "known_attitudes": 1 },
+//!   "half_space": [-1.0, 0.0, 1.0] }
 //! ```
+//!
+//! (`half_space`, the prior half-space the stages were fitted with, is
+//! absent from files written before it was kept.)
 //!
 //! The stages are applied in the order they were fitted
 //! ([`Calibration::locate`]).
@@ -58,6 +62,12 @@ pub struct CalibrationFile {
     pub calibration: Calibration,
     /// Fit sizes (informational).
     pub fit: FitCounts,
+    /// The prior half-space normal (transmitter frame) the calibration was
+    /// fitted with, its known positions on that side (`em calibrate
+    /// --half-space`); `em locate` warns when it is given another. Absent
+    /// in files written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_space: Option<[f64; 3]>,
 }
 
 impl CalibrationFile {
@@ -69,6 +79,16 @@ impl CalibrationFile {
             moments_am2,
             calibration,
             fit,
+            half_space: None,
+        }
+    }
+
+    /// The file with the prior half-space normal the calibration was
+    /// fitted with ([`CalibrationFile::half_space`]).
+    pub fn with_half_space(self, normal: [f64; 3]) -> Self {
+        Self {
+            half_space: Some(normal),
+            ..self
         }
     }
 
@@ -121,6 +141,18 @@ impl CalibrationFile {
         {
             return Err(EmError::InvalidData {
                 reason: "non-finite number in the calibration".into(),
+            });
+        }
+        if let Some(n) = f.half_space
+            && !(n.iter().all(|v| v.is_finite()) && n.iter().any(|&v| v != 0.0))
+        {
+            return Err(EmError::InvalidData {
+                reason: format!(
+                    "field 'half_space' is {},{},{}: expected a finite, non-zero normal",
+                    shown(n[0]),
+                    shown(n[1]),
+                    shown(n[2])
+                ),
             });
         }
         let q = &c.attitude_q;
@@ -198,6 +230,14 @@ mod tests {
         assert!(err(&text.replace("\"version\": 1", "\"version\": 2")).contains("version"));
         assert!(err(&text.replace("aeromag-em-calibration", "something-else")).contains("format"));
         assert!(err(&text[..text.len() / 2]).contains("line"));
+        // The half-space kept since it was added round-trips; a zero one is refused.
+        let with_half = f.clone().with_half_space([-1.0, 0.0, 1.0]);
+        let half_text = with_half.to_json().unwrap();
+        assert!(half_text.contains("\"half_space\""));
+        assert_eq!(CalibrationFile::from_json(&half_text).unwrap(), with_half);
+        assert!(
+            err(&f.clone().with_half_space([0.0; 3]).to_json().unwrap()).contains("half_space")
+        );
         let mut singular = f.clone();
         singular.moments_am2 = Matrix3::zeros();
         assert!(err(&singular.to_json().unwrap()).contains("moments_am2"));
