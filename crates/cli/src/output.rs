@@ -204,3 +204,18 @@ pub fn check_files<'a>(
 pub fn check_folder(dir: &Path) -> anyhow::Result<()> {
     check_writable_folder(dir).map_err(|e| bad_input!("cannot write into '{}': {e}", dir.display()))
 }
+
+/// The files `names` a command writes into the folder `dir` as a set
+/// ([`aeromag::model_file::write_files`]), checked before the command's
+/// work as [`check_folder`] and [`check_files`] do (a folder in the place
+/// of one is bad input at once, not an I/O error after the run).
+pub fn check_folder_files<const N: usize>(
+    dir: &Path,
+    names: [&str; N],
+    inputs: &[&Path],
+) -> anyhow::Result<[std::path::PathBuf; N]> {
+    check_folder(dir)?;
+    let paths = names.map(|n| dir.join(n));
+    check_files(paths.iter().map(|p| p.as_path()), inputs)?;
+    Ok(paths)
+}

@@ -97,6 +97,21 @@ fn calibrate_compensate_report_keep_every_row() {
         assert!(html.contains(k), "{k} missing in the report");
     }
     assert!(rep.join("figures.json").exists());
+    // A folder in the place of figures.json: the report is not replaced
+    // either (index.html was written first, then figures.json failed).
+    let html_before = std::fs::read(rep.join("index.html")).unwrap();
+    std::fs::remove_file(rep.join("figures.json")).unwrap();
+    std::fs::create_dir(rep.join("figures.json")).unwrap();
+    let o = aeromag(&[
+        "report",
+        "--input",
+        out.to_str().unwrap(),
+        "--out",
+        rep.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("figures.json"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(rep.join("index.html")).unwrap(), html_before);
     // One row selected: no time step to score by (was "invalid argument
     // `fs_hz`", naming neither the file nor the flag).
     let t0 = rows[1].split(',').next().unwrap();

@@ -35,7 +35,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_folder(&a.out)?;
+    let [summary, index] =
+        crate::output::check_folder_files(&a.out, ["summary.json", "index.html"], &[])?;
     let start = Instant::now();
     std::fs::create_dir_all(a.out.join("data"))
         .map_err(|e| aeromag::Error::write(a.out.join("data"), e))?;
@@ -47,9 +48,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         out: a.out.clone(),
     };
     let out = demo.run(StudySize::quick_if(a.quick), &mut Bars::new())?;
-    let summary = a.out.join("summary.json");
-    aeromag::model_file::write_atomically(&summary, out.summary.to_json()?.as_bytes())?;
-    out.report().write_html(a.out.join("index.html"))?;
+    // The summary and the report as a set: both old or both new.
+    aeromag::model_file::write_files(&[
+        (&summary, out.summary.to_json()?.as_bytes()),
+        (&index, out.report().to_html().as_bytes()),
+    ])?;
     println!(
         "aeromag demo (seed {}, {:.1} s)",
         a.seed,

@@ -101,9 +101,7 @@ const STUDY_FILES: [&str; 4] = [
 ];
 
 fn study(a: StudyArgs) -> anyhow::Result<()> {
-    crate::output::check_folder(&a.out)?;
-    let paths = STUDY_FILES.map(|n| a.out.join(n));
-    crate::output::check_files(paths.iter().map(|p| p.as_path()), &[])?;
+    let paths = crate::output::check_folder_files(&a.out, STUDY_FILES, &[])?;
     let mut run = EmStudy::default();
     run.config.seed = a.seed;
     let out = run.run(StudySize::quick_if(a.quick), &mut Bars::new())?;

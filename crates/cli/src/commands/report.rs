@@ -40,8 +40,11 @@ pub struct Args {
     out: PathBuf,
 }
 
+/// The files `report` writes into its folder, as a set.
+const REPORT_FILES: [&str; 2] = ["index.html", "figures.json"];
+
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_folder(&a.out)?;
+    crate::output::check_folder_files(&a.out, REPORT_FILES, &[a.input.input.as_path()])?;
     if let Some(m) = &a.model
         && aeromag::model_file::kind_of(m)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {
@@ -69,12 +72,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     write(&a, r, serde_json::to_string_pretty(&fig)?)
 }
 
-/// The report and `figures.json` into the output folder.
+/// The report and `figures.json` into the output folder, as a set: an
+/// interruption or a failure leaves both old or both new.
 fn write(a: &Args, r: Report, figures: String) -> anyhow::Result<()> {
-    let path = a.out.join("index.html");
-    r.write_html(&path)?;
-    aeromag::io::atomic::write_file(&a.out.join("figures.json"), figures)
-        .map_err(|e| aeromag::Error::write(a.out.join("figures.json"), e))?;
+    std::fs::create_dir_all(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
+    let [path, fig_path] = REPORT_FILES.map(|n| a.out.join(n));
+    aeromag::model_file::write_files(&[
+        (&path, r.to_html().as_bytes()),
+        (&fig_path, figures.as_bytes()),
+    ])?;
     println!("report written to {}", path.display());
     Ok(())
 }
