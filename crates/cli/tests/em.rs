@@ -1053,36 +1053,57 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
         std::fs::write(&o, lines.join("\n") + "\n").unwrap();
         o
     };
-    let k0 = edit(&known, "k0.csv", 2, &["x_m", "y_m", "z_m"], "0");
-    bad(
-        &calibrate_args(&det, &k0, &system, &out),
-        &[
+    // (file edited: the KNOWN file or the detected one, name, row, columns, value; fragments)
+    let cases: [(bool, &str, usize, &[&str], &str, [&str; 4]); 3] = [
+        (
+            true,
             "k0.csv",
-            "line 4 (data row 3)",
-            "column 'x_m'",
-            "0 m from the transmitter",
-        ],
-    );
-    let kh = edit(&known, "kh.csv", 4, &["y_m"], "1e300");
-    bad(
-        &calibrate_args(&det, &kh, &system, &out),
-        &[
+            2,
+            &["x_m", "y_m", "z_m"],
+            "0",
+            [
+                "k0.csv",
+                "line 4 (data row 3)",
+                "column 'x_m'",
+                "0 m from the transmitter",
+            ],
+        ),
+        (
+            true,
             "kh.csv",
-            "line 6 (data row 5)",
-            "column 'y_m'",
-            "expected 1 … 10000 m",
-        ],
-    );
-    let dh = edit(&det, "dh.csv", 5, &["h2_z_im_t"], "1e300");
-    bad(
-        &calibrate_args(&dh, &known, &system, &out),
-        &[
+            4,
+            &["y_m"],
+            "1e300",
+            [
+                "kh.csv",
+                "line 6 (data row 5)",
+                "column 'y_m'",
+                "expected 1 … 10000 m",
+            ],
+        ),
+        (
+            false,
             "dh.csv",
-            "line 7 (data row 6)",
-            "column 'h2_z_im_t'",
-            "1e300 T",
-        ],
-    );
+            5,
+            &["h2_z_im_t"],
+            "1e300",
+            [
+                "dh.csv",
+                "line 7 (data row 6)",
+                "column 'h2_z_im_t'",
+                "1e300 T",
+            ],
+        ),
+    ];
+    for (in_known, name, row, cols, v, fragments) in cases {
+        let edited = edit(if in_known { &known } else { &det }, name, row, cols, v);
+        let (d_in, k_in) = if in_known {
+            (&det, &edited)
+        } else {
+            (&edited, &known)
+        };
+        bad(&calibrate_args(d_in, k_in, &system, &out), &fragments);
+    }
     // Known positions on the other side of --half-space: `em locate` would
     // mirror the bird (84 m off with exit 0 for birds ahead of the
     // transmitter and the default half-space).
