@@ -1053,56 +1053,65 @@ fn known_positions_and_fields_out_of_range_are_bad_input_at_their_cell() {
         std::fs::write(&o, lines.join("\n") + "\n").unwrap();
         o
     };
-    // (file edited: the KNOWN file or the detected one, name, row, columns, value; fragments)
-    let cases: [(bool, &str, usize, &[&str], &str, [&str; 4]); 3] = [
-        (
-            true,
-            "k0.csv",
-            2,
-            &["x_m", "y_m", "z_m"],
-            "0",
-            [
+    // One cell edited in the KNOWN file or the detected one.
+    struct Case<'a> {
+        in_known: bool,
+        name: &'a str,
+        row: usize,
+        cols: &'a [&'a str],
+        value: &'a str,
+        fragments: [&'a str; 4],
+    }
+    let cases = [
+        Case {
+            in_known: true,
+            name: "k0.csv",
+            row: 2,
+            cols: &["x_m", "y_m", "z_m"],
+            value: "0",
+            fragments: [
                 "k0.csv",
                 "line 4 (data row 3)",
                 "column 'x_m'",
                 "0 m from the transmitter",
             ],
-        ),
-        (
-            true,
-            "kh.csv",
-            4,
-            &["y_m"],
-            "1e300",
-            [
+        },
+        Case {
+            in_known: true,
+            name: "kh.csv",
+            row: 4,
+            cols: &["y_m"],
+            value: "1e300",
+            fragments: [
                 "kh.csv",
                 "line 6 (data row 5)",
                 "column 'y_m'",
                 "expected 1 … 10000 m",
             ],
-        ),
-        (
-            false,
-            "dh.csv",
-            5,
-            &["h2_z_im_t"],
-            "1e300",
-            [
+        },
+        Case {
+            in_known: false,
+            name: "dh.csv",
+            row: 5,
+            cols: &["h2_z_im_t"],
+            value: "1e300",
+            fragments: [
                 "dh.csv",
                 "line 7 (data row 6)",
                 "column 'h2_z_im_t'",
                 "1e300 T",
             ],
-        ),
+        },
     ];
-    for (in_known, name, row, cols, v, fragments) in cases {
-        let edited = edit(if in_known { &known } else { &det }, name, row, cols, v);
-        let (d_in, k_in) = if in_known {
+    for c in cases {
+        let source = if c.in_known { &known } else { &det };
+        let edited = edit(source, c.name, c.row, c.cols, c.value);
+        let (d_in, k_in) = if c.in_known {
             (&det, &edited)
         } else {
             (&edited, &known)
         };
-        bad(&calibrate_args(d_in, k_in, &system, &out), &fragments);
+        bad(&calibrate_args(d_in, k_in, &system, &out), &c.fragments);
     }
     // Known positions on the other side of --half-space: `em locate` would
     // mirror the bird (84 m off with exit 0 for birds ahead of the
