@@ -251,6 +251,13 @@ impl PyEmPoses {
     fn by_continuity(&self) -> usize {
         self.inner.by_continuity()
     }
+    /// Notes and warnings of the location ("warning: …"), as `aeromag em
+    /// locate` prints them: epochs not located, a half-space other than
+    /// the one the calibration was fitted with.
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        note_texts(&self.inner.notes)
+    }
     /// The poses as float64 arrays: `time_s`; `x_m, y_m, z_m` (transmitter
     /// frame, m); `range_m`; `roll_deg, pitch_deg, yaw_deg` (Z-Y-X, deg);
     /// `pol_ratio_1..3`; `residual_rel`; `hemisphere_by_continuity` (0/1);

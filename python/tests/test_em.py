@@ -37,6 +37,26 @@ def test_chain_equals_the_cli(cli, record, tmp_path):
         np.testing.assert_array_equal(v, again.to_dict()[k])
     assert len(det) == len(poses) == files["epochs"]
     assert cal.polarization_ratio_after < cal.polarization_ratio_before
+    assert poses.notes == []
+
+
+def test_a_half_space_other_than_the_calibrations_is_warned_of(cli, record, tmp_path):
+    out, files = record
+    det = aeromag.detect_em(files["raw"])
+    cal = aeromag.calibrate_em(det, files["known"], files["system"])
+    # The birds trail behind and below (the default half-space's side):
+    # located with the half-space ahead, every pose is mirrored to -r.
+    poses = aeromag.locate_em(det, cal, half_space=(1.0, 0.0, 0.0))
+    assert len(poses.notes) == 1 and poses.notes[0].startswith("warning: ")
+    assert "--half-space=-1,0,1" in poses.notes[0] and "mirrored" in poses.notes[0]
+    right = aeromag.locate_em(det, cal).to_dict()
+    np.testing.assert_allclose(poses.to_dict()["x_m"], -right["x_m"], rtol=1e-9)
+    # The CLI prints the same warning.
+    cal.save(str(tmp_path / "cal.json"))
+    det.save(str(tmp_path / "det.csv"))
+    r = cli("em", "locate", "-i", tmp_path / "det.csv", "--calibration", tmp_path / "cal.json",
+            "--half-space=1,0,0", "--out", tmp_path / "poses.csv")
+    assert poses.notes[0] in r.stderr
 
 
 def test_poses_match_the_truth(record):
