@@ -35,11 +35,12 @@ from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulat
 from ._aeromag import Grid, Microlevelled
 from ._aeromag import Flight, Levelled, Model, OnlineCompensator, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
-from .errors import AeromagError, BadInputError
+from .errors import AeromagError, AeromagWarning, BadInputError
 from .tolles_lawson import TollesLawson, calibrate_sensors, load_model
 
 __all__ = [
     "AeromagError",
+    "AeromagWarning",
     "BadInputError",
     "Flight",
     "Levelled",

@@ -10,6 +10,13 @@
 - :class:`AeromagError`: valid input on which a method failed (a fit that
   did not converge, a flight that does not determine the model, …).
 - :class:`OSError`: an output file could not be written.
+
+And the warning it raises:
+
+- :class:`AeromagWarning` (a :class:`UserWarning`): a model was applied to
+  a flight that does not quite look like its calibration (another sample
+  rate, dropouts bridged), as the CLI warns; the results are computed.
+  Results of fits carry their warnings in ``notes`` instead.
 """
 
 from __future__ import annotations
@@ -41,3 +48,8 @@ class AeromagError(Exception):
 
 class BadInputError(AeromagError, ValueError):
     """The input (a file, an array, an option) cannot be used."""
+
+
+class AeromagWarning(UserWarning):
+    """A model applied to a flight that does not quite fit it (the CLI's
+    "warning: …" lines): raised with :func:`warnings.warn`."""

@@ -1,10 +1,14 @@
 //! What every fitted model does to a flight (any [`Compensator`]: the
 //! Tolles-Lawson, rotor and pod models), with the GIL released; the model
-//! classes' `interference`, `compensate` and `apply` call these.
+//! classes' `interference`, `compensate` and `apply` call these. The
+//! warnings the CLI prints when it applies a model (a sample rate other
+//! than the model's, dropouts bridged) are raised as Python warnings of
+//! the category `aeromag.AeromagWarning`.
 
 use crate::errors::IntoPy;
 use crate::flight::PyFlight;
-use aeromag::Compensator;
+use crate::progress::PyProgress;
+use aeromag::{Compensator, Note};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -14,8 +18,10 @@ pub fn interference<'py>(
     model: &(dyn Compensator + Sync),
     flight: &PyFlight,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let v = py.detach(|| model.interference(&flight.inner)).py_err()?;
-    Ok(PyArray1::from_vec(py, v))
+    let mut notes = PyProgress::new(None);
+    let v = py.detach(|| model.interference_checked(&flight.inner, &mut notes));
+    warn(py, &notes.notes)?;
+    Ok(PyArray1::from_vec(py, v.py_err()?))
 }
 
 /// `mag` minus the modelled interference, nT.
@@ -24,8 +30,10 @@ pub fn compensate<'py>(
     model: &(dyn Compensator + Sync),
     flight: &PyFlight,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let c = py.detach(|| model.compensated(&flight.inner)).py_err()?;
-    Ok(PyArray1::from_vec(py, c))
+    let mut notes = PyProgress::new(None);
+    let c = py.detach(|| model.compensated_observed(&flight.inner, &mut notes));
+    warn(py, &notes.notes)?;
+    Ok(PyArray1::from_vec(py, c.py_err()?))
 }
 
 /// The flight with the model's output columns added.
@@ -34,12 +42,27 @@ pub fn apply(
     model: &(dyn Compensator + Sync),
     flight: &PyFlight,
 ) -> PyResult<PyFlight> {
-    let f = py
-        .detach(|| {
-            model
-                .compensate(&flight.inner)
-                .and_then(|c| c.into_flight(flight.inner.clone()))
-        })
-        .py_err()?;
-    Ok(PyFlight::new(f))
+    let mut notes = PyProgress::new(None);
+    let f = py.detach(|| {
+        model
+            .compensate_observed(&flight.inner, &mut notes)
+            .and_then(|c| c.into_flight(flight.inner.clone()))
+    });
+    warn(py, &notes.notes)?;
+    Ok(PyFlight::new(f.py_err()?))
+}
+
+/// Raises each warning of `notes` (not the plain notes) with
+/// `warnings.warn(message, aeromag.AeromagWarning)`, pointing at the
+/// caller's line.
+fn warn(py: Python<'_>, notes: &[Note]) -> PyResult<()> {
+    if !notes.iter().any(Note::is_warning) {
+        return Ok(());
+    }
+    let warnings = py.import("warnings")?;
+    let category = py.import("aeromag.errors")?.getattr("AeromagWarning")?;
+    for n in notes.iter().filter(|n| n.is_warning()) {
+        warnings.call_method1("warn", (n.message.as_str(), &category, 1))?;
+    }
+    Ok(())
 }

@@ -1,5 +1,7 @@
 """Rotor and pod models: the CLI's model files, applied like the CLI."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -22,7 +24,20 @@ def test_rotor_model_equals_the_cli(cli, tmp_path):
     out = tmp_path / "out.csv"
     cli("rotor", "apply", "--model", model, "-i", csv, "--out", out)
     written = aeromag.read_flight(out)
-    np.testing.assert_array_equal(loaded.apply(flight)["mag_comp"], written["mag_comp"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(loaded.apply(flight)["mag_comp"], written["mag_comp"])
+    # Applied to a flight with a spike in mag: the CLI's warning, as an
+    # AeromagWarning (none on the clean flight above).
+    data = flight.to_dict()
+    data["mag"][5000] += 1000.0
+    spiked = aeromag.Flight.from_dict(data)
+    for call in (loaded.apply, loaded.compensate, loaded.interference):
+        with pytest.warns(aeromag.AeromagWarning, match="spikes") as caught:
+            call(spiked)
+        assert len(caught) == 1 and caught[0].filename == __file__
+    r = cli("rotor", "apply", "--model", model, "-i", csv, "--out", out)
+    assert "warning" not in r.stderr
     with pytest.raises(aeromag.BadInputError, match="preset"):
         aeromag.fit_rotor(flight, hub_m=(0, 0, -2.6))
     with pytest.raises(aeromag.BadInputError, match="tail rotor"):

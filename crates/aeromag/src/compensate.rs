@@ -68,7 +68,17 @@ pub trait Compensator {
     /// value is beyond any magnetic field ([`aeromag_io::MAX_FIELD_NT`]:
     /// a model file that does not fit the flight).
     fn interference(&self, flight: &Flight) -> Result<Vec<f64>> {
-        let v = self.interference_observed(flight, &mut Silent)?;
+        self.interference_checked(flight, &mut Silent)
+    }
+
+    /// [`Compensator::interference`], its notes and warnings going to
+    /// `observer`.
+    fn interference_checked(
+        &self,
+        flight: &Flight,
+        observer: &mut dyn Observer,
+    ) -> Result<Vec<f64>> {
+        let v = self.interference_observed(flight, observer)?;
         check_interference(flight, self.output(), &v)?;
         Ok(v)
     }
@@ -97,7 +107,17 @@ pub trait Compensator {
     /// [`Compensated::compensated_nt`], computed in the place of the
     /// interference instead of beside it (one flight-long buffer, not two).
     fn compensated(&self, flight: &Flight) -> Result<Vec<f64>> {
-        let mut out = self.interference(flight)?;
+        self.compensated_observed(flight, &mut Silent)
+    }
+
+    /// [`Compensator::compensated`], its notes and warnings going to
+    /// `observer`.
+    fn compensated_observed(
+        &self,
+        flight: &Flight,
+        observer: &mut dyn Observer,
+    ) -> Result<Vec<f64>> {
+        let mut out = self.interference_checked(flight, observer)?;
         minus_from_mag(flight, &mut out)?;
         Ok(out)
     }
