@@ -6,9 +6,10 @@
 //! the category `aeromag.AeromagWarning`.
 
 use crate::errors::IntoPy;
+use crate::errors::warn;
 use crate::flight::PyFlight;
 use crate::progress::PyProgress;
-use aeromag::{Compensator, Note};
+use aeromag::Compensator;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -50,19 +51,4 @@ pub fn apply(
     });
     warn(py, &notes.notes)?;
     Ok(PyFlight::new(f.py_err()?))
-}
-
-/// Raises each warning of `notes` (not the plain notes) with
-/// `warnings.warn(message, aeromag.AeromagWarning)`, pointing at the
-/// caller's line.
-fn warn(py: Python<'_>, notes: &[Note]) -> PyResult<()> {
-    if !notes.iter().any(Note::is_warning) {
-        return Ok(());
-    }
-    let warnings = py.import("warnings")?;
-    let category = py.import("aeromag.errors")?.getattr("AeromagWarning")?;
-    for n in notes.iter().filter(|n| n.is_warning()) {
-        warnings.call_method1("warn", (n.message.as_str(), &category, 1))?;
-    }
-    Ok(())
 }

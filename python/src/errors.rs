@@ -83,3 +83,19 @@ pub fn whole_opt<T: TryFrom<u128>>(
 pub fn bad_argument(reason: impl Into<String>) -> PyErr {
     to_py(aeromag::Error::bad_input(reason))
 }
+
+/// Raises each warning of `notes` (not the plain notes) with
+/// `warnings.warn(message, aeromag.AeromagWarning)`, pointing at the
+/// caller's line: for calls whose result has no `notes` of its own (a
+/// model applied to a flight, a located dipole's track).
+pub fn warn(py: Python<'_>, notes: &[aeromag::Note]) -> PyResult<()> {
+    if !notes.iter().any(aeromag::Note::is_warning) {
+        return Ok(());
+    }
+    let warnings = py.import("warnings")?;
+    let category = py.import("aeromag.errors")?.getattr("AeromagWarning")?;
+    for n in notes.iter().filter(|n| n.is_warning()) {
+        warnings.call_method1("warn", (n.message.as_str(), &category, 1))?;
+    }
+    Ok(())
+}

@@ -1,12 +1,12 @@
 //! Dipole estimation from gradiometer passes (`aeromag dipole locate`,
 //! `aeromag dipole crlb`, `aeromag simulate gradiometer`).
 
-use crate::errors::{IntoPy, whole_opt};
+use crate::errors::{IntoPy, warn, whole_opt};
 use crate::flight::PyFlight;
-use aeromag::Flight;
 use aeromag::gradiometry::{
     LocateSettings, crlb, locate_pass, parse_name, read_config, read_pass, simulate_pass,
 };
+use aeromag::{Flight, Note};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -15,6 +15,9 @@ use std::path::PathBuf;
 /// describes the system). Returns the track as a Flight: per epoch the
 /// estimated position (m, body frame), moment (A·m²), their standard
 /// deviations, detection and convergence flags, as `--out` writes it.
+/// The command's warnings (time gaps in the pass, innovations that say the
+/// filter's σ do not describe its errors) are raised as
+/// `aeromag.AeromagWarning`.
 #[pyfunction]
 #[pyo3(signature = (flight, config=None, gradiometer=None, layout=None, baseline_m=None,
     noise_nt=None, passes=None, multistart=None))]
@@ -48,15 +51,17 @@ pub fn locate_dipole(
     }
     .apply(&mut cfg)
     .py_err()?;
-    let table = py
-        .detach(|| -> aeromag::Result<_> {
-            let pass = read_pass(&flight.inner, &cfg)?;
-            let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
-            let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();
-            track.to_table(&time)
-        })
-        .py_err()?;
-    Ok(PyFlight::new(Flight::from_table(table).py_err()?))
+    let mut notes = Vec::new();
+    let table = py.detach(|| -> aeromag::Result<_> {
+        let pass = read_pass(&flight.inner, &cfg)?;
+        notes.extend(pass.notes);
+        let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
+        notes.extend(track.inconsistency_warning().map(Note::warning));
+        let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();
+        track.to_table(&time)
+    });
+    warn(py, &notes)?;
+    Ok(PyFlight::new(Flight::from_table(table.py_err()?).py_err()?))
 }
 
 /// The Cramér–Rao bound of a configured pass (`aeromag dipole crlb

@@ -1,6 +1,7 @@
 """Gradiometer dipole estimation: the CLI's track and bound."""
 
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -29,3 +30,26 @@ def test_locate_equals_the_cli(cli, tmp_path):
 def test_crlb_equals_the_cli(cli):
     ref = json.loads(cli("dipole", "crlb", "--json").stdout)
     assert aeromag.dipole_crlb() == ref
+
+
+def test_locate_warns_as_the_cli(cli, tmp_path):
+    """The command's warnings reach Python as AeromagWarning: the object's
+    track in km (the filter's innovations then far above 1) and a gap in
+    the pass; none on the clean pass."""
+    sim = aeromag.simulate_gradiometer()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        aeromag.locate_dipole(sim)
+    data = sim.to_dict()
+    km = {k: (v / 1000.0 if k.startswith("obj_") and k.endswith("_m") else v) for k, v in data.items()}
+    with pytest.warns(aeromag.AeromagWarning, match="normalised innovations") as caught:
+        aeromag.locate_dipole(aeromag.Flight.from_dict(km))
+    assert len(caught) == 1 and caught[0].filename == __file__
+    path = tmp_path / "km.csv"
+    aeromag.Flight.from_dict(km).to_csv(str(path))
+    r = cli("dipole", "locate", "-i", path, "--out", tmp_path / "est.csv")
+    assert str(caught[0].message) in r.stderr
+    keep = np.r_[0:150, 200:len(sim)]
+    gap = aeromag.Flight.from_dict({k: v[keep] for k, v in data.items()})
+    with pytest.warns(aeromag.AeromagWarning, match="gap"):
+        aeromag.locate_dipole(gap)
