@@ -49,11 +49,15 @@ pub fn load_only(
     names: Vec<String>,
     columns: Option<&str>,
 ) -> anyhow::Result<Flight> {
+    let columns = match columns {
+        Some(m) => ColumnMap::parse_within(m, &names)?,
+        None => ColumnMap::new(),
+    };
     read_checked(
         path,
         &ReadOptions {
             fields: Fields::Only(names),
-            columns: column_map(columns)?,
+            columns,
             ..ReadOptions::default()
         },
     )

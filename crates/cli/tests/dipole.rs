@@ -238,6 +238,19 @@ fn columns_map_the_navigation_names() {
         std::fs::read(&mapped).unwrap(),
         std::fs::read(&plain).unwrap()
     );
+    // A canonical name the command does not read (it was taken and
+    // changed nothing) and an unknown one: bad input naming those it maps.
+    for map in ["yaw=heading,mag=b1_x", "bogus=lat"] {
+        let o = locate(&renamed, &d.path().join("x.csv"), &["--columns", map]);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains(
+                "not a column this command reads; it maps: time, lat, lon, alt, roll, pitch, yaw"
+            ) && !stderr(&o).contains("flux_x"),
+            "{}",
+            stderr(&o)
+        );
+    }
 }
 
 #[test]

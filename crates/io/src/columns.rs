@@ -169,6 +169,18 @@ impl ColumnMap {
     /// an entry without exactly one `=`, an empty name, an unknown canonical
     /// name, or a name used twice.
     pub fn parse(text: &str) -> Result<Self> {
+        Self::parse_for(text, None)
+    }
+
+    /// [`ColumnMap::parse`] for a reader of the fields `fields` alone: a
+    /// canonical name it does not read is an error naming those it does
+    /// (`--columns mag=b1_x` to `aeromag dipole locate`, which reads no
+    /// `mag`, was taken and changed nothing, without a word).
+    pub fn parse_within(text: &str, fields: &[String]) -> Result<Self> {
+        Self::parse_for(text, Some(fields))
+    }
+
+    fn parse_for(text: &str, fields: Option<&[String]>) -> Result<Self> {
         let mut map = ColumnMap::new();
         if text.trim().is_empty() {
             return Ok(map);
@@ -193,6 +205,20 @@ impl ColumnMap {
                     "entry '{entry}' must have the form canonical=file_column"
                 )));
             };
+            if let Some(fields) = fields
+                && !fields.iter().any(|f| f == canonical.trim())
+            {
+                let read: Vec<&str> = fields
+                    .iter()
+                    .map(String::as_str)
+                    .filter(|f| is_canonical(f))
+                    .collect();
+                return Err(err(format!(
+                    "'{}' is not a column this command reads; it maps: {}",
+                    canonical.trim(),
+                    read.join(", ")
+                )));
+            }
             map.insert(canonical.trim(), file_column.trim())
                 .map_err(|e| match e {
                     IoError::ColumnMap { reason, .. } => err(reason),
