@@ -33,23 +33,27 @@ def test_crlb_equals_the_cli(cli):
 
 
 def test_locate_warns_as_the_cli(cli, tmp_path):
-    """The command's warnings reach Python as AeromagWarning: the object's
-    track in km (the filter's innovations then far above 1) and a gap in
-    the pass; none on the clean pass."""
+    """The command's warnings reach Python as AeromagWarning: a sensor
+    noise set 4 times the sensors' (the filter's innovations then far below
+    1) and a gap in the pass; none on the clean pass. The object's track in
+    km is bad input."""
     sim = aeromag.simulate_gradiometer()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         aeromag.locate_dipole(sim)
-    data = sim.to_dict()
-    km = {k: (v / 1000.0 if k.startswith("obj_") and k.endswith("_m") else v) for k, v in data.items()}
     with pytest.warns(aeromag.AeromagWarning, match="normalised innovations") as caught:
-        aeromag.locate_dipole(aeromag.Flight.from_dict(km))
+        aeromag.locate_dipole(sim, noise_nt=2.0)
     assert len(caught) == 1 and caught[0].filename == __file__
-    path = tmp_path / "km.csv"
-    aeromag.Flight.from_dict(km).to_csv(str(path))
-    r = cli("dipole", "locate", "-i", path, "--out", tmp_path / "est.csv")
+    path = tmp_path / "pass.csv"
+    sim.to_csv(str(path))
+    r = cli("dipole", "locate", "-i", path, "--noise-nt", "2", "--out", tmp_path / "est.csv")
     assert str(caught[0].message) in r.stderr
+    data = sim.to_dict()
     keep = np.r_[0:150, 200:len(sim)]
     gap = aeromag.Flight.from_dict({k: v[keep] for k, v in data.items()})
     with pytest.warns(aeromag.AeromagWarning, match="gap"):
         aeromag.locate_dipole(gap)
+    km = {k: (v / 1000.0 if k.startswith("obj_") and k.endswith("_m") else v) for k, v in data.items()}
+    with pytest.raises(aeromag.BadInputError, match="inside the sphere") as e:
+        aeromag.locate_dipole(aeromag.Flight.from_dict(km))
+    assert e.value.column == "obj_north_m"

@@ -5,9 +5,10 @@
 
 use aeromag::gradiometry::config::GradiometerConfig;
 use aeromag::gradiometry::convergence::ConvergenceCase;
+use aeromag::gradiometry::sim::Gradiometer;
 use aeromag::gradiometry::sim::simulate;
 use aeromag::gradiometry::{
-    MAX_MEAN_NIS, TRUTH, Track, both_maps, crlb, locate_pass, pass_table, read_pass,
+    MAX_MEAN_NIS, MIN_MEAN_NIS, TRUTH, Track, both_maps, crlb, locate_pass, pass_table, read_pass,
 };
 use aeromag::studies::{GradiometryStudy, Study, StudyOutcome, StudySize};
 use aeromag::{Flight, FlightTable, Silent};
@@ -114,8 +115,12 @@ fn the_default_pass_is_tracked_without_the_truth() {
 /// warning, where the estimates are wrong but each epoch's residual is at
 /// the noise level. Before, the plain IEKF locked 180 m from the object and
 /// the pass with sensor 1's and sensor 2's columns swapped (48 m off) both
-/// ended with `converged` 1, σ of centimetres to a metre and no word; the
-/// object's track in km (55 m off) is flagged too.
+/// ended with `converged` 1, σ of centimetres to a metre and no word. Far
+/// below [`MIN_MEAN_NIS`] with a sensor noise set 4 times the sensors'
+/// (σ far too large). The object's track in km (55 m off for the tensor
+/// gradiometer, a moment of 2 A·m² against 1200 for the scalar one, whose
+/// mean innovations were 0.00) is refused when the pass is read: it
+/// passes inside the sphere through the sensors.
 #[test]
 fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     let cfg = GradiometerConfig::default();
@@ -156,7 +161,6 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     for (what, track) in [
         ("plain", locate(&plain, &bare(""))),
         ("swapped", locate(&cfg, &bare("swap"))),
-        ("track in km", locate(&cfg, &bare("km"))),
     ] {
         let m = track.mean_nis().unwrap();
         eprintln!("{what}: mean NIS per contrast {m:.1}");
@@ -166,6 +170,38 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
                 .inconsistency_warning()
                 .is_some_and(|w| w.contains("not to be trusted")),
             "{what}"
+        );
+    }
+    let mut noisy = cfg.clone();
+    noisy.sensors.vector.noise_nt *= 4.0;
+    let m = locate(&noisy, &bare("")).mean_nis().unwrap();
+    eprintln!("noise 4 times the sensors': mean NIS per contrast {m:.4}");
+    // About 1/16: the σ four times too large.
+    assert!(m < MIN_MEAN_NIS / 2.0, "{m}");
+    assert!(
+        locate(&noisy, &bare(""))
+            .inconsistency_warning()
+            .is_some_and(|w| w.contains("below 0.25") && w.contains("not to be trusted"))
+    );
+    for system in [Gradiometer::Tensor, Gradiometer::Scalar] {
+        let mut c = cfg.clone();
+        c.system.gradiometer = system;
+        let sim = simulate(&c.scenario().unwrap()).unwrap();
+        let mut t = FlightTable::new();
+        for col in pass_table(&c, &sim).unwrap().columns() {
+            let mut values = col.values().unwrap().to_vec();
+            if col.name().starts_with("obj_") && col.name().ends_with("_m") {
+                values.iter_mut().for_each(|v| *v /= 1000.0);
+            }
+            t.add_column(col.name(), values).unwrap();
+        }
+        let e = read_pass(&Flight::from_table(t).unwrap(), &c).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        assert!(
+            e.to_string().contains("obj_north_m")
+                && e.to_string()
+                    .contains("inside the sphere through its sensors"),
+            "{system:?}: {e}"
         );
     }
 }

@@ -73,7 +73,10 @@ pub struct SimulateArgs {
 /// north_m, east_m, down_m, roll, pitch, yaw`), the object's track
 /// (`obj_north_m, obj_east_m, obj_down_m, obj_yaw`: its motion, and for the
 /// scalar gradiometer its known position) and the readings (`b1_x … b4_z`
-/// or `f1 … f4`); never the `true_` columns. Geometry, noise and estimator
+/// or `f1 … f4`, nT); never the `true_` columns. Angles are in degrees
+/// (an `obj_yaw` in radians reads as a turn 57 times slower, which the
+/// file cannot show: the moment is then reported in a wrongly turned
+/// frame), positions in metres. Geometry, noise and estimator
 /// settings come from the scenario file (the one `simulate` writes) and the
 /// flags. Writes EST.csv: `time, detected, x_m, y_m, z_m, mx_am2, my_am2,
 /// mz_am2` (body frame), their standard deviations `sd_…`, `iterations,
@@ -81,11 +84,13 @@ pub struct SimulateArgs {
 /// (μ = σ⁺/σ⁰: 0 = determined by the measurements, 1 = left at its prior)
 /// and `nis`, the epoch's normalised innovation squared per contrast
 /// (about 1 on average when the σ describe the errors). A mean `nis` above
-/// 3 is warned of: the filter is locked on a wrong solution or its inputs
-/// are not what they say (swapped sensors, quiet epochs that are not
-/// quiet), and its estimates and σ are not to be trusted. Readings whose
-/// median field is not the IGRF's within a factor 2 are refused (another
-/// unit), and time gaps in the pass are warned of.
+/// 3 or below 0.25 is warned of: the filter is locked on a wrong solution
+/// or its inputs are not what they say (swapped sensors, quiet epochs
+/// that are not quiet, positions in another unit), and its estimates and
+/// σ are not to be trusted. Readings whose median field is not the IGRF's
+/// within a factor 2 are refused (another unit), as is an object's track
+/// passing inside the sphere through the sensors (positions in km?); time
+/// gaps in the pass are warned of.
 /// The scalar gradiometer does not estimate the position (it is known from
 /// the tracks): its `sd_x_m … mu_z` cells are empty and the summary says
 /// "σ not estimated".
