@@ -81,9 +81,11 @@ pub struct SensorConfig {
     pub bias_sigma_nt: f64,
 }
 
-/// Both sensor types.
+/// Both sensor types. A field not given takes its sensor type's default
+/// (`[sensors.vector]` with `noise_nt` alone keeps the vector sensors'
+/// 5 nT bias: it was refused, "missing field `bias_sigma_nt`").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(from = "PartialSensors")]
 pub struct SensorsConfig {
     /// Vector (fluxgate) sensors. Default 0.5 nT noise, 5 nT bias.
     pub vector: SensorConfig,
@@ -102,6 +104,43 @@ impl Default for SensorsConfig {
                 noise_nt: 0.02,
                 bias_sigma_nt: 0.5,
             },
+        }
+    }
+}
+
+/// [`SensorsConfig`] as written in a scenario file: any field may be left
+/// out.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartialSensors {
+    vector: Option<PartialSensor>,
+    scalar: Option<PartialSensor>,
+}
+
+/// [`SensorConfig`] as written in a scenario file.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartialSensor {
+    noise_nt: Option<f64>,
+    bias_sigma_nt: Option<f64>,
+}
+
+impl PartialSensor {
+    /// The given fields over `default`'s.
+    fn over(self, default: SensorConfig) -> SensorConfig {
+        SensorConfig {
+            noise_nt: self.noise_nt.unwrap_or(default.noise_nt),
+            bias_sigma_nt: self.bias_sigma_nt.unwrap_or(default.bias_sigma_nt),
+        }
+    }
+}
+
+impl From<PartialSensors> for SensorsConfig {
+    fn from(p: PartialSensors) -> Self {
+        let d = Self::default();
+        Self {
+            vector: p.vector.map_or(d.vector, |v| v.over(d.vector)),
+            scalar: p.scalar.map_or(d.scalar, |v| v.over(d.scalar)),
         }
     }
 }
@@ -544,6 +583,19 @@ mod tests {
         assert_eq!(
             c.locate_config(None).unwrap().difference_model,
             DifferenceModel::Exact
+        );
+        // One field of a sensor type: the other keeps that type's default.
+        let noise = GradiometerConfig::from_toml("[sensors.vector]\nnoise_nt = 0.3\n").unwrap();
+        assert_eq!(noise.sensors.vector.noise_nt, 0.3);
+        assert_eq!(noise.sensors.vector.bias_sigma_nt, 5.0);
+        assert_eq!(noise.sensors.scalar, SensorsConfig::default().scalar);
+        let bias = GradiometerConfig::from_toml("[sensors.scalar]\nbias_sigma_nt = 0.1\n").unwrap();
+        assert_eq!(bias.sensors.scalar.noise_nt, 0.02);
+        assert!(
+            GradiometerConfig::from_toml("[sensors.scalar]\nnoise = 0.1\n")
+                .unwrap_err()
+                .to_string()
+                .contains("noise")
         );
         let approx =
             GradiometerConfig::from_toml("[estimator]\ndifference_model = \"gradient_tensor\"\n")
