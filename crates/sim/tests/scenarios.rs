@@ -404,6 +404,17 @@ fn configuration_errors_are_clear() {
         None,
     );
     assert!(matches!(bad_date, Err(SimError::Core(_))), "{bad_date:?}");
+    // A start time beyond a day (1e300 s was passed on as a date of 300
+    // digits, naming no key) or before midnight.
+    for start in ["1e300", "86400.5", "-1.0"] {
+        let text = format!("[flight]\nstart_time_utc_s = {start}\n");
+        match simulate(ScenarioKind::Calibration, Some(&text), None) {
+            Err(SimError::InvalidConfig { field, .. }) => {
+                assert_eq!(field, "flight.start_time_utc_s")
+            }
+            other => panic!("{start}: expected an invalid value, got {other:?}"),
+        }
+    }
     let bad_toml = simulate(ScenarioKind::Calibration, Some("[pattern\n"), None);
     assert!(matches!(bad_toml, Err(SimError::ConfigParse(_))));
     let huge_seed = simulate(ScenarioKind::Calibration, None, Some(u64::MAX));

@@ -66,12 +66,24 @@ impl Default for FlightConfig {
     }
 }
 
+/// Seconds in a day: [`FlightConfig::start_time_utc_s`] is at most this.
+pub const DAY_S: f64 = 86_400.0;
+
 impl FlightConfig {
     /// Check the values.
     pub fn validate(&self) -> Result<()> {
         aeromag_core::time::Date::parse(&self.date)
             .map_err(|e| invalid("flight.date", e.to_string()))?;
-        require_finite("flight.start_time_utc_s", self.start_time_utc_s)?;
+        // A time of day: a start of 1e300 s was passed on as a date
+        // 300 digits long, without the key's name.
+        if !(0.0..=DAY_S).contains(&self.start_time_utc_s) {
+            return Err(invalid(
+                "flight.start_time_utc_s",
+                format!(
+                    "must be seconds after 00:00 UTC of flight.date, 0 … {DAY_S} (another day: set flight.date)"
+                ),
+            ));
+        }
         require_positive("flight.sample_rate_hz", self.sample_rate_hz)?;
         if self.sample_rate_hz > 10_000.0 {
             return Err(invalid("flight.sample_rate_hz", "must be ≤ 10 000 Hz"));
