@@ -36,7 +36,7 @@ def test_locate_warns_as_the_cli(cli, tmp_path):
     """The command's warnings reach Python as AeromagWarning: a sensor
     noise set 4 times the sensors' (the filter's innovations then far below
     1) and a gap in the pass; none on the clean pass. The object's track in
-    km is bad input."""
+    km is bad input for the scalar gradiometer."""
     sim = aeromag.simulate_gradiometer()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -53,7 +53,11 @@ def test_locate_warns_as_the_cli(cli, tmp_path):
     gap = aeromag.Flight.from_dict({k: v[keep] for k, v in data.items()})
     with pytest.warns(aeromag.AeromagWarning, match="gap"):
         aeromag.locate_dipole(gap)
+    # The scalar gradiometer takes the object's track as known positions.
+    scalar = tmp_path / "scalar.toml"
+    scalar.write_text('[system]\ngradiometer = "scalar"\n')
+    data = aeromag.simulate_gradiometer(config=str(scalar)).to_dict()
     km = {k: (v / 1000.0 if k.startswith("obj_") and k.endswith("_m") else v) for k, v in data.items()}
     with pytest.raises(aeromag.BadInputError, match="inside the sphere") as e:
-        aeromag.locate_dipole(aeromag.Flight.from_dict(km))
+        aeromag.locate_dipole(aeromag.Flight.from_dict(km), config=str(scalar))
     assert e.value.column == "obj_north_m"

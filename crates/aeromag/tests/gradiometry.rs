@@ -117,10 +117,12 @@ fn the_default_pass_is_tracked_without_the_truth() {
 /// the pass with sensor 1's and sensor 2's columns swapped (48 m off) both
 /// ended with `converged` 1, σ of centimetres to a metre and no word. Far
 /// below [`MIN_MEAN_NIS`] with a sensor noise set 4 times the sensors'
-/// (σ far too large). The object's track in km (55 m off for the tensor
-/// gradiometer, a moment of 2 A·m² against 1200 for the scalar one, whose
-/// mean innovations were 0.00) is refused when the pass is read: it
-/// passes inside the sphere through the sensors.
+/// (σ far too large). The object's track in km: flagged for the tensor
+/// gradiometer (55 m off), and refused when the pass is read for the
+/// scalar one, which takes the positions as known (a moment of 2 A·m²
+/// against 1200, mean innovations 0.00): it passes inside the sphere
+/// through the sensors. A track of zeros (a still object of unknown
+/// place) is read for the tensor gradiometer.
 #[test]
 fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     let cfg = GradiometerConfig::default();
@@ -161,6 +163,7 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
     for (what, track) in [
         ("plain", locate(&plain, &bare(""))),
         ("swapped", locate(&cfg, &bare("swap"))),
+        ("track in km", locate(&cfg, &bare("km"))),
     ] {
         let m = track.mean_nis().unwrap();
         eprintln!("{what}: mean NIS per contrast {m:.1}");
@@ -183,27 +186,30 @@ fn a_filter_locked_on_a_wrong_solution_is_flagged_by_its_innovations() {
             .inconsistency_warning()
             .is_some_and(|w| w.contains("below 0.25") && w.contains("not to be trusted"))
     );
-    for system in [Gradiometer::Tensor, Gradiometer::Scalar] {
-        let mut c = cfg.clone();
-        c.system.gradiometer = system;
+    // The object's track scaled by `k` (its positions and heading).
+    let scaled = |c: &GradiometerConfig, k: f64| {
         let sim = simulate(&c.scenario().unwrap()).unwrap();
         let mut t = FlightTable::new();
-        for col in pass_table(&c, &sim).unwrap().columns() {
+        for col in pass_table(c, &sim).unwrap().columns() {
             let mut values = col.values().unwrap().to_vec();
-            if col.name().starts_with("obj_") && col.name().ends_with("_m") {
-                values.iter_mut().for_each(|v| *v /= 1000.0);
+            if col.name().starts_with("obj_") {
+                values.iter_mut().for_each(|v| *v *= k);
             }
             t.add_column(col.name(), values).unwrap();
         }
-        let e = read_pass(&Flight::from_table(t).unwrap(), &c).unwrap_err();
-        assert!(e.is_bad_input(), "{e}");
-        assert!(
-            e.to_string().contains("obj_north_m")
-                && e.to_string()
-                    .contains("inside the sphere through its sensors"),
-            "{system:?}: {e}"
-        );
-    }
+        Flight::from_table(t).unwrap()
+    };
+    let mut scalar = cfg.clone();
+    scalar.system.gradiometer = Gradiometer::Scalar;
+    let e = read_pass(&scaled(&scalar, 1e-3), &scalar).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    assert!(
+        e.to_string().contains("obj_north_m")
+            && e.to_string()
+                .contains("inside the sphere through its sensors"),
+        "{e}"
+    );
+    assert!(read_pass(&scaled(&cfg, 0.0), &cfg).is_ok());
 }
 
 /// A pass of 320 s: the object's heading passes 360° and is written so

@@ -645,18 +645,24 @@ fn check_reading_units(
     Ok(())
 }
 
-/// The object's track relative to the gradiometer (`positions_m`, body
-/// frame, m) stays outside the sphere through the gradiometer's sensors,
-/// else bad input naming the first row inside it: an object passing
-/// between the sensors is not a pass (it would strike the frame), and the
-/// scalar gradiometer takes these positions as known. The object's track
-/// in km (the default pass's 6 m closest approach read as 6 mm) gave a
-/// moment of about 2 A·m² against 1200 and "0.00" mean innovations, exit 0.
+/// For the scalar gradiometer, which takes the object's positions from
+/// the tracks as known: the object's track relative to the gradiometer
+/// (`positions_m`, body frame, m) stays outside the sphere through the
+/// gradiometer's sensors, else bad input naming the first row inside it
+/// (an object passing between the sensors would strike the frame). The
+/// object's track in km (the default pass's 6 m closest approach read as
+/// 6 mm) gave a moment of about 2 A·m² against 1200 and "0.00" mean
+/// innovations, exit 0. The tensor gradiometer estimates the position and
+/// takes only the object's motion from the track (a track of zeros is a
+/// still object of unknown place), and its innovations show a track in km.
 fn check_track_outside_array(
     t: &Flight,
     cfg: &GradiometerConfig,
     positions_m: &[Vector3<f64>],
 ) -> Result<()> {
+    if cfg.system.gradiometer != Gradiometer::Scalar {
+        return Ok(());
+    }
     let radius = cfg
         .geometry()?
         .offsets_m()

@@ -88,9 +88,9 @@ pub struct SimulateArgs {
 /// or its inputs are not what they say (swapped sensors, quiet epochs
 /// that are not quiet, positions in another unit), and its estimates and
 /// σ are not to be trusted. Readings whose median field is not the IGRF's
-/// within a factor 2 are refused (another unit), as is an object's track
-/// passing inside the sphere through the sensors (positions in km?); time
-/// gaps in the pass are warned of.
+/// within a factor 2 are refused (another unit), as is, for the scalar
+/// gradiometer, an object's track passing inside the sphere through the
+/// sensors (positions in km?); time gaps in the pass are warned of.
 /// The scalar gradiometer does not estimate the position (it is known from
 /// the tracks): its `sd_x_m … mu_z` cells are empty and the summary says
 /// "σ not estimated".
