@@ -797,22 +797,23 @@ impl Track {
     /// are then not to be trusted.
     pub fn inconsistency_warning(&self) -> Option<String> {
         let m = self.mean_nis()?;
-        let causes = "A filter locked on a wrong solution (--plain from the half-space away from the \
-                      object?), sensor columns swapped or mis-mapped, positions (north_m …, obj_north_m …) \
-                      in another unit than metres, or quiet epochs (estimator.quiet_epochs) that are not \
-                      quiet?";
         if m > MAX_MEAN_NIS {
             Some(format!(
                 "the filter's normalised innovations squared average {m:.1} per contrast, where a filter \
                  whose σ describe its errors averages about 1 (above {MAX_MEAN_NIS} here): the estimates \
-                 and their σ are not to be trusted. {causes}"
+                 and their σ are not to be trusted. A filter locked on a wrong solution (--plain from \
+                 the half-space away from the object?), sensor columns swapped or mis-mapped, positions \
+                 (north_m …, obj_north_m …) in another unit than metres, or quiet epochs \
+                 (estimator.quiet_epochs) that are not quiet?"
             ))
         } else if m < MIN_MEAN_NIS {
             Some(format!(
                 "the filter's normalised innovations squared average {} per contrast, where a filter \
                  whose σ describe its errors averages about 1 (below {MIN_MEAN_NIS} here): its model \
                  predicts far larger innovations than the readings show, and the estimates and their σ \
-                 are not to be trusted. {causes}",
+                 are not to be trusted. A sensor noise (--noise-nt, sensors.vector.noise_nt or \
+                 sensors.scalar.noise_nt) larger than the sensors' own, or positions (north_m …, \
+                 obj_north_m …) in another unit than metres?",
                 aeromag_core::error::figure(m)
             ))
         } else {
