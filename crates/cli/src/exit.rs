@@ -20,6 +20,15 @@ pub fn classify(e: &anyhow::Error) -> i32 {
     1
 }
 
+/// The exit code of a failed command, `None` when the failure is an
+/// interruption's (`interrupted`: a write refused after SIGINT/SIGTERM,
+/// "cannot write 'st/index.html': interrupted"): the signal's thread exits
+/// with 130/143 and the caller waits for it (it exited 1 first, 2 of 180
+/// runs of `em study` interrupted during its final write).
+pub fn code(e: &anyhow::Error, interrupted: bool) -> Option<i32> {
+    (!interrupted).then(|| classify(e))
+}
+
 /// The message of an error chain: each cause whose text the message does
 /// not already hold, joined by ": " (library errors that quote their
 /// source are not repeated).
@@ -57,5 +66,15 @@ mod tests {
         assert_eq!(classify(&bad_input!("--x")), 2);
         let bad = anyhow::Error::new(aeromag::Error::bad_input("no"));
         assert_eq!(classify(&bad), 2);
+    }
+
+    /// A write refused after an interruption is no failure of its own:
+    /// the command exits as interrupted (130/143), not with 1.
+    #[test]
+    fn an_interrupted_write_leaves_the_exit_to_the_signal() {
+        let io = std::io::Error::new(std::io::ErrorKind::Interrupted, "interrupted");
+        let e = anyhow::Error::new(aeromag::Error::write("st/index.html", io));
+        assert_eq!(code(&e, false), Some(1));
+        assert_eq!(code(&e, true), None);
     }
 }

@@ -123,8 +123,15 @@ fn main() {
         Command::Observability(a) => commands::observability::run(a),
     });
     if let Err(e) = result {
+        let Some(code) = exit::code(&e, aeromag::io::atomic::interrupted()) else {
+            // The interruption's error: the signal's thread removes the
+            // temporaries and exits with 130/143.
+            loop {
+                std::thread::park();
+            }
+        };
         eprintln!("error: {}", exit::message(&e));
-        std::process::exit(exit::classify(&e));
+        std::process::exit(code);
     }
 }
 

@@ -100,9 +100,19 @@ pub fn simulate_em(
         cfg.seed = s;
     }
     let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
+    let _created = NewFolder::before(out);
+    // The five files checked before the synthesis (a folder in the place
+    // of one failed with exit 1 after the first were replaced).
+    let inputs: Vec<&Path> = config.into_iter().collect();
+    check_folder_files(out, aeromag::em::SimulatedEm::FILE_NAMES, &inputs)?;
     let spinner = crate::progress::spinner("simulating em");
-    let files = aeromag::em::simulate_to_dir(&cfg, known_positions, out)
-        .map_err(|e| anyhow::Error::new(e).context(format!("'{file}'")))?;
+    // A scenario file is named with the errors (with none, the message
+    // named a file 'defaults' that does not exist).
+    let files =
+        aeromag::em::simulate_to_dir(&cfg, known_positions, out).map_err(|e| match config {
+            Some(p) => anyhow::Error::new(e).context(format!("'{}'", p.display())),
+            None => anyhow::Error::new(e),
+        })?;
     spinner.finish_and_clear();
     println!(
         "simulated em (seed {}): {} frames × 3 channels at {} Hz ({} s, {} epochs of {} samples)",
@@ -142,6 +152,9 @@ pub fn simulate_gradiometer(
         cfg.validate().map_err(|e| bad_input!("--seed: {e}"))?;
     }
     let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
+    let _created = NewFolder::before(out);
+    let inputs: Vec<&Path> = config.into_iter().collect();
+    check_folder_files(out, aeromag::gradiometry::SIMULATED_FILES, &inputs)?;
     let files = aeromag::gradiometry::simulate_to_dir(&cfg, out)?;
     println!(
         "simulated gradiometer ({:?} system, {:?} gradiometer, {:?} {} m; seed {}): {} epochs × {} columns",
@@ -218,4 +231,33 @@ pub fn check_folder_files<const N: usize>(
     let paths = names.map(|n| dir.join(n));
     check_files(paths.iter().map(|p| p.as_path()), inputs)?;
     Ok(paths)
+}
+
+/// An output folder that a command is about to create (with the folders
+/// above it that do not exist): removed again, when dropped, if the
+/// command wrote nothing into it (a refused scenario left an empty folder
+/// behind). Only empty folders are removed.
+pub struct NewFolder(Vec<std::path::PathBuf>);
+
+impl NewFolder {
+    /// Notes which of `dir` and the folders above it do not exist yet.
+    pub fn before(dir: &Path) -> Self {
+        Self(
+            dir.ancestors()
+                .filter(|d| !d.as_os_str().is_empty())
+                .take_while(|d| std::fs::symlink_metadata(d).is_err())
+                .map(Path::to_path_buf)
+                .collect(),
+        )
+    }
+}
+
+impl Drop for NewFolder {
+    fn drop(&mut self) {
+        for d in &self.0 {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
+        }
+    }
 }

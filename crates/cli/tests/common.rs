@@ -107,3 +107,37 @@ pub const POD_SETUP: [&str; 10] = [
     "--grad-up-nt-per-km",
     "-25.91",
 ];
+
+/// Every file under `dir` (hidden ones too), by relative name, with its
+/// bytes: for checking that a refused or interrupted run left a folder as
+/// it was (no file replaced, no temporary or staging folder left).
+pub fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut files = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let name = p.strip_prefix(dir).unwrap().display().to_string();
+                // A FIFO is not read (that would wait for a writer).
+                let bytes = if p.is_file() {
+                    std::fs::read(&p).unwrap()
+                } else {
+                    b"(not a file)".to_vec()
+                };
+                files.insert(name, bytes);
+            }
+        }
+    }
+    files
+}
+
+/// Make a FIFO at `path`.
+#[cfg(unix)]
+pub fn mkfifo(path: &Path) {
+    let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path; mkfifo reads nothing else.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+}

@@ -598,3 +598,31 @@ fn a_time_gap_in_the_pass_is_warned_of() {
     let o = locate_with(&csv, &toml, &d.path().join("est.csv"), &[]);
     assert!(!stderr(&o).contains("gap"), "{}", stderr(&o));
 }
+
+/// `dipole simulate` wrote the CSV, then the scenario: a folder in the
+/// place of gradiometer.toml failed with exit 1 after the CSV was
+/// replaced. Both are checked first (exit 2, nothing replaced) and
+/// written as a set.
+#[test]
+fn a_folder_in_the_place_of_the_scenario_replaces_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("g");
+    let (csv, toml) = simulate_into(&out, None);
+    std::fs::remove_file(&toml).unwrap();
+    std::fs::create_dir(&toml).unwrap();
+    let before = std::fs::read(&csv).unwrap();
+    let o = aeromag(&["dipole", "simulate", "--seed", "7", "--out", p(&out)]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("gradiometer.toml"), "{}", stderr(&o));
+    assert!(
+        std::fs::read(&csv).unwrap() == before,
+        "the CSV was replaced"
+    );
+    std::fs::remove_dir(&toml).unwrap();
+    assert_code(
+        &aeromag(&["dipole", "simulate", "--seed", "7", "--out", p(&out)]),
+        0,
+    );
+    assert!(std::fs::read(&csv).unwrap() != before);
+    assert!(std::fs::read_to_string(&toml).unwrap().contains("seed = 7"));
+}

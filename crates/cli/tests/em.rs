@@ -81,6 +81,62 @@ fn em_study_replaces_an_earlier_study_whole_or_not_at_all() {
     );
 }
 
+/// `em simulate` wrote its five files one by one: a folder in the place
+/// of em.truth.csv failed with exit 1 after em.raw, em.system.json and
+/// em.known.csv were replaced (em.toml old), and the message named a
+/// scenario file 'defaults' that does not exist. Every file is checked
+/// before the synthesis (exit 2, nothing replaced), a FIFO that no process
+/// reads too, and the five are written as a set.
+#[cfg(unix)]
+#[test]
+fn em_simulate_replaces_its_files_whole_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("em");
+    let run =
+        |seed: &str, out: &Path| aeromag(&["em", "simulate", "--seed", seed, "--out", s(out)]);
+    assert_code(&run("1", &out), 0);
+    let old = tree(&out);
+    assert_eq!(old.len(), 5);
+    let truth = out.join("em.truth.csv");
+    std::fs::remove_file(&truth).unwrap();
+    for make in ["folder", "FIFO"] {
+        if make == "folder" {
+            std::fs::create_dir(&truth).unwrap();
+        } else {
+            mkfifo(&truth);
+        }
+        let before = tree(&out);
+        let o = run("5", &out);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains("em.truth.csv"),
+            "{make}: {}",
+            stderr(&o)
+        );
+        assert!(!stderr(&o).contains("defaults"), "{}", stderr(&o));
+        assert!(tree(&out) == before, "{make}: files changed");
+        if make == "folder" {
+            std::fs::remove_dir(&truth).unwrap();
+        } else {
+            std::fs::remove_file(&truth).unwrap();
+        }
+    }
+    // --out naming a file: bad input naming it, not 'defaults'.
+    let o = run("5", &out.join("em.toml"));
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("em.toml") && !stderr(&o).contains("defaults"),
+        "{}",
+        stderr(&o)
+    );
+    assert_code(&run("5", &out), 0);
+    let new = tree(&out);
+    assert_eq!(new.len(), 5);
+    for name in ["em.raw", "em.toml"] {
+        assert!(old[name] != new[name], "{name} is the old one");
+    }
+}
+
 #[test]
 fn em_study_requires_out() {
     assert_code(&aeromag(&["em", "study"]), 2);

@@ -201,3 +201,42 @@ fn outputs_never_replace_inputs_devices_or_links() {
     assert_eq!(reader.join().unwrap(), written);
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
 }
+
+/// `report` with a FIFO that no process reads in the place of
+/// figures.json waited forever (killed at 10 s): a FIFO with no reader is
+/// refused before the work by the shared output check (exit 2, naming
+/// it), as a socket is; a FIFO with a reader is still written through
+/// (`outputs_never_replace_inputs_devices_or_links`).
+#[cfg(unix)]
+#[test]
+fn a_fifo_that_no_process_reads_is_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let flight = simulate(d, "calibration", "1");
+    let rep = d.join("rep");
+    std::fs::create_dir(&rep).unwrap();
+    mkfifo(&rep.join("figures.json"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aeromag"))
+        .args(["report", "--input", flight.to_str().unwrap(), "--out"])
+        .arg(&rep)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(30) {
+            child.kill().unwrap();
+            panic!("report still waits on the FIFO after 30 s");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("figures.json") && stderr(&o).contains("FIFO"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!rep.join("index.html").exists());
+}

@@ -180,7 +180,8 @@ fn scenario_files_round_trip_and_typos_are_errors() {
         "{}",
         stderr(&o)
     );
-    assert!(!lag_out.join("calibration.csv").exists());
+    // Not even its folder (an empty folder was left behind).
+    assert!(!lag_out.exists());
     assert_code(
         &aeromag(&["simulate", "spaceship", "--out", out.to_str().unwrap()]),
         2,
@@ -215,26 +216,33 @@ fn an_out_that_is_no_folder_and_an_unwritable_seed_are_bad_input() {
 }
 
 /// A folder in the place of the truth file: nothing is written (the flight
-/// and scenario of the new seed were written beside the old truth).
+/// and scenario of the new seed were written beside the old truth), and
+/// it is bad input, found before the simulation (exit 2; it was 1).
 #[test]
 fn a_run_that_cannot_write_every_file_writes_none() {
     let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("out");
-    let o = aeromag(&["simulate", "pod", "--out", out.to_str().unwrap()]);
-    assert_code(&o, 0);
-    let csv = std::fs::read(out.join("pod.csv")).unwrap();
-    let truth = out.join("pod.truth.json");
-    std::fs::remove_file(&truth).unwrap();
-    std::fs::create_dir(&truth).unwrap();
-    let o = aeromag(&[
-        "simulate",
-        "pod",
-        "--seed",
-        "9",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.code() != Some(0), "{}", stderr(&o));
-    assert!(stderr(&o).contains("pod.truth.json"), "{}", stderr(&o));
-    assert_eq!(std::fs::read(out.join("pod.csv")).unwrap(), csv);
+    for scenario in ["pod", "calibration"] {
+        let out = d.path().join(scenario);
+        let o = aeromag(&["simulate", scenario, "--out", out.to_str().unwrap()]);
+        assert_code(&o, 0);
+        let truth = out.join(format!("{scenario}.truth.json"));
+        std::fs::remove_file(&truth).unwrap();
+        std::fs::create_dir(&truth).unwrap();
+        let old = tree(&out);
+        let o = aeromag(&[
+            "simulate",
+            scenario,
+            "--seed",
+            "9",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains(&format!("{scenario}.truth.json")),
+            "{}",
+            stderr(&o)
+        );
+        assert!(tree(&out) == old, "{scenario}: files changed");
+    }
 }

@@ -7,12 +7,17 @@
 //!   `.NAME.PID.N.tmp` beside the target, then rename (atomic on one file
 //!   system); on any error the temporary is removed.
 //! - [`write_files`]: several files as a set: all written to temporaries
-//!   first, then renamed one right after another.
+//!   first, then renamed one right after another; [`FileSet`] the same
+//!   with each file streamed to its temporary.
+//! - [`Staging`]: a staging folder in an output folder, for a run that
+//!   writes (and reads back) a tree of files as it goes (`demo`): its
+//!   files replace the old ones together at the end.
 //! - The temporaries being written are registered; [`remove_temporaries`]
 //!   deletes them (the command-line program calls it on SIGINT/SIGTERM
 //!   before exiting with 130/143).
 //! - [`check_writable`]: before a command starts its work, make sure an
-//!   output's folder exists (it is created) and takes a file.
+//!   output's folder exists (it is created) and takes a file, and that a
+//!   FIFO has a reader.
 //!
 //! ```
 //! let dir = std::env::temp_dir().join(format!("aeromag-atomic-doc-{}", std::process::id()));
@@ -33,6 +38,9 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Temporaries being written (removed by [`remove_temporaries`]).
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// Tries of opening a FIFO for its reader ([`check_stream`]), 20 ms apart.
+#[cfg(target_os = "linux")]
+const FIFO_TRIES: u32 = 50;
 /// Counter that makes temporary names unique within the process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 /// Set by [`remove_temporaries`]: no file is completed after it.
@@ -141,54 +149,202 @@ fn write_temporary(
 /// targets, one right after another (microseconds apart, where writing
 /// them one by one left seconds between the first and the last). An error
 /// or an interruption ([`remove_temporaries`]) before the renames removes
-/// every temporary and leaves every target as it was; only a failure of a
-/// rename itself leaves the earlier targets replaced. Devices, FIFOs and
-/// sockets (`/dev/null`) are written directly, before the renames.
+/// every temporary and leaves every target as it was; an interruption
+/// during the renames waits for them to end; only a failure of a rename
+/// itself leaves the earlier targets replaced. Devices, FIFOs and sockets
+/// (`/dev/null`) are written directly, before the renames.
 ///
-/// Errors name the path that failed.
+/// Errors name the path that failed. [`FileSet`] does the same for files
+/// streamed to their temporaries.
 pub fn write_files(files: &[(&Path, &[u8])]) -> Result<(), (PathBuf, std::io::Error)> {
-    let at = |p: &Path| {
-        let p = p.to_path_buf();
-        move |e| (p, e)
-    };
-    for &(path, _) in files {
-        check_writable(path).map_err(at(path))?;
+    let mut set = FileSet::new(files.iter().map(|f| f.0))?;
+    for &(path, bytes) in files {
+        set.write(path, |w| w.write_all(bytes))?;
     }
-    let mut staged: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
-    let mut stage = || -> Result<(), (PathBuf, std::io::Error)> {
-        for &(path, bytes) in files {
-            not_interrupted().map_err(at(path))?;
-            match output_target(path).map_err(at(path))? {
-                OutputTarget::Stream(p) => {
-                    write_stream(&p, |w| w.write_all(bytes)).map_err(at(path))?;
-                }
-                OutputTarget::File(target) => {
-                    let tmp = temporary(&target);
-                    staged.push((tmp.clone(), target));
-                    write_temporary(&tmp, |w| w.write_all(bytes)).map_err(at(path))?;
-                }
+    set.commit()
+}
+
+/// A set of files written as one ([`write_files`]), each streamed to its
+/// temporary through a writer: [`FileSet::new`] checks every target,
+/// [`FileSet::write`] fills one file's temporary, [`FileSet::commit`]
+/// renames them all into place one right after another. Dropped without
+/// a commit (an error on the way), it removes its temporaries and leaves
+/// every target as it was.
+///
+/// ```
+/// use std::io::Write;
+/// let dir = std::env::temp_dir().join(format!("aeromag-fileset-doc-{}", std::process::id()));
+/// let (a, b) = (dir.join("a.csv"), dir.join("b.toml"));
+/// let mut set = aeromag_io::atomic::FileSet::new([a.as_path(), b.as_path()]).map_err(|e| e.1)?;
+/// set.write(&a, |w| w.write_all(b"x\n")).map_err(|e| e.1)?;
+/// set.write(&b, |w| w.write_all(b"y = 1\n")).map_err(|e| e.1)?;
+/// assert!(!a.exists(), "nothing is in place before the commit");
+/// set.commit().map_err(|e| e.1)?;
+/// assert_eq!(std::fs::read(&b)?, b"y = 1\n");
+/// # std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), std::io::Error>(())
+/// ```
+#[derive(Debug, Default)]
+pub struct FileSet {
+    /// (temporary, target) of every file written so far.
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl FileSet {
+    /// A new set whose `targets` are all checked ([`check_writable`])
+    /// before anything is written. Errors name the target.
+    pub fn new<'a>(
+        targets: impl IntoIterator<Item = &'a Path>,
+    ) -> Result<Self, (PathBuf, std::io::Error)> {
+        for path in targets {
+            check_writable(path).map_err(at(path))?;
+        }
+        Ok(Self::default())
+    }
+
+    /// Writes `path` to a registered temporary beside it through `write`
+    /// (flushed and synced), renamed by [`FileSet::commit`]; a device,
+    /// FIFO or socket is written directly, now.
+    pub fn write(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&mut BufWriter<Output>) -> std::io::Result<()>,
+    ) -> Result<(), (PathBuf, std::io::Error)> {
+        not_interrupted().map_err(at(path))?;
+        match output_target(path).map_err(at(path))? {
+            OutputTarget::Stream(p) => write_stream(&p, write).map_err(at(path)),
+            OutputTarget::File(target) => {
+                let tmp = temporary(&target);
+                self.staged.push((tmp.clone(), target));
+                write_temporary(&tmp, write).map_err(at(path))
             }
         }
-        not_interrupted().map_err(at(files.last().map_or(Path::new("."), |f| f.0)))
-    };
-    let mut result = stage();
-    let mut renamed = 0;
-    if result.is_ok() {
-        for (tmp, target) in &staged {
-            if let Err(e) = std::fs::rename(tmp, target) {
-                result = Err((target.clone(), e));
-                break;
-            }
-            renamed += 1;
+    }
+
+    /// Renames every temporary over its target, one right after another
+    /// ([`rename_all`]).
+    pub fn commit(mut self) -> Result<(), (PathBuf, std::io::Error)> {
+        rename_all(&mut self.staged)
+    }
+}
+
+impl Drop for FileSet {
+    fn drop(&mut self) {
+        for (tmp, _) in self.staged.drain(..) {
+            let _ = std::fs::remove_file(&tmp);
+            unregister(&tmp);
         }
     }
-    for (tmp, _) in &staged[renamed..] {
-        let _ = std::fs::remove_file(tmp);
+}
+
+/// An error naming `p`.
+fn at(p: &Path) -> impl FnOnce(std::io::Error) -> (PathBuf, std::io::Error) {
+    let p = p.to_path_buf();
+    move |e| (p, e)
+}
+
+/// Held while a set's files are renamed into place and while
+/// [`remove_temporaries`] runs: an interruption during the renames waits
+/// for them (microseconds), so the set is all new, never a mix.
+static RENAMING: Mutex<()> = Mutex::new(());
+
+/// Renames each (temporary, target) of `staged`, one right after another,
+/// unless interrupted before the first; every rename done is taken out of
+/// `staged` (whose rest the caller removes), and its temporary
+/// unregistered.
+fn rename_all(staged: &mut Vec<(PathBuf, PathBuf)>) -> Result<(), (PathBuf, std::io::Error)> {
+    let _renaming = RENAMING.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, first)) = staged.first() {
+        not_interrupted().map_err(at(first))?;
     }
-    for (tmp, _) in &staged {
+    while let Some((tmp, target)) = staged.first() {
+        std::fs::rename(tmp, target).map_err(at(target))?;
         unregister(tmp);
+        staged.remove(0);
     }
-    result
+    Ok(())
+}
+
+/// A staging folder inside an output folder, for a command whose outputs
+/// (a tree of files, some read back by the command itself) are written as
+/// the run goes and must replace the old ones as a set (`demo`): the run
+/// writes under [`Staging::path`] (`OUT/.aeromag-staging.PID.N/`, on the
+/// output's file system), and [`Staging::commit`] renames every file
+/// staged to the same place under `OUT`, one right after another. Dropped
+/// without a commit, or on an interruption ([`remove_temporaries`]), the
+/// staging folder is removed and `OUT` is left as it was.
+#[derive(Debug)]
+pub struct Staging {
+    out: PathBuf,
+    dir: PathBuf,
+}
+
+impl Staging {
+    /// A new, empty staging folder in `out` (created if missing, checked
+    /// to take files).
+    pub fn new(out: &Path) -> std::io::Result<Self> {
+        check_writable_folder(out)?;
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = out.join(format!(".aeromag-staging.{}.{n}", std::process::id()));
+        lock().push(dir.clone());
+        let staging = Self {
+            out: out.to_path_buf(),
+            dir,
+        };
+        std::fs::create_dir(&staging.dir)?;
+        Ok(staging)
+    }
+
+    /// Where the run writes its outputs.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Moves every file staged to its place under the output folder: all
+    /// targets checked first ([`check_writable`]; their subfolders
+    /// created), then renamed one right after another ([`FileSet`]'s
+    /// renames). Errors name the target.
+    pub fn commit(self) -> Result<(), (PathBuf, std::io::Error)> {
+        let mut files = Vec::new();
+        staged_files(&self.dir, &mut files).map_err(at(&self.dir))?;
+        files.sort();
+        let mut staged = Vec::with_capacity(files.len());
+        for tmp in files {
+            let rel = tmp.strip_prefix(&self.dir).unwrap_or(&tmp);
+            let target = self.out.join(rel);
+            check_writable(&target).map_err(at(&target))?;
+            match output_target(&target).map_err(at(&target))? {
+                OutputTarget::Stream(p) => {
+                    let mut from = File::open(&tmp).map_err(at(&target))?;
+                    write_stream(&p, |w| std::io::copy(&mut from, w).map(|_| ()))
+                        .map_err(at(&target))?;
+                }
+                OutputTarget::File(t) => staged.push((tmp, t)),
+            }
+        }
+        rename_all(&mut staged)
+    }
+}
+
+/// Every regular file under `dir`, recursively.
+fn staged_files(dir: &Path, files: &mut Vec<PathBuf>) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let kind = entry.file_type()?;
+        if kind.is_dir() {
+            staged_files(&entry.path(), files)?;
+        } else {
+            files.push(entry.path());
+        }
+    }
+    Ok(())
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+        unregister(&self.dir);
+    }
 }
 
 /// Writes `bytes` to `path` atomically ([`write_atomically`]).
@@ -199,23 +355,34 @@ pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
 /// Removes every temporary still being written and stops any file from
 /// being completed afterwards; returns how many were removed. For a signal
 /// handler (the process exits right after).
+/// A set being renamed into place ([`write_files`], [`Staging`]) is
+/// completed first (microseconds). A staging folder is removed whole.
 pub fn remove_temporaries() -> usize {
+    let _renaming = RENAMING.lock().unwrap_or_else(|e| e.into_inner());
     INTERRUPTED.store(true, Ordering::SeqCst);
     let list = std::mem::take(&mut *lock());
     list.iter()
-        .filter(|p| std::fs::remove_file(p).is_ok())
+        .filter(|p| std::fs::remove_file(p).is_ok() || std::fs::remove_dir_all(p).is_ok())
         .count()
+}
+
+/// Whether [`remove_temporaries`] has run (an interruption): the error a
+/// write then returns is the interruption's, for the caller to exit as
+/// interrupted rather than as failed.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
 }
 
 /// Checks, before any work, that `path` can be written: its folder is
 /// created if missing, must be a folder, and must take a new file (a probe
 /// file is created and removed); `path` itself must not be a folder.
-/// Symbolic links are followed; a device, FIFO or socket passes (it is
-/// written directly).
+/// Symbolic links are followed; a device, or a FIFO or pipe with a reader
+/// (`/dev/null`, `/dev/stdout` piped), passes (it is written directly); a
+/// FIFO with no reader and a socket do not ([`check_stream`]).
 pub fn check_writable(path: &Path) -> std::io::Result<()> {
     let err = |kind, msg: String| std::io::Error::new(kind, msg);
     let path = match output_target(path)? {
-        OutputTarget::Stream(_) => return Ok(()),
+        OutputTarget::Stream(p) => return check_stream(&p),
         OutputTarget::File(p) => p,
     };
     let path = path.as_path();
@@ -239,6 +406,61 @@ pub fn check_writable(path: &Path) -> std::io::Result<()> {
     let _ = std::fs::remove_file(&probe);
     unregister(&probe);
     made.map(|_| ())
+}
+
+/// Checks an output that is not a regular file ([`OutputTarget::Stream`]):
+/// a device passes; a socket cannot be opened, and a FIFO that no process
+/// reads would block the write forever (`report` with a FIFO in the place
+/// of figures.json waited until killed): both are refused. A FIFO with a
+/// reader passes; the descriptor of the check is kept open until the
+/// process ends, so the reader does not see the end of its data before
+/// the output is written.
+///
+/// A FIFO's reader is waited for during `FIFO_TRIES` × 20 ms (1 s).
+fn check_stream(p: &Path) -> std::io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+        static HELD: Mutex<Vec<File>> = Mutex::new(Vec::new());
+        let kind = std::fs::metadata(p)?.file_type();
+        if kind.is_socket() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is a socket, not a file",
+            ));
+        }
+        if kind.is_fifo() {
+            // A reader started with the command (`cat FIFO & aeromag …`)
+            // is waited for a moment.
+            let open = || {
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .custom_flags(libc::O_NONBLOCK)
+                    .open(p)
+            };
+            let mut tries = 0;
+            let file = loop {
+                match open() {
+                    Err(e) if e.raw_os_error() == Some(libc::ENXIO) && tries < FIFO_TRIES => {
+                        tries += 1;
+                        std::thread::sleep(std::time::Duration::from_millis(20));
+                    }
+                    Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {
+                        return Err(std::io::Error::new(
+                            std::io::ErrorKind::InvalidInput,
+                            "is a FIFO that no process reads (writing it would wait for a reader \
+                             forever); name a file",
+                        ));
+                    }
+                    other => break other?,
+                }
+            };
+            HELD.lock().unwrap_or_else(|e| e.into_inner()).push(file);
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = p;
+    Ok(())
 }
 
 /// Checks that folder `dir` exists (created if missing) and takes new files.
@@ -438,6 +660,76 @@ mod tests {
             assert_eq!(std::fs::read_to_string(p).unwrap(), "new");
         }
         assert_eq!(entries(&d), names);
+    }
+
+    /// The files of a staging folder replace the old ones together at the
+    /// commit; dropped without one (an error on the way), or with a target
+    /// that cannot be written (a file in the place of a subfolder), the
+    /// folder is left as it was, without the staging folder (`demo` wrote
+    /// its files in place as it went, and an interruption left a mix).
+    #[test]
+    fn a_staging_folder_replaces_a_tree_whole_or_not_at_all() {
+        let _serial = serial();
+        let d = dir("staging");
+        let names = ["a.csv", "sub/b.json", "sub2/c.tif"];
+        let stage = |text: &str| {
+            let s = Staging::new(&d).unwrap();
+            for n in names {
+                let p = s.path().join(n);
+                std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+                write_file(&p, text).unwrap();
+            }
+            s
+        };
+        let read = || -> Vec<String> {
+            names
+                .iter()
+                .map(|n| std::fs::read_to_string(d.join(n)).unwrap_or_default())
+                .collect()
+        };
+        stage("old").commit().unwrap();
+        assert_eq!(read(), ["old", "old", "old"]);
+        assert_eq!(entries(&d), ["a.csv", "sub", "sub2"]);
+        drop(stage("new"));
+        assert_eq!(read(), ["old", "old", "old"]);
+        assert_eq!(entries(&d), ["a.csv", "sub", "sub2"]);
+        std::fs::remove_dir_all(d.join("sub2")).unwrap();
+        std::fs::write(d.join("sub2"), "a file").unwrap();
+        let (at, _) = stage("new").commit().unwrap_err();
+        assert_eq!(at, d.join("sub2/c.tif"));
+        assert_eq!(read()[..2], ["old", "old"]);
+        assert_eq!(entries(&d), ["a.csv", "sub", "sub2"]);
+        std::fs::remove_file(d.join("sub2")).unwrap();
+        stage("new").commit().unwrap();
+        assert_eq!(read(), ["new", "new", "new"]);
+        assert_eq!(entries(&d), ["a.csv", "sub", "sub2"]);
+        // An interruption removes the staging folder whole.
+        let s = stage("newer");
+        assert_eq!(remove_temporaries(), 1);
+        assert!(!s.path().exists());
+        assert!(s.commit().is_err());
+        INTERRUPTED.store(false, Ordering::SeqCst); // for the other tests
+        assert_eq!(read(), ["new", "new", "new"]);
+        assert_eq!(entries(&d), ["a.csv", "sub", "sub2"]);
+    }
+
+    /// A set streamed through [`FileSet`] and dropped before its commit
+    /// leaves the targets and no temporary.
+    #[test]
+    fn a_file_set_dropped_before_its_commit_leaves_the_old_files() {
+        let _serial = serial();
+        let d = dir("fileset");
+        let (a, b) = (d.join("a.raw"), d.join("b.toml"));
+        write_files(&[(&a, b"old"), (&b, b"old")]).unwrap();
+        let mut set = FileSet::new([a.as_path(), b.as_path()]).unwrap();
+        set.write(&a, |w| w.write_all(b"new")).unwrap();
+        let e = set
+            .write(&b, |_| Err(std::io::Error::other("no space")))
+            .unwrap_err();
+        assert_eq!(e.0, b);
+        drop(set);
+        assert_eq!(std::fs::read(&a).unwrap(), b"old");
+        assert_eq!(entries(&d), ["a.raw", "b.toml"]);
     }
 
     #[test]

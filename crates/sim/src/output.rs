@@ -162,38 +162,49 @@ impl Simulation {
         aeromag_io::write_csv_to(table, &mut w).map_err(werr)
     }
 
+    /// The three files [`Simulation::write_to_dir`] writes for `kind`:
+    /// `<stem>.csv`, `<stem>.toml` and `<stem>.truth.json`, `stem` being
+    /// the scenario name (for checking them before a run).
+    pub fn file_names(kind: ScenarioKind) -> [String; 3] {
+        let stem = kind.name();
+        [
+            format!("{stem}.csv"),
+            format!("{stem}.toml"),
+            format!("{stem}.truth.json"),
+        ]
+    }
+
     /// Write `<stem>.csv`, `<stem>.toml` and `<stem>.truth.json` into `dir`
     /// (created if missing), `stem` being the scenario name; nothing when
     /// the readers would refuse the flight ([`Simulation::check_readable`]).
+    /// The three are written as a set ([`aeromag_io::atomic::FileSet`]):
+    /// all checked first, then all old or all new after an error or an
+    /// interruption (the flight was renamed into place before the scenario
+    /// and the truth were written).
     pub fn write_to_dir(&self, dir: &Path) -> Result<WrittenFiles> {
-        let stem = self.kind.name();
         let mut table = self.to_flight_table()?;
-        table.set_source(format!("{stem}.csv"));
+        let [csv, scenario, truth] = Self::file_names(self.kind).map(|n| dir.join(n));
+        table.set_source(
+            csv.file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        );
         Self::check_readable(&table)?;
         std::fs::create_dir_all(dir).map_err(|e| SimError::Write {
             path: dir.to_path_buf(),
             source: e,
         })?;
         let files = WrittenFiles {
-            csv: dir.join(format!("{stem}.csv")),
-            scenario: dir.join(format!("{stem}.toml")),
-            truth: dir.join(format!("{stem}.truth.json")),
+            csv,
+            scenario,
+            truth,
         };
-        let werr = |p: &Path| {
-            let p = p.to_path_buf();
-            move |e| SimError::Write {
-                path: p.clone(),
-                source: e,
-            }
-        };
-        // All three checked before any is written (a folder in the place
-        // of the truth file left a new flight beside the old truth), then
-        // each file through a temporary renamed when complete.
-        for p in [&files.csv, &files.scenario, &files.truth] {
-            aeromag_io::atomic::check_writable(p).map_err(werr(p))?;
-        }
+        let werr = |(path, source): (PathBuf, std::io::Error)| SimError::Write { path, source };
+        let mut set = aeromag_io::atomic::FileSet::new(
+            [&files.csv, &files.scenario, &files.truth].map(|p| p.as_path()),
+        )
+        .map_err(werr)?;
         let mut failure: Option<SimError> = None;
-        aeromag_io::atomic::write_atomically(&files.csv, |w| {
+        set.write(&files.csv, |w| {
             self.write_table_csv(&table, w).map_err(|e| {
                 let io = std::io::Error::other(e.to_string());
                 failure = Some(e);
@@ -206,12 +217,15 @@ impl Simulation {
                 source,
             },
             Some(other) => other,
-            None => werr(&files.csv)(e),
+            None => werr(e),
         })?;
-        aeromag_io::atomic::write_file(&files.scenario, &self.scenario_toml)
-            .map_err(werr(&files.scenario))?;
-        aeromag_io::atomic::write_file(&files.truth, &self.truth_json)
-            .map_err(werr(&files.truth))?;
+        set.write(&files.scenario, |w| {
+            w.write_all(self.scenario_toml.as_bytes())
+        })
+        .map_err(werr)?;
+        set.write(&files.truth, |w| w.write_all(self.truth_json.as_bytes()))
+            .map_err(werr)?;
+        set.commit().map_err(werr)?;
         Ok(files)
     }
 }

@@ -5,12 +5,13 @@
 use super::calibrate::check_known_position;
 use super::files::{MAX_FRAME_INDEX, check_raw_header};
 use crate::error::{Error, Result};
-use crate::model_file::{write_atomically, write_streamed};
 use aeromag_em::detection::block_centre_time_s;
 use aeromag_em::sim::{
     EmScenario, EmSimConfig, RawHeader, known_csv, synthesize, truth_csv, write_raw,
 };
 use aeromag_em::study::STUDY_WINDOW_LEN;
+use aeromag_io::atomic::FileSet;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Known positions written by default (calibration stage 2 needs ≥ 2).
@@ -153,32 +154,72 @@ pub fn simulate_to_dir(
     }
     debug_assert_eq!(rec.header, header);
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
-    let path = |n: &str| out.join(n);
+    let [raw, system, known, truth, scenario] = SimulatedEm::FILE_NAMES.map(|n| out.join(n));
     let files = SimulatedEm {
-        raw: path("em.raw"),
-        system: path("em.system.json"),
-        known: path("em.known.csv"),
-        truth: path("em.truth.csv"),
-        scenario: path("em.toml"),
+        raw,
+        system,
+        known,
+        truth,
+        scenario,
         frames: rec.header.frames,
         epochs: times.len(),
     };
-    write_streamed(&files.raw, |w| Ok(write_raw(w, &rec.header, &rec.samples)?))?;
-    write_atomically(
-        &files.system,
-        serde_json::to_string_pretty(&rec.header.system)?.as_bytes(),
-    )?;
-    write_atomically(
-        &files.known,
-        known_csv(&sc, &times[..known_positions], &times[..1]).as_bytes(),
-    )?;
-    write_atomically(&files.truth, truth_csv(&sc, &times).as_bytes())?;
     let scenario = toml::to_string(cfg).map_err(|e| Error::Serialize {
         what: "EM scenario",
         reason: e.to_string(),
     })?;
-    write_atomically(&files.scenario, scenario.as_bytes())?;
+    // The five as a set (each was renamed into place as it was written: a
+    // folder in the place of em.truth.csv left a new record beside the old
+    // scenario): all checked, written to temporaries (the record streamed
+    // to its own), then renamed one right after another.
+    let werr = |(path, e): (PathBuf, std::io::Error)| Error::write(path, e);
+    let mut set = FileSet::new(
+        [
+            &files.raw,
+            &files.system,
+            &files.known,
+            &files.truth,
+            &files.scenario,
+        ]
+        .map(|p| p.as_path()),
+    )
+    .map_err(werr)?;
+    let mut failure = None;
+    set.write(&files.raw, |w| {
+        write_raw(w, &rec.header, &rec.samples).map_err(|e| {
+            failure = Some(e);
+            std::io::Error::other("write failed")
+        })
+    })
+    .map_err(|e| failure.take().map_or_else(|| werr(e), Error::from))?;
+    let system = serde_json::to_string_pretty(&rec.header.system)?;
+    let texts = [
+        (&files.system, system),
+        (
+            &files.known,
+            known_csv(&sc, &times[..known_positions], &times[..1]),
+        ),
+        (&files.truth, truth_csv(&sc, &times)),
+        (&files.scenario, scenario),
+    ];
+    for (path, text) in texts {
+        set.write(path, |w| w.write_all(text.as_bytes()))
+            .map_err(werr)?;
+    }
+    set.commit().map_err(werr)?;
     Ok(files)
+}
+
+impl SimulatedEm {
+    /// The names of the five files [`simulate_to_dir`] writes in its
+    /// folder: record, system, known positions, truth, scenario.
+    pub const FILE_NAMES: [&str; 5] = [
+        "em.raw",
+        "em.system.json",
+        "em.known.csv",
+        "em.truth.csv",
+        "em.toml",
+    ];
 }
 
 #[cfg(test)]

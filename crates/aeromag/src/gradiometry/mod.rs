@@ -194,16 +194,27 @@ pub struct SimulatedPass {
     pub columns: usize,
 }
 
+/// The files [`simulate_to_dir`] writes in its folder: the pass and its
+/// scenario.
+pub const SIMULATED_FILES: [&str; 2] = ["gradiometer.csv", "gradiometer.toml"];
+
 /// Simulate the configured pass and write `DIR/gradiometer.csv`
-/// ([`pass_table`]) and `DIR/gradiometer.toml`.
+/// ([`pass_table`]) and `DIR/gradiometer.toml`, as a set.
 pub fn simulate_to_dir(cfg: &GradiometerConfig, out: &Path) -> Result<SimulatedPass> {
     let table = simulate_pass(cfg)?;
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
-    let csv = out.join("gradiometer.csv");
-    let scenario = out.join("gradiometer.toml");
-    aeromag_io::write_csv(&table, &csv)?;
+    let [csv, scenario] = SIMULATED_FILES.map(|n| out.join(n));
     let text = cfg.to_toml()?;
-    crate::model_file::write_atomically(&scenario, text.as_bytes())?;
+    // The two as a set, checked first (the CSV was replaced before a
+    // folder in the place of the scenario failed its write).
+    let werr = |(path, e): (std::path::PathBuf, std::io::Error)| Error::write(path, e);
+    let mut set =
+        aeromag_io::atomic::FileSet::new([csv.as_path(), scenario.as_path()]).map_err(werr)?;
+    set.write(&csv, |w| aeromag_io::write_csv_to(&table, w))
+        .map_err(werr)?;
+    set.write(&scenario, |w| std::io::Write::write_all(w, text.as_bytes()))
+        .map_err(werr)?;
+    set.commit().map_err(werr)?;
     Ok(SimulatedPass {
         csv,
         scenario,

@@ -108,6 +108,18 @@ impl StudyOutcome for DemoOutcome {
     }
 }
 
+impl Demo {
+    /// Every file a run at `size` writes in `out`, relative to it: the
+    /// fixed-wing study's simulated flights, models and compensated
+    /// flights, and the maps (the command adds its summary and report),
+    /// for checking them all before minutes of work.
+    pub fn outputs(size: StudySize) -> Vec<PathBuf> {
+        let mut files = FixedWingStudy::outputs(size);
+        files.extend(MapsStudy::outputs());
+        files
+    }
+}
+
 impl DemoOutcome {
     /// The single-file HTML report.
     pub fn report(&self) -> Report {

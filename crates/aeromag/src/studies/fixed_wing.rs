@@ -323,6 +323,43 @@ fn duration(f: &Flight) -> Result<f64> {
     Ok(time.last().copied().unwrap_or(0.0) - time.first().copied().unwrap_or(0.0))
 }
 
+/// The models and compensated flights the study writes in its folder
+/// (beside `data/`).
+const MODEL_LS: &str = "model_ls.json";
+const MODEL_KALMAN: &str = "model_kalman.json";
+const CALIBRATION_COMP: &str = "calibration_comp.csv";
+const SURVEY_COMP: &str = "survey_comp.csv";
+
+/// The calibration pattern flown at `size`.
+fn calibration_kind(size: StudySize) -> ScenarioKind {
+    if size == StudySize::Quick {
+        ScenarioKind::CalibrationTruncated
+    } else {
+        ScenarioKind::Calibration
+    }
+}
+
+impl FixedWingStudy {
+    /// Every file a run at `size` writes, relative to its folder (for
+    /// checking them all before a run, [`super::Demo::outputs`]).
+    pub fn outputs(size: StudySize) -> Vec<PathBuf> {
+        let data = Path::new("data");
+        let simulated =
+            |dir: &Path, kind| aeromag_sim::Simulation::file_names(kind).map(|n| dir.join(n));
+        let cal_kind = calibration_kind(size);
+        let mut files: Vec<PathBuf> = simulated(data, cal_kind).into();
+        for g in &GEOLOGY_AREAS {
+            files.extend(simulated(&data.join(g.dir), cal_kind));
+        }
+        files.extend(simulated(data, ScenarioKind::Survey));
+        if size != StudySize::Quick {
+            files.extend(simulated(data, ScenarioKind::CalibrationTruncated));
+        }
+        files.extend([MODEL_LS, MODEL_KALMAN, CALIBRATION_COMP, SURVEY_COMP].map(PathBuf::from));
+        files
+    }
+}
+
 impl Study for FixedWingStudy {
     type Outcome = FixedWingOutcome;
 
@@ -335,11 +372,7 @@ impl Study for FixedWingStudy {
         // 1. Simulate: a quiet calibration area (the default), the same
         //    aircraft calibrated over geology, and an independent survey.
         observer.stage("simulating");
-        let cal_kind = if quick {
-            ScenarioKind::CalibrationTruncated
-        } else {
-            ScenarioKind::Calibration
-        };
+        let cal_kind = calibration_kind(size);
         let cal_files = written(simulate(cal_kind, None, Some(self.seed))?, &data)?;
         let geology_files = GEOLOGY_AREAS
             .iter()
@@ -367,16 +400,16 @@ impl Study for FixedWingStudy {
             .iter()
             .map(|f| self.fit_both(&f.csv, &opts, observer))
             .collect::<Result<Vec<_>>>()?;
-        crate::ModelFile::write(&quiet.ls, self.out.join("model_ls.json"))?;
-        crate::ModelFile::write(&quiet.kalman, self.out.join("model_kalman.json"))?;
+        crate::ModelFile::write(&quiet.ls, self.out.join(MODEL_LS))?;
+        crate::ModelFile::write(&quiet.kalman, self.out.join(MODEL_KALMAN))?;
 
         // 3. Compensate.
         observer.stage("compensating");
         let survey_raw = Flight::read(&survey_files.csv)?;
         let cal = compensated(&quiet.flight, &quiet.ls)?;
         let survey = compensated(&survey_raw, &quiet.ls)?;
-        io::write_csv(&cal, &self.out.join("calibration_comp.csv"))?;
-        io::write_csv(&survey, &self.out.join("survey_comp.csv"))?;
+        io::write_csv(&cal, &self.out.join(CALIBRATION_COMP))?;
+        io::write_csv(&survey, &self.out.join(SURVEY_COMP))?;
 
         // 4. Score.
         observer.stage("scoring");

@@ -284,15 +284,16 @@ impl Study for MapsStudy {
                 path: dir.clone(),
                 source: e,
             })?;
-            for (name, g) in [
-                ("uncompensated", &unc.grid),
-                ("compensated", &comp.grid),
-                ("levelled", &lev.grid),
-                ("microlevelled", &mlev.grid),
-                ("truth", &truth.grid),
-                ("levelled_minus_truth", &err),
-            ] {
-                let path = dir.join(format!("{name}.tif"));
+            let grids = [
+                &unc.grid,
+                &comp.grid,
+                &lev.grid,
+                &mlev.grid,
+                &truth.grid,
+                &err,
+            ];
+            for (path, g) in Self::outputs().into_iter().zip(grids) {
+                let path = out.join(path);
                 write_grid(&path, g)?;
                 written.push(path);
             }
@@ -303,6 +304,23 @@ impl Study for MapsStudy {
             lines: tracks.into_values().collect(),
             written,
         })
+    }
+}
+
+impl MapsStudy {
+    /// The GeoTIFF files a run with an output folder writes, relative to
+    /// it (for checking them before a run, [`super::Demo::outputs`]).
+    pub fn outputs() -> Vec<PathBuf> {
+        [
+            "uncompensated",
+            "compensated",
+            "levelled",
+            "microlevelled",
+            "truth",
+            "levelled_minus_truth",
+        ]
+        .map(|name| PathBuf::from(format!("maps/{name}.tif")))
+        .into()
     }
 }
 

@@ -2,6 +2,8 @@
 //! [`aeromag::studies::Demo`]).
 
 use crate::progress::Bars;
+use aeromag::io::atomic::Staging;
+use aeromag::observer::{Note, Observer};
 use aeromag::studies::{Demo, PrintedSummary, Study, StudySize};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,25 +36,53 @@ pub struct Args {
     quick: bool,
 }
 
+/// The command's own files in DIR, beside the studies' ([`Demo::outputs`]).
+const SUMMARY: &str = "summary.json";
+const INDEX: &str = "index.html";
+
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let [summary, index] =
-        crate::output::check_folder_files(&a.out, ["summary.json", "index.html"], &[])?;
+    let size = StudySize::quick_if(a.quick);
+    // Every file of the run checked before minutes of work (a folder in
+    // the place of maps/levelled.tif failed after 40 s, with a mix of old
+    // and new files).
+    let mut files = Demo::outputs(size);
+    files.extend([SUMMARY, INDEX].map(PathBuf::from));
+    crate::output::check_folder(&a.out)?;
+    let targets: Vec<PathBuf> = files.iter().map(|f| a.out.join(f)).collect();
+    crate::output::check_files(targets.iter().map(|p| p.as_path()), &[])?;
     let start = Instant::now();
-    std::fs::create_dir_all(a.out.join("data"))
-        .map_err(|e| aeromag::Error::write(a.out.join("data"), e))?;
     if a.quick {
         eprintln!("--quick: the truncated calibration pattern is used");
     }
+    // The run writes into a staging folder in DIR, whose files replace the
+    // old ones together at the end: an error or an interruption on the way
+    // leaves the old set whole (data and models were replaced as the run
+    // went, the summary, report and maps at the end).
+    let staging = Staging::new(&a.out).map_err(|e| aeromag::Error::write(&a.out, e))?;
     let demo = Demo {
         seed: a.seed,
-        out: a.out.clone(),
+        out: staging.path().to_path_buf(),
     };
-    let out = demo.run(StudySize::quick_if(a.quick), &mut Bars::new())?;
-    // The summary and the report as a set: both old or both new.
+    let mut bars = Bars::new();
+    let mut observer = Staged {
+        inner: &mut bars,
+        staging: staging.path().display().to_string(),
+        out: a.out.display().to_string(),
+    };
+    let out = demo.run(size, &mut observer)?;
     aeromag::model_file::write_files(&[
-        (&summary, out.summary.to_json()?.as_bytes()),
-        (&index, out.report().to_html().as_bytes()),
+        (
+            &staging.path().join(SUMMARY),
+            out.summary.to_json()?.as_bytes(),
+        ),
+        (
+            &staging.path().join(INDEX),
+            out.report().to_html().as_bytes(),
+        ),
     ])?;
+    staging
+        .commit()
+        .map_err(|(path, e)| aeromag::Error::write(path, e))?;
     println!(
         "aeromag demo (seed {}, {:.1} s)",
         a.seed,
@@ -62,6 +92,30 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for row in out.summary.printed() {
         println!("{:<56} {:>12}", row.key, row.value);
     }
-    println!("results in {}/ (summary.json, index.html)", a.out.display());
+    println!("results in {}/ ({SUMMARY}, {INDEX})", a.out.display());
     Ok(())
+}
+
+/// The run's observer, its notes naming the files where they end up
+/// (`DIR/data/…`), not in the staging folder where the run writes them.
+struct Staged<'a> {
+    inner: &'a mut dyn Observer,
+    staging: String,
+    out: String,
+}
+
+impl Observer for Staged<'_> {
+    fn stage(&mut self, name: &str) {
+        self.inner.stage(name);
+    }
+
+    fn progress(&mut self, done: u64, total: u64) {
+        self.inner.progress(done, total);
+    }
+
+    fn note(&mut self, note: &Note) {
+        let mut note = note.clone();
+        note.message = note.message.replace(&self.staging, &self.out);
+        self.inner.note(&note);
+    }
 }

@@ -48,6 +48,12 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     // Before simulating: an --out that is a file (or /dev/null) failed
     // after the simulation with exit 1.
+    // A folder this run creates is removed again if the run writes nothing
+    // into it (a refused scenario left an empty folder behind).
+    let _created = (!a.print_config)
+        .then_some(a.out.as_deref())
+        .flatten()
+        .map(crate::output::NewFolder::before);
     if let (Some(out), false) = (&a.out, a.print_config) {
         crate::output::check_folder(out)?;
     }
@@ -80,6 +86,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ),
         None => None,
     };
+    let out = a
+        .out
+        .as_ref()
+        .ok_or_else(|| bad_input!("--out DIR is required"))?;
+    // The three files checked before the simulation: a folder in the
+    // place of one is bad input (it failed with exit 1).
+    let names = aeromag_sim::Simulation::file_names(kind);
+    let inputs: Vec<&std::path::Path> = a.config.as_deref().into_iter().collect();
+    crate::output::check_folder_files(out, names.each_ref().map(|n| n.as_str()), &inputs)?;
     let spinner = crate::progress::spinner(&format!("simulating {kind}"));
     // The scenario file named with its values' errors (a flight the
     // readers would refuse is found at writing).
@@ -91,10 +106,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let sim = simulate(kind, text.as_deref(), a.seed).map_err(in_config)?;
     spinner.finish_and_clear();
-    let out = a
-        .out
-        .as_ref()
-        .ok_or_else(|| bad_input!("--out DIR is required"))?;
     let files = sim.write_to_dir(out).map_err(in_config)?;
     println!(
         "simulated {kind} (seed {}): {} rows × {} columns",
