@@ -234,12 +234,16 @@ pub struct EmCalibration {
     pub attitude_correction_deg: f64,
 }
 
-/// The known positions against the prior half-space: a known position
-/// whose direction `e` lies on the other side beyond the continuity margin
-/// (`e·n/|n| < −margin`, [`Hemisphere`]) is bad input, as `em locate` with
-/// this half-space would mirror every such bird to `−r`. A scenario's birds
-/// ahead of the transmitter (mean direction `1,0,0`) with the default
-/// `-1,0,1` were calibrated without a word and then located 84 m off.
+/// The known positions against the prior half-space: each known
+/// position's direction `e` must lie clearly on the half-space's side,
+/// `e·n/|n| ≥ margin` ([`Hemisphere`]); one within the continuity margin
+/// or beyond the plane is bad input. Then the half-space stored in the
+/// calibration file decides the sign at the known positions. A scenario's
+/// birds ahead of the transmitter (mean direction `1,0,0`) with the
+/// default `-1,0,1` were calibrated without a word and then located 84 m
+/// off; birds 4–9° beyond the plane (`e·n` = −0.08 … −0.16, mean direction
+/// `0.8,0,0.6`, or `--half-space=1,0,1.2` on the default flight) were
+/// calibrated too, and `em locate` mirrored every one (87 m off, exit 0).
 fn check_known_side(
     epochs: &[FieldEpoch],
     known: &KnownPoints,
@@ -251,7 +255,7 @@ fn check_known_side(
     let Some(&(k, r)) = known
         .positions
         .iter()
-        .find(|(_, r)| side(r) < -hemisphere.margin)
+        .find(|(_, r)| side(r) < hemisphere.margin)
     else {
         return Ok(());
     };
@@ -265,13 +269,19 @@ fn check_known_side(
     } else {
         String::new()
     };
+    let s = side(&r);
+    let margin = hemisphere.margin;
+    let place = if s < 0.0 {
+        format!("lies in the half-space opposite to --half-space={half_space}")
+    } else {
+        format!("lies within the continuity margin of the plane of --half-space={half_space}")
+    };
     Err(Error::bad_input(format!(
-        "the known position at {} s ({}, {}, {} m from the transmitter) lies in the half-space opposite to --half-space={half_space} (its direction makes e·n = {:.2}): `em locate` would mirror the bird to −r{hint}",
+        "the known position at {} s ({}, {}, {} m from the transmitter) {place} (its direction makes e·n = {s:.2}; known positions must be clearly on the half-space's side, e·n ≥ {margin}, ≈ 11.5° from the plane, for the half-space to decide the sign of r): `em locate` would mirror the bird to −r{hint}",
         shown(epochs.get(k).map_or(f64::NAN, |e| e.time_s)),
         shown(r.x),
         shown(r.y),
         shown(r.z),
-        side(&r),
     )))
 }
 

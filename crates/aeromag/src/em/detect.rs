@@ -67,7 +67,10 @@ pub struct Detection {
 /// a warning. Samples far outside their block's robust spread (impulsive
 /// spikes: sferics, ADC glitches) are repaired by interpolation before
 /// detection and counted in a warning naming the file, frame, epoch time
-/// and channel ([`aeromag_em::detection::impulse`]).
+/// and channel ([`aeromag_em::detection::impulse`]). An epoch in which a
+/// channel is flat (pilot sensitivity below [`FLAT_CHANNEL_RATIO`] of the
+/// others': a dead or saturated channel) is left out, with a warning
+/// naming the file, frames, epoch time and channel.
 ///
 /// ```
 /// use aeromag::em::files::{load_table, read_system};
@@ -149,6 +152,7 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
             system.pilot_offset_hz
         ));
     }
+    system.check_tone_plan(fs, n).in_file(&file)?;
     let chain = system
         .chain(fs, n, opts.window, opts.pilot)
         .in_file(&file)?;
@@ -183,6 +187,28 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
             s.value
         ));
     }
+    // Epochs with a flat channel (its pilots not in the signal) left out.
+    let flat: Vec<(usize, usize, f64, f64)> = epochs
+        .iter()
+        .enumerate()
+        .filter_map(|(k, e)| flat_channel(&e.xi).map(|(c, x, o)| (k, c, x, o)))
+        .collect();
+    if let Some(&(k, c, x, o)) = flat.first() {
+        let a = k as u64 * n as u64;
+        notes.warn(format!(
+            "'{file}': a flat channel (no signal at the tones while the others carry it) in {} epoch(s), left out of the detected epochs: the first in frames {a} … {} (epoch at {} s), channel {c}, pilot-measured sensitivity |ξ| {} against {} on the other channels (a dead or saturated channel)",
+            flat.len(),
+            a + n as u64 - 1,
+            epochs[k].time_s,
+            aeromag_core::error::figure(x),
+            aeromag_core::error::figure(o)
+        ));
+        let mut k = 0;
+        epochs.retain(|_| {
+            k += 1;
+            !flat.iter().any(|f| f.0 == k - 1)
+        });
+    }
     let ratios: Vec<f64> = epochs
         .iter()
         .flat_map(|e| e.h.iter().map(|h| major_axis(h).ratio))
@@ -195,6 +221,26 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         spikes,
         notes: notes.into_notes(),
     })
+}
+
+/// Below this fraction of the largest channel's pilot-measured
+/// sensitivity |ξ| in an epoch, a channel is flat: it carries no signal at
+/// the tones. Measured on the default flight: every channel of every epoch
+/// 0.950–0.999 (gain drift 5 %); channel 1 held at 1 mV (or 1000 V) for a
+/// block gave 1.2·10⁻¹² there, just above the pilot's "not detected"
+/// (10⁻¹²), and calibration from it reached 2× instead of 1669×.
+pub const FLAT_CHANNEL_RATIO: f64 = 1e-3;
+
+/// The flat channel of an epoch whose sensitivities are `xi[i][c]`
+/// (frequency `i`, channel `c`), with its largest |ξ| and the epoch's
+/// largest: a channel whose |ξ| at every frequency is below
+/// [`FLAT_CHANNEL_RATIO`] of the epoch's largest.
+fn flat_channel(xi: &[[aeromag_em::detection::Complex64; 3]; 3]) -> Option<(usize, f64, f64)> {
+    let of = |c: usize| (0..3).map(|i| xi[i][c].norm()).fold(0.0, f64::max);
+    let largest = (0..3).map(of).fold(0.0, f64::max);
+    (0..3)
+        .find(|&c| of(c) < FLAT_CHANNEL_RATIO * largest)
+        .map(|c| (c, of(c), largest))
 }
 
 /// The error of detecting a chunk of `samples` (interleaved, 3 channels,

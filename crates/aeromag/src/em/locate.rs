@@ -1,7 +1,7 @@
 //! The calibrated per-epoch pose of the bird.
 
 use super::HalfSpace;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::observer::{Note, Notes, Observer};
 use aeromag_em::EmError;
 use aeromag_em::calibration::CalibrationFile;
@@ -125,13 +125,16 @@ impl Poses {
 /// the stage-2 moments, a Levenberg–Marquardt polish fits all nine
 /// components, and the stage-3 rotation corrects the attitude. r and −r
 /// give the same data: the sign comes from the half-space unless the
-/// direction is within ≈ 11.5° of its plane, where the previous epoch's
-/// direction decides. An epoch that fails, or whose misfit exceeds
+/// direction is within ≈ 11.5° of its plane, where the neighbouring
+/// epoch's direction decides (continuity). The sign is anchored at the
+/// first epoch the half-space decides; epochs before it take theirs by
+/// continuity backwards from it. An epoch that fails, or whose misfit exceeds
 /// [`MAX_RESIDUAL_REL`], is kept (`located: None`) and warned about with
 /// the counts.
 ///
 /// Errors ([`EmError::Failed`], not bad input) when epochs were given and
-/// none was located.
+/// none was located; bad input when no epoch's direction is decisively on
+/// one side of `half_space` (the sign of r would be a guess).
 pub fn locate(
     epochs: &[FieldEpoch],
     file: &CalibrationFile,
@@ -151,15 +154,80 @@ pub fn locate(
             "the calibration was fitted with --half-space={fitted} (its known positions on that side) and the bird is located with --half-space={half_space}: a bird on the calibration's side but not on this one comes out mirrored to −r; give both commands the same half-space"
         ));
     }
-    let mut hemi = Hemisphere::new(half_space.normal());
+    let hemi0 = Hemisphere::new(half_space.normal());
+    // Each epoch's fit and whether continuity decided its sign.
+    let fit = |e: &FieldEpoch, hemi: &mut Hemisphere| {
+        let got = file.calibration.locate(&e.h, &file.moments_am2, hemi);
+        (got, hemi.by_continuity)
+    };
+    let mut fits: Vec<Option<_>> = epochs.iter().map(|_| None).collect();
+    // The sign is anchored at the first epoch whose direction the
+    // half-space decides (outside the margin), fitted as if it were the
+    // first: an undecided first epoch took its sign from the half-space
+    // alone and continuity carried a wrong hemisphere through the record
+    // (birds 4–9° beyond the plane all mirrored, 87 m off, exit 0).
+    let mut anchor = None;
+    // The epoch whose direction is furthest from the plane, |e·n|, time.
+    let mut nearest_decisive = (f64::NEG_INFINITY, f64::NAN);
+    for (k, e) in epochs.iter().enumerate() {
+        let mut probe = hemi0;
+        let got = fit(e, &mut probe);
+        let Some(dir) = probe.previous else { continue };
+        if probe.decisive(&dir) {
+            fits[k] = Some(got);
+            anchor = Some((k, probe));
+            break;
+        }
+        let side = probe.side(&dir).abs();
+        if side > nearest_decisive.0 {
+            nearest_decisive = (side, e.time_s);
+        }
+    }
+    let (start, mut forward) = match anchor {
+        Some((k, hemi)) => (k + 1, hemi),
+        // No epoch gave a direction at all: each fails below.
+        None if nearest_decisive.0.is_infinite() => (0, hemi0),
+        None => {
+            let stored = file
+                .half_space
+                .map(|n| {
+                    format!(
+                        " (the calibration was fitted with --half-space={},{},{})",
+                        n[0], n[1], n[2]
+                    )
+                })
+                .unwrap_or_default();
+            return Err(Error::bad_input(format!(
+                "--half-space={half_space}{stored}: no epoch of {} has its direction decisively on one side (|e·n| ≥ {} of the plane; the largest is {:.3}, at {} s), so the sign of r cannot be chosen: pass the bird's half-space as --half-space=NX,NY,NZ",
+                epochs.len(),
+                hemi0.margin,
+                nearest_decisive.0,
+                nearest_decisive.1
+            )));
+        }
+    };
+    for k in start..epochs.len() {
+        fits[k] = Some(fit(&epochs[k], &mut forward));
+    }
+    // Continuity from the anchor backwards over the undecided epochs before it.
+    if let Some((k, hemi)) = anchor {
+        let mut backward = Hemisphere {
+            previous: hemi.previous,
+            ..hemi0
+        };
+        for j in (0..k).rev() {
+            fits[j] = Some(fit(&epochs[j], &mut backward));
+        }
+    }
     let mut poses = Vec::with_capacity(epochs.len());
     let mut failed = 0usize;
     // Epochs whose fit does not explain the field: count, first time, range.
     let mut misfit = 0usize;
     let mut misfit_first = 0.0;
     let (mut misfit_lo, mut misfit_hi) = (f64::INFINITY, 0.0f64);
-    for e in epochs {
-        let located = match file.calibration.locate(&e.h, &file.moments_am2, &mut hemi) {
+    // Every epoch is fitted, in one of the three passes above.
+    for (e, (got, by_continuity)) in epochs.iter().zip(fits.into_iter().flatten()) {
+        let located = match got {
             Ok(l) if l.rms_residual.is_nan() || l.rms_residual > MAX_RESIDUAL_REL => {
                 misfit += 1;
                 if misfit == 1 {
@@ -182,7 +250,7 @@ pub fn locate(
                     ],
                     polarisation_ratio: l.polarisation_ratio,
                     residual_rel: l.rms_residual,
-                    by_continuity: hemi.by_continuity,
+                    by_continuity,
                 })
             }
             Err(err) => {

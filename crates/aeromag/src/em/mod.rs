@@ -14,7 +14,7 @@ mod simulate;
 
 pub use aeromag_em::{EmError, calibration, detection, positioning, sim, study};
 pub use calibrate::{EmCalibration, KNOWN_RANGE_M, calibrate, check_known_position, known_points};
-pub use detect::{DetectOptions, Detection, detect};
+pub use detect::{DetectOptions, Detection, FLAT_CHANNEL_RATIO, detect};
 pub use locate::{Located, MAX_RESIDUAL_REL, Pose, Poses, locate};
 pub use simulate::{DEFAULT_KNOWN, SimulatedEm, command_default, parse_config, simulate_to_dir};
 

@@ -121,6 +121,10 @@ pub fn simulate_to_dir(
     );
     check_raw_header(&header)
         .map_err(|m| Error::bad_input(format!("em detect would refuse the record: {m}")))?;
+    header
+        .system
+        .check_tone_plan(fs, STUDY_WINDOW_LEN)
+        .map_err(|e| Error::bad_input(format!("em detect would refuse the record: {e}")))?;
     let start = header.start_index;
     let blocks = header.frames as usize / STUDY_WINDOW_LEN;
     let times: Vec<f64> = (0..blocks)

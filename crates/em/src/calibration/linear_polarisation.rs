@@ -89,8 +89,9 @@ impl PolarisationCalibration {
     /// vanishes, so that the real part is not rotated into the imaginary
     /// coupling.
     ///
-    /// Errors: fewer than 8 epochs, non-finite data, or a rank-deficient
-    /// system (too little variety of positions and attitudes).
+    /// Errors (all bad input): fewer than 8 epochs, non-finite data, or a
+    /// rank-deficient system (too little variety of positions and
+    /// attitudes).
     pub fn fit(epochs: &[[[Complex64; 3]; 3]]) -> Result<Self> {
         if epochs.len() < 8 {
             return Err(EmError::InvalidArgument {
@@ -140,8 +141,13 @@ impl PolarisationCalibration {
                 }
                 let sol = ata
                     .cholesky()
-                    .ok_or_else(|| EmError::Singular {
-                        what: format!("stage-1 normal equations, frequency {i}"),
+                    // Bad input, not a failed fit: the data cannot
+                    // determine stage 1 (every epoch carrying the same
+                    // field gave "singular matrix", exit 1).
+                    .ok_or_else(|| EmError::InvalidData {
+                        reason: format!(
+                            "the detected epochs do not determine calibration stage 1 (singular normal equations at frequency {i}): its fields do not vary, and stage 1 needs epochs at varied attitudes (a record of one repeated epoch, or one swamped by interference)"
+                        ),
                     })?
                     .solve(&aty);
                 let mut p = Matrix3::zeros();

@@ -46,14 +46,26 @@ impl Hemisphere {
         }
     }
 
-    /// Orient `e` (unit) and remember it for the next epoch.
-    pub fn resolve(&mut self, e: &Vector3<f64>) -> Vector3<f64> {
+    /// `e·n/|n|` of a unit direction `e`: its side of the dividing plane
+    /// (0 for a zero or non-finite normal, which decides nothing).
+    pub fn side(&self, e: &Vector3<f64>) -> f64 {
         let n = self.normal.norm();
-        let s = if n > 0.0 {
+        if n > 0.0 {
             e.dot(&self.normal) / n
         } else {
             0.0
-        };
+        }
+    }
+
+    /// Whether the half-space alone decides the sign of `e` (unit):
+    /// `|e·n|/|n| ≥ margin`. The same for `e` and `−e`.
+    pub fn decisive(&self, e: &Vector3<f64>) -> bool {
+        self.side(e).abs() >= self.margin
+    }
+
+    /// Orient `e` (unit) and remember it for the next epoch.
+    pub fn resolve(&mut self, e: &Vector3<f64>) -> Vector3<f64> {
+        let s = self.side(e);
         let flip = match self.previous {
             Some(p) if s.abs() < self.margin => {
                 self.by_continuity = true;

@@ -74,6 +74,16 @@ pub struct EmSimConfig {
     pub sferic_amplitude_v: f64,
 }
 
+/// The largest noise or interference amplitude simulated
+/// (`coil_noise_v`, `power_line_v`, `sferic_amplitude_v`), V. Measured on
+/// the default flight (`em simulate` → `detect` → `calibrate` → `locate`)
+/// with `power_line_v` raised: up to 10⁴ V the 400 Hz harmonics are
+/// rejected (polarisation ratio after calibration 2.31–2.42·10⁻⁵, largest
+/// position error 0.011 m, as at the default 10⁻² V); at 10⁶ V the f32
+/// record's rounding gives 5.9·10⁻⁴ and 0.12 m, and at 10³⁰ V every epoch
+/// carried the same field (calibrate: "singular matrix", exit 1).
+pub const MAX_INTERFERENCE_V: f64 = 1e4;
+
 /// The highest sferic rate simulated, 1/s: every sferic is a waveform of
 /// its own, so 10⁸/s (a mutated scenario file) ran for minutes on a
 /// 10-second record; lightning gives tens to hundreds per second.
@@ -137,21 +147,83 @@ fn random_phase_complex(rng: &mut ChaCha8Rng, lo: f64, hi: f64) -> Complex64 {
     Complex64::from_polar(rng.random_range(lo..hi), rng.random_range(0.0..TAU))
 }
 
+/// The unit mean direction `e`, the swing direction `side = (0, 1, 0)`
+/// and `up = e × side` (normalised) of the simulated motion; NaN when
+/// `mean_direction` is along `side` or too small to normalise.
+fn swing_frame(mean_direction: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let e = mean_direction.normalize();
+    let side = Vector3::new(0.0, 1.0, 0.0);
+    let up = e.cross(&side).normalize();
+    (e, side, up)
+}
+
 impl EmScenario {
     /// Draw the scenario from the configuration's seed.
     ///
-    /// Errors ([`EmError::InvalidArgument`]) for non-positive rate, duration
-    /// or ranges, negative or non-finite noise and interference levels, or
+    /// Errors ([`EmError::InvalidArgument`], naming the field) for
+    /// non-positive rate, duration or ranges, a minimum above its maximum
+    /// (ranges, cross-coupling), a period of 0, a mean direction that is 0,
+    /// along the swing axis y or too small to normalise, noise and
+    /// interference levels outside 0 … [`MAX_INTERFERENCE_V`], or
     /// frequencies (with pilots) outside `(0, f_s/2)`.
     pub fn new(config: EmSimConfig) -> Result<Self> {
         let c = &config;
-        if !(c.sample_rate_hz > 0.0
-            && c.duration_s > 0.0
-            && c.range_min_m > 0.0
-            && c.range_max_m >= c.range_min_m)
-        {
-            return Err(EmError::InvalidArgument {
-                reason: "rate, duration and ranges must be positive".into(),
+        let invalid = |reason: String| Err(EmError::InvalidArgument { reason });
+        let shown = aeromag_core::error::shown;
+        for (name, v) in [
+            ("sample_rate_hz", c.sample_rate_hz),
+            ("duration_s", c.duration_s),
+            ("range_min_m", c.range_min_m),
+        ] {
+            if v.is_nan() || v <= 0.0 {
+                return invalid(format!("field '{name}' is {}, must be positive", shown(v)));
+            }
+        }
+        if c.range_max_m.is_nan() || c.range_max_m < c.range_min_m {
+            return invalid(format!(
+                "field 'range_min_m' {} m is above 'range_max_m' {} m: the range sweeps from the minimum to the maximum",
+                shown(c.range_min_m),
+                shown(c.range_max_m)
+            ));
+        }
+        // The motion and the drift divide flight time by these: 0 gave
+        // positions of NaN m ("0 m from the transmitter") or NaN samples.
+        for (name, v) in [
+            ("range_period_s", c.range_period_s),
+            ("swing_period_s", c.swing_period_s),
+            ("drift_period_s", c.drift_period_s),
+        ] {
+            if v == 0.0 {
+                return invalid(format!(
+                    "field '{name}' is 0 s: a period must not be 0 (the simulation divides flight time by it)"
+                ));
+            }
+        }
+        let [lo, hi] = c.cross_coupling;
+        if lo.is_nan() || hi.is_nan() || lo > hi {
+            return invalid(format!(
+                "field 'cross_coupling' is [{}, {}]: the minimum is above the maximum (expected [min, max])",
+                shown(lo),
+                shown(hi)
+            ));
+        }
+        let (_, _, up) = swing_frame(&c.mean_direction);
+        if c.mean_direction != Vector3::zeros() && !up.iter().all(|v| v.is_finite()) {
+            let d = c.mean_direction;
+            return invalid(if d.normalize().iter().all(|v| v.is_finite()) {
+                format!(
+                    "field 'mean_direction' {}, {}, {} lies along the y axis, the bird's swing direction (the vertical swing is along mean_direction × y, which is then 0): give a direction with an x or z component",
+                    shown(d.x),
+                    shown(d.y),
+                    shown(d.z)
+                )
+            } else {
+                format!(
+                    "field 'mean_direction' {}, {}, {} is too small to normalise (its length underflows to 0): give a direction such as -0.8, 0, 0.6",
+                    shown(d.x),
+                    shown(d.y),
+                    shown(d.z)
+                )
             });
         }
         if !(c.sferic_rate_hz >= 0.0 && c.sferic_rate_hz <= MAX_SFERIC_RATE_HZ) {
@@ -171,19 +243,17 @@ impl EmScenario {
             ("power_line_v", c.power_line_v),
             ("sferic_amplitude_v", c.sferic_amplitude_v),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=MAX_INTERFERENCE_V).contains(&v)) {
                 return Err(EmError::InvalidArgument {
                     reason: format!(
-                        "{name} {} V must be finite and ≥ 0 (an amplitude; 0 turns it off)",
+                        "{name} {} V must be from 0 to {MAX_INTERFERENCE_V:e} V (an amplitude; 0 turns it off; larger levels drown the signal in the f32 record's rounding)",
                         aeromag_core::error::shown(v)
                     ),
                 });
             }
         }
-        if c.mean_direction.norm() == 0.0 {
-            return Err(EmError::InvalidArgument {
-                reason: "zero mean direction".into(),
-            });
+        if c.mean_direction == Vector3::zeros() {
+            return invalid("field 'mean_direction' is 0, 0, 0: the bird needs a direction from the transmitter".into());
         }
         for f in c.frequencies_hz {
             if !(f - c.pilot_offset_hz > 0.0 && f + c.pilot_offset_hz < c.sample_rate_hz / 2.0) {
@@ -232,12 +302,10 @@ impl EmScenario {
     pub fn pose_at(&self, t_s: f64) -> Pose {
         let c = &self.config;
         let ph = &self.motion_phase_rad;
-        let e = c.mean_direction.normalize();
+        let (e, side, up) = swing_frame(&c.mean_direction);
         let mid = 0.5 * (c.range_min_m + c.range_max_m);
         let half = 0.5 * (c.range_max_m - c.range_min_m);
         let range = mid + half * (TAU * t_s / c.range_period_s + ph[0]).sin();
-        let side = Vector3::new(0.0, 1.0, 0.0);
-        let up = e.cross(&side).normalize();
         let w = TAU / c.swing_period_s;
         let pos = e * range
             + side * (c.swing_amplitude_m * (w * t_s + ph[1]).sin())
