@@ -328,8 +328,7 @@ fn epochs_without_variety_and_drowned_scenarios_are_bad_input() {
 /// the field and its rule.
 #[test]
 fn scenario_values_are_refused_naming_the_field_and_rule() {
-    let d = tempfile::tempdir().unwrap();
-    for (text, want) in [
+    refused_by_simulate(&[
         (
             "mean_direction = [0.0, 1.0, 0.0]",
             "field 'mean_direction' 0, 1, 0 lies along the y axis",
@@ -358,7 +357,14 @@ fn scenario_values_are_refused_naming_the_field_and_rule() {
             "cross_coupling = [0.5, 0.1]",
             "field 'cross_coupling' is [0.5, 0.1]: the minimum is above the maximum",
         ),
-    ] {
+    ]);
+}
+
+/// Each scenario text of `cases` is bad input to `em simulate`, with a
+/// message holding its text.
+fn refused_by_simulate(cases: &[(&str, &str)]) {
+    let d = tempfile::tempdir().unwrap();
+    for (text, want) in cases {
         let cfg = aeromag::em::parse_config(Some(text), "s.toml").unwrap();
         let e = simulate_to_dir(&cfg, 8, &d.path().join("x")).unwrap_err();
         assert!(e.is_bad_input(), "{text}: {e}");
@@ -373,7 +379,7 @@ fn scenario_values_are_refused_naming_the_field_and_rule() {
 #[test]
 fn colliding_tones_are_refused_by_simulate_and_detect() {
     let d = tempfile::tempdir().unwrap();
-    for (text, want) in [
+    refused_by_simulate(&[
         (
             "pilot_offset_hz = 525.0",
             "the pilot tone 1550 Hz of dipole 1 and the pilot tone 1550 Hz of dipole 2 are 0 bins apart (bin f_s/N = 6.25 Hz)",
@@ -382,12 +388,7 @@ fn colliding_tones_are_refused_by_simulate_and_detect() {
             "frequencies_hz = [2000.0, 3000.0, 5000.0]\npilot_offset_hz = 1000.0",
             "the working tone 2000 Hz of dipole 1 and the pilot tone 2000 Hz of dipole 2 are 0 bins apart",
         ),
-    ] {
-        let cfg = aeromag::em::parse_config(Some(text), "s.toml").unwrap();
-        let e = simulate_to_dir(&cfg, 8, &d.path().join("x")).unwrap_err();
-        assert!(e.is_bad_input(), "{text}: {e}");
-        assert!(e.to_string().contains(want), "{text}: {e}");
-    }
+    ]);
     // A record made with such a plan (header written by hand).
     let files = simulate_to_dir(&command_default(), 8, d.path()).unwrap();
     let mut system = read_system(&files.system).unwrap();
