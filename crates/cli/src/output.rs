@@ -100,11 +100,9 @@ pub fn simulate_em(
         cfg.seed = s;
     }
     let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
-    let _created = NewFolder::before(out);
     // The five files checked before the synthesis (a folder in the place
     // of one failed with exit 1 after the first were replaced).
-    let inputs: Vec<&Path> = config.into_iter().collect();
-    check_folder_files(out, aeromag::em::SimulatedEm::FILE_NAMES, &inputs)?;
+    let _created = simulation_folder(out, aeromag::em::SimulatedEm::FILE_NAMES, config)?;
     let spinner = crate::progress::spinner("simulating em");
     // A scenario file is named with the errors (with none, the message
     // named a file 'defaults' that does not exist).
@@ -152,9 +150,7 @@ pub fn simulate_gradiometer(
         cfg.validate().map_err(|e| bad_input!("--seed: {e}"))?;
     }
     let out = out.ok_or_else(|| bad_input!("--out DIR is required"))?;
-    let _created = NewFolder::before(out);
-    let inputs: Vec<&Path> = config.into_iter().collect();
-    check_folder_files(out, aeromag::gradiometry::SIMULATED_FILES, &inputs)?;
+    let _created = simulation_folder(out, aeromag::gradiometry::SIMULATED_FILES, config)?;
     let files = aeromag::gradiometry::simulate_to_dir(&cfg, out)?;
     println!(
         "simulated gradiometer ({:?} system, {:?} gradiometer, {:?} {} m; seed {}): {} epochs × {} columns",
@@ -231,6 +227,21 @@ pub fn check_folder_files<const N: usize>(
     let paths = names.map(|n| dir.join(n));
     check_files(paths.iter().map(|p| p.as_path()), inputs)?;
     Ok(paths)
+}
+
+/// A simulation's output folder `out` before the run: its files `names`
+/// checked ([`check_folder_files`], the scenario file `config` not among
+/// them), and the folder, if this run creates it, removed again if nothing
+/// is written into it ([`NewFolder`]; also when the check fails).
+pub fn simulation_folder<const N: usize>(
+    out: &Path,
+    names: [&str; N],
+    config: Option<&Path>,
+) -> anyhow::Result<NewFolder> {
+    let created = NewFolder::before(out);
+    let inputs: Vec<&Path> = config.into_iter().collect();
+    check_folder_files(out, names, &inputs)?;
+    Ok(created)
 }
 
 /// An output folder that a command is about to create (with the folders

@@ -93,8 +93,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // The three files checked before the simulation: a folder in the
     // place of one is bad input (it failed with exit 1).
     let names = aeromag_sim::Simulation::file_names(kind);
-    let inputs: Vec<&std::path::Path> = a.config.as_deref().into_iter().collect();
-    crate::output::check_folder_files(out, names.each_ref().map(|n| n.as_str()), &inputs)?;
+    let _checked = crate::output::simulation_folder(
+        out,
+        names.each_ref().map(|n| n.as_str()),
+        a.config.as_deref(),
+    )?;
     let spinner = crate::progress::spinner(&format!("simulating {kind}"));
     // The scenario file named with its values' errors (a flight the
     // readers would refuse is found at writing).
