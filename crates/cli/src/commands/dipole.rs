@@ -87,7 +87,8 @@ pub struct SimulateArgs {
 /// 3 or below 0.25 is warned of: the filter is locked on a wrong solution
 /// or its inputs are not what they say (swapped sensors, quiet epochs
 /// that are not quiet, positions in another unit), and its estimates and
-/// σ are not to be trusted. Readings whose median field is not the IGRF's
+/// σ are not to be trusted; a pass of which no epoch's iterations
+/// converge is a failure (exit 1). Readings whose median field is not the IGRF's
 /// within a factor 2 are refused (another unit), as is, for the scalar
 /// gradiometer, an object's track passing inside the sphere through the
 /// sensors (positions in km?); time gaps in the pass are warned of.
