@@ -464,11 +464,11 @@ def calibrate_em(
     detected: Union[EmDetection, str],
     known: str,
     system: str,
-    half_space: Tuple[float, float, float] = (-1.0, 0.0, 1.0),
+    half_space: Sequence[float] = (-1.0, 0.0, 1.0),
 ) -> EmCalibration: ...
 def locate_em(
     detected: Union[EmDetection, str],
     calibration: Union[EmCalibration, str],
-    half_space: Tuple[float, float, float] = (-1.0, 0.0, 1.0),
+    half_space: Sequence[float] = (-1.0, 0.0, 1.0),
     progress: _Progress = None,
 ) -> EmPoses: ...

@@ -56,8 +56,10 @@ fn save(path: &Path, text: String) -> PyResult<()> {
 /// The half-space of a normal `(nx, ny, nz)`, through the CLI's parser of
 /// `--half-space NX,NY,NZ` (Rust prints floats so that they read back
 /// exactly).
-fn half_space(normal: (f64, f64, f64)) -> PyResult<HalfSpace> {
-    format!("{},{},{}", normal.0, normal.1, normal.2)
+/// Any sequence of three numbers is taken (a list or an array was refused:
+/// "'list' object is not an instance of 'tuple'").
+fn half_space(normal: [f64; 3]) -> PyResult<HalfSpace> {
+    format!("{},{},{}", normal[0], normal[1], normal[2])
         .parse::<HalfSpace>()
         .py_err()
 }
@@ -210,14 +212,14 @@ impl PyEmCalibration {
 /// transmitter geometry from the known positions; attitude from the known
 /// attitude) from detected vectors, a KNOWN CSV and the system JSON.
 #[pyfunction]
-#[pyo3(signature = (detected, known, system, half_space=(-1.0, 0.0, 1.0)),
+#[pyo3(signature = (detected, known, system, half_space=[-1.0, 0.0, 1.0]),
        text_signature = "(detected, known, system, half_space=(-1.0, 0.0, 1.0))")]
 pub fn calibrate_em(
     py: Python<'_>,
     detected: &Bound<'_, PyAny>,
     known: PathBuf,
     system: PathBuf,
-    half_space: (f64, f64, f64),
+    half_space: [f64; 3],
 ) -> PyResult<PyEmCalibration> {
     let h = self::half_space(half_space)?;
     let epochs = epochs_of(detected)?;
@@ -281,13 +283,13 @@ impl PyEmPoses {
 /// Locate the bird at every epoch with a calibration (an `EmCalibration`
 /// or the path of a calibration file).
 #[pyfunction]
-#[pyo3(signature = (detected, calibration, half_space=(-1.0, 0.0, 1.0), progress=None),
+#[pyo3(signature = (detected, calibration, half_space=[-1.0, 0.0, 1.0], progress=None),
        text_signature = "(detected, calibration, half_space=(-1.0, 0.0, 1.0), progress=None)")]
 pub fn locate_em(
     py: Python<'_>,
     detected: &Bound<'_, PyAny>,
     calibration: &Bound<'_, PyAny>,
-    half_space: (f64, f64, f64),
+    half_space: [f64; 3],
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyEmPoses> {
     let h = self::half_space(half_space)?;

@@ -21,7 +21,7 @@ fn exception(py: Python<'_>, e: &aeromag::Error) -> PyResult<PyErr> {
         .to_string()
         .replace("--lines: ", "lines: ")
         .replace("--time-range: ", "time_range: ");
-    if let aeromag::Error::Write { .. } = e {
+    if e.is_write_failure() {
         return Ok(PyOSError::new_err(message));
     }
     let errors = py.import("aeromag.errors")?;

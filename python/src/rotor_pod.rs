@@ -245,12 +245,21 @@ pub fn fit_pod(
         grad_north_nt_per_km,
         grad_up_nt_per_km,
     };
-    let model = py
-        .detach(|| lib_fit_pod(&flight.inner, &setup, method, source_points.as_deref()))
-        .py_err()?;
+    let mut obs = PyProgress::new(None);
+    let result = py.detach(|| {
+        lib_fit_pod(
+            &flight.inner,
+            &setup,
+            method,
+            source_points.as_deref(),
+            &mut obs,
+        )
+    });
+    obs.finish()?;
+    let fit = result.py_err()?;
     Ok(PyModel {
-        model: AnyModel::Pod(model),
-        notes: Vec::new(),
+        model: AnyModel::Pod(fit.model),
+        notes: fit.notes,
     })
 }
 

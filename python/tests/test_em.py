@@ -62,7 +62,11 @@ def test_a_half_space_other_than_the_calibrations_is_warned_of(cli, record, tmp_
 def test_poses_match_the_truth(record):
     out, files = record
     det = aeromag.detect_em(files["raw"])
-    poses = aeromag.locate_em(det, aeromag.calibrate_em(det, files["known"], files["system"])).to_dict()
+    cal = aeromag.calibrate_em(det, files["known"], files["system"])
+    poses = aeromag.locate_em(det, cal).to_dict()
+    # The half-space as any sequence of three numbers (a list was refused).
+    for normal in ([-1.0, 0.0, 1.0], np.array([-1.0, 0.0, 1.0])):
+        np.testing.assert_array_equal(aeromag.locate_em(det, cal, half_space=normal).to_dict()["x_m"], poses["x_m"])
     truth = aeromag.read_flight(files["truth"])
     assert poses["status"].sum() == 0
     np.testing.assert_allclose(poses["time_s"], truth["time_s"], atol=1e-9)
@@ -74,6 +78,9 @@ def test_poses_match_the_truth(record):
 
 def test_bad_input(record, tmp_path):
     out, files = record
+    # An empty folder name wrote the five files into the current folder.
+    with pytest.raises(aeromag.BadInputError, match="output folder is empty"):
+        aeromag.simulate_em("")
     with pytest.raises(aeromag.BadInputError, match="half-space"):
         aeromag.locate_em(files["raw"], files["raw"], half_space=(0.0, 0.0, 0.0))
     with pytest.raises(aeromag.BadInputError, match="window"):

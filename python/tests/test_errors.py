@@ -60,6 +60,16 @@ def test_unwritable_output_is_oserror(tmp_path):
     (tmp_path / "a_file").write_text("")
     with pytest.raises(OSError):
         tl.save(tmp_path / "a_file" / "m.json")
+    # A flight's CSV and a grid file raised AeromagError for the same path.
+    cal = aeromag.simulate("calibration", seed=1)
+    with pytest.raises(OSError):
+        cal.to_csv(tmp_path / "a_file" / "f.csv")
+    with pytest.raises(OSError):
+        cal.to_csv(tmp_path)
+    grid = aeromag.grid_flight(aeromag.simulate("survey", seed=1), cell=200.0, max_sweeps=5)
+    for name in ["g.tif", "g.nc", "g.asc"]:
+        with pytest.raises(OSError):
+            grid.write(tmp_path / "a_file" / name)
 
 
 def test_arguments_are_named_in_their_errors(tmp_path):

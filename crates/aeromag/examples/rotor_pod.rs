@@ -40,7 +40,14 @@ fn main() -> Result<(), Error> {
     let pod_learn = simulate_flight(ScenarioKind::Pod, Some("swing_sine = true\n"), None)?;
     let test_headings = "swing_sine = true\nheadings_deg = [30.0, 120.0, 210.0, 300.0]\n";
     let pod_test = simulate_flight(ScenarioKind::Pod, Some(test_headings), Some(1001))?;
-    let model = fit_pod(&pod_learn, &setup, PodMethod::DipoleArray, None)?;
+    let model = fit_pod(
+        &pod_learn,
+        &setup,
+        PodMethod::DipoleArray,
+        None,
+        &mut Silent,
+    )?
+    .model;
     let applied = apply_pod(&model, &pod_test)?;
     for h in &applied.per_heading {
         println!(

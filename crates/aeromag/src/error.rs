@@ -155,6 +155,17 @@ impl Error {
         }
     }
 
+    /// Whether writing an output (a file or its folder) failed: Python
+    /// raises these as `OSError`, whichever part of the library wrote.
+    pub fn is_write_failure(&self) -> bool {
+        match self {
+            Error::Write { .. } | Error::Grid(aeromag_grid::GridError::Write { .. }) => true,
+            Error::Io(e) => matches!(**e, aeromag_io::IoError::Write { .. }),
+            Error::InFile { error, .. } => error.is_write_failure(),
+            _ => false,
+        }
+    }
+
     /// Where the error is (file, line, data row, column), as far as it
     /// says; Python's `BadInputError` carries these.
     pub fn location(&self) -> Location {

@@ -128,6 +128,19 @@ impl ModelFile for PodModelFile {
     }
 }
 
+/// Create the output folder `out` (and its parents) for a set of files.
+/// An empty path is bad input: `simulate_em("")` from Python wrote its
+/// five files into the current folder without a word (the CLI's
+/// `--out ''` is refused by its parser); `.` names the current folder.
+pub fn create_output_folder(out: &Path) -> Result<()> {
+    if out.as_os_str().is_empty() {
+        return Err(Error::bad_input(
+            "the output folder is empty: name a folder ('.' for the current one)",
+        ));
+    }
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))
+}
+
 /// Write `bytes` to `path` through a temporary file in the same folder,
 /// renamed when complete.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {

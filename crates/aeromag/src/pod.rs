@@ -28,7 +28,7 @@
 use crate::compensate::{Compensator, OutputColumns};
 use crate::error::{Error, Result};
 use crate::flight::{Flight, SegmentRule, finite_segments};
-use crate::observer::Observer;
+use crate::observer::{Note, Notes, Observer};
 use aeromag_compensation::model_file::MODEL_FORMAT;
 use aeromag_compensation::pod::{
     Cable, DipoleArrayModel, JointFit, PodHeading, compensation_rate, compensation_rate_pooled,
@@ -184,7 +184,10 @@ pub const MIN_HEADING_SEPARATION_DEG: f64 = 30.0;
 
 /// Split `t` into headings and build the model inputs of each with the
 /// pod trajectory of `method`. Returns the headings and the sample rate.
-fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Heading>, f64)> {
+/// The headings of `t` (straight stretches of at least [`MIN_HEADING_S`]
+/// with every column finite), the sample rate, Hz, and the number of rows
+/// left out for a missing value.
+fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Heading>, f64, usize)> {
     let time = t.require("time")?;
     let mag = t.require("mag")?;
     let (roll, pitch, yaw) = (t.require("roll")?, t.require("pitch")?, t.require("yaw")?);
@@ -205,7 +208,9 @@ fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Head
     let fs = t.sample_rate_hz()?;
     let min_len = (MIN_HEADING_S * fs).ceil() as usize;
     let rule = SegmentRule::default().min_len(min_len);
-    let segs = finite_segments(time, t.line_numbers(), &cols, &rule).1.kept;
+    let (usable, segs) = finite_segments(time, t.line_numbers(), &cols, &rule);
+    let missing = usable.iter().filter(|u| !**u).count();
+    let segs = segs.kept;
     let cable = Cable {
         length_m: setup.cable_length_m,
         attach_m: setup.attach_m,
@@ -262,7 +267,7 @@ fn headings(t: &Flight, setup: &PodSetup, method: PodMethod) -> Result<(Vec<Head
             data: h,
         });
     }
-    Ok((out, fs))
+    Ok((out, fs, missing))
 }
 
 /// Prediction of `model` on heading `h`: high-passed (for rates) or raw.
@@ -325,6 +330,7 @@ fn rates(model: &PodModelFile, hs: &[Heading]) -> Result<(Vec<HeadingRate>, f64)
 /// compensation rate of each learning heading.
 ///
 /// ```
+/// use aeromag::Silent;
 /// use aeromag::pod::{PodMethod, PodSetup, apply_pod, fit_pod};
 /// use aeromag::simulate::{ScenarioKind, simulate_flight};
 /// // The seed's installation: 40 m cable, 45° inclination.
@@ -337,7 +343,7 @@ fn rates(model: &PodModelFile, hs: &[Heading]) -> Result<(Vec<HeadingRate>, f64)
 ///     grad_up_nt_per_km: -25.91,
 /// };
 /// let learn = simulate_flight(ScenarioKind::Pod, Some("swing_sine = true\n"), None)?;
-/// let model = fit_pod(&learn, &setup, PodMethod::DipoleArray, None)?;
+/// let model = fit_pod(&learn, &setup, PodMethod::DipoleArray, None, &mut Silent)?.model;
 /// let test = simulate_flight(ScenarioKind::Pod, Some("swing_sine = true\n"), Some(1001))?;
 /// let applied = apply_pod(&model, &test)?;
 /// assert!(applied.per_heading.iter().all(|h| h.rate > 0.9)); // > 90 % removed
@@ -348,11 +354,28 @@ pub fn fit_pod(
     setup: &PodSetup,
     method: PodMethod,
     sources: Option<&[[f64; 3]]>,
-) -> Result<PodModelFile> {
+    observer: &mut dyn Observer,
+) -> Result<PodFit> {
     setup
         .validate()
         .map_err(|e| Error::bad_input(e.to_string()))?;
-    let (hs, fs) = headings(t, setup, method)?;
+    let mut notes = Notes::new(observer);
+    let (hs, fs, missing) = headings(t, setup, method)?;
+    // Left out without a word before, where the Tolles-Lawson and rotor
+    // fits say so.
+    if missing > 0 {
+        notes.warn(format!(
+            "{missing} of {} rows of {} have missing values (mag, attitude, cable angles{}) and are \
+             not fitted",
+            t.n_rows(),
+            t.file_label(),
+            if setup.grad_north_nt_per_km != 0.0 || setup.grad_up_nt_per_km != 0.0 {
+                ", lat, alt"
+            } else {
+                ""
+            }
+        ));
+    }
     if hs.is_empty() {
         return Err(Error::bad_file(
             t.file_label(),
@@ -450,7 +473,19 @@ pub fn fit_pod(
         software_version: env!("CARGO_PKG_VERSION").into(),
     };
     model.learning = rates(&model, &hs)?.0;
-    Ok(model)
+    Ok(PodFit {
+        model,
+        notes: notes.into_notes(),
+    })
+}
+
+/// The result of [`fit_pod`].
+#[derive(Debug, Clone)]
+pub struct PodFit {
+    /// The model file.
+    pub model: PodModelFile,
+    /// Notes and warnings (rows left out).
+    pub notes: Vec<Note>,
 }
 
 /// What [`apply_pod`] returns.
@@ -468,7 +503,7 @@ pub struct PodApplied {
 /// Apply `model` to the flight `t`: the interference of every heading of at
 /// least 10 s and the compensation rates.
 pub fn apply_pod(model: &PodModelFile, t: &Flight) -> Result<PodApplied> {
-    let (hs, _) = headings(t, &model.setup, model.method)?;
+    let (hs, _, _) = headings(t, &model.setup, model.method)?;
     let mut out = vec![f64::NAN; t.n_rows()];
     for h in &hs {
         out[h.rows.clone()].copy_from_slice(&predict(model, &h.data, false)?);

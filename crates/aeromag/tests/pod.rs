@@ -56,7 +56,7 @@ fn fit_apply(
     methods
         .iter()
         .map(|&m| {
-            let model = fit_pod(learn, setup, m, None).unwrap();
+            let model = fit_pod(learn, setup, m, None, &mut Silent).unwrap().model;
             rates(test, &apply_pod(&model, test).unwrap().interf_nt)
         })
         .collect()
@@ -130,7 +130,29 @@ fn other_geometry_and_headings() {
 fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_input() {
     let (learn, test) = pair("swing_sine = true\n", "[30.0, 120.0]");
     let s = setup(40.0, [0.0, 0.0, 1.2], 45.0);
-    let model = fit_pod(&learn, &s, PodMethod::DipoleArray, None).unwrap();
+    let fit = fit_pod(&learn, &s, PodMethod::DipoleArray, None, &mut Silent).unwrap();
+    assert!(fit.notes.iter().all(|n| !n.is_warning()), "{:?}", fit.notes);
+    let model = fit.model;
+    // Rows of the learning flight with a missing value are left out with
+    // a warning (they were left out without a word).
+    let mut t = learn.table().clone();
+    for col in ["mag", "roll"] {
+        let mut x = t.require(col).unwrap().to_vec();
+        x[500..575].iter_mut().for_each(|v| *v = f64::NAN);
+        t.set_column(col, x).unwrap();
+    }
+    let gappy = Flight::from_table(t).unwrap();
+    let fit = fit_pod(&gappy, &s, PodMethod::DipoleArray, None, &mut Silent).unwrap();
+    let warned: Vec<String> = fit
+        .notes
+        .iter()
+        .filter(|n| n.is_warning())
+        .map(|n| n.message.clone())
+        .collect();
+    assert!(
+        warned.len() == 1 && warned[0].starts_with(&format!("75 of {} rows", learn.n_rows())),
+        "{warned:?}"
+    );
     let edit = |col: &str, row: usize, v: f64| {
         let mut t = test.table().clone();
         let mut x = t.require(col).unwrap().to_vec();
@@ -159,7 +181,7 @@ fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_
         ..s
     };
     assert!(
-        fit_pod(&learn, &bad, PodMethod::Joint, None)
+        fit_pod(&learn, &bad, PodMethod::Joint, None, &mut Silent)
             .unwrap_err()
             .is_bad_input()
     );
@@ -173,7 +195,9 @@ fn a_missing_value_leaves_its_row_uncompensated_and_out_of_range_angles_are_bad_
 fn cable_angles_in_radians_are_bad_input() {
     let (learn, test) = pair("", "[30.0, 120.0]");
     let s = setup(40.0, [0.0, 0.0, 1.2], 45.0);
-    let model = fit_pod(&learn, &s, PodMethod::DipoleArray, None).unwrap();
+    let model = fit_pod(&learn, &s, PodMethod::DipoleArray, None, &mut Silent)
+        .unwrap()
+        .model;
     let radians = |f: &Flight, col: &str| {
         let mut t = f.table().clone();
         let x: Vec<f64> = t
@@ -186,7 +210,14 @@ fn cable_angles_in_radians_are_bad_input() {
         Flight::from_table(t).unwrap()
     };
     for col in ["cable_inclination", "cable_azimuth"] {
-        let e = fit_pod(&radians(&learn, col), &s, PodMethod::DipoleArray, None).unwrap_err();
+        let e = fit_pod(
+            &radians(&learn, col),
+            &s,
+            PodMethod::DipoleArray,
+            None,
+            &mut Silent,
+        )
+        .unwrap_err();
         assert!(e.is_bad_input(), "{e}");
         assert!(
             e.to_string().contains(col) && e.to_string().contains("radians?"),
@@ -248,7 +279,14 @@ fn a_learning_flight_of_fewer_than_four_directions_is_refused() {
     };
     // The learning set is 0, 90, 180, 270, 45, 135, 225, 315°.
     for keep in [&[0.0][..], &[0.0, 4.0], &[0.0, 4.0, 1.0]] {
-        let e = fit_pod(&headings(keep), &s, PodMethod::DipoleArray, None).unwrap_err();
+        let e = fit_pod(
+            &headings(keep),
+            &s,
+            PodMethod::DipoleArray,
+            None,
+            &mut Silent,
+        )
+        .unwrap_err();
         assert!(
             e.is_bad_input() && e.to_string().contains("at least 4 directions"),
             "{keep:?}: {e}"
@@ -259,7 +297,8 @@ fn a_learning_flight_of_fewer_than_four_directions_is_refused() {
             &headings(&[0.0, 1.0, 2.0, 3.0]),
             &s,
             PodMethod::DipoleArray,
-            None
+            None,
+            &mut Silent
         )
         .is_ok()
     );

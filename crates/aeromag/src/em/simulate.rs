@@ -157,7 +157,7 @@ pub fn simulate_to_dir(
         )));
     }
     debug_assert_eq!(rec.header, header);
-    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    crate::model_file::create_output_folder(out)?;
     let [raw, system, known, truth, scenario] = SimulatedEm::FILE_NAMES.map(|n| out.join(n));
     let files = SimulatedEm {
         raw,

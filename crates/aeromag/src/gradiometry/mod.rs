@@ -202,7 +202,7 @@ pub const SIMULATED_FILES: [&str; 2] = ["gradiometer.csv", "gradiometer.toml"];
 /// ([`pass_table`]) and `DIR/gradiometer.toml`, as a set.
 pub fn simulate_to_dir(cfg: &GradiometerConfig, out: &Path) -> Result<SimulatedPass> {
     let table = simulate_pass(cfg)?;
-    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    crate::model_file::create_output_folder(out)?;
     let [csv, scenario] = SIMULATED_FILES.map(|n| out.join(n));
     let text = cfg.to_toml()?;
     // The two as a set, checked first (the CSV was replaced before a

@@ -5,7 +5,7 @@
 use super::{PrintedFigure, PrintedSummary, Study, StudyOutcome, StudySize, fixed};
 use crate::error::Result;
 use crate::flight::Flight;
-use crate::observer::Observer;
+use crate::observer::{Observer, Silent};
 use crate::pod::{HeadingRate, PodApplied, PodMethod, PodSetup, apply_pod, fit_pod};
 use crate::simulate::{ScenarioKind, simulate_flight};
 use aeromag_compensation::pod::detrend;
@@ -156,7 +156,7 @@ impl Study for PodStudy {
                 inclination_deg: inclination,
                 ..setup
             };
-            let model = fit_pod(&tr, &s, PodMethod::TwoStep, None)?;
+            let model = fit_pod(&tr, &s, PodMethod::TwoStep, None, &mut Silent)?.model;
             let applied = apply_pod(&model, &te)?;
             let worst = applied
                 .per_heading
@@ -168,7 +168,7 @@ impl Study for PodStudy {
         let results = PodMethod::ALL
             .into_iter()
             .map(|m| {
-                let model = fit_pod(&train, &setup, m, None)?;
+                let model = fit_pod(&train, &setup, m, None, &mut Silent)?.model;
                 let applied = apply_pod(&model, &test)?;
                 Ok((m, model.learning, applied))
             })

@@ -3,6 +3,7 @@
 
 use crate::args;
 use crate::input::InputArgs;
+use crate::progress::Bars;
 use aeromag::ModelFile;
 use aeromag::pod::{HeadingRate, PodMethod, PodModelFile, PodSetup, apply_pod, fit_pod};
 use aeromag::{Compensated, Compensator};
@@ -131,7 +132,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
     };
     let t = a.input.load_canonical(&aeromag::pod::POD_COLUMNS)?;
     let sources = a.source_points.as_ref().map(|p| p.0.as_slice());
-    let model = fit_pod(&t, &setup, a.method, sources)?;
+    let model = fit_pod(&t, &setup, a.method, sources, &mut Bars::new())?.model;
     model.write(&a.model)?;
     println!(
         "fitted the {} pod model on {} headings of {} ({} coefficients); written to {}",

@@ -2,7 +2,7 @@
 //! `aeromag rotor fit` writes and `rotor apply` reads, so that library
 //! callers can read and write the same files.
 
-use super::blade::{FlapAngles, RotorGeometry};
+use super::blade::{FlapAngles, MAX_FLAP_RAD, RotorGeometry};
 use super::coning::SlowAngleOptions;
 use super::linear::{RotorFit, RotorFitOptions};
 use super::tail::TailRotor;
@@ -128,9 +128,23 @@ impl RotorModelFile {
                 self.sample_rate_hz,
                 self.sample_rate_hz > 0.0,
             ),
-            ("nominal_angles.coning_rad", a.coning_rad, true),
-            ("nominal_angles.tilt_lon_rad", a.tilt_lon_rad, true),
-            ("nominal_angles.tilt_lat_rad", a.tilt_lat_rad, true),
+            // An edited coning of 100 rad was applied: 281 331 nT of
+            // "interference" with exit 0.
+            (
+                "nominal_angles.coning_rad",
+                a.coning_rad,
+                a.coning_rad.abs() <= MAX_FLAP_RAD,
+            ),
+            (
+                "nominal_angles.tilt_lon_rad",
+                a.tilt_lon_rad,
+                a.tilt_lon_rad.abs() <= MAX_FLAP_RAD,
+            ),
+            (
+                "nominal_angles.tilt_lat_rad",
+                a.tilt_lat_rad,
+                a.tilt_lat_rad.abs() <= MAX_FLAP_RAD,
+            ),
         ] {
             if !(ok && v.is_finite()) {
                 return Err(CompError::data(format!(
@@ -234,7 +248,7 @@ mod tests {
         // The options apply runs with: 2⁶³ alternations kept `rotor
         // apply` running for ever; the others were not checked either.
         type Edit = fn(&mut RotorModelFile);
-        let edits: [(&str, Edit); 6] = [
+        let edits: [(&str, Edit); 8] = [
             ("slow_angles.iterations", |m| {
                 m.slow_angles.iterations = 1 << 63
             }),
@@ -248,6 +262,13 @@ mod tests {
             }),
             ("nominal_angles.coning_rad", |m| {
                 m.nominal_angles.coning_rad = f64::NAN
+            }),
+            // Applied before: 281 331 nT of interference.
+            ("nominal_angles.coning_rad", |m| {
+                m.nominal_angles.coning_rad = 100.0
+            }),
+            ("nominal_angles.tilt_lat_rad", |m| {
+                m.nominal_angles.tilt_lat_rad = -0.6
             }),
         ];
         for (name, edit) in edits {

@@ -748,6 +748,10 @@ pub(crate) fn solve_accumulated(
     cfg: &LsConfig,
 ) -> Result<LsFit> {
     let (used, effective_dof) = (acc.used, acc.effective_dof);
+    let terms = cfg.design.n_columns();
+    if ne.rows() <= terms {
+        return Err(CompError::data(underdetermined(ne.rows(), terms)));
+    }
     let mut warnings = acc.warnings.clone();
     let sol = ne
         .solve_with_dof(cfg.lambda, effective_dof)
@@ -780,6 +784,19 @@ pub(crate) fn solve_accumulated(
         warnings,
         notes: Vec::new(),
     })
+}
+
+/// The refusal of a fit of `terms` terms on `rows` rows (`rows ≤ terms`):
+/// such a fit passes through every row, its residual is zero whatever the
+/// flight's noise, and its standard deviations are those of a residual
+/// with no degree of freedom. Before, 3 rows of a real survey line fitted
+/// the three permanent terms with a residual of 0.0008 nT and exit 0.
+fn underdetermined(rows: usize, terms: usize) -> String {
+    format!(
+        "{rows} rows to fit {terms} terms: a fit needs more rows than terms (many more to \
+         determine them); fit a longer flight or more of its lines (--lines), or fewer terms \
+         (--terms)"
+    )
 }
 
 /// A warning when the ridge λ (added to each diagonal element of `AᵀA`)
@@ -1358,6 +1375,45 @@ pub(crate) mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// A fit with no more rows than terms passes through every row: it is
+    /// refused (it was fitted, residual 0, exit 0); one row more is a fit.
+    #[test]
+    fn a_fit_needs_more_rows_than_terms() {
+        let terms = TermSet::observable16();
+        let coef = coef16();
+        let cfg = LsConfig {
+            band_hz: None,
+            trim: 0,
+            ..LsConfig::default()
+        };
+        let n = cfg.design.n_columns();
+        // The four-heading box as one segment, `rows[k]` rows spread over
+        // leg `k`.
+        let fit = |rows: [usize; 4]| {
+            let (mut t, mut f, mut m) = (vec![], [vec![], vec![], vec![]], vec![]);
+            for (k, (h, r)) in [0.0, 90.0, 180.0, 270.0].iter().zip(rows).enumerate() {
+                let (lt, lf, lm) = leg(*h, &coef, &terms, k as f64 * 1000.0, true);
+                let every = |v: &[f64], to: &mut Vec<f64>| {
+                    to.extend(v.iter().step_by(v.len() / r).take(r));
+                };
+                every(&lt, &mut t);
+                every(&lm, &mut m);
+                for (axis, to) in lf.iter().zip(&mut f) {
+                    every(axis, to);
+                }
+            }
+            fit_band_pass_ls(&segments_of(&[(t, f, m)]), &cfg)
+        };
+        assert_eq!(n, 16);
+        let e = fit([4, 4, 4, 4]).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("16 rows to fit 16 terms"),
+            "{e}"
+        );
+        let r = fit([5, 4, 4, 4]);
+        assert!(r.is_ok(), "{:?}", r.err());
     }
 
     /// A non-finite value inside a segment (the callers split segments at
