@@ -19,7 +19,8 @@ pub struct InputArgs {
     #[arg(long, value_name = "MAP")]
     pub columns: Option<String>,
     /// The scalar magnetometer to use, e.g. `mag_3_uc` (SGL names also find
-    /// the XYZ export's `UNCOMPMAG3`), or any column. Default: the first of
+    /// the XYZ export's `UNCOMPMAG3` and back, as do the columns of a
+    /// model, --extra and --reference-sensor), or any column. Default: the first of
     /// mag_1_uc … mag_5_uc present. `calibrate` takes several,
     /// comma-separated (one model per sensor).
     #[arg(long, value_name = "NAME")]

@@ -50,8 +50,17 @@
 //! mapped. The flux triplet is taken from the first vector magnetometer (A,
 //! B, C, D; `flux_a_x` or `FLUXA_X`) that has all three components.
 //!
+//! Any other SGL field is found in either naming without a mapping:
+//! [`FlightTable::resolve`](crate::FlightTable::resolve) falls back on
+//! [`sensor_names`] (`mag_1_uc` ↔ `UNCOMPMAG1`, `cur_com_1` ↔ `CUR_COM1`,
+//! `flux_b_x` ↔ `FLUXB_X`), so the columns a model, `--extra` or
+//! `--reference-sensor` name apply to a flight of either naming, and a
+//! model keeps the MagNav name ([`magnav_name`]).
+//!
 //! Fields in another unit are **not** mapped, because an alias cannot
-//! convert: `ins_lat`/`ins_lon` (`INS_LAT`/`INS_LON`) are radians, and
+//! convert: `ins_lat`/`ins_lon` (`INS_LAT`/`INS_LON`) are radians in the
+//! SGL layout (degrees in MagNav's XYZ0 layout; [`crate::derive`] tells
+//! them apart by their values), and
 //! `ins_vw`/`ins_vu` (`INS_VEL_W`/`INS_VEL_V`) point west and up. They are
 //! recognised with their units ([`known_field`](crate::known_field)), and
 //! mapping one of them onto a degree or NED column by hand is caught by the
@@ -241,8 +250,17 @@ impl ColumnMap {
             let hint = closest_canonical(canonical)
                 .map(|c| format!("did you mean '{c}'? "))
                 .unwrap_or_default();
+            // An SGL field needs no mapping: it is found in either naming.
+            let sgl = if sensor_names(canonical).len() > 1 {
+                format!(
+                    "'{canonical}' needs no mapping: SGL fields are found under their MagNav or XYZ export names ({}) without one; ",
+                    sensor_names(canonical).join(" = ")
+                )
+            } else {
+                String::new()
+            };
             return Err(err(format!(
-                "'{canonical}' is not a canonical column name; {hint}known names: {}, or true_*",
+                "'{canonical}' is not a canonical column name; {sgl}{hint}known names: {}, or true_*",
                 CANONICAL_COLUMNS.join(", ")
             )));
         }
@@ -561,12 +579,126 @@ impl Sensors {
     }
 }
 
-/// The names one sensor goes by: as given, and its SGL HDF5 / Geosoft XYZ
-/// counterpart (`mag_3_uc` ↔ `UNCOMPMAG3`, `mag_1_c` ↔ `COMPMAG1`,
-/// `flux_b` ↔ `FLUXB`).
+/// SGL fields whose Geosoft XYZ export name is not the HDF5 name in
+/// another case nor follows [`sensor_names`]' patterns: `(HDF5, XYZ)`,
+/// lower case. The pairs are MagNav.jl's: `xyz2h5` reads the export's
+/// columns in the order of `readmes/sgl_2020_fields_readme.txt`, so the
+/// export's header (`Flt1003_sample.xyz`) and that list pair up by
+/// position. Fields that play a canonical role (`TIME`, `LONG`, `PITCH`,
+/// `AZIMUTH`, …) are left to the preset ([`MAGNAV_PRESET`]).
+const SGL_XYZ_NAMES: [(&str, &str); 50] = [
+    ("flight", "flt"),
+    ("utm_x", "utm-x"),
+    ("utm_y", "utm-y"),
+    ("utm_z", "utm-z"),
+    ("msl", "msl-z"),
+    ("ogs_alt", "ogs_hgt"),
+    ("ins_alt", "ins_hgt"),
+    ("ins_vn", "ins_vel_n"),
+    ("ins_vw", "ins_vel_w"),
+    ("ins_vu", "ins_vel_v"),
+    ("pitch_rate", "pitchrt"),
+    ("roll_rate", "rollrt"),
+    ("yaw_rate", "yawrt"),
+    ("lgtl_acc", "long_acc"),
+    ("ltrl_acc", "lat_acc"),
+    ("nrml_acc", "norm_acc"),
+    ("tas", "true_as"),
+    ("total_p", "tot_p"),
+    ("cur_com_1", "cur_com1"),
+    ("cur_ac_hi", "cur_achi"),
+    ("cur_ac_lo", "cur_aclo"),
+    ("cur_tank", "cur_tank"),
+    ("cur_flap", "cur_flap"),
+    ("cur_strb", "cur_strb"),
+    ("cur_srvo_o", "cur_srvo_o"),
+    ("cur_srvo_m", "cur_srvo_m"),
+    ("cur_srvo_i", "cur_srvo_i"),
+    ("cur_heat", "cur_ihtr"),
+    ("cur_acpwr", "cur_acpwr"),
+    ("cur_outpwr", "cur_outpwr"),
+    ("cur_bat_1", "cur_bat1"),
+    ("cur_bat_2", "cur_bat2"),
+    ("vol_acpwr", "v_acpwr"),
+    ("vol_outpwr", "v_outpwr"),
+    ("vol_bat_1", "v_bat1"),
+    ("vol_bat_2", "v_bat2"),
+    ("vol_res_p", "v_resp"),
+    ("vol_res_n", "v_resn"),
+    ("vol_back_p", "v_backp"),
+    ("vol_back_n", "v_backn"),
+    ("vol_gyro_1", "v_gyro1"),
+    ("vol_gyro_2", "v_gyro2"),
+    ("vol_acc_p", "v_accp"),
+    ("vol_acc_n", "v_accn"),
+    ("vol_block", "v_block"),
+    ("vol_back", "v_back"),
+    ("vol_srvo", "v_servo"),
+    ("vol_cabt", "v_cabt"),
+    ("vol_fan", "v_fan"),
+    ("ogs_mag", "ogs_mag"),
+];
+
+/// The MagNav (SGL HDF5) name of a field given by its MagNav name or its
+/// Geosoft XYZ export name, in any case (`UNCOMPMAG3` → `mag_3_uc`,
+/// `CUR_COM1` → `cur_com_1`, `FLUXB_X` → `flux_b_x`, `FLUXB` → `flux_b`);
+/// any other name as it is. What a model file stores, so that it applies
+/// to a flight in either naming ([`sensor_names`] finds the other).
+pub fn magnav_name(name: &str) -> String {
+    let names = sensor_names(name);
+    let is_magnav = |n: &str| {
+        let l = n.to_ascii_lowercase();
+        SGL_XYZ_NAMES.iter().any(|(h, _)| *h == l)
+            || (l.starts_with("mag_") && l.matches('_').count() == 2)
+            || (l.starts_with("flux_") && l.len() >= 6)
+    };
+    let lower = name.to_ascii_lowercase();
+    if is_canonical(&lower) {
+        return name.to_string();
+    }
+    if (names.len() > 1 || SGL_XYZ_NAMES.iter().any(|(_, x)| *x == lower))
+        && let Some(n) = names.iter().find(|n| is_magnav(n))
+    {
+        return n.to_ascii_lowercase();
+    }
+    name.to_string()
+}
+
+/// The names one sensor or field goes by: as given, and its SGL HDF5 /
+/// Geosoft XYZ counterpart (`mag_3_uc` ↔ `UNCOMPMAG3`, `mag_1_c` ↔
+/// `COMPMAG1`, `flux_b` ↔ `FLUXB`, `flux_b_x` ↔ `FLUXB_X`, `flux_b_t` ↔
+/// `FLUXB_TOT`, `cur_com_1` ↔ `CUR_COM1`, the other pairs of
+/// `SGL_XYZ_NAMES`). Compared without regard to case by every lookup.
 pub fn sensor_names(name: &str) -> Vec<String> {
     let lower = name.to_ascii_lowercase();
     let mut names = vec![name.to_string()];
+    for (h, x) in SGL_XYZ_NAMES {
+        if lower == h && h != x {
+            names.push(x.to_string());
+        } else if lower == x && h != x {
+            names.push(h.to_string());
+        }
+    }
+    // flux_<s>_<c> ↔ flux<s>_<c>; total: flux_<s>_t ↔ flux<s>_tot
+    let component = |c: &str| matches!(c, "x" | "y" | "z");
+    if let Some((s, c)) = lower.strip_prefix("flux_").and_then(|r| r.split_once('_'))
+        && s.len() == 1
+    {
+        if component(c) {
+            names.push(format!("flux{s}_{c}"));
+        } else if c == "t" {
+            names.push(format!("flux{s}_tot"));
+        }
+    } else if let Some((s, c)) = lower.strip_prefix("flux").and_then(|r| r.split_once('_'))
+        && s.len() == 1
+        && s != "_"
+    {
+        if component(c) {
+            names.push(format!("flux_{s}_{c}"));
+        } else if c == "tot" {
+            names.push(format!("flux_{s}_t"));
+        }
+    }
     let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
     // mag_<k>_<kind> (HDF5) ↔ <KIND>MAG<k> (XYZ)
     const KINDS: [(&str, &str); 5] = [
@@ -975,6 +1107,50 @@ mod tests {
         assert_eq!(sensor_names("flux_d"), ["flux_d", "fluxd"]);
         assert_eq!(sensor_names("FLUXA"), ["FLUXA", "flux_a"]);
         assert_eq!(sensor_names("my_mag"), ["my_mag"]);
+    }
+
+    /// Every SGL field pairs with its XYZ export name both ways, and the
+    /// MagNav name is what a model keeps (the reviewer's `--extra
+    /// cur_com_1` on `CUR_COM1`, a model's `mag_1_uc` on `UNCOMPMAG1`).
+    #[test]
+    fn sgl_fields_pair_with_their_xyz_export_names() {
+        for (h5, xyz) in [
+            ("mag_1_uc", "UNCOMPMAG1"),
+            ("mag_1_dc", "DCMAG1"),
+            ("mag_1_igrf", "IGRFMAG1"),
+            ("cur_com_1", "CUR_COM1"),
+            ("cur_ac_hi", "CUR_ACHi"),
+            ("cur_heat", "CUR_IHTR"),
+            ("cur_bat_2", "CUR_BAT2"),
+            ("vol_srvo", "V_SERVO"),
+            ("vol_res_p", "V_RESp"),
+            ("flux_b_x", "FLUXB_X"),
+            ("flux_c_t", "FLUXC_TOT"),
+            ("flux_d", "FLUXD"),
+            ("ins_vw", "INS_VEL_W"),
+            ("pitch_rate", "PITCHRT"),
+        ] {
+            let lower = xyz.to_ascii_lowercase();
+            assert!(
+                sensor_names(h5).contains(&lower),
+                "{h5}: {:?}",
+                sensor_names(h5)
+            );
+            assert!(sensor_names(xyz).iter().any(|n| n == h5), "{xyz}");
+            assert_eq!(magnav_name(xyz), h5);
+            assert_eq!(magnav_name(h5), h5);
+            assert_eq!(magnav_name(&h5.to_ascii_uppercase()), h5);
+        }
+        // Same name in both (any case), and names of no SGL field.
+        assert_eq!(magnav_name("CUR_STRB"), "cur_strb");
+        for other in ["my_mag", "mag_2", "cable_azimuth", "mag", "Flux_X"] {
+            assert_eq!(magnav_name(other), other);
+        }
+        // A mapping of an SGL name says it needs none.
+        let e = ColumnMap::parse("mag_1_uc=UNCOMPMAG1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("needs no mapping"), "{e}");
     }
 
     #[test]

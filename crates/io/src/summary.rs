@@ -20,6 +20,7 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::columns::MappedColumn;
+use crate::derive::Conversion;
 use crate::derive::DerivedColumn;
 use crate::fields::known_field;
 use crate::table::{ColumnData, FlightTable, Missing};
@@ -137,6 +138,7 @@ pub struct LineCount {
 
 /// Computes the [`Summary`] of a table.
 pub fn summarize(table: &FlightTable) -> Summary {
+    let ins_unit = crate::derive::ins_position_unit(table).map(|(c, _)| c);
     let columns = table
         .columns()
         .iter()
@@ -146,7 +148,17 @@ pub fn summarize(table: &FlightTable) -> Summary {
                 .iter()
                 .find(|m| m.file_column == c.name())
                 .map(|m| m.canonical.clone());
-            let unit = known_field(canonical.as_deref().unwrap_or(c.name())).map(|k| k.unit);
+            let mut unit = known_field(canonical.as_deref().unwrap_or(c.name())).map(|k| k.unit);
+            // `ins_lat`/`ins_lon` in degrees (MagNav's XYZ0 layout), told by
+            // their values (`derive` module docs).
+            if unit == Some("rad")
+                && ["ins_lat", "ins_lon"]
+                    .iter()
+                    .any(|f| c.name().eq_ignore_ascii_case(f))
+                && ins_unit == Some(Conversion::DegreesAsRecorded)
+            {
+                unit = Some("deg");
+            }
             match c.data() {
                 ColumnData::Numeric { values, missing } => {
                     let (min, max, mean) = min_max_mean(values);

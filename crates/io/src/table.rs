@@ -196,15 +196,33 @@ impl FlightTable {
     }
 
     /// The column name in the table that `name` refers to: the file column of
-    /// an alias, else `name` itself if such a column exists.
+    /// an alias, else `name` itself if such a column exists, else the one
+    /// column that is `name` or its SGL counterpart without regard to case
+    /// ([`crate::sensor_names`]: `mag_1_uc` finds `UNCOMPMAG1`, `cur_com_1`
+    /// finds `CUR_COM1` and back), so that a model's or an option's column
+    /// (`--extra`, `--reference-sensor`) finds the SGL field in either
+    /// naming. Two columns that both match are no match (the caller's
+    /// message lists the columns).
     pub fn resolve(&self, name: &str) -> Option<&str> {
         if let Some(m) = self.aliases.iter().find(|m| m.canonical == name) {
             return Some(m.file_column.as_str());
         }
-        self.columns
-            .iter()
-            .find(|c| c.name == name)
-            .map(|c| c.name.as_str())
+        if let Some(c) = self.columns.iter().find(|c| c.name == name) {
+            return Some(c.name.as_str());
+        }
+        if crate::columns::is_canonical(name) {
+            return None;
+        }
+        crate::columns::sensor_names(name).iter().find_map(|n| {
+            let mut hits = self
+                .columns
+                .iter()
+                .filter(|c| c.name.eq_ignore_ascii_case(n));
+            match (hits.next(), hits.next()) {
+                (Some(c), None) => Some(c.name.as_str()),
+                _ => None,
+            }
+        })
     }
 
     /// The column `name` (alias resolved), numeric or text.

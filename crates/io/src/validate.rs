@@ -21,6 +21,7 @@
 //! | `diurnal` | 0 < max \|B\| < 1e-3 (tesla), median \|B\| > 1e6 | — |
 //! | `lat` | \|lat\| > 90 | all \|lat\| ≤ π/2 and \|lon\| ≤ π (radians?) |
 //! | `lon` | \|lon\| > 360 | (see `lat`) |
+//! | `lat`, `lon` derived from `ins_lat`, `ins_lon` | as `lat`, `lon`, naming the file's field | taken as degrees because a value cannot be radians (`ins-degrees`; [`crate::derive`]) |
 //! | `roll`, `pitch` | \|roll\| > 180, \|pitch\| > 90 | |
 //! | `yaw` | — | outside ±360 |
 //! | `roll`, `pitch`, `yaw` | — | radians: \|roll\|, \|pitch\| ≤ π/2 while yaw stays in [−π, 2π] and spans more than π (a turn of over 180° in radians; in degrees that would be a heading range of 3–9° without a single roll above 1.6°) |
@@ -36,6 +37,7 @@ use std::fmt;
 use serde::Serialize;
 
 use crate::columns::MAGNETIC_COLUMNS;
+use crate::derive::Conversion;
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
 use aeromag_core::error::{figure, shown};
@@ -104,6 +106,10 @@ pub enum WarningKind {
     /// A median ground speed no aircraft flies: time in minutes or hours
     /// (or positions in another unit).
     TimeUnit,
+    /// `ins_lat`/`ins_lon`, which the SGL layout records in radians, taken
+    /// as degrees because their values cannot be radians
+    /// ([`crate::derive::ins_position_unit`]).
+    InsDegrees,
 }
 
 impl WarningKind {
@@ -116,6 +122,7 @@ impl WarningKind {
             WarningKind::YawRange => "yaw-range",
             WarningKind::AltitudeUnit => "altitude-unit",
             WarningKind::TimeUnit => "time-unit",
+            WarningKind::InsDegrees => "ins-degrees",
         }
     }
 }
@@ -731,24 +738,69 @@ impl Ctx<'_> {
         ))
     }
 
+    /// The column a message about canonical `name` names, and what it adds:
+    /// the file's field a derived `lat`/`lon` comes from (`INS_LAT`, not a
+    /// `lat` the file does not have), with the unit it was read in.
+    fn source_of(&self, name: &str) -> (String, String) {
+        match self.table.derived().iter().find(|d| d.canonical == name) {
+            Some(d) => (
+                d.from.clone(),
+                format!(
+                    " (read as {name}, {})",
+                    match d.conversion {
+                        Conversion::RadiansToDegrees => "radians converted to degrees",
+                        _ => "degrees as recorded",
+                    }
+                ),
+            ),
+            None => (name.to_string(), String::new()),
+        }
+    }
+
     fn position(&self, w: &mut Vec<Warning>) -> Result<()> {
         let lat = self.table.column("lat");
         let lon = self.table.column("lon");
+        if let Some(d) = self
+            .table
+            .derived()
+            .iter()
+            .find(|d| d.conversion == Conversion::DegreesAsRecorded)
+            && let Some((_, evidence)) = crate::derive::ins_position_unit(self.table)
+        {
+            let taken: Vec<String> = self
+                .table
+                .derived()
+                .iter()
+                .filter(|d| d.conversion == Conversion::DegreesAsRecorded)
+                .map(|d| format!("{} = {}", d.canonical, d.from))
+                .collect();
+            w.push(self.warn(
+                WarningKind::InsDegrees,
+                &d.from,
+                None,
+                format!(
+                    "taken as degrees, not radians as the SGL layout records it: {evidence} is beyond ±π/2 (latitude) or ±π (longitude), which no position in radians reaches (MagNav's XYZ0 layout records degrees); {} as recorded",
+                    taken.join(", ")
+                ),
+            ));
+        }
         if let Some(lat) = lat
             && let Some((i, v)) = first_where(lat, |v| v.abs() > 90.0)
         {
+            let (column, read) = self.source_of("lat");
             return Err(self.units(
-                    "lat",
-                    format!("latitude {} at {} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", shown(v), data_row(self.table, i)),
+                    &column,
+                    format!("latitude {}{read} at {} is outside ±90°: lat/lon swapped, or projected coordinates? expected degrees", shown(v), data_row(self.table, i)),
                 ));
         }
         if let Some(lon) = lon
             && let Some((i, v)) = first_where(lon, |v| v.abs() > 360.0)
         {
+            let (column, read) = self.source_of("lon");
             return Err(self.units(
-                "lon",
+                &column,
                 format!(
-                    "longitude {} at {} is outside ±360°: projected coordinates? expected degrees",
+                    "longitude {}{read} at {} is outside ±360°: projected coordinates? expected degrees",
                     shown(v),
                     data_row(self.table, i)
                 ),
@@ -921,6 +973,38 @@ pub use aeromag_core::median::median_in_place;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An INS position in degrees is taken as degrees with a named
+    /// warning; a bad one names the file's field (`ins_lat`), not a `lat`
+    /// the file does not have; radians raise nothing.
+    #[test]
+    fn ins_positions_name_their_unit_and_their_field() {
+        let checked = |lat: f64, lon: f64| {
+            let mut t = FlightTable::new();
+            t.set_source("f.csv");
+            t.add_column("ins_lat", vec![lat, lat]).unwrap();
+            t.add_column("ins_lon", vec![lon, lon]).unwrap();
+            crate::derive_columns(&mut t).unwrap();
+            check_units(&t)
+        };
+        let w = checked(39.1607, -95.5207).unwrap();
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert_eq!(w[0].kind, WarningKind::InsDegrees);
+        let s = w[0].to_string();
+        assert!(
+            s.contains("column 'ins_lat'")
+                && s.contains("ins_lat = 39.1607 is beyond ±π/2")
+                && s.contains("lat = ins_lat, lon = ins_lon as recorded")
+                && s.ends_with("[ins-degrees]"),
+            "{s}"
+        );
+        assert!(checked(0.6835, -1.6672).unwrap().is_empty());
+        let e = checked(2243.74, -95.5).unwrap_err().to_string();
+        assert!(
+            e.contains("column 'ins_lat': latitude 2243.74 (read as lat, degrees as recorded)"),
+            "{e}"
+        );
+    }
 
     /// A time from −10³⁰⁸ to 10³⁰⁸ s gave `inspect` an infinite duration
     /// with exit 0, and Unix time in milliseconds a flight sampled a

@@ -2,7 +2,7 @@
 //! CSV, whitespace and XYZ) reads the same fields of the same header, so a
 //! command sees the same columns whatever the file's format.
 
-use crate::derive::DERIVATIONS;
+use crate::derive::{DERIVATIONS, DIFFERENCES};
 use crate::{Fields, ReadOptions};
 
 /// Which of the file's fields to read: all, or those [`Fields::Only`] names
@@ -36,6 +36,9 @@ pub(crate) fn wanted_fields(
                     || DERIVATIONS.iter().any(|(c, sources, _)| {
                         c == a && sources.iter().any(|s| h.eq_ignore_ascii_case(s))
                     })
+                    || DIFFERENCES
+                        .iter()
+                        .any(|(c, x, y)| c == a && (name_matches(h, x) || name_matches(h, y)))
             })
         })
         .collect();
@@ -62,6 +65,9 @@ fn name_matches(name: &str, asked: &str) -> bool {
             suffix,
         )
     } else {
-        name.eq_ignore_ascii_case(asked)
+        // The SGL field in either naming (`cur_com_1` reads `CUR_COM1`).
+        crate::columns::sensor_names(asked)
+            .iter()
+            .any(|n| name.eq_ignore_ascii_case(n))
     }
 }

@@ -311,6 +311,21 @@ impl Flight {
         }
     }
 
+    /// The vector magnetometer the MagNav preset chose for `flux_x/y/z`
+    /// in a file with several (SGL: fluxgates A–D, `flux_a_x` or
+    /// `FLUXA_X`), for a report: `FLUXB_X, FLUXB_Y, FLUXB_Z`; `None` when
+    /// the file's own `flux_x/y/z`, the column map or `--vector` chose.
+    pub fn preset_vector(&self) -> Option<String> {
+        let file = |c: &str| {
+            self.mapping()
+                .iter()
+                .find(|m| m.canonical == c && m.origin == aeromag_io::MapOrigin::MagNavPreset)
+                .map(|m| m.file_column.clone())
+        };
+        let [x, y, z] = ["flux_x", "flux_y", "flux_z"].map(file);
+        Some(format!("{}, {}, {}", x?, y?, z?))
+    }
+
     /// Canonical column name → the file's column name, for a model file.
     pub fn column_map_of(&self, names: &[&str]) -> std::collections::BTreeMap<String, String> {
         names

@@ -59,6 +59,27 @@ impl ReferenceChannels {
     }
 }
 
+impl ReferenceChannels {
+    /// The channels of `flight` this choice subtracts, for a report:
+    /// `diurnal, igrf (derived from DCMAG1 − IGRFMAG1)`, or `none`.
+    pub fn describe(&self, flight: &Flight) -> Result<String> {
+        let cols = self.resolve(flight)?;
+        if cols.is_empty() {
+            return Ok("none".into());
+        }
+        Ok(cols
+            .iter()
+            .map(
+                |c| match flight.derived().iter().find(|d| d.canonical == *c) {
+                    Some(d) if d.minus.is_some() => format!("{c} (derived from {})", d.describe()),
+                    _ => c.clone(),
+                },
+            )
+            .collect::<Vec<_>>()
+            .join(", "))
+    }
+}
+
 impl FromStr for ReferenceChannels {
     type Err = Error;
     /// `auto`, `none` or a comma-separated list of columns. Empty (or

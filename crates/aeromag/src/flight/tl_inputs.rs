@@ -57,6 +57,11 @@ impl SensorColumns {
     /// `--vector` (SGL HDF5 and Geosoft XYZ names of one sensor, without
     /// regard to case). A sensor the flight lacks is bad input naming the
     /// file and the sensor.
+    ///
+    /// An SGL sensor is kept under its MagNav name (`UNCOMPMAG3` →
+    /// `mag_3_uc`, `FLUXB_X` → `flux_b_x`; [`aeromag_io::magnav_name`]),
+    /// which finds it in a flight of either naming: a model fitted on the
+    /// XYZ export applies to the HDF5 layout and back.
     pub fn find(flight: &Flight, mag: &str, vector: Option<&str>) -> Result<Self> {
         let names = flight.column_names();
         let find = |name: &str| -> Option<String> {
@@ -64,7 +69,7 @@ impl SensorColumns {
                 names
                     .iter()
                     .find(|h| h.eq_ignore_ascii_case(n))
-                    .map(|h| h.to_string())
+                    .map(|h| aeromag_io::magnav_name(h))
             })
         };
         let absent = |what: &str, name: &str| {

@@ -361,7 +361,12 @@ impl LineCompensator {
             }
         }
         let lookup = |canonical: &str| -> Option<usize> {
-            let by = |n: &str| names.iter().position(|h| h.eq_ignore_ascii_case(n));
+            // An SGL field in either naming (`cur_com_1` = `CUR_COM1`).
+            let by = |n: &str| {
+                aeromag_io::sensor_names(n)
+                    .iter()
+                    .find_map(|s| names.iter().position(|h| h.eq_ignore_ascii_case(s)))
+            };
             opts.columns
                 .get(canonical)
                 .and_then(by)

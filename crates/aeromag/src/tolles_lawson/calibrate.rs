@@ -549,7 +549,12 @@ pub(super) fn model_columns(
         .copied()
         .chain(ref_cols.iter().map(String::as_str))
         .collect();
+    // SGL fields under their MagNav names (`UNCOMPMAG1` → `mag_1_uc`),
+    // which find them in either naming.
     let mut map = flight.column_map_of(&names);
+    for v in map.values_mut() {
+        *v = aeromag_io::magnav_name(v);
+    }
     let canonical = SensorColumns::default();
     for (c, s) in std::iter::once((&canonical.mag, &sensor.mag))
         .chain(canonical.flux.iter().zip(&sensor.flux))

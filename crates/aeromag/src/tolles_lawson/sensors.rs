@@ -110,13 +110,22 @@ pub fn calibrate_sensors(
         ..opts.clone()
     };
     // The reference: fitted first when it is one of the sensors.
+    // By its SGL name in either naming (`UNCOMPMAG1` is `mag_1_uc`), or
+    // its stem (`mag_1`).
     let ref_index = match &set.reference {
-        Some(r) => set
-            .sensors
-            .iter()
-            .position(|s| s.mag.eq_ignore_ascii_case(r) || s.stem() == *r),
+        Some(r) => set.sensors.iter().position(|s| {
+            aeromag_io::sensor_names(r)
+                .iter()
+                .any(|n| s.mag.eq_ignore_ascii_case(n))
+                || s.stem() == *r
+        }),
         None => None,
     };
+    // The model keeps the MagNav name (module docs of `SensorColumns::find`).
+    let reference_name = set.reference.as_ref().map(|r| match ref_index {
+        Some(i) => set.sensors[i].mag.clone(),
+        None => aeromag_io::magnav_name(r),
+    });
     let mut fitted: Vec<Option<(Calibration, Option<String>)>> = vec![None; set.sensors.len()];
     let mut reference_nt: Option<Vec<f64>> = None;
     if let Some(i) = ref_index {
@@ -160,7 +169,7 @@ pub fn calibrate_sensors(
             continue;
         }
         notes.stage(&format!("calibrating {}", s.mag));
-        let (o, series, reference) = match (&set.reference, &reference_nt) {
+        let (o, series, reference) = match (&reference_name, &reference_nt) {
             (None, _) => (of(s), None, None),
             (Some(r), Some(series)) => {
                 (reference_mode(&of(s))?, Some(&series[..]), Some(r.clone()))

@@ -169,7 +169,16 @@ impl CalibrateSettings {
                 arm_m,
                 decimal_year: self.decimal_year.unwrap_or(DEFAULT_DECIMAL_YEAR),
             }),
-            extra: self.extra.clone(),
+            // The model keeps the MagNav name of an SGL channel (`CUR_COM1`
+            // → `cur_com_1`), which finds it in either naming.
+            extra: self
+                .extra
+                .iter()
+                .map(|r| ExtraRequest {
+                    channel: aeromag_io::magnav_name(&r.channel),
+                    lag: r.lag,
+                })
+                .collect(),
             extra_selection: self.extra_selection,
             sensor: Default::default(),
         })

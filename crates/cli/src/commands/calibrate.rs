@@ -115,7 +115,9 @@ pub struct Args {
     series: Option<PathBuf>,
     /// Extra regressors: recorded channels times the direction cosines,
     /// `NAME` or `NAME:lag` (also through a fitted lag), comma-separated,
-    /// e.g. `cur_strb,cur_flap:lag`.
+    /// e.g. `cur_strb,cur_flap:lag`. SGL channels are found in either
+    /// naming (`cur_com_1` = the XYZ export's `CUR_COM1`); the model keeps
+    /// the MagNav name.
     #[arg(long, value_name = "NAME[:lag],…", value_parser = extras)]
     extra: Option<Extras>,
     /// Which of the --extra channels are kept, per sensor: `test` (those the
@@ -161,7 +163,9 @@ pub struct Args {
     #[arg(long)]
     no_split_lines: bool,
     /// Known external-field channels subtracted from `mag` before the fit:
-    /// `auto` (the `diurnal` and `igrf` columns when present), `none`
+    /// `auto` (the `diurnal` and `igrf` columns when present; `igrf`
+    /// derived as mag_1_dc − mag_1_igrf, MagNav's way, when a file has
+    /// those instead; printed), `none`
     /// (MagNav.jl's way), or a comma-separated list of columns.
     #[arg(long, value_parser = parsed::<ReferenceChannels>, default_value_t = ReferenceChannels::default())]
     reference: ReferenceChannels,
@@ -269,6 +273,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some(_) => a.input.load()?,
         None => a.input.load_canonical(&extra)?,
     };
+    print_inputs(&flight, &opts, None, false)?;
     let cal = calibrate(&flight, &opts, &mut Bars::new())?;
     let model = &cal.model;
     if let Some(k) = &cal.kalman {
@@ -362,6 +367,31 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What the fit reads that the file's names do not say: the fluxgate the
+/// MagNav preset chose for flux_x/y/z (SGL files carry four) and the
+/// reference channels subtracted from the scalar reading (a derived `igrf`
+/// named with its fields).
+fn print_inputs(
+    flight: &aeromag::Flight,
+    opts: &CalibrateOptions,
+    reference_sensor: Option<&str>,
+    vector_chosen: bool,
+) -> anyhow::Result<()> {
+    if let Some(v) = flight.preset_vector().filter(|_| !vector_chosen) {
+        println!(
+            "vector magnetometer: flux_x, flux_y, flux_z = {v} (the first complete one; choose with --vector)"
+        );
+    }
+    let sensor = reference_sensor
+        .map(|r| format!(" (the sensors other than {r}: {r} compensated)"))
+        .unwrap_or_default();
+    println!(
+        "reference subtracted from the scalar reading: {}{sensor}",
+        opts.reference.describe(flight)?
+    );
+    Ok(())
+}
+
 /// Several sensors (or the reference-sensor mode): one model each.
 fn run_sensors(a: &Args, opts: &CalibrateOptions) -> anyhow::Result<()> {
     if a.series.is_some() {
@@ -374,6 +404,12 @@ fn run_sensors(a: &Args, opts: &CalibrateOptions) -> anyhow::Result<()> {
         sensors: a.input.sensor_columns(&flight)?,
         reference: a.reference_sensor.clone(),
     };
+    print_inputs(
+        &flight,
+        opts,
+        a.reference_sensor.as_deref(),
+        a.input.vector.is_some(),
+    )?;
     let cal = aeromag::calibrate_sensors(&flight, &set, opts, &mut Bars::new())?;
     aeromag::io::atomic::write_file(&a.model, cal.model.to_json()?)
         .map_err(|e| aeromag::Error::write(&a.model, e))?;

@@ -162,12 +162,7 @@ pub fn render(s: &Summary) -> String {
                 .iter()
                 .map(|d| {
                     let unit = aeromag_io::known_field(&d.canonical).map_or("", |k| k.unit);
-                    format!(
-                        "{}={} ({}) [{unit}]",
-                        d.canonical,
-                        d.from,
-                        d.conversion.describe()
-                    )
+                    format!("{}={} [{unit}]", d.canonical, d.describe())
                 })
                 .collect::<Vec<_>>()
                 .join(", ")
