@@ -83,3 +83,22 @@ def test_bad_sensor_input_names_what_is_wrong(sgl_csv):
         aeromag.calibrate_sensors(flight, ["mag_1_uc"], extra=CURRENTS, extra_selection="some")
     with pytest.raises(TypeError):
         aeromag.calibrate_sensors(flight, ["mag_1_uc"], no_such_option=1)
+
+
+def test_another_sensors_units_are_checked_as_mags(sgl_csv):
+    """A second sensor in µT, pT or T, or its vector magnetometer in T,
+    was fitted without a word (the same column as the flight's `mag` was
+    refused)."""
+    d = aeromag.read_flight(sgl_csv).to_dict()
+
+    def scaled(prefix, k):
+        return aeromag.Flight.from_dict({c: v * k if c.startswith(prefix) else v for c, v in d.items()})
+
+    for prefix, k, says in [
+        ("mag_4_uc", 1e-3, "microtesla"),
+        ("mag_4_uc", 1e3, "picotesla"),
+        ("mag_4_uc", 1e-9, "tesla"),
+        ("flux_d_", 1e-9, "tesla"),
+    ]:
+        with pytest.raises(aeromag.BadInputError, match=says):
+            aeromag.calibrate_sensors(scaled(prefix, k), ["mag_1_uc", "mag_4_uc"], vector=["flux_a", "flux_d"])

@@ -398,6 +398,52 @@ pub fn check_units(table: &FlightTable) -> Result<Vec<Warning>> {
     Ok(warnings)
 }
 
+/// The unit checks [`check_units`] runs on `mag` and `flux_x/y/z`, for
+/// another sensor of the flight: the scalar column `mag` (a total field:
+/// tesla, gauss, microtesla and picotesla refused, readings below
+/// [`MIN_READING_NT`] and beyond [`MAX_FIELD_NT`] refused) and the vector
+/// magnetometer's components `flux` (tesla, picotesla refused) and
+/// magnitude. File column names or canonical names ([`FlightTable::resolve`]);
+/// a column the table lacks is not checked. Before, `calibrate --mag
+/// mag_1_uc,mag_4_uc` fitted a `mag_4_uc` in µT or T with exit 0 (and a
+/// model in pT, which `compensate` then said "does not fit").
+pub fn check_sensor_units(table: &FlightTable, mag: &str, flux: [&str; 3]) -> Result<()> {
+    let ctx = Ctx { table };
+    let column = |n: &str| {
+        table
+            .resolve(n)
+            .and_then(|c| table.column(c).map(|v| (c, v)))
+    };
+    if let Some((name, v)) = column(mag) {
+        let (median, min, max) = (
+            sampled_median(v.len(), |i| v[i].abs()),
+            min_value(v),
+            max_abs(v),
+        );
+        ctx.total_field(name, median, Some((min, max)), &mut Vec::new())?;
+        ctx.within_field(name, max)?;
+        ctx.readings(name, median, min)?;
+    }
+    let components = flux.map(column);
+    for (name, v) in components.iter().flatten() {
+        let max = max_abs(v);
+        ctx.component(name, (max, sampled_median(v.len(), |i| v[i].abs())))?;
+        ctx.within_field(name, max)?;
+    }
+    if let [Some((x_name, x)), Some((y_name, y)), Some((z_name, z))] = components {
+        let norm = sampled_median(x.len(), |i| {
+            (x[i] * x[i] + y[i] * y[i] + z[i] * z[i]).sqrt()
+        });
+        ctx.total_field(
+            &format!("{x_name}/{y_name}/{z_name}"),
+            norm,
+            None,
+            &mut Vec::new(),
+        )?;
+    }
+    Ok(())
+}
+
 /// Multiplies the magnetic columns present (`mag`, `flux_*`, `diurnal`,
 /// `igrf`) by 1e9, converting tesla to nT. Returns the
 /// names converted.
@@ -1010,6 +1056,45 @@ mod tests {
     /// with exit 0, and Unix time in milliseconds a flight sampled a
     /// thousand times too slowly: times beyond ±10¹¹ s are refused,
     /// naming the row; Unix time in seconds passes.
+    /// A second sensor's scalar and vector columns are checked as `mag`
+    /// and `flux_x/y/z` are (µT, T and pT were fitted with exit 0), in
+    /// either naming; nT passes.
+    #[test]
+    fn another_sensors_columns_have_the_unit_checks_of_mag_and_flux() {
+        let n = 200;
+        let wobble = |base: f64, k: usize| base * (1.0 + 1e-4 * (k as f64).sin());
+        let table = |scale: f64, flux_scale: f64| {
+            let mut t = FlightTable::new();
+            t.add_column(
+                "UNCOMPMAG4",
+                (0..n).map(|k| wobble(52_000.0, k) * scale).collect(),
+            )
+            .unwrap();
+            for (c, v) in [
+                ("flux_d_x", 20_000.0),
+                ("flux_d_y", 3_000.0),
+                ("flux_d_z", 48_000.0),
+            ] {
+                t.add_column(c, (0..n).map(|k| wobble(v, k) * flux_scale).collect())
+                    .unwrap();
+            }
+            t
+        };
+        let flux = ["flux_d_x", "flux_d_y", "flux_d_z"];
+        assert!(check_sensor_units(&table(1.0, 1.0), "mag_4_uc", flux).is_ok());
+        for (scale, flux_scale, column, says) in [
+            (1e-3, 1.0, "UNCOMPMAG4", "microtesla"),
+            (1e-9, 1.0, "UNCOMPMAG4", "tesla"),
+            (1e3, 1.0, "UNCOMPMAG4", "picotesla"),
+            (1.0, 1e-9, "flux_d_x", "tesla"),
+            (1.0, 1e3, "flux_d_x", "picotesla"),
+        ] {
+            let e = check_sensor_units(&table(scale, flux_scale), "mag_4_uc", flux).unwrap_err();
+            let text = e.to_string();
+            assert!(text.contains(column) && text.contains(says), "{text}");
+        }
+    }
+
     #[test]
     fn times_beyond_any_clock_in_seconds_are_refused() {
         let check = |t: Vec<f64>| {

@@ -91,6 +91,13 @@ impl SensorColumns {
                 [axis("x")?, axis("y")?, axis("z")?]
             }
         };
+        // The canonical `mag` and `flux_x/y/z` were checked when the
+        // flight was read; another sensor's columns are checked here.
+        let canonical = Self::default();
+        if mag != canonical.mag || flux != canonical.flux {
+            let [x, y, z] = flux.each_ref().map(String::as_str);
+            aeromag_io::check_sensor_units(flight.table(), &mag, [x, y, z])?;
+        }
         Ok(Self { mag, flux })
     }
 
