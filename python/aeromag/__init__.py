@@ -344,7 +344,9 @@ def level(
     """Level a survey at its line/tie-line crossovers (``aeromag level``).
 
     The keywords are the command's flags (``--lambda`` → ``ridge_lambda``):
-    ``value`` the column to level (default ``mag_comp``, else ``mag``),
+    ``value`` the column to level (default the compensated reading,
+    any case: ``mag_comp``, else the first ``mag_<k>_comp``; else ``mag``
+    with the warning ``[uncompensated-default]``),
     ``lever_arm`` the sensor's position (m, body frame), ``rate_of`` the
     column whose derivative is the ``k·d|B0|/dt`` regressor, ``tie_only``
     classic tie-line levelling, ``drift`` a linear drift per line,

@@ -13,7 +13,9 @@ use aeromag_io::FlightTable;
 /// What to level and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LevelOptions {
-    /// Column to level; `None`: `mag_comp` when the flight has it, else `mag`.
+    /// Column to level; `None`: the compensated reading (`mag_comp`, else
+    /// the first `mag_<k>_comp`, any case), else `mag` with the warning
+    /// `[uncompensated-default]` ([`crate::flight::default_column`]).
     pub value: Option<String>,
     /// Column whose along-track derivative is the regressor of the
     /// `d|B0|/dt` term, as recorded; `None`: `mag` (the uncompensated
@@ -25,8 +27,15 @@ pub struct LevelOptions {
     /// y right, z down; m): crossovers are found at the sensor's position.
     pub lever_arm_m: Option<[f64; 3]>,
     /// Known external-field channels subtracted from the value first
-    /// (default none: classic levelling).
+    /// (default none: classic levelling; `calibrate`'s default is `auto`).
     pub reference: ReferenceChannels,
+    /// Note when `reference` is none and the flight has reference channels
+    /// (`diurnal`, `igrf`) that `auto` would subtract: for a caller whose
+    /// `none` is the default rather than a choice (`aeromag level` without
+    /// `--reference`). On the simulated survey the crossover RMS after
+    /// levelling is 0.786 nT as recorded against 0.155 nT with `auto`; the
+    /// default stays `none`, which levelled outputs already rely on.
+    pub note_unused_reference: bool,
     /// Crossover finding (gap rule, derivative window, minimum angle).
     pub tracks: TrackConfig,
     /// The fit (k, drift, ridge λ, altitude term, robust weights).
@@ -43,6 +52,7 @@ impl Default for LevelOptions {
             rate_of: None,
             lever_arm_m: None,
             reference: ReferenceChannels::None,
+            note_unused_reference: false,
             tracks: TrackConfig::default(),
             fit: LevellingConfig::default(),
             ties: Vec::new(),
@@ -233,8 +243,13 @@ pub fn level(
     let mut notes = Notes::new(observer);
     let value_column = match &opts.value {
         Some(v) => v.clone(),
-        None if flight.column("mag_comp").is_some() => "mag_comp".into(),
-        None => "mag".into(),
+        None => {
+            let d = crate::flight::default_column(flight, &[""], "--value")?;
+            if let Some(w) = d.warning {
+                notes.warn(w);
+            }
+            d.name
+        }
     };
     let out_name = format!("{value_column}_level");
     if flight.get(&out_name).is_some() || flight.get(LEVEL_FLAG).is_some() {
@@ -284,6 +299,17 @@ pub fn level(
         None => (lat, lon),
     };
     let reference_columns = opts.reference.resolve(flight)?;
+    if opts.note_unused_reference && opts.reference == ReferenceChannels::None {
+        let present = ReferenceChannels::Auto.resolve(flight)?;
+        if !present.is_empty() {
+            notes.note(format!(
+                "the file has the reference channel{} {}, not subtracted (--reference none is the default); --reference auto subtracts {} before the crossovers are formed, which usually levels better (simulated survey: crossover RMS 0.155 against 0.786 nT)",
+                if present.len() > 1 { "s" } else { "" },
+                present.join(" and "),
+                if present.len() > 1 { "them" } else { "it" },
+            ));
+        }
+    }
     let sum = reference_sum(flight, &reference_columns, None)?;
     let value = reduced(flight.field_values(&value_column)?, &sum);
     let rate_column = match &opts.rate_of {

@@ -48,7 +48,8 @@ pub struct MinCurvatureArgs {
     /// Most sweeps of each of minimum curvature's relaxations on the final
     /// grid (two: between the coarser grid's nodes, then with the data),
     /// 1 to 100000 (GMT `surface -N`; the coarser grids before it get
-    /// more in proportion to their spacing).
+    /// more in proportion to their spacing). A solve stopped by it is
+    /// warned of, with how far the grid may be from the converged one.
     #[arg(long, value_name = "N", default_value_t = 500)]
     pub max_sweeps: usize,
     /// Convergence limit of minimum curvature: the largest change of a

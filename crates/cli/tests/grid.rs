@@ -485,3 +485,63 @@ fn derive_on_tiny_and_blank_grids_gives_an_error_or_a_valid_grid() {
         );
     }
 }
+
+/// The grid's format and path are checked before the work: `--out g.png`
+/// was refused only after the whole solve (here the input does not even
+/// exist, and the format is what is reported).
+#[test]
+fn an_unknown_grid_format_is_refused_before_the_work() {
+    let d = tempfile::tempdir().unwrap();
+    let o = grid(&d.path().join("nosuch.csv"), &d.path().join("g.png"), &[]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("unknown grid format"), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "");
+}
+
+/// A misspelt `--column` gets a "did you mean" among the file's columns.
+#[test]
+fn a_misspelt_column_gets_a_suggestion() {
+    let d = tempfile::tempdir().unwrap();
+    let input = survey(d.path());
+    let o = grid(&input, &d.path().join("g.tif"), &["--column", "mga"]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("required column 'mga' is missing (did you mean 'mag'?)"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// Three nodes with data (a plane) gridded by minimum curvature: the
+/// report names the method (it said "bi-directional … (Akima)" when the
+/// solve reported no grid level).
+#[test]
+fn minimum_curvature_without_sweeps_is_labelled_as_such() {
+    let d = tempfile::tempdir().unwrap();
+    let input = d.path().join("few.csv");
+    let mut text = String::from("time,lat,lon,line,mag\n");
+    // Three short lines far apart (diagonally): one node each.
+    for (k, (lat0, lon)) in [(56.0, 38.0), (56.3, 38.5), (56.6, 39.0)]
+        .iter()
+        .enumerate()
+    {
+        for j in 0..3 {
+            let t = 1000 * k + 10 * j;
+            let lat = lat0 + 0.001 * j as f64;
+            text.push_str(&format!("{t},{lat},{lon},{},{}\n", k + 1, 50_000 + 10 * k));
+        }
+    }
+    std::fs::write(&input, text).unwrap();
+    let o = grid(
+        &input,
+        &d.path().join("g.tif"),
+        &["--method", "min-curvature"],
+    );
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(
+        s.contains("minimum curvature, tension 0.25: 3 nodes hold data"),
+        "{s}"
+    );
+    assert!(!s.contains("bi-directional"), "{s}");
+}

@@ -171,3 +171,168 @@ fn dipole_convergence_map_multistart_converges_everywhere() {
         2,
     );
 }
+
+/// A small simulated survey (six lines, two ties) rewritten by `edit`,
+/// which gets the header's names and each row's cells (comments dropped).
+fn edited_survey(
+    dir: &std::path::Path,
+    name: &str,
+    edit: impl Fn(&mut Vec<String>, bool),
+) -> std::path::PathBuf {
+    let config = dir.join("small.toml");
+    std::fs::write(
+        &config,
+        "[pattern]\nline_count = 6\nline_length_m = 3000.0\ntie_count = 2\ntie_spacing_m = 1500.0\n",
+    )
+    .unwrap();
+    let input = simulate_with(dir, "survey", "4", Some(&config));
+    let text = std::fs::read_to_string(&input).unwrap();
+    let mut out = String::new();
+    let mut header = true;
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
+        edit(&mut cells, header);
+        header = false;
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+fn level_default(
+    input: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec![
+        "level",
+        "-i",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    aeromag(&args)
+}
+
+/// The default column is the compensated one whatever the header's case
+/// (an upper-cased `MAG_COMP` was passed over for the raw `mag`), and
+/// `grid` then takes its levelled form; the column is printed first.
+#[test]
+fn level_and_grid_default_to_the_compensated_column_in_any_case() {
+    let d = tempfile::tempdir().unwrap();
+    // MAG_COMP: the reading less 10 nT, so that it is told from MAG.
+    let input = edited_survey(d.path(), "upper.csv", |cells, header| {
+        let mag = cells[10].clone();
+        if header {
+            cells.iter_mut().for_each(|c| *c = c.to_uppercase());
+            cells.push("MAG_COMP".into());
+        } else {
+            cells.push(format!("{}", mag.parse::<f64>().unwrap() - 10.0));
+        }
+    });
+    assert!(
+        std::fs::read_to_string(&input)
+            .unwrap()
+            .starts_with("TIME,LAT")
+    );
+    let lev = d.path().join("lev.csv");
+    let o = level_default(&input, &lev, &[]);
+    assert_code(&o, 0);
+    let (s, e) = (stdout(&o), stderr(&o));
+    assert!(s.starts_with("levelling MAG_COMP\n"), "{s}");
+    assert!(s.contains("(column MAG_COMP_level)"), "{s}");
+    assert!(!e.contains("uncompensated-default"), "{e}");
+    // The reference channels are there but not subtracted: a note says so
+    // and names `--reference auto`; not when `none` is chosen.
+    assert!(
+        e.contains("note: the file has the reference channels diurnal and igrf")
+            && e.contains("--reference auto"),
+        "{e}"
+    );
+    let lev2 = d.path().join("lev2.csv");
+    let o = level_default(&input, &lev2, &["--reference", "none"]);
+    assert_code(&o, 0);
+    assert!(!stderr(&o).contains("reference channels"), "{}", stderr(&o));
+    let g = aeromag(&[
+        "grid",
+        "-i",
+        lev.to_str().unwrap(),
+        "--out",
+        d.path().join("g.tif").to_str().unwrap(),
+    ]);
+    assert_code(&g, 0);
+    assert!(
+        stdout(&g).starts_with("gridded MAG_COMP_level "),
+        "{}",
+        stdout(&g)
+    );
+    assert!(
+        !stderr(&g).contains("uncompensated-default"),
+        "{}",
+        stderr(&g)
+    );
+}
+
+/// After a multi-sensor `compensate` (`mag_1_uc` mapped onto `mag`,
+/// `mag_<k>_comp` per sensor) the first sensor's compensated reading is
+/// levelled, not the raw `mag`; a file with the raw reading only is
+/// levelled with the warning [uncompensated-default].
+#[test]
+fn level_prefers_the_multi_sensor_compensated_reading_and_warns_of_the_raw_one() {
+    let d = tempfile::tempdir().unwrap();
+    let input = edited_survey(d.path(), "sgl.csv", |cells, header| {
+        if header {
+            cells[10] = "mag_1_uc".into();
+            cells.extend(["mag_1_comp".into(), "mag_2_comp".into()]);
+        } else {
+            let mag: f64 = cells[10].parse().unwrap();
+            cells.extend([format!("{}", mag - 10.0), format!("{}", mag - 20.0)]);
+        }
+    });
+    let lev = d.path().join("lev.csv");
+    let o = level_default(&input, &lev, &[]);
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).starts_with("levelling mag_1_comp\n"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(!stderr(&o).contains("uncompensated"), "{}", stderr(&o));
+    let g = aeromag(&[
+        "grid",
+        "-i",
+        lev.to_str().unwrap(),
+        "--out",
+        d.path().join("g.tif").to_str().unwrap(),
+    ]);
+    assert_code(&g, 0);
+    assert!(
+        stdout(&g).starts_with("gridded mag_1_comp_level "),
+        "{}",
+        stdout(&g)
+    );
+
+    let d = tempfile::tempdir().unwrap();
+    let raw = edited_survey(d.path(), "raw.csv", |_, _| {});
+    let o = level_default(
+        &raw,
+        &d.path().join("raw_lev.csv"),
+        &["--reference", "auto"],
+    );
+    assert_code(&o, 0);
+    let e = stderr(&o);
+    assert!(
+        e.contains("warning: the column taken is `mag`, the uncompensated reading")
+            && e.contains("--value")
+            && e.contains("[uncompensated-default]"),
+        "{e}"
+    );
+    assert!(
+        stdout(&o).starts_with("levelling mag − diurnal − igrf\n"),
+        "{}",
+        stdout(&o)
+    );
+}

@@ -752,11 +752,23 @@ fn candidates(header: &[String], keep: impl Fn(&str) -> bool) -> String {
 
 /// The canonical name closest to `name` (case-insensitive edit distance ≤ 2).
 fn closest_canonical(name: &str) -> Option<&'static str> {
+    closest_name(name, CANONICAL_COLUMNS)
+}
+
+/// The name among `candidates` closest to `name`, for a "did you mean"
+/// hint: edit distance at most 2, compared without regard to case (a
+/// transposition such as `levle` is 2; a wider net suggests unrelated
+/// names among a survey file's 50 columns), the first of equally close
+/// ones. `None` for an exact match without regard to case: that is no typo.
+pub fn closest_name<'c>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'c str>,
+) -> Option<&'c str> {
     let lower = name.to_ascii_lowercase();
-    CANONICAL_COLUMNS
-        .iter()
-        .map(|c| (edit_distance(&lower, c), *c))
-        .filter(|(d, _)| *d <= 2)
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(&lower, &c.to_ascii_lowercase()), c))
+        .filter(|(d, _)| (1..=2).contains(d))
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c)
 }
@@ -1151,6 +1163,22 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("needs no mapping"), "{e}");
+    }
+
+    #[test]
+    fn closest_name_suggests_a_typo_not_an_unrelated_name() {
+        let names = ["mag_comp", "mag_comp_level", "level_flag", "MAG"];
+        assert_eq!(
+            closest_name("mag_comp_levle", names),
+            Some("mag_comp_level")
+        );
+        assert_eq!(closest_name("MAG_COMP_LEVL", names), Some("mag_comp_level"));
+        assert_eq!(closest_name("altitude", names), None);
+        assert_eq!(
+            closest_name("mag", names),
+            None,
+            "a match in another case is no typo"
+        );
     }
 
     #[test]

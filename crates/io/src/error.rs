@@ -162,12 +162,17 @@ pub enum IoError {
         hint: String,
     },
     /// A column that a command needs is not in the table.
-    #[error("'{file}': required column '{column}' is missing; columns present: {present}{hint}")]
+    #[error(
+        "'{file}': required column '{column}' is missing{suggestion}; columns present: {present}{hint}"
+    )]
     MissingColumn {
         /// File (or `"<in-memory table>"`).
         file: String,
         /// The required (canonical) name.
         column: String,
+        /// ` (did you mean 'NAME'?)` for a present column within a typo
+        /// of it ([`crate::closest_name`]), else empty.
+        suggestion: String,
         /// Comma-separated list of the columns present.
         present: String,
         /// Extra advice (starts with a space or is empty).

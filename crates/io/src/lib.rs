@@ -63,7 +63,7 @@ use std::path::Path;
 pub use builder::{MAX_COLUMNS, MAX_LINE_BYTES};
 pub use columns::{
     CANONICAL_COLUMNS, ColumnMap, MAGNAV_PRESET, MAGNETIC_COLUMNS, MapOrigin, MappedColumn,
-    Sensors, is_canonical, is_truth_column, magnav_name, sensor_names,
+    Sensors, closest_name, is_canonical, is_truth_column, magnav_name, sensor_names,
 };
 pub use csv_read::read_csv;
 pub use csv_write::{write_csv, write_csv_to};

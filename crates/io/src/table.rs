@@ -278,6 +278,15 @@ impl FlightTable {
             None => Err(IoError::MissingColumn {
                 file: self.file_label(),
                 column: name.to_string(),
+                suggestion: crate::columns::closest_name(
+                    name,
+                    self.file_columns
+                        .iter()
+                        .map(String::as_str)
+                        .chain(self.column_names()),
+                )
+                .map(|c| format!(" (did you mean '{c}'?)"))
+                .unwrap_or_default(),
                 present: self.present_columns(),
                 // Only canonical and truth names can be mapped.
                 hint: if crate::columns::is_canonical(name) || crate::columns::is_truth_column(name)

@@ -6,6 +6,8 @@
 //!   the usable-row rule and the segments ([`SegmentRule`]);
 //! - [`ReferenceChannels`] — the known external-field channels removed from
 //!   the scalar reading before a fit or a score;
+//! - [`default_column`] — the magnetic column `level`, `grid` and
+//!   `microlevel` take when none is named (compensated first, any case);
 //! - [`LeverArm`] and [`sensor_track`] — where the sensor is relative to
 //!   the navigation point;
 //! - [`position_glitches`] — rows whose position jumps off the track faster
@@ -16,6 +18,7 @@
 //! `spec/data-formats.md` (`time`, `lat`, `lon`, `alt`, `roll`, `pitch`,
 //! `yaw`, `mag`, `flux_x`, …) after the column map.
 
+mod default_column;
 mod line_labels;
 mod reference;
 mod segments;
@@ -23,6 +26,7 @@ mod tl_inputs;
 
 pub use aeromag_compensation::reference_field::LeverArm;
 pub use aeromag_io::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
+pub use default_column::{DefaultColumn, default_column, default_column_fields};
 pub use line_labels::LineLabels;
 pub(crate) use reference::NOT_FIELDS;
 pub(crate) use reference::reduced;

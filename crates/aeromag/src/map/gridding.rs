@@ -1,12 +1,12 @@
 //! A column of a survey on a grid.
 
-use super::MOST_PROCESSED;
+use super::PROCESSING_STAGES;
 use super::survey::{LineGeometry, ProjectedSurvey};
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use crate::observer::{Note, Notes, Observer};
 use aeromag_core::error::shown;
-use aeromag_grid::format::{GridFormat, write_grid};
+use aeromag_grid::format::GridFormat;
 use aeromag_grid::grid::MIN_CELL;
 use aeromag_grid::gridding::{
     Bidirectional, BlockMeans, LinePoints, MinCurvature, MinCurvatureReport, Points, blank_beyond,
@@ -33,7 +33,8 @@ pub enum GridMethod {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct GridOptions {
     /// The column to grid; `None`: the most processed magnetic column of
-    /// the file ([`MOST_PROCESSED`]).
+    /// the file, compensated first, any case ([`PROCESSING_STAGES`],
+    /// [`crate::flight::default_column`]).
     pub column: Option<String>,
     /// Node spacing, m; `None`: a quarter of the line spacing, rounded
     /// down to 1, 2, 2.5 or 5 × 10ᵏ m.
@@ -85,7 +86,16 @@ impl SurveyGrid {
     /// Write the grid; the format follows the extension (`.tif`, `.asc`,
     /// `.nc`).
     pub fn write(&self, path: &Path) -> Result<GridFormat> {
-        Ok(write_grid(path, &self.grid)?)
+        let format = Self::format_of(path)?;
+        format.write(path, &self.grid)?;
+        Ok(format)
+    }
+
+    /// The grid format [`Self::write`] uses for `path`, by its extension;
+    /// bad input for any other. Call it before the gridding: an unknown
+    /// extension (`g.png`) was reported only after the whole solve.
+    pub fn format_of(path: &Path) -> Result<GridFormat> {
+        Ok(GridFormat::from_path(path)?)
     }
 }
 
@@ -138,6 +148,37 @@ fn fine_cell_warning(geometry: &GridGeometry, lines: Option<&LineGeometry>) -> O
     })
 }
 
+/// The warning for a minimum-curvature solve stopped by the sweep limit,
+/// with how far the grid may be from the converged one
+/// ([`LevelReport::remaining_estimate`](aeromag_grid::gridding::LevelReport::remaining_estimate)):
+/// GMT's sweep limit (500) is kept, so that grids match GMT's at its
+/// defaults, and a survey whose solve needs more (the simulated survey:
+/// 1101 sweeps) is told what stopping costs. `None` when it converged.
+pub(crate) fn not_converged_warning(report: &MinCurvatureReport) -> Option<String> {
+    if report.converged {
+        return None;
+    }
+    let last = report.levels.last()?;
+    let off = last.remaining_estimate();
+    let off = if off.is_finite() {
+        format!(
+            "the grid may be about {} from the converged one",
+            aeromag_core::error::figure(off)
+        )
+    } else {
+        "the changes no longer shrink, so how far the grid is from the converged one is unknown"
+            .to_string()
+    };
+    Some(format!(
+        "minimum curvature stopped after {} sweeps with a change of {:.3e} (limit {:.3e}): {off} (the change shrinking by {:.4} a sweep); \
+         raise the sweep limit (--max-sweeps) or the convergence limit (--convergence)",
+        report.final_sweeps(),
+        last.max_change,
+        report.convergence_limit,
+        last.decay_per_sweep,
+    ))
+}
+
 /// The finest cell, in line spacings, `grid` takes without the warning
 /// `[fine-cell]`; the finest `microlevel` takes at all
 /// ([`super::microlevel::MIN_CELL_LINE_SPACINGS`]).
@@ -155,19 +196,13 @@ pub(crate) fn grid_flight_finest(
     let mut notes = Notes::new(observer);
     let column = match &opts.column {
         Some(c) => c.clone(),
-        None => MOST_PROCESSED
-            .iter()
-            .find(|c| flight.get(c).is_some())
-            .map(|c| c.to_string())
-            .ok_or_else(|| {
-                Error::bad_file(
-                    flight.label(),
-                    format!(
-                        "has none of the magnetic columns {} (choose one with --column)",
-                        MOST_PROCESSED.join(", ")
-                    ),
-                )
-            })?,
+        None => {
+            let d = crate::flight::default_column(flight, &PROCESSING_STAGES, "--column")?;
+            if let Some(w) = d.warning {
+                notes.warn(w);
+            }
+            d.name
+        }
     };
     // A magnetic column is checked as one (tesla, 1e300); any other (a
     // height, a time) only for infinities, which a grid dropped silently.
@@ -304,14 +339,8 @@ pub(crate) fn grid_flight_finest(
             ));
         }
     };
-    if !report.converged {
-        notes.warn(format!(
-            "minimum curvature stopped after {} sweeps with a change of {:.3e} (limit {:.3e}); \
-             raise the sweep limit (--max-sweeps) or the convergence limit (--convergence)",
-            report.final_sweeps(),
-            report.levels.last().map_or(f64::NAN, |l| l.max_change),
-            report.convergence_limit
-        ));
+    if let Some(w) = not_converged_warning(&report) {
+        notes.warn(w);
     }
     let distance = distance_to_data(&geometry, &BlockMeans::of(points, &geometry));
     let blanked = blank_beyond(&mut grid_values, &distance, blanking);

@@ -22,13 +22,11 @@ pub use gridding::{GridOptions, SurveyGrid, grid_flight};
 pub use microlevel::{MicrolevelOptions, Microlevelled, microlevel};
 pub use survey::{LineGeometry, ProjectedSurvey};
 
-/// The magnetic columns a survey file may hold, the most processed first:
-/// the default column to grid.
-pub const MOST_PROCESSED: [&str; 6] = [
-    "mag_comp_level_mlev",
-    "mag_level_mlev",
-    "mag_comp_level",
-    "mag_level",
-    "mag_comp",
-    "mag",
-];
+/// The processing stages of a survey's magnetic columns, the most
+/// processed first (suffixes of the column: micro-levelled levelled,
+/// levelled, as compensated or recorded): the default column to grid is
+/// the first stage the file has, and within a stage the compensated
+/// reading before the uncompensated ([`crate::flight::default_column`]):
+/// `mag_comp_level_mlev`, `mag_<k>_comp_level_mlev`, `mag_level_mlev`,
+/// `mag_comp_level`, …, `mag_comp`, `mag_<k>_comp`, `mag`.
+pub const PROCESSING_STAGES: [&str; 3] = ["_level_mlev", "_level", ""];

@@ -35,8 +35,10 @@ pub struct Args {
     #[arg(long, value_name = "GRID")]
     out: PathBuf,
     /// Column to grid (default: the most processed magnetic column of the
-    /// file: mag_comp_level_mlev, mag_level_mlev, mag_comp_level,
-    /// mag_level, mag_comp, mag).
+    /// file, compensated first, names in any case: mag_comp_level_mlev,
+    /// mag_<k>_comp_level_mlev, mag_level_mlev, mag_comp_level, …,
+    /// mag_comp, mag_<k>_comp (the first sensor's in the file), mag; an
+    /// uncompensated column taken so is warned of [uncompensated-default]).
     #[arg(long)]
     column: Option<String>,
     /// Cell size (node spacing), m, 1e-6 to 1e6 (default: a quarter of
@@ -75,6 +77,8 @@ fn extent(s: &str) -> Result<[f64; 4], String> {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    // The format by the extension, then the path: both before the work.
+    aeromag::map::SurveyGrid::format_of(&a.out)?;
     crate::output::check_files([a.out.as_path()], &[a.input.input.as_path()])?;
     let geometry = match (&a.extent, a.cell) {
         (Some(e), Some(cell)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], cell)?),
@@ -83,7 +87,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     // The canonical columns and the magnetic ones it may grid: a wide
     // survey file's other fields are not parsed.
-    let mut extra: Vec<&str> = aeromag::map::MOST_PROCESSED.to_vec();
+    let wanted = aeromag::flight::default_column_fields(&aeromag::map::PROCESSING_STAGES);
+    let mut extra: Vec<&str> = wanted.iter().map(String::as_str).collect();
     extra.extend(a.column.as_deref());
     let flight = a.input.load_canonical(&extra)?;
     let opts = GridOptions {
@@ -118,19 +123,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         geo.y0,
         geo.y_max()
     );
-    match (a.method, g.report.levels.last()) {
-        (GridMethod::MinCurvature, Some(last)) => println!(
+    match a.method {
+        // No levels: data that are exactly a plane need no sweep.
+        GridMethod::MinCurvature => println!(
             "minimum curvature, tension {}: {} nodes hold data, {} sweeps on the final grid, {}",
             opts.min_curvature.tension,
             g.report.constrained_nodes,
-            last.iterations,
+            g.report.levels.last().map_or(0, |l| l.iterations),
             if g.report.converged {
                 "converged"
             } else {
                 "NOT converged"
             }
         ),
-        _ => println!(
+        GridMethod::Bidirectional => println!(
             "bi-directional: along the lines, then across them (Akima); {} nodes hold data",
             g.report.constrained_nodes
         ),

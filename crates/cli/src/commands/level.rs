@@ -33,7 +33,9 @@ pub struct Args {
     /// Output CSV file.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
-    /// Column to level (default `mag_comp`, else `mag`).
+    /// Column to level (default: the compensated reading, names in any
+    /// case: `mag_comp`, else the first `mag_<k>_comp` of a multi-sensor
+    /// `compensate`; else `mag`, with the warning [uncompensated-default]).
     #[arg(long)]
     value: Option<String>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m.
@@ -76,9 +78,12 @@ pub struct Args {
     /// 10–300 s, which per-line offsets cannot follow) leave the crossovers,
     /// and the d|B0|/dt coefficient k is determined far better. The levelled
     /// column is then the reduced value, levelled.
-    #[arg(long, default_value_t = ReferenceChannels::None, value_name = "none|auto|COLS",
+    ///
+    /// Without this option, a file with `diurnal` or `igrf` columns gets a
+    /// note naming them and `--reference auto` (`calibrate`'s default).
+    #[arg(long, value_name = "none|auto|COLS",
           value_parser = args::parsed::<ReferenceChannels>)]
-    reference: ReferenceChannels,
+    reference: Option<ReferenceChannels>,
     /// Labels of the tie lines (e.g. `901,902`), for files whose labels
     /// do not say it: crossovers are then formed only between a line and a
     /// tie. Not needed with a `line_type` column (Geosoft XYZ `Line`/`Tie`
@@ -105,7 +110,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         value: a.value.clone(),
         rate_of: a.rate_of.clone(),
         lever_arm_m: a.lever_arm,
-        reference: a.reference.clone(),
+        reference: a.reference.clone().unwrap_or(ReferenceChannels::None),
+        note_unused_reference: a.reference.is_none(),
         fit: LevelFitChoices {
             tie_only: a.tie_only,
             drift: a.drift,
@@ -120,7 +126,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let lev = level(&flight, &opts, &mut Bars::new())?;
     let value_name = &lev.value_column;
     let out_name = lev.output_column();
-    if !lev.reference_columns.is_empty() {
+    if lev.reference_columns.is_empty() {
+        println!("levelling {value_name}");
+    } else {
         println!(
             "levelling {value_name} − {}",
             lev.reference_columns.join(" − ")

@@ -122,6 +122,37 @@ pub struct LevelReport {
     pub iterations: usize,
     /// Largest change of the last sweep, data unit.
     pub max_change: f64,
+    /// The factor by which the largest change shrank per sweep over the
+    /// last [`DECAY_WINDOW`] sweeps with the data (their geometric mean;
+    /// NaN with fewer than two sweeps).
+    pub decay_per_sweep: f64,
+}
+
+/// Sweeps over which [`LevelReport::decay_per_sweep`] is taken: the largest
+/// change of one sweep jitters (it is one node's), its trend over 50
+/// sweeps does not.
+pub const DECAY_WINDOW: usize = 50;
+
+impl LevelReport {
+    /// How far the grid may still be from the converged one, data unit:
+    /// the sum of the changes still to come if they keep shrinking by
+    /// [`Self::decay_per_sweep`] a sweep, `max_change · r / (1 − r)`
+    /// (infinite when they do not shrink, NaN when unknown). Over-relaxation
+    /// converges geometrically once the slowest mode dominates, which it
+    /// does by the sweep limit, so this is the order of the error and on
+    /// the safe side: on the simulated survey stopped at 516 sweeps it is
+    /// 2.99 nT, and the grid differs from the one converged with
+    /// `--max-sweeps 5000` (1101 sweeps) by at most 1.36 nT (std 0.055).
+    pub fn remaining_estimate(&self) -> f64 {
+        let r = self.decay_per_sweep;
+        if r.is_nan() {
+            f64::NAN
+        } else if r >= 1.0 {
+            f64::INFINITY
+        } else {
+            self.max_change * r / (1.0 - r)
+        }
+    }
 }
 
 /// What the gridding did ([`MinCurvature::grid`]).
@@ -293,7 +324,8 @@ impl MinCurvature {
                     let held = coarse.spacing / stride;
                     iterations += next.solve(self, Phase::Between(held), limit_here, sweeps).0;
                 }
-                let (data_sweeps, max_change) = next.solve(self, Phase::Data, limit_here, sweeps);
+                let (data_sweeps, max_change, decay_per_sweep) =
+                    next.solve(self, Phase::Data, limit_here, sweeps);
                 iterations += data_sweeps;
                 report.levels.push(LevelReport {
                     spacing_cells: stride,
@@ -301,6 +333,7 @@ impl MinCurvature {
                     ny: next.ny,
                     iterations,
                     max_change,
+                    decay_per_sweep,
                 });
                 if stride == 1 {
                     report.converged = max_change <= limit;
@@ -651,7 +684,8 @@ impl Level {
 
     /// Over-relaxed sweeps, rows from the north as GMT, until the largest
     /// change of a sweep is at most `limit` or after `max_sweeps`: (sweeps,
-    /// largest change of the last one).
+    /// largest change of the last one, the factor it shrank by per sweep
+    /// over the last [`DECAY_WINDOW`] sweeps).
     ///
     /// A node's update waits for the one before it (its west neighbour,
     /// just updated), about 60 cycles of latency. So [`WAVE_ROWS`] rows are
@@ -666,7 +700,7 @@ impl Level {
         phase: Phase,
         limit: f64,
         max_sweeps: usize,
-    ) -> (usize, f64) {
+    ) -> (usize, f64, f64) {
         let t = s.tension;
         let (nx, ny, w) = (self.nx, self.ny, self.width());
         let denom = 20.0 * (1.0 - t) + 4.0 * t;
@@ -720,6 +754,8 @@ impl Level {
         let done: Vec<AtomicUsize> = groups.iter().map(|_| AtomicUsize::new(0)).collect();
         let mut change = f64::INFINITY;
         let mut sweeps = 0;
+        // The last DECAY_WINDOW + 1 changes, a ring.
+        let mut recent = [f64::NAN; DECAY_WINDOW + 1];
         while sweeps < max_sweeps {
             self.fill_ghosts(t);
             let z = Padded(self.z.as_mut_ptr());
@@ -756,13 +792,21 @@ impl Level {
                         .fold(part(0), f64::max)
                 })
             };
+            recent[sweeps % recent.len()] = change;
             sweeps += 1;
             if change <= limit {
                 break;
             }
         }
         (self.nodes, self.slot) = (nodes, slot);
-        (sweeps, change)
+        let span = (sweeps.saturating_sub(1)).min(DECAY_WINDOW);
+        let decay = if span == 0 {
+            f64::NAN
+        } else {
+            let first = recent[(sweeps - 1 - span) % recent.len()];
+            (change / first).powf(1.0 / span as f64)
+        };
+        (sweeps, change, decay)
     }
 }
 
@@ -1107,7 +1151,7 @@ mod tests {
                 l.start_from(&coarse);
                 l.wave_rows = rows;
                 l.threads = Some(threads);
-                let (sweeps, change) = l.solve(&s, phase, 0.0, 7);
+                let (sweeps, change, _) = l.solve(&s, phase, 0.0, 7);
                 assert_eq!(sweeps, 7);
                 (l.z, change)
             };
