@@ -251,7 +251,10 @@ impl ColumnMap {
                 .map(|c| format!("did you mean '{c}'? "))
                 .unwrap_or_default();
             // An SGL field needs no mapping: it is found in either naming.
-            let sgl = if sensor_names(canonical).len() > 1 {
+            let sgl = if closest_canonical(canonical)
+                .is_none_or(|c| !c.eq_ignore_ascii_case(canonical))
+                && sensor_names(canonical).len() > 1
+            {
                 format!(
                     "'{canonical}' needs no mapping: SGL fields are found under their MagNav or XYZ export names ({}) without one; ",
                     sensor_names(canonical).join(" = ")
@@ -752,7 +755,12 @@ fn candidates(header: &[String], keep: impl Fn(&str) -> bool) -> String {
 
 /// The canonical name closest to `name` (case-insensitive edit distance ≤ 2).
 fn closest_canonical(name: &str) -> Option<&'static str> {
-    closest_name(name, CANONICAL_COLUMNS)
+    // A canonical name in another case (`flux_X`) is the suggestion.
+    CANONICAL_COLUMNS
+        .iter()
+        .find(|c| c.eq_ignore_ascii_case(name))
+        .copied()
+        .or_else(|| closest_name(name, CANONICAL_COLUMNS))
 }
 
 /// The name among `candidates` closest to `name`, for a "did you mean"
