@@ -26,6 +26,7 @@
 //! | [`median`] | the median of a sample (one definition for every crate) |
 //! | [`quadrature`] | composite Simpson's rule (reference integrals in tests) |
 //! | [`simd`] | kernels compiled with and without AVX, chosen at run time |
+//! | [`memory`] | the memory this process can still take (refusing work sized beyond it) |
 //! | [`output_target`] | where an output goes: a regular file (written atomically) or a device, FIFO or socket |
 //! | [`error`] | [`CoreError`], with `is_bad_input()` |
 
@@ -35,6 +36,7 @@ pub mod field;
 pub mod filter;
 pub mod frames;
 pub mod median;
+pub mod memory;
 pub mod output_target;
 pub mod parallel;
 pub mod quadrature;

@@ -28,6 +28,41 @@ pub struct GridGeometry {
 /// size is an error and not an out-of-memory abort.
 pub const MAX_NODES: usize = 250_000_000;
 
+/// Peak memory per node while a grid is made and written, bytes: the
+/// slope of `aeromag grid`'s peak resident size over grids of 2.7·10⁵ to
+/// 4.3·10⁶ nodes of one survey (41, 70 and 177 MB at cells of 20, 10 and
+/// 5 m: 33.4 bytes a node), rounded up.
+pub const GRIDDING_BYTES_PER_NODE: f64 = 34.0;
+
+/// A grid of `fx × fy` nodes at `cell` m is refused when it needs more
+/// memory than the process can take (`available`, bytes;
+/// [`aeromag_core::memory`]): an allocation failure aborts the process.
+/// Before, Python's `grid_flight` with a 1 m cell over 15 km (2.4·10⁸
+/// nodes, under [`MAX_NODES`]) under a 6 GB address-space limit died
+/// with "memory allocation of 7590105632 bytes failed".
+fn check_memory(fx: f64, fy: f64, cell: f64, available: Option<u64>) -> Result<()> {
+    let need = fx * fy * GRIDDING_BYTES_PER_NODE;
+    let Some(available) = available.map(|a| a as f64) else {
+        return Ok(());
+    };
+    if need <= available {
+        return Ok(());
+    }
+    // The cell that fits, with room to spare (the nodes go as 1/cell²).
+    let fits = cell * (need / (0.8 * available)).sqrt();
+    Err(GridError::Data(format!(
+        "{} × {} nodes at a {} m cell need about {:.1} GB while gridding ({GRIDDING_BYTES_PER_NODE} \
+         bytes a node), more than the {:.1} GB this process can take: choose a larger cell (about \
+         {} m) or a smaller area",
+        shown(fx),
+        shown(fy),
+        shown(cell),
+        need / 1e9,
+        available / 1e9,
+        shown((fits * 100.0).ceil() / 100.0)
+    )))
+}
+
 /// Smallest cell size of a grid read from a file, m (1 µm). Survey grids
 /// have cells of decimetres (drone, ground) to kilometres (compilations);
 /// a smaller "cell" is a corrupt header, and would put wavenumbers of
@@ -96,6 +131,7 @@ impl GridGeometry {
                 shown(cell)
             )));
         }
+        check_memory(fx, fy, cell, aeromag_core::memory::available_bytes())?;
         Ok(Self {
             x0,
             y0,
@@ -336,6 +372,25 @@ pub struct GridStats {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A grid needing more memory than the process can take is refused
+    /// with the cell that fits; one that fits, or an unknown amount of
+    /// memory, passes.
+    #[test]
+    fn a_grid_beyond_the_memory_available_is_refused_with_a_cell_that_fits() {
+        // The campaign's grid: 15 401² nodes at 1 m, 6 GB.
+        let e = check_memory(15_401.0, 15_401.0, 1.0, Some(6_000_000_000))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("need about 8.1 GB") && e.contains("6.0 GB") && e.contains("about 1.3 m"),
+            "{e}"
+        );
+        let fits: f64 = 1.3;
+        let n = (15_400.0 / fits).ceil() + 1.0;
+        assert!(check_memory(n, n, fits, Some(6_000_000_000)).is_ok());
+        assert!(check_memory(15_401.0, 15_401.0, 1.0, None).is_ok());
+    }
 
     #[test]
     fn covering_aligns_nodes_to_the_cell_and_covers_the_extent() {
