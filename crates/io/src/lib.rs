@@ -80,8 +80,8 @@ pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
 pub use validate::{
     EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MAX_TIME_S, MEDIAN_SAMPLES,
     MIN_READING_NT, MIN_TIME_STEP_FRACTION, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind,
-    check_sensor_units, check_time, check_units, convert_tesla_to_nt, median_in_place,
-    sampled_median, step_distance_m,
+    check_sensor_units, check_time, check_units, column_spread, convert_tesla_to_nt,
+    median_in_place, reads_as_microtesla, sampled_median, step_distance_m,
 };
 pub use values::{SharedBuffer, Values};
 pub use xyz::read_xyz;

@@ -415,11 +415,7 @@ pub fn check_sensor_units(table: &FlightTable, mag: &str, flux: [&str; 3]) -> Re
             .and_then(|c| table.column(c).map(|v| (c, v)))
     };
     if let Some((name, v)) = column(mag) {
-        let (median, min, max) = (
-            sampled_median(v.len(), |i| v[i].abs()),
-            min_value(v),
-            max_abs(v),
-        );
+        let (median, min, max) = column_spread(v);
         ctx.total_field(name, median, Some((min, max)), &mut Vec::new())?;
         ctx.within_field(name, max)?;
         ctx.readings(name, median, min)?;
@@ -540,6 +536,29 @@ impl Stats {
     }
 }
 
+/// Whether a column of median |value| `m` reads as Earth's total field in
+/// microtesla: `m` within [`EARTH_FIELD_UT`] and, when `range` gives the
+/// column's smallest and largest value (a column that may be an anomaly),
+/// every value within half and twice `m`. A total field varies by a few
+/// per cent; an anomaly of this median would be all of one sign and
+/// within a factor of 2 of it.
+pub fn reads_as_microtesla(m: f64, range: Option<(Option<f64>, Option<f64>)>) -> bool {
+    let total = range.is_none_or(|(lo, hi)| {
+        lo.is_some_and(|lo| lo >= m / 2.0) && hi.is_some_and(|hi| hi <= 2.0 * m)
+    });
+    (EARTH_FIELD_UT.0..=EARTH_FIELD_UT.1).contains(&m) && total
+}
+
+/// The median |value|, smallest value and largest |value| of a column
+/// (finite values), as the unit checks use them.
+pub fn column_spread(v: &[f64]) -> (Option<f64>, Option<f64>, Option<f64>) {
+    (
+        sampled_median(v.len(), |i| v[i].abs()),
+        min_value(v),
+        max_abs(v),
+    )
+}
+
 struct Ctx<'a> {
     table: &'a FlightTable,
 }
@@ -584,12 +603,7 @@ impl Ctx<'_> {
     ) -> Result<()> {
         let Some(m) = median_abs else { return Ok(()) };
         let fix = "expected nT";
-        // A total field varies by a few per cent; an anomaly of this median
-        // would be all of one sign and within a factor of 2 of it.
-        let total = range.is_none_or(|(lo, hi)| {
-            lo.is_some_and(|lo| lo >= m / 2.0) && hi.is_some_and(|hi| hi <= 2.0 * m)
-        });
-        if (EARTH_FIELD_UT.0..=EARTH_FIELD_UT.1).contains(&m) && total {
+        if reads_as_microtesla(m, range) {
             return Err(self.units(
                 name,
                 format!("median |value| = {} looks like microtesla (Earth's field is 22 to 67 µT), {fix} (multiply by 1000)", shown(m)),

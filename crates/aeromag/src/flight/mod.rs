@@ -241,7 +241,8 @@ impl Flight {
     /// were levelled into `inf` and dropped from a grid without a word),
     /// or when every value is below 10⁻³ in magnitude (tesla: the unit
     /// checks test `mag` and the reference columns, not a compensated or
-    /// levelled column). Missing values (NaN) pass.
+    /// levelled column), or when it reads as a total field in microtesla.
+    /// Missing values (NaN) pass.
     pub fn field_values(&self, name: &str) -> Result<&[f64]> {
         let v = self.require(name)?;
         if let Some(k) = v
@@ -267,6 +268,21 @@ impl Flight {
                 name,
                 format!(
                     "every value is below 1e-3 in magnitude (largest {max:.3e}): tesla? the values must be in nT (multiply by 1e9)"
+                ),
+            ));
+        }
+        // A total field in µT (`level`, `grid` and `microlevel` took a
+        // `mag_comp` of 53 "nT"); an anomaly of such values is told apart
+        // by its spread ([`aeromag_io::reads_as_microtesla`]).
+        let (median, min, max) = aeromag_io::column_spread(v);
+        if let Some(m) = median
+            && aeromag_io::reads_as_microtesla(m, Some((min, max)))
+        {
+            return Err(self.bad_column(
+                name,
+                format!(
+                    "median |value| = {} looks like microtesla (Earth's field is 22 to 67 µT): the values must be in nT (multiply by 1000)",
+                    aeromag_core::error::shown(m)
                 ),
             ));
         }
@@ -370,6 +386,36 @@ pub fn sensor_track_at(flight: &Flight, alt: &[f64], arm_m: [f64; 3]) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A compensated total field in µT was levelled and gridded as nT
+    /// (`score` refused it); an anomaly of the same median but its spread,
+    /// and a total field in nT, are taken.
+    #[test]
+    fn a_total_field_in_microtesla_is_no_field_value() {
+        let n = 500;
+        let mut t = FlightTable::new();
+        t.add_column("time", (0..n).map(|k| k as f64).collect())
+            .unwrap();
+        let total = |k: usize| 53_000.0 + 40.0 * (k as f64 / 30.0).sin();
+        t.add_column("mag_comp", (0..n).map(|k| total(k) / 1000.0).collect())
+            .unwrap();
+        t.add_column("mag_nt", (0..n).map(total).collect()).unwrap();
+        t.add_column(
+            "anomaly",
+            (0..n)
+                .map(|k| 53.0 + 40.0 * (k as f64 / 30.0).sin())
+                .collect(),
+        )
+        .unwrap();
+        let f = Flight::from_table(t).unwrap();
+        let e = f.field_values("mag_comp").unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("microtesla"),
+            "{e}"
+        );
+        assert!(f.field_values("mag_nt").is_ok());
+        assert!(f.field_values("anomaly").is_ok());
+    }
 
     /// After `--lines`, a bad cell is named by the file's data row and line.
     #[test]
