@@ -1387,3 +1387,26 @@ fn a_compensated_flight_whose_columns_disagree_is_not_scored() {
         );
     }
 }
+
+/// A flight without `alt` (MagNav's TL test arrays have no positions):
+/// the Kalman method and `observability` said only "required column 'alt'
+/// is missing"; now what it is needed for and that the LS method fits
+/// without it.
+#[test]
+fn the_kalman_method_says_why_it_needs_the_altitude() {
+    let cal = simulate_flight(ScenarioKind::Calibration, None, Some(1)).unwrap();
+    let mut t = FlightTable::new();
+    for c in cal.table().columns() {
+        if c.name() != "alt" && !c.name().starts_with("true_") {
+            t.add_column(c.name(), c.values().unwrap().to_vec())
+                .unwrap();
+        }
+    }
+    let flight = Flight::from_table(t).unwrap();
+    let e = calibrate(&flight, &CalibrateOptions::kalman(), &mut Silent).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        e.is_bad_input() && text.contains("has no `alt` column") && text.contains("--method ls"),
+        "{text}"
+    );
+}

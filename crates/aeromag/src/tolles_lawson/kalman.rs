@@ -340,7 +340,11 @@ fn sensor_altitude(
     notes: &mut Notes,
 ) -> Result<(Vec<f64>, AltitudeSource)> {
     let time = flight.require("time")?;
-    let alt = flight.require("alt")?;
+    let alt = kalman_needs(
+        flight,
+        "alt",
+        "the altitude (m), through which the field's vertical gradient changes the reading",
+    )?;
     let vd = flight.column("vd");
     let runs: Vec<NavRun> = segs
         .iter()
@@ -403,12 +407,32 @@ fn sensor_altitude(
 pub(crate) fn ground_speed(flight: &Flight) -> Result<Vec<f64>> {
     Ok(match (flight.column("vn"), flight.column("ve")) {
         (Some(vn), Some(ve)) => ground_speed_from_velocity(vn, ve),
-        _ => ground_speed_from_positions(
-            flight.require("time")?,
-            flight.require("lat")?,
-            flight.require("lon")?,
-        ),
+        _ => {
+            let why = "the position (deg), whose ground speed sets how fast the external field changes (or vn, ve)";
+            ground_speed_from_positions(
+                flight.require("time")?,
+                kalman_needs(flight, "lat", why)?,
+                kalman_needs(flight, "lon", why)?,
+            )
+        }
     })
+}
+
+/// The column `name` the Kalman method (and `observability`, which runs
+/// it) needs, for `why`: a flight without it was told only "required
+/// column 'alt' is missing" (MagNav's TL test arrays have no positions),
+/// now what it is for and that `--method ls` fits without it.
+fn kalman_needs<'f>(flight: &'f Flight, name: &str, why: &str) -> Result<&'f [f64]> {
+    if flight.resolve(name).is_none() {
+        return Err(Error::bad_file(
+            flight.label(),
+            format!(
+                "has no `{name}` column: the Kalman method (which `observability` runs too) needs {why}; \
+                 map it with --columns {name}=NAME, or fit with --method ls, which does not"
+            ),
+        ));
+    }
+    Ok(flight.require(name)?)
 }
 
 /// One series of a Kalman fit (`pick` from each segment's [`KalmanSeries`])
