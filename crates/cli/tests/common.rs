@@ -4,6 +4,19 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+/// Run `aeromag COMMAND -i INPUT --out OUT EXTRA…`.
+pub fn run_on(command: &str, input: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        command,
+        "-i",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    aeromag(&args)
+}
+
 /// Run the `aeromag` binary with arguments.
 pub fn aeromag(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_aeromag"))

@@ -17,15 +17,7 @@ fn survey(dir: &Path) -> std::path::PathBuf {
 }
 
 fn grid(input: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "grid",
-        "-i",
-        input.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend(extra);
-    aeromag(&args)
+    run_on("grid", input, out, extra)
 }
 
 #[test]

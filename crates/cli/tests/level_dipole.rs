@@ -206,15 +206,7 @@ fn level_default(
     out: &std::path::Path,
     extra: &[&str],
 ) -> std::process::Output {
-    let mut args = vec![
-        "level",
-        "-i",
-        input.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend(extra);
-    aeromag(&args)
+    run_on("level", input, out, extra)
 }
 
 /// The default column is the compensated one whatever the header's case
@@ -256,13 +248,7 @@ fn level_and_grid_default_to_the_compensated_column_in_any_case() {
     let o = level_default(&input, &lev2, &["--reference", "none"]);
     assert_code(&o, 0);
     assert!(!stderr(&o).contains("reference channels"), "{}", stderr(&o));
-    let g = aeromag(&[
-        "grid",
-        "-i",
-        lev.to_str().unwrap(),
-        "--out",
-        d.path().join("g.tif").to_str().unwrap(),
-    ]);
+    let g = run_on("grid", &lev, &d.path().join("g.tif"), &[]);
     assert_code(&g, 0);
     assert!(
         stdout(&g).starts_with("gridded MAG_COMP_level "),
@@ -301,13 +287,7 @@ fn level_prefers_the_multi_sensor_compensated_reading_and_warns_of_the_raw_one()
         stdout(&o)
     );
     assert!(!stderr(&o).contains("uncompensated"), "{}", stderr(&o));
-    let g = aeromag(&[
-        "grid",
-        "-i",
-        lev.to_str().unwrap(),
-        "--out",
-        d.path().join("g.tif").to_str().unwrap(),
-    ]);
+    let g = run_on("grid", &lev, &d.path().join("g.tif"), &[]);
     assert_code(&g, 0);
     assert!(
         stdout(&g).starts_with("gridded mag_1_comp_level "),
