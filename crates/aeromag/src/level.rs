@@ -291,7 +291,7 @@ pub fn level(
         }
         (la, lo)
     });
-    if let Some(w) = crate::map::survey::off_track_warning(flight, &off_track) {
+    if let Some(w) = crate::map::survey::off_track_warning(flight, &off_track, ["lat", "lon"]) {
         notes.warn(w);
     }
     let (lat, lon) = match &on_track_positions {

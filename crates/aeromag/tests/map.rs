@@ -284,3 +284,166 @@ fn a_cell_far_finer_than_the_lines_is_warned_of() {
         warned[0]
     );
 }
+
+/// `flight` with its latitude and longitude replaced by the columns `X`
+/// and `Y` of `x` and `y` (a Geosoft XYZ export's projected positions).
+fn projected(flight: &Flight, x: &[f64], y: &[f64]) -> Flight {
+    let mut table = aeromag::io::FlightTable::new();
+    for name in flight.table().column_names() {
+        if !["lat", "lon"].contains(&name) {
+            let v = flight.table().column(name).unwrap().to_vec();
+            table.add_column(name, v).unwrap();
+        }
+    }
+    table.add_column("X", x.to_vec()).unwrap();
+    table.add_column("Y", y.to_vec()).unwrap();
+    Flight::from_table(table).unwrap()
+}
+
+/// A survey whose positions are already projected (`X`, `Y`, no lat/lon)
+/// grids as its latitude and longitude do: with their zone given, the
+/// same grid to the bit and the same coordinate system; without, the same
+/// values, no coordinate system and the warning `[no-crs]`. A GPS dropout
+/// at 0, 0 is found and named by its X and Y; northings in degrees are
+/// refused with a zone; a lever arm is refused.
+#[test]
+fn projected_positions_grid_as_latitude_and_longitude() {
+    let flight = survey(
+        "[pattern]\nline_count = 6\nline_length_m = 4000.0\ntie_count = 2\n",
+        12,
+    );
+    let opts = GridOptions {
+        column: Some("true_anomaly".into()),
+        ..GridOptions::default()
+    };
+    let geodetic = grid_flight(&flight, &opts, &mut Silent).unwrap();
+    let zone = geodetic.survey.zone.unwrap();
+    let xy = projected(&flight, &geodetic.survey.x, &geodetic.survey.y);
+    let bits = |g: &aeromag::map::SurveyGrid| -> Vec<u64> {
+        g.grid.values.iter().map(|v| v.to_bits()).collect()
+    };
+    let in_zone = grid_flight(
+        &xy,
+        &GridOptions {
+            zone: Some(zone),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap();
+    assert_eq!(in_zone.grid.geometry, geodetic.grid.geometry);
+    assert_eq!(in_zone.grid.crs, geodetic.grid.crs);
+    assert_eq!(bits(&in_zone), bits(&geodetic));
+    assert_eq!(in_zone.survey.position_columns, ["X", "Y"]);
+    assert_eq!(in_zone.survey.lines, geodetic.survey.lines);
+    let plain = grid_flight(&xy, &opts, &mut Silent).unwrap();
+    assert_eq!(plain.grid.crs, None);
+    assert_eq!(bits(&plain), bits(&geodetic));
+    let said = |g: &aeromag::map::SurveyGrid, what: &str| {
+        g.notes
+            .iter()
+            .filter(|n| n.message.contains(what))
+            .map(|n| (n.is_warning(), n.message.clone()))
+            .collect::<Vec<_>>()
+    };
+    let no_crs = said(&plain, "[no-crs]");
+    assert_eq!(no_crs.len(), 1, "{:?}", plain.notes);
+    assert!(no_crs[0].0 && no_crs[0].1.contains("X and Y"), "{no_crs:?}");
+    assert!(said(&in_zone, "[no-crs]").is_empty());
+    assert_eq!(said(&plain, "projected columns X (easting)").len(), 1);
+    // Named columns: no note of where the positions come from.
+    let named = grid_flight(
+        &xy,
+        &GridOptions {
+            projected: Some(aeromag::map::ProjectedColumns::new("x", "y")),
+            zone: Some(zone),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap();
+    assert_eq!(bits(&named), bits(&geodetic));
+    assert!(said(&named, "projected columns").is_empty());
+
+    // A dropout written as 0, 0.
+    let row = flight
+        .require("line")
+        .unwrap()
+        .iter()
+        .position(|&l| l != 0.0)
+        .unwrap()
+        + 200;
+    let (mut x, mut y) = (geodetic.survey.x.clone(), geodetic.survey.y.clone());
+    (x[row], y[row]) = (0.0, 0.0);
+    let g = grid_flight(&projected(&flight, &x, &y), &opts, &mut Silent).unwrap();
+    assert_eq!(g.survey.off_track, [row]);
+    assert_eq!(g.grid.geometry, geodetic.grid.geometry);
+    let glitch = said(&g, "[position-glitch]");
+    assert!(
+        glitch.len() == 1 && glitch[0].1.contains(&format!("data row {}", row + 1)),
+        "{glitch:?}"
+    );
+    assert!(glitch[0].1.contains("X 0, Y 0"), "{glitch:?}");
+
+    // Negative northings, or longitudes for eastings, with a zone: bad
+    // input naming the column and the row.
+    let lon = flight.require("lon").unwrap();
+    let south: Vec<f64> = geodetic.survey.y.iter().map(|y| -y).collect();
+    let e = grid_flight(
+        &projected(&flight, &geodetic.survey.x, &south),
+        &GridOptions {
+            zone: Some(zone),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    let message = e.to_string();
+    assert!(
+        message.contains("'Y'") && message.contains("not a UTM northing"),
+        "{message}"
+    );
+    let e = grid_flight(
+        &projected(&flight, lon, &geodetic.survey.y),
+        &GridOptions {
+            zone: Some(zone),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("not a UTM easting"), "{e}");
+
+    // Micro-levelled on the same working grid; the correction not checked
+    // at the crossovers, which are found from lat/lon, and said so.
+    let mopts = MicrolevelOptions {
+        column: Some("true_anomaly".into()),
+        ..MicrolevelOptions::default()
+    };
+    let on_lat_lon = microlevel(&flight, &mopts, &mut Silent).unwrap();
+    let on_xy = microlevel(&xy, &mopts, &mut Silent).unwrap();
+    assert_eq!(on_xy.correction, on_lat_lon.correction);
+    assert_eq!(on_xy.crossover_rms_nt, None);
+    assert!(on_lat_lon.crossover_rms_nt.is_some());
+    let unchecked = |m: &aeromag::map::Microlevelled| {
+        m.notes
+            .iter()
+            .any(|n| n.message.contains("not checked at the crossovers"))
+    };
+    assert!(unchecked(&on_xy) && !unchecked(&on_lat_lon));
+
+    let e = grid_flight(
+        &xy,
+        &GridOptions {
+            lever_arm_m: Some([0.0, 0.0, 1.0]),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("lever arm"),
+        "{e}"
+    );
+}

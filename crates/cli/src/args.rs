@@ -120,6 +120,16 @@ pub fn utm_zone(s: &str) -> Result<aeromag::grid::projection::UtmZone, String> {
     aeromag::grid::projection::UtmZone::parse(s).map_err(|e| e.to_string())
 }
 
+/// Two column names `EASTING,NORTHING` of projected positions (m).
+pub fn projected_columns(s: &str) -> Result<aeromag::map::ProjectedColumns, String> {
+    match s.split(',').map(str::trim).collect::<Vec<_>>()[..] {
+        [e, n] if !e.is_empty() && !n.is_empty() && e != n => {
+            Ok(aeromag::map::ProjectedColumns::new(e, n))
+        }
+        _ => Err("expected two different column names EASTING,NORTHING, e.g. `X,Y`".into()),
+    }
+}
+
 /// A value parser from a library type's `FromStr` whose error is
 /// [`aeromag::Error`].
 pub fn parsed<T: FromStr<Err = aeromag::Error>>(s: &str) -> Result<T, String> {

@@ -537,3 +537,75 @@ fn minimum_curvature_without_sweeps_is_labelled_as_such() {
     );
     assert!(!s.contains("bi-directional"), "{s}");
 }
+
+/// A survey file with projected positions only (`X`, `Y`, no lat/lon, as
+/// a Geosoft XYZ export has them) grids: without a zone, with no
+/// coordinate system, said on stdout, warned of (`[no-crs]`) and no
+/// `.prj` written; with `--utm-zone`, the same grid file, byte for byte,
+/// as its latitudes and longitudes give. `--xy` names other columns; a
+/// missing one or a single name is an error (exit 2).
+#[test]
+fn projected_positions_are_gridded_as_they_are() {
+    use aeromag::grid::projection::{Utm, UtmZone};
+    let d = tempfile::tempdir().unwrap();
+    let input = survey(d.path());
+    let table = aeromag::io::read_table(&input, &aeromag::io::ReadOptions::default()).unwrap();
+    let zone: UtmZone = "37N".parse().unwrap();
+    let (lat, lon) = (table.column("lat").unwrap(), table.column("lon").unwrap());
+    let (x, y) = Utm::new(zone).forward_all(lat, lon).unwrap();
+    let mut xy = aeromag::io::FlightTable::new();
+    for name in ["time", "line", "mag"] {
+        xy.add_column(name, table.column(name).unwrap().to_vec())
+            .unwrap();
+    }
+    xy.add_column("X", x.clone()).unwrap();
+    xy.add_column("Y", y.clone()).unwrap();
+    xy.add_column("E2", x).unwrap();
+    xy.add_column("N2", y).unwrap();
+    let xy_file = d.path().join("xy.csv");
+    aeromag::io::write_csv(&xy, &xy_file).unwrap();
+
+    let geodetic = d.path().join("geodetic.asc");
+    assert_code(&grid(&input, &geodetic, &[]), 0);
+    let plain = d.path().join("plain.asc");
+    let o = grid(&xy_file, &plain, &[]);
+    assert_code(&o, 0);
+    assert!(
+        stdout(&o).contains("cell 100 m, no coordinate system"),
+        "{}",
+        stdout(&o)
+    );
+    let e = stderr(&o);
+    assert!(
+        e.contains("[no-crs]") && e.contains("projected columns X (easting) and Y"),
+        "{e}"
+    );
+    assert!(!d.path().join("plain.prj").exists());
+    let body = |p: &Path| std::fs::read_to_string(p).unwrap();
+    assert_eq!(body(&plain), body(&geodetic));
+    for (name, extra) in [
+        ("zone.asc", vec!["--utm-zone", "37N"]),
+        ("named.asc", vec!["--utm-zone", "37N", "--xy", "e2,n2"]),
+    ] {
+        let out = d.path().join(name);
+        let o = grid(&xy_file, &out, &extra);
+        assert_code(&o, 0);
+        assert!(
+            stdout(&o).contains("UTM zone 37N (EPSG:32637)"),
+            "{}",
+            stdout(&o)
+        );
+        assert!(!stderr(&o).contains("[no-crs]"), "{}", stderr(&o));
+        assert_eq!(body(&out), body(&geodetic), "{name}");
+        assert_eq!(
+            body(&out.with_extension("prj")),
+            body(&geodetic.with_extension("prj"))
+        );
+    }
+    let o = grid(&xy_file, &d.path().join("m.asc"), &["--xy", "east,N2"]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("east"), "{}", stderr(&o));
+    let o = grid(&xy_file, &d.path().join("m.asc"), &["--xy", "X"]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("EASTING,NORTHING"), "{}", stderr(&o));
+}

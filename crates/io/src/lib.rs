@@ -73,7 +73,9 @@ pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use number_text::NumberText;
 pub use parts::nan_count;
-pub use position_glitches::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
+pub use position_glitches::{
+    MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches, projected_position_glitches,
+};
 pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};

@@ -35,16 +35,37 @@ const EARTH_RADIUS_M: f64 = 6_371_000.0;
 /// docs): `time_s` (s, increasing), `lat_deg` and `lon_deg` (degrees) of
 /// every row; rows with a missing value are neither judged nor judge.
 pub fn position_glitches(time_s: &[f64], lat_deg: &[f64], lon_deg: &[f64]) -> Vec<usize> {
-    let n = time_s.len().min(lat_deg.len()).min(lon_deg.len());
-    let valid =
-        |k: usize| time_s[k].is_finite() && lat_deg[k].is_finite() && lon_deg[k].is_finite();
-    let consistent = |a: usize, b: usize| {
-        let most = MIN_JUMP_M.max(MAX_GROUND_SPEED_M_S * (time_s[b] - time_s[a]).abs());
+    off_track(time_s, lat_deg, lon_deg, |a, b, most| {
         within(
             [lat_deg[a].to_radians(), lon_deg[a].to_radians()],
             [lat_deg[b].to_radians(), lon_deg[b].to_radians()],
             most,
         )
+    })
+}
+
+/// [`position_glitches`] of projected positions: `x_m` and `y_m` (easting
+/// and northing, m), the distance between two rows the plane's.
+pub fn projected_position_glitches(time_s: &[f64], x_m: &[f64], y_m: &[f64]) -> Vec<usize> {
+    off_track(time_s, x_m, y_m, |a, b, most| {
+        (x_m[b] - x_m[a]).hypot(y_m[b] - y_m[a]) <= most
+    })
+}
+
+/// The rows off the track of positions given as two coordinates per row,
+/// `close(a, b, most_m)` saying whether rows `a` and `b` are at most
+/// `most_m` apart.
+fn off_track(
+    time_s: &[f64],
+    c0: &[f64],
+    c1: &[f64],
+    close: impl Fn(usize, usize, f64) -> bool,
+) -> Vec<usize> {
+    let n = time_s.len().min(c0.len()).min(c1.len());
+    let valid = |k: usize| time_s[k].is_finite() && c0[k].is_finite() && c1[k].is_finite();
+    let consistent = |a: usize, b: usize| {
+        let most = MIN_JUMP_M.max(MAX_GROUND_SPEED_M_S * (time_s[b] - time_s[a]).abs());
+        close(a, b, most)
     };
     // Runs between jumps, each its first and last valid row and how many
     // valid rows it holds (no per-row memory: 10⁷ rows take none).
@@ -91,7 +112,7 @@ pub fn position_glitches(time_s: &[f64], lat_deg: &[f64], lon_deg: &[f64]) -> Ve
         .collect()
 }
 
-/// Successive valid rows without a jump between them ([`position_glitches`]).
+/// Successive valid rows without a jump between them ([`off_track`]).
 struct Run {
     first: usize,
     last: usize,
@@ -127,6 +148,22 @@ mod tests {
         let t: Vec<f64> = (0..n).map(|k| 36_000.0 + 0.1 * k as f64).collect();
         let lat = (0..n).map(|k| 56.0 + 6.0 * k as f64 / 111_195.0).collect();
         (t, lat, vec![38.0; n])
+    }
+
+    /// The same track in metres (north at 60 m/s) finds the same rows as
+    /// in degrees, a dropout written as 0, 0 among them.
+    #[test]
+    fn projected_positions_find_the_same_rows() {
+        let (t, mut lat, mut lon) = track(1000);
+        let mut x = vec![412_000.0; 1000];
+        let mut y: Vec<f64> = (0..1000).map(|k| 6_200_000.0 + 6.0 * k as f64).collect();
+        for k in [0, 500, 501, 999] {
+            (lat[k], lon[k], x[k], y[k]) = (0.0, 0.0, 0.0, 0.0);
+        }
+        y[300] = f64::NAN;
+        let found = projected_position_glitches(&t, &x, &y);
+        assert_eq!(found, vec![0, 500, 501, 999]);
+        assert_eq!(found, position_glitches(&t, &lat, &lon));
     }
 
     #[test]

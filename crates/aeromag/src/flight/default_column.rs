@@ -41,7 +41,7 @@ fn is_sensor_compensated(name: &str) -> bool {
 /// The flight's column named `name` without regard to case: an exact
 /// match first, else the one differing only in case; several of those is
 /// bad input (taking the first would choose by the order of the columns).
-fn find_column(flight: &Flight, name: &str, flag: &str) -> Result<Option<String>> {
+pub(crate) fn find_column(flight: &Flight, name: &str, flag: &str) -> Result<Option<String>> {
     if name == UNCOMPENSATED {
         // The canonical reading, through the column map and the preset.
         return Ok(flight.column(name).map(|_| name.to_string()));

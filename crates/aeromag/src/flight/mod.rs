@@ -26,6 +26,7 @@ mod tl_inputs;
 
 pub use aeromag_compensation::reference_field::LeverArm;
 pub use aeromag_io::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
+pub(crate) use default_column::find_column;
 pub use default_column::{DefaultColumn, default_column, default_column_fields};
 pub use line_labels::LineLabels;
 pub(crate) use reference::NOT_FIELDS;

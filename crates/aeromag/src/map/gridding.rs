@@ -1,7 +1,7 @@
 //! A column of a survey on a grid.
 
 use super::PROCESSING_STAGES;
-use super::survey::{LineGeometry, ProjectedSurvey};
+use super::survey::{LineGeometry, ProjectedColumns, ProjectedSurvey};
 use crate::error::{Error, Result};
 use crate::flight::Flight;
 use crate::observer::{Note, Notes, Observer};
@@ -42,8 +42,15 @@ pub struct GridOptions {
     /// Nodes farther than this from the data are blank, m; `None`: the
     /// line spacing (5 cells without lines).
     pub blanking_m: Option<f64>,
-    /// The UTM zone; `None`: the zone of the data.
+    /// The UTM zone latitude and longitude are projected to; `None`: the
+    /// zone of the data. With projected columns: the zone they are in (the
+    /// grid's coordinate system); `None`: a system not given (the grid has
+    /// none).
     pub zone: Option<UtmZone>,
+    /// Positions already projected (easting and northing, m) in place of
+    /// `lat`/`lon`; `None`: `lat`/`lon`, or, in a flight without them, the
+    /// projected columns it has ([`ProjectedColumns::found_in`]).
+    pub projected: Option<ProjectedColumns>,
     /// The sensor's lever arm (body frame x, y, z, m, from the navigation
     /// point): grid at the sensor's positions. `None`: at `lat`/`lon`.
     pub lever_arm_m: Option<[f64; 3]>,
@@ -148,6 +155,39 @@ fn fine_cell_warning(geometry: &GridGeometry, lines: Option<&LineGeometry>) -> O
     })
 }
 
+/// The flight's positions as `opts` has them: `lat`/`lon` projected, or
+/// projected columns named or found ([`GridOptions::projected`]), of
+/// which a note says where they come from and a warning `[no-crs]` that
+/// the grid will have no coordinate system without a zone.
+fn survey_of(flight: &Flight, opts: &GridOptions, notes: &mut Notes) -> Result<ProjectedSurvey> {
+    let found = match &opts.projected {
+        Some(_) => None,
+        None => ProjectedColumns::found_in(flight, "--xy")?,
+    };
+    let Some(columns) = opts.projected.as_ref().or(found.as_ref()) else {
+        return ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m);
+    };
+    if opts.lever_arm_m.is_some() {
+        return Err(Error::bad_input(format!(
+            "a lever arm moves the positions by the attitude on the Earth (lat, lon, alt, roll, pitch, yaw): it is not applied to the projected {} and {}; leave it out",
+            columns.easting, columns.northing
+        )));
+    }
+    if found.is_some() {
+        notes.note(format!(
+            "positions from the projected columns {} (easting) and {} (northing), m: the file has no lat/lon (name others with --xy)",
+            columns.easting, columns.northing
+        ));
+    }
+    if opts.zone.is_none() {
+        notes.warn(format!(
+            "the grid has no coordinate system: {} and {} are taken as metres on a plane; give their UTM zone (--utm-zone) to have it written with the grid [no-crs]",
+            columns.easting, columns.northing
+        ));
+    }
+    ProjectedSurvey::of_columns(flight, columns, opts.zone)
+}
+
 /// The warning for a minimum-curvature solve stopped by the sweep limit,
 /// with how far the grid may be from the converged one
 /// ([`LevelReport::remaining_estimate`](aeromag_grid::gridding::LevelReport::remaining_estimate)):
@@ -222,7 +262,7 @@ pub(crate) fn grid_flight_finest(
         v
     };
     notes.stage("projecting");
-    let survey = ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m)?;
+    let survey = survey_of(flight, opts, &mut notes)?;
     if let Some(w) = survey.off_track_warning(flight) {
         notes.warn(w);
     }
@@ -347,7 +387,7 @@ pub(crate) fn grid_flight_finest(
     let grid = Grid {
         geometry,
         values: grid_values,
-        crs: Some(Crs::Utm(survey.zone)),
+        crs: survey.zone.map(Crs::Utm),
         name: column.clone(),
         unit: "nT".into(),
     };

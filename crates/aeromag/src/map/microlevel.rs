@@ -45,8 +45,10 @@ pub struct MicrolevelOptions {
     pub column: Option<String>,
     /// Cell of the working grid, m (default as [`grid_flight`](super::gridding::grid_flight)).
     pub cell_m: Option<f64>,
-    /// UTM zone (default: the data's).
+    /// UTM zone (as [`GridOptions::zone`]).
     pub zone: Option<UtmZone>,
+    /// Positions already projected (as [`GridOptions::projected`]).
+    pub projected: Option<super::survey::ProjectedColumns>,
     /// The sensor's lever arm, m (as [`GridOptions::lever_arm_m`]).
     pub lever_arm_m: Option<[f64; 3]>,
     /// Cut-off wavelength of the high-pass, in line spacings (default 4).
@@ -66,6 +68,7 @@ impl Default for MicrolevelOptions {
             column: None,
             cell_m: None,
             zone: None,
+            projected: None,
             lever_arm_m: None,
             cutoff_line_spacings: 4.0,
             along_line_m: None,
@@ -163,6 +166,7 @@ pub fn microlevel(
             column: opts.column.clone(),
             cell_m: opts.cell_m,
             zone: opts.zone,
+            projected: opts.projected.clone(),
             lever_arm_m: opts.lever_arm_m,
             // The filter needs the whole grid: nothing is blanked here.
             blanking_m: Some(f64::MAX),
@@ -244,6 +248,12 @@ pub fn microlevel(
     let max = on_line.iter().fold(0.0f64, |m, c| m.max(c.abs()));
     let values: Vec<f64> = value.iter().zip(&correction).map(|(v, c)| v + c).collect();
     let crossover_rms_nt = crossover_check(flight, value, &correction)?;
+    if gridded.survey.position_columns != ["lat", "lon"] {
+        notes.note(
+            "the correction is not checked at the crossovers of lines and ties: `level` finds them from lat/lon, which are not used here"
+                .to_string(),
+        );
+    }
     // A rise below the printed resolution is none (a constant column gave
     // "raises … from 0.000 to 0.000 nT").
     const RESOLUTION_NT: f64 = 1e-3;

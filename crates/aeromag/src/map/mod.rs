@@ -1,8 +1,9 @@
 //! From levelled lines to the map (issue 22).
 //!
 //! - [`survey`] — a flight's lines in UTM coordinates ([`ProjectedSurvey`]):
-//!   the zone picked from the data or given, the lines' direction and
-//!   spacing, and the grid's defaults that follow from them;
+//!   the zone picked from the data or given, or positions already projected
+//!   ([`ProjectedColumns`]: a Geosoft XYZ's `X`, `Y`), the lines' direction
+//!   and spacing, and the grid's defaults that follow from them;
 //! - [`gridding`] — [`grid_flight`]: a column of a flight on a grid by
 //!   minimum curvature with tension, blanked away from the lines
 //!   ([`SurveyGrid`]);
@@ -20,7 +21,7 @@ pub mod survey;
 pub use derive::{GridProduct, derive};
 pub use gridding::{GridOptions, SurveyGrid, grid_flight};
 pub use microlevel::{MicrolevelOptions, Microlevelled, microlevel};
-pub use survey::{LineGeometry, ProjectedSurvey};
+pub use survey::{LineGeometry, PROJECTED_NAMES, ProjectedColumns, ProjectedSurvey};
 
 /// The processing stages of a survey's magnetic columns, the most
 /// processed first (suffixes of the column: micro-levelled levelled,

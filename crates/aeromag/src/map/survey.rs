@@ -11,6 +11,11 @@
 //! traverse lines across the survey direction, gaps below a tenth of the
 //! median (re-flown parts such as 1003.01 beside 1003) left out.
 //!
+//! A flight whose positions are already projected (a Geosoft XYZ's `X` and
+//! `Y`, eastings and northings in metres, without latitude and longitude)
+//! is taken as it is ([`ProjectedColumns`], [`ProjectedSurvey::of_columns`]):
+//! its coordinate system is the UTM zone given, or none.
+//!
 //! Rows whose position jumps off the track faster than anything flies
 //! ([`position_glitches`]; a GPS dropout written as 0) are not projected:
 //! their easting and northing are NaN, as for a missing position, and
@@ -25,8 +30,12 @@ use aeromag_grid::projection::{Utm, UtmZone};
 /// A flight's rows in UTM (m) and its lines' geometry.
 #[derive(Debug, Clone)]
 pub struct ProjectedSurvey {
-    /// The UTM zone.
-    pub zone: UtmZone,
+    /// The UTM zone; `None` for projected columns of a coordinate system
+    /// not given ([`ProjectedSurvey::of_columns`]).
+    pub zone: Option<UtmZone>,
+    /// The flight's columns the positions come from: `lat` and `lon`, or
+    /// the projected columns.
+    pub position_columns: [String; 2],
     /// Easting of every row, m (NaN where latitude or longitude is missing).
     pub x: Vec<f64>,
     /// Northing of every row, m.
@@ -42,6 +51,53 @@ pub struct ProjectedSurvey {
     pub missing_labels: Option<String>,
     /// The lines' geometry, when there are lines.
     pub lines: Option<LineGeometry>,
+}
+
+/// The columns of a flight's projected positions: easting and northing, m.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProjectedColumns {
+    /// The easting column (`X` of a Geosoft XYZ file).
+    pub easting: String,
+    /// The northing column.
+    pub northing: String,
+}
+
+/// The column pairs [`ProjectedColumns::found_in`] takes, in this order,
+/// in any case.
+pub const PROJECTED_NAMES: [[&str; 2]; 4] = [
+    ["x", "y"],
+    ["easting", "northing"],
+    ["utm_x", "utm_y"],
+    ["utm_easting", "utm_northing"],
+];
+
+impl ProjectedColumns {
+    /// The columns `easting` and `northing`.
+    pub fn new(easting: impl Into<String>, northing: impl Into<String>) -> Self {
+        Self {
+            easting: easting.into(),
+            northing: northing.into(),
+        }
+    }
+
+    /// The projected columns of a flight without latitude and longitude:
+    /// the first pair of [`PROJECTED_NAMES`] it has, in any case (as the
+    /// file spells them); `None` when it has latitude and longitude or no
+    /// such pair. `flag` is the option naming them, for the error of two
+    /// columns differing only in case.
+    pub fn found_in(flight: &Flight, flag: &str) -> Result<Option<Self>> {
+        if flight.column("lat").is_some() && flight.column("lon").is_some() {
+            return Ok(None);
+        }
+        for [e, n] in PROJECTED_NAMES {
+            let e = crate::flight::find_column(flight, e, flag)?;
+            let n = crate::flight::find_column(flight, n, flag)?;
+            if let (Some(e), Some(n)) = (e, n) {
+                return Ok(Some(Self::new(e, n)));
+            }
+        }
+        Ok(None)
+    }
 }
 
 /// Direction and spacing of a survey's traverse lines ([`ProjectedSurvey`]).
@@ -122,6 +178,77 @@ impl ProjectedSurvey {
             x.push(e);
             y.push(n);
         }
+        Self::with_lines(
+            flight,
+            Some(zone),
+            ["lat".into(), "lon".into()],
+            (x, y),
+            off_track,
+        )
+    }
+
+    /// `flight`'s positions as they are in the columns `columns` (easting
+    /// and northing, m), in the UTM zone `zone` when given (checked: the
+    /// eastings within 100–900 km, where a zone's are, and the northings
+    /// within 0–10 000 km), in a coordinate system not given otherwise; and its
+    /// lines' geometry. Missing values are missing positions; rows off
+    /// the track are found as for latitude and longitude
+    /// ([`aeromag_io::projected_position_glitches`]).
+    pub fn of_columns(
+        flight: &Flight,
+        columns: &ProjectedColumns,
+        zone: Option<UtmZone>,
+    ) -> Result<Self> {
+        let names = [columns.easting.as_str(), columns.northing.as_str()];
+        let [x, y] = names.map(|c| flight.require(c));
+        let (x, y) = (x?, y?);
+        if let Some(z) = zone {
+            let ranges = [(100_000.0, 900_000.0), (0.0, 10_000_000.0)];
+            for ((v, name), (lo, hi)) in [x, y].into_iter().zip(names).zip(ranges) {
+                if let Some(k) = v
+                    .iter()
+                    .position(|&c| c.is_finite() && !(lo..=hi).contains(&c))
+                {
+                    return Err(flight.bad_value(
+                        k,
+                        flight.resolve(name).unwrap_or(name),
+                        format!(
+                            "{} m is not a UTM {} (a zone's are from {} to {} km): are these coordinates in {z}, and in metres?",
+                            shown(v[k]),
+                            if name == names[0] { "easting" } else { "northing" },
+                            lo / 1000.0,
+                            hi / 1000.0
+                        ),
+                    ));
+                }
+            }
+        }
+        let off_track = flight.column("time").map_or_else(Vec::new, |t| {
+            aeromag_io::projected_position_glitches(t, x, y)
+        });
+        let (mut x, mut y) = (x.to_vec(), y.to_vec());
+        for &k in &off_track {
+            x[k] = f64::NAN;
+            y[k] = f64::NAN;
+        }
+        Self::with_lines(
+            flight,
+            zone,
+            names.map(|c| flight.resolve(c).unwrap_or(c).to_string()),
+            (x, y),
+            off_track,
+        )
+    }
+
+    /// The survey of positions `x`, `y` (m) from `position_columns`, with
+    /// the lines of `flight`'s `line` column.
+    fn with_lines(
+        flight: &Flight,
+        zone: Option<UtmZone>,
+        position_columns: [String; 2],
+        (x, y): (Vec<f64>, Vec<f64>),
+        off_track: Vec<usize>,
+    ) -> Result<Self> {
         let labels = flight
             .get("line")
             .map(|_| LineLabels::of(flight, &[]))
@@ -133,6 +260,7 @@ impl ProjectedSurvey {
             .and_then(|ids| LineGeometry::of(&x, &y, ids));
         Ok(Self {
             zone,
+            position_columns,
             x,
             y,
             off_track,
@@ -146,7 +274,8 @@ impl ProjectedSurvey {
     /// none): how many, and the first few with their file rows, lines and
     /// positions, named `[position-glitch]`.
     pub fn off_track_warning(&self, flight: &Flight) -> Option<String> {
-        off_track_warning(flight, &self.off_track)
+        let [a, b] = &self.position_columns;
+        off_track_warning(flight, &self.off_track, [a, b])
     }
 
     /// Whether row `k` is survey data: on a line when there are lines
@@ -158,16 +287,20 @@ impl ProjectedSurvey {
 
 /// The warning for the rows `off_track` (ascending, 0-based) of `flight`
 /// whose position is off the track (`None` when there are none): how
-/// many, and the first few with their file rows, lines and positions,
-/// named `[position-glitch]`; `grid`, `microlevel` and `level` leave them
-/// out.
-pub(crate) fn off_track_warning(flight: &Flight, off_track: &[usize]) -> Option<String> {
+/// many, and the first few with their file rows, lines and positions (the
+/// columns `position`: `lat` and `lon`, or projected ones), named
+/// `[position-glitch]`; `grid`, `microlevel` and `level` leave them out.
+pub(crate) fn off_track_warning(
+    flight: &Flight,
+    off_track: &[usize],
+    position: [&str; 2],
+) -> Option<String> {
     const SHOWN: usize = 5;
     let n = off_track.len();
     if n == 0 {
         return None;
     }
-    let (lat, lon) = (flight.column("lat"), flight.column("lon"));
+    let [c0, c1] = position.map(|c| flight.column(c));
     let rows: Vec<String> = off_track[..n.min(SHOWN)]
         .iter()
         .map(|&k| {
@@ -176,10 +309,12 @@ pub(crate) fn off_track_warning(flight: &Flight, off_track: &[usize]) -> Option<
                 .map_or(String::new(), |l| format!(" (line {l})"));
             let at = |c: Option<&[f64]>| shown(c.map_or(f64::NAN, |c| c[k]));
             format!(
-                "data row {}{line}: lat {}, lon {}",
+                "data row {}{line}: {} {}, {} {}",
                 flight.file_row(k) + 1,
-                at(lat),
-                at(lon)
+                position[0],
+                at(c0),
+                position[1],
+                at(c1)
             )
         })
         .collect();

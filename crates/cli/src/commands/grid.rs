@@ -14,7 +14,8 @@ use std::path::PathBuf;
 /// Grid a levelled survey (or any column of it) and write the grid.
 ///
 /// Latitude and longitude are projected to UTM (the zone of the data, or
-/// --utm-zone); rows on lines (line label ≠ 0) are gridded. Defaults
+/// --utm-zone); positions already projected (X, Y) are taken as they are
+/// (--xy); rows on lines (line label ≠ 0) are gridded. Defaults
 /// follow the lines: the cell is a quarter of the line spacing, nodes
 /// farther than one line spacing from the data are blank. Rows whose
 /// position jumps off the track and back faster than 1000 m/s (a GPS
@@ -62,9 +63,18 @@ pub struct Args {
     #[arg(long, value_parser = args::positive)]
     blanking: Option<f64>,
     /// UTM zone, e.g. `37N`, `56S` or `EPSG:32637` (default: the zone of
-    /// the data's median longitude).
+    /// the data's median longitude); with projected positions (--xy), the
+    /// zone they are in.
     #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
     utm_zone: Option<UtmZone>,
+    /// Positions already projected: the columns EASTING,NORTHING (m),
+    /// e.g. `X,Y`, in place of lat/lon (default: lat/lon; in a file
+    /// without them, the first of x,y, easting,northing, utm_x,utm_y,
+    /// utm_easting,utm_northing, any case). Their UTM zone, when given
+    /// with --utm-zone, is the grid's coordinate system; without it the
+    /// grid has none [no-crs].
+    #[arg(long, value_name = "EASTING,NORTHING", value_parser = args::projected_columns)]
+    xy: Option<aeromag::map::ProjectedColumns>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
     /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
@@ -90,6 +100,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let wanted = aeromag::flight::default_column_fields(&aeromag::map::PROCESSING_STAGES);
     let mut extra: Vec<&str> = wanted.iter().map(String::as_str).collect();
     extra.extend(a.column.as_deref());
+    // Projected positions, named or those a file without lat/lon may have.
+    match &a.xy {
+        Some(xy) => extra.extend([xy.easting.as_str(), xy.northing.as_str()]),
+        None => extra.extend(aeromag::map::PROJECTED_NAMES.iter().flatten()),
+    }
     let flight = a.input.load_canonical(&extra)?;
     let opts = GridOptions {
         geometry,
@@ -97,6 +112,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         cell_m: a.cell,
         blanking_m: a.blanking,
         zone: a.utm_zone,
+        projected: a.xy.clone(),
         lever_arm_m: a.lever_arm,
         method: a.method,
         min_curvature: a.min_curvature.settings(),
@@ -112,12 +128,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     println!(
-        "grid: {} × {} nodes, cell {} m, {} (EPSG:{}), x {:.1}–{:.1} m, y {:.1}–{:.1} m",
+        "grid: {} × {} nodes, cell {} m, {}, x {:.1}–{:.1} m, y {:.1}–{:.1} m",
         geo.nx,
         geo.ny,
         geo.cell,
-        g.grid.crs.map_or("no CRS".into(), |c| c.name()),
-        g.grid.crs.map_or(0, |c| c.epsg()),
+        g.grid
+            .crs
+            .map_or("no coordinate system".into(), |c| format!(
+                "{} (EPSG:{})",
+                c.name(),
+                c.epsg()
+            )),
         geo.x0,
         geo.x_max(),
         geo.y0,

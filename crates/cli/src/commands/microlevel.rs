@@ -54,9 +54,18 @@ pub struct Args {
     cosine_power: f64,
     #[command(flatten)]
     min_curvature: args::MinCurvatureArgs,
-    /// UTM zone, e.g. `37N` (default: the data's).
+    /// UTM zone, e.g. `37N` (default: the data's); with projected
+    /// positions (--xy), the zone they are in.
     #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
     utm_zone: Option<UtmZone>,
+    /// Positions already projected: the columns EASTING,NORTHING (m),
+    /// e.g. `X,Y`, in place of lat/lon (default: lat/lon; in a file
+    /// without them, the first of x,y, easting,northing, utm_x,utm_y,
+    /// utm_easting,utm_northing, any case). Their UTM zone, when given
+    /// with --utm-zone, is the grid's coordinate system; without it the
+    /// grid has none [no-crs].
+    #[arg(long, value_name = "EASTING,NORTHING", value_parser = args::projected_columns)]
+    xy: Option<aeromag::map::ProjectedColumns>,
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m:
     /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
@@ -80,6 +89,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         column: a.column.clone(),
         cell_m: a.cell,
         zone: a.utm_zone,
+        projected: a.xy.clone(),
         lever_arm_m: a.lever_arm,
         cutoff_line_spacings: a.cutoff,
         along_line_m: a.along_line,
