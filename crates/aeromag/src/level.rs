@@ -26,6 +26,13 @@ pub struct LevelOptions {
     /// Sensor lever arm from the navigation point (body frame: x forward,
     /// y right, z down; m): crossovers are found at the sensor's position.
     pub lever_arm_m: Option<[f64; 3]>,
+    /// Positions already projected (easting and northing, m) in place of
+    /// `lat`/`lon`, as [`crate::map::GridOptions::projected`] (found in a
+    /// flight without lat/lon when `None`); they need their UTM zone,
+    /// `zone`, which turns them into latitudes and longitudes.
+    pub projected: Option<crate::map::ProjectedColumns>,
+    /// The UTM zone of the projected positions.
+    pub zone: Option<aeromag_grid::projection::UtmZone>,
     /// Known external-field channels subtracted from the value first
     /// (default none: classic levelling; `calibrate`'s default is `auto`).
     pub reference: ReferenceChannels,
@@ -51,6 +58,8 @@ impl Default for LevelOptions {
             value: None,
             rate_of: None,
             lever_arm_m: None,
+            projected: None,
+            zone: None,
             reference: ReferenceChannels::None,
             note_unused_reference: false,
             tracks: TrackConfig::default(),
@@ -269,14 +278,36 @@ pub fn level(
         .lever_arm_m
         .map(|arm| sensor_track(flight, arm))
         .transpose()?;
-    let (lat, lon, alt) = match &positions {
-        Some([la, lo, al]) => (la.as_slice(), lo.as_slice(), al.as_slice()),
-        None => (
+    let projected = crate::map::ProjectedColumns::chosen(
+        flight,
+        opts.projected.as_ref(),
+        opts.lever_arm_m.is_some(),
+        &mut notes,
+    )?;
+    let from_projected = match &projected {
+        Some(c) => {
+            let zone = opts.zone.ok_or_else(|| {
+                Error::bad_input(format!(
+                    "levelling finds the crossovers on the Earth: give the UTM zone of {} and {} (--utm-zone), which turns them into latitudes and longitudes",
+                    c.easting, c.northing
+                ))
+            })?;
+            Some(c.geodetic(flight, zone)?)
+        }
+        None => None,
+    };
+    let (lat, lon, alt) = match (&positions, &from_projected) {
+        (Some([la, lo, al]), _) => (la.as_slice(), lo.as_slice(), al.as_slice()),
+        (None, Some((la, lo))) => (la.as_slice(), lo.as_slice(), flight.require("alt")?),
+        (None, None) => (
             flight.require("lat")?,
             flight.require("lon")?,
             flight.require("alt")?,
         ),
     };
+    let position_columns = projected.as_ref().map_or(["lat", "lon"], |c| {
+        [c.easting.as_str(), c.northing.as_str()]
+    });
     // Rows off the track (a GPS dropout written as 0, 0) made crossovers
     // of their own: 10 on a survey, a line shifted by 55 nT. They are left
     // out as `grid` and `microlevel` leave them out.
@@ -291,7 +322,7 @@ pub fn level(
         }
         (la, lo)
     });
-    if let Some(w) = crate::map::survey::off_track_warning(flight, &off_track, ["lat", "lon"]) {
+    if let Some(w) = crate::map::survey::off_track_warning(flight, &off_track, position_columns) {
         notes.warn(w);
     }
     let (lat, lon) = match &on_track_positions {

@@ -435,3 +435,93 @@ fn a_label_flown_twice_is_levelled_per_pass() {
         / rows.len() as f64;
     assert!(mean.abs() < 1.0, "the re-flight is {mean} nT off the first");
 }
+
+/// A survey whose positions are UTM eastings and northings (`X`, `Y`, no
+/// lat/lon) levels as its latitudes and longitudes do once their zone is
+/// given: the same crossovers and levelled values to 10⁻⁶ nT (the inverse
+/// projection is exact to far below a millimetre). Without the zone it is
+/// bad input naming `--utm-zone`; a dropout at 0, 0 is named by its X, Y.
+#[test]
+fn projected_positions_level_as_latitude_and_longitude_given_their_zone() {
+    use aeromag::grid::projection::{Utm, UtmZone};
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(4)).unwrap();
+    let zone: UtmZone = "37N".parse().unwrap();
+    let (lat, lon) = (
+        survey.require("lat").unwrap(),
+        survey.require("lon").unwrap(),
+    );
+    let (x, y) = Utm::new(zone).forward_all(lat, lon).unwrap();
+    let with_xy = |x: &[f64], y: &[f64]| {
+        let mut t = FlightTable::new();
+        for name in survey.table().column_names() {
+            if !["lat", "lon"].contains(&name) {
+                let v = survey.table().column(name).unwrap().to_vec();
+                t.add_column(name, v).unwrap();
+            }
+        }
+        t.add_column("X", x.to_vec()).unwrap();
+        t.add_column("Y", y.to_vec()).unwrap();
+        aeromag::flight::Flight::from_table(t).unwrap()
+    };
+    let xy = with_xy(&x, &y);
+    let geodetic = level(&survey, &LevelOptions::default(), &mut Silent).unwrap();
+    let opts = LevelOptions {
+        zone: Some(zone),
+        ..LevelOptions::default()
+    };
+    let projected = level(&xy, &opts, &mut Silent).unwrap();
+    let (a, b) = (&geodetic.levelling, &projected.levelling);
+    assert_eq!(a.crossovers.crossovers.len(), b.crossovers.crossovers.len());
+    assert!(a.crossovers.crossovers.len() > 50);
+    let most = a
+        .levelled
+        .value_nt
+        .iter()
+        .zip(&b.levelled.value_nt)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max);
+    assert!(most < 1e-6, "levelled values differ by {most} nT");
+    assert!(
+        projected
+            .notes
+            .iter()
+            .any(|n| n.message.contains("projected columns X (easting) and Y")),
+        "{:?}",
+        projected.notes
+    );
+
+    let e = level(&xy, &LevelOptions::default(), &mut Silent).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("--utm-zone"),
+        "{e}"
+    );
+
+    // A dropout at 0, 0 (no UTM easting, but off the track) is left out
+    // with the warning naming its X and Y; eastings in kilometres are no
+    // UTM eastings: refused, naming the row and the column.
+    let row = 5000;
+    let (mut gx, mut gy) = (x.clone(), y.clone());
+    (gx[row], gy[row]) = (0.0, 0.0);
+    let glitched = level(&with_xy(&gx, &gy), &opts, &mut Silent).unwrap();
+    let warned: Vec<&str> = glitched
+        .notes
+        .iter()
+        .filter(|n| n.message.contains("[position-glitch]"))
+        .map(|n| n.message.as_str())
+        .collect();
+    assert!(
+        warned.len() == 1
+            && warned[0].contains(&format!("data row {}", row + 1))
+            && warned[0].contains("X 0, Y 0"),
+        "{warned:?}"
+    );
+    let km: Vec<f64> = x.iter().map(|v| v / 1000.0).collect();
+    let e = level(&with_xy(&km, &y), &opts, &mut Silent).unwrap_err();
+    assert!(
+        e.is_bad_input()
+            && e.to_string().contains("data row 1,")
+            && e.to_string().contains("'X'")
+            && e.to_string().contains("not a UTM easting"),
+        "{e}"
+    );
+}

@@ -546,24 +546,9 @@ fn minimum_curvature_without_sweeps_is_labelled_as_such() {
 /// missing one or a single name is an error (exit 2).
 #[test]
 fn projected_positions_are_gridded_as_they_are() {
-    use aeromag::grid::projection::{Utm, UtmZone};
     let d = tempfile::tempdir().unwrap();
     let input = survey(d.path());
-    let table = aeromag::io::read_table(&input, &aeromag::io::ReadOptions::default()).unwrap();
-    let zone: UtmZone = "37N".parse().unwrap();
-    let (lat, lon) = (table.column("lat").unwrap(), table.column("lon").unwrap());
-    let (x, y) = Utm::new(zone).forward_all(lat, lon).unwrap();
-    let mut xy = aeromag::io::FlightTable::new();
-    for name in ["time", "line", "mag"] {
-        xy.add_column(name, table.column(name).unwrap().to_vec())
-            .unwrap();
-    }
-    xy.add_column("X", x.clone()).unwrap();
-    xy.add_column("Y", y.clone()).unwrap();
-    xy.add_column("E2", x).unwrap();
-    xy.add_column("N2", y).unwrap();
-    let xy_file = d.path().join("xy.csv");
-    aeromag::io::write_csv(&xy, &xy_file).unwrap();
+    let xy_file = projected_survey(&input, d.path());
 
     let geodetic = d.path().join("geodetic.asc");
     assert_code(&grid(&input, &geodetic, &[]), 0);
@@ -608,4 +593,50 @@ fn projected_positions_are_gridded_as_they_are() {
     let o = grid(&xy_file, &d.path().join("m.asc"), &["--xy", "X"]);
     assert_code(&o, 2);
     assert!(stderr(&o).contains("EASTING,NORTHING"), "{}", stderr(&o));
+}
+
+/// The survey `input` with UTM zone 37N eastings and northings `X`, `Y`
+/// (and copies `E2`, `N2`) in place of lat/lon: `xy.csv` in `dir`.
+fn projected_survey(input: &Path, dir: &Path) -> std::path::PathBuf {
+    use aeromag::grid::projection::{Utm, UtmZone};
+    let table = aeromag::io::read_table(input, &aeromag::io::ReadOptions::default()).unwrap();
+    let zone: UtmZone = "37N".parse().unwrap();
+    let (lat, lon) = (table.column("lat").unwrap(), table.column("lon").unwrap());
+    let (x, y) = Utm::new(zone).forward_all(lat, lon).unwrap();
+    let mut xy = aeromag::io::FlightTable::new();
+    for name in ["time", "line", "alt", "mag"] {
+        xy.add_column(name, table.column(name).unwrap().to_vec())
+            .unwrap();
+    }
+    xy.add_column("X", x.clone()).unwrap();
+    xy.add_column("Y", y.clone()).unwrap();
+    xy.add_column("E2", x).unwrap();
+    xy.add_column("N2", y).unwrap();
+    let xy_file = dir.join("xy.csv");
+    aeromag::io::write_csv(&xy, &xy_file).unwrap();
+    xy_file
+}
+
+/// `level` of the same survey with projected positions: their UTM zone is
+/// needed (exit 2 naming --utm-zone without it), and with it the levelled
+/// column is written.
+#[test]
+fn projected_positions_are_levelled_given_their_zone() {
+    let d = tempfile::tempdir().unwrap();
+    let input = survey(d.path());
+    let xy_file = projected_survey(&input, d.path());
+    let out = d.path().join("lev.csv");
+    let o = run_on("level", &xy_file, &out, &[]);
+    assert_code(&o, 2);
+    assert!(stderr(&o).contains("--utm-zone"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let o = run_on("level", &xy_file, &out, &["--utm-zone", "37N"]);
+    assert_code(&o, 0);
+    assert!(
+        stderr(&o).contains("projected columns X (easting)"),
+        "{}",
+        stderr(&o)
+    );
+    let header = std::fs::read_to_string(&out).unwrap();
+    assert!(header.lines().next().unwrap().contains("mag_level"));
 }

@@ -160,32 +160,18 @@ fn fine_cell_warning(geometry: &GridGeometry, lines: Option<&LineGeometry>) -> O
 /// which a note says where they come from and a warning `[no-crs]` that
 /// the grid will have no coordinate system without a zone.
 fn survey_of(flight: &Flight, opts: &GridOptions, notes: &mut Notes) -> Result<ProjectedSurvey> {
-    let found = match &opts.projected {
-        Some(_) => None,
-        None => ProjectedColumns::found_in(flight, "--xy")?,
-    };
-    let Some(columns) = opts.projected.as_ref().or(found.as_ref()) else {
+    let given = opts.projected.as_ref();
+    let lever_arm = opts.lever_arm_m.is_some();
+    let Some(columns) = ProjectedColumns::chosen(flight, given, lever_arm, notes)? else {
         return ProjectedSurvey::of(flight, opts.zone, opts.lever_arm_m);
     };
-    if opts.lever_arm_m.is_some() {
-        return Err(Error::bad_input(format!(
-            "a lever arm moves the positions by the attitude on the Earth (lat, lon, alt, roll, pitch, yaw): it is not applied to the projected {} and {}; leave it out",
-            columns.easting, columns.northing
-        )));
-    }
-    if found.is_some() {
-        notes.note(format!(
-            "positions from the projected columns {} (easting) and {} (northing), m: the file has no lat/lon (name others with --xy)",
-            columns.easting, columns.northing
-        ));
-    }
     if opts.zone.is_none() {
         notes.warn(format!(
             "the grid has no coordinate system: {} and {} are taken as metres on a plane; give their UTM zone (--utm-zone) to have it written with the grid [no-crs]",
             columns.easting, columns.northing
         ));
     }
-    ProjectedSurvey::of_columns(flight, columns, opts.zone)
+    ProjectedSurvey::of_columns(flight, &columns, opts.zone)
 }
 
 /// The warning for a minimum-curvature solve stopped by the sweep limit,

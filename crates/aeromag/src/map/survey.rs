@@ -80,6 +80,100 @@ impl ProjectedColumns {
         }
     }
 
+    /// The columns a command takes its positions from: `given`, else those
+    /// of a flight without latitude and longitude ([`Self::found_in`]),
+    /// with a note of where they come from for `notes`; `None`: latitude
+    /// and longitude. A lever arm is refused with projected columns: it
+    /// moves the positions by the attitude on the Earth.
+    pub(crate) fn chosen(
+        flight: &Flight,
+        given: Option<&Self>,
+        lever_arm: bool,
+        notes: &mut crate::observer::Notes,
+    ) -> Result<Option<Self>> {
+        let columns = match given {
+            Some(c) => c.clone(),
+            None => match Self::found_in(flight, "--xy")? {
+                Some(c) => {
+                    notes.note(format!(
+                        "positions from the projected columns {} (easting) and {} (northing), m: the file has no lat/lon (name others with --xy)",
+                        c.easting, c.northing
+                    ));
+                    c
+                }
+                None => return Ok(None),
+            },
+        };
+        if lever_arm {
+            return Err(Error::bad_input(format!(
+                "a lever arm moves the positions by the attitude on the Earth (lat, lon, alt, roll, pitch, yaw): it is not applied to the projected {} and {}; leave it out",
+                columns.easting, columns.northing
+            )));
+        }
+        Ok(Some(columns))
+    }
+
+    /// Latitudes and longitudes (degrees) of `flight`'s positions in these
+    /// columns, UTM coordinates of `zone` (checked as
+    /// [`ProjectedSurvey::of_columns`] checks them, rows off the track
+    /// aside); missing where either is.
+    pub fn geodetic(&self, flight: &Flight, zone: UtmZone) -> Result<(Vec<f64>, Vec<f64>)> {
+        let (x, y) = (
+            flight.require(&self.easting)?,
+            flight.require(&self.northing)?,
+        );
+        let off_track = flight.column("time").map_or_else(Vec::new, |t| {
+            aeromag_io::projected_position_glitches(t, x, y)
+        });
+        self.check_in(flight, [x, y], zone, &off_track)?;
+        let utm = Utm::new(zone);
+        Ok(x.iter()
+            .zip(y)
+            .map(|(&e, &n)| match e.is_finite() && n.is_finite() {
+                true => utm.inverse(e, n),
+                false => (f64::NAN, f64::NAN),
+            })
+            .unzip())
+    }
+
+    /// Bad input naming the first row, not among `off_track` (ascending),
+    /// whose easting or northing (`values` of these columns) is not one of
+    /// `zone`'s: eastings within 100–900 km, where a zone's are, northings
+    /// within 0–10 000 km. (A dropout written as 0, 0 is off the track.)
+    fn check_in(
+        &self,
+        flight: &Flight,
+        values: [&[f64]; 2],
+        zone: UtmZone,
+        off_track: &[usize],
+    ) -> Result<()> {
+        let names = [self.easting.as_str(), self.northing.as_str()];
+        let what = ["easting", "northing"];
+        let ranges = [(100_000.0, 900_000.0), (0.0, 10_000_000.0)];
+        for k in 0..2 {
+            let (v, (lo, hi)) = (values[k], ranges[k]);
+            let outside = |r: usize| {
+                v[r].is_finite()
+                    && !(lo..=hi).contains(&v[r])
+                    && off_track.binary_search(&r).is_err()
+            };
+            if let Some(r) = (0..v.len()).find(|&r| outside(r)) {
+                return Err(flight.bad_value(
+                    r,
+                    flight.resolve(names[k]).unwrap_or(names[k]),
+                    format!(
+                        "{} m is not a UTM {} (a zone's are from {} to {} km): are these coordinates in {zone}, and in metres?",
+                        shown(v[r]),
+                        what[k],
+                        lo / 1000.0,
+                        hi / 1000.0
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The projected columns of a flight without latitude and longitude:
     /// the first pair of [`PROJECTED_NAMES`] it has, in any case (as the
     /// file spells them); `None` when it has latitude and longitude or no
@@ -202,30 +296,12 @@ impl ProjectedSurvey {
         let names = [columns.easting.as_str(), columns.northing.as_str()];
         let [x, y] = names.map(|c| flight.require(c));
         let (x, y) = (x?, y?);
-        if let Some(z) = zone {
-            let ranges = [(100_000.0, 900_000.0), (0.0, 10_000_000.0)];
-            for ((v, name), (lo, hi)) in [x, y].into_iter().zip(names).zip(ranges) {
-                if let Some(k) = v
-                    .iter()
-                    .position(|&c| c.is_finite() && !(lo..=hi).contains(&c))
-                {
-                    return Err(flight.bad_value(
-                        k,
-                        flight.resolve(name).unwrap_or(name),
-                        format!(
-                            "{} m is not a UTM {} (a zone's are from {} to {} km): are these coordinates in {z}, and in metres?",
-                            shown(v[k]),
-                            if name == names[0] { "easting" } else { "northing" },
-                            lo / 1000.0,
-                            hi / 1000.0
-                        ),
-                    ));
-                }
-            }
-        }
         let off_track = flight.column("time").map_or_else(Vec::new, |t| {
             aeromag_io::projected_position_glitches(t, x, y)
         });
+        if let Some(z) = zone {
+            columns.check_in(flight, [x, y], z, &off_track)?;
+        }
         let (mut x, mut y) = (x.to_vec(), y.to_vec());
         for &k in &off_track {
             x[k] = f64::NAN;

@@ -41,6 +41,17 @@ pub struct Args {
     /// Sensor lever arm X,Y,Z from the navigation point, body frame, m.
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
     lever_arm: Option<[f64; 3]>,
+    /// Positions already projected: the columns EASTING,NORTHING (m),
+    /// e.g. `X,Y`, in place of lat/lon (default: lat/lon; in a file
+    /// without them, the first of x,y, easting,northing, utm_x,utm_y,
+    /// utm_easting,utm_northing, any case), UTM coordinates of the zone
+    /// --utm-zone.
+    #[arg(long, value_name = "EASTING,NORTHING", value_parser = args::projected_columns)]
+    xy: Option<aeromag::map::ProjectedColumns>,
+    /// The UTM zone of projected positions (--xy), e.g. `37N` or
+    /// `EPSG:32637`: the crossovers are found on the Earth.
+    #[arg(long, value_name = "ZONE", value_parser = args::utm_zone)]
+    utm_zone: Option<aeromag::grid::projection::UtmZone>,
     /// Column whose along-track derivative is the regressor of the
     /// d|B0|/dt term, as recorded (default `mag`, the uncompensated
     /// reading, when the file has it; else the column levelled). A lag of the scalar channel
@@ -110,6 +121,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         value: a.value.clone(),
         rate_of: a.rate_of.clone(),
         lever_arm_m: a.lever_arm,
+        projected: a.xy.clone(),
+        zone: a.utm_zone,
         reference: a.reference.clone().unwrap_or(ReferenceChannels::None),
         note_unused_reference: a.reference.is_none(),
         fit: LevelFitChoices {
