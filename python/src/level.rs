@@ -175,6 +175,21 @@ impl PyLevelled {
     fn notes(&self) -> Vec<String> {
         self.levelled.notes.iter().map(|n| n.to_string()).collect()
     }
+
+    fn __repr__(&self) -> String {
+        let l = &self.levelled;
+        let f = &l.levelling.fit;
+        format!(
+            "<aeromag.Levelled {} → {}: {} lines, {} crossovers, RMS {:.4} → {:.4} nT, k {:.4} s>",
+            l.value_column,
+            l.output_column(),
+            f.lines.len(),
+            l.levelling.crossovers.crossovers.len(),
+            f.rms_before_nt,
+            f.rms_levelled_nt,
+            f.k_s
+        )
+    }
 }
 
 /// The figures of a compensated flight (needs `mag_comp`, as written by

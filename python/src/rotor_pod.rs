@@ -129,6 +129,12 @@ impl PyModel {
         self.model.write(&path).py_err()
     }
 
+    /// Pickling (and `copy.deepcopy`): the model file's text and the notes
+    /// ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(py, self.model.json().py_err()?, &self.notes, None)
+    }
+
     fn __repr__(&self) -> String {
         format!("<aeromag.Model {}>", self.kind())
     }
@@ -260,17 +266,5 @@ pub fn fit_pod(
     Ok(PyModel {
         model: AnyModel::Pod(fit.model),
         notes: fit.notes,
-    })
-}
-
-/// A rotor or pod model file by its `kind`.
-pub fn read_model(path: &std::path::Path, kind: &str) -> PyResult<PyModel> {
-    let model = match kind {
-        "helicopter-rotor" => AnyModel::Rotor(RotorModelFile::read(path).py_err()?),
-        _ => AnyModel::Pod(PodModelFile::read(path).py_err()?),
-    };
-    Ok(PyModel {
-        model,
-        notes: Vec::new(),
     })
 }

@@ -53,18 +53,8 @@ pub fn calibrate_sensors(
 /// `aeromag calibrate --mag A,B,…`; it applies itself to flights.
 #[pyclass(name = "SensorsModel", module = "aeromag._aeromag", frozen)]
 pub struct PySensorsModel {
-    model: SensorsModel,
-    notes: Vec<Note>,
-}
-
-impl PySensorsModel {
-    /// A model read from a file (no notes).
-    pub fn read(path: &std::path::Path) -> PyResult<Self> {
-        Ok(Self {
-            model: SensorsModel::read(path).py_err()?,
-            notes: Vec::new(),
-        })
-    }
+    pub(crate) model: SensorsModel,
+    pub(crate) notes: Vec<Note>,
 }
 
 #[pymethods]
@@ -176,6 +166,12 @@ impl PySensorsModel {
     /// Write the model file (atomically), as `aeromag calibrate --model`.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         self.model.write(&path).py_err()
+    }
+
+    /// Pickling (and `copy.deepcopy`): the model file's text and the notes
+    /// ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(py, self.model.json().py_err()?, &self.notes, None)
     }
 
     fn __len__(&self) -> usize {

@@ -221,9 +221,9 @@ pub fn calibrate(
 /// model file; it applies itself to flights.
 #[pyclass(name = "TlModel", module = "aeromag._aeromag", frozen)]
 pub struct PyTlModel {
-    model: TlModel,
-    notes: Vec<Note>,
-    series: Option<[Vec<f64>; 5]>,
+    pub(crate) model: TlModel,
+    pub(crate) notes: Vec<Note>,
+    pub(crate) series: Option<[Vec<f64>; 5]>,
 }
 
 impl PyTlModel {
@@ -368,6 +368,17 @@ impl PyTlModel {
         self.model.write(&path).py_err()
     }
 
+    /// Pickling (and `copy.deepcopy`): the model file's text, the notes
+    /// and the series ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(
+            py,
+            self.model.json().py_err()?,
+            &self.notes,
+            self.series.as_ref(),
+        )
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<aeromag.TlModel {} terms, method {}, residual {:.4} nT RMS>",
@@ -383,22 +394,8 @@ impl PyTlModel {
 /// model (`Model`), by the file's `kind`.
 #[pyfunction]
 pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
-    let kind = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .and_then(|v| v.get("kind")?.as_str().map(String::from));
-    match kind.as_deref() {
-        Some(k @ ("helicopter-rotor" | "towed-pod")) => {
-            Ok(Py::new(py, crate::rotor_pod::read_model(&path, k)?)?.into_any())
-        }
-        Some(aeromag::compensation::model_file::TL_SENSORS_KIND) => {
-            Ok(Py::new(py, crate::sensors::PySensorsModel::read(&path)?)?.into_any())
-        }
-        _ => {
-            let model = PyTlModel::of(TlModel::read(&path).py_err()?);
-            Ok(Py::new(py, model)?.into_any())
-        }
-    }
+    let text = aeromag::model_file::read_text_file(&path).py_err()?;
+    crate::pickle::model_of_text(py, &text, &path.display().to_string(), Vec::new(), None)
 }
 
 /// What a calibration flight determines (`aeromag observability`): per
