@@ -19,7 +19,7 @@
 //! | [`apply`] | what every model does to a flight (interference, compensate, apply) |
 //! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
 //! | [`progress`] | progress callbacks from the library's observer |
-//! | [`pickle`] | pickling of the models and grids: their `__reduce__` constructors |
+//! | [`pickle`] | pickling of the models, grids and flights: their `__reduce__` constructors |
 
 mod apply;
 mod em;
@@ -44,6 +44,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<flight::PyFlight>()?;
     m.add_function(wrap_pyfunction!(flight::read_flight, m)?)?;
+    m.add_function(wrap_pyfunction!(flight::flight_from_state, m)?)?;
     m.add_class::<tolles_lawson::PyTlModel>()?;
     m.add_class::<online::PyOnline>()?;
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate, m)?)?;

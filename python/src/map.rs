@@ -163,7 +163,7 @@ impl PyGrid {
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
         let g = self.grid.geometry;
         let args = (
-            crate::pickle::f64_bytes(py, &self.grid.values),
+            crate::pickle::f64_bytes(py, &self.grid.values)?,
             (g.x0, g.y0, g.cell, g.nx, g.ny),
             self.epsg(),
             &self.grid.name,

@@ -1,4 +1,4 @@
-//! Pickling of the models and grids (and so `copy.deepcopy`, and results
+//! Pickling of the models, grids and flights (and so `copy.deepcopy`, and results
 //! returned from `multiprocessing` or `concurrent.futures` workers): each
 //! class's `__reduce__` returns a module-level constructor of
 //! `aeromag._aeromag` with the object's state, which that constructor
@@ -10,8 +10,11 @@
 //! bits (the workspace turns on serde_json's `float_roundtrip`); the model
 //! files' NaN standard deviations and infinite condition numbers are
 //! written `null` and read back as such. Its notes travel as JSON (text
-//! only), and float arrays (the Kalman series, a grid's nodes) as their
-//! bytes, so NaN and every other value keep their bits.
+//! only), and float arrays (the Kalman series, a grid's nodes, a flight's
+//! numeric columns) as their bytes, so NaN and every other value keep their
+//! bits. A flight travels as its table's snapshot (JSON: names, text
+//! columns, mapping, source file, file lines; `aeromag::io::TableSnapshot`)
+//! beside its numbers, and is checked again as a flight when rebuilt.
 
 use crate::errors::{IntoPy, bad_argument};
 use crate::rotor_pod::{AnyModel, PyModel};
@@ -36,9 +39,13 @@ pub fn constructor<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAn
 
 /// Float values as their bytes (native order: a pickle goes between
 /// processes of one machine, or of machines of one byte order).
-pub fn f64_bytes<'py>(py: Python<'py>, values: &[f64]) -> Bound<'py, PyBytes> {
-    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_ne_bytes()).collect();
-    PyBytes::new(py, &bytes)
+pub fn f64_bytes<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyBytes>> {
+    PyBytes::new_with(py, std::mem::size_of_val(values), |bytes| {
+        for (b, v) in bytes.chunks_exact_mut(8).zip(values) {
+            b.copy_from_slice(&v.to_ne_bytes());
+        }
+        Ok(())
+    })
 }
 
 /// The floats of [`f64_bytes`]; bad input naming `what` when the length is
@@ -66,7 +73,7 @@ pub fn reduce_model<'py>(
     series: Option<&[Vec<f64>; 5]>,
 ) -> PyResult<Reduced<'py>> {
     let notes = serde_json::to_string(notes).map_err(|e| bad_argument(e.to_string()))?;
-    let series = series.map(|s| f64_bytes(py, &s.concat()));
+    let series = series.map(|s| f64_bytes(py, &s.concat())).transpose()?;
     let args = (text, notes, series).into_pyobject(py)?;
     Ok((constructor(py, "_model_from_json")?, args))
 }

@@ -72,6 +72,16 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
             }
             Ok(v.str()?.to_string())
         };
+        // A wrong type named the option only in a note ("while processing
+        // 'params'"), which str(e) leaves out.
+        let flag = || -> PyResult<bool> {
+            v.extract::<bool>().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "{key} must be True or False, got {}",
+                    crate::errors::repr_of(&v)
+                ))
+            })
+        };
         let number = |what: &str| -> PyResult<f64> {
             v.extract::<f64>()
                 .map_err(|_| bad_argument(format!("{key} must be {what}, got {v}")))
@@ -88,8 +98,8 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                     }
                 }
             }
-            "tune" => s.tune = Some(v.extract()?),
-            "no_tune" => no_tune = v.extract()?,
+            "tune" => s.tune = Some(flag()?),
+            "no_tune" => no_tune = flag()?,
             "kalman_noise" => {
                 let q: [f64; 3] = v
                     .extract()
@@ -101,7 +111,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                 });
             }
             "field_order" => s.field_order = Some(whole("field_order", &v)?),
-            "series" => s.series = v.extract()?,
+            "series" => s.series = flag()?,
             "terms" => s.terms = Some(TermSet::parse(&text()?).py_err()?),
             "extra" => s.extra = ExtraRequest::parse_list(&text()?).py_err()?,
             "extra_selection" => s.extra_selection = text()?.parse::<ExtraSelection>().py_err()?,
@@ -125,7 +135,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                 )
             }
             "bt_scale" => s.bt_scale_nt = Some(number("a number > 0 (nT)")?),
-            "no_split_lines" => s.no_split_lines = v.extract()?,
+            "no_split_lines" => s.no_split_lines = flag()?,
             "reference" => s.reference = text()?.parse::<ReferenceChannels>().py_err()?,
             "eddy_lag" => s.eddy_lag = Some(text()?.parse::<EddyLag>().py_err()?),
             "lever_arm" => {

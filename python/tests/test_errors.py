@@ -111,3 +111,11 @@ def test_arguments_are_named_in_their_errors(tmp_path):
     junk.write_bytes(b"II*\x00junk")
     with pytest.raises(aeromag.BadInputError, match="truncated or damaged"):
         aeromag.read_grid(junk)
+
+
+def test_a_flag_of_the_wrong_type_names_the_option():
+    # Was "'str' object is not an instance of 'bool'", naming no option.
+    cal = aeromag.simulate("calibration", seed=1)
+    for name in ("tune", "no_tune", "series", "no_split_lines"):
+        with pytest.raises(TypeError, match=f"^{name} must be True or False, got 'yes'$"):
+            aeromag.TollesLawson(**{name: "yes"}).fit(cal)

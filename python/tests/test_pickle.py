@@ -149,6 +149,80 @@ def test_grid_round_trips_bit_for_bit(survey):
     assert g.info["column"] == "true_anomaly" and g.epsg == 32637
 
 
+def assert_same_flight(a, b):
+    """The same flight: columns (bit for bit, text as text), mapping, file,
+    warnings, unread columns, and the same CSV written (integer columns as
+    read)."""
+    assert type(b) is aeromag.Flight and b is not a
+    for name in ("columns", "mapping", "file", "warnings", "unread_columns"):
+        assert getattr(b, name) == getattr(a, name), name
+    assert len(b) == len(a) and repr(b) == repr(a)
+    for name in a.columns:
+        assert bits(b[name]) == bits(a[name]), name
+
+
+def csv_bytes(flight, path):
+    flight.to_csv(path)
+    return path.read_bytes()
+
+
+def test_flights_round_trip_bit_for_bit(cal_csv, tmp_path):
+    read = aeromag.read_flight(cal_csv)
+    selected = aeromag.read_flight(cal_csv, lines=[2, 3], fields=["time", "lat", "lon", "alt", "mag",
+                                                                  "flux_x", "flux_y", "flux_z", "line"])
+    assert selected.unread_columns and len(selected) < len(read)
+    d = read.to_dict()
+    d["mag"][100:103] = np.nan
+    d["line"] = np.array([f"L{int(x)}" for x in d["line"]])
+    d["line"][5] = ""
+    built = aeromag.Flight.from_dict(d, copy=False)
+    model = aeromag.TollesLawson().fit(read).model_
+    for flight in (read, selected, built, model.apply(built)):
+        for c in copies(flight):
+            assert_same_flight(flight, c)
+            assert csv_bytes(c, tmp_path / "c.csv") == csv_bytes(flight, tmp_path / "f.csv")
+            assert bits(model.compensate(c)) == bits(model.compensate(flight))
+    assert read.file == str(cal_csv) and built["line"][5] == ""
+    # What is fitted on a copy is what is fitted on the flight.
+    assert aeromag.TollesLawson().fit(copy.deepcopy(selected)).model_.to_json() == (
+        aeromag.TollesLawson().fit(selected).model_.to_json())
+
+
+def test_a_corrupt_flight_payload_is_bad_input(cal):
+    make, (layout, numbers) = cal.__reduce__()
+    assert make is _aeromag._flight_from_state
+    assert_same_flight(cal, make(layout, numbers))
+    t = cal["time"]
+    backwards = bytearray(numbers)
+    backwards[:16] = np.array([t[1], t[0]]).tobytes()
+    cases = [
+        (("{not json", numbers), "layout is not readable"),
+        ((layout, numbers[:-8]), "numbers for"),
+        ((layout, numbers[:-1]), "8-byte floats"),
+        ((layout.replace('"name":"lat"', '"name":"lon"'), numbers), "repeated"),
+        ((layout, bytes(backwards)), "time"),
+    ]
+    for args, match in cases:
+        with pytest.raises(aeromag.BadInputError, match=match):
+            make(*args)
+
+
+def test_a_pickled_flight_keeps_its_file_lines_and_data_rows(tmp_path):
+    """The rows of a flight read with a line selection keep their file
+    lines and data rows: the errors of the rebuilt flight name them."""
+    p = tmp_path / "sel.csv"
+    p.write_text("time,mag,line\n0,50000,1\n1,50000,1\n2,50000,2\n3,50000,2\n4,50000,2\n")
+    f = aeromag.read_flight(p, lines=[2])
+    make, (layout, numbers) = f.__reduce__()
+    assert_same_flight(f, make(layout, numbers))
+    # Time 2, 1.5, 4: the second row (data row 3, line 5) goes back.
+    changed = bytearray(numbers)
+    changed[8:16] = np.array([1.5]).tobytes()
+    with pytest.raises(aeromag.BadInputError) as e:
+        make(layout, bytes(changed))
+    assert (e.value.file, e.value.line, e.value.row, e.value.column) == (str(p), 5, 3, "time")
+
+
 def fit_in_worker(seed):
     """In a worker process: simulate and fit; the model goes back pickled."""
     flight = aeromag.simulate("calibration", seed=seed)

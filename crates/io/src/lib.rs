@@ -76,7 +76,10 @@ pub use parts::nan_count;
 pub use position_glitches::{MAX_GROUND_SPEED_M_S, MIN_JUMP_M, position_glitches};
 pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
-pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
+pub use table::{
+    Column, ColumnData, ColumnSnapshot, ColumnSnapshotData, FlightTable, IN_MEMORY, Missing,
+    TableSnapshot,
+};
 pub use validate::{
     EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MAX_TIME_S, MEDIAN_SAMPLES,
     MIN_READING_NT, MIN_TIME_STEP_FRACTION, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind,
