@@ -42,6 +42,7 @@ __all__ = [
     "simulate_em",
     "detect_em",
     "calibrate_em",
+    "_em_calibration_from_json",
     "locate_em",
     "Levelled",
     "level",
@@ -457,6 +458,7 @@ class EmCalibration:
     def attitude_correction_deg(self) -> float: ...
     def to_json(self) -> str: ...
     def save(self, path: str) -> None: ...
+    def __reduce__(self) -> Tuple[Callable[..., Any], Tuple[Any, ...]]: ...
 
 @final
 class EmPoses:
@@ -489,6 +491,14 @@ def calibrate_em(
     system: str,
     half_space: Sequence[float] = (-1.0, 0.0, 1.0),
 ) -> EmCalibration: ...
+def _em_calibration_from_json(
+    text: str,
+    polarization_ratio_before: float,
+    polarization_ratio_after: float,
+    transmitter_distortion: float,
+    attitude_correction_deg: float,
+) -> EmCalibration:
+    """Rebuild a pickled EM calibration (``EmCalibration.__reduce__``)."""
 def locate_em(
     detected: Union[EmDetection, str],
     calibration: Union[EmCalibration, str],

@@ -79,6 +79,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(em::simulate_em, m)?)?;
     m.add_function(wrap_pyfunction!(em::detect_em, m)?)?;
     m.add_function(wrap_pyfunction!(em::calibrate_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::em_calibration_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(em::locate_em, m)?)?;
     Ok(())
 }

@@ -1,9 +1,11 @@
-//! Pickling of the models, grids and flights (and so `copy.deepcopy`, and results
-//! returned from `multiprocessing` or `concurrent.futures` workers): each
-//! class's `__reduce__` returns a module-level constructor of
-//! `aeromag._aeromag` with the object's state, which that constructor
-//! checks as it would check a file (a corrupt payload is a
-//! `BadInputError`, never a panic).
+//! Pickling of the models, grids, flights and EM calibrations (and so
+//! `copy.deepcopy`, and results returned from `multiprocessing` or
+//! `concurrent.futures` workers): each class's `__reduce__` returns a
+//! module-level constructor of `aeromag._aeromag` with the object's state,
+//! which that constructor checks as it would check a file (a corrupt
+//! payload is a `BadInputError`, never a panic). The models' constructor
+//! and helpers are here; the grid's, flight's and EM calibration's are
+//! beside their classes.
 //!
 //! The state is lossless. A model travels as its model file's text: every
 //! float is written in its shortest exact form and read back to the same
@@ -14,7 +16,9 @@
 //! numeric columns) as their bytes, so NaN and every other value keep their
 //! bits. A flight travels as its table's snapshot (JSON: names, text
 //! columns, mapping, source file, file lines; `aeromag::io::TableSnapshot`)
-//! beside its numbers, and is checked again as a flight when rebuilt.
+//! beside its numbers, and is checked again as a flight when rebuilt. An EM
+//! calibration travels as its calibration file's text and its fit's
+//! figures.
 
 use crate::errors::{IntoPy, bad_argument};
 use crate::rotor_pod::{AnyModel, PyModel};

@@ -282,3 +282,25 @@ def test_corrupt_payloads_are_bad_input(cal, survey):
     c = make(values, geometry, None, name, unit, {})
     assert c.crs is None and c.epsg is None and c.info == {}
     assert bits(c.values) == bits(g.values)
+
+
+def test_an_em_calibration_round_trips(tmp_path):
+    files = aeromag.simulate_em(str(tmp_path / "em"), seed=3)
+    det = aeromag.detect_em(files["raw"])
+    cal = aeromag.calibrate_em(det, files["known"], files["system"])
+    poses = aeromag.locate_em(det, cal).to_dict()
+    figures = ("polarization_ratio_before", "polarization_ratio_after", "transmitter_distortion",
+               "attitude_correction_deg")
+    for c in copies(cal):
+        assert type(c) is aeromag.EmCalibration and c is not cal
+        assert c.to_json() == cal.to_json() and repr(c) == repr(cal)
+        assert [getattr(c, f) for f in figures] == [getattr(cal, f) for f in figures]
+        again = aeromag.locate_em(det, c).to_dict()
+        assert again.keys() == poses.keys()
+        assert all(bits(again[k]) == bits(poses[k]) for k in poses)
+    make, (text, *numbers) = cal.__reduce__()
+    assert make is _aeromag._em_calibration_from_json
+    with pytest.raises(aeromag.BadInputError, match="pickled EM calibration"):
+        make("garbage", *numbers)
+    with pytest.raises(aeromag.BadInputError, match="version"):
+        make(text.replace('"version": 1', '"version": 99'), *numbers)
