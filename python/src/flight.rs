@@ -27,6 +27,39 @@ impl PyFlight {
     }
 }
 
+/// A `flight` argument: an `aeromag.Flight`, else a TypeError that names
+/// the argument and what makes a flight. PyO3 names the argument only in a
+/// note ("while processing 'flight'"), which `str(e)` leaves out and Python
+/// before 3.11 drops: "'str' object is not an instance of 'Flight'" was all
+/// it said. Every Python function and method taking a flight calls it
+/// `flight`.
+pub struct FlightArg<'a>(&'a PyFlight);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for FlightArg<'a> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        match obj.cast::<PyFlight>() {
+            Ok(f) => Ok(FlightArg(f.get())),
+            Err(_) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "flight must be an aeromag.Flight (read_flight, simulate, Flight.from_dict or \
+                 Flight.from_pandas), got {}",
+                obj.get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_string(), |n| n.to_string())
+            ))),
+        }
+    }
+}
+
+impl std::ops::Deref for FlightArg<'_> {
+    type Target = PyFlight;
+
+    fn deref(&self) -> &PyFlight {
+        self.0
+    }
+}
+
 /// The memory of a one-dimensional contiguous float64 NumPy array, read by
 /// a column in place (no copy): the array is kept alive by the reference
 /// held here, and the column never writes it (changes copy first). Like

@@ -2,7 +2,7 @@
 //! compensated flight (`aeromag report`'s FOM, IR, residuals).
 
 use crate::errors::{IntoPy, bad_argument};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::level::{LevelFitChoices, LevelOptions, Levelled, level as lib_level};
 use aeromag::score::score as lib_score;
@@ -38,7 +38,7 @@ pub fn reference_channels(
 #[allow(clippy::too_many_arguments)]
 pub fn level(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     value: Option<String>,
     lever_arm: Option<[f64; 3]>,
     rate_of: Option<String>,
@@ -200,7 +200,7 @@ impl PyLevelled {
 #[pyo3(signature = (flight, reference=None, lever_arm=None, decimal_year=None))]
 pub fn score(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     reference: Option<Bound<'_, PyAny>>,
     lever_arm: Option<[f64; 3]>,
     decimal_year: Option<f64>,

@@ -2,7 +2,7 @@
 //! `aeromag derive`): grids as NumPy arrays with their coordinates and CRS.
 
 use crate::errors::{IntoPy, bad_argument, whole_opt};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::Flight;
 use aeromag::grid::format::{read_grid as lib_read_grid, write_grid};
@@ -195,7 +195,7 @@ impl PyGrid {
 #[allow(clippy::too_many_arguments)]
 pub fn grid_flight(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     column: Option<String>,
     cell: Option<f64>,
     tension: f64,
@@ -455,7 +455,7 @@ impl PyMicrolevelled {
 #[allow(clippy::too_many_arguments)]
 pub fn microlevel(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     column: Option<String>,
     cell: Option<f64>,
     cutoff: f64,

@@ -5,7 +5,7 @@
 //! applies itself and scores a compensated flight (`aeromag report`).
 
 use crate::errors::IntoPy;
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use crate::tolles_lawson::PyTlModel;
 use aeromag::{
@@ -27,7 +27,7 @@ use std::path::PathBuf;
 #[pyo3(signature = (flight, mag, params, vector=None, reference_sensor=None, progress=None))]
 pub fn calibrate_sensors(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     mag: Vec<String>,
     params: &Bound<'_, PyDict>,
     vector: Option<Vec<String>>,
@@ -101,7 +101,11 @@ impl PySensorsModel {
     /// The output columns on `flight`: `<name>_interf` and `<name>_comp`
     /// per sensor, `<name>_grad` (compensated minus the first sensor's)
     /// for the others, nT (NaN where a model cannot be applied).
-    fn compensate<'py>(&self, py: Python<'py>, flight: &PyFlight) -> PyResult<Bound<'py, PyDict>> {
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        flight: FlightArg<'_>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let out = py
             .detach(|| self.model.compensate(&flight.inner))
             .py_err()?;
@@ -114,7 +118,7 @@ impl PySensorsModel {
 
     /// The flight with the output columns added, as `aeromag compensate
     /// --out` writes it.
-    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
+    fn apply(&self, py: Python<'_>, flight: FlightArg<'_>) -> PyResult<PyFlight> {
         let f = py
             .detach(|| -> aeromag::Result<Flight> {
                 let mut table = flight.inner.table().clone();
@@ -134,7 +138,7 @@ impl PySensorsModel {
     fn score<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
         reference: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let reference = match reference {

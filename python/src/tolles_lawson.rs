@@ -4,7 +4,7 @@
 //! library's [`CalibrateSettings`] as the CLI's flags are.
 
 use crate::errors::{IntoPy, bad_argument, whole};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::compensation::kalman::NoiseModel;
 use aeromag::compensation::tolles_lawson::{Convention, ExtraRequest, Magnitude, TermSet};
@@ -206,7 +206,7 @@ pub fn calibrate_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 #[pyo3(signature = (flight, params, progress=None))]
 pub fn calibrate(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     params: &Bound<'_, PyDict>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyTlModel> {
@@ -323,9 +323,9 @@ impl PyTlModel {
     fn interference<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        crate::apply::interference(py, &self.model, flight)
+        crate::apply::interference(py, &self.model, &flight)
     }
 
     /// `mag` minus the modelled interference, nT (NaN where it cannot be
@@ -336,17 +336,17 @@ impl PyTlModel {
     fn compensate<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
         causal: bool,
         sample_rate: Option<f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         if causal {
             let c = aeromag::online::CausalTl::new(&self.model, sample_rate).py_err()?;
-            crate::apply::compensate(py, &c, flight)
+            crate::apply::compensate(py, &c, &flight)
         } else if sample_rate.is_some() {
             Err(bad_argument("sample_rate is for causal=True"))
         } else {
-            crate::apply::compensate(py, &self.model, flight)
+            crate::apply::compensate(py, &self.model, &flight)
         }
     }
 
@@ -363,8 +363,8 @@ impl PyTlModel {
 
     /// The flight with the compensation columns added (`mag_comp`,
     /// `mag_interf`, `comp_flag`), as `aeromag compensate --out` writes it.
-    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
-        crate::apply::apply(py, &self.model, flight)
+    fn apply(&self, py: Python<'_>, flight: FlightArg<'_>) -> PyResult<PyFlight> {
+        crate::apply::apply(py, &self.model, &flight)
     }
 
     /// The model file's text (JSON), byte for byte what the CLI writes.
@@ -416,7 +416,7 @@ pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
 #[pyo3(signature = (flight, terms=None, lever_arm=None, decimal_year=None, progress=None))]
 pub fn observability(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     terms: Option<&str>,
     lever_arm: Option<[f64; 3]>,
     decimal_year: Option<f64>,
