@@ -117,7 +117,7 @@ def test_sensors_model_round_trips():
         assert [s.to_json() for s in c.models] == [s.to_json() for s in m.models]
 
 
-def test_rotor_and_pod_models_round_trip():
+def test_rotor_and_pod_models_round_trip(tmp_path):
     heli = aeromag.simulate("helicopter", seed=11)
     pod = aeromag.simulate("pod", seed=1)
     setup = dict(cable_length_m=40.0, attach_m=(0, 0, 1.2), inclination_deg=45.0,
@@ -130,6 +130,12 @@ def test_rotor_and_pod_models_round_trip():
             assert_same_model(m, c, flight)
             assert c.kind == m.kind and bits(c.coef) == bits(m.coef)
             assert c.heading_rates(flight) == m.heading_rates(flight)
+        # load_model shares the constructor's choice by kind; a file with a
+        # byte-order mark was read as a Tolles-Lawson model and refused.
+        path = tmp_path / "m.json"
+        path.write_text("\ufeff" + m.to_json(), encoding="utf-8")
+        loaded = aeromag.load_model(path)
+        assert type(loaded) is aeromag.Model and loaded.to_json() == m.to_json()
 
 
 def test_grid_round_trips_bit_for_bit(survey):
