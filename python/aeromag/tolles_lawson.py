@@ -31,7 +31,7 @@ def as_flight(x: FlightLike) -> Flight:
         return Flight.from_dict(x)
     if hasattr(x, "columns") and hasattr(x, "to_numpy"):
         return Flight.from_pandas(x)
-    raise TypeError(f"expected an aeromag.Flight, a dict of arrays or a DataFrame, got {type(x).__name__}")
+    raise TypeError(f"flight must be an aeromag.Flight, a dict of arrays or a DataFrame, got {type(x).__name__}")
 
 
 def progress_callback(progress: Any) -> Optional[Callable[[str, int, int], None]]:

@@ -199,6 +199,23 @@ impl PyEmCalibration {
     fn save(&self, path: PathBuf) -> PyResult<()> {
         save(&path, self.inner.file.to_json().py_err()?)
     }
+    /// Pickling (and `copy.deepcopy`): the calibration file's text and the
+    /// fit's four figures ([`em_calibration_from_json`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let c = &self.inner;
+        let args = (
+            c.file.to_json().py_err()?,
+            c.polarization_ratio_before,
+            c.polarization_ratio_after,
+            c.transmitter_distortion,
+            c.attitude_correction_deg,
+        )
+            .into_pyobject(py)?;
+        Ok((
+            crate::pickle::constructor(py, "_em_calibration_from_json")?,
+            args,
+        ))
+    }
     fn __repr__(&self) -> String {
         let c = &self.inner.file.fit;
         format!(
@@ -206,6 +223,33 @@ impl PyEmCalibration {
             c.epochs, c.known_positions, c.known_attitudes
         )
     }
+}
+
+/// Rebuild a pickled EM calibration (the constructor of
+/// `EmCalibration.__reduce__`): the calibration file's text, read and
+/// checked as `locate_em` reads the file (bad input when it is not one),
+/// and the fit's figures.
+#[pyfunction]
+#[pyo3(name = "_em_calibration_from_json")]
+pub fn em_calibration_from_json(
+    text: &str,
+    polarization_ratio_before: f64,
+    polarization_ratio_after: f64,
+    transmitter_distortion: f64,
+    attitude_correction_deg: f64,
+) -> PyResult<PyEmCalibration> {
+    let file = CalibrationFile::from_json(text)
+        .map_err(|e| aeromag::Error::bad_file("pickled EM calibration", e.to_string()))
+        .py_err()?;
+    Ok(PyEmCalibration {
+        inner: EmCalibration {
+            file,
+            polarization_ratio_before,
+            polarization_ratio_after,
+            transmitter_distortion,
+            attitude_correction_deg,
+        },
+    })
 }
 
 /// Fit the three calibration stages (polarisation from all epochs;

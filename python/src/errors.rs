@@ -53,9 +53,9 @@ impl<T, E: Into<aeromag::Error>> IntoPy<T> for Result<T, E> {
 /// `OverflowError: can't convert negative int to unsigned` named none).
 pub fn whole<T: TryFrom<u128>>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<T> {
     let i: i128 = v.extract().map_err(|_| {
-        let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
         pyo3::exceptions::PyTypeError::new_err(format!(
-            "{name} must be a whole number, got {shown}"
+            "{name} must be a whole number, got {}",
+            repr_of(v)
         ))
     })?;
     if i < 0 {
@@ -67,6 +67,11 @@ pub fn whole<T: TryFrom<u128>>(name: &str, v: &Bound<'_, PyAny>) -> PyResult<T> 
         .ok()
         .and_then(|u| T::try_from(u).ok())
         .ok_or_else(|| bad_argument(format!("{name}: {i} is too large")))
+}
+
+/// `repr(v)` for a message (`?` when it has none).
+pub fn repr_of(v: &Bound<'_, PyAny>) -> String {
+    v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string())
 }
 
 /// [`whole`] of an optional argument.

@@ -2,7 +2,9 @@
 //! file or built from arrays, checked as the CLI checks it.
 
 use crate::errors::{IntoPy, bad_argument};
-use aeromag::io::{ColumnData, Missing, SharedBuffer, Values, table_from_columns};
+use aeromag::io::{
+    ColumnData, FlightTable, Missing, SharedBuffer, TableSnapshot, Values, table_from_columns,
+};
 use aeromag::{ColumnMap, Flight, ReadOptions, RowSelection, Sensors};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyKeyError;
@@ -22,6 +24,39 @@ pub struct PyFlight {
 impl PyFlight {
     pub fn new(inner: Flight) -> Self {
         Self { inner }
+    }
+}
+
+/// A `flight` argument: an `aeromag.Flight`, else a TypeError that names
+/// the argument and what makes a flight. PyO3 names the argument only in a
+/// note ("while processing 'flight'"), which `str(e)` leaves out and Python
+/// before 3.11 drops: "'str' object is not an instance of 'Flight'" was all
+/// it said. Every Python function and method taking a flight calls it
+/// `flight`.
+pub struct FlightArg<'a>(&'a PyFlight);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for FlightArg<'a> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        match obj.cast::<PyFlight>() {
+            Ok(f) => Ok(FlightArg(f.get())),
+            Err(_) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "flight must be an aeromag.Flight (read_flight, simulate, Flight.from_dict or \
+                 Flight.from_pandas), got {}",
+                obj.get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_string(), |n| n.to_string())
+            ))),
+        }
+    }
+}
+
+impl std::ops::Deref for FlightArg<'_> {
+    type Target = PyFlight;
+
+    fn deref(&self) -> &PyFlight {
+        self.0
     }
 }
 
@@ -499,6 +534,16 @@ impl PyFlight {
             .collect()
     }
 
+    /// Pickling (and `copy.deepcopy`): the table's snapshot and its
+    /// numbers ([`flight_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let (snapshot, numbers) = self.inner.table().snapshot();
+        let layout = serde_json::to_string(&snapshot)
+            .map_err(|e| bad_argument(format!("this flight cannot be pickled: {e}")))?;
+        let args = (layout, crate::pickle::f64_bytes(py, &numbers)?).into_pyobject(py)?;
+        Ok((crate::pickle::constructor(py, "_flight_from_state")?, args))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<aeromag.Flight {}: {} rows, {} columns>",
@@ -507,4 +552,25 @@ impl PyFlight {
             self.inner.columns().len()
         )
     }
+}
+
+/// Rebuild a pickled flight (the constructor of `Flight.__reduce__`): the
+/// table's snapshot (JSON) and the bytes of its numeric columns, one after
+/// the other. Bad input when they do not make a table, or the table is not
+/// a flight (checked as `Flight.from_dict` checks one).
+#[pyfunction]
+#[pyo3(name = "_flight_from_state")]
+pub fn flight_from_state(py: Python<'_>, layout: &str, numbers: &[u8]) -> PyResult<PyFlight> {
+    let what = "pickled flight";
+    let snapshot: TableSnapshot = serde_json::from_str(layout)
+        .map_err(|e| bad_argument(format!("{what}: its layout is not readable ({e})")))?;
+    let numbers = crate::pickle::f64s_from_bytes(&format!("{what}: its numbers"), numbers)?;
+    let flight = py
+        .detach(|| {
+            FlightTable::from_snapshot(snapshot, numbers)
+                .map_err(aeromag::Error::from)
+                .and_then(Flight::from_table)
+        })
+        .py_err()?;
+    Ok(PyFlight::new(flight))
 }

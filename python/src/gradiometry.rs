@@ -2,7 +2,7 @@
 //! `aeromag dipole crlb`, `aeromag simulate gradiometer`).
 
 use crate::errors::{IntoPy, warn, whole_opt};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use aeromag::gradiometry::{
     LocateSettings, crlb, locate_pass, parse_name, read_config, read_pass, simulate_pass,
 };
@@ -24,7 +24,7 @@ use std::path::PathBuf;
 #[allow(clippy::too_many_arguments)]
 pub fn locate_dipole(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     config: Option<PathBuf>,
     gradiometer: Option<&str>,
     layout: Option<&str>,

@@ -2,7 +2,7 @@
 //! compensated flight (`aeromag report`'s FOM, IR, residuals).
 
 use crate::errors::{IntoPy, bad_argument};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::level::{LevelFitChoices, LevelOptions, Levelled, level as lib_level};
 use aeromag::score::score as lib_score;
@@ -38,7 +38,7 @@ pub fn reference_channels(
 #[allow(clippy::too_many_arguments)]
 pub fn level(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     value: Option<String>,
     lever_arm: Option<[f64; 3]>,
     rate_of: Option<String>,
@@ -175,6 +175,21 @@ impl PyLevelled {
     fn notes(&self) -> Vec<String> {
         self.levelled.notes.iter().map(|n| n.to_string()).collect()
     }
+
+    fn __repr__(&self) -> String {
+        let l = &self.levelled;
+        let f = &l.levelling.fit;
+        format!(
+            "<aeromag.Levelled {} → {}: {} lines, {} crossovers, RMS {:.4} → {:.4} nT, k {:.4} s>",
+            l.value_column,
+            l.output_column(),
+            f.lines.len(),
+            l.levelling.crossovers.crossovers.len(),
+            f.rms_before_nt,
+            f.rms_levelled_nt,
+            f.k_s
+        )
+    }
 }
 
 /// The figures of a compensated flight (needs `mag_comp`, as written by
@@ -185,7 +200,7 @@ impl PyLevelled {
 #[pyo3(signature = (flight, reference=None, lever_arm=None, decimal_year=None))]
 pub fn score(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     reference: Option<Bound<'_, PyAny>>,
     lever_arm: Option<[f64; 3]>,
     decimal_year: Option<f64>,

@@ -19,6 +19,7 @@
 //! | [`apply`] | what every model does to a flight (interference, compensate, apply) |
 //! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
 //! | [`progress`] | progress callbacks from the library's observer |
+//! | [`pickle`] | pickling of the models, grids and flights: their `__reduce__` constructors |
 
 mod apply;
 mod em;
@@ -29,6 +30,7 @@ mod gradiometry;
 mod level;
 mod map;
 mod online;
+mod pickle;
 mod progress;
 mod rotor_pod;
 mod sensors;
@@ -42,12 +44,14 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<flight::PyFlight>()?;
     m.add_function(wrap_pyfunction!(flight::read_flight, m)?)?;
+    m.add_function(wrap_pyfunction!(flight::flight_from_state, m)?)?;
     m.add_class::<tolles_lawson::PyTlModel>()?;
     m.add_class::<online::PyOnline>()?;
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::check_calibrate_options, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::calibrate_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::load_model, m)?)?;
+    m.add_function(wrap_pyfunction!(pickle::model_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(tolles_lawson::observability, m)?)?;
     m.add_class::<sensors::PySensorsModel>()?;
     m.add_function(wrap_pyfunction!(sensors::calibrate_sensors, m)?)?;
@@ -64,6 +68,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<map::PyMicrolevelled>()?;
     m.add_function(wrap_pyfunction!(map::grid_flight, m)?)?;
     m.add_function(wrap_pyfunction!(map::read_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(map::grid_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(map::microlevel, m)?)?;
     m.add_function(wrap_pyfunction!(fields::igrf, m)?)?;
     m.add_function(wrap_pyfunction!(fields::decimal_year, m)?)?;
@@ -74,6 +79,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(em::simulate_em, m)?)?;
     m.add_function(wrap_pyfunction!(em::detect_em, m)?)?;
     m.add_function(wrap_pyfunction!(em::calibrate_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::em_calibration_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(em::locate_em, m)?)?;
     Ok(())
 }

@@ -2,13 +2,13 @@
 //! `aeromag derive`): grids as NumPy arrays with their coordinates and CRS.
 
 use crate::errors::{IntoPy, bad_argument, whole_opt};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::Flight;
 use aeromag::grid::format::{read_grid as lib_read_grid, write_grid};
 use aeromag::grid::gridding::MinCurvature;
 use aeromag::grid::products::{Spectral, apply};
-use aeromag::grid::projection::UtmZone;
+use aeromag::grid::projection::{Crs, UtmZone};
 use aeromag::grid::{Grid, GridGeometry};
 use aeromag::map::gridding::GridMethod;
 use aeromag::map::{
@@ -28,7 +28,9 @@ fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
 #[pyclass(name = "Grid", module = "aeromag._aeromag", frozen)]
 pub struct PyGrid {
     grid: Grid,
-    info: Vec<(&'static str, Py<PyAny>)>,
+    /// What `info` returns (a list, not a dict: the object is frozen and
+    /// `info` hands out a new dict each time).
+    info: Vec<(String, Py<PyAny>)>,
 }
 
 impl PyGrid {
@@ -156,6 +158,22 @@ impl PyGrid {
         Ok(())
     }
 
+    /// Pickling (and `copy.deepcopy`): the node values' bytes, the
+    /// geometry, EPSG code, name, unit and `info` ([`grid_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let g = self.grid.geometry;
+        let args = (
+            crate::pickle::f64_bytes(py, &self.grid.values)?,
+            (g.x0, g.y0, g.cell, g.nx, g.ny),
+            self.epsg(),
+            &self.grid.name,
+            &self.grid.unit,
+            self.info(py)?,
+        )
+            .into_pyobject(py)?;
+        Ok((crate::pickle::constructor(py, "_grid_from_state")?, args))
+    }
+
     fn __repr__(&self) -> String {
         let g = self.grid.geometry;
         format!(
@@ -177,7 +195,7 @@ impl PyGrid {
 #[allow(clippy::too_many_arguments)]
 pub fn grid_flight(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     column: Option<String>,
     cell: Option<f64>,
     tension: f64,
@@ -224,7 +242,7 @@ pub fn grid_flight(
     let result = py.detach(|| lib_grid(&flight.inner, &opts, &mut obs));
     obs.finish()?;
     let g = result.py_err()?;
-    let mut info: Vec<(&'static str, Py<PyAny>)> = vec![
+    let mut info: Vec<(&str, Py<PyAny>)> = vec![
         (
             "column",
             g.column.clone().into_pyobject(py)?.into_any().unbind(),
@@ -269,13 +287,82 @@ pub fn grid_flight(
             l.direction_deg.into_pyobject(py)?.into_any().unbind(),
         ));
     }
-    Ok(PyGrid { grid: g.grid, info })
+    Ok(PyGrid {
+        grid: g.grid,
+        info: info.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+    })
 }
 
 /// Read a grid file (GeoTIFF, ESRI ASCII or netCDF).
 #[pyfunction]
 pub fn read_grid(path: std::path::PathBuf) -> PyResult<PyGrid> {
     Ok(PyGrid::plain(lib_read_grid(&path).py_err()?))
+}
+
+/// Rebuild a pickled grid (the constructor of `Grid.__reduce__`): the
+/// node values' bytes (row by row from the south), the geometry `(x0, y0,
+/// cell, nx, ny)`, the EPSG code (None: no CRS), name, unit and `info`.
+/// Bad input when the values do not fill the geometry, the geometry is not
+/// a grid's (a cell or coordinates out of range) or the EPSG code is not
+/// a UTM zone's.
+#[pyfunction]
+#[pyo3(name = "_grid_from_state")]
+pub fn grid_from_state(
+    values: &[u8],
+    geometry: (f64, f64, f64, Bound<'_, PyAny>, Bound<'_, PyAny>),
+    epsg: Option<Bound<'_, PyAny>>,
+    name: String,
+    unit: String,
+    info: &Bound<'_, PyDict>,
+) -> PyResult<PyGrid> {
+    use aeromag::grid::grid::{MAX_CELL, MAX_COORDINATE, MAX_NODES, MIN_CELL};
+    let what = "pickled grid";
+    let values = crate::pickle::f64s_from_bytes(&format!("{what}: its values"), values)?;
+    let (x0, y0, cell, nx, ny) = geometry;
+    let geometry = GridGeometry {
+        x0,
+        y0,
+        cell,
+        nx: crate::errors::whole("nx", &nx)?,
+        ny: crate::errors::whole("ny", &ny)?,
+    };
+    let g = geometry;
+    let nodes = g.nx.checked_mul(g.ny).filter(|&n| n > 0 && n <= MAX_NODES);
+    if nodes != Some(values.len()) {
+        return Err(bad_argument(format!(
+            "{what}: {} values for {} × {} nodes",
+            values.len(),
+            g.nx,
+            g.ny
+        )));
+    }
+    let inside = |v: f64| v.abs() <= MAX_COORDINATE;
+    let a_grid = (MIN_CELL..=MAX_CELL).contains(&g.cell)
+        && [g.x0, g.y0, g.x_max(), g.y_max()].into_iter().all(inside);
+    if !a_grid {
+        return Err(bad_argument(format!(
+            "{what}: cell {} m from ({}, {}) m is not a grid's geometry",
+            g.cell, g.x0, g.y0
+        )));
+    }
+    let crs = whole_opt::<u16>("epsg", epsg.as_ref())?
+        .map(|code| UtmZone::parse(&code.to_string()).map(Crs::Utm))
+        .transpose()
+        .py_err()?;
+    let info = info
+        .iter()
+        .map(|(k, v)| Ok((k.extract::<String>()?, v.unbind())))
+        .collect::<PyResult<_>>()?;
+    Ok(PyGrid {
+        grid: Grid {
+            geometry,
+            values,
+            crs,
+            name,
+            unit,
+        },
+        info,
+    })
 }
 
 /// A micro-levelled survey (`aeromag microlevel`).
@@ -343,6 +430,20 @@ impl PyMicrolevelled {
         self.m.add_to(&mut t).py_err()?;
         Ok(PyFlight::new(Flight::from_table(t).py_err()?))
     }
+
+    fn __repr__(&self) -> String {
+        let m = &self.m;
+        let crossovers = m.crossover_rms_nt.map_or("no crossovers".into(), |(a, b)| {
+            format!("crossovers {a:.4} → {b:.4} nT RMS")
+        });
+        format!(
+            "<aeromag.Microlevelled {} → {}: correction {:.4} nT RMS (largest {:.4} nT), {crossovers}>",
+            m.column,
+            m.output_column(),
+            m.correction_rms_nt,
+            m.correction_max_nt
+        )
+    }
 }
 
 /// Micro-level a levelled survey (the keywords are `aeromag microlevel`'s
@@ -354,7 +455,7 @@ impl PyMicrolevelled {
 #[allow(clippy::too_many_arguments)]
 pub fn microlevel(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     column: Option<String>,
     cell: Option<f64>,
     cutoff: f64,

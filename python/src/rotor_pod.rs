@@ -3,7 +3,7 @@
 //! flights like the Tolles-Lawson model.
 
 use crate::errors::{IntoPy, bad_argument, whole_opt};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::pod::{PodModelFile, PodSetup, apply_pod, fit_pod as lib_fit_pod};
 use aeromag::rotor::{
@@ -86,29 +86,29 @@ impl PyModel {
     fn interference<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        crate::apply::interference(py, self.model.compensator(), flight)
+        crate::apply::interference(py, self.model.compensator(), &flight)
     }
 
     /// `mag` minus the modelled interference, nT.
     fn compensate<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        crate::apply::compensate(py, self.model.compensator(), flight)
+        crate::apply::compensate(py, self.model.compensator(), &flight)
     }
 
     /// The flight with the model's output columns added, as `apply --out`
     /// writes it.
-    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
-        crate::apply::apply(py, self.model.compensator(), flight)
+    fn apply(&self, py: Python<'_>, flight: FlightArg<'_>) -> PyResult<PyFlight> {
+        crate::apply::apply(py, self.model.compensator(), &flight)
     }
 
     /// Per heading of a pod flight: (heading °, first row, end row, rate of
     /// interference removed); empty for a rotor model.
-    fn heading_rates(&self, flight: &PyFlight) -> PyResult<Vec<(f64, usize, usize, f64)>> {
+    fn heading_rates(&self, flight: FlightArg<'_>) -> PyResult<Vec<(f64, usize, usize, f64)>> {
         let AnyModel::Pod(m) = &self.model else {
             return Ok(Vec::new());
         };
@@ -129,6 +129,12 @@ impl PyModel {
         self.model.write(&path).py_err()
     }
 
+    /// Pickling (and `copy.deepcopy`): the model file's text and the notes
+    /// ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(py, self.model.json().py_err()?, &self.notes, None)
+    }
+
     fn __repr__(&self) -> String {
         format!("<aeromag.Model {}>", self.kind())
     }
@@ -144,7 +150,7 @@ impl PyModel {
 #[allow(clippy::too_many_arguments)]
 pub fn fit_rotor(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     preset: Option<&str>,
     hub_m: Option<[f64; 3]>,
     sensor_m: Option<[f64; 3]>,
@@ -219,7 +225,7 @@ pub fn fit_rotor(
 #[allow(clippy::too_many_arguments)]
 pub fn fit_pod(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     cable_length_m: f64,
     inclination_deg: f64,
     attach_m: Option<[f64; 3]>,
@@ -260,17 +266,5 @@ pub fn fit_pod(
     Ok(PyModel {
         model: AnyModel::Pod(fit.model),
         notes: fit.notes,
-    })
-}
-
-/// A rotor or pod model file by its `kind`.
-pub fn read_model(path: &std::path::Path, kind: &str) -> PyResult<PyModel> {
-    let model = match kind {
-        "helicopter-rotor" => AnyModel::Rotor(RotorModelFile::read(path).py_err()?),
-        _ => AnyModel::Pod(PodModelFile::read(path).py_err()?),
-    };
-    Ok(PyModel {
-        model,
-        notes: Vec::new(),
     })
 }

@@ -5,7 +5,7 @@
 //! applies itself and scores a compensated flight (`aeromag report`).
 
 use crate::errors::IntoPy;
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use crate::tolles_lawson::PyTlModel;
 use aeromag::{
@@ -27,7 +27,7 @@ use std::path::PathBuf;
 #[pyo3(signature = (flight, mag, params, vector=None, reference_sensor=None, progress=None))]
 pub fn calibrate_sensors(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     mag: Vec<String>,
     params: &Bound<'_, PyDict>,
     vector: Option<Vec<String>>,
@@ -53,18 +53,8 @@ pub fn calibrate_sensors(
 /// `aeromag calibrate --mag A,B,…`; it applies itself to flights.
 #[pyclass(name = "SensorsModel", module = "aeromag._aeromag", frozen)]
 pub struct PySensorsModel {
-    model: SensorsModel,
-    notes: Vec<Note>,
-}
-
-impl PySensorsModel {
-    /// A model read from a file (no notes).
-    pub fn read(path: &std::path::Path) -> PyResult<Self> {
-        Ok(Self {
-            model: SensorsModel::read(path).py_err()?,
-            notes: Vec::new(),
-        })
-    }
+    pub(crate) model: SensorsModel,
+    pub(crate) notes: Vec<Note>,
 }
 
 #[pymethods]
@@ -111,7 +101,11 @@ impl PySensorsModel {
     /// The output columns on `flight`: `<name>_interf` and `<name>_comp`
     /// per sensor, `<name>_grad` (compensated minus the first sensor's)
     /// for the others, nT (NaN where a model cannot be applied).
-    fn compensate<'py>(&self, py: Python<'py>, flight: &PyFlight) -> PyResult<Bound<'py, PyDict>> {
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        flight: FlightArg<'_>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let out = py
             .detach(|| self.model.compensate(&flight.inner))
             .py_err()?;
@@ -124,7 +118,7 @@ impl PySensorsModel {
 
     /// The flight with the output columns added, as `aeromag compensate
     /// --out` writes it.
-    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
+    fn apply(&self, py: Python<'_>, flight: FlightArg<'_>) -> PyResult<PyFlight> {
         let f = py
             .detach(|| -> aeromag::Result<Flight> {
                 let mut table = flight.inner.table().clone();
@@ -144,7 +138,7 @@ impl PySensorsModel {
     fn score<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
         reference: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let reference = match reference {
@@ -176,6 +170,12 @@ impl PySensorsModel {
     /// Write the model file (atomically), as `aeromag calibrate --model`.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         self.model.write(&path).py_err()
+    }
+
+    /// Pickling (and `copy.deepcopy`): the model file's text and the notes
+    /// ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(py, self.model.json().py_err()?, &self.notes, None)
     }
 
     fn __len__(&self) -> usize {

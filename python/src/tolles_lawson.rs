@@ -4,7 +4,7 @@
 //! library's [`CalibrateSettings`] as the CLI's flags are.
 
 use crate::errors::{IntoPy, bad_argument, whole};
-use crate::flight::PyFlight;
+use crate::flight::{FlightArg, PyFlight};
 use crate::progress::PyProgress;
 use aeromag::compensation::kalman::NoiseModel;
 use aeromag::compensation::tolles_lawson::{Convention, ExtraRequest, Magnitude, TermSet};
@@ -72,6 +72,16 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
             }
             Ok(v.str()?.to_string())
         };
+        // A wrong type named the option only in a note ("while processing
+        // 'params'"), which str(e) leaves out.
+        let flag = || -> PyResult<bool> {
+            v.extract::<bool>().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "{key} must be True or False, got {}",
+                    crate::errors::repr_of(&v)
+                ))
+            })
+        };
         let number = |what: &str| -> PyResult<f64> {
             v.extract::<f64>()
                 .map_err(|_| bad_argument(format!("{key} must be {what}, got {v}")))
@@ -88,8 +98,8 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                     }
                 }
             }
-            "tune" => s.tune = Some(v.extract()?),
-            "no_tune" => no_tune = v.extract()?,
+            "tune" => s.tune = Some(flag()?),
+            "no_tune" => no_tune = flag()?,
             "kalman_noise" => {
                 let q: [f64; 3] = v
                     .extract()
@@ -101,7 +111,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                 });
             }
             "field_order" => s.field_order = Some(whole("field_order", &v)?),
-            "series" => s.series = v.extract()?,
+            "series" => s.series = flag()?,
             "terms" => s.terms = Some(TermSet::parse(&text()?).py_err()?),
             "extra" => s.extra = ExtraRequest::parse_list(&text()?).py_err()?,
             "extra_selection" => s.extra_selection = text()?.parse::<ExtraSelection>().py_err()?,
@@ -125,7 +135,7 @@ fn parse_settings(params: &Bound<'_, PyDict>) -> PyResult<CalibrateSettings> {
                 )
             }
             "bt_scale" => s.bt_scale_nt = Some(number("a number > 0 (nT)")?),
-            "no_split_lines" => s.no_split_lines = v.extract()?,
+            "no_split_lines" => s.no_split_lines = flag()?,
             "reference" => s.reference = text()?.parse::<ReferenceChannels>().py_err()?,
             "eddy_lag" => s.eddy_lag = Some(text()?.parse::<EddyLag>().py_err()?),
             "lever_arm" => {
@@ -196,7 +206,7 @@ pub fn calibrate_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 #[pyo3(signature = (flight, params, progress=None))]
 pub fn calibrate(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     params: &Bound<'_, PyDict>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyTlModel> {
@@ -221,9 +231,9 @@ pub fn calibrate(
 /// model file; it applies itself to flights.
 #[pyclass(name = "TlModel", module = "aeromag._aeromag", frozen)]
 pub struct PyTlModel {
-    model: TlModel,
-    notes: Vec<Note>,
-    series: Option<[Vec<f64>; 5]>,
+    pub(crate) model: TlModel,
+    pub(crate) notes: Vec<Note>,
+    pub(crate) series: Option<[Vec<f64>; 5]>,
 }
 
 impl PyTlModel {
@@ -313,9 +323,9 @@ impl PyTlModel {
     fn interference<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        crate::apply::interference(py, &self.model, flight)
+        crate::apply::interference(py, &self.model, &flight)
     }
 
     /// `mag` minus the modelled interference, nT (NaN where it cannot be
@@ -326,17 +336,17 @@ impl PyTlModel {
     fn compensate<'py>(
         &self,
         py: Python<'py>,
-        flight: &PyFlight,
+        flight: FlightArg<'_>,
         causal: bool,
         sample_rate: Option<f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         if causal {
             let c = aeromag::online::CausalTl::new(&self.model, sample_rate).py_err()?;
-            crate::apply::compensate(py, &c, flight)
+            crate::apply::compensate(py, &c, &flight)
         } else if sample_rate.is_some() {
             Err(bad_argument("sample_rate is for causal=True"))
         } else {
-            crate::apply::compensate(py, &self.model, flight)
+            crate::apply::compensate(py, &self.model, &flight)
         }
     }
 
@@ -353,8 +363,8 @@ impl PyTlModel {
 
     /// The flight with the compensation columns added (`mag_comp`,
     /// `mag_interf`, `comp_flag`), as `aeromag compensate --out` writes it.
-    fn apply(&self, py: Python<'_>, flight: &PyFlight) -> PyResult<PyFlight> {
-        crate::apply::apply(py, &self.model, flight)
+    fn apply(&self, py: Python<'_>, flight: FlightArg<'_>) -> PyResult<PyFlight> {
+        crate::apply::apply(py, &self.model, &flight)
     }
 
     /// The model file's text (JSON), byte for byte what the CLI writes.
@@ -366,6 +376,17 @@ impl PyTlModel {
     /// complete), as `aeromag calibrate --model` does.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         self.model.write(&path).py_err()
+    }
+
+    /// Pickling (and `copy.deepcopy`): the model file's text, the notes
+    /// and the series ([`crate::pickle`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        crate::pickle::reduce_model(
+            py,
+            self.model.json().py_err()?,
+            &self.notes,
+            self.series.as_ref(),
+        )
     }
 
     fn __repr__(&self) -> String {
@@ -383,22 +404,8 @@ impl PyTlModel {
 /// model (`Model`), by the file's `kind`.
 #[pyfunction]
 pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
-    let kind = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .and_then(|v| v.get("kind")?.as_str().map(String::from));
-    match kind.as_deref() {
-        Some(k @ ("helicopter-rotor" | "towed-pod")) => {
-            Ok(Py::new(py, crate::rotor_pod::read_model(&path, k)?)?.into_any())
-        }
-        Some(aeromag::compensation::model_file::TL_SENSORS_KIND) => {
-            Ok(Py::new(py, crate::sensors::PySensorsModel::read(&path)?)?.into_any())
-        }
-        _ => {
-            let model = PyTlModel::of(TlModel::read(&path).py_err()?);
-            Ok(Py::new(py, model)?.into_any())
-        }
-    }
+    let text = aeromag::model_file::read_text_file(&path).py_err()?;
+    crate::pickle::model_of_text(py, &text, &path.display().to_string(), Vec::new(), None)
 }
 
 /// What a calibration flight determines (`aeromag observability`): per
@@ -409,7 +416,7 @@ pub fn load_model(py: Python<'_>, path: PathBuf) -> PyResult<Py<PyAny>> {
 #[pyo3(signature = (flight, terms=None, lever_arm=None, decimal_year=None, progress=None))]
 pub fn observability(
     py: Python<'_>,
-    flight: &PyFlight,
+    flight: FlightArg<'_>,
     terms: Option<&str>,
     lever_arm: Option<[f64; 3]>,
     decimal_year: Option<f64>,

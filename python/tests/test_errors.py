@@ -111,3 +111,35 @@ def test_arguments_are_named_in_their_errors(tmp_path):
     junk.write_bytes(b"II*\x00junk")
     with pytest.raises(aeromag.BadInputError, match="truncated or damaged"):
         aeromag.read_grid(junk)
+
+
+def test_a_flag_of_the_wrong_type_names_the_option():
+    # Was "'str' object is not an instance of 'bool'", naming no option.
+    cal = aeromag.simulate("calibration", seed=1)
+    for name in ("tune", "no_tune", "series", "no_split_lines"):
+        with pytest.raises(TypeError, match=f"^{name} must be True or False, got 'yes'$"):
+            aeromag.TollesLawson(**{name: "yes"}).fit(cal)
+
+
+def test_a_flight_argument_of_the_wrong_type_names_it():
+    # Was "'str' object is not an instance of 'Flight'": PyO3 names the
+    # argument only in a note, which str(e) leaves out.
+    cal = aeromag.simulate("calibration", seed=1)
+    tl = aeromag.TollesLawson().fit(cal)
+    calls = [
+        lambda: aeromag._aeromag.calibrate("x", {}),
+        lambda: tl.model_.compensate("x"),
+        lambda: tl.model_.interference("x"),
+        lambda: tl.model_.apply("x"),
+        lambda: aeromag.grid_flight("x"),
+        lambda: aeromag.level("x"),
+        lambda: aeromag.microlevel("x"),
+        lambda: aeromag.score("x"),
+        lambda: tl.fit("x"),
+        lambda: tl.transform("x"),
+    ]
+    for call in calls:
+        with pytest.raises(TypeError) as e:
+            call()
+        assert str(e.value).startswith("flight must be an aeromag.Flight")
+        assert str(e.value).endswith(", got str")

@@ -30,6 +30,12 @@ def test_level_equals_the_cli(cli, survey_csv, tmp_path):
     # Tie-line levelling: no k.
     tie = aeromag.level(survey, tie_only=True)
     assert tie.k_s[0] == 0.0
+    # The repr says what was levelled into what, and how well.
+    r = repr(lev)
+    assert r.startswith("<aeromag.Levelled mag → mag_level: ") and r.endswith(" s>")
+    assert f"{len(lev.line_levels)} lines, {len(table)} crossovers" in r
+    assert f"RMS {lev.rms_nt['before']:.4f} → {lev.rms_nt['levelled']:.4f} nT" in r
+    assert f"k {k:.4f} s" in r
 
 
 def test_score_equals_the_report(cli, cal_csv, tmp_path):

@@ -52,6 +52,10 @@ def test_microlevel_and_bad_arguments(survey_csv):
     assert before >= 0 and after >= 0
     f = m.to_flight()
     np.testing.assert_array_equal(f["true_anomaly_mlev"], m.values)
+    assert repr(m) == (
+        f"<aeromag.Microlevelled true_anomaly → true_anomaly_mlev: correction {rms:.4f} nT RMS "
+        f"(largest {largest:.4f} nT), crossovers {before:.4f} → {after:.4f} nT RMS>"
+    )
     with pytest.raises(aeromag.BadInputError, match="nope"):
         aeromag.grid_flight(survey, column="nope")
     with pytest.raises(aeromag.BadInputError, match="bidi"):

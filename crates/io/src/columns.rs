@@ -139,7 +139,7 @@ pub(crate) fn must_be_numeric(role: &str) -> bool {
 }
 
 /// Where a canonical alias came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MapOrigin {
     /// The user's `--columns` map.
@@ -151,7 +151,7 @@ pub enum MapOrigin {
 }
 
 /// One resolved alias: the canonical name `canonical` reads the file column `file_column`.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct MappedColumn {
     /// Canonical (or `true_*`) name.
     pub canonical: String,

@@ -56,7 +56,7 @@ use crate::error::Result;
 use crate::table::FlightTable;
 
 /// How a derived column is computed from its source.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Conversion {
     /// Radians to degrees.
@@ -94,7 +94,7 @@ impl Conversion {
 }
 
 /// A canonical column computed from a file column.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct DerivedColumn {
     /// The canonical name it plays (`lat`).
     pub canonical: String,

@@ -376,6 +376,13 @@ pub enum IoError {
         /// What is wrong.
         reason: String,
     },
+    /// A table's snapshot (a pickled Python `Flight`) that is not a
+    /// table's ([`crate::FlightTable::from_snapshot`]).
+    #[error("not a flight table's snapshot: {reason}")]
+    Snapshot {
+        /// What is wrong.
+        reason: String,
+    },
     /// A file format this build cannot read.
     #[error("'{file}': {reason}")]
     Unsupported {
@@ -486,7 +493,7 @@ impl IoError {
             LengthMismatch { column, .. } | ColumnExists { column } => {
                 at.column = Some(column.clone())
             }
-            ColumnMap { .. } => {}
+            ColumnMap { .. } | Snapshot { .. } => {}
         }
         at
     }

@@ -78,7 +78,10 @@ pub use position_glitches::{
 };
 pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
-pub use table::{Column, ColumnData, FlightTable, IN_MEMORY, Missing};
+pub use table::{
+    Column, ColumnData, ColumnSnapshot, ColumnSnapshotData, FlightTable, IN_MEMORY, Missing,
+    TableSnapshot,
+};
 pub use validate::{
     EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MAX_TIME_S, MEDIAN_SAMPLES,
     MIN_READING_NT, MIN_TIME_STEP_FRACTION, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind,

@@ -19,8 +19,11 @@ use crate::derive::DerivedColumn;
 use crate::error::{IoError, Result};
 use crate::values::Values;
 
+mod snapshot;
+pub use snapshot::{ColumnSnapshot, ColumnSnapshotData, TableSnapshot};
+
 /// Why samples of a numeric column are missing (`NaN`), counted per reason.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct Missing {
     /// Empty (or whitespace-only) cells.
     pub blank: usize,
