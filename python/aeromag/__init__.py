@@ -339,6 +339,8 @@ def level(
     ridge_lambda: Optional[float] = None,
     reference: Union[None, str, Sequence[str]] = None,
     ties: Optional[Sequence[str]] = None,
+    xy: Optional[Tuple[str, str]] = None,
+    utm_zone: Optional[str] = None,
     progress: Any = None,
 ) -> Levelled:
     """Level a survey at its line/tie-line crossovers (``aeromag level``).
@@ -351,7 +353,12 @@ def level(
     column whose derivative is the ``k·d|B0|/dt`` regressor, ``tie_only``
     classic tie-line levelling, ``drift`` a linear drift per line,
     ``reference`` channels removed first (default none), ``ties`` the tie
-    line labels when neither ``line_type`` nor ``L``/``T`` labels say.
+    line labels when neither ``line_type`` nor ``L``/``T`` labels say,
+    ``xy`` the columns ``(easting, northing)`` of positions already
+    projected (m; default ``lat``/``lon``, or in a flight without them the
+    first of ``x``/``y``, ``easting``/``northing``, ``utm_x``/``utm_y``,
+    ``utm_easting``/``utm_northing``, any case), UTM coordinates of the zone
+    ``utm_zone`` (``"37N"``), which they need.
 
     Returns a :class:`Levelled`: ``levelled`` (nT), ``flags``, ``k_s``
     (k, σ in s), ``rms_nt``, ``line_levels``, ``crossovers()`` (the
@@ -371,6 +378,8 @@ def level(
         ridge_lambda=ridge_lambda,
         reference=reference,
         ties=_labels(ties),
+        xy=xy,
+        utm_zone=utm_zone,
         progress=progress_callback(progress),
     )
 
@@ -387,6 +396,7 @@ def grid_flight(
     extent: Optional[Tuple[float, float, float, float]] = None,
     max_sweeps: int = 500,
     convergence: Optional[float] = None,
+    xy: Optional[Tuple[str, str]] = None,
     progress: Any = None,
 ) -> Grid:
     """Grid a column of a survey (``aeromag grid``).
@@ -401,7 +411,11 @@ def grid_flight(
     ``(xmin, xmax, ymin, ymax)`` in m with ``cell``. ``max_sweeps`` (1 to
     100000) and ``convergence`` (the largest change of a sweep, default
     10⁻⁴ × the data's RMS about their plane) are minimum curvature's limits,
-    GMT ``surface``'s ``-N`` and ``-C``.
+    GMT ``surface``'s ``-N`` and ``-C``. ``xy`` = ``(easting, northing)``
+    names columns of positions already projected (m), gridded as they are
+    (found in a flight without lat/lon: ``x``/``y``, ``easting``/``northing``,
+    ``utm_x``/``utm_y``, any case); ``utm_zone`` is then their zone, the
+    grid's CRS, without which the grid has none (warning ``[no-crs]``).
 
     Returns a :class:`Grid`: ``values`` (ny × nx, row 0 south, NaN blank),
     ``x``, ``y`` (m), ``epsg``, ``info`` (line spacing, blanking,
@@ -422,6 +436,7 @@ def grid_flight(
         extent=extent,
         max_sweeps=max_sweeps,
         convergence=convergence,
+        xy=xy,
         progress=progress_callback(progress),
     )
 
@@ -443,13 +458,15 @@ def microlevel(
     lever_arm: Optional[Tuple[float, float, float]] = None,
     max_sweeps: int = 500,
     convergence: Optional[float] = None,
+    xy: Optional[Tuple[str, str]] = None,
     progress: Any = None,
 ) -> Microlevelled:
     """Micro-level a levelled survey (``aeromag microlevel``, Minty 1991).
 
     ``cutoff`` (at least 2) is the high-pass's cut-off wavelength in line
     spacings; ``tension``, ``max_sweeps`` and ``convergence`` are those of
-    the working grid's minimum curvature, as in :func:`grid_flight`.
+    the working grid's minimum curvature, as in :func:`grid_flight`, and so
+    are ``utm_zone`` and ``xy``.
 
     Returns a :class:`Microlevelled`: ``values``, ``correction`` (nT per
     row), ``correction_nt`` (RMS, largest), ``gridding`` (the working
@@ -470,6 +487,7 @@ def microlevel(
         lever_arm=lever_arm,
         max_sweeps=max_sweeps,
         convergence=convergence,
+        xy=xy,
         progress=progress_callback(progress),
     )
 

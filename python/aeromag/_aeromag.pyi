@@ -311,6 +311,8 @@ def level(
     ridge_lambda: Optional[float] = None,
     reference: Union[None, str, Sequence[str]] = None,
     ties: Optional[Sequence[str]] = None,
+    xy: Optional[Tuple[str, str]] = None,
+    utm_zone: Optional[str] = None,
     progress: _Progress = None,
 ) -> Levelled: ...
 @final
@@ -377,6 +379,7 @@ def grid_flight(
     extent: Optional[Tuple[float, float, float, float]] = None,
     max_sweeps: int = 500,
     convergence: Optional[float] = None,
+    xy: Optional[Tuple[str, str]] = None,
     progress: _Progress = None,
 ) -> Grid: ...
 def read_grid(path: Union[str, "os.PathLike[str]"]) -> Grid: ...
@@ -401,6 +404,7 @@ def microlevel(
     lever_arm: Optional[Tuple[float, float, float]] = None,
     max_sweeps: int = 500,
     convergence: Optional[float] = None,
+    xy: Optional[Tuple[str, str]] = None,
     progress: _Progress = None,
 ) -> Microlevelled: ...
 def score(

@@ -34,7 +34,8 @@ pub fn reference_channels(
 /// (the keywords are `aeromag level`'s flags, `--lambda` → `ridge_lambda`).
 #[pyfunction]
 #[pyo3(signature = (flight, value=None, lever_arm=None, rate_of=None, tie_only=false, drift=false,
-    no_altitude_term=false, no_robust=false, ridge_lambda=None, reference=None, ties=None, progress=None))]
+    no_altitude_term=false, no_robust=false, ridge_lambda=None, reference=None, ties=None, xy=None,
+    utm_zone=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn level(
     py: Python<'_>,
@@ -49,6 +50,8 @@ pub fn level(
     ridge_lambda: Option<f64>,
     reference: Option<Bound<'_, PyAny>>,
     ties: Option<Vec<String>>,
+    xy: Option<(String, String)>,
+    utm_zone: Option<&str>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyLevelled> {
     let fit = LevelFitChoices {
@@ -62,6 +65,8 @@ pub fn level(
         value,
         rate_of,
         lever_arm_m: lever_arm,
+        projected: crate::map::projected(xy),
+        zone: crate::map::zone(utm_zone)?,
         reference: reference_channels(reference.as_ref(), ReferenceChannels::None)?,
         fit: fit.config(),
         ties: ties.unwrap_or_default(),

@@ -12,14 +12,19 @@ use aeromag::grid::projection::{Crs, UtmZone};
 use aeromag::grid::{Grid, GridGeometry};
 use aeromag::map::gridding::GridMethod;
 use aeromag::map::{
-    GridOptions, MicrolevelOptions, Microlevelled, grid_flight as lib_grid,
+    GridOptions, MicrolevelOptions, Microlevelled, ProjectedColumns, grid_flight as lib_grid,
     microlevel as lib_microlevel,
 };
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
+/// The columns `xy = (easting, northing)` of projected positions.
+pub(crate) fn projected(xy: Option<(String, String)>) -> Option<ProjectedColumns> {
+    xy.map(|(e, n)| ProjectedColumns::new(e, n))
+}
+
+pub(crate) fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
     utm_zone.map(|z| UtmZone::parse(z).py_err()).transpose()
 }
 
@@ -190,8 +195,8 @@ impl PyGrid {
 /// Grid a column of a survey (the keywords are `aeromag grid`'s flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, tension=0.25, method="min-curvature", blanking=None,
-    utm_zone=None, lever_arm=None, extent=None, max_sweeps=None, convergence=None, progress=None),
-    text_signature = "(flight, column=None, cell=None, tension=0.25, method='min-curvature', blanking=None, utm_zone=None, lever_arm=None, extent=None, max_sweeps=500, convergence=None, progress=None)")]
+    utm_zone=None, lever_arm=None, extent=None, max_sweeps=None, convergence=None, xy=None, progress=None),
+    text_signature = "(flight, column=None, cell=None, tension=0.25, method='min-curvature', blanking=None, utm_zone=None, lever_arm=None, extent=None, max_sweeps=500, convergence=None, xy=None, progress=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn grid_flight(
     py: Python<'_>,
@@ -206,6 +211,7 @@ pub fn grid_flight(
     extent: Option<[f64; 4]>,
     max_sweeps: Option<Bound<'_, PyAny>>,
     convergence: Option<f64>,
+    xy: Option<(String, String)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyGrid> {
     let method = match method {
@@ -227,6 +233,7 @@ pub fn grid_flight(
         cell_m: cell,
         blanking_m: blanking,
         zone: zone(utm_zone)?,
+        projected: projected(xy),
         lever_arm_m: lever_arm,
         geometry,
         method,
@@ -450,8 +457,8 @@ impl PyMicrolevelled {
 /// flags).
 #[pyfunction]
 #[pyo3(signature = (flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0,
-    tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=None, convergence=None, progress=None),
-    text_signature = "(flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0, tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=500, convergence=None, progress=None)")]
+    tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=None, convergence=None, xy=None, progress=None),
+    text_signature = "(flight, column=None, cell=None, cutoff=4.0, along_line=None, cosine_power=2.0, tension=0.25, utm_zone=None, lever_arm=None, max_sweeps=500, convergence=None, xy=None, progress=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn microlevel(
     py: Python<'_>,
@@ -466,12 +473,14 @@ pub fn microlevel(
     lever_arm: Option<[f64; 3]>,
     max_sweeps: Option<Bound<'_, PyAny>>,
     convergence: Option<f64>,
+    xy: Option<(String, String)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<PyMicrolevelled> {
     let opts = MicrolevelOptions {
         column,
         cell_m: cell,
         zone: zone(utm_zone)?,
+        projected: projected(xy),
         lever_arm_m: lever_arm,
         cutoff_line_spacings: cutoff,
         along_line_m: along_line,

@@ -97,3 +97,25 @@ def test_microlevel_gridding_limits_and_cutoff(survey_csv):
         aeromag.microlevel(survey, column="true_anomaly", cutoff=1.0)
     with pytest.raises(aeromag.BadInputError, match="max sweeps = 0"):
         aeromag.microlevel(survey, column="true_anomaly", max_sweeps=0)
+
+
+def test_projected_positions(survey_csv):
+    """A flight with eastings and northings (X, Y) instead of lat/lon grids
+    in their plane (no CRS without their zone), named or found; levelling
+    them needs their UTM zone."""
+    survey = aeromag.read_flight(survey_csv)
+    d = {c: np.asarray(survey[c]) for c in survey.columns if c not in ("lat", "lon")}
+    lat, lon = np.radians(np.asarray(survey["lat"])), np.radians(np.asarray(survey["lon"]))
+    x = 6371000.0 * np.cos(lat.mean()) * (lon - lon.mean())
+    y = 6371000.0 * (lat - lat.mean())
+    found = aeromag.grid_flight(aeromag.Flight.from_dict({**d, "X": x, "Y": y}),
+                                column="true_anomaly", cell=100.0)
+    named = aeromag.grid_flight(aeromag.Flight.from_dict({**d, "E": x, "N": y}),
+                                column="true_anomaly", cell=100.0, xy=("E", "N"))
+    assert found.epsg is None and named.epsg is None
+    assert np.isfinite(found.values).sum() > found.values.size / 2
+    np.testing.assert_array_equal(found.values, named.values)
+    np.testing.assert_array_equal(found.x, named.x)
+    assert found.x[0] < 0 < found.x[-1]
+    with pytest.raises(aeromag.BadInputError, match="utm-zone"):
+        aeromag.level(aeromag.Flight.from_dict({**d, "X": x, "Y": y}))
