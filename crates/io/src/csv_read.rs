@@ -267,6 +267,7 @@ struct CsvSource {
     budget: Arc<AtomicU64>,
     rec: csv::ByteRecord,
     file: String,
+    path: std::path::PathBuf,
     delimiter: u8,
     header_line: u64,
     /// Line on which the previous record ended (0 before the first).
@@ -337,6 +338,7 @@ impl CsvSource {
             budget,
             rec: csv::ByteRecord::new(),
             file,
+            path: path.to_path_buf(),
             delimiter,
             header_line: 0,
             last_line_end: at.line - 1,
@@ -403,11 +405,52 @@ impl CsvSource {
             if record_bytes as u64 > MAX_LINE_BYTES {
                 return Err(line_too_long(&self.file, self.line));
             }
+            if at_end && self.quote_left_open()? {
+                // The file's last line end is inside the record's field,
+                // not the record's own.
+                let ends = self.rec.as_slice().iter().filter(|&&b| b == b'\n').count();
+                let line = (last_line + 1).saturating_sub(ends as u64).max(1);
+                return Err(IoError::UnclosedQuote {
+                    file: self.file.clone(),
+                    line,
+                });
+            }
             if self.rec.len() == 1 && self.rec[0].trim_ascii().is_empty() {
                 continue;
             }
             return Ok(true);
         }
+    }
+
+    /// Whether the last record, which reached the end of the file, is a
+    /// quote left open (csv-core reads one to the end of the file without an
+    /// error): in a file ending with a line end, that line end is then in
+    /// the record's last field (a record's own line end never is), and no
+    /// closing quote comes before it (`"\n`, as a quoted field closed on
+    /// the last line has it). Not told in a file without a last line end.
+    fn quote_left_open(&self) -> Result<bool> {
+        use std::io::{Read, Seek, SeekFrom};
+        if !(self.ends_with_newline && self.rec.as_slice().ends_with(b"\n")) {
+            return Ok(false);
+        }
+        let mut tail = [0u8; 3];
+        let n = self.file_size.min(3) as usize;
+        let read = |tail: &mut [u8]| -> std::io::Result<()> {
+            let mut f = File::open(&self.path)?;
+            f.seek(SeekFrom::Start(self.file_size - n as u64))?;
+            f.read_exact(tail)
+        };
+        read(&mut tail[3 - n..]).map_err(|source| IoError::Read {
+            file: self.file.clone(),
+            line: self.last_line_end,
+            source,
+        })?;
+        let body = match tail {
+            [_, b'\r', b'\n'] => &tail[..1],
+            [_, _, b'\n'] => &tail[..2],
+            _ => &tail[..],
+        };
+        Ok(body.last() != Some(&b'"'))
     }
 
     /// Where the next record starts (after the last one read).

@@ -104,6 +104,17 @@ pub enum IoError {
         /// The header's line.
         line: u64,
     },
+    /// A quote opened in a field is not closed before the end of the file:
+    /// every line after it was read as that field's text.
+    #[error(
+        "'{file}' line {line}: a quote (\") opened in this row is not closed before the end of the file, so every line after it was read as one field; close it or remove it"
+    )]
+    UnclosedQuote {
+        /// File as given.
+        file: String,
+        /// The row's first line.
+        line: u64,
+    },
     /// A column name appears twice in the header.
     #[error(
         "'{file}' line {line}: column name '{column}' appears twice in the header (columns {first} and {second}, counted from 1)"
@@ -414,6 +425,7 @@ impl IoError {
             Read { file, line, .. }
             | Binary { file, line, .. }
             | CrLineEnds { file, line }
+            | UnclosedQuote { file, line }
             | WrongDelimiter { file, line, .. }
             | TooLarge { file, line, .. }
             | XyzHeader { file, line, .. } => {

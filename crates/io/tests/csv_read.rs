@@ -602,3 +602,38 @@ fn a_damaged_h5_is_an_hdf5_error_naming_the_file() {
     assert!(matches!(e, IoError::Hdf5 { .. }), "{e:?}");
     assert_mentions(&e.to_string(), &["flight.h5"]);
 }
+
+/// A quote left open runs to the end of the file (csv-core reads every
+/// line after it as one field): an error naming the row's first line and
+/// the quote (it was "2 fields, but the header has 3 columns" on the line
+/// before the row's). A quoted field closed on the last line, with a line
+/// end in it or not, reads.
+#[test]
+fn a_quote_left_open_is_named_at_its_row() {
+    let d = tempfile::tempdir().unwrap();
+    let read = |text: &str| {
+        let p = d.path().join("q.csv");
+        std::fs::write(&p, text).unwrap();
+        aeromag_io::read_table(&p, &ReadOptions::default())
+    };
+    for text in [
+        "time,mag,note\n0,1,a\n0.1,2,b\n0.2,\"3,c\n0.3,4,d\n",
+        "time,mag,note\r\n0,1,a\r\n0.1,2,b\r\n0.2,\"3,c\r\n0.3,4,d\r\n",
+        "time,mag,note\n0,1,a\n0.1,2,b\n0.2,3,\"c\n",
+    ] {
+        let e = read(text).unwrap_err();
+        assert!(
+            matches!(e, IoError::UnclosedQuote { line: 4, .. }) && e.is_bad_input(),
+            "{text:?}: {e:?}"
+        );
+        assert!(e.to_string().contains("line 4: a quote"), "{e}");
+    }
+    for text in [
+        "time,mag,note\n0,1,a\n0.1,2,\"b\nc\"\n",
+        "time,mag,note\n0,1,a\n0.1,2,\"b\n\"\n",
+        "time,mag,note\n0,1,a\n0.1,\"2\",\"b\nc\"\n",
+    ] {
+        let t = read(text).unwrap();
+        assert_eq!(t.n_rows(), 2, "{text:?}");
+    }
+}
