@@ -298,6 +298,14 @@ impl MinCurvature {
             .sum::<f64>()
             / means.blocks.len() as f64)
             .sqrt();
+        // Residuals at the values' rounding are none: data on a plane gave a
+        // limit of 10⁻¹⁶ nT that no sweep reached ("NOT converged").
+        let scale = means.blocks.iter().fold(0.0f64, |m, b| m.max(b.z.abs()));
+        let rms = if rms <= PLANE_ROUNDING * scale {
+            0.0
+        } else {
+            rms
+        };
         let limit = self.convergence.unwrap_or(1e-4 * rms);
         let mut report = MinCurvatureReport {
             levels: Vec::new(),
@@ -354,6 +362,12 @@ impl MinCurvature {
         Ok((values, report))
     }
 }
+
+/// The RMS of the block means about their plane, relative to their
+/// largest magnitude, below which they are taken as the plane itself (the
+/// grid is the plane; no sweep): a few hundred times the rounding of one
+/// value (2.2·10⁻¹⁶), as the plane's fit and the block means round.
+const PLANE_ROUNDING: f64 = 1e-13;
 
 /// The least-squares plane `z = a + b (u − ū) + c (v − v̄)` of the block
 /// means (node units).
@@ -1063,6 +1077,38 @@ mod tests {
                 assert!((v[g.index(i, j)] - f(g.x(i), g.y(j))).abs() < 1e-9);
             }
         }
+    }
+
+    /// Points off the nodes on a plane far from zero (a field of 50 000
+    /// nT): the block means' residuals are the rounding's, the grid is the
+    /// plane, converged without a sweep (it ran 580 sweeps to a limit of
+    /// 10⁻¹⁶ nT and said "NOT converged"); a residual of 10⁻⁶ nT is solved.
+    #[test]
+    fn points_on_a_plane_far_from_zero_give_the_plane_converged() {
+        let g = GridGeometry::covering(0.0, 2000.0, 0.0, 1500.0, 50.0).unwrap();
+        let f = |x: f64, y: f64| 50_000.0 + 0.01 * x - 0.02 * y;
+        let (x, y, _) = lines(&g, 8, f);
+        let (x, y): (Vec<f64>, Vec<f64>) =
+            x.iter().zip(&y).map(|(x, y)| (x + 7.3, y + 3.1)).unzip();
+        let z: Vec<f64> = x.iter().zip(&y).map(|(&x, &y)| f(x, y)).collect();
+        let (v, rep) = MinCurvature::default()
+            .grid(Points::new(&x, &y, &z).unwrap(), g)
+            .unwrap();
+        assert!(rep.converged && rep.levels.is_empty(), "{rep:?}");
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                assert!((v[g.index(i, j)] - f(g.x(i), g.y(j))).abs() < 1e-8);
+            }
+        }
+        let bumped: Vec<f64> = z
+            .iter()
+            .enumerate()
+            .map(|(k, z)| z + if k % 97 == 0 { 1e-6 } else { 0.0 })
+            .collect();
+        let (_, rep) = MinCurvature::default()
+            .grid(Points::new(&x, &y, &bumped).unwrap(), g)
+            .unwrap();
+        assert!(!rep.levels.is_empty(), "{rep:?}");
     }
 
     #[test]
