@@ -344,9 +344,7 @@ pub fn locate_em(
         let path: PathBuf = calibration
             .extract()
             .map_err(|_| bad_argument("calibration must be an EmCalibration or a file path"))?;
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| aeromag::Error::read(&path, e))
-            .py_err()?;
+        let text = aeromag::model_file::read_text_file(&path).py_err()?;
         CalibrationFile::from_json(&text)
             .map_err(|e| aeromag::Error::bad_file(path.display().to_string(), e.to_string()))
             .py_err()?
@@ -376,7 +374,7 @@ pub fn simulate_em<'py>(
         .unwrap_or(aeromag::em::DEFAULT_KNOWN);
     let text = config
         .as_deref()
-        .map(|p| std::fs::read_to_string(p).map_err(|e| aeromag::Error::read(p, e)))
+        .map(aeromag::model_file::read_text_file)
         .transpose()
         .py_err()?;
     let origin = config

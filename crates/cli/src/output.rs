@@ -92,7 +92,7 @@ pub fn simulate_em(
         return Ok(());
     }
     let text = config
-        .map(|p| std::fs::read_to_string(p).map_err(|e| aeromag::Error::read(p, e)))
+        .map(aeromag::model_file::read_text_file)
         .transpose()?;
     let file = config.map_or_else(|| "defaults".to_string(), |p| p.display().to_string());
     let mut cfg = aeromag::em::parse_config(text.as_deref(), &file)?;

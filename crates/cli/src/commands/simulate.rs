@@ -80,10 +80,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     let text = match &a.config {
-        Some(p) => Some(
-            std::fs::read_to_string(p)
-                .map_err(|e| bad_input!("cannot read scenario file '{}': {e}", p.display()))?,
-        ),
+        Some(p) => Some(aeromag::model_file::read_text_file(p)?),
         None => None,
     };
     let out = a
