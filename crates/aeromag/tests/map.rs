@@ -433,6 +433,19 @@ fn projected_positions_grid_as_latitude_and_longitude() {
     };
     assert!(unchecked(&on_xy) && !unchecked(&on_lat_lon));
 
+    // The grid's unit is the column's: nT, m for the altitude.
+    assert_eq!(plain.grid.unit, "nT");
+    let alt = grid_flight(
+        &xy,
+        &GridOptions {
+            column: Some("alt".into()),
+            ..opts.clone()
+        },
+        &mut Silent,
+    )
+    .unwrap();
+    assert_eq!(alt.grid.unit, "m");
+
     let e = grid_flight(
         &xy,
         &GridOptions {

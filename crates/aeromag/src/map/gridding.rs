@@ -375,7 +375,13 @@ pub(crate) fn grid_flight_finest(
         values: grid_values,
         crs: survey.zone.map(Crs::Utm),
         name: column.clone(),
-        unit: "nT".into(),
+        // A magnetic column's unit is nT, and so is an unknown one's (a
+        // field, `true_anomaly`); a known field's is its own (`alt`: m; it
+        // was nT for any column).
+        unit: match magnetic {
+            true => "nT".into(),
+            false => aeromag_io::known_field(&column).map_or("nT".into(), |f| f.unit.into()),
+        },
     };
     Ok(SurveyGrid {
         grid,
