@@ -652,6 +652,18 @@ fn files_are_written_and_documented() {
         let text = default_config_toml(kind).unwrap();
         assert!(text.starts_with("# aeromag-sim scenario"));
         let _: toml::Table = toml::from_str(&text).unwrap();
+        // The fixed-wing files show the installation key the default
+        // leaves out, just before `seed`.
+        let fixed_wing = !matches!(kind, ScenarioKind::Helicopter | ScenarioKind::Pod);
+        assert_eq!(
+            text.contains("\n# installation = \"stinger\" (the default"),
+            fixed_wing,
+            "{kind:?}"
+        );
+        if fixed_wing {
+            let i = text.find("# installation").unwrap();
+            assert!(text[i..].lines().nth(2).unwrap().starts_with("seed = "));
+        }
     }
     assert_eq!(
         "calibration-truncated".parse::<ScenarioKind>().unwrap(),

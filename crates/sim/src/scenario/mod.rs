@@ -195,10 +195,26 @@ pub fn simulate(
 pub fn default_config_toml(kind: ScenarioKind) -> Result<String> {
     match kind {
         ScenarioKind::Calibration | ScenarioKind::CalibrationTruncated => {
-            calibration_defaults(kind == ScenarioKind::CalibrationTruncated).to_toml(kind)
+            calibration_defaults(kind == ScenarioKind::CalibrationTruncated)
+                .to_toml(kind)
+                .map(with_installation_choice)
         }
-        ScenarioKind::Survey => survey_defaults().to_toml(kind),
+        ScenarioKind::Survey => survey_defaults()
+            .to_toml(kind)
+            .map(with_installation_choice),
         ScenarioKind::Helicopter => helicopter::helicopter_defaults().to_toml(),
         ScenarioKind::Pod => pod::PodConfig::default().to_toml(),
+    }
+}
+
+/// A fixed-wing default scenario file with the installation key, which the
+/// default (`stinger`) leaves out of the file, shown as a comment before
+/// `seed`: the one key a user could not see to change.
+fn with_installation_choice(text: String) -> String {
+    const CHOICE: &str = "# installation = \"stinger\" (the default: the stinger pair mag, flux_x/y/z) or \"sgl\"\n\
+                          # (an SGL-like installation: mag_1_uc … mag_5_uc, flux_a … flux_d and 14 current loops)\n";
+    match text.find("\nseed = ") {
+        Some(k) => format!("{}{CHOICE}{}", &text[..=k], &text[k + 1..]),
+        None => text,
     }
 }
