@@ -2,11 +2,14 @@
 //! by line levels, and `k` of the `k·d|B0|/dt` term recovered with the base
 //! station removed.
 
+mod common;
+
 use aeromag::FlightTable;
 use aeromag::compensation::levelling::LevellingConfig;
 use aeromag::level::{LevelOptions, Levelled, level};
 use aeromag::prelude::*;
 use aeromag::simulate::{ScenarioKind, simulate_flight};
+use common::with_projected_positions;
 
 const LEVER_ARM_M: [f64; 3] = [-9.5, 0.0, -0.6];
 
@@ -451,18 +454,7 @@ fn projected_positions_level_as_latitude_and_longitude_given_their_zone() {
         survey.require("lon").unwrap(),
     );
     let (x, y) = Utm::new(zone).forward_all(lat, lon).unwrap();
-    let with_xy = |x: &[f64], y: &[f64]| {
-        let mut t = FlightTable::new();
-        for name in survey.table().column_names() {
-            if !["lat", "lon"].contains(&name) {
-                let v = survey.table().column(name).unwrap().to_vec();
-                t.add_column(name, v).unwrap();
-            }
-        }
-        t.add_column("X", x.to_vec()).unwrap();
-        t.add_column("Y", y.to_vec()).unwrap();
-        aeromag::flight::Flight::from_table(t).unwrap()
-    };
+    let with_xy = |x: &[f64], y: &[f64]| with_projected_positions(&survey, x, y);
     let xy = with_xy(&x, &y);
     let geodetic = level(&survey, &LevelOptions::default(), &mut Silent).unwrap();
     let opts = LevelOptions {

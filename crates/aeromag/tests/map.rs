@@ -1,11 +1,14 @@
 //! From lines to the map on simulated surveys: gridding honours the line
 //! data, micro-levelling removes line-to-line corrugation.
 
+mod common;
+
 use aeromag::Silent;
 use aeromag::flight::Flight;
 use aeromag::map::gridding::GridMethod;
 use aeromag::map::{GridOptions, MicrolevelOptions, grid_flight, microlevel};
 use aeromag::simulate::{ScenarioKind, simulate_flight};
+use common::with_projected_positions;
 
 fn survey(pattern: &str, seed: u64) -> Flight {
     simulate_flight(ScenarioKind::Survey, Some(pattern), Some(seed)).unwrap()
@@ -285,21 +288,6 @@ fn a_cell_far_finer_than_the_lines_is_warned_of() {
     );
 }
 
-/// `flight` with its latitude and longitude replaced by the columns `X`
-/// and `Y` of `x` and `y` (a Geosoft XYZ export's projected positions).
-fn projected(flight: &Flight, x: &[f64], y: &[f64]) -> Flight {
-    let mut table = aeromag::io::FlightTable::new();
-    for name in flight.table().column_names() {
-        if !["lat", "lon"].contains(&name) {
-            let v = flight.table().column(name).unwrap().to_vec();
-            table.add_column(name, v).unwrap();
-        }
-    }
-    table.add_column("X", x.to_vec()).unwrap();
-    table.add_column("Y", y.to_vec()).unwrap();
-    Flight::from_table(table).unwrap()
-}
-
 /// A survey whose positions are already projected (`X`, `Y`, no lat/lon)
 /// grids as its latitude and longitude do: with their zone given, the
 /// same grid to the bit and the same coordinate system; without, the same
@@ -318,7 +306,7 @@ fn projected_positions_grid_as_latitude_and_longitude() {
     };
     let geodetic = grid_flight(&flight, &opts, &mut Silent).unwrap();
     let zone = geodetic.survey.zone.unwrap();
-    let xy = projected(&flight, &geodetic.survey.x, &geodetic.survey.y);
+    let xy = with_projected_positions(&flight, &geodetic.survey.x, &geodetic.survey.y);
     let bits = |g: &aeromag::map::SurveyGrid| -> Vec<u64> {
         g.grid.values.iter().map(|v| v.to_bits()).collect()
     };
@@ -375,7 +363,12 @@ fn projected_positions_grid_as_latitude_and_longitude() {
         + 200;
     let (mut x, mut y) = (geodetic.survey.x.clone(), geodetic.survey.y.clone());
     (x[row], y[row]) = (0.0, 0.0);
-    let g = grid_flight(&projected(&flight, &x, &y), &opts, &mut Silent).unwrap();
+    let g = grid_flight(
+        &with_projected_positions(&flight, &x, &y),
+        &opts,
+        &mut Silent,
+    )
+    .unwrap();
     assert_eq!(g.survey.off_track, [row]);
     assert_eq!(g.grid.geometry, geodetic.grid.geometry);
     let glitch = said(&g, "[position-glitch]");
@@ -390,7 +383,7 @@ fn projected_positions_grid_as_latitude_and_longitude() {
     let lon = flight.require("lon").unwrap();
     let south: Vec<f64> = geodetic.survey.y.iter().map(|y| -y).collect();
     let e = grid_flight(
-        &projected(&flight, &geodetic.survey.x, &south),
+        &with_projected_positions(&flight, &geodetic.survey.x, &south),
         &GridOptions {
             zone: Some(zone),
             ..opts.clone()
@@ -405,7 +398,7 @@ fn projected_positions_grid_as_latitude_and_longitude() {
         "{message}"
     );
     let e = grid_flight(
-        &projected(&flight, lon, &geodetic.survey.y),
+        &with_projected_positions(&flight, lon, &geodetic.survey.y),
         &GridOptions {
             zone: Some(zone),
             ..opts.clone()
