@@ -118,14 +118,7 @@ impl ProjectedColumns {
     /// [`ProjectedSurvey::of_columns`] checks them, rows off the track
     /// aside); missing where either is.
     pub fn geodetic(&self, flight: &Flight, zone: UtmZone) -> Result<(Vec<f64>, Vec<f64>)> {
-        let (x, y) = (
-            flight.require(&self.easting)?,
-            flight.require(&self.northing)?,
-        );
-        let off_track = flight.column("time").map_or_else(Vec::new, |t| {
-            aeromag_io::projected_position_glitches(t, x, y)
-        });
-        self.check_in(flight, [x, y], zone, &off_track)?;
+        let ([x, y], _) = self.read(flight, Some(zone))?;
         let utm = Utm::new(zone);
         Ok(x.iter()
             .zip(y)
@@ -134,6 +127,27 @@ impl ProjectedColumns {
                 false => (f64::NAN, f64::NAN),
             })
             .unzip())
+    }
+
+    /// The two columns of `flight` and its rows off the track
+    /// ([`aeromag_io::projected_position_glitches`]; none without `time`),
+    /// checked against `zone` when given ([`Self::check_in`]).
+    fn read<'f>(
+        &self,
+        flight: &'f Flight,
+        zone: Option<UtmZone>,
+    ) -> Result<([&'f [f64]; 2], Vec<usize>)> {
+        let (x, y) = (
+            flight.require(&self.easting)?,
+            flight.require(&self.northing)?,
+        );
+        let off_track = flight.column("time").map_or_else(Vec::new, |t| {
+            aeromag_io::projected_position_glitches(t, x, y)
+        });
+        if let Some(z) = zone {
+            self.check_in(flight, [x, y], z, &off_track)?;
+        }
+        Ok(([x, y], off_track))
     }
 
     /// Bad input naming the first row, not among `off_track` (ascending),
@@ -284,8 +298,8 @@ impl ProjectedSurvey {
     /// `flight`'s positions as they are in the columns `columns` (easting
     /// and northing, m), in the UTM zone `zone` when given (checked: the
     /// eastings within 100–900 km, where a zone's are, and the northings
-    /// within 0–10 000 km), in a coordinate system not given otherwise; and its
-    /// lines' geometry. Missing values are missing positions; rows off
+    /// within 0–10 000 km), in a coordinate system not given otherwise;
+    /// and its lines' geometry. Missing values are missing positions; rows off
     /// the track are found as for latitude and longitude
     /// ([`aeromag_io::projected_position_glitches`]).
     pub fn of_columns(
@@ -294,14 +308,7 @@ impl ProjectedSurvey {
         zone: Option<UtmZone>,
     ) -> Result<Self> {
         let names = [columns.easting.as_str(), columns.northing.as_str()];
-        let [x, y] = names.map(|c| flight.require(c));
-        let (x, y) = (x?, y?);
-        let off_track = flight.column("time").map_or_else(Vec::new, |t| {
-            aeromag_io::projected_position_glitches(t, x, y)
-        });
-        if let Some(z) = zone {
-            columns.check_in(flight, [x, y], z, &off_track)?;
-        }
+        let ([x, y], off_track) = columns.read(flight, zone)?;
         let (mut x, mut y) = (x.to_vec(), y.to_vec());
         for &k in &off_track {
             x[k] = f64::NAN;
