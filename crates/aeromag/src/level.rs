@@ -274,16 +274,16 @@ pub fn level(
         )));
     }
     notes.stage("levelling");
-    let positions = opts
-        .lever_arm_m
-        .map(|arm| sensor_track(flight, arm))
-        .transpose()?;
     let projected = crate::map::ProjectedColumns::chosen(
         flight,
         opts.projected.as_ref(),
         opts.lever_arm_m.is_some(),
         &mut notes,
     )?;
+    let positions = opts
+        .lever_arm_m
+        .map(|arm| sensor_track(flight, arm))
+        .transpose()?;
     let from_projected = match &projected {
         Some(c) => {
             let zone = opts.zone.ok_or_else(|| {

@@ -487,6 +487,17 @@ fn projected_positions_level_as_latitude_and_longitude_given_their_zone() {
         e.is_bad_input() && e.to_string().contains("--utm-zone"),
         "{e}"
     );
+    // A lever arm is refused with projected positions (it said that the
+    // file had no `lat`).
+    let arm = LevelOptions {
+        lever_arm_m: Some(LEVER_ARM_M),
+        ..opts.clone()
+    };
+    let e = level(&xy, &arm, &mut Silent).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("lever arm"),
+        "{e}"
+    );
 
     // A dropout at 0, 0 (no UTM easting, but off the track) is left out
     // with the warning naming its X and Y; eastings in kilometres are no
