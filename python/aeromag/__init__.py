@@ -357,7 +357,7 @@ def level(
     ``xy`` the columns ``(easting, northing)`` of positions already
     projected (m; default ``lat``/``lon``, or in a flight without them the
     first of ``x``/``y``, ``easting``/``northing``, ``utm_x``/``utm_y``,
-    ``utm_easting``/``utm_northing``, any case), UTM coordinates of the zone
+    ``utm-x``/``utm-y``, ``utm_easting``/``utm_northing``, any case), UTM coordinates of the zone
     ``utm_zone`` (``"37N"``), which they need.
 
     Returns a :class:`Levelled`: ``levelled`` (nT), ``flags``, ``k_s``
@@ -414,7 +414,7 @@ def grid_flight(
     GMT ``surface``'s ``-N`` and ``-C``. ``xy`` = ``(easting, northing)``
     names columns of positions already projected (m), gridded as they are
     (found in a flight without lat/lon: ``x``/``y``, ``easting``/``northing``,
-    ``utm_x``/``utm_y``, any case); ``utm_zone`` is then their zone, the
+    ``utm_x``/``utm_y``, ``utm-x``/``utm-y``, any case); ``utm_zone`` is then their zone, the
     grid's CRS, without which the grid has none (warning ``[no-crs]``).
 
     Returns a :class:`Grid`: ``values`` (ny × nx, row 0 south, NaN blank),

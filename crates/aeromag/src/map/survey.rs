@@ -64,10 +64,11 @@ pub struct ProjectedColumns {
 
 /// The column pairs [`ProjectedColumns::found_in`] takes, in this order,
 /// in any case.
-pub const PROJECTED_NAMES: [[&str; 2]; 4] = [
+pub const PROJECTED_NAMES: [[&str; 2]; 5] = [
     ["x", "y"],
     ["easting", "northing"],
     ["utm_x", "utm_y"],
+    ["utm-x", "utm-y"],
     ["utm_easting", "utm_northing"],
 ];
 
@@ -505,6 +506,35 @@ pub fn nice_below(v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each pair of [`PROJECTED_NAMES`] is found in any case (SGL's export
+    /// writes `UTM-X`, `UTM-Y`), the first pair first, and none beside
+    /// latitude and longitude; two columns differing only in case (and
+    /// none exactly) are an error naming the flag.
+    #[test]
+    fn projected_columns_are_found_by_name_in_any_case() {
+        let flight = |names: &[&str]| {
+            let mut t = aeromag_io::FlightTable::new();
+            for n in names {
+                t.add_column(n, vec![1.0, 2.0, 3.0]).unwrap();
+            }
+            Flight::from_table(t).unwrap()
+        };
+        for [e, n] in PROJECTED_NAMES {
+            let upper = [e.to_uppercase(), n.to_uppercase()];
+            let f = flight(&["time", &upper[0], &upper[1]]);
+            let found = ProjectedColumns::found_in(&f, "--xy").unwrap();
+            assert_eq!(found, Some(ProjectedColumns::new(&upper[0], &upper[1])));
+        }
+        let f = flight(&["time", "UTM-X", "UTM-Y", "x", "y"]);
+        let found = ProjectedColumns::found_in(&f, "--xy").unwrap().unwrap();
+        assert_eq!(found.easting, "x");
+        let f = flight(&["time", "lat", "lon", "x", "y"]);
+        assert_eq!(ProjectedColumns::found_in(&f, "--xy").unwrap(), None);
+        let f = flight(&["time", "Easting", "EASTING", "northing"]);
+        let e = ProjectedColumns::found_in(&f, "--xy").unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains("--xy"), "{e}");
+    }
 
     #[test]
     fn spacing_and_direction_of_lines_with_ties_and_a_reflight() {

@@ -70,7 +70,7 @@ pub struct Args {
     /// Positions already projected: the columns EASTING,NORTHING (m),
     /// e.g. `X,Y`, in place of lat/lon (default: lat/lon; in a file
     /// without them, the first of x,y, easting,northing, utm_x,utm_y,
-    /// utm_easting,utm_northing, any case). Their UTM zone, when given
+    /// utm-x,utm-y, utm_easting,utm_northing, any case). Their UTM zone, when given
     /// with --utm-zone, is the grid's coordinate system; without it the
     /// grid has none [no-crs].
     #[arg(long, value_name = "EASTING,NORTHING", value_parser = args::projected_columns)]

@@ -44,7 +44,7 @@ pub struct Args {
     /// Positions already projected: the columns EASTING,NORTHING (m),
     /// e.g. `X,Y`, in place of lat/lon (default: lat/lon; in a file
     /// without them, the first of x,y, easting,northing, utm_x,utm_y,
-    /// utm_easting,utm_northing, any case), UTM coordinates of the zone
+    /// utm-x,utm-y, utm_easting,utm_northing, any case), UTM coordinates of the zone
     /// --utm-zone.
     #[arg(long, value_name = "EASTING,NORTHING", value_parser = args::projected_columns)]
     xy: Option<aeromag::map::ProjectedColumns>,
