@@ -274,6 +274,7 @@ pub fn level(
         )));
     }
     notes.stage("levelling");
+    notes.check_cancelled()?;
     let positions = opts
         .lever_arm_m
         .map(|arm| sensor_track(flight, arm))
