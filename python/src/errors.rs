@@ -1,9 +1,11 @@
 //! aeromag errors as Python exceptions (classes in `aeromag/errors.py`):
 //! bad input → `BadInputError` (a `ValueError`) with `file`, `line`, `row`
 //! and `column`; a failed write → `OSError`; anything else (a fit that
-//! failed on valid input) → `AeromagError`.
+//! failed on valid input) → `AeromagError`; a cancelled call →
+//! `KeyboardInterrupt` (the library stops only when asked to, and the
+//! Python layer asks only on Ctrl-C).
 
-use pyo3::exceptions::PyOSError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError};
 use pyo3::prelude::*;
 
 /// The Python exception of a library error.
@@ -23,6 +25,9 @@ fn exception(py: Python<'_>, e: &aeromag::Error) -> PyResult<PyErr> {
         .replace("--time-range: ", "time_range: ");
     if e.is_write_failure() {
         return Ok(PyOSError::new_err(message));
+    }
+    if e.is_cancelled() {
+        return Ok(PyKeyboardInterrupt::new_err(message));
     }
     let errors = py.import("aeromag.errors")?;
     let class = if e.is_bad_input() {

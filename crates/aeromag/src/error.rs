@@ -11,6 +11,9 @@
 //!   result (a singular or diverging fit, a numerical failure), or an output
 //!   could not be written (exit code 1).
 //!
+//! A workflow its observer cancelled ([`crate::Observer::cancelled`])
+//! returns [`Error::Cancelled`], which is neither (not bad input).
+//!
 //! Errors of the sub-crates are kept as they are (with their own
 //! classification) and, where they do not know it, given the file they
 //! concern ([`Error::InFile`]).
@@ -50,7 +53,7 @@ pub enum Error {
     },
     /// Tolles-Lawson fits, levelling, rotor and pod models.
     #[error(transparent)]
-    Compensation(#[from] aeromag_compensation::CompError),
+    Compensation(aeromag_compensation::CompError),
     /// The physical simulator (scenario files, running, writing).
     #[error(transparent)]
     Simulation(Box<aeromag_sim::SimError>),
@@ -62,7 +65,7 @@ pub enum Error {
     Gradiometry(#[from] aeromag_gradiometry::GradiometryError),
     /// Projection, gridding and grid files.
     #[error(transparent)]
-    Grid(#[from] aeromag_grid::GridError),
+    Grid(aeromag_grid::GridError),
     /// Plots and reports.
     #[error(transparent)]
     Report(#[from] aeromag_report::ReportError),
@@ -89,6 +92,11 @@ pub enum Error {
         /// The operating system's reason.
         source: std::io::Error,
     },
+    /// The observer cancelled the workflow ([`crate::Observer::cancelled`]):
+    /// the user asked it to stop (not bad input). A sub-crate's cancelled
+    /// error becomes this one.
+    #[error("cancelled")]
+    Cancelled,
     /// Serialising a result (JSON, TOML) failed: a bug, reported instead of
     /// a panic.
     #[error("cannot serialise {what}: {reason}")]
@@ -151,7 +159,17 @@ impl Error {
             Error::Core(e) => e.is_bad_input(),
             Error::Estimation(e) => e.is_bad_input(),
             Error::Read { .. } => true,
-            Error::Write { .. } | Error::Serialize { .. } => false,
+            Error::Write { .. } | Error::Serialize { .. } | Error::Cancelled => false,
+        }
+    }
+
+    /// Whether the workflow was cancelled ([`Error::Cancelled`], also when
+    /// given a file).
+    pub fn is_cancelled(&self) -> bool {
+        match self {
+            Error::Cancelled => true,
+            Error::InFile { error, .. } => error.is_cancelled(),
+            _ => false,
         }
     }
 
@@ -288,7 +306,9 @@ impl<T, E: Into<Error>> InFile<T> for std::result::Result<T, E> {
     /// printed with the file twice: "f.csv: 'f.csv': …").
     fn in_file(self, file: &str) -> Result<T> {
         self.map_err(|e| match e.into() {
-            e @ (Error::BadInput { file: Some(_), .. } | Error::InFile { .. }) => e,
+            e @ (Error::BadInput { file: Some(_), .. }
+            | Error::InFile { .. }
+            | Error::Cancelled) => e,
             e => Error::InFile {
                 file: file.to_string(),
                 error: Box::new(e),
@@ -300,6 +320,26 @@ impl<T, E: Into<Error>> InFile<T> for std::result::Result<T, E> {
 impl From<aeromag_io::IoError> for Error {
     fn from(e: aeromag_io::IoError) -> Self {
         Error::Io(Box::new(e))
+    }
+}
+
+/// A cancelled fit is [`Error::Cancelled`].
+impl From<aeromag_compensation::CompError> for Error {
+    fn from(e: aeromag_compensation::CompError) -> Self {
+        match e {
+            aeromag_compensation::CompError::Cancelled(_) => Error::Cancelled,
+            e => Error::Compensation(e),
+        }
+    }
+}
+
+/// A cancelled grid is [`Error::Cancelled`].
+impl From<aeromag_grid::GridError> for Error {
+    fn from(e: aeromag_grid::GridError) -> Self {
+        match e {
+            aeromag_grid::GridError::Cancelled(_) => Error::Cancelled,
+            e => Error::Grid(e),
+        }
     }
 }
 
@@ -356,5 +396,22 @@ mod tests {
         assert!(bad.in_file("f.csv").unwrap_err().is_bad_input());
         let w = Error::write("/x", std::io::Error::other("disk full"));
         assert!(!w.is_bad_input());
+    }
+
+    #[test]
+    fn a_cancelled_sub_crate_error_is_cancelled_not_bad_input() {
+        use aeromag_core::cancel::Cancelled;
+        let comp: Error = aeromag_compensation::CompError::from(Cancelled).into();
+        let grid: Error = aeromag_grid::GridError::from(Cancelled).into();
+        for e in [comp, grid] {
+            assert!(matches!(e, Error::Cancelled), "{e:?}");
+            assert!(!e.is_bad_input());
+            assert_eq!(e.to_string(), "cancelled");
+        }
+        let failed: std::result::Result<(), Error> = Err(Error::Cancelled);
+        let e = failed.in_file("f.csv").unwrap_err();
+        assert!(e.is_cancelled() && !e.is_bad_input());
+        assert_eq!(e.to_string(), "cancelled");
+        assert!(!Error::bad_input("no").is_cancelled());
     }
 }

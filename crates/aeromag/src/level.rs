@@ -274,6 +274,7 @@ pub fn level(
         )));
     }
     notes.stage("levelling");
+    notes.check_cancelled()?;
     let projected = crate::map::ProjectedColumns::chosen(
         flight,
         opts.projected.as_ref(),

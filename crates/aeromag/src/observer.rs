@@ -6,7 +6,9 @@
 //! warning it raises is both sent to the observer as it happens and kept in
 //! the result ([`Note`]), so that a caller that ignores the observer loses
 //! nothing. The design follows argmin's observers: the workflow calls the
-//! observer; the observer never changes the result.
+//! observer; the observer never changes the result — except to stop it:
+//! [`Observer::cancelled`] is asked between steps, and a workflow told to
+//! stop returns [`crate::Error::Cancelled`].
 //!
 //! ```
 //! use aeromag::{Note, Observer};
@@ -94,6 +96,17 @@ pub trait Observer {
     fn progress(&mut self, _done: u64, _total: u64) {}
     /// A note or warning was raised (it is also kept in the result).
     fn note(&mut self, _note: &Note) {}
+    /// Whether the workflow should stop (default: never). Asked on the
+    /// calling thread at every stage and between the steps of the long
+    /// loops (the Kalman fit's noise-tuning evaluations and filter rounds,
+    /// minimum curvature's sweeps): a few milliseconds to a few tens of
+    /// milliseconds apart, so it must be cheap. Once it returns `true`, the
+    /// workflow returns [`crate::Error::Cancelled`] at its next check
+    /// (usually at once); it should keep returning `true`. Python's
+    /// observer checks for Ctrl-C here.
+    fn cancelled(&mut self) -> bool {
+        false
+    }
 }
 
 /// An observer that ignores everything.
@@ -138,6 +151,21 @@ impl<'o> Notes<'o> {
         self.observer.stage(name);
     }
 
+    /// Whether the observer asks to stop ([`Observer::cancelled`]).
+    pub(crate) fn cancelled(&mut self) -> bool {
+        self.observer.cancelled()
+    }
+
+    /// [`crate::Error::Cancelled`] when the observer asks to stop: for
+    /// workflows' stages and loops (`notes.check_cancelled()?`).
+    pub(crate) fn check_cancelled(&mut self) -> crate::Result<()> {
+        if self.cancelled() {
+            Err(crate::Error::Cancelled)
+        } else {
+            Ok(())
+        }
+    }
+
     /// The notes raised so far.
     pub(crate) fn into_notes(self) -> Vec<Note> {
         self.kept
@@ -165,5 +193,8 @@ impl Observer for Notes<'_> {
     }
     fn note(&mut self, note: &Note) {
         self.push(note.clone());
+    }
+    fn cancelled(&mut self) -> bool {
+        self.observer.cancelled()
     }
 }

@@ -411,6 +411,7 @@ pub fn fit_pod(
             ),
         ));
     }
+    notes.check_cancelled()?;
     let data: Vec<PodHeading> = hs.iter().map(|h| h.data.clone()).collect();
     let mut reference = [0.0; 3];
     let (names, coefficients, sources_m, heading_coefficients) = match method {

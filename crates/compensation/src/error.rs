@@ -65,6 +65,10 @@ pub enum CompError {
     /// An error from the core crate (filters, validation).
     #[error(transparent)]
     Core(#[from] aeromag_core::CoreError),
+    /// The caller's cancellation probe stopped the computation
+    /// ([`aeromag_core::cancel`]; not bad input).
+    #[error(transparent)]
+    Cancelled(#[from] aeromag_core::cancel::Cancelled),
     /// Serialising a model failed (a bug, reported instead of a panic).
     #[error("cannot serialise {what}: {reason}")]
     Serialize {
@@ -85,9 +89,10 @@ impl CompError {
             | CompError::InvalidSetting { .. }
             | CompError::UnusableData { .. }
             | CompError::ModelFile { .. } => true,
-            CompError::Singular { .. } | CompError::Failed { .. } | CompError::Serialize { .. } => {
-                false
-            }
+            CompError::Singular { .. }
+            | CompError::Failed { .. }
+            | CompError::Serialize { .. }
+            | CompError::Cancelled(_) => false,
             CompError::Estimation { source, .. } => source.is_bad_input(),
             CompError::Core(e) => e.is_bad_input(),
         }

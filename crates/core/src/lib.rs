@@ -28,8 +28,10 @@
 //! | [`simd`] | kernels compiled with and without AVX, chosen at run time |
 //! | [`memory`] | the memory this process can still take (refusing work sized beyond it) |
 //! | [`output_target`] | where an output goes: a regular file (written atomically) or a device, FIFO or socket |
+//! | [`cancel`] | stopping a long computation between its steps ([`cancel::Cancelled`]) |
 //! | [`error`] | [`CoreError`], with `is_bad_input()` |
 
+pub mod cancel;
 pub mod error;
 pub mod estimability;
 pub mod field;

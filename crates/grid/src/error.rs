@@ -99,6 +99,10 @@ pub enum GridError {
         /// The highest allowed, m.
         max: f64,
     },
+    /// The caller's cancellation probe stopped the computation
+    /// ([`aeromag_core::cancel`]; not bad input).
+    #[error(transparent)]
+    Cancelled(#[from] aeromag_core::cancel::Cancelled),
     /// Writing a grid file failed.
     #[error("writing '{path}': {source}")]
     Write {
@@ -112,9 +116,9 @@ pub enum GridError {
 
 impl GridError {
     /// Whether the caller's input caused the error (everything but a failed
-    /// write).
+    /// write and a cancelled computation).
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, GridError::Write { .. })
+        !matches!(self, GridError::Write { .. } | GridError::Cancelled(_))
     }
 }
 

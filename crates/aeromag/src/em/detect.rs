@@ -157,6 +157,7 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         .chain(fs, n, opts.window, opts.pilot)
         .in_file(&file)?;
     notes.stage("detecting");
+    notes.check_cancelled()?;
     // Streamed: whole detector blocks of about 2¹⁸ frames (3 MB) per
     // chunk, the default 10.24 s record in four. Mapped: in one piece.
     let chunk = n * (1usize << 18).div_ceil(n);

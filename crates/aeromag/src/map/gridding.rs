@@ -248,6 +248,7 @@ pub(crate) fn grid_flight_finest(
         v
     };
     notes.stage("projecting");
+    notes.check_cancelled()?;
     let survey = survey_of(flight, opts, &mut notes)?;
     if let Some(w) = survey.off_track_warning(flight) {
         notes.warn(w);
@@ -330,8 +331,12 @@ pub(crate) fn grid_flight_finest(
         notes.warn(w);
     }
     notes.stage("gridding");
+    notes.check_cancelled()?;
     let (mut grid_values, report) = match (opts.method, &survey.lines) {
-        (GridMethod::MinCurvature, _) => opts.min_curvature.grid(points, geometry)?,
+        (GridMethod::MinCurvature, _) => {
+            opts.min_curvature
+                .grid_cancellable(points, geometry, &mut || notes.cancelled())?
+        }
         (GridMethod::Bidirectional, Some(l)) => {
             // Tie lines are left out (`traverse_ids` is ascending).
             let keep: Vec<usize> = (0..line.len())

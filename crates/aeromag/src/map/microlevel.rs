@@ -206,6 +206,7 @@ pub fn microlevel(
         )));
     }
     notes.stage("filtering the grid");
+    notes.check_cancelled()?;
     let corrugation = apply(
         &gridded.grid,
         Spectral::Corrugation(Corrugation {
@@ -216,6 +217,7 @@ pub fn microlevel(
         }),
     )?;
     notes.stage("correcting the lines");
+    notes.check_cancelled()?;
     let survey = &gridded.survey;
     let ids = survey.line_ids.as_deref().unwrap_or(&[]);
     let value = flight.field_values(&column)?;

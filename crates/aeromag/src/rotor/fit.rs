@@ -526,6 +526,7 @@ pub fn fit_rotor(
     )?;
     let nominal = [opts.nominal_angles];
     if estimated {
+        notes.check_cancelled()?;
         let inp = RotorInput {
             b_body_nt: &b,
             phase_rad: &phase,
@@ -541,6 +542,7 @@ pub fn fit_rotor(
             angles: &nominal,
         };
         let o = phase_refinement(opts.window_s);
+        notes.check_cancelled()?;
         phase = fit_slow_angles(geom, BladeTerms::Full, &inp, mag, fs, &fit_opts, &o)?.phase_rad;
     }
     let slow_opts = SlowAngleOptions {
@@ -553,6 +555,7 @@ pub fn fit_rotor(
         omega_rad_s: &omega,
         angles: &nominal,
     };
+    notes.check_cancelled()?;
     // A tail rotor whose blade-passing signal the sensor does not see is
     // left out (`TailFit::tail_is_seen`).
     let joint = match &opts.tail {
@@ -632,6 +635,7 @@ pub fn fit_rotor(
     // angles tracked as `rotor apply` would.
     if segs.len() > 1 {
         for _ in 0..REFINE_ITERATIONS {
+            notes.check_cancelled()?;
             // Each stretch tracked alone: the stretches on the cores, the
             // first failure in their order reported.
             let threads = aeromag_core::parallel::threads();

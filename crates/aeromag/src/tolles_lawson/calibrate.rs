@@ -619,6 +619,7 @@ fn select_channels(
         |ls, _, segments, _| {
             let choice = choose_terms(&label, segments, ls, &opts.eddy_lag, &opts.extra, notes)?;
             notes.stage("testing the extra regressors");
+            notes.check_cancelled()?;
             // A fit of unfiltered data (the reference-sensor mode) tests its
             // channels in the default band: the test's ν and threshold are
             // those of a band-passed residual, and the unfiltered one is
@@ -681,6 +682,7 @@ fn fit_ls_segments(
         ..ls.clone()
     };
     notes.stage("fitting");
+    notes.check_cancelled()?;
     let fit = fit_band_pass_ls(segments, cfg).in_file(&label)?;
     for w in &fit.warnings {
         notes.warn(w.clone());

@@ -12,8 +12,8 @@ use aeromag_compensation::kalman::altitude::{
 };
 use aeromag_compensation::kalman::{
     CoefficientPass, DEFAULT_ORDER, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries,
-    NoiseModel, ORDERS, X2Prior, fit_kalman, fit_kalman_exact, ground_speed_from_positions,
-    ground_speed_from_velocity,
+    NoiseModel, ORDERS, X2Prior, fit_kalman_cancellable, fit_kalman_exact_cancellable,
+    ground_speed_from_positions, ground_speed_from_velocity,
 };
 use aeromag_compensation::model_file::TlModel;
 use aeromag_compensation::tolles_lawson::fit_ls::{LsConfig, Segment};
@@ -222,6 +222,7 @@ pub(super) fn fit_kalman_flight(
     let (choice, tuned) = match opts.eddy_lag {
         EddyLag::Auto if cfg.design.terms.has_eddy() => {
             notes.stage("Kalman pass 1: removing the field");
+            notes.check_cancelled()?;
             let pass1 = KalmanConfig {
                 design: cfg.design.with_terms(
                     cfg.design
@@ -235,7 +236,8 @@ pub(super) fn fit_kalman_flight(
                 coefficient_pass: CoefficientPass::Augmented,
                 ..cfg.clone()
             };
-            let first = fit_kalman(&segments, &pass1).in_file(&file)?;
+            let first = fit_kalman_cancellable(&segments, &pass1, &mut || notes.cancelled())
+                .in_file(&file)?;
             let field = on_rows(y.len(), &segs, &first.series, |s| &s.external_nt);
             let y_field_removed: Vec<f64> = y.iter().zip(&field).map(|(a, b)| a - b).collect();
             let reduced = cols.with_mag(&y_field_removed);
@@ -272,9 +274,11 @@ pub(super) fn fit_kalman_flight(
         cfg.tuning.grid_starts = 0;
     }
     notes.stage("Kalman filter and smoother");
+    notes.check_cancelled()?;
+    let cancel = &mut || notes.cancelled();
     let fit = match cfg.design.magnitude {
-        Magnitude::FirstOrder => fit_kalman(&segments, &cfg),
-        Magnitude::Exact => fit_kalman_exact(&segments, &cfg),
+        Magnitude::FirstOrder => fit_kalman_cancellable(&segments, &cfg, cancel),
+        Magnitude::Exact => fit_kalman_exact_cancellable(&segments, &cfg, cancel),
     }
     .in_file(&file)?;
     let series = (!fit.series.is_empty()).then(|| {

@@ -140,6 +140,7 @@ pub(super) fn choose_terms(
         EddyLag::Auto if !cfg.design.terms.has_eddy() => (cfg.design.terms.clone(), None),
         EddyLag::Auto => {
             notes.stage("choosing eddy-current lags");
+            notes.check_cancelled()?;
             let sel = select_eddy_lags(
                 &sample(DEFAULT_SELECTION_ROWS),
                 cfg,
@@ -177,6 +178,7 @@ pub(super) fn choose_terms(
                 r.channel,
                 pass + 1
             ));
+            notes.check_cancelled()?;
             let c = LsConfig {
                 design: cfg.design.with_terms(terms.clone()),
                 ..cfg.clone()
@@ -319,8 +321,10 @@ pub(super) fn add_lags_by_kalman_likelihood(
         Ok((f.profile_log_likelihood(), f.coef.len()))
     };
     notes.stage("Kalman likelihood-ratio test of further lags");
+    notes.check_cancelled()?;
     let (mut base, mut m) = profile(&terms)?;
     while terms.eddy_lags_s().len() < 2 {
+        notes.check_cancelled()?;
         let lags = terms.eddy_lags_s().to_vec();
         let mut best: Option<(f64, usize, TermSet, f64)> = None;
         let candidates = DEFAULT_LAG_GRID_S

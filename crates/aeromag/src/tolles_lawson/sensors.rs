@@ -131,6 +131,7 @@ pub fn calibrate_sensors(
     if let Some(i) = ref_index {
         let s = &set.sensors[i];
         notes.stage(&format!("calibrating the reference sensor {}", s.mag));
+        notes.check_cancelled()?;
         // Filtered through the turns, as the other sensors are fitted
         // against it (module docs).
         let through = CalibrateOptions {
@@ -145,6 +146,7 @@ pub fn calibrate_sensors(
             None
         } else {
             notes.stage(&format!("least-squares reference fit of {}", s.mag));
+            notes.check_cancelled()?;
             let ls = CalibrateOptions {
                 method: Method::Ls,
                 ..through.clone()
@@ -169,6 +171,7 @@ pub fn calibrate_sensors(
             continue;
         }
         notes.stage(&format!("calibrating {}", s.mag));
+        notes.check_cancelled()?;
         let (o, series, reference) = match (&reference_name, &reference_nt) {
             (None, _) => (of(s), None, None),
             (Some(r), Some(series)) => {

@@ -27,6 +27,7 @@ use crate::model_file::{
 use crate::tolles_lawson::Design;
 use crate::tolles_lawson::fit_ls::{LsFit, Segment, diagnose};
 use crate::tolles_lawson::segments::split_segments;
+use aeromag_core::cancel::{check, never};
 use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::kalman::{
     Checkpoint, FILTER_LANES, Innovation, LeadingConditional, SqrtKalmanFilter, default_block_len,
@@ -217,8 +218,18 @@ struct Run {
 /// [`MAX_GAUSS_NEWTON_STEPS`](crate::tolles_lawson::fit_ls::MAX_GAUSS_NEWTON_STEPS)
 /// steps; a warning says how many). The first fit's tuning report is kept.
 pub fn fit_kalman_exact(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<KalmanFit> {
+    fit_kalman_exact_cancellable(segments, cfg, &mut never)
+}
+
+/// [`fit_kalman_exact`], each of its fits asking `cancel` as
+/// [`fit_kalman_cancellable`] does.
+pub fn fit_kalman_exact_cancellable(
+    segments: &[KalmanSegment],
+    cfg: &KalmanConfig,
+    cancel: &mut dyn FnMut() -> bool,
+) -> Result<KalmanFit> {
     use crate::tolles_lawson::fit_ls::{MAX_GAUSS_NEWTON_STEPS, linearised};
-    let first = fit_kalman(segments, cfg)?;
+    let first = fit_kalman_cancellable(segments, cfg, cancel)?;
     let mut fixed = KalmanConfig {
         noise: first.noise,
         ..cfg.clone()
@@ -244,7 +255,7 @@ pub fn fit_kalman_exact(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Resul
                 ..*s
             })
             .collect();
-        let next = fit_kalman(&step, &fixed)?;
+        let next = fit_kalman_cancellable(&step, &fixed, cancel)?;
         steps += 1;
         let moved = next
             .coef
@@ -272,12 +283,29 @@ pub fn fit_kalman_exact(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Resul
     Ok(fit)
 }
 
+/// Samples of the joint filter between two questions to the cancellation
+/// probe ([`fit_kalman_cancellable`]): a few milliseconds of filtering.
+pub const CANCEL_ROWS: usize = 4096;
+
 /// Runs shorter than this are skipped (the eddy derivatives need 3 samples).
 const MIN_RUN: usize = 3;
 
 /// Fit the Tolles-Lawson coefficients jointly with the stochastic field
 /// model (spec `compensation.md`, Method 2; module docs of [`super`]).
 pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<KalmanFit> {
+    fit_kalman_cancellable(segments, cfg, &mut never)
+}
+
+/// [`fit_kalman`], asking `cancel` ([`aeromag_core::cancel`]) on the
+/// calling thread before every evaluation of the noise tuning, every
+/// [`CANCEL_ROWS`] samples of the joint filter, every round of the split
+/// pass's groups and before the smoother: [`CompError::Cancelled`] as soon
+/// as it says to stop. The same fit as [`fit_kalman`] when it never does.
+pub fn fit_kalman_cancellable(
+    segments: &[KalmanSegment],
+    cfg: &KalmanConfig,
+    cancel: &mut dyn FnMut() -> bool,
+) -> Result<KalmanFit> {
     validate(cfg)?;
     let m = cfg.design.n_columns();
     let names = cfg.design.column_names();
@@ -372,6 +400,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
             noise,
             &cfg.tuning,
             dec,
+            cancel,
         )?;
         if !rep.converged {
             warnings.push(format!(
@@ -418,9 +447,12 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
         innovations,
         conditionals,
     } = match cfg.coefficient_pass {
-        CoefficientPass::Joint => joint_pass(&inputs, &mut series)?,
-        CoefficientPass::Augmented => augmented_pass(&inputs)?,
-        CoefficientPass::Split => split_pass(&inputs, &mut series)?,
+        CoefficientPass::Joint => joint_pass(&inputs, &mut series, cancel)?,
+        CoefficientPass::Augmented => {
+            check(cancel)?;
+            augmented_pass(&inputs)?
+        }
+        CoefficientPass::Split => split_pass(&inputs, &mut series, cancel)?,
     };
     let std: Vec<f64> = (0..m)
         .map(|j| posterior_covariance[(j, j)].max(0.0).sqrt())
@@ -436,6 +468,7 @@ pub fn fit_kalman(segments: &[KalmanSegment], cfg: &KalmanConfig) -> Result<Kalm
     // ---- compensated series and pass 2: the smoothed field.
     let mut residual_rms_nt = f64::NAN;
     if cfg.compute_series {
+        check(cancel)?;
         let transition = AnomalyTransition::new(&noise, cfg.field_prior.order);
         // The runs are independent given X̂1: each run's compensated reading
         // and smoothed field on the cores (run-local slices, the same
@@ -630,7 +663,11 @@ fn restart_point(cfg: &KalmanConfig, local: usize, len: usize) -> bool {
 
 /// Pass 1 by the joint filter over the runs in turn; the innovations go
 /// into `series` (when computed).
-fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
+fn joint_pass(
+    p: &PassInputs,
+    series: &mut [KalmanSeries],
+    cancel: &mut dyn FnMut() -> bool,
+) -> Result<Pass1> {
     let mut jf = JointFilter::new(p.coef_mean, p.coef_std, &p.cfg.field_prior, p.noise)?;
     let mut tally = InnovationTally::new(p.cfg.field_prior.dim());
     // Per run: restart points of the pass-2 smoother (run-local step, X2 | X1).
@@ -641,8 +678,16 @@ fn joint_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
         .iter()
         .map(|r| (&p.segments[r.seg].data, r.range.clone()))
         .collect();
-    let (mut err, mut current) = (None, usize::MAX);
+    let (mut err, mut current, mut since_asked) = (None, usize::MAX, 0usize);
     for_each_design_row_ahead(&p.cfg.design, &run_list, |r, i, row| {
+        since_asked += 1;
+        if since_asked == CANCEL_ROWS {
+            since_asked = 0;
+            if let Err(c) = check(cancel) {
+                err = Some(c.into());
+                return false;
+            }
+        }
         let run = &p.runs[r];
         let s = &p.segments[run.seg];
         let len = run.range.len();
@@ -804,7 +849,11 @@ fn augmented_pass(p: &PassInputs) -> Result<Pass1> {
 /// the field filter on the cores, each round's whitened innovations fed to
 /// the coefficients' recursive least squares while the next round is
 /// filtered; the innovations go into `series` (when computed).
-fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
+fn split_pass(
+    p: &PassInputs,
+    series: &mut [KalmanSeries],
+    cancel: &mut dyn FnMut() -> bool,
+) -> Result<Pass1> {
     let cfg = p.cfg;
     let (groups, transition) = pass_groups(p)?;
     let model = p.field_model(&transition, true);
@@ -858,6 +907,7 @@ fn split_pass(p: &PassInputs, series: &mut [KalmanSeries]) -> Result<Pass1> {
             Ok(())
         });
         let filtered = (0..groups.len()).step_by(round).try_for_each(|start| {
+            check(cancel)?;
             let end = (start + round).min(groups.len());
             let done = filter_groups(end - start, threads(), &model, |gi| {
                 group_samples(p, &p.runs[groups[start + gi].clone()])

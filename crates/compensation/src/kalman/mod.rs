@@ -102,8 +102,8 @@ pub mod tuning;
 
 pub use anomaly_model::{DEFAULT_ORDER, NoiseModel, ORDERS, THESIS_ORDER, X2Prior, q1_unit};
 pub use fit::{
-    CoefficientPass, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman,
-    fit_kalman_exact,
+    CANCEL_ROWS, CoefficientPass, KalmanConfig, KalmanFit, KalmanSegment, KalmanSeries, fit_kalman,
+    fit_kalman_cancellable, fit_kalman_exact, fit_kalman_exact_cancellable,
 };
 pub use joint_filter::JointFilter;
 pub use track::{ground_speed_from_positions, ground_speed_from_velocity};

@@ -145,6 +145,7 @@ use super::field_filter::{
 };
 use super::joint_filter::est;
 use crate::error::{CompError, Result};
+use aeromag_core::cancel::{Cancelled, check};
 use aeromag_core::parallel::{parallel_map, threads};
 use aeromag_estimation::optimize::{NelderMeadOptions, NelderMeadResult, nelder_mead};
 use serde::{Deserialize, Serialize};
@@ -297,6 +298,11 @@ impl Subset {
 
 /// Maximise the likelihood of `subset` over the selected `ln q₁, ln q₂,
 /// ln r` from `start` (the others stay at their start values).
+///
+/// `cancel` ([`aeromag_core::cancel`]) is asked before the grid of starts
+/// and before every evaluation of the local searches (one likelihood
+/// evaluation apart): [`CompError::Cancelled`] once it says to stop.
+#[allow(clippy::too_many_arguments)]
 pub fn tune(
     subset: &Subset,
     coef_mean: &[f64],
@@ -305,6 +311,7 @@ pub fn tune(
     start: NoiseModel,
     cfg: &TuningConfig,
     decimation: usize,
+    cancel: &mut dyn FnMut() -> bool,
 ) -> Result<TuningReport> {
     if subset.len() < 10 {
         return Err(CompError::data(format!(
@@ -366,6 +373,7 @@ pub fn tune(
         }
     };
     let theta0: Vec<f64> = free.iter().map(|&i| all[i]).collect();
+    check(cancel)?;
     let starts = grid_starts(&free, &theta0, cfg.grid_starts, &objective);
     let opts = NelderMeadOptions {
         initial_step: vec![dec; free.len()],
@@ -375,10 +383,25 @@ pub fn tune(
     };
     let mut evaluations = starts.evaluations;
     let mut best: Option<NelderMeadResult> = None;
+    // Once the probe says to stop, the search's remaining evaluations
+    // return at once (+∞) and the search ends with its budget.
+    let mut stopped = false;
     for x0 in &starts.points {
+        check(cancel)?;
         // Each evaluation on all cores (its runs shared out).
-        let r = nelder_mead(|t| objective(t, threads()), x0, &opts)
-            .map_err(CompError::estimation("noise tuning"))?;
+        let evaluate = |t: &[f64]| {
+            stopped = stopped || cancel();
+            if stopped {
+                f64::INFINITY
+            } else {
+                objective(t, threads())
+            }
+        };
+        let r = nelder_mead(evaluate, x0, &opts);
+        if stopped {
+            return Err(Cancelled.into());
+        }
+        let r = r.map_err(CompError::estimation("noise tuning"))?;
         evaluations += r.evaluations;
         if best.as_ref().is_none_or(|b| r.f < b.f) {
             best = Some(r);

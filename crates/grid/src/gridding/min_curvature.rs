@@ -69,6 +69,7 @@ use super::good_size::{Enlargement, enlargement, strides};
 use super::points::{BlockMeans, Points};
 use crate::error::{GridError, Result};
 use crate::grid::GridGeometry;
+use aeromag_core::cancel::{Cancelled, check};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Settings of minimum-curvature gridding (module docs).
@@ -244,6 +245,18 @@ impl MinCurvature {
         points: Points,
         geometry: GridGeometry,
     ) -> Result<(Vec<f64>, MinCurvatureReport)> {
+        self.grid_cancellable(points, geometry, &mut aeromag_core::cancel::never)
+    }
+
+    /// [`Self::grid`], asking `cancel` ([`aeromag_core::cancel`]) before
+    /// every sweep: [`GridError::Cancelled`] as soon as it says to stop.
+    /// The same values as [`Self::grid`] when it never does.
+    pub fn grid_cancellable(
+        &self,
+        points: Points,
+        geometry: GridGeometry,
+        cancel: &mut dyn FnMut() -> bool,
+    ) -> Result<(Vec<f64>, MinCurvatureReport)> {
         self.validate()?;
         if geometry.nx < 4 || geometry.ny < 4 {
             return Err(GridError::Data(format!(
@@ -256,7 +269,7 @@ impl MinCurvature {
             .then(|| enlargement(geometry.nx - 1, geometry.ny - 1))
             .flatten();
         let Some(e) = grown else {
-            return self.solve(points, geometry);
+            return self.solve(points, geometry, cancel);
         };
         let big = GridGeometry {
             x0: geometry.x0 - e.west as f64 * geometry.cell,
@@ -265,7 +278,7 @@ impl MinCurvature {
             nx: geometry.nx + e.west + e.east,
             ny: geometry.ny + e.south + e.north,
         };
-        let (all, mut report) = self.solve(points, big)?;
+        let (all, mut report) = self.solve(points, big, cancel)?;
         report.enlarged = Some(e);
         let mut values = vec![0.0; geometry.len()];
         for j in 0..geometry.ny {
@@ -281,6 +294,7 @@ impl MinCurvature {
         &self,
         points: Points,
         geometry: GridGeometry,
+        cancel: &mut dyn FnMut() -> bool,
     ) -> Result<(Vec<f64>, MinCurvatureReport)> {
         let means = BlockMeans::of(points, &geometry);
         if means.blocks.len() < 3 {
@@ -330,10 +344,12 @@ impl MinCurvature {
                 if let Some(coarse) = &level {
                     next.start_from(coarse);
                     let held = coarse.spacing / stride;
-                    iterations += next.solve(self, Phase::Between(held), limit_here, sweeps).0;
+                    iterations += next
+                        .solve(self, Phase::Between(held), limit_here, sweeps, cancel)?
+                        .0;
                 }
                 let (data_sweeps, max_change, decay_per_sweep) =
-                    next.solve(self, Phase::Data, limit_here, sweeps);
+                    next.solve(self, Phase::Data, limit_here, sweeps, cancel)?;
                 iterations += data_sweeps;
                 report.levels.push(LevelReport {
                     spacing_cells: stride,
@@ -708,13 +724,17 @@ impl Level {
     /// one after another (its north neighbours already updated, its south
     /// ones not yet), so the result is the same to the bit, and the rows'
     /// updates overlap in the processor.
+    ///
+    /// `cancel` is asked before every sweep; when it says to stop, the
+    /// level is left as it is and [`Cancelled`] returned.
     fn solve(
         &mut self,
         s: &MinCurvature,
         phase: Phase,
         limit: f64,
         max_sweeps: usize,
-    ) -> (usize, f64, f64) {
+        cancel: &mut dyn FnMut() -> bool,
+    ) -> std::result::Result<(usize, f64, f64), Cancelled> {
         let t = s.tension;
         let (nx, ny, w) = (self.nx, self.ny, self.width());
         let denom = 20.0 * (1.0 - t) + 4.0 * t;
@@ -771,6 +791,10 @@ impl Level {
         // The last DECAY_WINDOW + 1 changes, a ring.
         let mut recent = [f64::NAN; DECAY_WINDOW + 1];
         while sweeps < max_sweeps {
+            if let Err(c) = check(cancel) {
+                (self.nodes, self.slot) = (nodes, slot);
+                return Err(c);
+            }
             self.fill_ghosts(t);
             let z = Padded(self.z.as_mut_ptr());
             done.iter().for_each(|d| d.store(0, Ordering::Relaxed));
@@ -820,7 +844,7 @@ impl Level {
             let first = recent[(sweeps - 1 - span) % recent.len()];
             (change / first).powf(1.0 / span as f64)
         };
-        (sweeps, change, decay)
+        Ok((sweeps, change, decay))
     }
 }
 
@@ -1186,7 +1210,8 @@ mod tests {
         let s = MinCurvature::default();
         let coarse = {
             let mut c = Level::new(&g, 2, &means, &plane);
-            c.solve(&s, Phase::Data, 0.0, 5);
+            c.solve(&s, Phase::Data, 0.0, 5, &mut aeromag_core::cancel::never)
+                .unwrap();
             c
         };
         for phase in [Phase::Between(2), Phase::Data] {
@@ -1197,7 +1222,9 @@ mod tests {
                 l.start_from(&coarse);
                 l.wave_rows = rows;
                 l.threads = Some(threads);
-                let (sweeps, change, _) = l.solve(&s, phase, 0.0, 7);
+                let (sweeps, change, _) = l
+                    .solve(&s, phase, 0.0, 7, &mut aeromag_core::cancel::never)
+                    .unwrap();
                 assert_eq!(sweeps, 7);
                 (l.z, change)
             };
@@ -1274,5 +1301,34 @@ mod tests {
         assert_eq!(rep.points_non_finite, 2);
         assert_eq!(rep.points_outside, 1);
         assert_eq!(rep.points_used, x.len() - 3);
+    }
+
+    #[test]
+    fn a_cancelled_grid_stops_at_the_next_sweep_and_an_uncancelled_one_is_unchanged() {
+        let g = GridGeometry::covering(0.0, 2000.0, 0.0, 1500.0, 50.0).unwrap();
+        let (x, y, z) = lines(&g, 8, |x, y| (x / 300.0).sin() * (y / 200.0).cos());
+        let points = Points::new(&x, &y, &z).unwrap();
+        let s = MinCurvature::default();
+        let (plain, _) = s.grid(points, g).unwrap();
+        let mut asked = 0usize;
+        let (probed, _) = s
+            .grid_cancellable(points, g, &mut || {
+                asked += 1;
+                false
+            })
+            .unwrap();
+        assert!(asked > 10, "{asked}");
+        assert_eq!(plain, probed);
+        let mut after = 0usize;
+        let e = s
+            .grid_cancellable(points, g, &mut || {
+                after += 1;
+                after > 5
+            })
+            .unwrap_err();
+        assert!(matches!(e, GridError::Cancelled(_)), "{e}");
+        assert!(!e.is_bad_input());
+        assert_eq!(e.to_string(), "cancelled");
+        assert_eq!(after, 6, "asked again after it said to stop");
     }
 }
