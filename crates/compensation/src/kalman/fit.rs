@@ -719,7 +719,8 @@ fn joint_pass(
                 true
             }
             Err(e) => {
-                err = Some(e.at(format!("segment {}, row {i}", run.seg)));
+                let name = p.segments[run.seg].data.name(run.seg);
+                err = Some(e.at(format!("{name}, its row {i}")));
                 false
             }
         }
@@ -797,7 +798,10 @@ fn group_samples(p: &PassInputs, runs: &[Run]) -> Result<GroupSamples<'static>> 
                         "non-finite design row, reading or altitude, or an along-track step {d} m \
                          (must be finite and ≥ 0)"
                     ))
-                    .at(format!("segment {}, row {i}", run.seg)),
+                    .at(format!(
+                        "{}, its row {i}",
+                        p.segments[run.seg].data.name(run.seg)
+                    )),
                 );
                 return;
             }

@@ -104,6 +104,19 @@ pub struct Segment<'a> {
 }
 
 impl<'a> Segment<'a> {
+    /// How the messages name the `k`-th segment (from 0) of a fit: counted
+    /// from 1, with its time span, which finds it in the file (a single
+    /// segment was "segment 0"): `segment 3 (time 49820–50117.5 s)`.
+    pub fn name(&self, k: usize) -> String {
+        let shown = aeromag_core::error::shown;
+        match (self.time.first(), self.time.last()) {
+            (Some(&t0), Some(&t1)) => {
+                format!("segment {} (time {}–{} s)", k + 1, shown(t0), shown(t1))
+            }
+            _ => format!("segment {} (empty)", k + 1),
+        }
+    }
+
     /// A segment without extra regressor channels.
     pub fn new(time: &'a [f64], flux: [&'a [f64]; 3], mag: &'a [f64]) -> Self {
         Self {
@@ -364,7 +377,8 @@ fn segment_filter(
     let dt = median_step(seg.time);
     if dt.is_nan() || dt <= 0.0 {
         return Ok(Err(format!(
-            "segment {k} ({n} samples) has no valid time step; skipped"
+            "{} ({n} samples) has no valid time step; skipped",
+            seg.name(k)
         )));
     }
     // The band's high edge at or above the flight's Nyquist frequency:
@@ -376,12 +390,13 @@ fn segment_filter(
     {
         let shown = aeromag_core::error::shown;
         return Err(CompError::setting(format!(
-            "pass band {}–{} Hz needs a sampling rate above {} Hz, and segment {k} is sampled at {} \
+            "pass band {}–{} Hz needs a sampling rate above {} Hz, and {} is sampled at {} \
              Hz (median step {} s): lower the band's high edge (--band; the default is 0.1–0.9 Hz), \
              or is the time not in seconds?",
             shown(lo),
             shown(hi),
             shown(2.0 * hi),
+            seg.name(k),
             shown((1e3 / dt).round() / 1e3),
             aeromag_core::error::figure(dt)
         )));
@@ -417,7 +432,8 @@ fn segment_filter(
         .map_or(ncol, |s| s.padlen() + 1 + 2 * cfg.trim + ncol);
     if n < min_len {
         return Ok(Err(format!(
-            "segment {k} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped"
+            "{} has {n} samples, fewer than the {min_len} needed to filter and trim it; skipped",
+            seg.name(k)
         )));
     }
     Ok(Ok((dt, sos)))
@@ -477,7 +493,8 @@ pub(crate) fn band_passed_residuals(
                     Ok(r)
                 } else {
                     Err(CompError::data(format!(
-                        "segment {k}: a non-finite value in the band-passed residual"
+                        "{}: a non-finite value in the band-passed residual",
+                        seg.name(k)
                     )))
                 }
             },
@@ -661,7 +678,7 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
             Ok(f) => f,
             Err(w) => return Ok(Err(w)),
         };
-        let context = || format!("segment {k}");
+        let context = || seg.name(k);
         let mut blocks = Vec::new();
         for_each_filtered_block(
             seg,
@@ -688,7 +705,7 @@ pub(crate) fn accumulate(segments: &[Segment], cfg: &LsConfig) -> Result<Accumul
             Ok((dt, blocks)) => {
                 for p in &blocks {
                     ne.add_products(p)
-                        .map_err(CompError::estimation(format!("segment {k}")))?;
+                        .map_err(CompError::estimation(segments[k].name(k)))?;
                 }
                 used += 1;
                 fs_used.push(1.0 / dt);
@@ -1341,6 +1358,16 @@ pub(crate) mod tests {
         .slice(0..50);
         let e = fit_band_pass_ls(&[short], &LsConfig::default()).unwrap_err();
         assert!(e.to_string().contains("no segment"), "{e}");
+        // A segment skipped beside a long one is named by its place, from
+        // 1, and its time span (it was "segment 0").
+        let long = Segment::new(&t, [&f[0], &f[1], &f[2]], &m);
+        let fit = fit_band_pass_ls(&[long, short], &LsConfig::default()).unwrap();
+        let name = format!("segment 2 (time {}–{} s) has 50 samples", t[0], t[49]);
+        assert!(
+            fit.warnings.iter().any(|w| w.starts_with(&name)),
+            "{name}: {:?}",
+            fit.warnings
+        );
         let cfg = LsConfig {
             band_hz: Some((0.9, 0.1)),
             ..LsConfig::default()
