@@ -19,8 +19,10 @@ height), attitude in degrees, time in s. Files keep their own names
 ``flux_x`` …) are mapped onto them as the CLI maps them.
 
 Errors: :class:`BadInputError` (a ``ValueError``, with ``file``, ``line``,
-``row``, ``column``) for input that cannot be used, :class:`AeromagError`
-for methods that failed, ``OSError`` for outputs that could not be written.
+``row``, ``column``) for input that cannot be used (:class:`MissingFileError`,
+also a ``FileNotFoundError``, for an input file that does not exist),
+:class:`AeromagError` for methods that failed, ``OSError`` for outputs that
+could not be written.
 """
 
 from __future__ import annotations
@@ -35,13 +37,14 @@ from ._aeromag import EmCalibration, EmDetection, EmPoses, calibrate_em, simulat
 from ._aeromag import Grid, Microlevelled
 from ._aeromag import Flight, Levelled, Model, OnlineCompensator, SensorsModel, TlModel, fit_pod, fit_rotor, locate_dipole, simulate_gradiometer
 from ._aeromag import __version__
-from .errors import AeromagError, AeromagWarning, BadInputError
+from .errors import AeromagError, AeromagWarning, BadInputError, MissingFileError
 from .tolles_lawson import TollesLawson, calibrate_sensors, load_model
 
 __all__ = [
     "AeromagError",
     "AeromagWarning",
     "BadInputError",
+    "MissingFileError",
     "Flight",
     "Levelled",
     "Model",
@@ -195,14 +198,15 @@ def simulate(
     if config is not None:
         path = os.fspath(config)
         if os.path.isfile(path):
-            text = open(path, encoding="utf-8").read()
+            return _aeromag.simulate(scenario, seed=seed, config_path=path)
         elif isinstance(config, str) and ("\n" in config or "=" in config or not config.strip()):
             text = config
         else:
             # A path that names no file was parsed as TOML text ("expected
             # `.`, `=`"): say which file is missing.
-            raise BadInputError(
-                f"config: no file {path!r} (config is a scenario file's path or its TOML text)"
+            raise MissingFileError(
+                f"config: no file {path!r} (config is a scenario file's path or its TOML text)",
+                file=path,
             )
     return _aeromag.simulate(scenario, seed=seed, config=text)
 

@@ -223,7 +223,12 @@ def igrf(
     alt_m: npt.NDArray[np.float64],
     decimal_year: npt.NDArray[np.float64],
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
-def simulate(scenario: str, seed: Optional[int] = None, config: Optional[str] = None) -> Flight: ...
+def simulate(
+    scenario: str,
+    seed: Optional[int] = None,
+    config: Optional[str] = None,
+    config_path: Optional[str] = None,
+) -> Flight: ...
 
 @final
 class Model:

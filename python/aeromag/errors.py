@@ -7,9 +7,14 @@
   file), ``row`` (0-based data row of the file: the index into the file's
   rows, whatever rows a ``lines=`` selection kept) and ``column``, each
   ``None`` when not known. The CLI exits with code 2 on these.
+- :class:`MissingFileError` (a :class:`BadInputError` and a
+  :class:`FileNotFoundError`): an input file that does not exist, with
+  ``errno`` and ``filename`` as :func:`open` gives them.
 - :class:`AeromagError`: valid input on which a method failed (a fit that
   did not converge, a flight that does not determine the model, …).
-- :class:`OSError`: an output file could not be written.
+- :class:`OSError`: an output file could not be written; the subclass of
+  its ``errno`` (``NotADirectoryError``, ``PermissionError``, …) with
+  ``filename``, as :func:`open` raises it.
 
 And the warning it raises:
 
@@ -21,7 +26,9 @@ And the warning it raises:
 
 from __future__ import annotations
 
-from typing import Optional
+import errno as _errno
+import os as _os
+from typing import Any, Optional
 
 
 class AeromagError(Exception):
@@ -48,6 +55,30 @@ class AeromagError(Exception):
 
 class BadInputError(AeromagError, ValueError):
     """The input (a file, an array, an option) cannot be used."""
+
+
+class MissingFileError(BadInputError, FileNotFoundError):
+    """An input file that does not exist (``except FileNotFoundError``
+    catches it too): ``filename`` and ``file`` name it, ``errno`` is
+    ``ENOENT``; ``str()`` is aeromag's message."""
+
+    def __init__(self, message: str, *where: Any, **named: Any) -> None:
+        super().__init__(message, *where, **named)
+        self.errno = _errno.ENOENT
+        self.strerror = _os.strerror(_errno.ENOENT)
+        self.filename = self.file
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+def _os_error(message: str, errno: Optional[int], filename: Optional[str]) -> OSError:
+    """The OSError of a file that could not be written: the subclass of
+    ``errno`` with ``filename``, as :func:`open` raises it (``message``
+    alone when the system gave no error number)."""
+    if errno is None:
+        return OSError(message)
+    return OSError(errno, _os.strerror(errno), filename)
 
 
 class AeromagWarning(UserWarning):

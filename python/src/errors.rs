@@ -1,11 +1,13 @@
 //! aeromag errors as Python exceptions (classes in `aeromag/errors.py`):
 //! bad input → `BadInputError` (a `ValueError`) with `file`, `line`, `row`
-//! and `column`; a failed write → `OSError`; anything else (a fit that
+//! and `column`, a missing input file → `MissingFileError` (also a
+//! `FileNotFoundError`); a failed write → the `OSError` of its `errno`
+//! with `filename`; anything else (a fit that
 //! failed on valid input) → `AeromagError`; a cancelled call →
 //! `KeyboardInterrupt` (the library stops only when asked to, and the
 //! Python layer asks only on Ctrl-C).
 
-use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError};
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
 /// The Python exception of a library error.
@@ -23,19 +25,26 @@ fn exception(py: Python<'_>, e: &aeromag::Error) -> PyResult<PyErr> {
         .to_string()
         .replace("--lines: ", "lines: ")
         .replace("--time-range: ", "time_range: ");
-    if e.is_write_failure() {
-        return Ok(PyOSError::new_err(message));
-    }
     if e.is_cancelled() {
         return Ok(PyKeyboardInterrupt::new_err(message));
     }
     let errors = py.import("aeromag.errors")?;
-    let class = if e.is_bad_input() {
+    let at = e.location();
+    let os = e.os_error();
+    if e.is_write_failure() {
+        let errno = os.and_then(std::io::Error::raw_os_error);
+        let exc = errors
+            .getattr("_os_error")?
+            .call1((message, errno, at.file))?;
+        return Ok(PyErr::from_value(exc));
+    }
+    let class = if os.is_some_and(|o| o.kind() == std::io::ErrorKind::NotFound) {
+        "MissingFileError"
+    } else if e.is_bad_input() {
         "BadInputError"
     } else {
         "AeromagError"
     };
-    let at = e.location();
     let exc = errors
         .getattr(class)?
         .call1((message, at.file, at.line, at.row, at.column))?;

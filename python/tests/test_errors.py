@@ -46,6 +46,59 @@ def test_missing_file_and_bad_options(tmp_path):
         aeromag.TollesLawson().set_params(lambda_=1.0)
 
 
+def test_missing_files_are_file_not_found_errors(tmp_path):
+    """A missing input is a BadInputError and a FileNotFoundError naming
+    it, whatever kind of file it is (a flight, model, grid or scenario)."""
+    missing = [
+        lambda p: aeromag.read_flight(p / "none.csv"),
+        lambda p: aeromag.load_model(p / "none.json"),
+        lambda p: aeromag.read_grid(p / "none.asc"),
+        lambda p: aeromag.read_grid(p / "none.tif"),
+        lambda p: aeromag.simulate("calibration", config=p / "none.toml"),
+        lambda p: aeromag.dipole_crlb(p / "none.toml"),
+    ]
+    for call in missing:
+        with pytest.raises(FileNotFoundError) as e:
+            call(tmp_path)
+        err = e.value
+        assert isinstance(err, aeromag.MissingFileError) and isinstance(err, aeromag.BadInputError)
+        assert err.filename == err.file and err.file.startswith(str(tmp_path)), err.file
+        assert err.errno == 2 and str(err).startswith(("cannot", "reading", "config: no file")), str(err)
+
+
+def test_settings_files_name_file_and_line(tmp_path):
+    """Model, scenario and gradiometer files give their name and the line
+    of a syntax or type error (they gave neither as attributes)."""
+    model = tmp_path / "bad.json"
+    model.write_text('{\n  "format": "aeromag-model/2",\n  "kind": ,\n}\n')
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.load_model(model)
+    assert (e.value.file, e.value.line) == (str(model), 3), (e.value.file, e.value.line)
+    scenario = tmp_path / "bad.toml"
+    scenario.write_text('seed = 1\n\n[scalar]\nlag_s = "x"\n')
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.simulate("calibration", config=scenario)
+    assert (e.value.file, e.value.line) == (str(scenario), 4), str(e.value)
+    assert str(e.value).startswith(f"'{scenario}': scenario file: TOML parse error at line 4")
+    # Text given directly has no file, but still the line.
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.simulate("calibration", config='seed = 1\n[scalar\n')
+    assert (e.value.file, e.value.line) == (None, 2)
+    gradiometer = tmp_path / "grad.toml"
+    gradiometer.write_text("seed = 3\n[system]\nbaseline_m = [1\n")
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.dipole_crlb(gradiometer)
+    assert (e.value.file, e.value.line) == (str(gradiometer), 3), str(e.value)
+    grid = tmp_path / "bad.asc"
+    grid.write_text("ncols 2\nnrows x\n")
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.read_grid(grid)
+    assert e.value.file == str(grid)
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.read_grid(tmp_path / "g.xyz")
+    assert e.value.file == str(tmp_path / "g.xyz")
+
+
 def test_missing_column_for_a_fit():
     cal = aeromag.simulate("calibration", seed=1)
     d = cal.to_dict()
@@ -58,8 +111,11 @@ def test_missing_column_for_a_fit():
 def test_unwritable_output_is_oserror(tmp_path):
     tl = aeromag.TollesLawson(eddy_lag="none").fit(aeromag.simulate("calibration", seed=1))
     (tmp_path / "a_file").write_text("")
-    with pytest.raises(OSError):
+    with pytest.raises(NotADirectoryError) as e:
         tl.save(tmp_path / "a_file" / "m.json")
+    # As open() raises it: errno, filename, the system's reason.
+    assert e.value.errno == 20 and e.value.filename.endswith("m.json"), repr(e.value)
+    assert str(e.value).startswith("[Errno 20] Not a directory: "), str(e.value)
     # A flight's CSV and a grid file raised AeromagError for the same path.
     cal = aeromag.simulate("calibration", seed=1)
     with pytest.raises(OSError):

@@ -34,7 +34,8 @@ pub enum Error {
     BadInput {
         /// The file (or table) concerned, when there is one.
         file: Option<String>,
-        /// 1-based line in the file, when known.
+        /// 1-based line in the file, when known (printed with the data row;
+        /// a parser's message names the line of a syntax error itself).
         line: Option<u64>,
         /// 0-based data row (printed 1-based as "data row N").
         row: Option<usize>,
@@ -184,6 +185,28 @@ impl Error {
         }
     }
 
+    /// The operating system's error of a file that could not be opened,
+    /// read or written (a missing input, a folder in the place of an
+    /// output, no permission, a full disk): Python raises the matching
+    /// `OSError` subclass (`FileNotFoundError`, …) with its `errno` and
+    /// `filename`.
+    pub fn os_error(&self) -> Option<&std::io::Error> {
+        use aeromag_io::IoError;
+        match self {
+            Error::Read { source, .. } | Error::Write { source, .. } => Some(source),
+            Error::Io(e) => match &**e {
+                IoError::Open { source, .. } | IoError::Write { source, .. } => Some(source),
+                _ => None,
+            },
+            Error::Grid(
+                aeromag_grid::GridError::Open { source, .. }
+                | aeromag_grid::GridError::Write { source, .. },
+            ) => Some(source),
+            Error::InFile { error, .. } => error.os_error(),
+            _ => None,
+        }
+    }
+
     /// Where the error is (file, line, data row, column), as far as it
     /// says; Python's `BadInputError` carries these.
     pub fn location(&self) -> Location {
@@ -206,10 +229,44 @@ impl Error {
                 at.file.get_or_insert_with(|| file.clone());
                 at
             }
-            Error::Read { path, .. } | Error::Write { path, .. } => Location {
-                file: Some(path.display().to_string()),
-                ..Location::default()
+            Error::Read { path, .. }
+            | Error::Write { path, .. }
+            | Error::Report(aeromag_report::ReportError::Io { path, .. }) => {
+                Location::in_file(path.display().to_string())
+            }
+            Error::Compensation(aeromag_compensation::CompError::ModelFile {
+                origin,
+                line,
+                ..
+            }) => Location {
+                line: *line,
+                ..Location::in_file(origin.clone())
             },
+            Error::Grid(
+                aeromag_grid::GridError::Read { path, .. }
+                | aeromag_grid::GridError::Open { path, .. }
+                | aeromag_grid::GridError::BadValue { path, .. }
+                | aeromag_grid::GridError::Write { path, .. }
+                | aeromag_grid::GridError::UnknownFormat(path),
+            ) => Location::in_file(path.clone()),
+            // Scenario files: the file is the caller's (`Error::InFile`),
+            // the line the parser's.
+            Error::Simulation(e) => match &**e {
+                aeromag_sim::SimError::ConfigParse { line, .. } => Location {
+                    line: *line,
+                    ..Location::default()
+                },
+                aeromag_sim::SimError::Write { path, .. } => {
+                    Location::in_file(path.display().to_string())
+                }
+                _ => Location::default(),
+            },
+            Error::Gradiometry(aeromag_gradiometry::GradiometryError::Config { line, .. }) => {
+                Location {
+                    line: *line,
+                    ..Location::default()
+                }
+            }
             _ => Location::default(),
         }
     }
@@ -222,6 +279,47 @@ impl Error {
             row: None,
             column: None,
             reason: reason.into(),
+        }
+    }
+
+    /// Bad input in the text of `file` (a scenario, settings, model or EM
+    /// file): the error's message after the file's name, and the line its
+    /// parser placed it on (TOML and JSON syntax and type errors; their
+    /// messages name the line and column themselves, so it is kept for
+    /// [`Error::location`] and printed only through the message).
+    pub fn in_text(file: impl Into<String>, e: impl Into<Error>) -> Self {
+        let e = e.into();
+        Error::BadInput {
+            file: Some(file.into()),
+            line: e.location().line,
+            row: None,
+            column: None,
+            reason: e.to_string(),
+        }
+    }
+
+    /// [`Error::in_text`] of a TOML parser's error on `text`.
+    pub fn toml(file: impl Into<String>, text: &str, e: &toml::de::Error) -> Self {
+        Error::BadInput {
+            file: Some(file.into()),
+            line: e
+                .span()
+                .map(|s| aeromag_core::error::line_of(text, s.start)),
+            row: None,
+            column: None,
+            reason: e.to_string(),
+        }
+    }
+
+    /// [`Error::in_text`] of a JSON parser's error, after `what` ("not a
+    /// JSON model file").
+    pub fn json(file: impl Into<String>, what: &str, e: &serde_json::Error) -> Self {
+        Error::BadInput {
+            file: Some(file.into()),
+            line: aeromag_compensation::model_file::json_error_line(e),
+            row: None,
+            column: None,
+            reason: format!("{what} ({e})"),
         }
     }
 
@@ -371,6 +469,89 @@ mod tests {
         );
         assert!(e.is_bad_input());
         assert_eq!(Error::bad_input("--band 1,0").to_string(), "--band 1,0");
+    }
+
+    /// Files other than flights say where in their errors as well
+    /// (`location`: what Python's exceptions carry), and a missing or
+    /// unwritable file gives the system's error.
+    #[test]
+    fn settings_model_and_grid_files_are_located() {
+        use crate::ModelFile;
+        let dir = std::env::temp_dir().join(format!("aeromag-located-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = |name: &str, text: &str| {
+            let p = dir.join(name);
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let at = |e: &Error| (e.location().file, e.location().line);
+        let shown = |p: &std::path::Path| Some(p.display().to_string());
+
+        let model = file(
+            "m.json",
+            "{\n  \"format\": \"aeromag-model/2\",\n  \"kind\" ,\n}\n",
+        );
+        let e = crate::TlModel::read(&model).unwrap_err();
+        assert_eq!(at(&e), (shown(&model), Some(3)), "{e}");
+        assert!(e.is_bad_input());
+        let e = crate::model_file::kind_of(&model).unwrap_err();
+        assert_eq!(at(&e), (shown(&model), Some(3)), "{e}");
+
+        let scenario = file("s.toml", "seed = 1\n\n[scalar]\nlag_s = \"x\"\n");
+        let kind = crate::simulate::ScenarioKind::Calibration;
+        let e = crate::simulate::simulate_scenario(kind, Some(&scenario), None).unwrap_err();
+        assert_eq!(at(&e), (shown(&scenario), Some(4)), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with(&format!(
+                "'{}': scenario file: TOML parse error at line 4",
+                scenario.display()
+            )),
+            "{text}"
+        );
+        // A value wrong after merging over the defaults: the file, no line.
+        let negative = file("n.toml", "[scalar]\nlag_s = -1.0\n");
+        let e = crate::simulate::simulate_scenario(kind, Some(&negative), None).unwrap_err();
+        assert_eq!(at(&e), (shown(&negative), None), "{e}");
+
+        let grad = file("g.toml", "seed = 3\n[system]\nbaseline_m = [1\n");
+        let e = crate::gradiometry::read_config(Some(&grad)).unwrap_err();
+        assert_eq!(at(&e), (shown(&grad), Some(3)), "{e}");
+
+        let read_grid = |p: &std::path::Path| -> Error {
+            crate::grid::format::read_grid(p).unwrap_err().into()
+        };
+        let grid = file("g.asc", "ncols 2\nnrows x\n");
+        let e = read_grid(&grid);
+        assert_eq!(at(&e).0, shown(&grid), "{e}");
+        assert!(e.os_error().is_none());
+
+        for missing in [
+            dir.join("none.asc"),
+            dir.join("none.tif"),
+            dir.join("none.nc"),
+        ] {
+            let e = read_grid(&missing);
+            assert_eq!(at(&e).0, shown(&missing), "{e}");
+            assert_eq!(
+                e.os_error().map(|o| o.kind()),
+                Some(std::io::ErrorKind::NotFound)
+            );
+        }
+        let missing = dir.join("none.json");
+        let e = crate::TlModel::read(&missing).unwrap_err();
+        assert_eq!(
+            e.os_error().map(|o| o.kind()),
+            Some(std::io::ErrorKind::NotFound)
+        );
+        let missing = dir.join("none.csv");
+        let e = crate::Flight::read(&missing).unwrap_err();
+        assert_eq!(at(&e).0, shown(&missing), "{e}");
+        assert_eq!(
+            e.os_error().map(|o| o.kind()),
+            Some(std::io::ErrorKind::NotFound)
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

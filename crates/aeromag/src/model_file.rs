@@ -77,12 +77,8 @@ pub fn read_text_file(path: &Path) -> Result<String> {
 pub fn kind_of(path: impl AsRef<Path>) -> Result<String> {
     let path = path.as_ref();
     let text = read_text_file(path)?;
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
-        Error::bad_file(
-            path.display().to_string(),
-            format!("not a JSON model file ({e})"),
-        )
-    })?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::json(path.display().to_string(), "not a JSON model file", &e))?;
     match v.get("kind").and_then(|k| k.as_str()) {
         Some(k) => Ok(k.to_string()),
         None => Err(Error::bad_file(

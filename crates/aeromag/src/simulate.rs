@@ -1,9 +1,10 @@
 //! Simulated flights with known truth, in memory (the simulator is
 //! [`aeromag_sim`]; `aeromag simulate` writes the same to a folder).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::flight::Flight;
-pub use aeromag_sim::ScenarioKind;
+pub use aeromag_sim::{ScenarioKind, Simulation};
+use std::path::Path;
 
 /// Simulate a fixed-wing, helicopter or pod scenario and return the flight:
 /// the canonical columns the instruments record and the `true_` columns of
@@ -27,6 +28,38 @@ pub fn simulate_flight(
     config_toml: Option<&str>,
     seed: Option<u64>,
 ) -> Result<Flight> {
-    let sim = aeromag_sim::simulate(kind, config_toml, seed)?;
-    Flight::from_table(sim.to_flight_table()?)
+    Flight::from_table(aeromag_sim::simulate(kind, config_toml, seed)?.to_flight_table()?)
+}
+
+/// Simulate a fixed-wing, helicopter or pod scenario with the scenario file
+/// at `config` (`None`: the scenario's defaults; `aeromag simulate
+/// --config`): the file is read with [`crate::model_file::read_text_file`]'s
+/// bound, and its errors name it (`'my.toml': scenario file: TOML parse
+/// error at line 3, column 9 …`, the line also in [`Error::location`]).
+pub fn simulate_scenario(
+    kind: ScenarioKind,
+    config: Option<&Path>,
+    seed: Option<u64>,
+) -> Result<Simulation> {
+    let Some(path) = config else {
+        return Ok(aeromag_sim::simulate(kind, None, seed)?);
+    };
+    let text = crate::model_file::read_text_file(path)?;
+    aeromag_sim::simulate(kind, Some(&text), seed).map_err(|e| {
+        if e.is_bad_input() {
+            Error::in_text(path.display().to_string(), e)
+        } else {
+            e.into()
+        }
+    })
+}
+
+/// [`simulate_flight`] with the scenario file at `config`
+/// ([`simulate_scenario`]).
+pub fn simulate_flight_file(
+    kind: ScenarioKind,
+    config: Option<&Path>,
+    seed: Option<u64>,
+) -> Result<Flight> {
+    Flight::from_table(simulate_scenario(kind, config, seed)?.to_flight_table()?)
 }

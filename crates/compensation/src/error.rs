@@ -36,6 +36,9 @@ pub enum CompError {
     ModelFile {
         /// The file (or other origin) as given.
         origin: String,
+        /// 1-based line of the file, for a syntax error the JSON parser
+        /// places (its message says the line and column too).
+        line: Option<u64>,
         /// What is wrong.
         reason: String,
     },
@@ -105,6 +108,15 @@ impl CompError {
         }
     }
 
+    /// [`CompError::ModelFile`] of `origin`, without a line.
+    pub fn model_file(origin: &str, reason: impl Into<String>) -> Self {
+        CompError::ModelFile {
+            origin: origin.to_string(),
+            line: None,
+            reason: reason.into(),
+        }
+    }
+
     /// [`CompError::UnusableData`].
     pub fn data(reason: impl Into<String>) -> Self {
         CompError::UnusableData {
@@ -157,13 +169,7 @@ mod tests {
     fn input_errors_and_failures_are_told_apart() {
         assert!(CompError::setting("λ < 0").is_bad_input());
         assert!(CompError::data("3 rows").is_bad_input());
-        assert!(
-            CompError::ModelFile {
-                origin: "m.json".into(),
-                reason: "not JSON".into()
-            }
-            .is_bad_input()
-        );
+        assert!(CompError::model_file("m.json", "not JSON").is_bad_input());
         assert!(!CompError::Singular { reason: "P".into() }.is_bad_input());
         assert!(!CompError::Failed { reason: "x".into() }.is_bad_input());
         let under = EstError::Underdetermined {

@@ -28,12 +28,10 @@ pub const READ_FORMATS: [&str; 2] = [MODEL_FORMAT, "aeromag-model/1"];
 /// `kind` of a Tolles-Lawson model (both fitting methods).
 pub const TL_KIND: &str = "tolles-lawson";
 
-/// [`CompError::ModelFile`] of `origin`.
-fn model_error(origin: &str, reason: impl Into<String>) -> CompError {
-    CompError::ModelFile {
-        origin: origin.to_string(),
-        reason: reason.into(),
-    }
+/// The 1-based line of a JSON parser's error (`None` when it names none:
+/// an error found after parsing, such as a missing field of a value).
+pub fn json_error_line(e: &serde_json::Error) -> Option<u64> {
+    (e.line() > 0).then_some(e.line() as u64)
 }
 
 /// Parse a model file and check its `format` (one of [`READ_FORMATS`]) and `kind`
@@ -45,12 +43,15 @@ pub fn parse_model_json(
     kind: &str,
     writer: &str,
 ) -> Result<serde_json::Value> {
-    let v: serde_json::Value = serde_json::from_str(text)
-        .map_err(|e| model_error(origin, format!("not a JSON model file ({e})")))?;
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| CompError::ModelFile {
+        origin: origin.to_string(),
+        line: json_error_line(&e),
+        reason: format!("not a JSON model file ({e})"),
+    })?;
     match v.get("format").and_then(|f| f.as_str()) {
         Some(f) if READ_FORMATS.contains(&f) => {}
         Some(other) => {
-            return Err(model_error(
+            return Err(CompError::model_file(
                 origin,
                 format!(
                     "model format {} is not supported (expected one of {})",
@@ -60,7 +61,7 @@ pub fn parse_model_json(
             ));
         }
         None => {
-            return Err(model_error(
+            return Err(CompError::model_file(
                 origin,
                 "no \"format\" key; not an aeromag model file",
             ));
@@ -68,7 +69,7 @@ pub fn parse_model_json(
     }
     match v.get("kind").and_then(|k| k.as_str()) {
         Some(k) if k == kind => Ok(v),
-        found => Err(model_error(
+        found => Err(CompError::model_file(
             origin,
             format!(
                 "model kind {} is not a `{kind}` model (written by `{writer}`)",
@@ -91,7 +92,7 @@ pub fn parse_model<T: serde::de::DeserializeOwned>(
     // convert before they come here).
     v["format"] = MODEL_FORMAT.into();
     serde_json::from_value(v)
-        .map_err(|e| model_error(origin, format!("invalid `{kind}` model: {e}")))
+        .map_err(|e| CompError::model_file(origin, format!("invalid `{kind}` model: {e}")))
 }
 
 /// One named coefficient.
@@ -269,11 +270,11 @@ impl TlModel {
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let v = parse_model_json(text, origin, TL_KIND, "aeromag calibrate")?;
         let mut m: TlModel = serde_json::from_value(v)
-            .map_err(|e| model_error(origin, format!("invalid model file: {e}")))?;
+            .map_err(|e| CompError::model_file(origin, format!("invalid model file: {e}")))?;
         m.format = MODEL_FORMAT.into();
         m.design
             .validate()
-            .map_err(|e| model_error(origin, e.to_string()))?;
+            .map_err(|e| CompError::model_file(origin, e.to_string()))?;
         let expect = m.design.column_names();
         let got: Vec<&str> = m.coefficients.iter().map(|c| c.name.as_str()).collect();
         if expect.iter().map(|s| s.as_str()).ne(got.iter().copied()) {
@@ -287,7 +288,7 @@ impl TlModel {
                 1 => " with 1 eddy lag".to_string(),
                 n => format!(" with {n} eddy lags"),
             };
-            return Err(model_error(
+            return Err(CompError::model_file(
                 origin,
                 format!(
                     "its terms `{}`{lags} take {} coefficients and it names {}: coefficient {} is {} where the terms have {}",
@@ -301,10 +302,10 @@ impl TlModel {
             ));
         }
         if m.coefficients.iter().any(|c| !c.value.is_finite()) {
-            return Err(model_error(origin, "a coefficient is not finite"));
+            return Err(CompError::model_file(origin, "a coefficient is not finite"));
         }
         if let Some(c) = m.coefficients.iter().find(|c| c.std < 0.0) {
-            return Err(model_error(
+            return Err(CompError::model_file(
                 origin,
                 format!(
                     "coefficient `{}` has a negative standard deviation {}",
@@ -381,14 +382,14 @@ impl SensorsModel {
             "aeromag calibrate --mag A,B,…",
         )?;
         let mut m: SensorsModel = serde_json::from_value(v)
-            .map_err(|e| model_error(origin, format!("invalid model file: {e}")))?;
+            .map_err(|e| CompError::model_file(origin, format!("invalid model file: {e}")))?;
         m.format = MODEL_FORMAT.into();
         if m.sensors.is_empty() {
-            return Err(model_error(origin, "no sensor"));
+            return Err(CompError::model_file(origin, "no sensor"));
         }
         for s in m.sensors.iter_mut() {
-            let json =
-                serde_json::to_string(&s.model).map_err(|e| model_error(origin, e.to_string()))?;
+            let json = serde_json::to_string(&s.model)
+                .map_err(|e| CompError::model_file(origin, e.to_string()))?;
             s.model = TlModel::from_json(&json, &format!("{origin}, sensor {}", s.name))?;
         }
         let names: Vec<&str> = m.sensors.iter().map(|s| s.name.as_str()).collect();
@@ -397,7 +398,7 @@ impl SensorsModel {
             .enumerate()
             .find(|(k, n)| names[..*k].contains(n))
         {
-            return Err(model_error(
+            return Err(CompError::model_file(
                 origin,
                 format!("sensor `{}` appears twice", d.1),
             ));

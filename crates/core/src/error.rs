@@ -95,9 +95,30 @@ pub fn shown_text(s: &str) -> String {
     }
 }
 
+/// The 1-based line of byte `offset` of `text` (a parser's error span →
+/// the line a caller reports in a structured error; offsets past the end
+/// give the last line).
+pub fn line_of(text: &str, offset: usize) -> u64 {
+    let end = offset.min(text.len());
+    1 + text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count() as u64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn line_of_counts_the_lines_before_an_offset() {
+        let text = "a = 1\nb = [\nc";
+        assert_eq!(line_of(text, 0), 1);
+        assert_eq!(line_of(text, 5), 1);
+        assert_eq!(line_of(text, 6), 2);
+        assert_eq!(line_of(text, 12), 3);
+        assert_eq!(line_of(text, 999), 3);
+    }
 
     #[test]
     fn texts_are_escaped_and_cut() {

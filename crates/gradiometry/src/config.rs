@@ -355,7 +355,7 @@ pub const MAX_PASSES: usize = 100;
 pub const NOISE_RANGE_NT: (f64, f64) = (1e-6, 1e4);
 
 fn cfg_err(e: impl std::fmt::Display) -> GradiometryError {
-    GradiometryError::Config(e.to_string())
+    GradiometryError::config(e.to_string())
 }
 
 fn v3(a: [f64; 3]) -> Vector3<f64> {
@@ -366,7 +366,7 @@ impl GradiometerConfig {
     /// Parse a scenario file (fields not given take the defaults) and
     /// validate it. Errors: [`GradiometryError::Config`] naming the field.
     pub fn from_toml(text: &str) -> Result<Self> {
-        let c: Self = toml::from_str(text).map_err(cfg_err)?;
+        let c: Self = toml::from_str(text).map_err(|e| GradiometryError::toml(text, &e))?;
         c.validate()?;
         Ok(c)
     }
@@ -650,8 +650,23 @@ mod tests {
             ),
         ] {
             let e = GradiometerConfig::from_toml(text).unwrap_err();
-            assert!(matches!(e, GradiometryError::Config(_)), "{e:?}");
+            assert!(matches!(e, GradiometryError::Config { .. }), "{e:?}");
             assert!(e.to_string().contains(needle), "{text}: {e}");
         }
+    }
+
+    #[test]
+    fn syntax_errors_carry_their_line() {
+        let e = GradiometerConfig::from_toml("seed = 3\n[system\n").unwrap_err();
+        assert!(
+            matches!(e, GradiometryError::Config { line: Some(2), .. }),
+            "{e:?}"
+        );
+        let e =
+            GradiometerConfig::from_toml("seed = 3\n\n[system]\nbaseline_m = \"x\"\n").unwrap_err();
+        assert!(
+            matches!(e, GradiometryError::Config { line: Some(4), .. }),
+            "{e:?}"
+        );
     }
 }

@@ -46,8 +46,14 @@ pub enum GradiometryError {
     Singular(&'static str),
     /// A scenario file that does not parse or holds an invalid value (the
     /// message names the field, and the line and column for syntax errors).
-    #[error("scenario file: {0}")]
-    Config(String),
+    #[error("scenario file: {message}")]
+    Config {
+        /// 1-based line of the file, for a syntax or type error the TOML
+        /// parser places (`None` for a value found wrong afterwards).
+        line: Option<u64>,
+        /// What is wrong.
+        message: String,
+    },
     /// Inconsistent input lengths.
     #[error("length mismatch: {what} has {got}, expected {expected}")]
     LengthMismatch {
@@ -70,6 +76,27 @@ impl GradiometryError {
             self,
             GradiometryError::Singular(_) | GradiometryError::Diverged(_)
         )
+    }
+}
+
+impl GradiometryError {
+    /// [`GradiometryError::Config`] without a line.
+    pub fn config(message: impl Into<String>) -> Self {
+        GradiometryError::Config {
+            line: None,
+            message: message.into(),
+        }
+    }
+
+    /// [`GradiometryError::Config`] of a TOML parser's error on `text`
+    /// (its span gives the line).
+    pub fn toml(text: &str, e: &toml::de::Error) -> Self {
+        GradiometryError::Config {
+            line: e
+                .span()
+                .map(|s| aeromag_core::error::line_of(text, s.start)),
+            message: e.to_string(),
+        }
     }
 }
 
@@ -107,7 +134,7 @@ mod tests {
     #[test]
     fn only_a_singular_matrix_is_not_bad_input() {
         assert!(GradiometryError::NotFinite { name: "x" }.is_bad_input());
-        assert!(GradiometryError::Config("bad".into()).is_bad_input());
+        assert!(GradiometryError::config("bad").is_bad_input());
         assert!(!GradiometryError::Singular("information").is_bad_input());
         assert!(!GradiometryError::Diverged("passes".into()).is_bad_input());
         let e = in_range("estimator.passes", 1e300, 1.0, 100.0).unwrap_err();

@@ -285,7 +285,7 @@ fn rng(seed: u64, stream: Stream) -> ChaCha8Rng {
 pub fn simulate(s: &Scenario) -> Result<Vec<SimEpoch>> {
     s.validate()?;
     let igrf = IgrfModel::new(s.decimal_year)
-        .map_err(|e| GradiometryError::Config(format!("decimal_year: {e}")))?;
+        .map_err(|e| GradiometryError::config(format!("decimal_year: {e}")))?;
     let mut bias_rng = rng(s.seed, Stream::Bias);
     let mut noise_rng = rng(s.seed, Stream::Noise);
     let mut var_rng = rng(s.seed, Stream::Variation);

@@ -61,6 +61,16 @@ pub enum GridError {
         /// What is wrong.
         reason: String,
     },
+    /// A grid file (or its `.prj`) that cannot be opened or read: missing,
+    /// not readable, not text where text is expected.
+    #[error("reading '{path}': {source}")]
+    Open {
+        /// The file.
+        path: String,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
     /// A node value of a grid file that is not a grid value: infinite, or
     /// larger in magnitude than [`MAX_VALUE`](crate::grid::MAX_VALUE)
     /// (float32's largest).

@@ -559,3 +559,13 @@ pub struct Location {
     /// The column (or field) concerned.
     pub column: Option<String>,
 }
+
+impl Location {
+    /// A location that names the file alone.
+    pub fn in_file(file: impl Into<String>) -> Self {
+        Location {
+            file: Some(file.into()),
+            ..Location::default()
+        }
+    }
+}

@@ -13,8 +13,14 @@ use std::path::PathBuf;
 pub enum SimError {
     /// The scenario TOML could not be parsed (syntax, unknown field, wrong
     /// type). The message of the TOML parser names the line and column.
-    #[error("scenario file: {0}")]
-    ConfigParse(String),
+    #[error("scenario file: {message}")]
+    ConfigParse {
+        /// 1-based line of the file, when the parser names one (a value
+        /// found wrong after merging over the defaults has none).
+        line: Option<u64>,
+        /// The parser's message.
+        message: String,
+    },
     /// A configuration value is outside its valid range.
     #[error("scenario value `{field}` is invalid: {reason}")]
     InvalidConfig {
@@ -80,12 +86,32 @@ pub enum SimError {
 }
 
 impl SimError {
+    /// [`SimError::ConfigParse`] of a TOML parser's error on `text` (its
+    /// span gives the line).
+    pub fn toml(text: &str, e: &toml::de::Error) -> Self {
+        SimError::ConfigParse {
+            line: e
+                .span()
+                .map(|s| aeromag_core::error::line_of(text, s.start)),
+            message: e.to_string(),
+        }
+    }
+
+    /// [`SimError::ConfigParse`] without a line (a value found wrong after
+    /// the file's table was merged over the defaults).
+    pub fn config(message: impl Into<String>) -> Self {
+        SimError::ConfigParse {
+            line: None,
+            message: message.into(),
+        }
+    }
+
     /// Whether the user's input caused the error: a scenario file that does
     /// not parse or holds an invalid value, a date outside IGRF-14, a
     /// pattern that cannot be flown. Running and writing failures are not.
     pub fn is_bad_input(&self) -> bool {
         match self {
-            SimError::ConfigParse(_)
+            SimError::ConfigParse { .. }
             | SimError::InvalidConfig { .. }
             | SimError::Trajectory(_)
             | SimError::Overflow { .. }
@@ -147,7 +173,13 @@ mod tests {
 
     #[test]
     fn scenario_problems_are_bad_input_and_failures_are_not() {
-        assert!(SimError::ConfigParse("line 3".into()).is_bad_input());
+        assert!(
+            SimError::ConfigParse {
+                line: Some(3),
+                message: "line 3".into()
+            }
+            .is_bad_input()
+        );
         assert!(invalid("scalar.lag_s", "< 0").is_bad_input());
         assert!(!SimError::Numerics("fft".into()).is_bad_input());
         let w = SimError::Write {

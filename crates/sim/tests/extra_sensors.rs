@@ -270,7 +270,7 @@ fn extra_sensors_are_reproducible_and_their_file_reruns_the_flight() {
 fn extra_sensor_settings_are_checked() {
     let bad = |text: &str| simulate(ScenarioKind::Calibration, Some(text), Some(1)).unwrap_err();
     let e = bad("[[extra_scalars]]\nposition_m = [-2.0, 0.0]\n");
-    assert!(matches!(e, SimError::ConfigParse(_)), "{e}");
+    assert!(matches!(e, SimError::ConfigParse { .. }), "{e}");
     let e = bad("[[extra_scalars]]\nposition = [-2.0, 0.0, 0.0]\n");
     assert!(e.to_string().contains("position"), "{e}");
     let e = bad("[[extra_fluxgates]]\nposition_m = [-200.0, 0.0, 0.0]\n");

@@ -383,14 +383,18 @@ fn configuration_errors_are_clear() {
         None,
     );
     match typo {
-        Err(SimError::ConfigParse(msg)) => {
-            assert!(msg.contains("altitud_m") && msg.contains("line 2"), "{msg}");
+        Err(SimError::ConfigParse { line, message }) => {
+            assert!(
+                message.contains("altitud_m") && message.contains("line 2"),
+                "{message}"
+            );
+            assert_eq!(line, Some(2));
         }
         other => panic!("expected a parse error, got {other:?}"),
     }
     let wrong_type = simulate(ScenarioKind::Survey, Some("seed = \"seven\"\n"), None);
     assert!(
-        matches!(wrong_type, Err(SimError::ConfigParse(_))),
+        matches!(wrong_type, Err(SimError::ConfigParse { line: Some(1), .. })),
         "{wrong_type:?}"
     );
     let bad_value = simulate(ScenarioKind::Survey, Some("[scalar]\nlag_s = -1.0\n"), None);
@@ -416,7 +420,10 @@ fn configuration_errors_are_clear() {
         }
     }
     let bad_toml = simulate(ScenarioKind::Calibration, Some("[pattern\n"), None);
-    assert!(matches!(bad_toml, Err(SimError::ConfigParse(_))));
+    assert!(matches!(
+        bad_toml,
+        Err(SimError::ConfigParse { line: Some(1), .. })
+    ));
     let huge_seed = simulate(ScenarioKind::Calibration, None, Some(u64::MAX));
     assert!(matches!(huge_seed, Err(SimError::InvalidConfig { .. })));
     // TOML's nan and inf are refused naming the key, in every scenario

@@ -88,7 +88,7 @@ pub fn read_system(path: &Path) -> Result<EmSystem> {
     let file = path.display().to_string();
     let text = crate::model_file::read_text_file(path)?;
     let s: EmSystem = serde_json::from_str(&text)
-        .map_err(|e| Error::bad_file(&file, format!("not an EM system description: {e}")))?;
+        .map_err(|e| Error::json(&file, "not an EM system description", &e))?;
     s.validate()
         .map_err(|e| Error::bad_file(&file, e.to_string()))?;
     Ok(s)

@@ -42,8 +42,9 @@ pub fn parse_config(text: Option<&str>, origin: &str) -> Result<EmSimConfig> {
         });
     };
     if let Some(text) = text {
-        let user: toml::Table = toml::from_str(text).map_err(|e| bad(&e))?;
-        aeromag_sim::scenario::config::check_finite_numbers(&user).map_err(|e| bad(&e))?;
+        let user: toml::Table = toml::from_str(text).map_err(|e| Error::toml(origin, text, &e))?;
+        aeromag_sim::scenario::config::check_finite_numbers(&user)
+            .map_err(|e| Error::in_text(origin, e))?;
         table.extend(user);
     }
     toml::Value::Table(table).try_into().map_err(|e| bad(&e))

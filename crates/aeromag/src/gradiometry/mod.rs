@@ -44,11 +44,10 @@ pub fn read_config(path: Option<&Path>) -> Result<GradiometerConfig> {
         None => Ok(GradiometerConfig::default()),
         Some(p) => {
             let text = crate::model_file::read_text_file(p)?;
-            let bad =
-                |e: &dyn std::fmt::Display| Error::bad_file(p.display().to_string(), e.to_string());
-            let cfg = GradiometerConfig::from_toml(&text).map_err(|e| bad(&e))?;
+            let bad = |e: Error| Error::in_text(p.display().to_string(), e);
+            let cfg = GradiometerConfig::from_toml(&text).map_err(|e| bad(e.into()))?;
             // TOML nan and inf, which the configuration's own checks let through.
-            aeromag_sim::scenario::config::parse_table(&text).map_err(|e| bad(&e))?;
+            aeromag_sim::scenario::config::parse_table(&text).map_err(|e| bad(e.into()))?;
             Ok(cfg)
         }
     }

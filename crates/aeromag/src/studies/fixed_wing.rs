@@ -221,7 +221,7 @@ pub struct FixedWingOutcome {
 /// The typed scenario of a written fixed-wing flight.
 fn scenario<P: serde::de::DeserializeOwned + Default>(path: &Path) -> Result<FixedWingConfig<P>> {
     let text = crate::model_file::read_text_file(path)?;
-    toml::from_str(&text).map_err(|e| Error::bad_file(path.display().to_string(), e.to_string()))
+    toml::from_str(&text).map_err(|e| Error::toml(path.display().to_string(), &text, &e))
 }
 
 /// The truth metadata the demo describes its boxes with.

@@ -1,7 +1,7 @@
 //! `aeromag simulate`: realistic flight data with known truth.
 
 use crate::exit::bad_input;
-use aeromag_sim::{ScenarioKind, default_config_toml, simulate};
+use aeromag_sim::{ScenarioKind, default_config_toml};
 use std::path::PathBuf;
 
 /// Simulate a flight with the physical simulator and write it to a folder.
@@ -79,10 +79,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         print!("{}", default_config_toml(kind)?);
         return Ok(());
     }
-    let text = match &a.config {
-        Some(p) => Some(aeromag::model_file::read_text_file(p)?),
-        None => None,
-    };
     let out = a
         .out
         .as_ref()
@@ -96,15 +92,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.config.as_deref(),
     )?;
     let spinner = crate::progress::spinner(&format!("simulating {kind}"));
-    // The scenario file named with its values' errors (a flight the
-    // readers would refuse is found at writing).
+    // The scenario file named with its errors at writing too (a flight the
+    // readers would refuse is found there).
     let in_config = |e: aeromag_sim::SimError| match &a.config {
         Some(p) if e.is_bad_input() => {
             anyhow::Error::new(e).context(format!("in '{}'", p.display()))
         }
         _ => anyhow::Error::new(e),
     };
-    let sim = simulate(kind, text.as_deref(), a.seed).map_err(in_config)?;
+    let sim = aeromag::simulate::simulate_scenario(kind, a.config.as_deref(), a.seed)?;
     spinner.finish_and_clear();
     let files = sim.write_to_dir(out).map_err(in_config)?;
     println!(

@@ -90,10 +90,8 @@ impl RotorModelFile {
     /// fields and [`Self::validate`].
     pub fn from_json(text: &str, origin: &str) -> Result<Self> {
         let m: Self = parse_model(text, origin, ROTOR_KIND, "aeromag rotor fit")?;
-        m.validate().map_err(|e| CompError::ModelFile {
-            origin: origin.to_string(),
-            reason: e.to_string(),
-        })?;
+        m.validate()
+            .map_err(|e| CompError::model_file(origin, e.to_string()))?;
         Ok(m)
     }
 

@@ -44,7 +44,7 @@ use std::path::Path;
 
 use super::{
     CoordinateUnit, NODATA, check_declared_size, check_grid, check_values, checked_geometry,
-    crs_from_wkt, crs_wkt, not_metres, read_error, stem, wkt_unit, write_atomic,
+    crs_from_wkt, crs_wkt, not_metres, open_error, read_error, stem, wkt_unit, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -114,7 +114,7 @@ fn push_f32(s: &mut String, v: f64) {
 /// Reads an ESRI ASCII grid and its `.prj` sidecar, if any. The name is the
 /// file stem and the unit empty (the format carries neither).
 pub fn read(path: &Path) -> Result<Grid> {
-    let text = fs::read_to_string(path).map_err(|e| read_error(path, e))?;
+    let text = fs::read_to_string(path).map_err(|e| open_error(path, e))?;
     let (mut nx, mut ny, mut x, mut y, mut cell, mut nodata) = (None, None, None, None, None, None);
     let mut corner = (false, false);
     // The header: one `keyword value` per line, up to the first line that
@@ -205,7 +205,7 @@ pub fn read(path: &Path) -> Result<Grid> {
     let prj = path.with_extension("prj");
     let mut crs = None;
     if prj.is_file() {
-        let wkt = fs::read_to_string(&prj).map_err(|e| read_error(&prj, e))?;
+        let wkt = fs::read_to_string(&prj).map_err(|e| open_error(&prj, e))?;
         if let Some(unit) = wkt_unit(&wkt).filter(|u| *u != CoordinateUnit::Metre) {
             let by = format!("its .prj ({})", prj.display());
             return Err(not_metres(path, &by, &unit));

@@ -46,7 +46,7 @@ use tiff::{ColorType, TiffError};
 
 use super::{
     CoordinateUnit, NODATA, check_declared_size, check_grid, check_values, checked_geometry,
-    crs_from_epsg, label_from_file, not_metres, read_error, stem, write_atomic,
+    crs_from_epsg, label_from_file, not_metres, open_error, read_error, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -342,7 +342,7 @@ fn check_chunks<R: std::io::Read + Seek>(
 /// come from `GDAL_METADATA` (else the file stem and no unit), the CRS
 /// from `ProjectedCSTypeGeoKey` when it is a WGS 84 / UTM code.
 pub fn read(path: &Path) -> Result<Grid> {
-    let file = File::open(path).map_err(|e| read_error(path, e))?;
+    let file = File::open(path).map_err(|e| open_error(path, e))?;
     let err = |e: TiffError| read_error(path, tiff_reason(e));
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(err)?

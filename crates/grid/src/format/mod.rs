@@ -305,6 +305,14 @@ pub(crate) fn read_error(path: &Path, what: impl std::fmt::Display) -> GridError
     }
 }
 
+/// The error of a file that cannot be opened or read.
+pub(crate) fn open_error(path: &Path, source: std::io::Error) -> GridError {
+    GridError::Open {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
 /// Checks the geometry of a grid read from a file: a cell size within
 /// [`MIN_CELL`]–[`MAX_CELL`], node coordinates within ±[`MAX_COORDINATE`],
 /// a node count within [`MAX_NODES`].

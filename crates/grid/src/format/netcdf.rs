@@ -50,7 +50,8 @@ use std::path::Path;
 
 use super::{
     CoordinateUnit, check_grid, check_values, checked_geometry, crs_from_epsg, crs_from_wkt,
-    crs_wkt, in_nanotesla, label_from_file, not_metres_reason, read_error, wkt_unit, write_atomic,
+    crs_wkt, in_nanotesla, label_from_file, not_metres_reason, open_error, read_error, wkt_unit,
+    write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -640,7 +641,7 @@ fn in_metres(mut values: Vec<f64>, v: &Variable) -> Parse<Vec<f64>> {
 
 /// Reads a netCDF classic grid (module docs for what is accepted).
 pub fn read(path: &Path) -> Result<Grid> {
-    let bytes = fs::read(path).map_err(|e| read_error(path, e))?;
+    let bytes = fs::read(path).map_err(|e| open_error(path, e))?;
     let (geometry, grid) = read_bytes(&bytes).map_err(|e| read_error(path, e))?;
     checked_geometry(path, geometry)?;
     check_values(path, &grid)?;

@@ -238,8 +238,7 @@ impl<P: Pattern> FixedWingConfig<P> {
             None => defaults,
             Some(text) => {
                 // Pass 1: syntax, unknown fields and types, with line numbers.
-                let _: Self =
-                    toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+                let _: Self = toml::from_str(text).map_err(|e| SimError::toml(text, &e))?;
                 let mut user = parse_table(text)?;
                 apply_area_preset(&mut user);
                 let mut defaults = defaults;
@@ -256,7 +255,7 @@ impl<P: Pattern> FixedWingConfig<P> {
                 toml::Value::Table(base)
                     .try_into()
                     .map_err(|e: toml::de::Error| {
-                        SimError::ConfigParse(format!("{} scenario: {e}", kind.name()))
+                        SimError::config(format!("{} scenario: {e}", kind.name()))
                     })?
             }
         };
@@ -391,8 +390,7 @@ pub fn check_finite_numbers(table: &toml::Table) -> Result<()> {
 /// A scenario file's text as a TOML table (syntax errors with the parser's
 /// line and column), its numbers checked finite ([`check_finite_numbers`]).
 pub fn parse_table(text: &str) -> Result<toml::Table> {
-    let table: toml::Table =
-        toml::from_str(text).map_err(|e| SimError::ConfigParse(e.to_string()))?;
+    let table: toml::Table = toml::from_str(text).map_err(|e| SimError::toml(text, &e))?;
     check_finite_numbers(&table)?;
     Ok(table)
 }

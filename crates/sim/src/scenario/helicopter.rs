@@ -146,13 +146,13 @@ impl HelicopterConfig {
             None => defaults.rotor,
             Some(v) => v
                 .try_into::<RotorConfig>()
-                .map_err(|e| SimError::ConfigParse(format!("[rotor]: {e}")))?,
+                .map_err(|e| SimError::config(format!("[rotor]: {e}")))?,
         };
         let tail_rotor = match user.remove("tail_rotor") {
             None => defaults.tail_rotor,
             Some(v) => Some(
                 v.try_into::<TailRotorConfig>()
-                    .map_err(|e| SimError::ConfigParse(format!("[tail_rotor]: {e}")))?,
+                    .map_err(|e| SimError::config(format!("[tail_rotor]: {e}")))?,
             ),
         };
         let rest = toml::to_string(&user).map_err(|e| SimError::Serialize {

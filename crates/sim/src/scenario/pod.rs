@@ -584,8 +584,7 @@ impl PodConfig {
             None => Self::default(),
             Some(t) => {
                 super::config::parse_table(t)?;
-                toml::from_str::<Self>(t)
-                    .map_err(|e| crate::error::SimError::ConfigParse(e.to_string()))?
+                toml::from_str::<Self>(t).map_err(|e| crate::error::SimError::toml(t, &e))?
             }
         };
         if let Some(s) = seed {
