@@ -3,16 +3,22 @@
 //! warnings.
 
 use aeromag::{ColumnMap, Fields, Flight, ReadOptions, RowSelection, Sensors};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Input-file arguments shared by the commands that read flight data.
 #[derive(Debug, Clone, clap::Args)]
+#[group(skip)]
+#[command(group = clap::ArgGroup::new("flight_file").required(true).multiple(false))]
 pub struct InputArgs {
     /// Flight data file: CSV (header row, `#` comments), Geosoft XYZ
     /// (`.xyz`) or HDF5 in the MagNav/SGL layout (`.h5`: one dataset per
     /// field).
-    #[arg(long, short = 'i', value_name = "FILE")]
-    pub input: PathBuf,
+    #[arg(long, short = 'i', value_name = "FILE", group = "flight_file")]
+    input: Option<PathBuf>,
+    /// The flight data file, as --input gives it (`aeromag inspect
+    /// flight.xyz`).
+    #[arg(value_name = "FILE", group = "flight_file")]
+    file: Option<PathBuf>,
     /// Map canonical column names onto the file's names, e.g.
     /// `mag=mag_1_uc,flux_x=flux_a_x,time=tt` (MagNav names are recognised
     /// automatically).
@@ -82,6 +88,15 @@ fn read_checked(path: &std::path::Path, opts: &ReadOptions) -> anyhow::Result<Fl
 }
 
 impl InputArgs {
+    /// The flight file, given with --input or as the positional FILE (clap
+    /// asks for one of them).
+    pub fn path(&self) -> &Path {
+        self.input
+            .as_deref()
+            .or(self.file.as_deref())
+            .unwrap_or(Path::new(""))
+    }
+
     /// The library's reading options for these arguments.
     pub fn read_options(&self) -> anyhow::Result<ReadOptions> {
         Ok(ReadOptions {
@@ -145,6 +160,6 @@ impl InputArgs {
             fields,
             ..self.read_options()?
         };
-        read_checked(&self.input, &opts)
+        read_checked(self.path(), &opts)
     }
 }

@@ -35,6 +35,45 @@ fn summarises_a_good_file() {
     assert!(!s.contains("off the track"), "{s}");
 }
 
+/// The flight file may be given as the command's argument, as `--input`
+/// gives it (`aeromag inspect flight.xyz`), but not both ways at once nor
+/// not at all.
+#[test]
+fn the_file_may_be_given_without_input() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(&d, "good.csv", GOOD.as_bytes());
+    let file = p.to_str().unwrap();
+    let with_input = aeromag(&["inspect", "--input", file]);
+    let plain = aeromag(&["inspect", file]);
+    assert_code(&plain, 0);
+    assert_eq!(stdout(&plain), stdout(&with_input));
+    let one_line = aeromag(&["inspect", file, "--lines", "1"]);
+    assert_code(&one_line, 0);
+    assert!(
+        stdout(&one_line).contains("rows     3"),
+        "{}",
+        stdout(&one_line)
+    );
+    let both = aeromag(&["inspect", "--input", file, file]);
+    assert_code(&both, 2);
+    assert!(
+        stderr(&both).contains("cannot be used with"),
+        "{}",
+        stderr(&both)
+    );
+    let neither = aeromag(&["inspect"]);
+    assert_code(&neither, 2);
+    assert!(
+        stderr(&neither).contains("<--input <FILE>|FILE>"),
+        "{}",
+        stderr(&neither)
+    );
+    // Every command reading a flight takes it so.
+    let out = d.path().join("m.json");
+    let cal = aeromag(&["calibrate", file, "--model", out.to_str().unwrap()]);
+    assert!(!stderr(&cal).contains("required"), "{}", stderr(&cal));
+}
+
 /// A file of one row has a time but no sampling (it said the file had
 /// no `time` column); a file without one still says so.
 #[test]

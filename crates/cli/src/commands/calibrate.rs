@@ -252,7 +252,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         std::iter::once(a.model.as_path())
             .chain(a.series.as_deref())
             .chain(a.compensated.as_deref()),
-        &[a.input.input.as_path()],
+        &[a.input.path()],
     )?;
     if a.input.several_sensors() || a.reference_sensor.is_some() {
         return run_sensors(&a, &opts);

@@ -42,10 +42,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_files(
-        [a.out.as_path()],
-        &[a.input.input.as_path(), a.model.as_path()],
-    )?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
     if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {
         return run_sensors(&a);

@@ -89,7 +89,7 @@ fn extent(s: &str) -> Result<[f64; 4], String> {
 pub fn run(a: Args) -> anyhow::Result<()> {
     // The format by the extension, then the path: both before the work.
     aeromag::map::SurveyGrid::format_of(&a.out)?;
-    crate::output::check_files([a.out.as_path()], &[a.input.input.as_path()])?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path()])?;
     let geometry = match (&a.extent, a.cell) {
         (Some(e), Some(cell)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], cell)?),
         (Some(_), None) => return Err(crate::exit::bad_input!("--extent needs --cell")),

@@ -114,7 +114,7 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files(
         std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()),
-        &[a.input.input.as_path()],
+        &[a.input.path()],
     )?;
     let flight = a.input.load()?;
     let opts = LevelOptions {

@@ -83,7 +83,7 @@ fn fixed(x: f64, decimals: usize) -> String {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()], &[a.input.input.as_path()])?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path()])?;
     let flight = a.input.load()?;
     let opts = MicrolevelOptions {
         column: a.column.clone(),

@@ -121,7 +121,7 @@ fn print_rates(label: &str, r: &[HeadingRate]) {
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.model.as_path()], &[a.input.input.as_path()])?;
+    crate::output::check_files([a.model.as_path()], &[a.input.path()])?;
     let setup = PodSetup {
         cable_length_m: a.cable_length_m,
         attach_m: a.attach_m.unwrap_or_default(),
@@ -147,10 +147,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 }
 
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
-    crate::output::check_files(
-        [a.out.as_path()],
-        &[a.input.input.as_path(), a.model.as_path()],
-    )?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
     let model = PodModelFile::read(&a.model)?;
     let t = a.input.load()?;
     let applied = apply_pod(&model, &t)?;

@@ -44,7 +44,7 @@ pub struct Args {
 const REPORT_FILES: [&str; 2] = ["index.html", "figures.json"];
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_folder_files(&a.out, REPORT_FILES, &[a.input.input.as_path()])?;
+    crate::output::check_folder_files(&a.out, REPORT_FILES, &[a.input.path()])?;
     if let Some(m) = &a.model
         && aeromag::model_file::kind_of(m)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {

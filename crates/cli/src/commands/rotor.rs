@@ -227,7 +227,7 @@ fn options(a: &FitArgs) -> anyhow::Result<RotorOptions> {
 }
 
 fn fit(a: FitArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.model.as_path()], &[a.input.input.as_path()])?;
+    crate::output::check_files([a.model.as_path()], &[a.input.path()])?;
     let opts = options(&a)?;
     let flight = a.input.load_canonical(&opts.extra_columns())?;
     let fit = fit_rotor(&flight, &opts, &mut Bars::new())?;
@@ -261,10 +261,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 }
 
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
-    crate::output::check_files(
-        [a.out.as_path()],
-        &[a.input.input.as_path(), a.model.as_path()],
-    )?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
     let model = aeromag::rotor::RotorModelFile::read(&a.model)?;
     let flight = a.input.load()?;
     let out = model.compensate_observed(&flight, &mut Bars::new())?;
