@@ -25,7 +25,10 @@ def test_chain_equals_the_cli(cli, record, tmp_path):
     # Python chain, from the objects.
     det = aeromag.detect_em(files["raw"])
     cal = aeromag.calibrate_em(det, files["known"], files["system"])
-    poses = aeromag.locate_em(det, cal)
+    calls = []
+    poses = aeromag.locate_em(det, cal, progress=lambda *call: calls.append(call))
+    # The progress callback was never called.
+    assert ("locating", 0, len(poses)) in calls, calls
     det.save(str(tmp_path / "det.csv"))
     cal.save(str(tmp_path / "cal.json"))
     poses.save(str(tmp_path / "poses.csv"))

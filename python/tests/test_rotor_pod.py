@@ -15,8 +15,12 @@ def test_rotor_model_equals_the_cli(cli, tmp_path):
     model = tmp_path / "rotor.json"
     cli("rotor", "fit", "-i", csv, "--preset", "aeromag-sim-helicopter", "--model", model)
     flight = aeromag.read_flight(csv)
-    m = aeromag.fit_rotor(flight, preset="aeromag-sim-helicopter")
+    stages = []
+    m = aeromag.fit_rotor(flight, preset="aeromag-sim-helicopter",
+                          progress=lambda stage, done, total: stages.append(stage))
     assert m.kind == "helicopter-rotor"
+    # The progress callback was never called.
+    assert "fitting the rotor model" in stages, stages
     m.save(tmp_path / "py.json")
     assert (tmp_path / "py.json").read_bytes() == model.read_bytes()
     loaded = aeromag.load_model(model)

@@ -411,6 +411,7 @@ pub fn fit_pod(
             ),
         ));
     }
+    notes.stage("fitting the pod model");
     notes.check_cancelled()?;
     let data: Vec<PodHeading> = hs.iter().map(|h| h.data.clone()).collect();
     let mut reference = [0.0; 3];

@@ -119,6 +119,10 @@ impl Poses {
     }
 }
 
+/// Epochs located between two progress reports and Ctrl-C checks of
+/// [`locate`].
+const LOCATE_STEP: usize = 1024;
+
 /// Locate the bird at every epoch: the calibration's stage 1 turns the
 /// complex fields into real major-axis vectors, the closed form (Gram
 /// matrix eigen-decomposition; rotation by SVD projection onto SO(3)) uses
@@ -142,6 +146,7 @@ pub fn locate(
     observer: &mut dyn Observer,
 ) -> Result<Poses> {
     let mut notes = Notes::new(observer);
+    notes.stage("locating");
     if let Some(fitted) = file.half_space.map(Vector3::from)
         && let Ok(fitted) = HalfSpace::new(fitted)
         && fitted
@@ -206,7 +211,18 @@ pub fn locate(
             )));
         }
     };
+    // Progress and Ctrl-C every LOCATE_STEP epochs (each fit takes tens
+    // of microseconds).
+    let total = epochs.len() as u64;
+    let step = |done: usize, notes: &mut Notes| -> Result<()> {
+        if done.is_multiple_of(LOCATE_STEP) {
+            notes.progress(done as u64, total);
+            notes.check_cancelled()?;
+        }
+        Ok(())
+    };
     for k in start..epochs.len() {
+        step(k - start, &mut notes)?;
         fits[k] = Some(fit(&epochs[k], &mut forward));
     }
     // Continuity from the anchor backwards over the undecided epochs before it.
@@ -216,6 +232,7 @@ pub fn locate(
             ..hemi0
         };
         for j in (0..k).rev() {
+            step(epochs.len() - start + (k - j), &mut notes)?;
             fits[j] = Some(fit(&epochs[j], &mut backward));
         }
     }

@@ -526,6 +526,7 @@ pub fn fit_rotor(
     )?;
     let nominal = [opts.nominal_angles];
     if estimated {
+        notes.stage("estimating the rotor phase");
         notes.check_cancelled()?;
         let inp = RotorInput {
             b_body_nt: &b,
@@ -555,6 +556,7 @@ pub fn fit_rotor(
         omega_rad_s: &omega,
         angles: &nominal,
     };
+    notes.stage("fitting the rotor model");
     notes.check_cancelled()?;
     // A tail rotor whose blade-passing signal the sensor does not see is
     // left out (`TailFit::tail_is_seen`).
@@ -634,7 +636,9 @@ pub fn fit_rotor(
     // are refined on all of them, each with its own phase and slowly varying
     // angles tracked as `rotor apply` would.
     if segs.len() > 1 {
-        for _ in 0..REFINE_ITERATIONS {
+        notes.stage(&format!("refining on {} stretches", segs.len()));
+        for round in 0..REFINE_ITERATIONS {
+            notes.progress(round as u64, REFINE_ITERATIONS as u64);
             notes.check_cancelled()?;
             // Each stretch tracked alone: the stretches on the cores, the
             // first failure in their order reported.
