@@ -457,6 +457,15 @@ impl PyFlight {
             .py_err()
     }
 
+    /// Write the flight as Geosoft XYZ (`/` header of the column names,
+    /// `*` for missing values, the line labels a column; as the CLI writes
+    /// `--out X.xyz`): bad input for a column name or text cell the format
+    /// cannot hold.
+    fn to_xyz(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| aeromag::io::write_xyz(self.inner.table(), &path))
+            .py_err()
+    }
+
     /// Number of rows.
     fn __len__(&self) -> usize {
         self.inner.n_rows()

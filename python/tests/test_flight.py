@@ -192,3 +192,20 @@ def test_a_field_asked_for_that_the_file_lacks_is_bad_input(cal_csv):
     assert "nosuch" in str(e.value)
     f = aeromag.read_flight(cal_csv, fields=["MAG"])
     assert "mag" in f.columns
+
+
+def test_to_xyz_reads_back_to_the_same_flight(tmp_path):
+    """Geosoft XYZ out (as ``--out X.xyz``) and in again: the same columns
+    and bits; a text cell with a space is refused naming column and row."""
+    cal = aeromag.simulate("calibration", seed=2)
+    cal.to_xyz(tmp_path / "c.xyz")
+    assert (tmp_path / "c.xyz").read_text().startswith("/ XYZ export of aeromag ")
+    back = aeromag.read_flight(tmp_path / "c.xyz")
+    assert back.columns == cal.columns
+    for name in cal.columns:
+        np.testing.assert_array_equal(back[name], cal[name])
+    spaced = aeromag.Flight.from_dict({"time": [0.0, 1.0], "mag": [5e4, 5e4], "note": ["ok", "two words"]})
+    with pytest.raises(aeromag.BadInputError) as e:
+        spaced.to_xyz(tmp_path / "s.xyz")
+    assert (e.value.column, e.value.row) == ("note", 1)
+    assert not (tmp_path / "s.xyz").exists()

@@ -20,7 +20,7 @@ pub fn write_compensated(
 ) -> anyhow::Result<()> {
     let (missing, output) = (out.missing, out.output);
     let table = out.into_table(flight)?;
-    aeromag::io::write_csv(&table, path)?;
+    aeromag::io::write_table(&table, path)?;
     let n = table.n_rows();
     if missing > 0 {
         eprintln!(
@@ -62,7 +62,7 @@ pub fn write_compensated_sensors(
     let names: Vec<String> = out.columns().into_iter().map(|(n, _)| n).collect();
     let mut table = flight.into_table();
     out.add_to(&mut table)?;
-    aeromag::io::write_csv(&table, path)?;
+    aeromag::io::write_table(&table, path)?;
     let n = table.n_rows();
     if missing > 0 {
         eprintln!(
@@ -164,6 +164,16 @@ pub fn simulate_gradiometer(
     );
     println!("  data      {}", files.csv.display());
     println!("  scenario  {}", files.scenario.display());
+    Ok(())
+}
+
+/// Check, before any work, that a flight table can be written in the
+/// format each of `tables` asks for (CSV, or Geosoft XYZ for `.xyz`; a
+/// grid, model or HDF5 name is bad input).
+pub fn check_tables<'a>(tables: impl IntoIterator<Item = &'a Path>) -> anyhow::Result<()> {
+    for p in tables {
+        aeromag::io::TableFormat::of_path(p)?;
+    }
     Ok(())
 }
 

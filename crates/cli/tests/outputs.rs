@@ -240,3 +240,68 @@ fn a_fifo_that_no_process_reads_is_bad_input() {
     );
     assert!(!rep.join("index.html").exists());
 }
+
+/// `--out X.xyz` writes Geosoft XYZ (it wrote CSV under that name), which
+/// reads back to the table the CSV holds; a grid, model or HDF5 name is
+/// refused before the work (`--out out.h5` was CSV under that name).
+#[test]
+fn xyz_outputs_hold_the_csv_table_and_other_formats_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let cal = simulate(dir.path(), "calibration", "3");
+    let model = dir.path().join("m.json");
+    assert_code(
+        &aeromag(&[
+            "calibrate",
+            cal.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+            "--eddy-lag",
+            "none",
+        ]),
+        0,
+    );
+    let (csv, xyz) = (dir.path().join("c.csv"), dir.path().join("c.xyz"));
+    assert_code(&compensate(&model, &cal, &csv), 0);
+    assert_code(&compensate(&model, &cal, &xyz), 0);
+    let text = std::fs::read_to_string(&xyz).unwrap();
+    assert!(
+        text.starts_with("/ XYZ export of aeromag "),
+        "{}",
+        &text[..80]
+    );
+    let (a, b) = (
+        aeromag::Flight::read(&csv).unwrap(),
+        aeromag::Flight::read(&xyz).unwrap(),
+    );
+    let (ta, tb) = (a.table(), b.table());
+    assert_eq!(ta.column_names(), tb.column_names());
+    for name in ta.column_names() {
+        let bits = |t: &aeromag::io::FlightTable| -> Vec<u64> {
+            t.column(name)
+                .unwrap()
+                .iter()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        assert_eq!(bits(ta), bits(tb), "{name}");
+    }
+    for refused in ["c.h5", "c.tif", "c.json"] {
+        let out = dir.path().join(refused);
+        let o = aeromag(&[
+            "compensate",
+            "--model",
+            "absent.json",
+            "-i",
+            "absent.csv",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_code(&o, 2);
+        assert!(
+            stderr(&o).contains("CSV (.csv) or Geosoft XYZ (.xyz)"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!out.exists());
+    }
+}

@@ -53,13 +53,7 @@ pub fn write_csv(table: &FlightTable, path: &Path) -> Result<()> {
 /// Writes `table` as CSV to any writer (wrap unbuffered writers in a `BufWriter`).
 pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Result<()> {
     let mut line: Vec<u8> = Vec::with_capacity(4096);
-    // Derived columns (`lat` from `ins_lat` in radians) are not the input's:
-    // left out, so the output is the input plus the results.
-    let columns: Vec<&Column> = table
-        .columns()
-        .iter()
-        .filter(|c| !table.is_derived(c.name()))
-        .collect();
+    let columns = written_columns(table);
     for (i, c) in columns.iter().enumerate() {
         if i > 0 {
             line.push(b',');
@@ -69,7 +63,30 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
     line.push(b'\n');
     out.write_all(&line)?;
     let missing: &[u8] = if columns.len() == 1 { b"NaN" } else { b"" };
-    let n = table.n_rows();
+    write_rows::<b',', W>(&columns, table.n_rows(), missing, out)
+}
+
+/// The columns a table's file holds: derived columns (`lat` from
+/// `ins_lat` in radians) are not the input's and are left out, so the
+/// output is the input plus the results.
+pub(crate) fn written_columns(table: &FlightTable) -> Vec<&Column> {
+    table
+        .columns()
+        .iter()
+        .filter(|c| !table.is_derived(c.name()))
+        .collect()
+}
+
+/// Writes the `n` rows of `columns`, cells separated by `SEP` (`,` for
+/// CSV, a space for Geosoft XYZ, whose text cells [`crate::xyz_write`] has
+/// checked to need no quotes: an empty one is written `missing`), missing
+/// values as `missing`.
+pub(crate) fn write_rows<const SEP: u8, W: Write>(
+    columns: &[&Column],
+    n: usize,
+    missing: &[u8],
+    mut out: W,
+) -> std::io::Result<()> {
     let threads = aeromag_core::parallel::threads();
     // Chunks of rows are formatted by `threads` workers, each taking the
     // next chunk in turn, and written in order by the calling thread
@@ -83,7 +100,7 @@ pub fn write_csv_to<W: Write>(table: &FlightTable, mut out: W) -> std::io::Resul
         |(buf, len): &mut (Vec<u8>, usize)| {
             let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let a = k.checked_mul(chunk_rows).filter(|&a| a < n)?;
-            *len = format_rows(&columns, a..(a + chunk_rows).min(n), missing, buf);
+            *len = format_rows::<SEP>(columns, a..(a + chunk_rows).min(n), missing, buf);
             Some(k)
         },
         |(buf, len)| out.write_all(&buf[..*len]).map(|()| true),
@@ -127,7 +144,7 @@ impl<'a> Cells<'a> {
 /// `out[..len]`, returning `len`; missing values as `missing`. What `out`
 /// holds after `len` is left over (a buffer reused chunk after chunk is
 /// neither zeroed nor cut each time).
-fn format_rows(
+fn format_rows<const SEP: u8>(
     columns: &[&Column],
     rows: std::ops::Range<usize>,
     missing: &[u8],
@@ -141,10 +158,12 @@ fn format_rows(
         for row in rows {
             for (i, c) in cells.iter().enumerate() {
                 if i > 0 {
-                    out.push(b',');
+                    out.push(SEP);
                 }
                 match c {
-                    Cells::Text(t) => push_text(out, &t[row]),
+                    Cells::Text(t) if SEP == b',' => push_text(out, &t[row]),
+                    Cells::Text(t) if t[row].is_empty() => out.extend_from_slice(missing),
+                    Cells::Text(t) => out.extend_from_slice(t[row].as_bytes()),
                     _ => out.extend_from_slice(number(c, row, missing, &mut int, &mut float)),
                 }
             }
@@ -179,11 +198,11 @@ fn format_rows(
             }
             for text in &texts[..group.len()] {
                 pos = put(out, pos, text);
-                out[pos] = b',';
+                out[pos] = SEP;
                 pos += 1;
             }
         }
-        // The row's last comma is its line end.
+        // The row's last separator is its line end.
         if cells.is_empty() {
             pos += 1;
         }
@@ -330,7 +349,7 @@ mod tests {
         write_csv_to(&t, &mut out).unwrap();
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut rows = Vec::new();
-        let len = format_rows(&columns, 0..n, b"", &mut rows);
+        let len = format_rows::<b','>(&columns, 0..n, b"", &mut rows);
         let header_end = out.iter().position(|&b| b == b'\n').unwrap() + 1;
         assert_eq!(&out[header_end..], &rows[..len]);
         assert_eq!(String::from_utf8_lossy(&out).lines().count(), n + 1);
@@ -359,7 +378,7 @@ mod tests {
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut one = b"x,tag\n".to_vec();
         let mut rows = Vec::new();
-        let len = format_rows(&columns, 0..n, b"", &mut rows);
+        let len = format_rows::<b','>(&columns, 0..n, b"", &mut rows);
         rows.truncate(len);
         one.extend(rows);
         assert_eq!(out, one);
@@ -417,7 +436,7 @@ mod tests {
         t.add_column("b", shifted.clone()).unwrap();
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut got = Vec::new();
-        let len = format_rows(&columns, 0..n, b"", &mut got);
+        let len = format_rows::<b','>(&columns, 0..n, b"", &mut got);
         got.truncate(len);
         let mut text = NumberText::new();
         let mut cell = |v: f64| {
@@ -488,7 +507,7 @@ mod tests {
             }
             let columns: Vec<&Column> = t.columns().iter().collect();
             let mut got = Vec::new();
-            let len = format_rows(&columns, 0..rows, b"", &mut got);
+            let len = format_rows::<b','>(&columns, 0..rows, b"", &mut got);
             got.truncate(len);
             let want: String = want.iter().map(|r| format!("{r}\n")).collect();
             assert_eq!(String::from_utf8(got).unwrap(), want, "{width} columns");
@@ -516,8 +535,8 @@ mod tests {
             .unwrap();
         let columns: Vec<&Column> = t.columns().iter().collect();
         let mut buf = Vec::new();
-        let first = format_rows(&columns, 0..WRITE_CHUNK_ROWS, b"", &mut buf);
-        let second = format_rows(&columns, WRITE_CHUNK_ROWS..n, b"", &mut buf);
+        let first = format_rows::<b','>(&columns, 0..WRITE_CHUNK_ROWS, b"", &mut buf);
+        let second = format_rows::<b','>(&columns, WRITE_CHUNK_ROWS..n, b"", &mut buf);
         assert!(second < first && buf.len() > second);
         let mut text = NumberText::new();
         let want: String = (WRITE_CHUNK_ROWS..n)

@@ -394,7 +394,20 @@ pub enum IoError {
         /// What is wrong.
         reason: String,
     },
-    /// A file format this build cannot read.
+    /// A table the output's format cannot hold (a text cell with a space
+    /// in Geosoft XYZ): bad input, found before anything is written.
+    #[error("'{file}': column '{column}'{}: {reason}", row.map(|r| format!(", data row {}", r + 1)).unwrap_or_default())]
+    CannotWrite {
+        /// The output file as given.
+        file: String,
+        /// The column.
+        column: String,
+        /// 0-based data row of the table, when a cell is the cause.
+        row: Option<usize>,
+        /// Why, and what to do.
+        reason: String,
+    },
+    /// A file format this build cannot read (or write as a flight table).
     #[error("'{file}': {reason}")]
     Unsupported {
         /// File as given.
@@ -459,6 +472,13 @@ impl IoError {
                 // The label of a message: `'name'` or `'name' (mapped to 'role')`.
                 let name = column.strip_prefix('\'').and_then(|c| c.split('\'').next());
                 at.column = Some(name.unwrap_or(column).to_string());
+            }
+            CannotWrite {
+                file, column, row, ..
+            } => {
+                at.file = Some(file.clone());
+                at.column = Some(column.clone());
+                at.row = *row;
             }
             MissingColumn { file, column, .. }
             | NotNumeric { file, column, .. }

@@ -53,10 +53,12 @@ pub mod select;
 mod sniff;
 mod summary;
 mod table;
+mod table_file;
 mod validate;
 mod values;
 mod wanted;
 mod xyz;
+mod xyz_write;
 
 use std::path::Path;
 
@@ -82,6 +84,7 @@ pub use table::{
     Column, ColumnData, ColumnSnapshot, ColumnSnapshotData, FlightTable, IN_MEMORY, Missing,
     TableSnapshot,
 };
+pub use table_file::{TableFormat, write_table};
 pub use validate::{
     EARTH_FIELD_NT, FINITE_COLUMNS, MAX_ALT_M, MAX_FIELD_NT, MAX_TIME_S, MEDIAN_SAMPLES,
     MIN_READING_NT, MIN_TIME_STEP_FRACTION, VECTOR_SCALAR_TOLERANCE, Warning, WarningKind,
@@ -90,6 +93,7 @@ pub use validate::{
 };
 pub use values::{SharedBuffer, Values};
 pub use xyz::read_xyz;
+pub use xyz_write::{check_xyz, write_xyz, write_xyz_to};
 
 /// File formats [`read_table`] can read.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

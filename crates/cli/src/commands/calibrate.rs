@@ -68,7 +68,7 @@ pub struct Args {
     #[arg(long, value_name = "MODEL.json")]
     model: PathBuf,
     /// Also write the calibration flight compensated by the fitted model to
-    /// this CSV: what `aeromag compensate --model MODEL.json` writes for the
+    /// this CSV (Geosoft XYZ for `.xyz`): what `aeromag compensate --model MODEL.json` writes for the
     /// same input (every input column plus the interference, compensated
     /// and flag columns), from the flight read once.
     #[arg(long, value_name = "OUT.csv")]
@@ -254,6 +254,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             .chain(a.compensated.as_deref()),
         &[a.input.path()],
     )?;
+    crate::output::check_tables(a.series.iter().chain(&a.compensated).map(|p| p.as_path()))?;
     if a.input.several_sensors() || a.reference_sensor.is_some() {
         return run_sensors(&a, &opts);
     }
@@ -280,7 +281,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         if let (Some(path), Some(series)) = (&a.series, &k.series) {
             let mut t = flight.table().clone();
             series.add_to(&mut t)?;
-            aeromag::io::write_csv(&t, path)?;
+            aeromag::io::write_table(&t, path)?;
             println!(
                 "Kalman series (smoothed field, innovations) written to {}",
                 path.display()

@@ -29,7 +29,7 @@ pub struct Args {
     model: PathBuf,
     #[command(flatten)]
     input: InputArgs,
-    /// Output CSV file.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
     /// Apply the model causally (backward differences; see above).
@@ -43,6 +43,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
+    crate::output::check_tables([a.out.as_path()])?;
     if aeromag::model_file::kind_of(&a.model)? == aeromag::compensation::model_file::TL_SENSORS_KIND
     {
         return run_sensors(&a);

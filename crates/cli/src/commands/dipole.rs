@@ -202,6 +202,7 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
         .chain(a.config.as_deref())
         .collect();
     crate::output::check_files([a.out.as_path()], &inputs)?;
+    crate::output::check_tables([a.out.as_path()])?;
     let mut cfg = read_config(a.config.as_deref())?;
     let settings = LocateSettings {
         gradiometer: a
@@ -235,7 +236,7 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
     }
     let track = locate_pass(&cfg, &pass.epochs, &pass.positions_m)?;
     let time: Vec<f64> = pass.epochs.iter().map(|e| e.t_s).collect();
-    aeromag::io::write_csv(&track.to_table(&time)?, &a.out)?;
+    aeromag::io::write_table(&track.to_table(&time)?, &a.out)?;
     let n = track.x.len();
     match track.detected.iter().position(|&d| d) {
         None => println!("object not detected in {n} epochs"),

@@ -30,7 +30,7 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     input: InputArgs,
-    /// Output CSV file.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
     /// Column to level (default: the compensated reading, names in any
@@ -116,6 +116,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()),
         &[a.input.path()],
     )?;
+    crate::output::check_tables(std::iter::once(a.out.as_path()).chain(a.crossovers.as_deref()))?;
     let flight = a.input.load()?;
     let opts = LevelOptions {
         value: a.value.clone(),
@@ -156,7 +157,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let n = flight.n_rows();
     let mut table = flight.into_table();
     lev.add_to(&mut table)?;
-    aeromag::io::write_csv(&table, &a.out)?;
+    aeromag::io::write_table(&table, &a.out)?;
     let (xs, f) = (&lev.levelling.crossovers, &lev.levelling.fit);
     println!(
         "{} crossovers ({} skipped in gaps, {} with missing values, {} too shallow)",
@@ -225,7 +226,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.out.display()
     );
     if let Some(path) = &a.crossovers {
-        aeromag::io::write_csv(&lev.crossover_table()?, path)?;
+        aeromag::io::write_table(&lev.crossover_table()?, path)?;
         println!("crossover table written to {}", path.display());
     }
     Ok(())

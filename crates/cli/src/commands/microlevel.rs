@@ -28,7 +28,7 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     input: InputArgs,
-    /// Output CSV file.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
     /// Column to micro-level (default: the most processed magnetic column).
@@ -84,6 +84,7 @@ fn fixed(x: f64, decimals: usize) -> String {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()], &[a.input.path()])?;
+    crate::output::check_tables([a.out.as_path()])?;
     let flight = a.input.load()?;
     let opts = MicrolevelOptions {
         column: a.column.clone(),
@@ -99,7 +100,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let m = microlevel(&flight, &opts, &mut Bars::new())?;
     let mut table = flight.into_table();
     m.add_to(&mut table)?;
-    aeromag::io::write_csv(&table, &a.out)?;
+    aeromag::io::write_table(&table, &a.out)?;
     println!(
         "micro-levelled {} → {} ({} lines at {:.1}° from grid north, spacing {:.1} m)",
         m.column,

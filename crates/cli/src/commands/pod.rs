@@ -92,7 +92,7 @@ pub struct ApplyArgs {
     model: PathBuf,
     #[command(flatten)]
     input: InputArgs,
-    /// Output CSV file.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
 }
@@ -148,6 +148,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
+    crate::output::check_tables([a.out.as_path()])?;
     let model = PodModelFile::read(&a.model)?;
     let t = a.input.load()?;
     let applied = apply_pod(&model, &t)?;

@@ -188,7 +188,7 @@ struct ApplyArgs {
     model: PathBuf,
     #[command(flatten)]
     input: InputArgs,
-    /// Output CSV file.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
 }
@@ -262,6 +262,7 @@ fn fit(a: FitArgs) -> anyhow::Result<()> {
 
 fn apply(a: ApplyArgs) -> anyhow::Result<()> {
     crate::output::check_files([a.out.as_path()], &[a.input.path(), a.model.as_path()])?;
+    crate::output::check_tables([a.out.as_path()])?;
     let model = aeromag::rotor::RotorModelFile::read(&a.model)?;
     let flight = a.input.load()?;
     let out = model.compensate_observed(&flight, &mut Bars::new())?;
