@@ -163,6 +163,22 @@ impl PyGrid {
         Ok(())
     }
 
+    /// Draw the grid as a map, PNG (`.png`) or SVG (`.svg`), as `aeromag
+    /// grid --map` draws it: colour with shaded relief, or `diverging`
+    /// colours centred on zero for a derivative or a difference; easting
+    /// and northing in km.
+    #[pyo3(signature = (path, diverging=false))]
+    fn write_map(&self, py: Python<'_>, path: std::path::PathBuf, diverging: bool) -> PyResult<()> {
+        use aeromag::map::picture::MapPicture;
+        let picture = if diverging {
+            MapPicture::diverging(&self.grid)
+        } else {
+            MapPicture::field(&self.grid)
+        };
+        py.detach(|| picture.write(&self.grid, &path)).py_err()?;
+        Ok(())
+    }
+
     /// Pickling (and `copy.deepcopy`): the node values' bytes, the
     /// geometry, EPSG code, name, unit and `info` ([`grid_from_state`]).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {

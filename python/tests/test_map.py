@@ -40,6 +40,13 @@ def test_products_and_files(survey_csv, tmp_path):
         g.write(tmp_path / name)
         back = aeromag.read_grid(tmp_path / name)
         np.testing.assert_allclose(back.values, g.values, atol=1e-3, equal_nan=True)
+    # Maps, as `aeromag grid --map` draws them.
+    g.write_map(tmp_path / "g.png")
+    assert (tmp_path / "g.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    d.write_map(tmp_path / "d.svg", diverging=True)
+    assert "<svg" in (tmp_path / "d.svg").read_text()
+    with pytest.raises(aeromag.BadInputError, match="PNG"):
+        g.write_map(tmp_path / "g.jpg")
 
 
 def test_microlevel_and_bad_arguments(survey_csv):

@@ -167,6 +167,15 @@ pub fn simulate_gradiometer(
     Ok(())
 }
 
+/// Check, before any work, that a map picture (`--map`) is named `.png`
+/// or `.svg`.
+pub fn check_map(map: Option<&Path>) -> anyhow::Result<()> {
+    if let Some(p) = map {
+        aeromag::map::picture::PictureFormat::of_path(p)?;
+    }
+    Ok(())
+}
+
 /// Check, before any work, that a flight table can be written in the
 /// format each of `tables` asks for (CSV, or Geosoft XYZ for `.xyz`; a
 /// grid, model or HDF5 name is bad input).

@@ -640,3 +640,61 @@ fn projected_positions_are_levelled_given_their_zone() {
     let header = std::fs::read_to_string(&out).unwrap();
     assert!(header.lines().next().unwrap().contains("mag_level"));
 }
+
+/// `--map` draws the grid (PNG or SVG by the extension, the same bytes
+/// run after run), on `grid` with the flight lines and on `derive`; another
+/// extension is refused before the work, nothing written.
+#[test]
+fn grids_are_drawn_as_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = survey(dir.path());
+    let (tif, png) = (dir.path().join("g.tif"), dir.path().join("g.png"));
+    let o = grid(
+        &input,
+        &tif,
+        &["--cell", "100", "--map", png.to_str().unwrap()],
+    );
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("map: "), "{}", stdout(&o));
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"));
+    // The picture is 1200 × 900 (IHDR: width, height, big-endian).
+    assert_eq!(&bytes[16..24], &[0, 0, 4, 176, 0, 0, 3, 132]);
+    assert_code(
+        &grid(
+            &input,
+            &tif,
+            &["--cell", "100", "--map", png.to_str().unwrap()],
+        ),
+        0,
+    );
+    assert_eq!(std::fs::read(&png).unwrap(), bytes, "deterministic");
+    let svg = dir.path().join("d.svg");
+    let o = aeromag(&[
+        "derive",
+        "-i",
+        tif.to_str().unwrap(),
+        "--vertical-derivative",
+        "--out",
+        dir.path().join("d.tif").to_str().unwrap(),
+        "--map",
+        svg.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("<svg") && text.contains("vertical derivative"),
+        "{}",
+        &text[..200]
+    );
+    let jpg = dir.path().join("g.jpg");
+    let other = dir.path().join("other.tif");
+    let o = grid(&input, &other, &["--map", jpg.to_str().unwrap()]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("PNG (.png) or SVG (.svg)"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!other.exists() && !jpg.exists());
+}

@@ -16,6 +16,7 @@
 pub mod derive;
 pub mod gridding;
 pub mod microlevel;
+pub mod picture;
 pub mod survey;
 
 pub use derive::{GridProduct, derive};

@@ -25,12 +25,13 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::flight::{Flight, ReferenceChannels, reference_sum};
+use crate::map::picture::{MapPicture, tracks};
 use crate::map::{GridOptions, MicrolevelOptions, SurveyGrid, grid_flight, microlevel};
 use crate::observer::{Observer, Silent};
 use aeromag_grid::Grid;
 use aeromag_grid::format::write_grid;
 use aeromag_grid::products::{Spectral, apply, corrugation_power};
-use aeromag_report::{Block, Colormap, Heatmap, ReportSection, Table};
+use aeromag_report::{Block, Colormap, ReportSection, Table};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -214,18 +215,6 @@ impl Study for MapsStudy {
             microlevelled_grid_rms_vs_truth_nt: rms_about_mean(&err_micro.values),
             microlevel_crossover_rms_nt: micro.crossover_rms_nt,
         };
-        // Flight lines for the maps, a point every 10 rows.
-        let mut tracks: std::collections::BTreeMap<i64, Vec<(f64, f64)>> = Default::default();
-        if let Some(ids) = &truth.survey.line_ids {
-            for k in (0..ids.len()).step_by(10) {
-                if ids[k] != 0.0 && truth.survey.x[k].is_finite() {
-                    tracks
-                        .entry(ids[k] as i64)
-                        .or_default()
-                        .push((truth.survey.x[k], truth.survey.y[k]));
-                }
-            }
-        }
         let nt = |t: &str, g: &Grid, label: &str, colormap| Map {
             title: t.into(),
             grid: g.clone(),
@@ -301,7 +290,8 @@ impl Study for MapsStudy {
         Ok(MapsOutcome {
             summary,
             maps,
-            lines: tracks.into_values().collect(),
+            // Flight lines for the maps, a point every 10 rows.
+            lines: tracks(&truth.survey, 10),
             written,
         })
     }
@@ -398,24 +388,14 @@ impl StudyOutcome for MapsOutcome {
             "Map figures.",
         )));
         for m in &self.maps {
-            let g = m.grid.geometry;
-            let mut h = Heatmap::new(
-                m.title.clone(),
-                "easting (km)",
-                "northing (km)",
-                (0..g.nx).map(|i| g.x(i) / 1000.0).collect(),
-                (0..g.ny).map(|j| g.y(j) / 1000.0).collect(),
-                m.grid.values.clone(),
-                m.label.clone(),
-            );
-            h.colormap = m.colormap;
-            h.equal_aspect = true;
-            h.shaded = m.colormap == Colormap::Viridis;
-            h.overlay = self
-                .lines
-                .iter()
-                .map(|l| l.iter().map(|&(x, y)| (x / 1000.0, y / 1000.0)).collect())
-                .collect();
+            let h = MapPicture {
+                title: m.title.clone(),
+                label: m.label.clone(),
+                colormap: m.colormap,
+                shaded: m.colormap == Colormap::Viridis,
+                tracks: self.lines.clone(),
+            }
+            .heatmap(&m.grid);
             sec.blocks.push(Block::Figure {
                 svg: h.to_svg()?,
                 caption: format!(

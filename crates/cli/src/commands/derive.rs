@@ -3,6 +3,7 @@
 //! [`aeromag::map::derive`]).
 
 use aeromag::core::error::fixed;
+use aeromag::map::picture::MapPicture;
 use aeromag::map::{GridProduct, derive};
 use std::path::PathBuf;
 
@@ -52,10 +53,19 @@ pub struct Args {
     /// node set in both).
     #[arg(long, value_name = "GRID", group = "product")]
     minus: Option<PathBuf>,
+    /// Also draw the derived grid as a map, PNG (`.png`) or SVG (`.svg`):
+    /// a derivative or difference in diverging colours centred on zero, a
+    /// continued field in colour with shaded relief.
+    #[arg(long, value_name = "MAP.png")]
+    map: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
+    crate::output::check_map(a.map.as_deref())?;
+    crate::output::check_files(
+        std::iter::once(a.out.as_path()).chain(a.map.as_deref()),
+        &[a.input.as_path()],
+    )?;
     let product = match (a.vertical_derivative, a.upward, &a.minus) {
         (true, _, _) => GridProduct::VerticalDerivative,
         (_, Some(h), _) => GridProduct::Upward(h),
@@ -82,5 +92,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         g.unit
     );
     println!("wrote {}", a.out.display());
+    if let Some(path) = &a.map {
+        let picture = match product {
+            GridProduct::Upward(_) => MapPicture::field(&g),
+            GridProduct::VerticalDerivative | GridProduct::Minus(_) => MapPicture::diverging(&g),
+        };
+        let format = picture.write(&g, path)?;
+        println!("map: {} ({format:?})", path.display());
+    }
     Ok(())
 }

@@ -8,6 +8,7 @@ use crate::progress::Bars;
 use aeromag::grid::GridGeometry;
 use aeromag::grid::projection::UtmZone;
 use aeromag::map::gridding::GridMethod;
+use aeromag::map::picture::{MapPicture, tracks};
 use aeromag::map::{GridOptions, grid_flight};
 use std::path::PathBuf;
 
@@ -79,6 +80,11 @@ pub struct Args {
     /// grid at the sensor's positions (needs roll, pitch, yaw and alt).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = args::xyz)]
     lever_arm: Option<[f64; 3]>,
+    /// Also draw the grid as a map, PNG (`.png`) or SVG (`.svg`): colour
+    /// with shaded relief, the flight lines over it, easting and northing
+    /// in km.
+    #[arg(long, value_name = "MAP.png")]
+    map: Option<PathBuf>,
 }
 
 fn extent(s: &str) -> Result<[f64; 4], String> {
@@ -89,7 +95,11 @@ fn extent(s: &str) -> Result<[f64; 4], String> {
 pub fn run(a: Args) -> anyhow::Result<()> {
     // The format by the extension, then the path: both before the work.
     aeromag::map::SurveyGrid::format_of(&a.out)?;
-    crate::output::check_files([a.out.as_path()], &[a.input.path()])?;
+    crate::output::check_map(a.map.as_deref())?;
+    crate::output::check_files(
+        std::iter::once(a.out.as_path()).chain(a.map.as_deref()),
+        &[a.input.path()],
+    )?;
     let geometry = match (&a.extent, a.cell) {
         (Some(e), Some(cell)) => Some(GridGeometry::covering(e[0], e[1], e[2], e[3], cell)?),
         (Some(_), None) => return Err(crate::exit::bad_input!("--extent needs --cell")),
@@ -174,5 +184,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         s.mean, s.std, s.min, s.max, g.grid.unit
     );
     println!("wrote {} ({format:?})", a.out.display());
+    if let Some(path) = &a.map {
+        // A point of each line every so many rows: at most about 50 000.
+        let step = (g.survey.x.len() / 50_000).max(1);
+        let picture = MapPicture::field(&g.grid).with_tracks(tracks(&g.survey, step));
+        let format = picture.write(&g.grid, path)?;
+        println!("map: {} ({format:?})", path.display());
+    }
     Ok(())
 }
