@@ -101,6 +101,40 @@ pub struct SensorTruth<'a> {
     pub noise: Option<&'a [f64]>,
 }
 
+/// A compensated reading of another processing that the file holds under
+/// its own name, any case (SGL's `COMPMAG1`, MagNav's `mag_1_c`): named
+/// when `mag_comp` is missing.
+fn other_compensated(t: &Flight) -> Option<String> {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let table = t.table();
+    table
+        .column_names()
+        .into_iter()
+        .chain(table.unread_columns())
+        .find(|name| {
+            let l = name.to_ascii_lowercase();
+            l.strip_prefix("compmag").is_some_and(digits)
+                || l.strip_prefix("mag_")
+                    .and_then(|r| r.strip_suffix("_c"))
+                    .is_some_and(digits)
+        })
+        .map(str::to_string)
+}
+
+/// The error of a missing `mag_comp` in a file that holds `name`, a
+/// compensated reading of another processing.
+fn missing_comp(t: &Flight, name: &str) -> Error {
+    Error::BadInput {
+        file: Some(t.file_label()),
+        line: None,
+        row: None,
+        column: Some("mag_comp".into()),
+        reason: format!(
+            "required column 'mag_comp' is missing; the file has '{name}', a reading compensated by another processing: compensate the flight with `aeromag compensate` (which writes mag_comp), or name that column mag_comp to score its compensation"
+        ),
+    }
+}
+
 impl<'a> SensorSeries<'a> {
     /// The single-sensor columns of a compensated flight: `mag`,
     /// `mag_comp`, and `mag_interf`, `true_external`, `true_lag`,
@@ -108,7 +142,9 @@ impl<'a> SensorSeries<'a> {
     pub fn of(t: &'a Flight) -> Result<Self> {
         Self {
             mag: t.require("mag")?,
-            comp: t.require("mag_comp")?,
+            comp: t.require("mag_comp").map_err(|e| {
+                other_compensated(t).map_or(e.into(), |name| missing_comp(t, &name))
+            })?,
             interf: t.column("mag_interf"),
             truth: SensorTruth {
                 external: t.column("true_external"),
@@ -358,4 +394,36 @@ pub fn score_series(
         fom_before,
         fom_after,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aeromag_io::FlightTable;
+
+    /// A flight without `mag_comp` whose file holds a compensated reading
+    /// of another processing (SGL's COMPMAG1, MagNav's mag_1_c) names it.
+    #[test]
+    fn a_missing_mag_comp_names_the_compensated_reading_the_file_has() {
+        for (other, named) in [
+            ("COMPMAG1", true),
+            ("mag_3_c", true),
+            ("mag_c", false),
+            ("compmagx", false),
+        ] {
+            let mut t = FlightTable::new();
+            t.add_column("time", vec![0.0, 0.1, 0.2]).unwrap();
+            t.add_column("mag", vec![5e4; 3]).unwrap();
+            t.add_column(other, vec![5e4; 3]).unwrap();
+            let flight = Flight::from_table(t).unwrap();
+            let e = SensorSeries::of(&flight).map(|_| ()).unwrap_err();
+            assert!(e.is_bad_input());
+            assert_eq!(
+                e.to_string().contains(&format!("the file has '{other}'")),
+                named,
+                "{e}"
+            );
+            assert!(e.to_string().contains("'mag_comp' is missing"), "{e}");
+        }
+    }
 }
