@@ -82,6 +82,13 @@ __all__ = [
     "batch",
 ]
 
+
+def __dir__() -> List[str]:
+    """The package's API and its modules (``dir(aeromag)``, tab completion),
+    without the names its own code imports (``np``, ``os``, ``Optional`` …)."""
+    return sorted(set(__all__) | {"errors", "tolles_lawson"})
+
+
 PathLike = Union[str, "os.PathLike[str]"]
 
 

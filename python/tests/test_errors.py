@@ -199,3 +199,9 @@ def test_a_flight_argument_of_the_wrong_type_names_it():
             call()
         assert str(e.value).startswith("flight must be an aeromag.Flight")
         assert str(e.value).endswith(", got str")
+
+
+def test_dir_shows_the_api_not_the_imports():
+    names = dir(aeromag)
+    assert "read_flight" in names and "MissingFileError" in names and "errors" in names
+    assert not {"np", "os", "Optional", "annotations"} & set(names)
