@@ -477,8 +477,8 @@ mod tests {
     #[test]
     fn settings_model_and_grid_files_are_located() {
         use crate::ModelFile;
-        let dir = std::env::temp_dir().join(format!("aeromag-located-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
         let file = |name: &str, text: &str| {
             let p = dir.join(name);
             std::fs::write(&p, text).unwrap();
@@ -551,7 +551,6 @@ mod tests {
             e.os_error().map(|o| o.kind()),
             Some(std::io::ErrorKind::NotFound)
         );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
