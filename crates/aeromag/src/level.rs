@@ -226,7 +226,8 @@ impl Levelled {
 /// `k·d|B0|/dt` term jointly with a level per line (and the altitude term,
 /// robust weights: [`LevellingConfig`]), and correct every row.
 ///
-/// Reads `time`, `lat`, `lon`, `alt`, `line`, the value and rate columns,
+/// Reads `time`, `lat`, `lon`, `alt` (without it, the altitude term is
+/// left out, with a note), `line`, the value and rate columns,
 /// the reference channels, and the attitude with a lever arm. Bad input if
 /// the flight already has the output columns.
 ///
@@ -297,14 +298,30 @@ pub fn level(
         }
         None => None,
     };
+    // The height is needed only by the altitude term: a file without
+    // `alt` (an XYZ of X, Y and the field) is levelled without it, saying
+    // so (it was refused: "required column 'alt' is missing").
+    let no_height;
+    let recorded_alt = match flight.column("alt") {
+        Some(a) => a,
+        None => {
+            if opts.fit.altitude_term {
+                notes.note(
+                    "the file has no `alt` column: the altitude term is left out (map a height onto it with --columns alt=NAME to fit it)",
+                );
+            }
+            no_height = vec![f64::NAN; flight.n_rows()];
+            &no_height
+        }
+    };
     let (lat, lon, alt) = match (&positions, &from_projected) {
         (Some([la, lo, al]), _) => (la.as_slice(), lo.as_slice(), al.as_slice()),
-        (None, Some((la, lo))) => (la.as_slice(), lo.as_slice(), flight.require("alt")?),
-        (None, None) => (
-            flight.require("lat")?,
-            flight.require("lon")?,
-            flight.require("alt")?,
-        ),
+        (None, Some((la, lo))) => (la.as_slice(), lo.as_slice(), recorded_alt),
+        (None, None) => (flight.require("lat")?, flight.require("lon")?, recorded_alt),
+    };
+    let fit_config = LevellingConfig {
+        altitude_term: opts.fit.altitude_term && flight.column("alt").is_some(),
+        ..opts.fit.clone()
     };
     let position_columns = projected.as_ref().map_or(["lat", "lon"], |c| {
         [c.easting.as_str(), c.northing.as_str()]
@@ -385,9 +402,9 @@ pub fn level(
         pairing: lines.pairing(),
         ..opts.tracks.clone()
     };
-    let levelling = level_survey(&tracks, &track_config, &opts.fit).in_file(&flight.label())?;
+    let levelling = level_survey(&tracks, &track_config, &fit_config).in_file(&flight.label())?;
     let f = &levelling.fit;
-    if opts.fit.altitude_term && !f.altitude_term_used {
+    if fit_config.altitude_term && !f.altitude_term_used {
         notes.warn(
             "no crossover has heights and profiles on both sides; the altitude term is left out",
         );

@@ -528,3 +528,55 @@ fn projected_positions_level_as_latitude_and_longitude_given_their_zone() {
         "{e}"
     );
 }
+
+/// A survey without `alt` (an XYZ of positions and the field) is levelled
+/// without the altitude term, saying so: the same values as the full
+/// survey levelled without it (it was refused: "required column 'alt' is
+/// missing").
+#[test]
+fn a_survey_without_heights_is_levelled_without_the_altitude_term() {
+    let survey = simulate_flight(ScenarioKind::Survey, None, Some(6)).unwrap();
+    let mut t = FlightTable::new();
+    for c in survey
+        .table()
+        .columns()
+        .iter()
+        .filter(|c| c.name() != "alt")
+    {
+        match (c.values(), c.text()) {
+            (Some(v), _) => t.add_column(c.name(), v.to_vec()),
+            (_, Some(text)) => t.add_text_column(c.name(), text.to_vec()),
+            _ => unreachable!("a column holds numbers or text"),
+        }
+        .unwrap();
+    }
+    let no_alt = Flight::from_table(t).unwrap();
+    let lev = level(&no_alt, &LevelOptions::default(), &mut Silent).unwrap();
+    let without_term = LevelOptions {
+        fit: LevellingConfig {
+            altitude_term: false,
+            ..LevellingConfig::default()
+        },
+        ..LevelOptions::default()
+    };
+    let reference = level(&survey, &without_term, &mut Silent).unwrap();
+    assert!(!lev.levelling.crossovers.crossovers.is_empty());
+    assert!(!lev.levelling.fit.altitude_term_used);
+    let bits = |l: &Levelled| -> Vec<u64> {
+        l.levelling
+            .levelled
+            .value_nt
+            .iter()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    assert_eq!(bits(&lev), bits(&reference));
+    let said = |l: &Levelled| {
+        l.notes
+            .iter()
+            .any(|n| n.message.contains("no `alt` column"))
+    };
+    assert!(said(&lev), "{:?}", lev.notes);
+    // Asked for no altitude term, nothing to say.
+    assert!(!said(&level(&no_alt, &without_term, &mut Silent).unwrap()));
+}
