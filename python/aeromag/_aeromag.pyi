@@ -304,6 +304,7 @@ def fit_pod(
     grad_up_nt_per_km: float = 0.0,
     method: str = "dipole-array",
     source_points: Optional[Sequence[Tuple[float, float, float]]] = None,
+    progress: _Progress = None,
 ) -> Model: ...
 def level(
     flight: Flight,

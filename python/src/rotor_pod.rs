@@ -218,10 +218,12 @@ pub fn fit_rotor(
 
 /// Fit the towed-pod model (`aeromag pod fit`; the keywords are its flags;
 /// `method` is `dipole-array` (default), `two-step` or `joint`;
-/// `source_points` the dipole positions (m) of the dipole-array method).
+/// `source_points` the dipole positions (m) of the dipole-array method;
+/// `progress` a callable `progress(stage, done, total)`).
 #[pyfunction]
 #[pyo3(signature = (flight, cable_length_m, inclination_deg, attach_m=None, declination_deg=0.0,
-    grad_north_nt_per_km=0.0, grad_up_nt_per_km=0.0, method="dipole-array", source_points=None))]
+    grad_north_nt_per_km=0.0, grad_up_nt_per_km=0.0, method="dipole-array", source_points=None,
+    progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_pod(
     py: Python<'_>,
@@ -234,6 +236,7 @@ pub fn fit_pod(
     grad_up_nt_per_km: f64,
     method: &str,
     source_points: Option<Vec<[f64; 3]>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<PyModel> {
     let method = aeromag::pod::PodMethod::ALL
         .into_iter()
@@ -251,7 +254,7 @@ pub fn fit_pod(
         grad_north_nt_per_km,
         grad_up_nt_per_km,
     };
-    let mut obs = PyProgress::new(None);
+    let mut obs = PyProgress::new(progress);
     let result = py.detach(|| {
         lib_fit_pod(
             &flight.inner,

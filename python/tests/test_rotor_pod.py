@@ -60,8 +60,10 @@ def test_pod_model_equals_the_cli(cli, tmp_path):
     cli("pod", "fit", "-i", csv, "--model", model, "--cable-length-m", 40, "--attach-m", "0,0,1.2",
         "--inclination-deg", 45, "--grad-north-nt-per-km", 5.91, "--grad-up-nt-per-km", -25.91)
     flight = aeromag.read_flight(csv)
-    m = aeromag.fit_pod(flight, **setup)
+    stages = []
+    m = aeromag.fit_pod(flight, **setup, progress=lambda stage, done, total: stages.append(stage))
     assert m.to_json() == model.read_text()
+    assert "fitting the pod model" in stages, stages
     rates = m.heading_rates(flight)
     assert rates and all(r[3] > 0.9 for r in rates)
     assert np.all(np.isfinite(m.interference(flight)))
