@@ -29,7 +29,9 @@
 //! is never held (one record buffer is reused). After
 //! [`RESERVE_AFTER_ROWS`] rows the number of rows is estimated from the file
 //! size and the bytes per row so far, and every column reserves
-//! `1.02 × estimate` values at once, so the vectors are allocated about once
+//! `1.02 × estimate` values at once (a table that would fill more than
+//! 80 % of the memory the process can take is refused there instead,
+//! [`IoError::OutOfMemory`]), so the vectors are allocated about once
 //! at their final size instead of growing by doubling. If the estimate is
 //! short (later rows longer than the first ones) the vectors grow by
 //! doubling from there (large reallocations are page remaps, not copies, on
@@ -155,6 +157,34 @@ pub(crate) struct TableBuilder {
     label_texts: LabelTexts,
     /// Whether two of its texts (from either reader) give one number.
     label_clash: LabelClash,
+}
+
+/// Bytes a text cell takes at least (a `String`).
+const TEXT_CELL_BYTES: u64 = 24;
+
+/// The share of the memory this process can take that a table may fill
+/// as read: the commands then make copies and results of its columns.
+const MEMORY_SHARE: f64 = 0.8;
+
+/// The error of a table of `rows` rows whose columns take `column_bytes`
+/// bytes a row each, when it would fill more than [`MEMORY_SHARE`] of the
+/// `available` bytes ([`aeromag_core::memory::available_bytes`]; `None`,
+/// unknown: no error).
+fn memory_error(
+    file: &str,
+    rows: u64,
+    column_bytes: &[u64],
+    available: Option<u64>,
+) -> Option<IoError> {
+    let available = available?;
+    let need = rows.saturating_mul(column_bytes.iter().sum());
+    (need as f64 > MEMORY_SHARE * available as f64).then(|| IoError::OutOfMemory {
+        file: file.to_string(),
+        rows,
+        columns: column_bytes.len(),
+        need_bytes: need,
+        available_bytes: available,
+    })
 }
 
 impl TableBuilder {
@@ -284,7 +314,7 @@ impl TableBuilder {
         let row = self.n_rows;
         let line = src.line();
         if row == RESERVE_AFTER_ROWS {
-            self.reserve(src.bytes_read());
+            self.reserve(src.bytes_read())?;
         }
         for (i, col) in self.cols.iter_mut().enumerate() {
             if matches!(col, ColState::Skipped) {
@@ -367,12 +397,12 @@ impl TableBuilder {
         part: &crate::csv_clean::CleanRows,
         first_line: u64,
         bytes_read: u64,
-    ) -> bool {
+    ) -> Result<bool> {
         if self.cols.iter().any(|c| matches!(c, ColState::Text { .. })) {
-            return false;
+            return Ok(false);
         }
         if part.rows == 0 {
-            return true;
+            return Ok(true);
         }
         self.label_clash.add_all(&part.labels);
         for (i, col) in self.cols.iter_mut().enumerate() {
@@ -397,18 +427,32 @@ impl TableBuilder {
         self.n_rows += part.rows;
         self.last_line = first_line + part.last_row_line;
         if before <= RESERVE_AFTER_ROWS && self.n_rows > RESERVE_AFTER_ROWS {
-            self.reserve(bytes_read);
+            self.reserve(bytes_read)?;
         }
-        true
+        Ok(true)
     }
 
-    /// Reserves every column for the estimated total number of rows.
-    fn reserve(&mut self, bytes_read: u64) {
+    /// Reserves every column for the estimated total number of rows, once
+    /// the table is known to fit in memory ([`memory_error`]).
+    fn reserve(&mut self, bytes_read: u64) -> Result<()> {
         let used = bytes_read.saturating_sub(self.header_bytes).max(1);
         let rest = self.file_size.saturating_sub(self.header_bytes);
         let estimate = (rest as f64 / used as f64 * self.n_rows as f64 * 1.02) as usize + 16;
         // Guard against absurd estimates (e.g. a file growing while read).
         let estimate = estimate.min(self.file_size as usize / 2 + 16);
+        let columns: Vec<u64> = self
+            .cols
+            .iter()
+            .filter_map(|c| match c {
+                ColState::Numeric { .. } => Some(8),
+                ColState::Text { .. } => Some(TEXT_CELL_BYTES),
+                ColState::Skipped => None,
+            })
+            .collect();
+        let available = aeromag_core::memory::available_bytes();
+        if let Some(e) = memory_error(&self.file, estimate as u64, &columns, available) {
+            return Err(e);
+        }
         for col in &mut self.cols {
             match col {
                 ColState::Numeric { values, .. } => {
@@ -420,6 +464,7 @@ impl TableBuilder {
                 ColState::Skipped => {}
             }
         }
+        Ok(())
     }
 
     /// Finishes the table. Text columns that started as numbers get their
@@ -603,4 +648,39 @@ pub(crate) fn is_integer_text(bytes: &[u8]) -> bool {
         .or_else(|| b.strip_prefix(b"+"))
         .unwrap_or(b);
     !digits.is_empty() && digits.len() <= 15 && digits.iter().all(u8::is_ascii_digit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_table_larger_than_the_memory_left_is_refused() {
+        // 10⁸ rows of 20 numeric columns and a text one: 18.4 GB.
+        let cols: Vec<u64> = std::iter::repeat_n(8, 20)
+            .chain([TEXT_CELL_BYTES])
+            .collect();
+        let e = memory_error("big.csv", 100_000_000, &cols, Some(16_000_000_000)).unwrap();
+        let small = memory_error("f.csv", 1_000_000, &[8; 6], Some(20_000_000)).unwrap();
+        assert!(
+            small
+                .to_string()
+                .contains("about 48 MB in memory, more than the 20 MB"),
+            "{small}"
+        );
+        assert!(e.is_bad_input());
+        assert_eq!(e.location().file.as_deref(), Some("big.csv"));
+        let text = e.to_string();
+        assert!(
+            text.contains("about 100000000 rows of 21 columns"),
+            "{text}"
+        );
+        assert!(
+            text.contains("18.4 GB") && text.contains("16.0 GB"),
+            "{text}"
+        );
+        // Within 80 % of what is left, or nothing known: no error.
+        assert!(memory_error("big.csv", 100_000_000, &cols, Some(24_000_000_000)).is_none());
+        assert!(memory_error("big.csv", 100_000_000, &cols, None).is_none());
+    }
 }

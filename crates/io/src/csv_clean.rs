@@ -665,7 +665,7 @@ pub(crate) fn push_clean_rows(
         }
         let part = &piece.rows;
         let bytes_read = at.offset + part.bytes as u64;
-        if !builder.append_clean(part, at.line, bytes_read) {
+        if !builder.append_clean(part, at.line, bytes_read)? {
             return Ok(false);
         }
         on_piece(part);

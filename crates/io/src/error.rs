@@ -93,6 +93,26 @@ pub enum IoError {
         /// What is too large, with the limit.
         what: String,
     },
+    /// A file whose table would not fit in the memory this process can
+    /// take (estimated from the file's size and its first rows): refused
+    /// with a message instead of ending in an allocation failure, which
+    /// aborts the process (a Python kernel dies with it).
+    #[error(
+        "'{file}': about {rows} rows of {columns} columns to read, about {} in memory, more than the {} this process can take; split the file, or read fewer of its fields",
+        size_text(*need_bytes), size_text(*available_bytes)
+    )]
+    OutOfMemory {
+        /// File as given.
+        file: String,
+        /// Rows estimated.
+        rows: u64,
+        /// Columns read.
+        columns: usize,
+        /// Bytes the table would take.
+        need_bytes: u64,
+        /// Bytes this process can take.
+        available_bytes: u64,
+    },
     /// The lines end in `\r` alone (a classic Mac OS text file): the whole
     /// file read as one header line ("column name '0.0' appears twice").
     #[error(
@@ -434,6 +454,7 @@ impl IoError {
             | AmbiguousColumn { file, .. }
             | Selection { file, .. }
             | Write { file, .. }
+            | OutOfMemory { file, .. }
             | Unsupported { file, .. } => at.file = Some(file.clone()),
             Read { file, line, .. }
             | Binary { file, line, .. }
@@ -543,6 +564,15 @@ impl IoError {
                 | IoError::LengthMismatch { .. }
                 | IoError::ColumnExists { .. }
         )
+    }
+}
+
+/// Bytes as GB with one decimal, or MB below a GB.
+fn size_text(bytes: u64) -> String {
+    if bytes >= 1_000_000_000 {
+        format!("{:.1} GB", bytes as f64 / 1e9)
+    } else {
+        format!("{:.0} MB", bytes as f64 / 1e6)
     }
 }
 
