@@ -682,3 +682,77 @@ fn several_sensors_with_current_terms() {
         assert!(stderr(&o).contains(needle), "{needle}: {}", stderr(&o));
     }
 }
+
+/// A compensated reading of another processing (SGL's `COMPMAG1`) is
+/// scored by mapping it (`--columns mag_comp=COMPMAG1`): the figures of the
+/// same values named `mag_comp`. Without the map the error names it.
+#[test]
+fn a_contractors_compensated_column_is_scored_when_mapped() {
+    let d = tempfile::tempdir().unwrap();
+    let cal = simulate(d.path(), "calibration", "4");
+    let model = d.path().join("m.json");
+    let ours = d.path().join("ours.csv");
+    assert_code(
+        &aeromag(&[
+            "calibrate",
+            cal.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+        ]),
+        0,
+    );
+    assert_code(&compensate(&model, &cal, &ours), 0);
+    // The same file as a contractor's: mag_comp named COMPMAG1, no model columns.
+    let text = std::fs::read_to_string(&ours).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&i| !matches!(header[i], "mag_interf" | "comp_flag"))
+        .collect();
+    let row = |cells: Vec<&str>| keep.iter().map(|&i| cells[i]).collect::<Vec<_>>().join(",");
+    let renamed: Vec<&str> = header
+        .iter()
+        .map(|&h| if h == "mag_comp" { "COMPMAG1" } else { h })
+        .collect();
+    let mut theirs_text = row(renamed) + "\n";
+    for l in lines {
+        theirs_text += &(row(l.split(',').collect()) + "\n");
+    }
+    let theirs = d.path().join("theirs.csv");
+    std::fs::write(&theirs, theirs_text).unwrap();
+    let figures = |input: &std::path::Path, extra: &[&str], dir: &str| {
+        let out = d.path().join(dir);
+        let mut args = vec![
+            "report",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = aeromag(&args);
+        assert_code(&o, 0);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("figures.json")).unwrap())
+                .unwrap();
+        (
+            v["fom_before_nt"].clone(),
+            v["fom_after_nt"].clone(),
+            v["ir"].clone(),
+        )
+    };
+    let mapped = figures(&theirs, &["--columns", "mag_comp=COMPMAG1"], "r1");
+    assert!(mapped.2.as_f64().unwrap() > 1.0, "{mapped:?}");
+    assert_eq!(mapped, figures(&ours, &[], "r2"));
+    let o = aeromag(&[
+        "report",
+        theirs.to_str().unwrap(),
+        "--out",
+        d.path().join("r3").to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("--columns mag_comp=COMPMAG1"),
+        "{}",
+        stderr(&o)
+    );
+}

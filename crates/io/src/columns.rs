@@ -130,12 +130,19 @@ pub fn is_truth_column(name: &str) -> bool {
     name.len() > "true_".len() && name.starts_with("true_")
 }
 
+/// The compensation's own columns that a file of another processing may
+/// hold under other names, mapped for `report` to score them
+/// (`--columns mag_comp=COMPMAG1`: SGL's compensated reading).
+pub const RESULT_COLUMNS: [&str; 2] = ["mag_comp", "mag_interf"];
+
 /// True when text in the column (by its canonical role) is an error rather
 /// than a pass-through text column: every canonical column except `line`
 /// (which the spec calls a label and may be text such as `L1010`), and every
 /// `true_*` column.
 pub(crate) fn must_be_numeric(role: &str) -> bool {
-    (is_canonical(role) && role != "line") || is_truth_column(role)
+    (is_canonical(role) && role != "line")
+        || is_truth_column(role)
+        || RESULT_COLUMNS.contains(&role)
 }
 
 /// Where a canonical alias came from.
@@ -246,7 +253,10 @@ impl ColumnMap {
         if canonical.is_empty() || file_column.is_empty() {
             return Err(err("both sides of '=' need a name".into()));
         }
-        if !is_canonical(canonical) && !is_truth_column(canonical) {
+        if !is_canonical(canonical)
+            && !is_truth_column(canonical)
+            && !RESULT_COLUMNS.contains(&canonical)
+        {
             let hint = closest_canonical(canonical)
                 .map(|c| format!("did you mean '{c}'? "))
                 .unwrap_or_default();
@@ -263,8 +273,9 @@ impl ColumnMap {
                 String::new()
             };
             return Err(err(format!(
-                "'{canonical}' is not a canonical column name; {sgl}{hint}known names: {}, or true_*",
-                CANONICAL_COLUMNS.join(", ")
+                "'{canonical}' is not a canonical column name; {sgl}{hint}known names: {}, {}, or true_*",
+                CANONICAL_COLUMNS.join(", "),
+                RESULT_COLUMNS.join(", ")
             )));
         }
         if self.get(canonical).is_some() {

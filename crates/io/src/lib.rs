@@ -65,7 +65,8 @@ use std::path::Path;
 pub use builder::{MAX_COLUMNS, MAX_LINE_BYTES};
 pub use columns::{
     CANONICAL_COLUMNS, ColumnMap, MAGNAV_PRESET, MAGNETIC_COLUMNS, MapOrigin, MappedColumn,
-    Sensors, closest_name, is_canonical, is_truth_column, magnav_name, sensor_names,
+    RESULT_COLUMNS, Sensors, closest_name, is_canonical, is_truth_column, magnav_name,
+    sensor_names,
 };
 pub use csv_read::read_csv;
 pub use csv_write::{write_csv, write_csv_to};

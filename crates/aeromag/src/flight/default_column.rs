@@ -42,8 +42,11 @@ fn is_sensor_compensated(name: &str) -> bool {
 /// match first, else the one differing only in case; several of those is
 /// bad input (taking the first would choose by the order of the columns).
 pub(crate) fn find_column(flight: &Flight, name: &str, flag: &str) -> Result<Option<String>> {
-    if name == UNCOMPENSATED {
-        // The canonical reading, through the column map and the preset.
+    let mapped = || flight.table().mapping().iter().any(|m| m.canonical == name);
+    if name == UNCOMPENSATED || aeromag_io::RESULT_COLUMNS.contains(&name) && mapped() {
+        // The canonical reading, through the column map and the preset;
+        // `mag_comp` mapped onto another processing's column (`--columns
+        // mag_comp=COMPMAG1`).
         return Ok(flight.column(name).map(|_| name.to_string()));
     }
     let names = flight.column_names();

@@ -130,7 +130,7 @@ fn missing_comp(t: &Flight, name: &str) -> Error {
         row: None,
         column: Some("mag_comp".into()),
         reason: format!(
-            "required column 'mag_comp' is missing; the file has '{name}', a reading compensated by another processing: compensate the flight with `aeromag compensate` (which writes mag_comp), or name that column mag_comp to score its compensation"
+            "required column 'mag_comp' is missing; the file has '{name}', a reading compensated by another processing: map it to score that compensation (--columns mag_comp={name}), or compensate the flight with `aeromag compensate` (which writes mag_comp)"
         ),
     }
 }
