@@ -302,7 +302,9 @@ pub fn level(
     // `alt` (an XYZ of X, Y and the field) is levelled without it, saying
     // so (it was refused: "required column 'alt' is missing").
     let no_height;
-    let recorded_alt = match flight.column("alt") {
+    let recorded = flight.column("alt");
+    let has_alt = recorded.is_some();
+    let recorded_alt = match recorded {
         Some(a) => a,
         None => {
             if opts.fit.altitude_term {
@@ -320,7 +322,7 @@ pub fn level(
         (None, None) => (flight.require("lat")?, flight.require("lon")?, recorded_alt),
     };
     let fit_config = LevellingConfig {
-        altitude_term: opts.fit.altitude_term && flight.column("alt").is_some(),
+        altitude_term: opts.fit.altitude_term && has_alt,
         ..opts.fit.clone()
     };
     let position_columns = projected.as_ref().map_or(["lat", "lon"], |c| {

@@ -35,6 +35,7 @@ pub mod cancel;
 pub mod error;
 pub mod estimability;
 pub mod field;
+pub mod file_name;
 pub mod filter;
 pub mod frames;
 pub mod median;

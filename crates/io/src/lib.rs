@@ -276,12 +276,7 @@ pub fn table_from_columns(
 }
 
 fn detect_format(path: &Path) -> Result<Format> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    match ext.as_str() {
+    match aeromag_core::file_name::extension(path).as_str() {
         "xyz" => Ok(Format::Xyz),
         "csv" | "tsv" => Ok(Format::Csv),
         "h5" | "hdf5" | "he5" => Ok(Format::Hdf5),

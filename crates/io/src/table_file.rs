@@ -37,11 +37,7 @@ impl TableFormat {
     /// bad input ([`IoError::Unsupported`]) for a grid, model or HDF5 name,
     /// so a long run never ends on one.
     pub fn of_path(path: &Path) -> Result<Self> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
+        let ext = aeromag_core::file_name::extension(path);
         if ext == "xyz" {
             return Ok(TableFormat::Xyz);
         }

@@ -63,13 +63,9 @@ impl PictureFormat {
     /// The format of a picture named `path`: `.png` or `.svg` (any case);
     /// bad input otherwise.
     pub fn of_path(path: &Path) -> Result<Self> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("png") => Ok(PictureFormat::Png),
-            Some("svg") => Ok(PictureFormat::Svg),
+        match aeromag_core::file_name::extension(path).as_str() {
+            "png" => Ok(PictureFormat::Png),
+            "svg" => Ok(PictureFormat::Svg),
             _ => Err(Error::bad_file(
                 path.display().to_string(),
                 "a map is written as PNG (.png) or SVG (.svg)",

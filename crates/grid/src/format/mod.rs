@@ -65,12 +65,7 @@ impl GridFormat {
     /// `.asc` ESRI ASCII, `.nc`/`.grd` netCDF (case insensitive); anything
     /// else is [`GridError::UnknownFormat`].
     pub fn from_path(path: &Path) -> Result<Self> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .unwrap_or_default();
-        match ext.as_str() {
+        match aeromag_core::file_name::extension(path).as_str() {
             "tif" | "tiff" => Ok(GridFormat::GeoTiff),
             "asc" => Ok(GridFormat::EsriAscii),
             "nc" | "grd" => Ok(GridFormat::NetCdf),
