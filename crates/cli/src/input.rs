@@ -8,17 +8,16 @@ use std::path::{Path, PathBuf};
 /// Input-file arguments shared by the commands that read flight data.
 #[derive(Debug, Clone, clap::Args)]
 #[group(skip)]
-#[command(group = clap::ArgGroup::new("flight_file").required(true).multiple(false))]
+#[command(mut_arg("input", |a| a.help(
+    "Flight data file: CSV (header row, `#` comments), Geosoft XYZ (`.xyz`) or HDF5 in the \
+     MagNav/SGL layout (`.h5`: one dataset per field)"
+)))]
+#[command(mut_arg("file", |a| a.help(
+    "The flight data file, as --input gives it (`aeromag inspect flight.xyz`)"
+)))]
 pub struct InputArgs {
-    /// Flight data file: CSV (header row, `#` comments), Geosoft XYZ
-    /// (`.xyz`) or HDF5 in the MagNav/SGL layout (`.h5`: one dataset per
-    /// field).
-    #[arg(long, short = 'i', value_name = "FILE", group = "flight_file")]
-    input: Option<PathBuf>,
-    /// The flight data file, as --input gives it (`aeromag inspect
-    /// flight.xyz`).
-    #[arg(value_name = "FILE", group = "flight_file")]
-    file: Option<PathBuf>,
+    #[command(flatten)]
+    file: InputFile,
     /// Map canonical column names onto the file's names, e.g.
     /// `mag=mag_1_uc,flux_x=flux_a_x,time=tt` (MagNav names are recognised
     /// automatically).
@@ -43,6 +42,34 @@ pub struct InputArgs {
     /// Keep only the rows with T0 ≤ time ≤ T1 (s).
     #[arg(long, value_name = "T0,T1", allow_hyphen_values = true)]
     pub time_range: Option<String>,
+}
+
+/// One input file of another kind than a flight (a grid, an EM record, a
+/// gradiometer pass), given with --input or as the positional FILE, exactly
+/// one of them. A command names its file with `mut_arg`, e.g.
+/// `#[command(mut_arg("input", |a| a.value_name("GRID").help("Input grid file")))]`
+/// and `#[command(mut_arg("file", |a| a.value_name("GRID")))]`.
+#[derive(Debug, Clone, clap::Args)]
+#[group(skip)]
+#[command(group = clap::ArgGroup::new("input_file").required(true).multiple(false))]
+pub struct InputFile {
+    /// The input file.
+    #[arg(long, short = 'i', value_name = "FILE", group = "input_file")]
+    input: Option<PathBuf>,
+    /// The same file as --input, given without the flag.
+    #[arg(value_name = "FILE", group = "input_file")]
+    file: Option<PathBuf>,
+}
+
+impl InputFile {
+    /// The file, given with --input or as the positional FILE (clap asks
+    /// for one of them).
+    pub fn path(&self) -> &Path {
+        self.input
+            .as_deref()
+            .or(self.file.as_deref())
+            .unwrap_or(Path::new(""))
+    }
 }
 
 /// Read and check a file of another kind than a flight (a gradiometer
@@ -88,13 +115,9 @@ fn read_checked(path: &std::path::Path, opts: &ReadOptions) -> anyhow::Result<Fl
 }
 
 impl InputArgs {
-    /// The flight file, given with --input or as the positional FILE (clap
-    /// asks for one of them).
+    /// The flight file, given with --input or as the positional FILE.
     pub fn path(&self) -> &Path {
-        self.input
-            .as_deref()
-            .or(self.file.as_deref())
-            .unwrap_or(Path::new(""))
+        self.file.path()
     }
 
     /// The library's reading options for these arguments.

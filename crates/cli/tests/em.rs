@@ -440,6 +440,13 @@ fn pilot_correction_measures_the_drifted_channel_sensitivity() {
         &aeromag(&["em", "detect", "--input", s(&raw), "--out", s(&with)]),
         0,
     );
+    // The record may be given without --input.
+    let plain = dir.path().join("plain.csv");
+    assert_code(&aeromag(&["em", "detect", s(&raw), "--out", s(&plain)]), 0);
+    assert_eq!(
+        std::fs::read(&with).unwrap(),
+        std::fs::read(&plain).unwrap()
+    );
     assert_code(
         &aeromag(&[
             "em",

@@ -222,6 +222,19 @@ fn derived_grids_and_micro_levelling_from_the_command_line() {
     let fvd = d.path().join("fvd.nc");
     let o = run(&["--vertical-derivative", "--out", fvd.to_str().unwrap()]);
     assert_code(&o, 0);
+    // The grid may be given without --input, but not both ways.
+    let fvd2 = d.path().join("fvd2.nc");
+    let (gs, f2) = (g.to_str().unwrap(), fvd2.to_str().unwrap());
+    let plain = aeromag(&["derive", gs, "--vertical-derivative", "--out", f2]);
+    assert_code(&plain, 0);
+    assert_eq!(std::fs::read(&fvd).unwrap(), std::fs::read(&fvd2).unwrap());
+    let both = aeromag(&["derive", "-i", gs, gs, "--vertical-derivative", "--out", f2]);
+    assert_code(&both, 2);
+    assert!(
+        stderr(&both).contains("cannot be used with"),
+        "{}",
+        stderr(&both)
+    );
     assert!(
         stdout(&o).contains("vertical derivative") && stdout(&o).contains("nT/m"),
         "{}",

@@ -32,10 +32,11 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 #[command(group(clap::ArgGroup::new("product").required(true).multiple(false)))]
+#[command(mut_arg("input", |a| a.value_name("GRID").help("Input grid file")))]
+#[command(mut_arg("file", |a| a.value_name("GRID")))]
 pub struct Args {
-    /// Input grid file.
-    #[arg(long, short = 'i', value_name = "GRID")]
-    input: PathBuf,
+    #[command(flatten)]
+    input: crate::input::InputFile,
     /// Output grid file.
     #[arg(long, value_name = "GRID")]
     out: PathBuf,
@@ -64,7 +65,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     crate::output::check_map(a.map.as_deref())?;
     crate::output::check_files(
         std::iter::once(a.out.as_path()).chain(a.map.as_deref()),
-        &[a.input.as_path()],
+        &[a.input.path()],
     )?;
     let product = match (a.vertical_derivative, a.upward, &a.minus) {
         (true, _, _) => GridProduct::VerticalDerivative,
@@ -76,7 +77,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             ));
         }
     };
-    let g = derive(&a.input, &product)?;
+    let g = derive(a.input.path(), &product)?;
     aeromag::grid::format::write_grid(&a.out, &g)?;
     let s = g.stats();
     println!(

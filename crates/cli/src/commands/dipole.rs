@@ -99,10 +99,11 @@ pub struct SimulateArgs {
 /// Example: `aeromag dipole locate --input grad/gradiometer.csv --config grad/gradiometer.toml --out est.csv`
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
+#[command(mut_arg("input", |a| a.value_name("FILE").help("The pass (CSV as written by `aeromag dipole simulate`)")))]
+#[command(mut_arg("file", |a| a.value_name("FILE")))]
 struct LocateArgs {
-    /// The pass (CSV as written by `aeromag dipole simulate`).
-    #[arg(long, short = 'i', value_name = "FILE")]
-    input: PathBuf,
+    #[command(flatten)]
+    input: crate::input::InputFile,
     /// Map the navigation's canonical column names onto the file's names,
     /// e.g. `time=t,yaw=heading` (time, lat, lon, alt, roll, pitch, yaw;
     /// the pass's other columns keep the names above).
@@ -198,7 +199,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 fn locate(a: LocateArgs) -> anyhow::Result<()> {
     // The scenario file is an input too (`--config X --out X` replaced it
     // with the estimates).
-    let inputs: Vec<&Path> = std::iter::once(a.input.as_path())
+    let inputs: Vec<&Path> = std::iter::once(a.input.path())
         .chain(a.config.as_deref())
         .collect();
     crate::output::check_files([a.out.as_path()], &inputs)?;
@@ -226,7 +227,7 @@ fn locate(a: LocateArgs) -> anyhow::Result<()> {
     };
     settings.apply(&mut cfg)?;
     let table = crate::input::load_only(
-        &a.input,
+        a.input.path(),
         pass_columns(cfg.system.gradiometer),
         a.columns.as_deref(),
     )?;

@@ -41,10 +41,11 @@ use std::path::PathBuf;
 ///       --system em/em.system.json --out em/cal.json
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
+#[command(mut_arg("input", |a| a.value_name("DETECTED.csv").help("Detected-vector CSV (`aeromag em detect`)")))]
+#[command(mut_arg("file", |a| a.value_name("DETECTED.csv")))]
 pub struct CalibrateArgs {
-    /// Detected-vector CSV (`aeromag em detect`).
-    #[arg(long, short = 'i', value_name = "DETECTED.csv")]
-    input: PathBuf,
+    #[command(flatten)]
+    input: crate::input::InputFile,
     /// Known positions and attitude (format above).
     #[arg(long, value_name = "KNOWN.csv")]
     known: PathBuf,
@@ -61,15 +62,15 @@ pub struct CalibrateArgs {
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     crate::output::check_files(
         [a.out.as_path()],
-        &[a.input.as_path(), a.known.as_path(), a.system.as_path()],
+        &[a.input.path(), a.known.as_path(), a.system.as_path()],
     )?;
     let system = read_system(&a.system)?;
-    let epochs = read_detected(&a.input)?;
+    let epochs = read_detected(a.input.path())?;
     let known = known_points(&load_table(&a.known)?, &epochs)?;
     let cal = calibrate(&epochs, &known, &system, &a.half_space.half_space).map_err(|e| {
         anyhow::Error::new(e).context(format!(
             "calibration from '{}', '{}' and '{}' failed",
-            a.input.display(),
+            a.input.path().display(),
             a.known.display(),
             a.system.display()
         ))

@@ -31,10 +31,11 @@ use std::path::PathBuf;
 /// Example: `aeromag em detect --input em/em.raw --out em/detected.csv`
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
+#[command(mut_arg("input", |a| a.value_name("RAW").help("Raw record (`aeromag em simulate` writes DIR/em.raw)")))]
+#[command(mut_arg("file", |a| a.value_name("RAW")))]
 pub struct DetectArgs {
-    /// Raw record (`aeromag em simulate` writes DIR/em.raw).
-    #[arg(long, short = 'i', value_name = "RAW")]
-    input: PathBuf,
+    #[command(flatten)]
+    input: crate::input::InputFile,
     /// Detected-vector CSV to write.
     #[arg(long, value_name = "DETECTED.csv")]
     out: PathBuf,
@@ -83,14 +84,14 @@ fn window(name: &str) -> Result<WindowName, String> {
 }
 
 pub fn run(a: DetectArgs) -> anyhow::Result<()> {
-    crate::output::check_files([a.out.as_path()], &[a.input.as_path()])?;
+    crate::output::check_files([a.out.as_path()], &[a.input.path()])?;
     let opts = DetectOptions {
         window_len: a.window_len,
         window: a.window.0,
         pilot: !a.no_pilot,
         system: a.system.as_deref().map(read_system).transpose()?,
     };
-    let d = detect(&a.input, &opts, &mut Bars::new())?;
+    let d = detect(a.input.path(), &opts, &mut Bars::new())?;
     aeromag::io::atomic::write_file(&a.out, detected_csv(&d.epochs))
         .map_err(|e| aeromag::Error::write(&a.out, e))?;
     let n = d.window_len;
@@ -99,7 +100,7 @@ pub fn run(a: DetectArgs) -> anyhow::Result<()> {
         d.epochs.len(),
         n as f64 / d.sample_rate_hz,
         d.sample_rate_hz / n as f64,
-        a.input.display(),
+        a.input.path().display(),
         if a.no_pilot {
             ", no pilot correction"
         } else {

@@ -37,10 +37,11 @@ use std::path::PathBuf;
 ///   aeromag em locate --input em/detected.csv --calibration em/cal.json --out em/poses.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
+#[command(mut_arg("input", |a| a.value_name("DETECTED.csv").help("Detected-vector CSV (`aeromag em detect`)")))]
+#[command(mut_arg("file", |a| a.value_name("DETECTED.csv")))]
 pub struct LocateArgs {
-    /// Detected-vector CSV (`aeromag em detect`).
-    #[arg(long, short = 'i', value_name = "DETECTED.csv")]
-    input: PathBuf,
+    #[command(flatten)]
+    input: crate::input::InputFile,
     /// Calibration file (`aeromag em calibrate`).
     #[arg(long, value_name = "CAL.json")]
     calibration: PathBuf,
@@ -54,15 +55,15 @@ pub struct LocateArgs {
 pub fn run(a: LocateArgs) -> anyhow::Result<()> {
     crate::output::check_files(
         [a.out.as_path()],
-        &[a.input.as_path(), a.calibration.as_path()],
+        &[a.input.path(), a.calibration.as_path()],
     )?;
     let file = read_calibration(&a.calibration)?;
-    let epochs = read_detected(&a.input)?;
+    let epochs = read_detected(a.input.path())?;
     let poses =
         locate(&epochs, &file, &a.half_space.half_space, &mut Bars::new()).map_err(|e| {
             anyhow::Error::new(e).context(format!(
                 "locating '{}' with '{}' failed",
-                a.input.display(),
+                a.input.path().display(),
                 a.calibration.display()
             ))
         })?;
