@@ -262,14 +262,10 @@ impl Compensated {
     /// Add the interference, [`COMPENSATED`] and flag columns to `table`
     /// (bad input if one of them exists already).
     pub fn add_to(self, table: &mut FlightTable) -> Result<()> {
-        for name in [self.output.interference, COMPENSATED, self.output.flag] {
-            if table.get(name).is_some() {
-                return Err(Error::bad_file(
-                    table.file_label(),
-                    format!("already has a column `{name}`; rename it first"),
-                ));
-            }
-        }
+        check_new_columns(
+            table,
+            [self.output.interference, COMPENSATED, self.output.flag],
+        )?;
         let flags = self.flags();
         table.add_column(self.output.interference, self.interference_nt)?;
         table.add_column(COMPENSATED, self.compensated_nt)?;
@@ -342,4 +338,34 @@ mod tests {
             );
         }
     }
+}
+
+/// Bad input when `table` already reads a column as one of `names`, the
+/// columns a compensation adds: a column of that name ("rename it first"),
+/// or one the column map reads under it (`--columns mag_comp=COMPMAG1` on
+/// `compensate`: the map is the thing to change; the file's column, left
+/// unmapped, is written as it is beside the new one).
+pub(crate) fn check_new_columns<'a>(
+    table: &FlightTable,
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<()> {
+    for name in names {
+        let Some(column) = table.resolve(name) else {
+            continue;
+        };
+        let mapped = table.mapping().iter().any(|m| m.canonical == name);
+        let message = if mapped {
+            format!(
+                "the column map reads its column '{column}' as `{name}`, a column the \
+                 compensation adds; leave `{name}` out of the map ('{column}' is then kept as it is \
+                 beside the new `{name}`)"
+            )
+        } else if column == name {
+            format!("already has a column `{name}`; rename it first")
+        } else {
+            format!("already has a column '{column}', read as `{name}`; rename it first")
+        };
+        return Err(Error::bad_file(table.file_label(), message));
+    }
+    Ok(())
 }

@@ -755,4 +755,26 @@ fn a_contractors_compensated_column_is_scored_when_mapped() {
         "{}",
         stderr(&o)
     );
+    // Compensating that file again: the map is what clashes with the new
+    // mag_comp, and the message says so; without it COMPMAG1 stays as it is.
+    let again = d.path().join("again.csv");
+    let mut args = vec!["compensate", theirs.to_str().unwrap()];
+    args.extend(["--model", model.to_str().unwrap()]);
+    args.extend(["--out", again.to_str().unwrap()]);
+    let o = aeromag(&[&args[..], &["--columns", "mag_comp=COMPMAG1"]].concat());
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("the column map reads its column 'COMPMAG1' as `mag_comp`")
+            && stderr(&o).contains("leave `mag_comp` out of the map"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!again.exists());
+    assert_code(&aeromag(&args), 0);
+    let header = std::fs::read_to_string(&again).unwrap();
+    let header: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+    assert!(
+        header.contains(&"COMPMAG1") && header.contains(&"mag_comp"),
+        "{header:?}"
+    );
 }

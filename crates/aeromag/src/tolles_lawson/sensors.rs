@@ -298,12 +298,7 @@ impl SensorsCompensated {
     /// exists already is bad input).
     pub fn add_to(self, table: &mut FlightTable) -> Result<()> {
         let cols = self.columns();
-        if let Some((name, _)) = cols.iter().find(|(n, _)| table.get(n).is_some()) {
-            return Err(Error::bad_file(
-                table.file_label(),
-                format!("already has a column `{name}`; rename it first"),
-            ));
-        }
+        crate::compensate::check_new_columns(table, cols.iter().map(|(n, _)| n.as_str()))?;
         for (name, v) in cols {
             table.add_column(&name, v)?;
         }
