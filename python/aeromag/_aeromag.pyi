@@ -17,6 +17,7 @@ __all__ = [
     "microlevel",
     "read_grid",
     "_grid_from_state",
+    "_microlevelled_from_state",
     "Flight",
     "read_flight",
     "_flight_from_state",
@@ -43,8 +44,11 @@ __all__ = [
     "detect_em",
     "calibrate_em",
     "_em_calibration_from_json",
+    "_em_detection_from_state",
+    "_em_poses_from_state",
     "locate_em",
     "Levelled",
+    "_levelled_from_state",
     "level",
     "score",
     "igrf",
@@ -271,6 +275,10 @@ class Levelled:
     def notes(self) -> List[str]: ...
     def crossovers(self) -> Flight: ...
     def to_flight(self) -> Flight: ...
+    def __reduce__(self) -> Tuple[Callable[..., Any], Tuple[Any, ...]]: ...
+
+def _levelled_from_state(state: bytes, flight: Flight) -> Levelled:
+    """Rebuild a pickled levelled survey (``Levelled.__reduce__``)."""
 
 def fit_rotor(
     flight: Flight,
@@ -374,6 +382,10 @@ class Microlevelled:
     @property
     def notes(self) -> List[str]: ...
     def to_flight(self) -> Flight: ...
+    def __reduce__(self) -> Tuple[Callable[..., Any], Tuple[Any, ...]]: ...
+
+def _microlevelled_from_state(state: bytes, flight: Flight) -> Microlevelled:
+    """Rebuild a pickled micro-levelled survey (``Microlevelled.__reduce__``)."""
 
 def grid_flight(
     flight: Flight,
@@ -455,6 +467,7 @@ class EmDetection:
     def __len__(self) -> int: ...
     def to_dict(self) -> Dict[str, np.ndarray]: ...
     def save(self, path: str) -> None: ...
+    def __reduce__(self) -> Tuple[Callable[..., Any], Tuple[Any, ...]]: ...
 
 @final
 class EmCalibration:
@@ -485,6 +498,7 @@ class EmPoses:
     def __len__(self) -> int: ...
     def to_dict(self) -> Dict[str, np.ndarray]: ...
     def save(self, path: str) -> None: ...
+    def __reduce__(self) -> Tuple[Callable[..., Any], Tuple[Any, ...]]: ...
 
 def simulate_em(
     out: str, config: Optional[str] = None, seed: Optional[int] = None, known_positions: int = 8
@@ -511,6 +525,10 @@ def _em_calibration_from_json(
     attitude_correction_deg: float,
 ) -> EmCalibration:
     """Rebuild a pickled EM calibration (``EmCalibration.__reduce__``)."""
+def _em_detection_from_state(state: bytes) -> EmDetection:
+    """Rebuild a pickled EM detection (``EmDetection.__reduce__``)."""
+def _em_poses_from_state(state: bytes) -> EmPoses:
+    """Rebuild pickled EM poses (``EmPoses.__reduce__``)."""
 def locate_em(
     detected: Union[EmDetection, str],
     calibration: Union[EmCalibration, str],

@@ -70,6 +70,7 @@ fn note_texts(notes: &[Note]) -> Vec<String> {
 
 /// Detected complex field vectors of a raw EM record (`aeromag em detect`).
 #[pyclass(name = "EmDetection", module = "aeromag._aeromag", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct PyEmDetection {
     epochs: Vec<FieldEpoch>,
     #[pyo3(get)]
@@ -99,6 +100,16 @@ impl PyEmDetection {
     /// Write the detected-vector CSV of `aeromag em detect`.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         save(&path, detected_csv(&self.epochs))
+    }
+
+    /// Pickling (and `copy.deepcopy`): the epochs and figures
+    /// ([`em_detection_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let args = (crate::pickle::to_cbor(py, "EM detection", self)?,).into_pyobject(py)?;
+        Ok((
+            crate::pickle::constructor(py, "_em_detection_from_state")?,
+            args,
+        ))
     }
 
     fn __repr__(&self) -> String {
@@ -315,6 +326,17 @@ impl PyEmPoses {
     fn save(&self, path: PathBuf) -> PyResult<()> {
         save(&path, self.inner.to_csv())
     }
+    /// Pickling (and `copy.deepcopy`): the poses and notes
+    /// ([`em_poses_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let state = crate::pickle::to_cbor(py, "EM poses", &self.inner)?;
+        let args = (state,).into_pyobject(py)?;
+        Ok((
+            crate::pickle::constructor(py, "_em_poses_from_state")?,
+            args,
+        ))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "EmPoses({} epochs, {} failed)",
@@ -322,6 +344,24 @@ impl PyEmPoses {
             self.inner.failed()
         )
     }
+}
+
+/// Rebuild a pickled EM detection (the constructor of
+/// `EmDetection.__reduce__`); bad input when the state is not one.
+#[pyfunction]
+#[pyo3(name = "_em_detection_from_state")]
+pub fn em_detection_from_state(state: &[u8]) -> PyResult<PyEmDetection> {
+    crate::pickle::from_cbor("EM detection", state)
+}
+
+/// Rebuild pickled EM poses (the constructor of `EmPoses.__reduce__`); bad
+/// input when the state is not theirs.
+#[pyfunction]
+#[pyo3(name = "_em_poses_from_state")]
+pub fn em_poses_from_state(state: &[u8]) -> PyResult<PyEmPoses> {
+    Ok(PyEmPoses {
+        inner: crate::pickle::from_cbor("EM poses", state)?,
+    })
 }
 
 /// Locate the bird at every epoch with a calibration (an `EmCalibration`

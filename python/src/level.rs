@@ -181,6 +181,18 @@ impl PyLevelled {
         self.levelled.notes.iter().map(|n| n.to_string()).collect()
     }
 
+    /// Pickling (and `copy.deepcopy`): the result and its flight
+    /// ([`levelled_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let state = crate::pickle::to_cbor(py, "levelled survey", &self.levelled)?;
+        let flight = Py::new(py, PyFlight::new(self.flight.clone()))?;
+        let args = (state, flight).into_pyobject(py)?;
+        Ok((
+            crate::pickle::constructor(py, "_levelled_from_state")?,
+            args,
+        ))
+    }
+
     fn __repr__(&self) -> String {
         let l = &self.levelled;
         let f = &l.levelling.fit;
@@ -195,6 +207,28 @@ impl PyLevelled {
             f.k_s
         )
     }
+}
+
+/// Rebuild a pickled levelled survey (the constructor of
+/// `Levelled.__reduce__`): the result's state and its flight. Bad input
+/// when the state is not a levelled survey's or its series do not have
+/// one value per row of the flight.
+#[pyfunction]
+#[pyo3(name = "_levelled_from_state")]
+pub fn levelled_from_state(state: &[u8], flight: PyRef<'_, PyFlight>) -> PyResult<PyLevelled> {
+    let what = "levelled survey";
+    let levelled: Levelled = crate::pickle::from_cbor(what, state)?;
+    let flight = flight.inner.clone();
+    let l = &levelled.levelling;
+    for (series, len) in [
+        ("levelled series", l.levelled.value_nt.len()),
+        ("flags", l.levelled.flag.len()),
+        ("derivative", l.derivative_nt_per_s.len()),
+        ("line ids", levelled.lines.ids.len()),
+    ] {
+        crate::pickle::check_rows(what, series, len, &flight)?;
+    }
+    Ok(PyLevelled { levelled, flight })
 }
 
 /// The figures of a compensated flight (needs `mag_comp`, as written by

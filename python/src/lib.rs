@@ -19,7 +19,7 @@
 //! | [`apply`] | what every model does to a flight (interference, compensate, apply) |
 //! | [`errors`] | library errors → `BadInputError`, `AeromagError`, `OSError` |
 //! | [`progress`] | progress callbacks from the library's observer |
-//! | [`pickle`] | pickling of the models, grids and flights: their `__reduce__` constructors |
+//! | [`pickle`] | pickling of the models, grids, flights and results: their `__reduce__` constructors |
 
 mod apply;
 mod em;
@@ -63,6 +63,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gradiometry::simulate_gradiometer, m)?)?;
     m.add_class::<level::PyLevelled>()?;
     m.add_function(wrap_pyfunction!(level::level, m)?)?;
+    m.add_function(wrap_pyfunction!(level::levelled_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(level::score, m)?)?;
     m.add_class::<map::PyGrid>()?;
     m.add_class::<map::PyMicrolevelled>()?;
@@ -70,6 +71,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(map::read_grid, m)?)?;
     m.add_function(wrap_pyfunction!(map::grid_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(map::microlevel, m)?)?;
+    m.add_function(wrap_pyfunction!(map::microlevelled_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(fields::igrf, m)?)?;
     m.add_function(wrap_pyfunction!(fields::decimal_year, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
@@ -81,5 +83,7 @@ fn _aeromag(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(em::calibrate_em, m)?)?;
     m.add_function(wrap_pyfunction!(em::em_calibration_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(em::locate_em, m)?)?;
+    m.add_function(wrap_pyfunction!(em::em_detection_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(em::em_poses_from_state, m)?)?;
     Ok(())
 }

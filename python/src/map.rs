@@ -454,6 +454,20 @@ impl PyMicrolevelled {
         Ok(PyFlight::new(Flight::from_table(t).py_err()?))
     }
 
+    /// Pickling (and `copy.deepcopy`): the result, the traverse lines' ids
+    /// (which the reports' JSON leaves out) and the flight
+    /// ([`microlevelled_from_state`]).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<crate::pickle::Reduced<'py>> {
+        let state = (&self.m, &self.m.lines.traverse_ids);
+        let state = crate::pickle::to_cbor(py, "micro-levelled survey", &state)?;
+        let flight = Py::new(py, PyFlight::new(self.flight.clone()))?;
+        let args = (state, flight).into_pyobject(py)?;
+        Ok((
+            crate::pickle::constructor(py, "_microlevelled_from_state")?,
+            args,
+        ))
+    }
+
     fn __repr__(&self) -> String {
         let m = &self.m;
         let crossovers = m.crossover_rms_nt.map_or("no crossovers".into(), |(a, b)| {
@@ -516,4 +530,23 @@ pub fn microlevel(
         m: result.py_err()?,
         flight: flight.inner.clone(),
     })
+}
+
+/// Rebuild a pickled micro-levelled survey (the constructor of
+/// `Microlevelled.__reduce__`): the result's state and its flight. Bad
+/// input when the state is not a micro-levelled survey's or its series do
+/// not have one value per row of the flight.
+#[pyfunction]
+#[pyo3(name = "_microlevelled_from_state")]
+pub fn microlevelled_from_state(
+    state: &[u8],
+    flight: PyRef<'_, PyFlight>,
+) -> PyResult<PyMicrolevelled> {
+    let what = "micro-levelled survey";
+    let (mut m, traverse_ids): (Microlevelled, Vec<i64>) = crate::pickle::from_cbor(what, state)?;
+    m.lines.traverse_ids = traverse_ids;
+    let flight = flight.inner.clone();
+    crate::pickle::check_rows(what, "values", m.values.len(), &flight)?;
+    crate::pickle::check_rows(what, "correction", m.correction.len(), &flight)?;
+    Ok(PyMicrolevelled { m, flight })
 }

@@ -18,7 +18,11 @@
 //! columns, mapping, source file, file lines; `aeromag::io::TableSnapshot`)
 //! beside its numbers, and is checked again as a flight when rebuilt. An EM
 //! calibration travels as its calibration file's text and its fit's
-//! figures.
+//! figures. The other results (a levelled or micro-levelled survey, an EM
+//! detection or its poses) travel as their library value in CBOR
+//! ([`to_cbor`], [`from_cbor`]: every float read back as written, NaN as
+//! NaN), with the flight they belong to, and are checked against it when
+//! rebuilt.
 
 use crate::errors::{IntoPy, bad_argument};
 use crate::rotor_pod::{AnyModel, PyModel};
@@ -172,4 +176,36 @@ pub fn model_from_json(
         })
         .transpose()?;
     model_of_text(py, text, PICKLED, notes, series)
+}
+
+/// `value` as CBOR bytes, for a result's `__reduce__`; `what` names it in
+/// the error (none is expected: the results hold numbers and text).
+pub fn to_cbor<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    what: &str,
+    value: &T,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let mut bytes = Vec::new();
+    ciborium::into_writer(value, &mut bytes)
+        .map_err(|e| bad_argument(format!("this {what} cannot be pickled: {e}")))?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// The value of [`to_cbor`]'s bytes; bad input naming the pickled `what`
+/// when they are not one.
+pub fn from_cbor<T: serde::de::DeserializeOwned>(what: &str, bytes: &[u8]) -> PyResult<T> {
+    ciborium::from_reader(bytes)
+        .map_err(|e| bad_argument(format!("pickled {what}: its state is not readable ({e})")))
+}
+
+/// Bad input unless the pickled `what`'s `series` has one value per row of
+/// its `flight`.
+pub fn check_rows(what: &str, series: &str, len: usize, flight: &aeromag::Flight) -> PyResult<()> {
+    if len != flight.n_rows() {
+        return Err(bad_argument(format!(
+            "pickled {what}: its {series} has {len} values for a flight of {} rows",
+            flight.n_rows()
+        )));
+    }
+    Ok(())
 }

@@ -310,3 +310,67 @@ def test_an_em_calibration_round_trips(tmp_path):
         make("garbage", *numbers)
     with pytest.raises(aeromag.BadInputError, match="version"):
         make(text.replace('"version": 1', '"version": 99'), *numbers)
+
+
+def same_flight(a, b):
+    """Two flights with the same columns, bit for bit."""
+    x, y = a.to_dict(), b.to_dict()
+    return list(x) == list(y) and all(
+        bits(x[k]) == bits(y[k]) if np.asarray(x[k]).dtype.kind == "f" else list(x[k]) == list(y[k])
+        for k in x
+    )
+
+
+def test_levelled_and_microlevelled_surveys_round_trip(survey):
+    lev = aeromag.level(survey)
+    figures = ("value_column", "output_column", "k_s", "rms_nt", "line_levels", "notes")
+    for c in copies(lev):
+        assert type(c) is aeromag.Levelled and c is not lev and repr(c) == repr(lev)
+        assert [getattr(c, f) for f in figures] == [getattr(lev, f) for f in figures]
+        assert bits(c.levelled) == bits(lev.levelled) and bits(c.flags) == bits(lev.flags)
+        assert same_flight(c.crossovers(), lev.crossovers())
+        assert same_flight(c.to_flight(), lev.to_flight())
+    make, (state, flight) = lev.__reduce__()
+    assert make is _aeromag._levelled_from_state and isinstance(flight, aeromag.Flight)
+    with pytest.raises(aeromag.BadInputError, match="pickled levelled survey: its state"):
+        make(b"garbage", flight)
+    short = aeromag.Flight.from_dict({k: v[:10] for k, v in survey.to_dict().items()})
+    with pytest.raises(aeromag.BadInputError, match="values for a flight of 10 rows"):
+        make(state, short)
+
+    m = aeromag.microlevel(lev.to_flight(), column=lev.output_column)
+    figures = ("column", "output_column", "correction_nt", "crossover_rms_nt", "gridding", "notes")
+    for c in copies(m):
+        assert type(c) is aeromag.Microlevelled and c is not m and repr(c) == repr(m)
+        assert [getattr(c, f) for f in figures] == [getattr(m, f) for f in figures]
+        assert bits(c.values) == bits(m.values) and bits(c.correction) == bits(m.correction)
+        assert same_flight(c.to_flight(), m.to_flight())
+    make, (state, flight) = m.__reduce__()
+    assert make is _aeromag._microlevelled_from_state
+    with pytest.raises(aeromag.BadInputError, match="pickled micro-levelled survey: its state"):
+        make(state[:-5], flight)
+    with pytest.raises(aeromag.BadInputError, match="values for a flight of 10 rows"):
+        make(state, short)
+
+
+def test_em_detections_and_poses_round_trip(tmp_path):
+    files = aeromag.simulate_em(str(tmp_path / "em"), seed=4)
+    det = aeromag.detect_em(files["raw"])
+    poses = aeromag.locate_em(det, aeromag.calibrate_em(det, files["known"], files["system"]))
+    for x, figures in [
+        (det, ("sample_rate_hz", "window_len", "polarization_ratio_rms", "notes")),
+        (poses, ("failed", "by_continuity", "notes")),
+    ]:
+        for c in copies(x):
+            assert type(c) is type(x) and c is not x and repr(c) == repr(x)
+            assert len(c) == len(x) > 0
+            assert [getattr(c, f) for f in figures] == [getattr(x, f) for f in figures]
+            a, b = c.to_dict(), x.to_dict()
+            assert a.keys() == b.keys() and all(bits(a[k]) == bits(b[k]) for k in a)
+        make, (state,) = x.__reduce__()
+        with pytest.raises(aeromag.BadInputError, match="its state is not readable"):
+            make(state[: len(state) // 2])
+    # A pickled detection locates as the original does.
+    again = aeromag.locate_em(pickle.loads(pickle.dumps(det)), aeromag.calibrate_em(
+        det, files["known"], files["system"]))
+    assert all(bits(again.to_dict()[k]) == bits(poses.to_dict()[k]) for k in poses.to_dict())

@@ -113,7 +113,7 @@ impl LevelFitChoices {
 }
 
 /// A levelled survey ([`level`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Levelled {
     /// Crossovers, the fit (k, line levels, residuals) and the corrected
     /// series.

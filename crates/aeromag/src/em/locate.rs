@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use std::fmt::Write;
 
 /// The pose of one epoch (`None` fields when it could not be located).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pose {
     /// Epoch time, s.
     pub time_s: f64,
@@ -24,7 +24,7 @@ pub struct Pose {
 }
 
 /// A located epoch.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Located {
     /// Position, transmitter frame, m.
     pub position_m: [f64; 3],
@@ -59,7 +59,7 @@ pub struct Located {
 pub const MAX_RESIDUAL_REL: f64 = 1e-3;
 
 /// The poses of a pass.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Poses {
     /// One per epoch, in order.
     pub poses: Vec<Pose>,

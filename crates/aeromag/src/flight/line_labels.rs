@@ -35,7 +35,7 @@ use aeromag_compensation::levelling::Pairing;
 use aeromag_core::error::shown;
 
 /// Ids (1, 2, …, in order of first appearance) of a flight's line labels.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LineLabels {
     /// Per row: the id of its line, `0.0` for rows on no line. The labels
     /// have ids 1, 2, … in order of first appearance; per pass

@@ -80,7 +80,7 @@ impl Default for MicrolevelOptions {
 
 /// The result of [`microlevel`]: the correction of every row and what it
 /// amounts to.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Microlevelled {
     /// The column micro-levelled.
     pub column: String,

@@ -210,7 +210,7 @@ impl ProjectedColumns {
 }
 
 /// Direction and spacing of a survey's traverse lines ([`ProjectedSurvey`]).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LineGeometry {
     /// Direction of the traverse lines, degrees clockwise from grid north,
     /// 0–180.
@@ -221,8 +221,9 @@ pub struct LineGeometry {
     pub traverse_lines: usize,
     /// Other lines (ties, turns).
     pub other_lines: usize,
-    /// The ids ([`LineLabels`] ids) of the traverse lines, ascending.
-    #[serde(skip)]
+    /// The ids ([`LineLabels`] ids) of the traverse lines, ascending (left
+    /// out of the reports' JSON; empty when read back from it).
+    #[serde(skip_serializing, default)]
     pub traverse_ids: Vec<i64>,
 }
 

@@ -34,7 +34,7 @@
 //! 1.10 %; the demo's compensated, unlevelled lines 0.68–0.69 %.
 
 /// Intervals added on each side of a grid (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Enlargement {
     /// Added to the west, intervals.
     pub west: usize,

@@ -111,7 +111,7 @@ impl Default for MinCurvature {
 }
 
 /// How a grid of the sequence converged.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LevelReport {
     /// Node spacing of this grid, in cells of the final grid.
     pub spacing_cells: usize,
@@ -157,7 +157,7 @@ impl LevelReport {
 }
 
 /// What the gridding did ([`MinCurvature::grid`]).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MinCurvatureReport {
     /// The grids of the sequence, coarsest first.
     pub levels: Vec<LevelReport>,
