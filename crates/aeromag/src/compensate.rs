@@ -285,6 +285,36 @@ impl Compensated {
     }
 }
 
+/// Bad input when `table` already reads a column as one of `names`, the
+/// columns a compensation adds: a column of that name ("rename it first"),
+/// or one the column map reads under it (`--columns mag_comp=COMPMAG1` on
+/// `compensate`: the map is the thing to change; the file's column, left
+/// unmapped, is written as it is beside the new one).
+pub(crate) fn check_new_columns<'a>(
+    table: &FlightTable,
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<()> {
+    for name in names {
+        let Some(column) = table.resolve(name) else {
+            continue;
+        };
+        let mapped = table.mapping().iter().any(|m| m.canonical == name);
+        let message = if mapped {
+            format!(
+                "the column map reads its column '{column}' as `{name}`, a column the \
+                 compensation adds; leave `{name}` out of the map ('{column}' is then kept as it is \
+                 beside the new `{name}`)"
+            )
+        } else if column == name {
+            format!("already has a column `{name}`; rename it first")
+        } else {
+            format!("already has a column '{column}', read as `{name}`; rename it first")
+        };
+        return Err(Error::bad_file(table.file_label(), message));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -338,34 +368,4 @@ mod tests {
             );
         }
     }
-}
-
-/// Bad input when `table` already reads a column as one of `names`, the
-/// columns a compensation adds: a column of that name ("rename it first"),
-/// or one the column map reads under it (`--columns mag_comp=COMPMAG1` on
-/// `compensate`: the map is the thing to change; the file's column, left
-/// unmapped, is written as it is beside the new one).
-pub(crate) fn check_new_columns<'a>(
-    table: &FlightTable,
-    names: impl IntoIterator<Item = &'a str>,
-) -> Result<()> {
-    for name in names {
-        let Some(column) = table.resolve(name) else {
-            continue;
-        };
-        let mapped = table.mapping().iter().any(|m| m.canonical == name);
-        let message = if mapped {
-            format!(
-                "the column map reads its column '{column}' as `{name}`, a column the \
-                 compensation adds; leave `{name}` out of the map ('{column}' is then kept as it is \
-                 beside the new `{name}`)"
-            )
-        } else if column == name {
-            format!("already has a column `{name}`; rename it first")
-        } else {
-            format!("already has a column '{column}', read as `{name}`; rename it first")
-        };
-        return Err(Error::bad_file(table.file_label(), message));
-    }
-    Ok(())
 }
