@@ -466,6 +466,15 @@ impl PyFlight {
             .py_err()
     }
 
+    /// Write the flight as HDF5 in the MagNav/SGL layout (one 1-D dataset
+    /// per column at the root: float64, int64 for integer columns, UTF-8
+    /// strings for text; as the CLI writes `--out X.h5`), which h5py and
+    /// MagNav.jl read: bad input for a column name HDF5 cannot hold (`/`).
+    fn to_hdf5(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| aeromag::io::write_hdf5(self.inner.table(), &path))
+            .py_err()
+    }
+
     /// Number of rows.
     fn __len__(&self) -> usize {
         self.inner.n_rows()

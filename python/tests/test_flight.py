@@ -209,3 +209,51 @@ def test_to_xyz_reads_back_to_the_same_flight(tmp_path):
         spaced.to_xyz(tmp_path / "s.xyz")
     assert (e.value.column, e.value.row) == ("note", 1)
     assert not (tmp_path / "s.xyz").exists()
+
+
+def test_to_hdf5_reads_back_in_h5py_and_here(tmp_path):
+    """HDF5 out (as ``--out X.h5``): h5py (the HDF5 C library) reads one
+    dataset per column with the flight's bits, integers as int64 and text
+    as UTF-8 strings, and so does read_flight; a name with '/' is refused."""
+    h5py = pytest.importorskip("h5py")
+    cal = aeromag.simulate("calibration", seed=2)
+    flight = aeromag.Flight.from_dict({**cal.to_dict(), "label": ["L1020 é"] * (len(cal) - 1) + [""]})
+    flight.to_hdf5(tmp_path / "c.h5")
+    with h5py.File(tmp_path / "c.h5", "r") as h:
+        assert sorted(h.keys()) == sorted(flight.columns)
+        for name in cal.columns:
+            assert h[name].shape == (len(cal),) and h[name].dtype == np.float64
+            assert h[name][:].tobytes() == np.asarray(cal[name]).tobytes(), name
+        labels = [b.decode() for b in h["label"][:]]
+        assert labels == list(flight["label"])
+    back = aeromag.read_flight(tmp_path / "c.h5")
+    assert back.columns == flight.columns
+    for name in cal.columns:
+        assert np.asarray(back[name]).tobytes() == np.asarray(cal[name]).tobytes(), name
+    assert list(back["label"]) == list(flight["label"])
+    # A compensated flight's flag column is written as integers.
+    applied = aeromag.TollesLawson().fit(cal).model_.apply(cal)
+    applied.to_hdf5(tmp_path / "a.h5")
+    with h5py.File(tmp_path / "a.h5", "r") as h:
+        assert h["comp_flag"].dtype == np.int64
+        assert (h["comp_flag"][:] == applied["comp_flag"]).all()
+        assert h["mag_comp"][:].tobytes() == np.asarray(applied["mag_comp"]).tobytes()
+    slash = aeromag.Flight.from_dict({"time": [0.0, 1.0], "a/b": [1.0, 2.0]})
+    with pytest.raises(aeromag.BadInputError) as e:
+        slash.to_hdf5(tmp_path / "s.h5")
+    assert e.value.column == "a/b" and not (tmp_path / "s.h5").exists()
+
+
+def test_text_datasets_written_by_h5py_are_text_columns(tmp_path):
+    """Line labels as strings in an HDF5 flight (variable-length, as h5py
+    writes Python str, or fixed-length bytes) are read as text columns."""
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(tmp_path / "t.h5", "w") as h:
+        h["tt"] = np.arange(4) * 0.1
+        h["mag_1_uc"] = np.full(4, 5.0e4)
+        h.create_dataset("line", data=["L1", "L1", "T2", ""], dtype=h5py.string_dtype())
+        h["code"] = np.array([b"a", b"bb", b"", b"c"], dtype="S2")
+    f = aeromag.read_flight(tmp_path / "t.h5")
+    assert list(f["line"]) == ["L1", "L1", "T2", ""]
+    assert list(f["code"]) == ["a", "bb", "", "c"]
+    assert np.asarray(f["mag"]).tolist() == [5.0e4] * 4

@@ -177,8 +177,8 @@ pub fn check_map(map: Option<&Path>) -> anyhow::Result<()> {
 }
 
 /// Check, before any work, that a flight table can be written in the
-/// format each of `tables` asks for (CSV, or Geosoft XYZ for `.xyz`; a
-/// grid, model or HDF5 name is bad input).
+/// format each of `tables` asks for (CSV, Geosoft XYZ for `.xyz`, HDF5 for
+/// `.h5`; a grid or model name is bad input).
 pub fn check_tables<'a>(tables: impl IntoIterator<Item = &'a Path>) -> anyhow::Result<()> {
     for p in tables {
         aeromag::io::TableFormat::of_path(p)?;

@@ -241,11 +241,11 @@ fn a_fifo_that_no_process_reads_is_bad_input() {
     assert!(!rep.join("index.html").exists());
 }
 
-/// `--out X.xyz` writes Geosoft XYZ (it wrote CSV under that name), which
-/// reads back to the table the CSV holds; a grid, model or HDF5 name is
-/// refused before the work (`--out out.h5` was CSV under that name).
+/// `--out X.xyz` writes Geosoft XYZ and `--out X.h5` HDF5 (both were CSV
+/// under that name), which read back to the table the CSV holds; a grid or
+/// model name is refused before the work.
 #[test]
-fn xyz_outputs_hold_the_csv_table_and_other_formats_are_refused() {
+fn xyz_and_hdf5_outputs_hold_the_csv_table_and_other_formats_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let cal = simulate(dir.path(), "calibration", "3");
     let model = dir.path().join("m.json");
@@ -260,32 +260,39 @@ fn xyz_outputs_hold_the_csv_table_and_other_formats_are_refused() {
         ]),
         0,
     );
-    let (csv, xyz) = (dir.path().join("c.csv"), dir.path().join("c.xyz"));
-    assert_code(&compensate(&model, &cal, &csv), 0);
-    assert_code(&compensate(&model, &cal, &xyz), 0);
+    let (csv, xyz, h5) = (
+        dir.path().join("c.csv"),
+        dir.path().join("c.xyz"),
+        dir.path().join("c.h5"),
+    );
+    for out in [&csv, &xyz, &h5] {
+        assert_code(&compensate(&model, &cal, out), 0);
+    }
     let text = std::fs::read_to_string(&xyz).unwrap();
     assert!(
         text.starts_with("/ XYZ export of aeromag "),
         "{}",
         &text[..80]
     );
-    let (a, b) = (
-        aeromag::Flight::read(&csv).unwrap(),
-        aeromag::Flight::read(&xyz).unwrap(),
-    );
-    let (ta, tb) = (a.table(), b.table());
-    assert_eq!(ta.column_names(), tb.column_names());
-    for name in ta.column_names() {
-        let bits = |t: &aeromag::io::FlightTable| -> Vec<u64> {
-            t.column(name)
-                .unwrap()
-                .iter()
-                .map(|v| v.to_bits())
-                .collect()
-        };
-        assert_eq!(bits(ta), bits(tb), "{name}");
+    let a = aeromag::Flight::read(&csv).unwrap();
+    for other in [&xyz, &h5] {
+        let b = aeromag::Flight::read(other).unwrap();
+        let (ta, tb) = (a.table(), b.table());
+        assert_eq!(ta.column_names(), tb.column_names());
+        for name in ta.column_names() {
+            let bits = |t: &aeromag::io::FlightTable| -> Vec<u64> {
+                t.column(name)
+                    .unwrap()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect()
+            };
+            assert_eq!(bits(ta), bits(tb), "{name} in {}", other.display());
+            let integer = |t: &aeromag::io::FlightTable| t.get(name).unwrap().integer_text();
+            assert_eq!(integer(ta), integer(tb), "{name} in {}", other.display());
+        }
     }
-    for refused in ["c.h5", "c.tif", "c.json"] {
+    for refused in ["c.he5", "c.tif", "c.json"] {
         let out = dir.path().join(refused);
         let o = aeromag(&[
             "compensate",
@@ -298,7 +305,7 @@ fn xyz_outputs_hold_the_csv_table_and_other_formats_are_refused() {
         ]);
         assert_code(&o, 2);
         assert!(
-            stderr(&o).contains("CSV (.csv) or Geosoft XYZ (.xyz)"),
+            stderr(&o).contains("CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"),
             "{}",
             stderr(&o)
         );

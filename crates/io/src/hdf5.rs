@@ -5,7 +5,8 @@
 //! file's root or inside one group (`/data`, `/flight`, …; used when the
 //! root holds no dataset and exactly one group). Datasets may be float64,
 //! float32 or integers (read exactly as `f64`; integer fields are written
-//! back as integers), contiguous or chunked with gzip/shuffle as h5py writes
+//! back as integers), or strings, fixed or variable length (a text column,
+//! such as line labels `L1020`), contiguous or chunked with gzip/shuffle as h5py writes
 //! them. Scalar and empty datasets (0-D, or of length 0 or 1 beside longer
 //! ones, e.g. a sample count) hold no rows and are skipped; any other shape
 //! is not this layout.
@@ -37,7 +38,7 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
-use hdf5_reader::{Dataset, Datatype, H5Type, Hdf5File, OpenOptions, group::Group};
+use hdf5_reader::{Dataset, Datatype, H5Type, Hdf5File, OpenOptions, VarLenKind, group::Group};
 
 use crate::ReadOptions;
 use crate::columns::resolve;
@@ -184,6 +185,16 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         }
         let path = format!("{prefix}{name}");
         check_units_attribute(file, &path, &name, &ds)?;
+        if let Datatype::String { .. }
+        | Datatype::VarLen {
+            kind: VarLenKind::String,
+            ..
+        } = ds.dtype()
+        {
+            let text = ds.read_strings().map_err(|e| h5err(Some(&path), e))?;
+            columns.push((name, ColumnData::Text(text), false));
+            continue;
+        }
         let (values, integer) = read_f64(&ds).map_err(|e| h5err(Some(&path), e))?;
         let missing = Missing {
             nan: crate::parts::nan_count(&values),

@@ -6,8 +6,9 @@
 //! column names onto aeromag's canonical names ([`ColumnMap`], MagNav
 //! preset), checks time and units ([`check_time`], [`check_units`]), finds
 //! positions off the track ([`position_glitches`]), summarizes a table for
-//! `aeromag inspect` ([`summarize`]) and writes CSV
-//! ([`write_csv`]) and other outputs atomically ([`atomic`]).
+//! `aeromag inspect` ([`summarize`]) and writes CSV ([`write_csv`]),
+//! Geosoft XYZ ([`write_xyz`]), HDF5 ([`write_hdf5`]; [`write_table`]
+//! chooses by the file name) and other outputs atomically ([`atomic`]).
 //!
 //! ```no_run
 //! use aeromag_io::{ColumnMap, ReadOptions, read_table, check_time, check_units};
@@ -43,6 +44,7 @@ pub mod derive;
 mod error;
 mod fields;
 mod hdf5;
+mod hdf5_write;
 mod label_texts;
 mod number_text;
 mod ordered;
@@ -74,6 +76,7 @@ pub use derive::{Conversion, DerivedColumn, derive_columns};
 pub use error::{IoError, Location, Result};
 pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
+pub use hdf5_write::{check_hdf5, write_hdf5, write_hdf5_to};
 pub use number_text::NumberText;
 pub use parts::nan_count;
 pub use position_glitches::{

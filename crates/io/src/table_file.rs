@@ -1,29 +1,30 @@
 //! Writing a flight table in the format its file name asks for: Geosoft
-//! XYZ for `.xyz` ([`crate::write_xyz`]), CSV otherwise
+//! XYZ for `.xyz` ([`crate::write_xyz`]), HDF5 in the MagNav/SGL layout
+//! for `.h5` and `.hdf5` ([`crate::write_hdf5`]), CSV otherwise
 //! ([`crate::write_csv`]; `.csv`, `.txt`, `.dat`, no extension), and a
 //! clear error for the formats aeromag reads or writes elsewhere but not
-//! as a flight table (`out.h5` was written as CSV under that name).
+//! as a flight table (`out.tif` would be CSV under a grid's name).
 
 use std::path::Path;
 
 use crate::error::{IoError, Result};
 use crate::table::FlightTable;
 
-/// The text formats a flight table is written in.
+/// The formats a flight table is written in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TableFormat {
     /// Comma-separated values with a header row ([`crate::write_csv`]).
     Csv,
     /// Geosoft XYZ ([`crate::write_xyz`]).
     Xyz,
+    /// HDF5, one dataset per column ([`crate::write_hdf5`]).
+    Hdf5,
 }
 
-/// Extensions of files that are not flight tables in text, or that
-/// aeromag does not write as one: refused as outputs of a table.
-const REFUSED: [(&str, &str); 9] = [
-    ("h5", "HDF5"),
-    ("hdf5", "HDF5"),
-    ("he5", "HDF5"),
+/// Extensions of files that are not flight tables, or that aeromag does
+/// not write as one: refused as outputs of a table.
+const REFUSED: [(&str, &str); 7] = [
+    ("he5", "HDF-EOS5"),
     ("nc", "a netCDF grid"),
     ("tif", "a GeoTIFF grid"),
     ("tiff", "a GeoTIFF grid"),
@@ -34,18 +35,20 @@ const REFUSED: [(&str, &str); 9] = [
 
 impl TableFormat {
     /// The format of an output named `path` (its extension, any case):
-    /// bad input ([`IoError::Unsupported`]) for a grid, model or HDF5 name,
-    /// so a long run never ends on one.
+    /// bad input ([`IoError::Unsupported`]) for a grid, model or HDF-EOS5
+    /// name, so a long run never ends on one.
     pub fn of_path(path: &Path) -> Result<Self> {
         let ext = aeromag_core::file_name::extension(path);
-        if ext == "xyz" {
-            return Ok(TableFormat::Xyz);
+        match ext.as_str() {
+            "xyz" => return Ok(TableFormat::Xyz),
+            "h5" | "hdf5" => return Ok(TableFormat::Hdf5),
+            _ => {}
         }
         match REFUSED.iter().find(|(e, _)| *e == ext) {
             Some((_, what)) => Err(IoError::Unsupported {
                 file: path.display().to_string(),
                 reason: format!(
-                    "a '.{ext}' file is {what}: aeromag writes a flight table as CSV (.csv) or Geosoft XYZ (.xyz)"
+                    "a '.{ext}' file is {what}: aeromag writes a flight table as CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"
                 ),
             }),
             None => Ok(TableFormat::Csv),
@@ -60,6 +63,7 @@ pub fn write_table(table: &FlightTable, path: &Path) -> Result<TableFormat> {
     match format {
         TableFormat::Csv => crate::write_csv(table, path)?,
         TableFormat::Xyz => crate::write_xyz(table, path)?,
+        TableFormat::Hdf5 => crate::write_hdf5(table, path)?,
     }
     Ok(format)
 }
@@ -75,11 +79,14 @@ mod tests {
         assert_eq!(of("out").unwrap(), TableFormat::Csv);
         assert_eq!(of("out.dat").unwrap(), TableFormat::Csv);
         assert_eq!(of("OUT.XYZ").unwrap(), TableFormat::Xyz);
-        for refused in ["out.h5", "o.HDF5", "g.tif", "g.nc", "m.json"] {
+        assert_eq!(of("out.h5").unwrap(), TableFormat::Hdf5);
+        assert_eq!(of("o.HDF5").unwrap(), TableFormat::Hdf5);
+        for refused in ["out.he5", "g.tif", "g.nc", "m.json"] {
             let e = of(refused).unwrap_err();
             assert!(e.is_bad_input(), "{refused}");
             assert!(
-                e.to_string().contains("CSV (.csv) or Geosoft XYZ (.xyz)"),
+                e.to_string()
+                    .contains("CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"),
                 "{e}"
             );
         }

@@ -68,7 +68,7 @@ pub struct Args {
     #[arg(long, value_name = "MODEL.json")]
     model: PathBuf,
     /// Also write the calibration flight compensated by the fitted model to
-    /// this CSV (Geosoft XYZ for `.xyz`): what `aeromag compensate --model MODEL.json` writes for the
+    /// this CSV (Geosoft XYZ for `.xyz`, HDF5 for `.h5`): what `aeromag compensate --model MODEL.json` writes for the
     /// same input (every input column plus the interference, compensated
     /// and flag columns), from the flight read once.
     #[arg(long, value_name = "OUT.csv")]

@@ -188,7 +188,8 @@ struct ApplyArgs {
     model: PathBuf,
     #[command(flatten)]
     input: InputArgs,
-    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`.
+    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`, HDF5 (one
+    /// dataset per column, as MagNav/SGL files) in `.h5`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
 }
