@@ -30,7 +30,7 @@
 //!
 //! What HDF5 cannot hold as a link name is refused before anything is
 //! written ([`IoError::CannotWrite`], bad input): an empty name, `.`, or a
-//! name containing `/` (a path separator in HDF5).
+//! name containing `/` (a path separator in HDF5) or a NUL.
 
 use std::io::Write;
 use std::path::Path;
@@ -71,6 +71,8 @@ pub fn check_hdf5(table: &FlightTable, file: &str) -> Result<()> {
             "an HDF5 dataset cannot be named '' or '.'"
         } else if name.contains('/') {
             "'/' separates groups in an HDF5 name, so a dataset name cannot hold one"
+        } else if name.contains('\0') {
+            "the HDF5 library ends a name at a NUL character"
         } else if name.len() > MAX_NAME_BYTES {
             "the name is longer than an HDF5 link can hold"
         } else {
@@ -411,7 +413,7 @@ mod tests {
 
     #[test]
     fn names_hdf5_cannot_hold_are_refused_before_writing() {
-        for name in ["a/b", "."] {
+        for name in ["a/b", ".", "a\0b"] {
             let mut t = FlightTable::new();
             t.add_column(name, vec![1.0]).unwrap();
             let d = tempfile::tempdir().unwrap();
