@@ -431,7 +431,7 @@ def grid_flight(
     Returns a :class:`Grid`: ``values`` (ny × nx, row 0 south, NaN blank),
     ``x``, ``y`` (m), ``epsg``, ``info`` (line spacing, blanking,
     convergence), ``vertical_derivative()``, ``upward(h)``, ``minus(g)``,
-    ``sample(x, y)``, ``write(path)`` (``.tif``, ``.asc``, ``.nc``).
+    ``sample(x, y)``, ``write(path)`` (``.tif``, ``.asc``, ``.nc``, ``.gxf``).
     """
     from .tolles_lawson import progress_callback
 
@@ -453,7 +453,7 @@ def grid_flight(
 
 
 def read_grid(path: PathLike) -> Grid:
-    """Read a grid file: GeoTIFF, ESRI ASCII or netCDF (as ``aeromag grid`` writes them)."""
+    """Read a grid file: GeoTIFF, ESRI ASCII, netCDF or GXF (as ``aeromag grid`` writes them)."""
     return _aeromag.read_grid(os.fspath(path))
 
 

@@ -157,7 +157,7 @@ impl PyGrid {
     }
 
     /// Write the grid; the format follows the extension (`.tif`, `.asc`,
-    /// `.nc`/`.grd`).
+    /// `.nc`/`.grd`, `.gxf`).
     fn write(&self, path: std::path::PathBuf) -> PyResult<()> {
         write_grid(&path, &self.grid).py_err()?;
         Ok(())
@@ -316,7 +316,7 @@ pub fn grid_flight(
     })
 }
 
-/// Read a grid file (GeoTIFF, ESRI ASCII or netCDF).
+/// Read a grid file (GeoTIFF, ESRI ASCII, netCDF or GXF).
 #[pyfunction]
 pub fn read_grid(path: std::path::PathBuf) -> PyResult<PyGrid> {
     Ok(PyGrid::plain(lib_read_grid(&path).py_err()?))

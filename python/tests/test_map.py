@@ -36,7 +36,7 @@ def test_products_and_files(survey_csv, tmp_path):
     up = g.upward(200.0)
     assert up.stats()["std"] < g.stats()["std"]
     assert g.minus(g).stats()["std"] == 0.0
-    for name in ["g.tif", "g.asc", "g.nc"]:
+    for name in ["g.tif", "g.asc", "g.nc", "g.gxf"]:
         g.write(tmp_path / name)
         back = aeromag.read_grid(tmp_path / name)
         np.testing.assert_allclose(back.values, g.values, atol=1e-3, equal_nan=True)

@@ -58,7 +58,7 @@
 //! | [`sim`] (`aeromag-sim`) | the physical simulator (truth in `true_` columns) |
 //! | [`estimation`] (`aeromag-estimation`) | least squares, square-root Kalman filters and smoothers |
 //! | [`compensation`] (`aeromag-compensation`) | Tolles-Lawson terms and fits, the Kalman method, levelling, rotor and pod models, metrics |
-//! | [`grid`] (`aeromag-grid`) | UTM projection, minimum-curvature gridding, blanking, GeoTIFF / ESRI ASCII / netCDF grid files |
+//! | [`grid`] (`aeromag-grid`) | UTM projection, minimum-curvature gridding, blanking, GeoTIFF / ESRI ASCII / netCDF / GXF grid files |
 //! | [`aeromag_em`] | EM bird positioning (its file workflows are [`em`]) |
 //! | [`aeromag_gradiometry`] | dipole parameters from gradiometers (its flight-level workflows are [`gradiometry`]) |
 //! | [`report`] (`aeromag-report`) | plots and the single-file HTML report |

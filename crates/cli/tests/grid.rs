@@ -46,6 +46,7 @@ fn grids_in_every_format_with_defaults_from_the_lines() {
     assert!(d.path().join("mag.prj").exists());
     for (name, extra) in [
         ("mag.tif", vec!["--cell", "100"]),
+        ("mag.gxf", vec!["--cell", "100"]),
         (
             "mag.nc",
             vec!["--method", "bidirectional", "--utm-zone", "37N"],
@@ -67,6 +68,16 @@ fn grids_in_every_format_with_defaults_from_the_lines() {
         assert_code(&o, 0);
         assert!(out.exists(), "{name}");
     }
+    // The same grid as GXF and GeoTIFF (float32 both).
+    let (tif, gxf) = (
+        aeromag::grid::format::read_grid(&d.path().join("mag.tif")).unwrap(),
+        aeromag::grid::format::read_grid(&d.path().join("mag.gxf")).unwrap(),
+    );
+    assert_eq!((tif.geometry, tif.crs), (gxf.geometry, gxf.crs));
+    let bits = |g: &aeromag::grid::Grid| -> Vec<u32> {
+        g.values.iter().map(|v| (*v as f32).to_bits()).collect()
+    };
+    assert_eq!(bits(&tif), bits(&gxf));
     let o = grid(
         &input,
         &d.path().join("b.tif"),

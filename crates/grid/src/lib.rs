@@ -9,7 +9,7 @@
 //! - [`gridding`] — minimum curvature with tension (Smith & Wessel 1990)
 //!   and blanking by distance from the data;
 //! - [`products`] — first vertical derivative and upward continuation by FFT;
-//! - [`format`](mod@format) — GeoTIFF, ESRI ASCII grid and netCDF (COARDS) files;
+//! - [`format`](mod@format) — GeoTIFF, ESRI ASCII grid, netCDF (COARDS) and GXF files;
 //! - [`error`] — [`GridError`], with `is_bad_input()`.
 
 #![warn(missing_docs)]

@@ -1,6 +1,6 @@
 //! `aeromag grid`: a survey column on a grid by minimum curvature with
-//! tension, blanked away from the lines, written as GeoTIFF, ESRI ASCII
-//! or netCDF (library: [`aeromag::map::grid_flight`]).
+//! tension, blanked away from the lines, written as GeoTIFF, ESRI ASCII,
+//! netCDF or GXF (library: [`aeromag::map::grid_flight`]).
 
 use crate::args;
 use crate::input::InputArgs;
@@ -31,9 +31,10 @@ pub struct Args {
     #[command(flatten)]
     input: InputArgs,
     /// Output grid; the format follows the extension: `.tif` (GeoTIFF,
-    /// float32), `.asc` (ESRI ASCII grid, with a `.prj`) or `.nc` / `.grd`
+    /// float32), `.asc` (ESRI ASCII grid, with a `.prj`), `.nc` / `.grd`
     /// (netCDF, COARDS, as GMT reads and writes it; not Surfer's or
-    /// Geosoft's binary .grd).
+    /// Geosoft's binary .grd) or `.gxf` (GXF-3, Geosoft's Grid eXchange
+    /// File, as Oasis montaj and GDAL read it).
     #[arg(long, value_name = "GRID")]
     out: PathBuf,
     /// Column to grid (default: the most processed magnetic column of the

@@ -99,7 +99,7 @@ fn write_asc(w: &mut impl Write, grid: &Grid) -> io::Result<()> {
 }
 
 /// Appends the shortest decimal of `v` as float32 (NaN as [`NODATA`]).
-fn push_f32(s: &mut String, v: f64) {
+pub(super) fn push_f32(s: &mut String, v: f64) {
     use std::fmt::Write as _;
     let v = if v.is_nan() { NODATA as f32 } else { v as f32 };
     let a = v.abs();

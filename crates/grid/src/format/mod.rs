@@ -10,6 +10,7 @@
 //! | `.tif`, `.tiff` | GeoTIFF, one float32 band, rows north to south | [`geotiff`] |
 //! | `.asc` | ESRI ASCII grid (+ `.prj` sidecar with the WKT) | [`esri_ascii`] |
 //! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration | [`netcdf`] |
+//! | `.gxf` | GXF-3, Geosoft's Grid eXchange File (text; compressed form read) | [`gxf`] |
 //!
 //! (`.grd` is GMT's netCDF grid, not Geosoft's binary `.grd`.)
 //!
@@ -19,10 +20,11 @@
 //! wider than the nodes' on each side and its origin (upper-left corner) is
 //! `(x0 − cell/2, y_max + cell/2)`.
 //!
-//! Values are stored as float32 in all three formats (the ESRI ASCII text
-//! holds the shortest decimal of the float32): relative precision 6·10⁻⁸,
-//! i.e. 0.004 nT at 50 000 nT. Blank (NaN) nodes are [`NODATA`] in the
-//! GeoTIFF and ESRI ASCII files and NaN (`_FillValue`) in netCDF.
+//! Values are stored as float32 in every format (the ESRI ASCII and GXF
+//! text holds the shortest decimal of the float32): relative precision
+//! 6·10⁻⁸, i.e. 0.004 nT at 50 000 nT. Blank (NaN) nodes are [`NODATA`] in
+//! the GeoTIFF and ESRI ASCII files, NaN (`_FillValue`) in netCDF and
+//! Geosoft's dummy `-1e32` in GXF.
 //!
 //! [`write_grid`] writes atomically: a temporary file in the destination
 //! folder, flushed to disk, then renamed over the destination, so a reader
@@ -30,6 +32,7 @@
 
 pub mod esri_ascii;
 pub mod geotiff;
+pub mod gxf;
 pub mod netcdf;
 
 use std::fs::{self, File, OpenOptions};
@@ -58,17 +61,20 @@ pub enum GridFormat {
     EsriAscii,
     /// netCDF classic, COARDS/CF as GMT reads it ([`netcdf`]).
     NetCdf,
+    /// GXF-3, Geosoft's Grid eXchange File ([`gxf`]).
+    Gxf,
 }
 
 impl GridFormat {
     /// The format of a file by its extension: `.tif`/`.tiff` GeoTIFF,
-    /// `.asc` ESRI ASCII, `.nc`/`.grd` netCDF (case insensitive); anything
-    /// else is [`GridError::UnknownFormat`].
+    /// `.asc` ESRI ASCII, `.nc`/`.grd` netCDF, `.gxf` GXF (case
+    /// insensitive); anything else is [`GridError::UnknownFormat`].
     pub fn from_path(path: &Path) -> Result<Self> {
         match aeromag_core::file_name::extension(path).as_str() {
             "tif" | "tiff" => Ok(GridFormat::GeoTiff),
             "asc" => Ok(GridFormat::EsriAscii),
             "nc" | "grd" => Ok(GridFormat::NetCdf),
+            "gxf" => Ok(GridFormat::Gxf),
             _ => Err(GridError::UnknownFormat(path.display().to_string())),
         }
     }
@@ -79,6 +85,7 @@ impl GridFormat {
             GridFormat::GeoTiff => "tif",
             GridFormat::EsriAscii => "asc",
             GridFormat::NetCdf => "nc",
+            GridFormat::Gxf => "gxf",
         }
     }
 
@@ -89,6 +96,7 @@ impl GridFormat {
             GridFormat::GeoTiff => geotiff::write(path, grid),
             GridFormat::EsriAscii => esri_ascii::write(path, grid),
             GridFormat::NetCdf => netcdf::write(path, grid),
+            GridFormat::Gxf => gxf::write(path, grid),
         }
     }
 
@@ -98,6 +106,7 @@ impl GridFormat {
             GridFormat::GeoTiff => geotiff::read(path),
             GridFormat::EsriAscii => esri_ascii::read(path),
             GridFormat::NetCdf => netcdf::read(path),
+            GridFormat::Gxf => gxf::read(path),
         }
     }
 }
@@ -693,6 +702,7 @@ mod tests {
         assert_eq!(f("b.asc").unwrap(), GridFormat::EsriAscii);
         assert_eq!(f("b.nc").unwrap(), GridFormat::NetCdf);
         assert_eq!(f("b.grd").unwrap(), GridFormat::NetCdf);
+        assert_eq!(f("b.GXF").unwrap(), GridFormat::Gxf);
         for bad in ["b.xyz", "b", "b.tif.bak", ".nc"] {
             let e = f(bad).unwrap_err();
             assert!(matches!(e, GridError::UnknownFormat(_)), "{bad}: {e}");
