@@ -410,6 +410,8 @@ pub fn read(path: &Path) -> Result<Grid> {
     if gtype == 0 {
         // Each value a character and a separator at least.
         check_declared_size(path, nx, ny, 2.0, bytes.len() as u64 + 1)?;
+    } else {
+        fits_in_memory(path, nx, ny, aeromag_core::memory::available_bytes())?;
     }
 
     let name = match h.title.as_deref().map(label_from_file) {
@@ -454,6 +456,23 @@ pub fn read(path: &Path) -> Result<Grid> {
     check_values(path, &grid)?;
     grid.crs = crs;
     Ok(grid)
+}
+
+/// Repeats let a few bytes of a compressed file declare a large grid: its
+/// nodes (8 bytes each) must fit in the memory `left` (none: not known).
+fn fits_in_memory(path: &Path, nx: usize, ny: usize, left: Option<u64>) -> Result<()> {
+    let need = (nx * ny) as u64 * 8;
+    match left {
+        Some(left) if need > left => Err(read_error(
+            path,
+            format!(
+                "the header declares {nx} × {ny} nodes, {} MB, more than the {} MB of memory left",
+                need >> 20,
+                left >> 20
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The error of a row: the line (none: the file ended) and what is wrong.
@@ -782,6 +801,21 @@ mod tests {
                 .to_string()
                 .contains("square cells")
         );
+    }
+
+    /// A compressed file of 195 kB declaring 15 000 × 15 000 nodes aborted
+    /// the process out of memory under `ulimit -v 1000000`.
+    #[test]
+    fn a_compressed_grid_larger_than_the_memory_left_is_refused() {
+        let path = Path::new("big.gxf");
+        let e = fits_in_memory(path, 15_000, 15_000, Some(1_000_000_000)).unwrap_err();
+        assert!(e.is_bad_input());
+        assert!(
+            e.to_string().contains("1716 MB, more than the 953 MB"),
+            "{e}"
+        );
+        fits_in_memory(path, 15_000, 15_000, Some(2_000_000_000)).unwrap();
+        fits_in_memory(path, 15_000, 15_000, None).unwrap();
     }
 
     #[test]
