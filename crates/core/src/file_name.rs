@@ -12,6 +12,32 @@ pub fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// The first 8 bytes of an HDF5 file (at offset 0, 512, 1024, … when the
+/// file has a user block, as MATLAB v7.3 files do): flights in the
+/// MagNav/SGL layout and netCDF-4 grids are HDF5.
+pub const HDF5_SIGNATURE: [u8; 8] = *b"\x89HDF\r\n\x1a\n";
+
+/// Whether the file starts with the HDF5 signature (at 0 or at a user-block
+/// offset 512, 1024, …, up to 64 KiB).
+pub fn is_hdf5(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    let Ok(mut f) = std::fs::File::open(path) else {
+        return false;
+    };
+    let mut offset = 0u64;
+    while offset <= 65_536 {
+        let mut sig = [0u8; 8];
+        if f.seek(SeekFrom::Start(offset)).is_err() || f.read_exact(&mut sig).is_err() {
+            return false;
+        }
+        if sig == HDF5_SIGNATURE {
+            return true;
+        }
+        offset = if offset == 0 { 512 } else { offset * 2 };
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -51,9 +51,7 @@ use crate::wanted::wanted_fields;
 /// together.
 pub const MAX_READ_BYTES: usize = 4 << 30;
 
-/// The first 8 bytes of an HDF5 file (at offset 0, 512, 1024, … when the
-/// file has a user block, as MATLAB v7.3 files do).
-pub const SIGNATURE: [u8; 8] = *b"\x89HDF\r\n\x1a\n";
+pub use aeromag_core::file_name::{HDF5_SIGNATURE as SIGNATURE, is_hdf5};
 
 /// Reads an HDF5 flight file in the MagNav/SGL layout (module docs): the
 /// fields [`ReadOptions::fields`] asks for, mapped like a CSV header.
@@ -349,25 +347,4 @@ fn read_f64(ds: &Dataset) -> std::result::Result<(Vec<f64>, bool), hdf5_reader::
             )));
         }
     })
-}
-
-/// Whether the file starts with the HDF5 signature (at 0 or at a user-block
-/// offset 512, 1024, …, up to 64 KiB).
-pub fn is_hdf5(path: &Path) -> bool {
-    use std::io::{Read, Seek, SeekFrom};
-    let Ok(mut f) = std::fs::File::open(path) else {
-        return false;
-    };
-    let mut offset = 0u64;
-    while offset <= 65_536 {
-        let mut sig = [0u8; 8];
-        if f.seek(SeekFrom::Start(offset)).is_err() || f.read_exact(&mut sig).is_err() {
-            return false;
-        }
-        if sig == SIGNATURE {
-            return true;
-        }
-        offset = if offset == 0 { 512 } else { offset * 2 };
-    }
-    false
 }

@@ -9,7 +9,7 @@
 //! | --- | --- | --- |
 //! | `.tif`, `.tiff` | GeoTIFF, one float32 band, rows north to south | [`geotiff`] |
 //! | `.asc` | ESRI ASCII grid (+ `.prj` sidecar with the WKT) | [`esri_ascii`] |
-//! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration | [`netcdf`] |
+//! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration; netCDF-4 read | [`netcdf`] |
 //! | `.gxf` | GXF-3, Geosoft's Grid eXchange File (text; compressed form read) | [`gxf`] |
 //!
 //! (`.grd` is GMT's netCDF grid, not Geosoft's binary `.grd`.)
@@ -34,6 +34,7 @@ pub mod esri_ascii;
 pub mod geotiff;
 pub mod gxf;
 pub mod netcdf;
+mod netcdf4;
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};

@@ -30,7 +30,8 @@
 //! for an all-blank grid. The 64-bit offsets leave the file size unlimited
 //! (CDF-1 stops at 2 GiB); every netCDF library since 3.6 reads CDF-2.
 //!
-//! [`read`] reads classic files (CDF-1 and CDF-2) holding a 2-D variable
+//! [`read`] reads classic files (CDF-1 and CDF-2), and netCDF-4 files (HDF5:
+//! GMT 6's and xarray's default; [`super::netcdf4`]), holding a 2-D variable
 //! (`z`, else the first 2-D one) with 1-D coordinate variables of regular
 //! and equal spacing, `y` ascending or descending; it applies `_FillValue`
 //! / `missing_value`, `scale_factor` and `add_offset`, and takes the CRS
@@ -64,7 +65,7 @@ const NC_ATTRIBUTE: u32 = 0x0C;
 
 /// netCDF external types.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum NcType {
+pub(super) enum NcType {
     Byte = 1,
     Char = 2,
     Short = 3,
@@ -98,7 +99,7 @@ impl NcType {
 
 /// An attribute value.
 #[derive(Debug, Clone, PartialEq)]
-enum Value {
+pub(super) enum Value {
     Text(String),
     Int(Vec<i32>),
     Float(Vec<f32>),
@@ -123,16 +124,17 @@ impl Value {
     }
 }
 
-type Attributes = Vec<(String, Value)>;
+pub(super) type Attributes = Vec<(String, Value)>;
 
 /// A variable of the header.
-struct Variable {
-    name: String,
-    dims: Vec<usize>,
-    attributes: Attributes,
-    nc_type: NcType,
-    /// Offset of the data (read: from the file; write: computed).
-    begin: u64,
+pub(super) struct Variable {
+    pub(super) name: String,
+    pub(super) dims: Vec<usize>,
+    pub(super) attributes: Attributes,
+    pub(super) nc_type: NcType,
+    /// Offset of the data (read: from the file; write: computed; netCDF-4:
+    /// none, 0).
+    pub(super) begin: u64,
 }
 
 impl Variable {
@@ -379,7 +381,7 @@ struct Cursor<'a> {
 }
 
 /// A parse failure (the caller adds the file name).
-type Parse<T> = std::result::Result<T, String>;
+pub(super) type Parse<T> = std::result::Result<T, String>;
 
 impl Cursor<'_> {
     fn take(&mut self, n: usize) -> Parse<&[u8]> {
@@ -476,10 +478,11 @@ fn decode(bytes: &[u8], t: NcType) -> Vec<f64> {
     }
 }
 
-/// The parsed header of a classic file.
-struct Header {
-    dims: Vec<(String, usize)>,
-    vars: Vec<Variable>,
+/// The parsed header of a classic file (or the same from a netCDF-4 file,
+/// [`super::netcdf4`]).
+pub(super) struct Header {
+    pub(super) dims: Vec<(String, usize)>,
+    pub(super) vars: Vec<Variable>,
 }
 
 fn parse_header(bytes: &[u8]) -> Parse<Header> {
@@ -490,7 +493,7 @@ fn parse_header(bytes: &[u8]) -> Parse<Header> {
         b"CDF\x02" => true,
         b"CDF\x05" => return Err("netCDF CDF-5 (64-bit data) is not read".into()),
         m if m.starts_with(b"\x89HDF") => {
-            return Err("netCDF-4 (HDF5) is not read: convert with `nccopy -k classic`".into());
+            return Err("netCDF-4 (HDF5) is read from a file, not from bytes".into());
         }
         _ => return Err("not a netCDF classic file".into()),
     };
@@ -639,10 +642,15 @@ fn in_metres(mut values: Vec<f64>, v: &Variable) -> Parse<Vec<f64>> {
     Ok(values)
 }
 
-/// Reads a netCDF classic grid (module docs for what is accepted).
+/// Reads a netCDF grid, classic or netCDF-4 ([`super::netcdf4`]; module
+/// docs for what is accepted).
 pub fn read(path: &Path) -> Result<Grid> {
-    let bytes = fs::read(path).map_err(|e| open_error(path, e))?;
-    let (geometry, grid) = read_bytes(&bytes).map_err(|e| read_error(path, e))?;
+    let (geometry, grid) = if aeromag_core::file_name::is_hdf5(path) {
+        super::netcdf4::read(path)?
+    } else {
+        let bytes = fs::read(path).map_err(|e| open_error(path, e))?;
+        read_bytes(&bytes).map_err(|e| read_error(path, e))?
+    };
     checked_geometry(path, geometry)?;
     check_values(path, &grid)?;
     Ok(grid)
@@ -650,6 +658,15 @@ pub fn read(path: &Path) -> Result<Grid> {
 
 fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
     let h = parse_header(bytes)?;
+    interpret(&h, |v| h.data(bytes, v))
+}
+
+/// The grid of a netCDF file's variables (module docs), the data of a
+/// variable given by `data`.
+pub(super) fn interpret(
+    h: &Header,
+    data: impl Fn(&Variable) -> Parse<Vec<f64>>,
+) -> Parse<(GridGeometry, Grid)> {
     let z = h
         .vars
         .iter()
@@ -679,8 +696,8 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         }
     }
     let (x_var, y_var) = (h.coordinate(xdim)?, h.coordinate(ydim)?);
-    let xs = in_metres(h.data(bytes, x_var)?, x_var)?;
-    let ys = in_metres(h.data(bytes, y_var)?, y_var)?;
+    let xs = in_metres(data(x_var)?, x_var)?;
+    let ys = in_metres(data(y_var)?, y_var)?;
     let (x0, dx) = regular(&xs, &h.dims[xdim].0)?;
     let (y_first, dy) = regular(&ys, &h.dims[ydim].0)?;
     let cell = match (dx, dy) {
@@ -707,7 +724,7 @@ fn read_bytes(bytes: &[u8]) -> Parse<(GridGeometry, Grid)> {
         nx,
         ny,
     };
-    let mut values = h.data(bytes, z)?;
+    let mut values = data(z)?;
     let number = |name: &str| z.attribute(name).and_then(|v| v.numbers().first().copied());
     let fill = number("_FillValue").or_else(|| number("missing_value"));
     let (scale, offset) = (
