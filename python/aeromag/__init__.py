@@ -453,7 +453,8 @@ def grid_flight(
 
 
 def read_grid(path: PathLike) -> Grid:
-    """Read a grid file: GeoTIFF, ESRI ASCII, netCDF or GXF (as ``aeromag grid`` writes them)."""
+    """Read a grid file: GeoTIFF, ESRI ASCII, netCDF (classic or netCDF-4), GXF (as ``aeromag
+    grid`` writes them) or a Surfer ``.grd``."""
     return _aeromag.read_grid(os.fspath(path))
 
 

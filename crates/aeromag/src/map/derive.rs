@@ -19,7 +19,7 @@ pub enum GridProduct {
     Minus(PathBuf),
 }
 
-/// Read the grid file `input` (GeoTIFF, ESRI ASCII, netCDF or GXF) and compute
+/// Read the grid file `input` (GeoTIFF, ESRI ASCII, netCDF, GXF, Surfer) and compute
 /// `product` from it; blanks stay blank.
 ///
 /// Errors name the file: a grid file that cannot be read or holds values

@@ -7,8 +7,9 @@ use aeromag::map::picture::MapPicture;
 use aeromag::map::{GridProduct, derive};
 use std::path::PathBuf;
 
-/// Derive a grid from a grid file (GeoTIFF, ESRI ASCII, netCDF or GXF; the
-/// output's format follows its extension). Exactly one of the products.
+/// Derive a grid from a grid file (GeoTIFF, ESRI ASCII, netCDF, GXF or a
+/// Surfer .grd; the output's format follows its extension). Exactly one of
+/// the products.
 ///
 /// The vertical derivative and upward continuation are computed by FFT on
 /// the grid made complete (blanks filled harmonically) and mirrored about

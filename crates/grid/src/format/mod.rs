@@ -11,8 +11,10 @@
 //! | `.asc` | ESRI ASCII grid (+ `.prj` sidecar with the WKT) | [`esri_ascii`] |
 //! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration; netCDF-4 read | [`netcdf`] |
 //! | `.gxf` | GXF-3, Geosoft's Grid eXchange File (text; compressed form read) | [`gxf`] |
+//! | `.grd` read | a Surfer grid (ASCII, 6 or 7 binary) when its first bytes say so | [`surfer`] |
 //!
-//! (`.grd` is GMT's netCDF grid, not Geosoft's binary `.grd`.)
+//! (`.grd` is written as GMT's netCDF grid; Geosoft's binary `.grd` is not
+//! read, and the message says to export it as GXF.)
 //!
 //! Every format keeps the node registration of [`Grid`]: the values are
 //! those of the nodes, and a reader that thinks in cells (GDAL, a GIS) sees
@@ -35,6 +37,7 @@ pub mod geotiff;
 pub mod gxf;
 pub mod netcdf;
 mod netcdf4;
+pub mod surfer;
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -106,10 +109,22 @@ impl GridFormat {
         match self {
             GridFormat::GeoTiff => geotiff::read(path),
             GridFormat::EsriAscii => esri_ascii::read(path),
+            GridFormat::NetCdf if surfer::kind(&head(path)).is_some() => surfer::read(path),
             GridFormat::NetCdf => netcdf::read(path),
             GridFormat::Gxf => gxf::read(path),
         }
     }
+}
+
+/// The first bytes of a file (fewer, or none, when it is shorter or
+/// cannot be read: the reader then says why).
+fn head(path: &Path) -> Vec<u8> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(8);
+    if let Ok(f) = File::open(path) {
+        let _ = f.take(8).read_to_end(&mut head);
+    }
+    head
 }
 
 /// Writes `grid` to `path` in the format its extension names

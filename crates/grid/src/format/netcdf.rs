@@ -478,6 +478,24 @@ fn decode(bytes: &[u8], t: NcType) -> Vec<f64> {
     }
 }
 
+/// Whether `bytes` start as a Geosoft binary grid (`.grd`) does: element
+/// size 1, 2, 4 or 8 bytes (1024 more when compressed), sign flag 0–3,
+/// positive counts of elements and vectors, orientation ±1 (little-endian
+/// 32-bit integers; Geosoft Grid File Format 2.0).
+fn looks_geosoft(bytes: &[u8]) -> bool {
+    let int = |k: usize| {
+        bytes
+            .get(4 * k..4 * k + 4)
+            .map(|b| i32::from_le_bytes(b.try_into().expect("4 bytes")))
+    };
+    matches!(
+        (int(0), int(1), int(2), int(3), int(4)),
+        (Some(es), Some(sf), Some(ne), Some(nv), Some(kx))
+            if [1, 2, 4, 8].contains(&(es % 1024)) && es < 2048
+                && (0..=3).contains(&sf) && ne > 0 && nv > 0 && kx.abs() == 1
+    )
+}
+
 /// The parsed header of a classic file (or the same from a netCDF-4 file,
 /// [`super::netcdf4`]).
 pub(super) struct Header {
@@ -494,6 +512,13 @@ fn parse_header(bytes: &[u8]) -> Parse<Header> {
         b"CDF\x05" => return Err("netCDF CDF-5 (64-bit data) is not read".into()),
         m if m.starts_with(b"\x89HDF") => {
             return Err("netCDF-4 (HDF5) is read from a file, not from bytes".into());
+        }
+        _ if looks_geosoft(bytes) => {
+            return Err(
+                "a Geosoft binary grid, which aeromag does not read: export it from \
+                 Oasis montaj as GXF (.gxf) or GeoTIFF (.tif)"
+                    .into(),
+            );
         }
         _ => return Err("not a netCDF classic file".into()),
     };
@@ -922,6 +947,17 @@ mod tests {
         assert!(read_bytes(b"CDF\x05").unwrap_err().contains("CDF-5"));
         assert!(read_bytes(b"\x89HDF\r\n").unwrap_err().contains("netCDF-4"));
         assert!(read_bytes(b"GIF89a").is_err());
+        // A Geosoft grid's header: float32 (4, sign flag 2), 5 × 4, rows.
+        let geosoft: Vec<u8> = [4i32, 2, 5, 4, 1]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .chain([0u8; 492])
+            .collect();
+        assert!(
+            read_bytes(&geosoft)
+                .unwrap_err()
+                .contains("Geosoft binary grid")
+        );
         assert!(
             read_bytes(b"CDF\x02\0\0")
                 .unwrap_err()
