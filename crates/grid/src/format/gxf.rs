@@ -72,7 +72,7 @@ use std::path::Path;
 
 use super::{
     CoordinateUnit, check_declared_size, check_grid, check_values, checked_geometry,
-    label_from_file, not_metres, open_error, read_error, stem, write_atomic,
+    label_from_file, north_up, not_metres, open_error, read_error, square_cell, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -278,28 +278,12 @@ pub fn read(path: &Path) -> Result<Grid> {
         }
     };
     let (nx, ny) = (count("POINTS", &h.points)?, count("ROWS", &h.rows)?);
-    let dx = number("PTSEPARATION", &h.pt_separation)?.unwrap_or(1.0);
-    let dy = number("RWSEPARATION", &h.rw_separation)?.unwrap_or(1.0);
-    if dx != dy {
-        return Err(read_error(
-            path,
-            format!(
-                "points {} apart and rows {} apart: aeromag's grids have square cells",
-                shown(dx),
-                shown(dy)
-            ),
-        ));
-    }
-    let rotation = number("ROTATION", &h.rotation)?.unwrap_or(0.0);
-    if rotation != 0.0 {
-        return Err(read_error(
-            path,
-            format!(
-                "the grid is rotated by {}°: aeromag's grids are north-up",
-                shown(rotation)
-            ),
-        ));
-    }
+    let dx = square_cell(
+        path,
+        number("PTSEPARATION", &h.pt_separation)?.unwrap_or(1.0),
+        number("RWSEPARATION", &h.rw_separation)?.unwrap_or(1.0),
+    )?;
+    north_up(path, number("ROTATION", &h.rotation)?.unwrap_or(0.0))?;
     let sense = match h.sense.as_deref().map(str::trim) {
         None => 1,
         Some(t) => t.parse::<i32>().map_err(|_| {
@@ -851,28 +835,13 @@ mod tests {
     /// a message) when GDAL is not on PATH.
     #[test]
     fn gdal_reads_written_files_and_decodes_compressed_ones_as_here() {
-        let Ok(out) = std::process::Command::new("gdal_translate")
-            .arg("--version")
-            .output()
-        else {
-            println!("SKIPPED: gdal_translate is not on PATH");
+        if !gdal_runs("gdal_translate") {
             return;
-        };
-        assert!(out.status.success());
+        }
         let dir = tempfile::tempdir().unwrap();
         let through_gdal = |gxf: &Path| -> (Grid, String) {
             let asc = gxf.with_extension("asc");
-            let out = std::process::Command::new("gdal_translate")
-                .args(["-q", "-of", "AAIGrid"])
-                .arg(gxf)
-                .arg(&asc)
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            gdal_translate("AAIGrid", gxf, &asc);
             let info = std::process::Command::new("gdalinfo")
                 .arg(gxf)
                 .output()

@@ -372,6 +372,38 @@ pub(crate) fn checked_geometry(path: &Path, geometry: GridGeometry) -> Result<Gr
     Ok(g)
 }
 
+/// The cell of a grid file whose nodes are `dx` apart in x and `dy` in y:
+/// bad input unless both are positive (x and y ascending) and equal to
+/// 10⁻⁹ relative, aeromag's cells being square.
+pub(crate) fn square_cell(path: &Path, dx: f64, dy: f64) -> Result<f64> {
+    if dx > 0.0 && dy > 0.0 && (dx - dy).abs() <= 1e-9 * dx {
+        return Ok(dx);
+    }
+    Err(read_error(
+        path,
+        format!(
+            "nodes {} apart in x and {} in y: aeromag's grids have square cells, x and y ascending",
+            shown(dx),
+            shown(dy)
+        ),
+    ))
+}
+
+/// Bad input for a grid file rotated by `degrees` (aeromag's grids are
+/// north-up).
+pub(crate) fn north_up(path: &Path, degrees: f64) -> Result<()> {
+    if degrees == 0.0 {
+        return Ok(());
+    }
+    Err(read_error(
+        path,
+        format!(
+            "the grid is rotated by {}°: aeromag's grids are north-up",
+            shown(degrees)
+        ),
+    ))
+}
+
 /// Checks, before they are allocated, that `nx × ny` nodes of at least
 /// `bytes_per_node` bytes each fit in a file of `file_len` bytes (a
 /// corrupt header must not claim gigabytes for a tiny file).
@@ -694,6 +726,34 @@ pub(crate) mod test_support {
         }
     }
 
+    /// Whether GDAL's `tool` (`gdalinfo`, `gdal_translate`) runs; when it
+    /// does not, the test that asks says it is skipped.
+    pub fn gdal_runs(tool: &str) -> bool {
+        let runs = std::process::Command::new(tool)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if !runs {
+            println!("SKIPPED: {tool} is not on PATH");
+        }
+        runs
+    }
+
+    /// `gdal_translate -q -of driver input output`, which must succeed.
+    pub fn gdal_translate(driver: &str, input: &Path, output: &Path) {
+        let out = std::process::Command::new("gdal_translate")
+            .args(["-q", "-of", driver])
+            .arg(input)
+            .arg(output)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{driver}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+
     /// Every entry of a folder, for checking that no temporary is left.
     pub fn entries(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = fs::read_dir(dir)
@@ -982,14 +1042,9 @@ mod tests {
     /// message) when `gdalinfo` is not on PATH.
     #[test]
     fn gdalinfo_reads_the_three_formats() {
-        let Ok(out) = std::process::Command::new("gdalinfo")
-            .arg("--version")
-            .output()
-        else {
-            println!("SKIPPED: gdalinfo is not on PATH");
+        if !gdal_runs("gdalinfo") {
             return;
-        };
-        assert!(out.status.success());
+        }
         let dir = tempfile::tempdir().unwrap();
         let grid = sample_grid();
         let g = grid.geometry;

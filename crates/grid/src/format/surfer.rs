@@ -27,10 +27,13 @@
 use std::fs;
 use std::path::Path;
 
-use super::{check_declared_size, check_values, checked_geometry, open_error, read_error, stem};
+use super::{
+    check_declared_size, check_values, checked_geometry, north_up, open_error, read_error,
+    square_cell, stem,
+};
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
-use aeromag_core::error::{shown, shown_text};
+use aeromag_core::error::shown_text;
 
 /// Surfer 6's blank value: a value at or above it is blank.
 const SURFER6_BLANK: f64 = 1.70141e38;
@@ -70,24 +73,17 @@ fn geometry6(path: &Path, nx: i64, ny: i64, x: [f64; 2], y: [f64; 2]) -> Result<
             .ok_or_else(|| read_error(path, format!("{n} {what}: a Surfer grid has at least 2")))
     };
     let (nx, ny) = (count(nx, "columns")?, count(ny, "rows")?);
-    let dx = (x[1] - x[0]) / (nx - 1) as f64;
-    let dy = (y[1] - y[0]) / (ny - 1) as f64;
-    if !(dx > 0.0 && dy > 0.0) || (dx - dy).abs() > 1e-9 * dx {
-        return Err(read_error(
-            path,
-            format!(
-                "nodes {} apart in x and {} in y: aeromag's grids have square cells, x and y ascending",
-                shown(dx),
-                shown(dy)
-            ),
-        ));
-    }
+    let cell = square_cell(
+        path,
+        (x[1] - x[0]) / (nx - 1) as f64,
+        (y[1] - y[0]) / (ny - 1) as f64,
+    )?;
     checked_geometry(
         path,
         GridGeometry {
             x0: x[0],
             y0: y[0],
-            cell: dx,
+            cell,
             nx,
             ny,
         },
@@ -232,25 +228,8 @@ fn surfer7(path: &Path, bytes: &[u8]) -> Result<(GridGeometry, Vec<f64>)> {
             b"DATA" => {
                 let (nx, ny, x0, y0, dx, dy, rotation, blank) =
                     grid.ok_or_else(|| read_error(path, "a DATA section before the GRID section"))?;
-                if rotation != 0.0 {
-                    return Err(read_error(
-                        path,
-                        format!(
-                            "the grid is rotated by {}°: aeromag's grids are north-up",
-                            shown(rotation)
-                        ),
-                    ));
-                }
-                if !(dx > 0.0 && dy > 0.0) || (dx - dy).abs() > 1e-9 * dx {
-                    return Err(read_error(
-                        path,
-                        format!(
-                            "nodes {} apart in x and {} in y: aeromag's grids have square cells",
-                            shown(dx),
-                            shown(dy)
-                        ),
-                    ));
-                }
+                north_up(path, rotation)?;
+                let cell = square_cell(path, dx, dy)?;
                 let count = |n: i32, what: &str| -> Result<usize> {
                     usize::try_from(n)
                         .ok()
@@ -262,7 +241,7 @@ fn surfer7(path: &Path, bytes: &[u8]) -> Result<(GridGeometry, Vec<f64>)> {
                     GridGeometry {
                         x0,
                         y0,
-                        cell: dx,
+                        cell,
                         nx: count(nx, "columns")?,
                         ny: count(ny, "rows")?,
                     },
@@ -312,14 +291,9 @@ mod tests {
     /// GDAL is not on PATH.
     #[test]
     fn surfer_grids_written_by_gdal_are_read() {
-        let Ok(out) = std::process::Command::new("gdal_translate")
-            .arg("--version")
-            .output()
-        else {
-            println!("SKIPPED: gdal_translate is not on PATH");
+        if !gdal_runs("gdal_translate") {
             return;
-        };
-        assert!(out.status.success());
+        }
         let dir = tempfile::tempdir().unwrap();
         let mut grid = sample_grid();
         grid.crs = None;
@@ -327,17 +301,7 @@ mod tests {
         super::super::write_grid(&asc, &grid).unwrap();
         for (driver, magic) in [("GSAG", "DSAA"), ("GSBG", "DSBB"), ("GS7BG", "DSRB")] {
             let grd = dir.path().join(format!("{driver}.grd"));
-            let out = std::process::Command::new("gdal_translate")
-                .args(["-q", "-of", driver])
-                .arg(&asc)
-                .arg(&grd)
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{driver}: {}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            gdal_translate(driver, &asc, &grd);
             assert_eq!(&fs::read(&grd).unwrap()[..4], magic.as_bytes());
             let back = read_grid(&grd).unwrap();
             assert_eq!(back.geometry, grid.geometry, "{driver}");
