@@ -841,7 +841,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let through_gdal = |gxf: &Path| -> (Grid, String) {
             let asc = gxf.with_extension("asc");
-            gdal_translate("AAIGrid", gxf, &asc);
+            gdal_translate(&["-of", "AAIGrid"], gxf, &asc);
             let info = std::process::Command::new("gdalinfo")
                 .arg(gxf)
                 .output()

@@ -739,17 +739,19 @@ pub(crate) mod test_support {
         runs
     }
 
-    /// `gdal_translate -q -of driver input output`, which must succeed.
-    pub fn gdal_translate(driver: &str, input: &Path, output: &Path) {
+    /// `gdal_translate -q <options> input output` (`-of DRIVER`, `-co
+    /// COMPRESS=LZW`, …), which must succeed.
+    pub fn gdal_translate(options: &[&str], input: &Path, output: &Path) {
         let out = std::process::Command::new("gdal_translate")
-            .args(["-q", "-of", driver])
+            .arg("-q")
+            .args(options)
             .arg(input)
             .arg(output)
             .output()
             .unwrap();
         assert!(
             out.status.success(),
-            "{driver}: {}",
+            "{options:?}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
     }

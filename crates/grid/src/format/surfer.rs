@@ -301,7 +301,7 @@ mod tests {
         super::super::write_grid(&asc, &grid).unwrap();
         for (driver, magic) in [("GSAG", "DSAA"), ("GSBG", "DSBB"), ("GS7BG", "DSRB")] {
             let grd = dir.path().join(format!("{driver}.grd"));
-            gdal_translate(driver, &asc, &grd);
+            gdal_translate(&["-of", driver], &asc, &grd);
             assert_eq!(&fs::read(&grd).unwrap()[..4], magic.as_bytes());
             let back = read_grid(&grd).unwrap();
             assert_eq!(back.geometry, grid.geometry, "{driver}");
