@@ -257,3 +257,29 @@ def test_text_datasets_written_by_h5py_are_text_columns(tmp_path):
     assert list(f["line"]) == ["L1", "L1", "T2", ""]
     assert list(f["code"]) == ["a", "bb", "", "c"]
     assert np.asarray(f["mag"]).tolist() == [5.0e4] * 4
+
+
+def test_matlab_mat_files(tmp_path):
+    """A MATLAB v7.3 MAT-file (HDF5 after a 512-byte user block; vectors as
+    1 x n matrices, text as uint16 'char') reads as a flight; a v5 one is
+    refused with what to do."""
+    h5py = pytest.importorskip("h5py")
+    path = tmp_path / "flight.mat"
+    n = 50
+    with h5py.File(path, "w", userblock_size=512) as h:
+        for name, values in [("tt", np.arange(n) * 0.1), ("mag_1_uc", 5.0e4 + np.arange(n)),
+                             ("lat", np.full(n, 45.0)), ("lon", np.full(n, -75.0))]:
+            h[name] = values.reshape(1, n) if name != "lat" else values.reshape(n, 1)
+            h[name].attrs["MATLAB_class"] = np.bytes_("double")
+        h["note"] = np.frombuffer("survey".encode("utf-16-le"), "<u2").reshape(6, 1)
+        h["note"].attrs["MATLAB_class"] = np.bytes_("char")
+    with open(path, "r+b") as f:
+        f.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116) + b"\0" * 8 + b"\x00\x02IM")
+    f = aeromag.read_flight(path)
+    assert len(f) == n and "note" not in f.columns
+    assert np.asarray(f["mag"]).tolist() == (5.0e4 + np.arange(n)).tolist()
+    assert np.asarray(f["lat"]).tolist() == [45.0] * n
+    v5 = tmp_path / "old.mat"
+    v5.write_bytes(b"MATLAB 5.0 MAT-file, Platform: MACI64".ljust(116) + b"\0" * 12)
+    with pytest.raises(aeromag.BadInputError, match="v5 MAT-file.*-v7.3"):
+        aeromag.read_flight(v5)

@@ -9,7 +9,10 @@
 //! such as line labels `L1020`), contiguous or chunked with gzip/shuffle as h5py writes
 //! them. Scalar and empty datasets (0-D, or of length 0 or 1 beside longer
 //! ones, e.g. a sample count) hold no rows and are skipped; any other shape
-//! is not this layout.
+//! is not this layout, except the 1 × n or n × 1 matrices in which a MATLAB
+//! v7.3 MAT-file (HDF5 after a 512-byte user block) holds its vectors,
+//! read as fields (its text, `MATLAB_class` `char`, is skipped). A MATLAB v5
+//! MAT-file is refused with what to do.
 //!
 //! **Only the fields a command needs are read** ([`Fields::Only`](crate::Fields::Only)): the
 //! datasets' headers are parsed when the file is opened, the data of a
@@ -116,9 +119,18 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     for name in names {
         let ds = group.dataset(&name).map_err(|e| h5err(Some(&name), e))?;
         let shape = ds.shape().to_vec();
+        // MATLAB v7.3 keeps its text as uint16 arrays: not a field.
+        let matlab_class = ds
+            .attribute("MATLAB_class")
+            .ok()
+            .and_then(|a| a.read_string().ok());
+        if matlab_class.as_deref() == Some("char") {
+            continue;
+        }
         match shape[..] {
             [] => {} // a scalar: not a field of the flight
-            [n] => fields.push((name, ds, n)),
+            // A MATLAB v7.3 vector is 2-D, 1 × n or n × 1.
+            [n] | [1, n] | [n, 1] => fields.push((name, ds, n)),
             _ => {
                 return Err(IoError::Hdf5Layout {
                     file: file.to_string(),

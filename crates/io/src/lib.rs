@@ -278,12 +278,30 @@ pub fn table_from_columns(
     Ok(table)
 }
 
+/// Whether the file at `path` starts with `magic` (false when it cannot be
+/// read: the reader then says why).
+fn file_starts_with(path: &Path, magic: &[u8]) -> bool {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(magic.len());
+    std::fs::File::open(path)
+        .and_then(|f| f.take(magic.len() as u64).read_to_end(&mut head))
+        .is_ok()
+        && head == magic
+}
+
 fn detect_format(path: &Path) -> Result<Format> {
     match aeromag_core::file_name::extension(path).as_str() {
         "xyz" => Ok(Format::Xyz),
         "csv" | "tsv" => Ok(Format::Csv),
         "h5" | "hdf5" | "he5" => Ok(Format::Hdf5),
         _ if hdf5::is_hdf5(path) => Ok(Format::Hdf5),
+        _ if file_starts_with(path, b"MATLAB 5.0 MAT-file") => Err(IoError::Unsupported {
+            file: path.display().to_string(),
+            reason: "a MATLAB v5 MAT-file, which aeromag does not read: save it as \
+                             v7.3 (`save(file, '-v7.3')`, HDF5, read here) or as CSV; from \
+                             Python, scipy.io.loadmat and aeromag.Flight.from_dict"
+                .into(),
+        }),
         _ => {
             let prefix = sniff::read_prefix(path)?;
             let first = sniff::first_content_line(&prefix.bytes, |_| false);
