@@ -444,3 +444,53 @@ fn huge_times_and_labels_are_printed_shortly_and_inf_is_bad_input() {
         "{e}"
     );
 }
+
+/// A grid file is summarised as a grid (it was read as a flight table:
+/// "NUL byte; this is not a UTF-8 text table" for a GeoTIFF); a flight
+/// command given one says it is a grid.
+#[test]
+fn a_grid_file_is_inspected_as_a_grid_and_refused_as_a_flight() {
+    let d = tempfile::tempdir().unwrap();
+    let asc = write(
+        &d,
+        "g.asc",
+        b"ncols 3\nnrows 3\nxllcenter 500000\nyllcenter 6000000\ncellsize 50\nNODATA_value -99999\n\
+          1 2 3\n4 -99999 6\n7 8 9\n",
+    );
+    let tif = d.path().join("g.tif");
+    let o = aeromag(&[
+        "derive",
+        asc.to_str().unwrap(),
+        "--upward",
+        "1",
+        "--out",
+        tif.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let o = aeromag(&["inspect", asc.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("grid     3 × 3 nodes, cell 50 m"), "{s}");
+    assert!(
+        s.contains("extent   x 500000 … 500100 m, y 6000000 … 6000100 m"),
+        "{s}"
+    );
+    assert!(s.contains("8 set, 1 blank; mean 5.0000"), "{s}");
+    let o = aeromag(&["inspect", tif.to_str().unwrap(), "--json"]);
+    assert_code(&o, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!((v["nx"].as_u64(), v["blank"].as_u64()), (Some(3), Some(1)));
+    let model = d.path().join("m.json");
+    let o = aeromag(&[
+        "calibrate",
+        tif.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("a grid file (TIFF), not a flight table"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -289,12 +289,38 @@ fn file_starts_with(path: &Path, magic: &[u8]) -> bool {
         && head == magic
 }
 
+/// The kind of grid file `path` is, by its first bytes (TIFF, netCDF
+/// classic, Surfer) or its `.gxf` extension; `None` for anything else.
+fn grid_kind(path: &Path) -> Option<&'static str> {
+    if aeromag_core::file_name::extension(path) == "gxf" {
+        return Some("GXF");
+    }
+    [
+        (&b"II*\0"[..], "TIFF"),
+        (b"MM\0*", "TIFF"),
+        (b"CDF", "netCDF"),
+        (b"DSAA", "Surfer"),
+        (b"DSBB", "Surfer"),
+        (b"DSRB", "Surfer"),
+    ]
+    .into_iter()
+    .find(|(magic, _)| file_starts_with(path, magic))
+    .map(|(_, kind)| kind)
+}
+
 fn detect_format(path: &Path) -> Result<Format> {
     match aeromag_core::file_name::extension(path).as_str() {
         "xyz" => Ok(Format::Xyz),
         "csv" | "tsv" => Ok(Format::Csv),
         "h5" | "hdf5" | "he5" => Ok(Format::Hdf5),
         _ if hdf5::is_hdf5(path) => Ok(Format::Hdf5),
+        _ if let Some(kind) = grid_kind(path) => Err(IoError::Unsupported {
+            file: path.display().to_string(),
+            reason: format!(
+                "a grid file ({kind}), not a flight table: `aeromag inspect` and `aeromag derive` \
+                 read grids, and aeromag.read_grid in Python"
+            ),
+        }),
         _ if file_starts_with(path, b"MATLAB 5.0 MAT-file") => Err(IoError::Unsupported {
             file: path.display().to_string(),
             reason: "a MATLAB v5 MAT-file, which aeromag does not read: save it as \

@@ -1,12 +1,16 @@
 //! `aeromag inspect`: what a processor checks first in a flight file.
 
 use crate::input::InputArgs;
-use aeromag_core::error::fixed;
+use aeromag_core::error::{fixed, shown};
 use aeromag_io::{Summary, summarize};
 
 /// Summarise a flight file: columns found and mapped, rows, duration, sample
 /// rate and its jitter, gaps, lines, missing values per column, and the range
 /// of the field magnitude with a units plausibility check.
+///
+/// A grid file (`.tif`, `.asc`, `.nc`, `.grd`, `.gxf`: every format
+/// `derive` reads) is summarised as a grid: nodes, cell, extent, coordinate
+/// system, name and unit, the values' statistics and blanks.
 ///
 /// Malformed files (empty, truncated rows, text in a number column, time
 /// going backwards or repeated) stop with a message naming the file, line
@@ -24,6 +28,16 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    let path = a.input.path();
+    if let Ok(format) = aeromag::grid::format::GridFormat::from_path(path) {
+        let grid = format.read(path)?;
+        if a.json {
+            println!("{}", serde_json::to_string_pretty(&grid_json(path, &grid))?);
+        } else {
+            print!("{}", render_grid(path, &grid));
+        }
+        return Ok(());
+    }
     let table = a.input.load()?;
     let s = summarize(&table);
     if a.json {
@@ -32,6 +46,71 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         print!("{}", render(&s));
     }
     Ok(())
+}
+
+/// A grid file's summary as JSON.
+fn grid_json(path: &std::path::Path, g: &aeromag::grid::Grid) -> serde_json::Value {
+    let geo = g.geometry;
+    serde_json::json!({
+        "file": path.display().to_string(),
+        "nx": geo.nx,
+        "ny": geo.ny,
+        "cell_m": geo.cell,
+        "x_m": [geo.x0, geo.x_max()],
+        "y_m": [geo.y0, geo.y_max()],
+        "epsg": g.crs.as_ref().map(|c| c.epsg()),
+        "name": g.name,
+        "unit": g.unit,
+        "blank": geo.len() - g.stats().count,
+        "stats": g.stats(),
+    })
+}
+
+/// A grid file's human-readable summary.
+fn render_grid(path: &std::path::Path, g: &aeromag::grid::Grid) -> String {
+    use std::fmt::Write;
+    let (geo, s) = (g.geometry, g.stats());
+    let mut o = String::new();
+    let _ = writeln!(o, "file     {}", path.display());
+    let _ = writeln!(
+        o,
+        "grid     {} × {} nodes, cell {} m",
+        geo.nx,
+        geo.ny,
+        shown(geo.cell)
+    );
+    let _ = writeln!(
+        o,
+        "extent   x {} … {} m, y {} … {} m (nodes)",
+        shown(geo.x0),
+        shown(geo.x_max()),
+        shown(geo.y0),
+        shown(geo.y_max())
+    );
+    let crs = g
+        .crs
+        .as_ref()
+        .map_or("not recorded (metres assumed)".to_string(), |c| {
+            format!("{} (EPSG {})", c.name(), c.epsg())
+        });
+    let _ = writeln!(o, "crs      {crs}");
+    let unit = if g.unit.is_empty() {
+        "no unit".to_string()
+    } else {
+        g.unit.clone()
+    };
+    let _ = writeln!(o, "values   {} ({unit})", g.name);
+    let _ = writeln!(
+        o,
+        "         {} set, {} blank; mean {}, std {}, min {}, max {}",
+        s.count,
+        geo.len() - s.count,
+        fmt_opt(Some(s.mean).filter(|v| v.is_finite())),
+        fmt_opt(Some(s.std).filter(|v| v.is_finite())),
+        fmt_opt(Some(s.min).filter(|v| v.is_finite())),
+        fmt_opt(Some(s.max).filter(|v| v.is_finite()))
+    );
+    o
 }
 
 fn fmt_opt(v: Option<f64>) -> String {
