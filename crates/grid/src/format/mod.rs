@@ -1090,6 +1090,86 @@ mod tests {
         }
     }
 
+    /// Valid files of the text and binary formats read here, each with its
+    /// extension: GXF (plain and compressed), Surfer ASCII, 6 and 7 binary.
+    fn valid_files() -> Vec<(&'static str, Vec<u8>)> {
+        let mut gxf = Vec::new();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.gxf");
+        write_grid(&path, &sample_grid()).unwrap();
+        gxf.extend(fs::read(&path).unwrap());
+        let compressed = b"#POINTS\n4\n#ROWS\n2\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n\
+            #SENSE\n-2\n#TRANSFORM\n0.5,1000\n#GTYPE\n2\n#GRID\n%&&%!!%(\n\"\"%(%*\n%,\n"
+            .to_vec();
+        let ascii = b"DSAA\n3 2\n100 120\n200 210\n1 6\n1 2 3\n4 1.70141e38 6\n".to_vec();
+        let mut six = b"DSBB".to_vec();
+        six.extend(3i16.to_le_bytes());
+        six.extend(2i16.to_le_bytes());
+        for v in [100.0f64, 120.0, 200.0, 210.0, 1.0, 6.0] {
+            six.extend(v.to_le_bytes());
+        }
+        for v in [1.0f32, 2.0, 3.0, 4.0, 1.70141e38, 6.0] {
+            six.extend(v.to_le_bytes());
+        }
+        let mut seven = b"DSRB".to_vec();
+        seven.extend(4i32.to_le_bytes());
+        seven.extend(2i32.to_le_bytes());
+        seven.extend(b"GRID");
+        seven.extend(72i32.to_le_bytes());
+        seven.extend(2i32.to_le_bytes());
+        seven.extend(3i32.to_le_bytes());
+        for v in [100.0f64, 200.0, 10.0, 10.0, 1.0, 6.0, 0.0, 1.70141e38] {
+            seven.extend(v.to_le_bytes());
+        }
+        seven.extend(b"DATA");
+        seven.extend(48i32.to_le_bytes());
+        for v in [1.0f64, 2.0, 3.0, 4.0, 1.70141e38, 6.0] {
+            seven.extend(v.to_le_bytes());
+        }
+        vec![
+            ("gxf", gxf),
+            ("gxf", compressed),
+            ("grd", ascii),
+            ("grd", six),
+            ("grd", seven),
+        ]
+    }
+
+    #[test]
+    fn the_valid_files_of_the_hostile_file_test_read() {
+        let dir = tempfile::tempdir().unwrap();
+        for (k, (ext, bytes)) in valid_files().into_iter().enumerate() {
+            let path = dir.path().join(format!("f{k}.{ext}"));
+            fs::write(&path, &bytes).unwrap();
+            read_grid(&path).unwrap_or_else(|e| panic!("file {k}: {e}"));
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
+        /// Damaged files (bytes changed, the file cut short) of the GXF and
+        /// Surfer readers give a grid or an error, never a panic.
+        #[test]
+        fn damaged_gxf_and_surfer_files_are_errors_not_panics(
+            which in 0usize..5,
+            edits in proptest::collection::vec((0.0f64..1.0, proptest::prelude::any::<u8>()), 0..6),
+            keep in 0.0f64..=1.0,
+        ) {
+            let (ext, mut bytes) = valid_files().swap_remove(which);
+            for (at, byte) in edits {
+                let k = ((bytes.len() as f64 * at) as usize).min(bytes.len() - 1);
+                bytes[k] = byte;
+            }
+            bytes.truncate(((bytes.len() as f64 * keep).ceil() as usize).max(4));
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join(format!("d.{ext}"));
+            fs::write(&path, &bytes).unwrap();
+            if let Err(e) = read_grid(&path) {
+                proptest::prop_assert!(e.to_string().contains("d."), "{e}");
+            }
+        }
+    }
+
     /// The numbers of the JSON value after `key` (a number or an array of
     /// numbers), by hand: the crate has no JSON parser.
     fn json_numbers_after(json: &str, key: &str) -> Vec<f64> {
