@@ -326,4 +326,28 @@ mod tests {
             );
         }
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(100))]
+        /// A damaged netCDF-4 file (bytes changed, cut short) gives a grid
+        /// or an error naming it, never a panic.
+        #[test]
+        fn damaged_netcdf4_files_are_errors_not_panics(
+            edits in proptest::collection::vec((0.0f64..1.0, proptest::prelude::any::<u8>()), 1..6),
+            keep in 0.5f64..=1.0,
+        ) {
+            let mut bytes = std::fs::read(data("nc4_packed.nc")).unwrap();
+            for (at, byte) in edits {
+                let k = ((bytes.len() as f64 * at) as usize).min(bytes.len() - 1);
+                bytes[k] = byte;
+            }
+            bytes.truncate((bytes.len() as f64 * keep).ceil() as usize);
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("d.nc");
+            std::fs::write(&path, &bytes).unwrap();
+            if let Err(e) = read_grid(&path) {
+                proptest::prop_assert!(e.to_string().contains("d.nc"), "{e}");
+            }
+        }
+    }
 }
