@@ -12,6 +12,18 @@ pub fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// The first `n` bytes of the file at `path` (fewer, or none, when it is
+/// shorter or cannot be read: its reader then says why), for telling
+/// formats apart by their magic numbers.
+pub fn first_bytes(path: &Path, n: usize) -> Vec<u8> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(n);
+    if let Ok(f) = std::fs::File::open(path) {
+        let _ = f.take(n as u64).read_to_end(&mut head);
+    }
+    head
+}
+
 /// The first 8 bytes of an HDF5 file (at offset 0, 512, 1024, … when the
 /// file has a user block, as MATLAB v7.3 files do): flights in the
 /// MagNav/SGL layout and netCDF-4 grids are HDF5.

@@ -278,21 +278,11 @@ pub fn table_from_columns(
     Ok(table)
 }
 
-/// Whether the file at `path` starts with `magic` (false when it cannot be
-/// read: the reader then says why).
-fn file_starts_with(path: &Path, magic: &[u8]) -> bool {
-    use std::io::Read;
-    let mut head = Vec::with_capacity(magic.len());
-    std::fs::File::open(path)
-        .and_then(|f| f.take(magic.len() as u64).read_to_end(&mut head))
-        .is_ok()
-        && head == magic
-}
-
-/// The kind of grid file `path` is, by its first bytes (TIFF, netCDF
-/// classic, Surfer) or its `.gxf` extension; `None` for anything else.
-fn grid_kind(path: &Path) -> Option<&'static str> {
-    if aeromag_core::file_name::extension(path) == "gxf" {
+/// The kind of grid file whose first bytes are `head` (TIFF, netCDF
+/// classic, Surfer) or whose extension is `ext` (`gxf`); `None` for
+/// anything else.
+fn grid_kind(head: &[u8], ext: &str) -> Option<&'static str> {
+    if ext == "gxf" {
         return Some("GXF");
     }
     [
@@ -304,37 +294,47 @@ fn grid_kind(path: &Path) -> Option<&'static str> {
         (b"DSRB", "Surfer"),
     ]
     .into_iter()
-    .find(|(magic, _)| file_starts_with(path, magic))
+    .find(|(magic, _)| head.starts_with(magic))
     .map(|(_, kind)| kind)
 }
 
+/// The start of a MATLAB v5 MAT-file.
+const MAT_V5: &[u8] = b"MATLAB 5.0 MAT-file";
+
 fn detect_format(path: &Path) -> Result<Format> {
-    match aeromag_core::file_name::extension(path).as_str() {
-        "xyz" => Ok(Format::Xyz),
-        "csv" | "tsv" => Ok(Format::Csv),
-        "h5" | "hdf5" | "he5" => Ok(Format::Hdf5),
-        _ if hdf5::is_hdf5(path) => Ok(Format::Hdf5),
-        _ if let Some(kind) = grid_kind(path) => Err(IoError::Unsupported {
+    let ext = aeromag_core::file_name::extension(path);
+    match ext.as_str() {
+        "xyz" => return Ok(Format::Xyz),
+        "csv" | "tsv" => return Ok(Format::Csv),
+        "h5" | "hdf5" | "he5" => return Ok(Format::Hdf5),
+        _ if hdf5::is_hdf5(path) => return Ok(Format::Hdf5),
+        _ => {}
+    }
+    // One read of the first bytes tells the binary files that are not
+    // flight tables.
+    let head = aeromag_core::file_name::first_bytes(path, MAT_V5.len());
+    if let Some(kind) = grid_kind(&head, &ext) {
+        return Err(IoError::Unsupported {
             file: path.display().to_string(),
             reason: format!(
                 "a grid file ({kind}), not a flight table: `aeromag inspect` and `aeromag derive` \
                  read grids, and aeromag.read_grid in Python"
             ),
-        }),
-        _ if file_starts_with(path, b"MATLAB 5.0 MAT-file") => Err(IoError::Unsupported {
-            file: path.display().to_string(),
-            reason: "a MATLAB v5 MAT-file, which aeromag does not read: save it as \
-                             v7.3 (`save(file, '-v7.3')`, HDF5, read here) or as CSV; from \
-                             Python, scipy.io.loadmat and aeromag.Flight.from_dict"
-                .into(),
-        }),
-        _ => {
-            let prefix = sniff::read_prefix(path)?;
-            let first = sniff::first_content_line(&prefix.bytes, |_| false);
-            Ok(match first {
-                Some((_, line, _)) if line.trim_ascii_start().starts_with(b"/") => Format::Xyz,
-                _ => Format::Csv,
-            })
-        }
+        });
     }
+    if head.starts_with(MAT_V5) {
+        return Err(IoError::Unsupported {
+            file: path.display().to_string(),
+            reason: "a MATLAB v5 MAT-file, which aeromag does not read: save it as v7.3 \
+                     (`save(file, '-v7.3')`, HDF5, read here) or as CSV; from Python, \
+                     scipy.io.loadmat and aeromag.Flight.from_dict"
+                .into(),
+        });
+    }
+    let prefix = sniff::read_prefix(path)?;
+    let first = sniff::first_content_line(&prefix.bytes, |_| false);
+    Ok(match first {
+        Some((_, line, _)) if line.trim_ascii_start().starts_with(b"/") => Format::Xyz,
+        _ => Format::Csv,
+    })
 }

@@ -109,22 +109,15 @@ impl GridFormat {
         match self {
             GridFormat::GeoTiff => geotiff::read(path),
             GridFormat::EsriAscii => esri_ascii::read(path),
-            GridFormat::NetCdf if surfer::kind(&head(path)).is_some() => surfer::read(path),
+            GridFormat::NetCdf
+                if surfer::kind(&aeromag_core::file_name::first_bytes(path, 4)).is_some() =>
+            {
+                surfer::read(path)
+            }
             GridFormat::NetCdf => netcdf::read(path),
             GridFormat::Gxf => gxf::read(path),
         }
     }
-}
-
-/// The first bytes of a file (fewer, or none, when it is shorter or
-/// cannot be read: the reader then says why).
-fn head(path: &Path) -> Vec<u8> {
-    use std::io::Read;
-    let mut head = Vec::with_capacity(8);
-    if let Ok(f) = File::open(path) {
-        let _ = f.take(8).read_to_end(&mut head);
-    }
-    head
 }
 
 /// Writes `grid` to `path` in the format its extension names
