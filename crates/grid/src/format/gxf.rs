@@ -716,13 +716,7 @@ mod tests {
     fn compressed_rows_senses_and_transforms_are_read() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("c.gxf");
-        // GTYPE 2: "%&" = 1, "&%" = 90; repeat 3 × "%*" (5); a dummy.
-        fs::write(
-            &path,
-            "#POINTS\n4\n#ROWS\n2\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n#XORIGIN\n100\n\
-             #YORIGIN\n230\n#SENSE\n-2\n#TRANSFORM\n0.5,1000\n#GTYPE\n2\n#GRID\n%&&%!!%(\n\"\"%(%*\n%,\n",
-        )
-        .unwrap();
+        fs::write(&path, COMPRESSED_GXF).unwrap();
         let g = read_grid(&path).unwrap();
         assert_eq!(
             (g.geometry.x0, g.geometry.y0, g.geometry.nx, g.geometry.ny),
@@ -869,13 +863,7 @@ mod tests {
             "{info}"
         );
         let compressed = dir.path().join("c.gxf");
-        fs::write(
-            &compressed,
-            "#POINTS\n4\n#ROWS\n2\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n#XORIGIN\n100\n\
-             #YORIGIN\n230\n#SENSE\n-2\n#DUMMY\n-1e32\n#TRANSFORM\n0.5,1000\n#GTYPE\n2\n\
-             #GRID\n%&&%!!%(\n\"\"%(%*\n%,\n",
-        )
-        .unwrap();
+        fs::write(&compressed, COMPRESSED_GXF).unwrap();
         let (by_gdal, _) = through_gdal(&compressed);
         assert_same_grid(&by_gdal, &read_grid(&compressed).unwrap());
     }

@@ -719,6 +719,16 @@ pub(crate) mod test_support {
         }
     }
 
+    /// A compressed GXF (`#GTYPE 2`, base 90 from `%`): sense -2 (the first
+    /// row the northern), `#TRANSFORM 0.5,1000`; "%&" = 1, "&%" = 90, "!!"
+    /// a dummy, "%(" = 3; then a repeat of 3 × "%*" (5) and "%," (7).
+    pub const COMPRESSED_GXF: &str = "#POINTS\n4\n#ROWS\n2\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n\
+        #XORIGIN\n100\n#YORIGIN\n230\n#SENSE\n-2\n#DUMMY\n-1e32\n#TRANSFORM\n0.5,1000\n#GTYPE\n2\n\
+        #GRID\n%&&%!!%(\n\"\"%(%*\n%,\n";
+
+    /// A Surfer ASCII grid of 3 × 2 nodes 10 m apart, one blank.
+    pub const SURFER_ASCII: &str = "DSAA\n3 2\n100 120\n200 210\n1 6\n1 2 3\n4 1.70141e38 6\n";
+
     /// Whether GDAL's `tool` (`gdalinfo`, `gdal_translate`) runs; when it
     /// does not, the test that asks says it is skipped.
     pub fn gdal_runs(tool: &str) -> bool {
@@ -1086,15 +1096,12 @@ mod tests {
     /// Valid files of the text and binary formats read here, each with its
     /// extension: GXF (plain and compressed), Surfer ASCII, 6 and 7 binary.
     fn valid_files() -> Vec<(&'static str, Vec<u8>)> {
-        let mut gxf = Vec::new();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("s.gxf");
         write_grid(&path, &sample_grid()).unwrap();
-        gxf.extend(fs::read(&path).unwrap());
-        let compressed = b"#POINTS\n4\n#ROWS\n2\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n\
-            #SENSE\n-2\n#TRANSFORM\n0.5,1000\n#GTYPE\n2\n#GRID\n%&&%!!%(\n\"\"%(%*\n%,\n"
-            .to_vec();
-        let ascii = b"DSAA\n3 2\n100 120\n200 210\n1 6\n1 2 3\n4 1.70141e38 6\n".to_vec();
+        let gxf = fs::read(&path).unwrap();
+        let compressed = COMPRESSED_GXF.as_bytes().to_vec();
+        let ascii = SURFER_ASCII.as_bytes().to_vec();
         let mut six = b"DSBB".to_vec();
         six.extend(3i16.to_le_bytes());
         six.extend(2i16.to_le_bytes());

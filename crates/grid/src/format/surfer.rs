@@ -322,11 +322,7 @@ mod tests {
     fn surfer_ascii_is_read_and_what_cannot_be_is_refused_naming_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("s.grd");
-        fs::write(
-            &path,
-            "DSAA\n3 2\n100 120\n200 210\n1 6\n1 2 3\n4 1.70141e38 6\n",
-        )
-        .unwrap();
+        fs::write(&path, SURFER_ASCII).unwrap();
         let g = read_grid(&path).unwrap();
         assert_eq!(
             (
