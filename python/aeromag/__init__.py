@@ -101,7 +101,12 @@ def read_flight(
     time_range: Optional[Tuple[float, float]] = None,
     fields: Union[None, str, Iterable[str]] = None,
 ) -> Flight:
-    """Read a flight file: CSV, Geosoft XYZ or HDF5 (MagNav/SGL layout).
+    """Read a flight file: CSV, Geosoft XYZ, HDF5 (MagNav/SGL layout) or a
+    MATLAB MAT-file (v5/v7, and v7.3 which is HDF5): its numeric vectors at
+    the top level, or the fields of its one struct, or of MagNav.jl's
+    ``traj`` and ``ins_data`` structs (``ins_data.lat`` → ``ins_lat``).
+    ``Flight.not_read`` lists what else the file holds (scalars, matrices,
+    text).
 
     Parameters are the CLI's reading options:
 

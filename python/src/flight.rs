@@ -3,7 +3,7 @@
 
 use crate::errors::{IntoPy, bad_argument};
 use aeromag::io::{
-    ColumnData, FlightTable, Missing, SharedBuffer, TableSnapshot, Values, table_from_columns,
+    ColumnData, FlightTable, SharedBuffer, TableSnapshot, Values, table_from_columns,
 };
 use aeromag::{ColumnMap, Flight, ReadOptions, RowSelection, Sensors};
 use numpy::{PyArray1, PyArrayMethods};
@@ -188,14 +188,7 @@ fn column_from_py(
             } else {
                 NumpyBuffer::share(a)?
             };
-            let nan = aeromag::io::nan_count(&values);
-            ColumnData::Numeric {
-                values,
-                missing: Missing {
-                    nan,
-                    ..Missing::default()
-                },
-            }
+            ColumnData::numeric(values)
         }
         "U" | "S" | "O" => {
             one_d(&arr)?;
@@ -521,6 +514,19 @@ impl PyFlight {
             .unread_columns()
             .into_iter()
             .map(String::from)
+            .collect()
+    }
+
+    /// What the file holds beside its fields, not read into the flight:
+    /// `(name, what)` pairs such as `("TL_data.A_a", "a 1000 × 18
+    /// matrix")` for a MATLAB MAT-file's scalars, matrices and text; empty
+    /// for the other formats.
+    #[getter]
+    fn not_read(&self) -> Vec<(String, String)> {
+        self.inner
+            .not_read()
+            .iter()
+            .map(|n| (n.name.clone(), n.what.clone()))
             .collect()
     }
 

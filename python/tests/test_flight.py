@@ -262,7 +262,7 @@ def test_text_datasets_written_by_h5py_are_text_columns(tmp_path):
 def test_matlab_mat_files(tmp_path):
     """A MATLAB v7.3 MAT-file (HDF5 after a 512-byte user block; vectors as
     1 x n matrices, text as uint16 'char') reads as a flight; a v5 one is
-    refused with what to do."""
+    read too (tests/test_flight.py::test_matlab_v5_mat_files)."""
     h5py = pytest.importorskip("h5py")
     path = tmp_path / "flight.mat"
     n = 50
@@ -279,7 +279,22 @@ def test_matlab_mat_files(tmp_path):
     assert len(f) == n and "note" not in f.columns
     assert np.asarray(f["mag"]).tolist() == (5.0e4 + np.arange(n)).tolist()
     assert np.asarray(f["lat"]).tolist() == [45.0] * n
-    v5 = tmp_path / "old.mat"
-    v5.write_bytes(b"MATLAB 5.0 MAT-file, Platform: MACI64".ljust(116) + b"\0" * 12)
-    with pytest.raises(aeromag.BadInputError, match="v5 MAT-file.*-v7.3"):
-        aeromag.read_flight(v5)
+
+
+MAT5 = pathlib.Path(__file__).resolve().parents[2] / "crates" / "io" / "tests" / "data" / "mat5"
+
+
+def test_matlab_v5_mat_files():
+    """A MATLAB v5 MAT-file (tools/reference/mat5_flights.py): MagNav.jl's
+    compressed traj and ins_data structs read as its HDF5 names, what is
+    not a field listed in not_read; a file without a flight refused."""
+    f = aeromag.read_flight(MAT5 / "magnav.mat")
+    assert f.columns[:4] == ["ins_tt", "ins_lat", "ins_lon", "ins_roll"]
+    k = np.arange(50.0)
+    assert np.asarray(f["mag"]).tolist() == (50_000.0 + 0.125 * k).tolist()
+    assert np.asarray(f["ins_lat"]).tolist() == (45.0 + k * 1e-4).tolist()
+    assert f.not_read == [("traj.Cnb", "a 3 × 3 × 50 matrix"), ("traj.fileName", "text (1 × 7)")]
+    only = aeromag.read_flight(MAT5 / "magnav.mat", fields="mag")
+    assert only.columns == ["mag_1_uc"]
+    with pytest.raises(aeromag.BadInputError, match=r"2 structs \(a, b\)"):
+        aeromag.read_flight(MAT5 / "two_structs.mat")

@@ -494,3 +494,39 @@ fn a_grid_file_is_inspected_as_a_grid_and_refused_as_a_flight() {
         stderr(&o)
     );
 }
+
+/// A MATLAB v5 MAT-file (aeromag-io's test files): the fields read, what
+/// is not a field printed and in the JSON; a file of several structs exits
+/// 2 naming them.
+#[test]
+fn a_matlab_v5_file_lists_what_is_not_a_field() {
+    let mat5 = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/data/mat5");
+    let p = mat5.join("magnav.mat");
+    let o = aeromag(&["inspect", p.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("rows     50"), "{s}");
+    assert!(
+        s.contains("not read traj.Cnb: a 3 × 3 × 50 matrix, traj.fileName: text (1 × 7)"),
+        "{s}"
+    );
+    assert!(s.contains("mag=mag_1_uc"), "{s}");
+    let j = aeromag(&["inspect", p.to_str().unwrap(), "--json"]);
+    assert_code(&j, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    assert_eq!(v["not_read"][0]["name"], "traj.Cnb");
+    assert_eq!(v["columns"][1]["name"], "ins_lat");
+    // Other formats leave the key out.
+    let d = tempfile::tempdir().unwrap();
+    let good = write(&d, "good.csv", GOOD.as_bytes());
+    let j = aeromag(&["inspect", good.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&stdout(&j)).unwrap();
+    assert!(v.get("not_read").is_none(), "{v}");
+    let o = aeromag(&["inspect", mat5.join("two_structs.mat").to_str().unwrap()]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("two_structs.mat': holds 2 structs (a, b)"),
+        "{}",
+        stderr(&o)
+    );
+}

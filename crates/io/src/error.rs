@@ -270,6 +270,17 @@ pub enum IoError {
         /// What the file holds instead.
         found: String,
     },
+    /// A MATLAB v5 MAT-file that cannot be read (damaged) or holds no
+    /// flight.
+    #[error("'{file}'{}: {message}", variable.as_ref().map(|v| format!(", variable '{v}'")).unwrap_or_default())]
+    Mat {
+        /// File as given.
+        file: String,
+        /// The variable concerned (`traj.lat` for a struct's field), if one.
+        variable: Option<String>,
+        /// What went wrong.
+        message: String,
+    },
     /// `--mag` / `--vector` names a sensor the file does not have.
     #[error(
         "'{file}': {option} {name}: no such column in the file; candidates present: {candidates}"
@@ -450,6 +461,7 @@ impl IoError {
             | NoData { file, .. }
             | Hdf5 { file, .. }
             | Hdf5Layout { file, .. }
+            | Mat { file, .. }
             | SensorAbsent { file, .. }
             | AmbiguousColumn { file, .. }
             | Selection { file, .. }
@@ -568,7 +580,7 @@ impl IoError {
 }
 
 /// Bytes as GB with one decimal, or MB below a GB.
-fn size_text(bytes: u64) -> String {
+pub(crate) fn size_text(bytes: u64) -> String {
     if bytes >= 1_000_000_000 {
         format!("{:.1} GB", bytes as f64 / 1e9)
     } else {

@@ -12,7 +12,7 @@
 //! is not this layout, except the 1 × n or n × 1 matrices in which a MATLAB
 //! v7.3 MAT-file (HDF5 after a 512-byte user block) holds its vectors,
 //! read as fields (its text, `MATLAB_class` `char`, is skipped). A MATLAB v5
-//! MAT-file is refused with what to do.
+//! MAT-file is read by [`crate::read_mat5`].
 //!
 //! **Only the fields a command needs are read** ([`Fields::Only`](crate::Fields::Only)): the
 //! datasets' headers are parsed when the file is opened, the data of a
@@ -44,10 +44,9 @@ use std::path::Path;
 use hdf5_reader::{Dataset, Datatype, H5Type, Hdf5File, OpenOptions, VarLenKind, group::Group};
 
 use crate::ReadOptions;
-use crate::columns::resolve;
 use crate::error::{IoError, Result};
-use crate::table::{ColumnData, FlightTable, Missing};
-use crate::wanted::wanted_fields;
+use crate::table::{ColumnData, FlightTable};
+use crate::wanted::mapped_fields;
 
 /// Largest single read, bytes (4 GiB, 5·10⁸ float64 values): far above any flight's field, far
 /// below what a forged header could claim; also the most the fields a command asks for may take
@@ -161,17 +160,10 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         });
     }
     let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
-    let aliases = resolve(
-        file,
-        &header,
-        &opts.columns,
-        &opts.sensors,
-        opts.magnav_preset,
-    )?;
     // The row count comes from data actually read, never from headers alone
     // (a forged header could claim 10^12 rows that nothing then checks): with
     // none of the fields asked for present, the first field is read.
-    let wanted = wanted_fields(&header, &aliases, opts);
+    let (aliases, wanted) = mapped_fields(file, &header, opts)?;
     // One read is capped by the reader; the reads together here, before
     // any: 7 fields of 4·10⁸ rows (3.2 GB each, each under the cap) in a
     // 10 kB file of unwritten chunks aborted the process out of memory.
@@ -206,18 +198,7 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
             continue;
         }
         let (values, integer) = read_f64(&ds).map_err(|e| h5err(Some(&path), e))?;
-        let missing = Missing {
-            nan: crate::parts::nan_count(&values),
-            ..Missing::default()
-        };
-        columns.push((
-            name,
-            ColumnData::Numeric {
-                values: values.into(),
-                missing,
-            },
-            integer,
-        ));
+        columns.push((name, ColumnData::numeric(values), integer));
     }
     // The rows are the values read (at least one field was), which must
     // match the headers' length.
@@ -235,14 +216,9 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         });
     }
     let n_rows = columns.first().map_or(0, |c| len(&c.1));
-    let aliases = aliases
-        .into_iter()
-        .filter(|m| columns.iter().any(|c| c.0 == m.file_column))
-        .collect();
-    let mut table =
-        FlightTable::from_parts(path.to_path_buf(), n_rows, columns, aliases, Vec::new());
-    table.set_file_columns(header);
-    Ok(table)
+    Ok(FlightTable::from_fields(
+        path, n_rows, columns, aliases, header,
+    ))
 }
 
 /// A `units` attribute that contradicts the unit the layout gives the field

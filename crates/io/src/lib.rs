@@ -46,6 +46,7 @@ mod fields;
 mod hdf5;
 mod hdf5_write;
 mod label_texts;
+mod mat5;
 mod number_text;
 mod ordered;
 mod parts;
@@ -77,6 +78,7 @@ pub use error::{IoError, Location, Result};
 pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use hdf5_write::{check_hdf5, write_hdf5, write_hdf5_to};
+pub use mat5::{MAX_DEPTH as MAT_MAX_DEPTH, read_mat5};
 pub use number_text::NumberText;
 pub use parts::nan_count;
 pub use position_glitches::{
@@ -86,7 +88,7 @@ pub use select::{RowSelection, label_number};
 pub use summary::{ColumnKind, ColumnSummary, LineCount, Range, Summary, TimeSummary, summarize};
 pub use table::{
     Column, ColumnData, ColumnSnapshot, ColumnSnapshotData, FlightTable, IN_MEMORY, Missing,
-    TableSnapshot,
+    NotRead, TableSnapshot,
 };
 pub use table_file::{TableFormat, write_table};
 pub use validate::{
@@ -111,6 +113,8 @@ pub enum Format {
     Xyz,
     /// HDF5 in the MagNav/SGL layout, see [`read_hdf5`].
     Hdf5,
+    /// A MATLAB v5 MAT-file, see [`read_mat5`].
+    Mat,
 }
 
 /// Which fields to read. Every format keeps the same fields of a file: an
@@ -186,7 +190,8 @@ impl Default for ReadOptions {
 /// With [`Format::Auto`]: extension `.xyz` → Geosoft XYZ; `.csv`, `.tsv` →
 /// CSV; `.h5`, `.hdf5`, `.he5` → HDF5; anything else (including `.txt` and
 /// `.mat`) → by content: HDF5 if the file has the HDF5 signature (MATLAB
-/// v7.3 files do), XYZ if the first non-blank line starts with `/`, else CSV.
+/// v7.3 files do), a MATLAB v5 MAT-file by its header, XYZ if the first
+/// non-blank line starts with `/`, else CSV.
 ///
 /// Then the canonical columns in another unit are derived
 /// ([`derive_columns`]: `lat` from `ins_lat` in radians, …) and the rows of
@@ -199,6 +204,7 @@ pub fn read_table(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     let mut table = match format {
         Format::Xyz => read_xyz(path, opts),
         Format::Hdf5 => read_hdf5(path, opts),
+        Format::Mat => read_mat5(path, opts),
         Format::Csv | Format::Auto => read_csv(path, opts),
     }?;
     opts.rows.apply(&mut table)?;
@@ -298,9 +304,6 @@ fn grid_kind(head: &[u8], ext: &str) -> Option<&'static str> {
     .map(|(_, kind)| kind)
 }
 
-/// The start of a MATLAB v5 MAT-file.
-const MAT_V5: &[u8] = b"MATLAB 5.0 MAT-file";
-
 fn detect_format(path: &Path) -> Result<Format> {
     let ext = aeromag_core::file_name::extension(path);
     match ext.as_str() {
@@ -312,7 +315,7 @@ fn detect_format(path: &Path) -> Result<Format> {
     }
     // One read of the first bytes tells the binary files that are not
     // flight tables.
-    let head = aeromag_core::file_name::first_bytes(path, MAT_V5.len());
+    let head = aeromag_core::file_name::first_bytes(path, mat5::SIGNATURE.len());
     if let Some(kind) = grid_kind(&head, &ext) {
         return Err(IoError::Unsupported {
             file: path.display().to_string(),
@@ -322,14 +325,8 @@ fn detect_format(path: &Path) -> Result<Format> {
             ),
         });
     }
-    if head.starts_with(MAT_V5) {
-        return Err(IoError::Unsupported {
-            file: path.display().to_string(),
-            reason: "a MATLAB v5 MAT-file, which aeromag does not read: save it as v7.3 \
-                     (`save(file, '-v7.3')`, HDF5, read here) or as CSV; from Python, \
-                     scipy.io.loadmat and aeromag.Flight.from_dict"
-                .into(),
-        });
+    if mat5::is_mat5(&head) {
+        return Ok(Format::Mat);
     }
     let prefix = sniff::read_prefix(path)?;
     let first = sniff::first_content_line(&prefix.bytes, |_| false);

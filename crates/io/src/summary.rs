@@ -53,6 +53,11 @@ pub struct Summary {
     /// faster than anything flies ([`crate::position_glitches`]); `None`
     /// without numeric `time`, `lat` and `lon` columns.
     pub position_glitch_rows: Option<Vec<usize>>,
+    /// What the file holds beside its fields, not read
+    /// ([`FlightTable::not_read`]: a MAT-file's scalars, matrices, text);
+    /// left out of the JSON when empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub not_read: Vec<crate::NotRead>,
 }
 
 /// Minimum and maximum.
@@ -216,6 +221,7 @@ pub fn summarize(table: &FlightTable) -> Summary {
             (Some(t), Some(lat), Some(lon)) => Some(crate::position_glitches(t, lat, lon)),
             _ => None,
         },
+        not_read: table.not_read().to_vec(),
     }
 }
 

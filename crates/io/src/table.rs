@@ -71,6 +71,19 @@ pub enum ColumnData {
     Text(Vec<String>),
 }
 
+impl ColumnData {
+    /// Numbers whose `NaN` values count as missing (`Missing::nan`), as a
+    /// binary file or an array holds them.
+    pub fn numeric(values: impl Into<Values>) -> Self {
+        let values = values.into();
+        let missing = Missing {
+            nan: crate::parts::nan_count(&values),
+            ..Missing::default()
+        };
+        ColumnData::Numeric { values, missing }
+    }
+}
+
 /// A named column.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Column {
@@ -149,6 +162,20 @@ pub struct FlightTable {
     /// Every column of the file, in file order, read or not
     /// ([`crate::Fields::Only`]); empty for in-memory tables.
     file_columns: Vec<String>,
+    /// What the file holds beside its fields (a MAT-file's scalars,
+    /// matrices, text): [`FlightTable::not_read`].
+    not_read: Vec<NotRead>,
+}
+
+/// Something a file holds that is not a field of the flight, so not read
+/// into the table: a MATLAB MAT-file's scalar, matrix, text or vector of
+/// another length ([`crate::read_mat5`]).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct NotRead {
+    /// Its name in the file (`TL_data.A_a` for a struct's field).
+    pub name: String,
+    /// What it is (`a 1000 × 18 matrix`, `a scalar`, `text (1 × 8)`).
+    pub what: String,
 }
 
 /// Name used in messages for tables that were not read from a file.
@@ -327,6 +354,17 @@ impl FlightTable {
             .collect()
     }
 
+    /// What the file holds beside its fields, not read into the table
+    /// ([`NotRead`]), in file order; empty for most formats, whose every
+    /// field is a column.
+    pub fn not_read(&self) -> &[NotRead] {
+        &self.not_read
+    }
+
+    pub(crate) fn set_not_read(&mut self, not_read: Vec<NotRead>) {
+        self.not_read = not_read;
+    }
+
     /// Records every column of the file the table was read from, in file
     /// order (read or not).
     pub(crate) fn set_file_columns(&mut self, names: Vec<String>) {
@@ -337,14 +375,9 @@ impl FlightTable {
     /// Errors if the name exists or the length differs from [`FlightTable::n_rows`]
     /// (any length is accepted for the first column).
     pub fn add_column(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
-        let values = Values::Owned(values);
-        let missing = Missing {
-            nan: crate::parts::nan_count(&values),
-            ..Missing::default()
-        };
         self.push_column(Column {
             name: name.to_string(),
-            data: ColumnData::Numeric { values, missing },
+            data: ColumnData::numeric(values),
             integer_text: false,
         })
     }
@@ -376,11 +409,7 @@ impl FlightTable {
         match self.columns.iter().position(|c| c.name == name) {
             Some(i) => {
                 self.check_len(name, values.len())?;
-                let missing = Missing {
-                    nan: crate::parts::nan_count(&values),
-                    ..Missing::default()
-                };
-                self.columns[i].data = ColumnData::Numeric { values, missing };
+                self.columns[i].data = ColumnData::numeric(values);
                 self.columns[i].integer_text = false;
                 Ok(())
             }
@@ -457,6 +486,25 @@ impl FlightTable {
     }
 
     /// Assembles a table read from a file (used by the readers).
+    /// A table of the fields read from a binary file (HDF5, MAT) whose
+    /// fields are `header`: the aliases of fields not read are dropped.
+    pub(crate) fn from_fields(
+        source: &Path,
+        n_rows: usize,
+        columns: Vec<(String, ColumnData, bool)>,
+        aliases: Vec<MappedColumn>,
+        header: Vec<String>,
+    ) -> Self {
+        let aliases = aliases
+            .into_iter()
+            .filter(|m| columns.iter().any(|c| c.0 == m.file_column))
+            .collect();
+        let mut table =
+            Self::from_parts(source.to_path_buf(), n_rows, columns, aliases, Vec::new());
+        table.set_file_columns(header);
+        table
+    }
+
     pub(crate) fn from_parts(
         source: PathBuf,
         n_rows: usize,
@@ -480,6 +528,7 @@ impl FlightTable {
             row_origin: Vec::new(),
             derived: Vec::new(),
             file_columns: Vec::new(),
+            not_read: Vec::new(),
         }
     }
 

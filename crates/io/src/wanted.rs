@@ -5,6 +5,24 @@
 use crate::derive::{DERIVATIONS, DIFFERENCES};
 use crate::{Fields, ReadOptions};
 
+/// The canonical aliases of a binary file's fields `header` (mapped as a
+/// CSV header is) and which of them to read ([`wanted_fields`]).
+pub(crate) fn mapped_fields(
+    file: &str,
+    header: &[String],
+    opts: &ReadOptions,
+) -> crate::Result<(Vec<crate::MappedColumn>, Vec<bool>)> {
+    let aliases = crate::columns::resolve(
+        file,
+        header,
+        &opts.columns,
+        &opts.sensors,
+        opts.magnav_preset,
+    )?;
+    let wanted = wanted_fields(header, &aliases, opts);
+    Ok((aliases, wanted))
+}
+
 /// Which of the file's fields to read: all, or those [`Fields::Only`] names
 /// (a file name, a canonical name through its alias, the source of a
 /// derived canonical column), plus `line`/`time` for a row selection; the

@@ -247,6 +247,17 @@ pub fn render(s: &Summary) -> String {
                 .join(", ")
         );
     }
+    if !s.not_read.is_empty() {
+        let _ = writeln!(
+            o,
+            "not read {} (not vectors of the flight's length)",
+            s.not_read
+                .iter()
+                .map(|n| format!("{}: {}", n.name, n.what))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     let _ = writeln!(
         o,
         "\n{:<22} {:<10} {:<6} {:>9} {:>14} {:>14} {:>14}",

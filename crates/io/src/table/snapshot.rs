@@ -35,6 +35,9 @@ pub struct TableSnapshot {
     pub derived: Vec<DerivedColumn>,
     /// Every column of the file, read or not.
     pub file_columns: Vec<String>,
+    /// What the file holds beside its fields ([`FlightTable::not_read`]).
+    #[serde(default)]
+    pub not_read: Vec<super::NotRead>,
 }
 
 /// One column of a [`TableSnapshot`].
@@ -124,6 +127,7 @@ impl FlightTable {
             row_origin: self.row_origin.clone(),
             derived: self.derived.clone(),
             file_columns: self.file_columns.clone(),
+            not_read: self.not_read.clone(),
         };
         (snapshot, numbers)
     }
@@ -159,6 +163,7 @@ impl FlightTable {
             row_origin: s.row_origin,
             derived: s.derived,
             file_columns: s.file_columns,
+            not_read: s.not_read,
         };
         let mut numbers = numbers.chunks_exact(n.max(1));
         for c in s.columns {
