@@ -298,3 +298,18 @@ def test_matlab_v5_mat_files():
     assert only.columns == ["mag_1_uc"]
     with pytest.raises(aeromag.BadInputError, match=r"2 structs \(a, b\)"):
         aeromag.read_flight(MAT5 / "two_structs.mat")
+    with pytest.raises(aeromag.BadInputError, match="MagNav.jl map"):
+        aeromag.read_flight(MAT5 / "map.mat")
+
+
+def test_a_magnav_map_is_not_read_as_a_flight(tmp_path):
+    """MagNav.jl's map HDF5 (map, xx, yy, alt) is named as a map."""
+    h5py = pytest.importorskip("h5py")
+    path = tmp_path / "map.h5"
+    with h5py.File(path, "w") as h:
+        h["map"] = np.zeros((4, 5))
+        h["xx"] = np.linspace(-95.0, -94.0, 5)
+        h["yy"] = np.linspace(38.0, 39.0, 4)
+        h["alt"] = 300.0
+    with pytest.raises(aeromag.BadInputError, match="is a MagNav.jl map"):
+        aeromag.read_flight(path)

@@ -10,6 +10,16 @@
 //! or when none of these can be read: unknown (`None`), and nothing is
 //! refused.
 
+/// Bytes as the messages about memory write them: GB with one decimal, or
+/// MB below a GB (`1.6 GB`, `320 MB`).
+pub fn size_text(bytes: u64) -> String {
+    if bytes >= 1_000_000_000 {
+        format!("{:.1} GB", bytes as f64 / 1e9)
+    } else {
+        format!("{:.0} MB", bytes as f64 / 1e6)
+    }
+}
+
 /// The bytes this process can still allocate, as far as the system says
 /// (module docs); `None` when unknown.
 pub fn available_bytes() -> Option<u64> {

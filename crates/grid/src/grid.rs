@@ -8,6 +8,7 @@
 use crate::error::{GridError, Result, positive};
 use crate::projection::Crs;
 use aeromag_core::error::shown;
+use aeromag_core::memory::size_text;
 
 /// Where the nodes of a grid are (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,14 +52,14 @@ fn check_memory(fx: f64, fy: f64, cell: f64, available: Option<u64>) -> Result<(
     // The cell that fits, with room to spare (the nodes go as 1/cell²).
     let fits = cell * (need / (0.8 * available)).sqrt();
     Err(GridError::Data(format!(
-        "{} × {} nodes at a {} m cell need about {:.1} GB while gridding ({GRIDDING_BYTES_PER_NODE} \
-         bytes a node), more than the {:.1} GB this process can take: choose a larger cell (about \
+        "{} × {} nodes at a {} m cell need about {} while gridding ({GRIDDING_BYTES_PER_NODE} \
+         bytes a node), more than the {} this process can take: choose a larger cell (about \
          {} m) or a smaller area",
         shown(fx),
         shown(fy),
         shown(cell),
-        need / 1e9,
-        available / 1e9,
+        size_text(need as u64),
+        size_text(available as u64),
         shown((fits * 100.0).ceil() / 100.0)
     )))
 }

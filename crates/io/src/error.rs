@@ -13,6 +13,7 @@
 //!   "data row 1"), so `row` 14 is printed as "data row 15".
 
 use aeromag_core::error::shown;
+use aeromag_core::memory::size_text;
 
 /// Everything that can go wrong while reading, mapping, checking or writing
 /// flight-data tables.
@@ -576,15 +577,6 @@ impl IoError {
                 | IoError::LengthMismatch { .. }
                 | IoError::ColumnExists { .. }
         )
-    }
-}
-
-/// Bytes as GB with one decimal, or MB below a GB.
-pub(crate) fn size_text(bytes: u64) -> String {
-    if bytes >= 1_000_000_000 {
-        format!("{:.1} GB", bytes as f64 / 1e9)
-    } else {
-        format!("{:.0} MB", bytes as f64 / 1e6)
     }
 }
 

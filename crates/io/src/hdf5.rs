@@ -113,6 +113,16 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         });
     };
     let (_, names) = group.member_names().map_err(|e| h5err(None, e))?;
+    if ["map", "xx", "yy"]
+        .iter()
+        .all(|n| names.iter().any(|m| m == n))
+    {
+        return Err(IoError::Hdf5 {
+            file: file.to_string(),
+            dataset: None,
+            message: format!("is {}", crate::mat5::MAGNAV_MAP),
+        });
+    }
     // Shapes first (headers only): every field 1-D and of one length.
     let mut fields: Vec<(String, Dataset, u64)> = Vec::new();
     for name in names {

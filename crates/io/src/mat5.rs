@@ -47,10 +47,17 @@ use std::io::Read;
 use std::path::Path;
 
 use crate::ReadOptions;
-use crate::error::{IoError, Result, size_text};
+use aeromag_core::memory::size_text;
+
+use crate::error::{IoError, Result};
 use crate::hdf5::MAX_READ_BYTES;
 use crate::table::{ColumnData, FlightTable, NotRead};
 use crate::wanted::mapped_fields;
+
+/// What a MagNav.jl map file (HDF5 or MAT: `map`, `xx`, `yy`) is, for the
+/// messages refusing it as a flight.
+pub(crate) const MAGNAV_MAP: &str = "a MagNav.jl map (`map`, `xx`, `yy`), not a flight table; \
+     aeromag reads grids from GeoTIFF, GXF, ESRI ASCII, netCDF and Surfer files";
 
 /// The start of a MATLAB v5 MAT-file's header text.
 pub(crate) const SIGNATURE: &[u8] = b"MATLAB 5.0 MAT-file";
@@ -200,12 +207,7 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         })
     };
     if has("map", true) && has("xx", false) && has("yy", false) {
-        return Err(err(
-            None,
-            "holds a MagNav.jl map (`map`, `xx`, `yy`), not a flight table; aeromag reads \
-             grids from GeoTIFF, GXF, ESRI ASCII, netCDF and Surfer files"
-                .into(),
-        ));
+        return Err(err(None, format!("holds {MAGNAV_MAP}")));
     }
 
     // The fields: the numeric vectors of the longest length.

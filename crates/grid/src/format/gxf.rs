@@ -78,6 +78,7 @@ use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
 use crate::projection::{Crs, UtmZone};
 use aeromag_core::error::{shown, shown_text};
+use aeromag_core::memory::size_text;
 
 /// The dummy (blank node) written: Geosoft's float dummy.
 const DUMMY: &str = "-1e32";
@@ -450,9 +451,9 @@ fn fits_in_memory(path: &Path, nx: usize, ny: usize, left: Option<u64>) -> Resul
         Some(left) if need > left => Err(read_error(
             path,
             format!(
-                "the header declares {nx} × {ny} nodes, {} MB, more than the {} MB of memory left",
-                need >> 20,
-                left >> 20
+                "the header declares {nx} × {ny} nodes, {}, more than the {} this process can take",
+                size_text(need),
+                size_text(left)
             ),
         )),
         _ => Ok(()),
@@ -789,7 +790,8 @@ mod tests {
         let e = fits_in_memory(path, 15_000, 15_000, Some(1_000_000_000)).unwrap_err();
         assert!(e.is_bad_input());
         assert!(
-            e.to_string().contains("1716 MB, more than the 953 MB"),
+            e.to_string()
+                .contains("1.8 GB, more than the 1.0 GB this process can take"),
             "{e}"
         );
         fits_in_memory(path, 15_000, 15_000, Some(2_000_000_000)).unwrap();
