@@ -468,6 +468,16 @@ impl PyFlight {
             .py_err()
     }
 
+    /// Write the flight as a MATLAB v5 MAT-file (one n × 1 variable per
+    /// column: double, int64 for integer columns, a space-padded char
+    /// matrix for text; as the CLI writes `--out X.mat`), which MATLAB's
+    /// `load`, Octave and scipy.io.loadmat read: bad input for a column
+    /// name that is not a MATLAB variable name.
+    fn to_mat(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| aeromag::io::write_mat5(self.inner.table(), &path))
+            .py_err()
+    }
+
     /// Number of rows.
     fn __len__(&self) -> usize {
         self.inner.n_rows()

@@ -302,6 +302,39 @@ def test_matlab_v5_mat_files():
         aeromag.read_flight(MAT5 / "map.mat")
 
 
+def test_to_mat_reads_back_here_and_in_scipy(tmp_path):
+    """Flight.to_mat writes a MATLAB v5 MAT-file of n x 1 variables that
+    reads back bit for bit, text included; SciPy reads the same values when
+    it is installed; a name MATLAB cannot hold is bad input."""
+    n = 6
+    flight = aeromag.Flight.from_dict({
+        "time": 0.1 * np.arange(n),
+        "x": np.array([53064.063, np.nan, -0.0, 1e300, 5e-324, -7.25]),
+        "line": ["L1020", "", "T901", "L1020", "1003.10", "x"],
+        "note": ["µ", "", "", "", "", "ok"],
+    })
+    path = tmp_path / "f.mat"
+    flight.to_mat(path)
+    back = aeromag.read_flight(path)
+    assert back.columns == flight.columns and back.not_read == []
+    for c in ("time", "x"):
+        assert np.asarray(back[c]).tobytes() == np.asarray(flight[c]).tobytes()
+    assert list(back["line"]) == list(flight["line"])
+    assert list(back["note"]) == list(flight["note"])
+    bad = aeromag.Flight.from_dict({"2nd": np.arange(3.0)})
+    with pytest.raises(aeromag.BadInputError, match="column '2nd'.*MATLAB variable name"):
+        bad.to_mat(tmp_path / "b.mat")
+    try:
+        import scipy.io
+    except ImportError:
+        return
+    m = scipy.io.loadmat(path)
+    assert m["x"].shape == (n, 1)
+    assert m["x"].ravel().tobytes() == np.asarray(flight["x"]).tobytes()
+    assert [s.rstrip() for s in m["line"]] == list(flight["line"])
+    assert [s.rstrip() for s in m["note"]] == list(flight["note"])
+
+
 def test_a_magnav_map_is_not_read_as_a_flight(tmp_path):
     """MagNav.jl's map HDF5 (map, xx, yy, alt) is named as a map."""
     h5py = pytest.importorskip("h5py")

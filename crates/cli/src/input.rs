@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, clap::Args)]
 #[group(skip)]
 #[command(mut_arg("input", |a| a.help(
-    "Flight data file: CSV (header row, `#` comments), Geosoft XYZ (`.xyz`) or HDF5 in the \
-     MagNav/SGL layout (`.h5`: one dataset per field)"
+    "Flight data file: CSV (header row, `#` comments), Geosoft XYZ (`.xyz`), HDF5 in the \
+     MagNav/SGL layout (`.h5`: one dataset per field) or a MATLAB MAT-file (`.mat`: vectors, \
+     or a struct of them)"
 )))]
 #[command(mut_arg("file", |a| a.help(
     "The flight data file, as --input gives it (`aeromag inspect flight.xyz`)"

@@ -178,7 +178,7 @@ pub fn check_map(map: Option<&Path>) -> anyhow::Result<()> {
 
 /// Check, before any work, that a flight table can be written in the
 /// format each of `tables` asks for (CSV, Geosoft XYZ for `.xyz`, HDF5 for
-/// `.h5`; a grid or model name is bad input).
+/// `.h5`, MATLAB for `.mat`; a grid or model name is bad input).
 pub fn check_tables<'a>(tables: impl IntoIterator<Item = &'a Path>) -> anyhow::Result<()> {
     for p in tables {
         aeromag::io::TableFormat::of_path(p)?;

@@ -245,7 +245,7 @@ fn a_fifo_that_no_process_reads_is_bad_input() {
 /// under that name), which read back to the table the CSV holds; a grid or
 /// model name is refused before the work.
 #[test]
-fn xyz_and_hdf5_outputs_hold_the_csv_table_and_other_formats_are_refused() {
+fn xyz_hdf5_and_mat_outputs_hold_the_csv_table_and_other_formats_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let cal = simulate(dir.path(), "calibration", "3");
     let model = dir.path().join("m.json");
@@ -260,12 +260,13 @@ fn xyz_and_hdf5_outputs_hold_the_csv_table_and_other_formats_are_refused() {
         ]),
         0,
     );
-    let (csv, xyz, h5) = (
+    let (csv, xyz, h5, mat) = (
         dir.path().join("c.csv"),
         dir.path().join("c.xyz"),
         dir.path().join("c.h5"),
+        dir.path().join("c.mat"),
     );
-    for out in [&csv, &xyz, &h5] {
+    for out in [&csv, &xyz, &h5, &mat] {
         assert_code(&compensate(&model, &cal, out), 0);
     }
     let text = std::fs::read_to_string(&xyz).unwrap();
@@ -275,7 +276,7 @@ fn xyz_and_hdf5_outputs_hold_the_csv_table_and_other_formats_are_refused() {
         &text[..80]
     );
     let a = aeromag::Flight::read(&csv).unwrap();
-    for other in [&xyz, &h5] {
+    for other in [&xyz, &h5, &mat] {
         let b = aeromag::Flight::read(other).unwrap();
         let (ta, tb) = (a.table(), b.table());
         assert_eq!(ta.column_names(), tb.column_names());
@@ -305,7 +306,8 @@ fn xyz_and_hdf5_outputs_hold_the_csv_table_and_other_formats_are_refused() {
         ]);
         assert_code(&o, 2);
         assert!(
-            stderr(&o).contains("CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"),
+            stderr(&o)
+                .contains("CSV (.csv), Geosoft XYZ (.xyz), HDF5 (.h5) or a MATLAB MAT-file (.mat)"),
             "{}",
             stderr(&o)
         );

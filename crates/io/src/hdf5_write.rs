@@ -38,7 +38,7 @@ use std::path::Path;
 use hdf5_reader::checksum::jenkins_lookup3;
 
 use crate::csv_write::written_columns;
-use crate::error::{IoError, Result};
+use crate::error::Result;
 use crate::table::{Column, FlightTable};
 
 /// "Undefined address" of the format: all bits set.
@@ -56,16 +56,13 @@ const MAX_NAME_BYTES: usize = 65_000;
 /// (bad input) for a column name HDF5 cannot hold, before anything is
 /// written; [`IoError::Write`] when the file cannot be written.
 pub fn write_hdf5(table: &FlightTable, path: &Path) -> Result<()> {
-    let file = path.display().to_string();
-    check_hdf5(table, &file)?;
-    crate::atomic::write_atomically(path, |w| write_hdf5_to(table, w))
-        .map_err(|source| IoError::Write { file, source })
+    crate::table_file::write_checked(table, path, check_hdf5, |t, w| write_hdf5_to(t, w))
 }
 
 /// Whether HDF5 can hold `table`'s column names (module docs); `file`
 /// names the output in the error.
 pub fn check_hdf5(table: &FlightTable, file: &str) -> Result<()> {
-    for c in written_columns(table) {
+    crate::table_file::refuse_column(table, file, "CSV (.csv) instead", |c| {
         let name = c.name();
         let reason = if name.is_empty() || name == "." {
             "an HDF5 dataset cannot be named '' or '.'"
@@ -76,16 +73,10 @@ pub fn check_hdf5(table: &FlightTable, file: &str) -> Result<()> {
         } else if name.len() > MAX_NAME_BYTES {
             "the name is longer than an HDF5 link can hold"
         } else {
-            continue;
+            return None;
         };
-        return Err(IoError::CannotWrite {
-            file: file.to_string(),
-            column: name.to_string(),
-            row: None,
-            reason: format!("{reason}; rename the column, or write CSV (.csv) instead"),
-        });
-    }
-    Ok(())
+        Some(reason.to_string())
+    })
 }
 
 /// Writes `table` as HDF5 to any writer, without the checks of
@@ -151,11 +142,7 @@ impl Kind {
         if let Some(text) = c.text() {
             return Kind::Text(text.iter().map(String::len).max().unwrap_or(0).max(1));
         }
-        let values = c.values().unwrap_or_default();
-        // 2⁵³: every whole f64 up to it is an i64 read back exactly.
-        let whole =
-            |v: &f64| v.is_finite() && v.fract() == 0.0 && v.abs() <= 9_007_199_254_740_992.0;
-        if c.integer_text() && values.iter().all(whole) {
+        if c.stores_integers() {
             Kind::Integer
         } else {
             Kind::Float

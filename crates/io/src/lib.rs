@@ -47,6 +47,7 @@ mod hdf5;
 mod hdf5_write;
 mod label_texts;
 mod mat5;
+mod mat5_write;
 mod number_text;
 mod ordered;
 mod parts;
@@ -79,6 +80,7 @@ pub use fields::{KnownField, known_field};
 pub use hdf5::{MAX_READ_BYTES, read_hdf5};
 pub use hdf5_write::{check_hdf5, write_hdf5, write_hdf5_to};
 pub use mat5::{MAX_DEPTH as MAT_MAX_DEPTH, read_mat5};
+pub use mat5_write::{check_mat5, write_mat5, write_mat5_to};
 pub use number_text::NumberText;
 pub use parts::nan_count;
 pub use position_glitches::{

@@ -17,7 +17,9 @@
 //!
 //! **Which variables are the flight's fields.**
 //! - Numeric vectors (1 × n, n × 1) at the top level: a workspace saved
-//!   with `save(file, 'time', 'mag', …)`, as an HDF5 file's root datasets.
+//!   with `save(file, 'time', 'mag', …)`, as an HDF5 file's root datasets
+//!   (or [`crate::write_mat5`]'s; a top level of scalars and no struct is a
+//!   one-row table).
 //! - Without those, the fields of a 1 × 1 struct. MagNav.jl's layout
 //!   (`get_XYZ0`'s `traj_field` and `ins_field`, "the standard way the
 //!   MATLAB-companion outputs data"): the struct `traj`, and the INS
@@ -27,12 +29,13 @@
 //!   an error naming them.
 //! - Of those, the numeric vectors of the longest length are the fields
 //!   (`double`, `single`, integer classes and `logical`, read exactly as
-//!   `f64`; integer classes are written back as integers). The other
-//!   variables there (scalars such as a sample rate `fs`, text, matrices
-//!   such as MagNav's 1000 × 18 design matrix `A_a` or its 3 × 3 × n `Cnb`,
-//!   vectors of another length, complex arrays, cells, objects) are not
-//!   fields: they are listed in [`FlightTable::not_read`], which
-//!   `aeromag inspect` prints, never dropped silently.
+//!   `f64`; integer classes are written back as integers), and the `char`
+//!   matrices of as many rows (text columns, each row's padding spaces
+//!   removed). The other variables there (scalars such as a sample rate
+//!   `fs`, text, matrices such as MagNav's 1000 × 18 design matrix `A_a` or
+//!   its 3 × 3 × n `Cnb`, vectors of another length, complex arrays, cells,
+//!   objects) are not fields: they are listed in [`FlightTable::not_read`],
+//!   which `aeromag inspect` prints, never dropped silently.
 //!
 //! **Damaged or hostile files** give [`IoError::Mat`] naming the file and
 //! the variable, never a panic: every byte count is checked against the
@@ -82,6 +85,8 @@ const MI_INT64: u32 = 12;
 const MI_UINT64: u32 = 13;
 const MI_MATRIX: u32 = 14;
 const MI_COMPRESSED: u32 = 15;
+const MI_UTF8: u32 = 16;
+const MI_UTF16: u32 = 17;
 
 // Array classes (Table 1-3).
 const MX_CELL: u8 = 1;
@@ -109,6 +114,8 @@ enum Value {
     },
     /// A 1 × 1 struct: its fields in file order.
     Struct(Vec<(String, Value)>),
+    /// A 2-D `char` array: its rows, the spaces that pad them removed.
+    Text { dims: Vec<usize>, rows: Vec<String> },
     /// Anything else, described for [`NotRead`]: text, a struct array,
     /// a cell, a complex or sparse array, an object.
     Other {
@@ -135,6 +142,7 @@ impl Value {
             }
             Value::Numeric { dims, .. } => format!("a {} matrix", Value::dims_text(dims)),
             Value::Struct(_) => "a struct".into(),
+            Value::Text { dims, .. } => format!("text ({})", Value::dims_text(dims)),
             Value::Other { dims, what } => format!("{what} ({})", Value::dims_text(dims)),
         }
     }
@@ -219,36 +227,41 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         })
         .max()
         .unwrap_or(0);
-    if n_rows < 2 {
+    if n_rows == 0 {
         return Err(err(
             None,
-            "holds no numeric vector of two values or more (a flight's fields are vectors, \
-             1 × n or n × 1, at the top level or in a struct)"
+            "holds no numeric vector (a flight's fields are vectors, 1 × n or n × 1, at the \
+             top level or in a struct)"
                 .into(),
         ));
     }
-    let mut fields: Vec<(String, Vec<f64>, bool)> = Vec::new();
+    // … and the text of as many rows (an n × k `char` matrix).
+    let mut fields: Vec<(String, ColumnData, bool)> = Vec::new();
     for Candidate { name, path, value } in chosen {
-        match value {
+        let field = match value {
             Value::Numeric {
                 dims,
                 values,
                 integer,
             } if vector_len(&dims).is_some() && values.len() == n_rows => {
-                if fields.iter().any(|f| f.0 == name) {
-                    return Err(err(
-                        Some(&name),
-                        "is given twice (a `traj` field and an `ins_data` field of the same name?)"
-                            .into(),
-                    ));
-                }
-                fields.push((name, values, integer));
+                (ColumnData::numeric(values), integer)
             }
-            other => not_read.push(NotRead {
-                name: path,
-                what: other.describe(),
-            }),
+            Value::Text { rows, .. } if rows.len() == n_rows => (ColumnData::Text(rows), false),
+            other => {
+                not_read.push(NotRead {
+                    name: path,
+                    what: other.describe(),
+                });
+                continue;
+            }
+        };
+        if fields.iter().any(|f| f.0 == name) {
+            return Err(err(
+                Some(&name),
+                "is given twice (a `traj` field and an `ins_data` field of the same name?)".into(),
+            ));
         }
+        fields.push((name, field.0, field.1));
     }
     let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
     let (aliases, wanted) = mapped_fields(&file, &header, opts)?;
@@ -256,7 +269,7 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         .into_iter()
         .zip(wanted)
         .filter(|(_, want)| *want)
-        .map(|((name, values, integer), _)| (name, ColumnData::numeric(values), integer))
+        .map(|(field, _)| field)
         .collect();
     let mut table = FlightTable::from_fields(path, n_rows, columns, aliases, header);
     table.set_not_read(not_read);
@@ -284,12 +297,15 @@ fn choose(
         name,
         what: v.describe(),
     };
+    let is_struct = |v: &Value| matches!(v, Value::Struct(_));
     let mut not_read = Vec::new();
     let mut chosen = Vec::new();
-    if variables.iter().any(|(_, v)| is_vector(v)) {
+    // The top level: with a vector, or with no struct (a one-row table is
+    // a workspace of scalars).
+    if variables.iter().any(|(_, v)| is_vector(v)) || !variables.iter().any(|(_, v)| is_struct(v)) {
         // The top level's variables; its structs are not fields.
         for (name, value) in variables {
-            if matches!(value, Value::Struct(_)) {
+            if is_struct(&value) {
                 not_read.push(passed_over(name, &value));
             } else {
                 chosen.push(Candidate {
@@ -303,7 +319,7 @@ fn choose(
     }
     let struct_names: Vec<&str> = variables
         .iter()
-        .filter(|(_, v)| matches!(v, Value::Struct(_)))
+        .filter(|(_, v)| is_struct(v))
         .map(|(n, _)| n.as_str())
         .collect();
     let picked: Vec<String> = if struct_names.contains(&"traj") {
@@ -314,12 +330,6 @@ fn choose(
             .collect()
     } else if struct_names.len() == 1 {
         vec![struct_names[0].to_string()]
-    } else if struct_names.is_empty() {
-        return Err(
-            "holds no numeric vector and no struct (a flight's fields are vectors, 1 × n or \
-             n × 1, at the top level or in a struct)"
-                .into(),
-        );
     } else {
         return Err(format!(
             "holds {} structs ({}) and no vector at the top level: save the flight's struct \
@@ -635,12 +645,49 @@ fn matrix(
             Ok((name, Value::Struct(fields)))
         }
         MX_STRUCT => other("a struct array"),
+        MX_CHAR if dims.len() == 2 => {
+            let (kind, data) = c.element().map_err(named)?;
+            let units = utf16_units(kind, data, big).map_err(named)?;
+            if units.len() != count {
+                return Err(named(format!(
+                    "holds {} characters where its dimensions {} say {count}: damaged",
+                    units.len(),
+                    Value::dims_text(&dims)
+                )));
+            }
+            // Column-major: row i's characters are i, i + n, i + 2n, …
+            let n = dims[0];
+            let rows = (0..n)
+                .map(|i| {
+                    let row: Vec<u16> = units.iter().skip(i).step_by(n).copied().collect();
+                    String::from_utf16_lossy(&row)
+                        .trim_end_matches(' ')
+                        .to_string()
+                })
+                .collect();
+            Ok((name, Value::Text { dims, rows }))
+        }
         MX_CHAR => other("text"),
         MX_CELL => other("a cell array"),
         MX_SPARSE => other("a sparse matrix"),
         MX_OBJECT => other("an object"),
         _ => other("an array of a class not read here"),
     }
+}
+
+/// The UTF-16 code units of a `char` array's element of type `kind`
+/// (MATLAB writes `uint16` or UTF-16, SciPy UTF-8 for ASCII text; a byte
+/// type is one character a byte).
+fn utf16_units(kind: u32, data: &[u8], big: bool) -> std::result::Result<Vec<u16>, String> {
+    Ok(match kind {
+        MI_UINT16 | MI_UTF16 => numbers(MI_UINT16, data, big)?
+            .into_iter()
+            .map(|u| u as u16)
+            .collect(),
+        MI_UTF8 => String::from_utf8_lossy(data).encode_utf16().collect(),
+        MI_UINT8 | MI_INT8 => data.iter().map(|&b| u16::from(b)).collect(),
+        other => return Err(format!("its text is of data type {other}: damaged")),
+    })
 }
 
 /// The values of a numeric element of type `kind`, as `f64` (exact for

@@ -112,6 +112,16 @@ impl Column {
         &self.data
     }
 
+    /// Whether a binary file stores this column as integers: a column read
+    /// as integers (`line` 1003, a flag) whose values are all whole and
+    /// within ±2⁵³ (every whole `f64` up to it is an `i64` read back
+    /// exactly).
+    pub(crate) fn stores_integers(&self) -> bool {
+        let whole =
+            |v: &f64| v.is_finite() && v.fract() == 0.0 && v.abs() <= 9_007_199_254_740_992.0;
+        self.integer_text && self.values().is_some_and(|v| v.iter().all(whole))
+    }
+
     /// Numeric values, `None` for a text column.
     pub fn values(&self) -> Option<&[f64]> {
         match &self.data {

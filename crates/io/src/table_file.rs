@@ -1,14 +1,19 @@
 //! Writing a flight table in the format its file name asks for: Geosoft
 //! XYZ for `.xyz` ([`crate::write_xyz`]), HDF5 in the MagNav/SGL layout
-//! for `.h5` and `.hdf5` ([`crate::write_hdf5`]), CSV otherwise
+//! for `.h5` and `.hdf5` ([`crate::write_hdf5`]), a MATLAB v5 MAT-file for
+//! `.mat` ([`crate::write_mat5`]), CSV otherwise
 //! ([`crate::write_csv`]; `.csv`, `.txt`, `.dat`, no extension), and a
 //! clear error for the formats aeromag reads or writes elsewhere but not
 //! as a flight table (`out.tif` would be CSV under a grid's name).
 
 use std::path::Path;
 
+use std::io::BufWriter;
+
+use crate::atomic::Output;
+use crate::csv_write::written_columns;
 use crate::error::{IoError, Result};
-use crate::table::FlightTable;
+use crate::table::{Column, FlightTable};
 
 /// The formats a flight table is written in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,6 +24,8 @@ pub enum TableFormat {
     Xyz,
     /// HDF5, one dataset per column ([`crate::write_hdf5`]).
     Hdf5,
+    /// MATLAB v5 MAT-file, one column vector per column ([`crate::write_mat5`]).
+    Mat,
 }
 
 /// Extensions of files that are not flight tables, or that aeromag does
@@ -42,13 +49,14 @@ impl TableFormat {
         match ext.as_str() {
             "xyz" => return Ok(TableFormat::Xyz),
             "h5" | "hdf5" => return Ok(TableFormat::Hdf5),
+            "mat" => return Ok(TableFormat::Mat),
             _ => {}
         }
         match REFUSED.iter().find(|(e, _)| *e == ext) {
             Some((_, what)) => Err(IoError::Unsupported {
                 file: path.display().to_string(),
                 reason: format!(
-                    "a '.{ext}' file is {what}: aeromag writes a flight table as CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"
+                    "a '.{ext}' file is {what}: aeromag writes a flight table as CSV (.csv), Geosoft XYZ (.xyz), HDF5 (.h5) or a MATLAB MAT-file (.mat)"
                 ),
             }),
             None => Ok(TableFormat::Csv),
@@ -64,8 +72,46 @@ pub fn write_table(table: &FlightTable, path: &Path) -> Result<TableFormat> {
         TableFormat::Csv => crate::write_csv(table, path)?,
         TableFormat::Xyz => crate::write_xyz(table, path)?,
         TableFormat::Hdf5 => crate::write_hdf5(table, path)?,
+        TableFormat::Mat => crate::write_mat5(table, path)?,
     }
     Ok(format)
+}
+
+/// Writes `table` to `path` in a format that `check`s it first (bad input
+/// found before anything is written), atomically as [`crate::write_csv`].
+pub(crate) fn write_checked(
+    table: &FlightTable,
+    path: &Path,
+    check: impl FnOnce(&FlightTable, &str) -> Result<()>,
+    write: impl FnOnce(&FlightTable, &mut BufWriter<Output>) -> std::io::Result<()>,
+) -> Result<()> {
+    let file = path.display().to_string();
+    check(table, &file)?;
+    crate::atomic::write_atomically(path, |w| write(table, w))
+        .map_err(|source| IoError::Write { file, source })
+}
+
+/// The first written column of `table` that a format cannot hold, by
+/// `reason` (why, `None` for a column it holds), as
+/// [`IoError::CannotWrite`] naming the output `file`, with what to do:
+/// rename the column, or write one of `instead`.
+pub(crate) fn refuse_column(
+    table: &FlightTable,
+    file: &str,
+    instead: &str,
+    reason: impl Fn(&Column) -> Option<String>,
+) -> Result<()> {
+    for c in written_columns(table) {
+        if let Some(reason) = reason(c) {
+            return Err(IoError::CannotWrite {
+                file: file.to_string(),
+                column: c.name().to_string(),
+                row: None,
+                reason: format!("{reason}; rename the column, or write {instead}"),
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -81,12 +127,14 @@ mod tests {
         assert_eq!(of("OUT.XYZ").unwrap(), TableFormat::Xyz);
         assert_eq!(of("out.h5").unwrap(), TableFormat::Hdf5);
         assert_eq!(of("o.HDF5").unwrap(), TableFormat::Hdf5);
+        assert_eq!(of("o.mat").unwrap(), TableFormat::Mat);
         for refused in ["out.he5", "g.tif", "g.nc", "m.json"] {
             let e = of(refused).unwrap_err();
             assert!(e.is_bad_input(), "{refused}");
             assert!(
-                e.to_string()
-                    .contains("CSV (.csv), Geosoft XYZ (.xyz) or HDF5 (.h5)"),
+                e.to_string().contains(
+                    "CSV (.csv), Geosoft XYZ (.xyz), HDF5 (.h5) or a MATLAB MAT-file (.mat)"
+                ),
                 "{e}"
             );
         }

@@ -40,10 +40,7 @@ use crate::table::{Column, FlightTable};
 /// (bad input) for a table the format cannot hold (module docs), before
 /// anything is written; [`IoError::Write`] when the file cannot be written.
 pub fn write_xyz(table: &FlightTable, path: &Path) -> Result<()> {
-    let file = path.display().to_string();
-    check_xyz(table, &file)?;
-    crate::atomic::write_atomically(path, |w| write_xyz_to(table, w))
-        .map_err(|source| IoError::Write { file, source })
+    crate::table_file::write_checked(table, path, check_xyz, |t, w| write_xyz_to(t, w))
 }
 
 /// Writes `table` as Geosoft XYZ to any writer, without the checks of

@@ -93,7 +93,7 @@ pub struct ApplyArgs {
     #[command(flatten)]
     input: InputArgs,
     /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`, HDF5 (one
-    /// dataset per column, as MagNav/SGL files) in `.h5`.
+    /// dataset per column, as MagNav/SGL files) in `.h5`, a MATLAB MAT-file in `.mat`.
     #[arg(long, value_name = "OUT.csv")]
     out: PathBuf,
 }
