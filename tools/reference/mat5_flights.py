@@ -1,4 +1,4 @@
-"""Writes the MATLAB v5 MAT-files of aeromag-io's tests
+"""Writes the MATLAB MAT-files of aeromag-io's tests
 (crates/io/tests/data/mat5/*.mat): scipy.io.savemat for what it writes,
 and by hand (struct.pack) what MATLAB writes and SciPy does not: a
 big-endian file, and a double array stored as uint8 and in the small
@@ -19,15 +19,20 @@ element form, as MATLAB stores small integers.
 - small_ints.mat: by hand, little-endian: line (double class stored as
   miUINT8 in the small element form, 1 x 3), mag (double), n = 3.
 
+- top73.mat, magnav73.mat: the workspaces of top.mat and magnav.mat as
+  MATLAB v7.3 files (HDF5), written by hdf5storage, which writes MATLAB's
+  v7.3 layout (without the struct `extra` and the logical `ok` of top.mat).
+
 The values are exact in binary or computed as the tests compute them
 (45 + k * 1e-4), so the tests compare bits.
 
-    pip install scipy numpy && python tools/reference/mat5_flights.py OUT_DIR
+    pip install scipy numpy hdf5storage && python tools/reference/mat5_flights.py OUT_DIR
 """
 
 import struct
 import sys
 
+import hdf5storage
 import numpy as np
 import scipy.io
 
@@ -35,43 +40,40 @@ out = sys.argv[1] if len(sys.argv) > 1 else "."
 n = 50
 k = np.arange(n, dtype=float)
 
-scipy.io.savemat(
-    f"{out}/top.mat",
-    {
-        "tt": 0.1 * k,
-        "mag_1_uc": (50_000.0 + 0.125 * k).reshape(n, 1),
-        "lat": 45.0 + k * 1e-4,
-        "flag": (np.arange(n) % 3).astype(np.uint8),
-        "ok": np.arange(n) % 2 == 0,
-        "fs": 10.0,
-        "note": "survey 2026",
-        "A": np.ones((n, 3)),
-        "extra": {"x": np.arange(4.0)},
-    },
-    do_compression=False,
-)
+top = {
+    "tt": 0.1 * k,
+    "mag_1_uc": (50_000.0 + 0.125 * k).reshape(n, 1),
+    "lat": 45.0 + k * 1e-4,
+    "flag": (np.arange(n) % 3).astype(np.uint8),
+    "ok": np.arange(n) % 2 == 0,
+    "fs": 10.0,
+    "note": "survey 2026",
+    "A": np.ones((n, 3)),
+    "extra": {"x": np.arange(4.0)},
+}
+scipy.io.savemat(f"{out}/top.mat", top, do_compression=False)
 
-scipy.io.savemat(
-    f"{out}/magnav.mat",
-    {
-        "ins_data": {
-            "tt": 0.1 * k,
-            "lat": 45.0 + k * 1e-4,
-            "lon": -75.0 - k * 1e-4,
-            "roll": 0.5 * np.ones(n),
-        },
-        "traj": {
-            "tt": 0.1 * k,
-            "lat": 45.0 + k * 1e-4,
-            "lon": -75.0 - k * 1e-4,
-            "mag_1_uc": 50_000.0 + 0.125 * k,
-            "flux_a_x": 30_000.0 - 0.25 * k,
-            "Cnb": np.tile(np.eye(3)[:, :, None], (1, 1, n)),
-            "fileName": "Flt1003",
-        },
+magnav = {
+    "ins_data": {
+        "tt": 0.1 * k,
+        "lat": 45.0 + k * 1e-4,
+        "lon": -75.0 - k * 1e-4,
+        "roll": 0.5 * np.ones(n),
     },
-    do_compression=True,
-)
+    "traj": {
+        "tt": 0.1 * k,
+        "lat": 45.0 + k * 1e-4,
+        "lon": -75.0 - k * 1e-4,
+        "mag_1_uc": 50_000.0 + 0.125 * k,
+        "flux_a_x": 30_000.0 - 0.25 * k,
+        "Cnb": np.tile(np.eye(3)[:, :, None], (1, 1, n)),
+        "fileName": "Flt1003",
+    },
+}
+scipy.io.savemat(f"{out}/magnav.mat", magnav, do_compression=True)
+v73 = {name: v for name, v in top.items() if name not in ("extra", "ok")}
+hdf5storage.savemat(f"{out}/top73.mat", v73, format="7.3", matlab_compatible=True)
+hdf5storage.savemat(f"{out}/magnav73.mat", magnav, format="7.3", matlab_compatible=True)
 
 scipy.io.savemat(
     f"{out}/one_struct.mat",

@@ -9,10 +9,12 @@
 //! such as line labels `L1020`), contiguous or chunked with gzip/shuffle as h5py writes
 //! them. Scalar and empty datasets (0-D, or of length 0 or 1 beside longer
 //! ones, e.g. a sample count) hold no rows and are skipped; any other shape
-//! is not this layout, except the 1 × n or n × 1 matrices in which a MATLAB
-//! v7.3 MAT-file (HDF5 after a 512-byte user block) holds its vectors,
-//! read as fields (its text, `MATLAB_class` `char`, is skipped). A MATLAB v5
-//! MAT-file is read by [`crate::read_mat5`].
+//! is not this layout.
+//!
+//! **MATLAB v7.3 MAT-files** (HDF5 after a 512-byte user block beginning
+//! `MATLAB 7.3 MAT-file`) are read as MATLAB workspaces instead
+//! ([`crate::mat73`]): their vectors at the root, or the fields of a
+//! struct, as a v5 MAT-file's ([`crate::read_mat5`]).
 //!
 //! **Only the fields a command needs are read** ([`Fields::Only`](crate::Fields::Only)): the
 //! datasets' headers are parsed when the file is opened, the data of a
@@ -92,6 +94,11 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     )
     .map_err(|e| h5err(None, e))?;
     let root = h5.root_group().map_err(|e| h5err(None, e))?;
+    if aeromag_core::file_name::first_bytes(path, crate::mat73::SIGNATURE.len())
+        .starts_with(crate::mat73::SIGNATURE)
+    {
+        return read_mat73(path, file, &root, opts);
+    }
     let (groups, datasets) = root.member_names().map_err(|e| h5err(None, e))?;
     let (group, prefix): (Group, String) = if !datasets.is_empty() {
         (root, "/".into())
@@ -120,7 +127,7 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
         return Err(IoError::Hdf5 {
             file: file.to_string(),
             dataset: None,
-            message: format!("is {}", crate::mat5::MAGNAV_MAP),
+            message: format!("is {}", crate::matlab::MAGNAV_MAP),
         });
     }
     // Shapes first (headers only): every field 1-D and of one length.
@@ -128,18 +135,9 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     for name in names {
         let ds = group.dataset(&name).map_err(|e| h5err(Some(&name), e))?;
         let shape = ds.shape().to_vec();
-        // MATLAB v7.3 keeps its text as uint16 arrays: not a field.
-        let matlab_class = ds
-            .attribute("MATLAB_class")
-            .ok()
-            .and_then(|a| a.read_string().ok());
-        if matlab_class.as_deref() == Some("char") {
-            continue;
-        }
         match shape[..] {
             [] => {} // a scalar: not a field of the flight
-            // A MATLAB v7.3 vector is 2-D, 1 × n or n × 1.
-            [n] | [1, n] | [n, 1] => fields.push((name, ds, n)),
+            [n] => fields.push((name, ds, n)),
             _ => {
                 return Err(IoError::Hdf5Layout {
                     file: file.to_string(),
@@ -174,22 +172,7 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     // (a forged header could claim 10^12 rows that nothing then checks): with
     // none of the fields asked for present, the first field is read.
     let (aliases, wanted) = mapped_fields(file, &header, opts)?;
-    // One read is capped by the reader; the reads together here, before
-    // any: 7 fields of 4·10⁸ rows (3.2 GB each, each under the cap) in a
-    // 10 kB file of unwritten chunks aborted the process out of memory.
-    let n_wanted = wanted.iter().filter(|&&w| w).count().max(1) as u64;
-    let total = n_rows.saturating_mul(n_wanted).saturating_mul(8);
-    if total > MAX_READ_BYTES as u64 {
-        return Err(IoError::Hdf5 {
-            file: file.to_string(),
-            dataset: None,
-            message: format!(
-                "{n_wanted} fields of {n_rows} values would take {} GB, more than {} GB read from one file: damaged, or far beyond any flight",
-                total >> 30,
-                MAX_READ_BYTES >> 30
-            ),
-        });
-    }
+    check_reads(file, n_rows, &wanted)?;
     let mut columns = Vec::new();
     for ((name, ds, _), want) in fields.into_iter().zip(wanted) {
         if !want {
@@ -229,6 +212,74 @@ fn read(path: &Path, file: &str, opts: &ReadOptions) -> Result<FlightTable> {
     Ok(FlightTable::from_fields(
         path, n_rows, columns, aliases, header,
     ))
+}
+
+/// One read is capped by the reader; the reads of the `wanted` fields of
+/// `n_rows` together here, before any: 7 fields of 4·10⁸ rows (3.2 GB
+/// each, each under the cap) in a 10 kB file of unwritten chunks aborted
+/// the process out of memory.
+fn check_reads(file: &str, n_rows: u64, wanted: &[bool]) -> Result<()> {
+    let n_wanted = wanted.iter().filter(|&&w| w).count().max(1) as u64;
+    let total = n_rows.saturating_mul(n_wanted).saturating_mul(8);
+    if total > MAX_READ_BYTES as u64 {
+        return Err(IoError::Hdf5 {
+            file: file.to_string(),
+            dataset: None,
+            message: format!(
+                "{n_wanted} fields of {n_rows} values would take {} GB, more than {} GB read from one file: damaged, or far beyond any flight",
+                total >> 30,
+                MAX_READ_BYTES >> 30
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// A MATLAB v7.3 MAT-file's flight ([`crate::mat73`], chosen by
+/// [`crate::matlab`]'s rules): the wanted fields' datasets read, each
+/// checked to hold the rows its dimensions say.
+fn read_mat73(path: &Path, file: &str, root: &Group, opts: &ReadOptions) -> Result<FlightTable> {
+    let mat = |(variable, message): crate::matlab::WorkspaceError| IoError::Mat {
+        file: file.to_string(),
+        variable,
+        message,
+    };
+    let variables = crate::mat73::variables(root, "", 0).map_err(mat)?;
+    let crate::matlab::Workspace {
+        fields,
+        n_rows,
+        not_read,
+    } = crate::matlab::flight_of(variables).map_err(mat)?;
+    let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
+    let (aliases, wanted) = mapped_fields(file, &header, opts)?;
+    check_reads(file, n_rows as u64, &wanted)?;
+    let mut columns = Vec::new();
+    for ((name, field), want) in fields.into_iter().zip(wanted) {
+        if !want {
+            continue;
+        }
+        let (data, integer) = match field {
+            crate::matlab::Field::Text(rows) => (ColumnData::Text(rows), false),
+            crate::matlab::Field::Numbers(ds, integer) => {
+                let (values, _) =
+                    read_f64(&ds).map_err(|e| mat((Some(name.clone()), e.to_string())))?;
+                if values.len() != n_rows {
+                    return Err(mat((
+                        Some(name),
+                        format!(
+                            "holds {} values where its dimensions say {n_rows}: damaged",
+                            values.len()
+                        ),
+                    )));
+                }
+                (ColumnData::numeric(values), integer)
+            }
+        };
+        columns.push((name, data, integer));
+    }
+    let mut table = FlightTable::from_fields(path, n_rows, columns, aliases, header);
+    table.set_not_read(not_read);
+    Ok(table)
 }
 
 /// A `units` attribute that contradicts the unit the layout gives the field

@@ -48,6 +48,8 @@ mod hdf5_write;
 mod label_texts;
 mod mat5;
 mod mat5_write;
+mod mat73;
+mod matlab;
 mod number_text;
 mod ordered;
 mod parts;

@@ -15,27 +15,8 @@
 //! column-major order; or a struct's field names and one `miMATRIX` per
 //! field and element.
 //!
-//! **Which variables are the flight's fields.**
-//! - Numeric vectors (1 × n, n × 1) at the top level: a workspace saved
-//!   with `save(file, 'time', 'mag', …)`, as an HDF5 file's root datasets
-//!   (or [`crate::write_mat5`]'s; a top level of scalars and no struct is a
-//!   one-row table).
-//! - Without those, the fields of a 1 × 1 struct. MagNav.jl's layout
-//!   (`get_XYZ0`'s `traj_field` and `ins_field`, "the standard way the
-//!   MATLAB-companion outputs data"): the struct `traj`, and the INS
-//!   fields in the struct `ins_data` without their `ins_` prefix, which is
-//!   put back (`ins_data.lat` → `ins_lat`, the name in MagNav's HDF5 files).
-//!   Otherwise the one struct there is; several structs without `traj` are
-//!   an error naming them.
-//! - Of those, the numeric vectors of the longest length are the fields
-//!   (`double`, `single`, integer classes and `logical`, read exactly as
-//!   `f64`; integer classes are written back as integers), and the `char`
-//!   matrices of as many rows (text columns, each row's padding spaces
-//!   removed). The other variables there (scalars such as a sample rate
-//!   `fs`, text, matrices such as MagNav's 1000 × 18 design matrix `A_a` or
-//!   its 3 × 3 × n `Cnb`, vectors of another length, complex arrays, cells,
-//!   objects) are not fields: they are listed in [`FlightTable::not_read`],
-//!   which `aeromag inspect` prints, never dropped silently.
+//! **Which variables are the flight's fields**: [`crate::matlab`]'s rules,
+//! shared with MATLAB v7.3 files.
 //!
 //! **Damaged or hostile files** give [`IoError::Mat`] naming the file and
 //! the variable, never a panic: every byte count is checked against the
@@ -54,13 +35,9 @@ use aeromag_core::memory::size_text;
 
 use crate::error::{IoError, Result};
 use crate::hdf5::MAX_READ_BYTES;
-use crate::table::{ColumnData, FlightTable, NotRead};
+use crate::matlab::{Field, Value, Variables, Workspace, dims_text, flight_of, text_value};
+use crate::table::{ColumnData, FlightTable};
 use crate::wanted::mapped_fields;
-
-/// What a MagNav.jl map file (HDF5 or MAT: `map`, `xx`, `yy`) is, for the
-/// messages refusing it as a flight.
-pub(crate) const MAGNAV_MAP: &str = "a MagNav.jl map (`map`, `xx`, `yy`), not a flight table; \
-     aeromag reads grids from GeoTIFF, GXF, ESRI ASCII, netCDF and Surfer files";
 
 /// The start of a MATLAB v5 MAT-file's header text.
 pub(crate) const SIGNATURE: &[u8] = b"MATLAB 5.0 MAT-file";
@@ -101,66 +78,6 @@ const MX_UINT64: u8 = 15;
 /// Array flag bits.
 const FLAG_COMPLEX: u32 = 0x0800;
 const FLAG_LOGICAL: u32 = 0x0200;
-
-/// A variable as read: what a flight table can hold, or what it is.
-#[derive(Debug)]
-enum Value {
-    /// A real numeric array, column-major, as `f64`.
-    Numeric {
-        dims: Vec<usize>,
-        values: Vec<f64>,
-        /// An integer class (or `logical`): written back as integers.
-        integer: bool,
-    },
-    /// A 1 × 1 struct: its fields in file order.
-    Struct(Vec<(String, Value)>),
-    /// A 2-D `char` array: its rows, the spaces that pad them removed.
-    Text { dims: Vec<usize>, rows: Vec<String> },
-    /// Anything else, described for [`NotRead`]: text, a struct array,
-    /// a cell, a complex or sparse array, an object.
-    Other {
-        dims: Vec<usize>,
-        what: &'static str,
-    },
-}
-
-impl Value {
-    /// `dims` as MATLAB writes them: `1000 × 18`.
-    fn dims_text(dims: &[usize]) -> String {
-        dims.iter()
-            .map(usize::to_string)
-            .collect::<Vec<_>>()
-            .join(" × ")
-    }
-
-    /// What this variable is, for [`NotRead::what`].
-    fn describe(&self) -> String {
-        match self {
-            Value::Numeric { values, .. } if values.len() == 1 => "a scalar".into(),
-            Value::Numeric { dims, values, .. } if vector_len(dims).is_some() => {
-                format!("a vector of {} values", values.len())
-            }
-            Value::Numeric { dims, .. } => format!("a {} matrix", Value::dims_text(dims)),
-            Value::Struct(_) => "a struct".into(),
-            Value::Text { dims, .. } => format!("text ({})", Value::dims_text(dims)),
-            Value::Other { dims, what } => format!("{what} ({})", Value::dims_text(dims)),
-        }
-    }
-}
-
-/// The length of a vector (every dimension but one is 1), `None` for a
-/// matrix. A scalar is a vector of 1, an empty array of 0.
-fn vector_len(dims: &[usize]) -> Option<usize> {
-    if dims.contains(&0) {
-        return Some(0);
-    }
-    let mut long = dims.iter().filter(|&&d| d != 1);
-    match (long.next(), long.next()) {
-        (None, _) => Some(1),
-        (Some(&n), None) => Some(n),
-        _ => None,
-    }
-}
 
 /// Whether the file at `path` begins as a MATLAB v5 MAT-file.
 pub(crate) fn is_mat5(head: &[u8]) -> bool {
@@ -206,63 +123,18 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         (a.saturating_sub(size) / 2).min(MAX_READ_BYTES as u64) as usize
     });
     let variables = parse(&bytes, budget).map_err(|(v, m)| err(v.as_deref(), m))?;
-    let (chosen, mut not_read) = choose(variables).map_err(|m| err(None, m))?;
-    let has = |name: &str, matrix: bool| {
-        chosen.iter().any(|c| {
-            c.name == name
-                && matches!(&c.value, Value::Numeric { dims, .. }
-                    if vector_len(dims).is_none() == matrix)
+    let Workspace {
+        fields,
+        n_rows,
+        not_read,
+    } = flight_of(variables).map_err(|(v, m)| err(v.as_deref(), m))?;
+    let fields: Vec<(String, ColumnData, bool)> = fields
+        .into_iter()
+        .map(|(name, field)| match field {
+            Field::Numbers(values, integer) => (name, ColumnData::numeric(values), integer),
+            Field::Text(rows) => (name, ColumnData::Text(rows), false),
         })
-    };
-    if has("map", true) && has("xx", false) && has("yy", false) {
-        return Err(err(None, format!("holds {MAGNAV_MAP}")));
-    }
-
-    // The fields: the numeric vectors of the longest length.
-    let n_rows = chosen
-        .iter()
-        .filter_map(|c| match &c.value {
-            Value::Numeric { dims, values, .. } if vector_len(dims).is_some() => Some(values.len()),
-            _ => None,
-        })
-        .max()
-        .unwrap_or(0);
-    if n_rows == 0 {
-        return Err(err(
-            None,
-            "holds no numeric vector (a flight's fields are vectors, 1 × n or n × 1, at the \
-             top level or in a struct)"
-                .into(),
-        ));
-    }
-    // … and the text of as many rows (an n × k `char` matrix).
-    let mut fields: Vec<(String, ColumnData, bool)> = Vec::new();
-    for Candidate { name, path, value } in chosen {
-        let field = match value {
-            Value::Numeric {
-                dims,
-                values,
-                integer,
-            } if vector_len(&dims).is_some() && values.len() == n_rows => {
-                (ColumnData::numeric(values), integer)
-            }
-            Value::Text { rows, .. } if rows.len() == n_rows => (ColumnData::Text(rows), false),
-            other => {
-                not_read.push(NotRead {
-                    name: path,
-                    what: other.describe(),
-                });
-                continue;
-            }
-        };
-        if fields.iter().any(|f| f.0 == name) {
-            return Err(err(
-                Some(&name),
-                "is given twice (a `traj` field and an `ins_data` field of the same name?)".into(),
-            ));
-        }
-        fields.push((name, field.0, field.1));
-    }
+        .collect();
     let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
     let (aliases, wanted) = mapped_fields(&file, &header, opts)?;
     let columns: Vec<(String, ColumnData, bool)> = fields
@@ -276,93 +148,12 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
     Ok(table)
 }
 
-/// A variable the flight's fields are taken from: its name as a field,
-/// its path in the file (`traj.lat`) and its value.
-struct Candidate {
-    name: String,
-    path: String,
-    value: Value,
-}
-
-/// The variables the flight's fields come from (module docs), and the
-/// variables passed over.
-fn choose(
-    variables: Vec<(String, Value)>,
-) -> std::result::Result<(Vec<Candidate>, Vec<NotRead>), String> {
-    let is_vector = |v: &Value| {
-        matches!(v, Value::Numeric { dims, values, .. }
-            if values.len() > 1 && vector_len(dims).is_some())
-    };
-    let passed_over = |name: String, v: &Value| NotRead {
-        name,
-        what: v.describe(),
-    };
-    let is_struct = |v: &Value| matches!(v, Value::Struct(_));
-    let mut not_read = Vec::new();
-    let mut chosen = Vec::new();
-    // The top level: with a vector, or with no struct (a one-row table is
-    // a workspace of scalars).
-    if variables.iter().any(|(_, v)| is_vector(v)) || !variables.iter().any(|(_, v)| is_struct(v)) {
-        // The top level's variables; its structs are not fields.
-        for (name, value) in variables {
-            if is_struct(&value) {
-                not_read.push(passed_over(name, &value));
-            } else {
-                chosen.push(Candidate {
-                    path: name.clone(),
-                    name,
-                    value,
-                });
-            }
-        }
-        return Ok((chosen, not_read));
-    }
-    let struct_names: Vec<&str> = variables
-        .iter()
-        .filter(|(_, v)| is_struct(v))
-        .map(|(n, _)| n.as_str())
-        .collect();
-    let picked: Vec<String> = if struct_names.contains(&"traj") {
-        ["traj", "ins_data"]
-            .into_iter()
-            .filter(|n| struct_names.contains(n))
-            .map(str::to_string)
-            .collect()
-    } else if struct_names.len() == 1 {
-        vec![struct_names[0].to_string()]
-    } else {
-        return Err(format!(
-            "holds {} structs ({}) and no vector at the top level: save the flight's struct \
-             alone (`s = data.flight; save(file, '-struct', 's')`), or name it `traj` as \
-             MagNav.jl does",
-            struct_names.len(),
-            struct_names.join(", ")
-        ));
-    };
-    for (name, value) in variables {
-        match value {
-            Value::Struct(members) if picked.contains(&name) => {
-                let prefix = if name == "ins_data" { "ins_" } else { "" };
-                for (field, value) in members {
-                    chosen.push(Candidate {
-                        name: format!("{prefix}{field}"),
-                        path: format!("{name}.{field}"),
-                        value,
-                    });
-                }
-            }
-            other => not_read.push(passed_over(name, &other)),
-        }
-    }
-    Ok((chosen, not_read))
-}
-
 /// An error while parsing: the variable concerned (if known) and what.
 type ParseError = (Option<String>, String);
 
 /// The file's named variables, in file order.
 /// Compressed variables decompress to `budget` bytes at most together.
-fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Vec<(String, Value)>, ParseError> {
+fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>, ParseError> {
     if bytes.len() < HEADER_BYTES || !is_mat5(bytes) {
         return Err((
             None,
@@ -536,7 +327,7 @@ fn matrix(
     big: bool,
     depth: usize,
     path: &str,
-) -> std::result::Result<(String, Value), ParseError> {
+) -> std::result::Result<(String, Value<Vec<f64>>), ParseError> {
     let known = |name: &str| {
         let shown = if path.is_empty() { name } else { path };
         (!shown.is_empty()).then(|| shown.to_string())
@@ -609,7 +400,7 @@ fn matrix(
                 return Err(named(format!(
                     "holds {} values where its dimensions {} say {count}: damaged",
                     values.len(),
-                    Value::dims_text(&dims)
+                    dims_text(&dims)
                 )));
             }
             let integer = !matches!(class, MX_DOUBLE | MX_SINGLE) || flag_word & FLAG_LOGICAL != 0;
@@ -617,7 +408,7 @@ fn matrix(
                 name,
                 Value::Numeric {
                     dims,
-                    values,
+                    data: values,
                     integer,
                 },
             ))
@@ -648,24 +439,7 @@ fn matrix(
         MX_CHAR if dims.len() == 2 => {
             let (kind, data) = c.element().map_err(named)?;
             let units = utf16_units(kind, data, big).map_err(named)?;
-            if units.len() != count {
-                return Err(named(format!(
-                    "holds {} characters where its dimensions {} say {count}: damaged",
-                    units.len(),
-                    Value::dims_text(&dims)
-                )));
-            }
-            // Column-major: row i's characters are i, i + n, i + 2n, …
-            let n = dims[0];
-            let rows = (0..n)
-                .map(|i| {
-                    let row: Vec<u16> = units.iter().skip(i).step_by(n).copied().collect();
-                    String::from_utf16_lossy(&row)
-                        .trim_end_matches(' ')
-                        .to_string()
-                })
-                .collect();
-            Ok((name, Value::Text { dims, rows }))
+            Ok((name.clone(), text_value(dims, &units).map_err(named)?))
         }
         MX_CHAR => other("text"),
         MX_CELL => other("a cell array"),
@@ -736,17 +510,6 @@ fn numbers(kind: u32, data: &[u8], big: bool) -> std::result::Result<Vec<f64>, S
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn vectors_scalars_and_matrices_are_told_apart() {
-        assert_eq!(vector_len(&[1, 100]), Some(100));
-        assert_eq!(vector_len(&[100, 1]), Some(100));
-        assert_eq!(vector_len(&[1, 1, 7]), Some(7));
-        assert_eq!(vector_len(&[1, 1]), Some(1));
-        assert_eq!(vector_len(&[0, 0]), Some(0));
-        assert_eq!(vector_len(&[1000, 18]), None);
-        assert_eq!(vector_len(&[3, 3, 100]), None);
-    }
 
     #[test]
     fn a_small_element_holds_its_data_in_the_tag() {

@@ -1,9 +1,10 @@
-//! MATLAB v5 MAT-files (`tools/reference/mat5_flights.py`, files in
-//! `tests/data/mat5`, written by `scipy.io.savemat` and by hand): the
-//! flight's fields read bit-exactly from the top level, one struct, or
-//! MagNav.jl's `traj` and `ins_data`; what is not a field listed; files
-//! that hold no flight refused; damaged and hostile files an error naming
-//! the file, never a panic.
+//! MATLAB MAT-files (`tools/reference/mat5_flights.py`, files in
+//! `tests/data/mat5`, v5 written by `scipy.io.savemat` and by hand, v7.3
+//! by `hdf5storage`): the flight's fields read bit-exactly from the top
+//! level, one struct, or MagNav.jl's `traj` and `ins_data`; a v7.3 file the
+//! same table as the v5 file of its workspace; what is not a field listed;
+//! files that hold no flight refused; damaged and hostile files an error
+//! naming the file, never a panic.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -110,6 +111,61 @@ fn magnav_traj_and_ins_data_structs_read_as_its_hdf5_names() {
             ("traj.fileName", "text (1 × 7)")
         ])
     );
+}
+
+/// The v7.3 file (HDF5) of a workspace gives the v5 file's table: the same
+/// columns with the same bits and integer flags, and the same variables not
+/// read (HDF5 keeps them in name order).
+#[test]
+fn a_v73_file_reads_as_the_v5_file_of_its_workspace() {
+    for (v5, v73, left_out) in [
+        ("top.mat", "top73.mat", &["ok", "extra"][..]),
+        ("magnav.mat", "magnav73.mat", &[][..]),
+    ] {
+        let (a, b) = (read(v5).unwrap(), read(v73).unwrap());
+        assert_eq!(a.n_rows(), b.n_rows());
+        let sorted = |mut v: Vec<String>| {
+            v.sort();
+            v
+        };
+        let names = |t: &aeromag_io::FlightTable| {
+            sorted(t.column_names().into_iter().map(String::from).collect())
+        };
+        let expected: Vec<String> = names(&a)
+            .into_iter()
+            .filter(|n| !left_out.contains(&n.as_str()))
+            .collect();
+        assert_eq!(names(&b), expected, "{v73}");
+        for name in &expected {
+            let bits = |t: &aeromag_io::FlightTable| -> Vec<u64> {
+                t.column(name)
+                    .unwrap()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect()
+            };
+            assert_eq!(bits(&a), bits(&b), "{v73}: {name}");
+            let integer = |t: &aeromag_io::FlightTable| t.get(name).unwrap().integer_text();
+            assert_eq!(integer(&a), integer(&b), "{v73}: {name}");
+        }
+        let not_read = |t: &aeromag_io::FlightTable| {
+            let mut v: Vec<(String, String)> = not_read(t)
+                .into_iter()
+                .filter(|(n, _)| !left_out.contains(&n.as_str()))
+                .collect();
+            v.sort();
+            v
+        };
+        assert_eq!(not_read(&a), not_read(&b), "{v73}");
+    }
+    // Only the fields asked for are read.
+    let opts = ReadOptions {
+        fields: Fields::Only(vec!["mag".into(), "ins_roll".into()]),
+        ..ReadOptions::default()
+    };
+    let t = read_table(&data("magnav73.mat"), &opts).unwrap();
+    assert_eq!(t.column_names(), ["ins_roll", "mag_1_uc"]);
+    assert_eq!(t.unread_columns().len(), 7);
 }
 
 #[test]
@@ -289,10 +345,10 @@ proptest! {
     /// Bytes changed anywhere in a file: a table or an error naming it.
     #[test]
     fn damaged_files_give_a_table_or_an_error(
-        which in 0usize..3,
+        which in 0usize..5,
         changes in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
     ) {
-        let name = ["top.mat", "magnav.mat", "one_struct.mat"][which];
+        let name = ["top.mat", "magnav.mat", "one_struct.mat", "top73.mat", "magnav73.mat"][which];
         let mut bytes = std::fs::read(data(name)).unwrap();
         for (at, b) in changes {
             let i = at.index(bytes.len());
