@@ -3,6 +3,7 @@ a model fitted in a worker process), and a corrupt payload is bad input."""
 
 import copy
 import multiprocessing
+import pathlib
 import pickle
 from concurrent.futures import ProcessPoolExecutor
 
@@ -155,12 +156,15 @@ def test_grid_round_trips_bit_for_bit(survey):
     assert g.info["column"] == "true_anomaly" and g.epsg == 32637
 
 
+MAT5 = pathlib.Path(__file__).resolve().parents[2] / "crates" / "io" / "tests" / "data" / "mat5"
+
+
 def assert_same_flight(a, b):
     """The same flight: columns (bit for bit, text as text), mapping, file,
-    warnings, unread columns, and the same CSV written (integer columns as
-    read)."""
+    warnings, unread columns and variables, and the same CSV written
+    (integer columns as read)."""
     assert type(b) is aeromag.Flight and b is not a
-    for name in ("columns", "mapping", "file", "warnings", "unread_columns"):
+    for name in ("columns", "mapping", "file", "warnings", "unread_columns", "not_read"):
         assert getattr(b, name) == getattr(a, name), name
     assert len(b) == len(a) and repr(b) == repr(a)
     for name in a.columns:
@@ -183,6 +187,11 @@ def test_flights_round_trip_bit_for_bit(cal_csv, tmp_path):
     d["line"][5] = ""
     built = aeromag.Flight.from_dict(d, copy=False)
     model = aeromag.TollesLawson().fit(read).model_
+    mat = MAT5 / "magnav.mat"
+    from_mat = aeromag.read_flight(mat)
+    assert from_mat.not_read
+    for c in copies(from_mat):
+        assert_same_flight(from_mat, c)
     for flight in (read, selected, built, model.apply(built)):
         for c in copies(flight):
             assert_same_flight(flight, c)
