@@ -118,10 +118,11 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         ));
     }
     let bytes = std::fs::read(path).map_err(open)?;
-    // A compressed variable's bytes, and its values as many again.
-    let budget = available.map_or(MAX_READ_BYTES, |a| {
-        (a.saturating_sub(size) / 2).min(MAX_READ_BYTES as u64) as usize
-    });
+    // The values, and the variable being decompressed, in what is left.
+    let budget = Budget {
+        memory: available.map_or(u64::MAX, |a| a.saturating_sub(size)),
+        inflate: MAX_READ_BYTES as u64,
+    };
     let variables = parse(&bytes, budget).map_err(|(v, m)| err(v.as_deref(), m))?;
     let Workspace {
         fields,
@@ -151,9 +152,9 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
 /// An error while parsing: the variable concerned (if known) and what.
 type ParseError = (Option<String>, String);
 
-/// The file's named variables, in file order.
-/// Compressed variables decompress to `budget` bytes at most together.
-fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>, ParseError> {
+/// The file's named variables, in file order, their values and
+/// decompressed bytes within `budget`.
+fn parse(bytes: &[u8], mut budget: Budget) -> std::result::Result<Variables<Vec<f64>>, ParseError> {
     if bytes.len() < HEADER_BYTES || !is_mat5(bytes) {
         return Err((
             None,
@@ -173,7 +174,6 @@ fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>
             ));
         }
     };
-    let mut budget = Budget { left: budget };
     let mut cursor = Cursor::new(&bytes[HEADER_BYTES..], big);
     let mut variables = Vec::new();
     let mut index = 0usize;
@@ -182,8 +182,10 @@ fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>
         let at = |m: String| (None, format!("variable {index}: {m}"));
         let (kind, data) = cursor.element().map_err(at)?;
         let decompressed;
+        let mut decompressed_len = 0;
         let (kind, data) = if kind == MI_COMPRESSED {
             decompressed = inflate(data, big, &mut budget).map_err(at)?;
+            decompressed_len = decompressed.len() as u64;
             let mut inner = Cursor::new(&decompressed, big);
             inner.element().map_err(at)?
         } else {
@@ -191,12 +193,15 @@ fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>
         };
         if kind != MI_MATRIX {
             // Not a variable (a stray element): nothing of the flight.
+            budget.memory = budget.memory.saturating_add(decompressed_len);
             continue;
         }
-        let (name, value) = matrix(data, big, 0, "").map_err(|(v, m)| match v {
+        let (name, value) = matrix(data, big, 0, "", &mut budget).map_err(|(v, m)| match v {
             Some(v) => (Some(v), m),
             None => (None, format!("variable {index}: {m}")),
         })?;
+        // The decompressed bytes are freed with the variable read.
+        budget.memory = budget.memory.saturating_add(decompressed_len);
         // The subsystem data (function handles, objects) has no name.
         if !name.is_empty() {
             variables.push((name, value));
@@ -205,9 +210,38 @@ fn parse(bytes: &[u8], budget: usize) -> std::result::Result<Variables<Vec<f64>>
     Ok(variables)
 }
 
-/// Bytes that decompression may still produce.
+/// Bytes a read may still take: `memory` for the values and the variable
+/// being decompressed together (what the process can take beyond the
+/// file; a uint8-stored `double` takes 8 bytes a value), `inflate` for
+/// all the decompressed variables ([`MAX_READ_BYTES`]).
 struct Budget {
-    left: usize,
+    memory: u64,
+    inflate: u64,
+}
+
+impl Budget {
+    /// Takes `bytes` of memory (and of decompression when `inflated`), or
+    /// says why not.
+    fn take(&mut self, bytes: u64, inflated: bool) -> std::result::Result<(), String> {
+        if inflated && bytes > self.inflate {
+            return Err(format!(
+                "its variables decompress to more than {} read from one file: damaged, or far \
+                 beyond any flight",
+                size_text(MAX_READ_BYTES as u64)
+            ));
+        }
+        if bytes > self.memory {
+            return Err(format!(
+                "its values need more than the {} this process can take",
+                size_text(self.memory)
+            ));
+        }
+        self.memory -= bytes;
+        if inflated {
+            self.inflate -= bytes;
+        }
+        Ok(())
+    }
 }
 
 /// Decompresses one `miCOMPRESSED` element: exactly the element its
@@ -224,18 +258,10 @@ fn inflate(data: &[u8], big: bool, budget: &mut Budget) -> std::result::Result<V
         t.u32_at(4) as usize
     };
     let want = 8usize.saturating_add(declared);
-    if want > budget.left {
-        return Err(format!(
-            "a compressed variable declares {}, more than the {} left to decompress (half the \
-             memory this process can take, and {} from one file at most): damaged, or too \
-             large for this machine",
-            size_text(declared as u64),
-            size_text(budget.left as u64),
-            size_text(MAX_READ_BYTES as u64)
-        ));
-    }
-    // Grown as the data arrives: a forged size allocates nothing.
-    let mut out = Vec::with_capacity(want.min(1 << 26));
+    budget.take(want as u64, true)?;
+    // Within the budget: allocated once (a vector doubling as the data
+    // arrived took up to twice the memory).
+    let mut out = Vec::with_capacity(want);
     out.extend_from_slice(&tag);
     (&mut z)
         .take((want - 8) as u64)
@@ -247,7 +273,6 @@ fn inflate(data: &[u8], big: bool, budget: &mut Budget) -> std::result::Result<V
             out.len()
         ));
     }
-    budget.left -= want;
     Ok(out)
 }
 
@@ -327,6 +352,7 @@ fn matrix(
     big: bool,
     depth: usize,
     path: &str,
+    budget: &mut Budget,
 ) -> std::result::Result<(String, Value<Vec<f64>>), ParseError> {
     let known = |name: &str| {
         let shown = if path.is_empty() { name } else { path };
@@ -395,6 +421,12 @@ fn matrix(
                 return other("a complex array");
             }
             let (kind, real) = c.element().map_err(named)?;
+            // The values there are, as `f64` (a uint8-stored one takes 8
+            // times its bytes); compared with the dimensions below.
+            let stored = real.len() / element_bytes(kind).max(1);
+            budget
+                .take((stored as u64).saturating_mul(8), false)
+                .map_err(named)?;
             let values = numbers(kind, real, big).map_err(named)?;
             if values.len() != count {
                 return Err(named(format!(
@@ -430,7 +462,7 @@ fn matrix(
                 if kind != MI_MATRIX {
                     return Err((Some(inner), "is not an array: damaged".into()));
                 }
-                let (_, value) = matrix(el, big, depth + 1, &inner)?;
+                let (_, value) = matrix(el, big, depth + 1, &inner, budget)?;
                 fields.push((field, value));
             }
             Ok((name, Value::Struct(fields)))
@@ -446,6 +478,17 @@ fn matrix(
         MX_SPARSE => other("a sparse matrix"),
         MX_OBJECT => other("an object"),
         _ => other("an array of a class not read here"),
+    }
+}
+
+/// The bytes of one value of numeric data type `kind` (0 for another type).
+fn element_bytes(kind: u32) -> usize {
+    match kind {
+        MI_INT8 | MI_UINT8 => 1,
+        MI_INT16 | MI_UINT16 => 2,
+        MI_INT32 | MI_UINT32 | MI_SINGLE => 4,
+        MI_DOUBLE | MI_INT64 | MI_UINT64 => 8,
+        _ => 0,
     }
 }
 

@@ -316,7 +316,13 @@ fn hostile_files_are_errors_not_crashes() {
     let e = read_table(&p, &ReadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("ends after 72 of the"), "{e}");
+    // Refused when the data run out, or before, on a machine with less
+    // memory than the size declared.
+    assert!(
+        e.contains("bomb.mat")
+            && (e.contains("ends after 72 of the") || e.contains("this process can take")),
+        "{e}"
+    );
 
     // Dimensions that claim 2^62 values.
     let mut body = element(6, &[6, 0, 0, 0, 0, 0, 0, 0]);
