@@ -74,6 +74,7 @@ const MX_SPARSE: u8 = 5;
 const MX_DOUBLE: u8 = 6;
 const MX_SINGLE: u8 = 7;
 const MX_UINT64: u8 = 15;
+const MX_OPAQUE: u8 = 17;
 
 /// Array flag bits.
 const FLAG_COMPLEX: u32 = 0x0800;
@@ -364,7 +365,7 @@ fn matrix(
             String::new(),
             Value::Other {
                 dims: vec![0, 0],
-                what: "an empty array",
+                what: "an empty array".into(),
             },
         ));
     }
@@ -390,6 +391,25 @@ fn matrix(
     let flags = header(&mut c, "array flags", MI_UINT32).map_err(|m| (known(""), m))?;
     let flag_word = Cursor::new(flags, big).u32_at(0);
     let class = (flag_word & 0xff) as u8;
+    if class == MX_OPAQUE {
+        // An object (a `table`, `datetime`, `string`): no dimensions; its
+        // name, its type system (`MCOS`) and its class name, then data.
+        let mut text = |what| {
+            header(&mut c, what, MI_INT8)
+                .map(|t| String::from_utf8_lossy(t).into_owned())
+                .map_err(|m| (known(""), m))
+        };
+        let name = text("name")?;
+        let _type_system = text("type system")?;
+        let class_name = text("class name")?;
+        return Ok((
+            name,
+            Value::Other {
+                dims: vec![1, 1],
+                what: format!("a MATLAB {class_name} object"),
+            },
+        ));
+    }
     let dims_bytes = header(&mut c, "dimensions", MI_INT32).map_err(|m| (known(""), m))?;
     let dc = Cursor::new(dims_bytes, big);
     let dims: Vec<Option<usize>> = (0..dims_bytes.len() / 4)
@@ -406,12 +426,12 @@ fn matrix(
         .iter()
         .try_fold(1usize, |a, &d| a.checked_mul(d))
         .ok_or_else(|| named("its dimensions overflow: damaged".into()))?;
-    let other = |what| {
+    let other = |what: &str| {
         Ok((
             name.clone(),
             Value::Other {
                 dims: dims.clone(),
-                what,
+                what: what.to_string(),
             },
         ))
     };

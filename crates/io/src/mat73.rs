@@ -81,7 +81,12 @@ fn value(ds: Dataset) -> Result<Value<Dataset>, String> {
     let empty = attr("MATLAB_empty")
         .and_then(|a| a.read_as_f64().ok())
         .is_some_and(|e| e != 0.0);
-    let other = |dims: Vec<usize>, what| Ok(Value::Other { dims, what });
+    let other = |dims: Vec<usize>, what: &str| {
+        Ok(Value::Other {
+            dims,
+            what: what.to_string(),
+        })
+    };
     if empty {
         return other(vec![0, 0], "an empty array");
     }
@@ -115,6 +120,6 @@ fn value(ds: Dataset) -> Result<Value<Dataset>, String> {
             Datatype::Compound { .. } => other(dims, "a complex array"),
             _ => other(dims, "an array of a type not read here"),
         },
-        Some(_) => other(dims, "an object"),
+        Some(c) => other(dims, &format!("a MATLAB {c} object")),
     }
 }

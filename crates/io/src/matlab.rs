@@ -52,10 +52,7 @@ pub(crate) enum Value<D> {
     Text { dims: Vec<usize>, rows: Vec<String> },
     /// Anything else, described for [`NotRead`]: a struct array, a cell, a
     /// complex or sparse array, an object, an empty array.
-    Other {
-        dims: Vec<usize>,
-        what: &'static str,
-    },
+    Other { dims: Vec<usize>, what: String },
 }
 
 /// A workspace's (or a struct's) variables: names and values, in order.
@@ -171,6 +168,22 @@ pub(crate) fn flight_of<D>(
         .max()
         .unwrap_or(0);
     if n_rows == 0 {
+        // A MATLAB table (`readtable`'s) is an object whose layout the
+        // format does not document: what to save instead.
+        if let Some(c) = chosen.iter().find(|c| {
+            matches!(&c.value, Value::Other { what, .. }
+                if what.ends_with(" table object") || what.ends_with(" timetable object"))
+        }) {
+            let n = &c.path;
+            return Err((
+                Some(n.clone()),
+                format!(
+                    "is a MATLAB table, an object aeromag does not read from a MAT-file: save \
+                     its columns as vectors (`s = table2struct({n}, 'ToScalar', true); \
+                     save(file, '-struct', 's')`) or as CSV (`writetable({n}, 'flight.csv')`)"
+                ),
+            ));
+        }
         return Err((
             None,
             "holds no numeric vector (a flight's fields are vectors, 1 × n or n × 1, at the \

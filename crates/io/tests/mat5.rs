@@ -345,6 +345,57 @@ fn hostile_files_are_errors_not_crashes() {
     );
 }
 
+/// A double row vector `name` of `values`.
+fn vector(name: &str, values: &[f64]) -> Vec<u8> {
+    let mut body = element(6, &[6, 0, 0, 0, 0, 0, 0, 0]);
+    let mut dims = 1u32.to_le_bytes().to_vec();
+    dims.extend((values.len() as u32).to_le_bytes());
+    body.extend(element(5, &dims));
+    body.extend(element(1, name.as_bytes()));
+    let data: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    body.extend(element(9, &data));
+    element(14, &body)
+}
+
+/// A MATLAB object (`mxOPAQUE`): flags, its name, `MCOS`, its class name,
+/// then data (not read).
+fn object(name: &str, class: &str) -> Vec<u8> {
+    let mut body = element(6, &[17, 0, 0, 0, 0, 0, 0, 0]);
+    body.extend(element(1, name.as_bytes()));
+    body.extend(element(1, b"MCOS"));
+    body.extend(element(1, class.as_bytes()));
+    body.extend(element(14, &[]));
+    element(14, &body)
+}
+
+#[test]
+fn matlab_objects_are_listed_and_a_table_alone_says_what_to_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = header();
+    bytes.extend(vector("tt", &[0.0, 0.1, 0.2]));
+    bytes.extend(object("when", "datetime"));
+    bytes.extend(vector("mag", &[5e4, 5e4, 5e4]));
+    let p = write_temp(&dir, "objects.mat", &bytes);
+    let t = read_table(&p, &ReadOptions::default()).unwrap();
+    assert_eq!(t.column_names(), ["tt", "mag"]);
+    assert_eq!(
+        not_read(&t),
+        pairs(&[("when", "a MATLAB datetime object (1 × 1)")])
+    );
+    let mut bytes = header();
+    bytes.extend(object("T", "table"));
+    let p = write_temp(&dir, "table.mat", &bytes);
+    let e = read_table(&p, &ReadOptions::default()).unwrap_err();
+    assert!(e.is_bad_input());
+    let e = e.to_string();
+    assert!(
+        e.contains("variable 'T': is a MATLAB table")
+            && e.contains("table2struct(T, 'ToScalar', true)")
+            && e.contains("writetable(T, 'flight.csv')"),
+        "{e}"
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
 
