@@ -332,7 +332,9 @@ fn normalise_unit(u: &str) -> Option<&'static str> {
 
 /// A 1-D numeric dataset as `f64` (exact for f32 and integers up to 2⁵³),
 /// and whether it holds integers.
-fn read_f64(ds: &Dataset) -> std::result::Result<(Vec<f64>, bool), hdf5_reader::error::Error> {
+pub(crate) fn read_f64(
+    ds: &Dataset,
+) -> std::result::Result<(Vec<f64>, bool), hdf5_reader::error::Error> {
     fn vec<T: H5Type>(ds: &Dataset) -> std::result::Result<Vec<T>, hdf5_reader::error::Error> {
         Ok(ds.read_array::<T>()?.into_raw_vec_and_offset().0)
     }

@@ -456,12 +456,14 @@ fn matrix(
                 )));
             }
             let integer = !matches!(class, MX_DOUBLE | MX_SINGLE) || flag_word & FLAG_LOGICAL != 0;
+            let scalar = (values.len() == 1).then(|| values[0]);
             Ok((
                 name,
                 Value::Numeric {
                     dims,
                     data: values,
                     integer,
+                    scalar,
                 },
             ))
         }

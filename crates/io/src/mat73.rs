@@ -111,10 +111,17 @@ fn value(ds: Dataset) -> Result<Value<Dataset>, String> {
                     Some(c) => !matches!(c, "double" | "single"),
                     None => matches!(ds.dtype(), Datatype::FixedPoint { .. }),
                 };
+                // A scalar's one value is read to be shown.
+                let one = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d)) == Some(1);
+                let scalar = one
+                    .then(|| crate::hdf5::read_f64(&ds).ok())
+                    .flatten()
+                    .and_then(|(v, _)| v.first().copied());
                 Ok(Value::Numeric {
                     dims,
                     data: ds,
                     integer,
+                    scalar,
                 })
             }
             Datatype::Compound { .. } => other(dims, "a complex array"),

@@ -45,6 +45,9 @@ pub(crate) enum Value<D> {
         data: D,
         /// An integer class (or `logical`): written back as integers.
         integer: bool,
+        /// Its value when it is a scalar (a sample rate `fs`, shown in
+        /// [`NotRead`]), if read.
+        scalar: Option<f64>,
     },
     /// A 1 × 1 struct: its fields in file order.
     Struct(Variables<D>),
@@ -117,8 +120,11 @@ impl<D> Value<D> {
     /// What this variable is, for [`NotRead::what`].
     fn describe(&self) -> String {
         match self {
-            Value::Numeric { dims, .. } => match vector_len(dims) {
-                Some(1) => "a scalar".into(),
+            Value::Numeric { dims, scalar, .. } => match vector_len(dims) {
+                Some(1) => match scalar {
+                    Some(v) => format!("a scalar, {}", aeromag_core::error::shown(*v)),
+                    None => "a scalar".into(),
+                },
                 Some(n) => format!("a vector of {n} values"),
                 None => format!("a {} matrix", dims_text(dims)),
             },
@@ -199,6 +205,7 @@ pub(crate) fn flight_of<D>(
                 dims,
                 data,
                 integer,
+                ..
             } if vector_len(&dims) == Some(n_rows) => Field::Numbers(data, integer),
             Value::Text { rows, .. } if rows.len() == n_rows => Field::Text(rows),
             other => {

@@ -78,7 +78,7 @@ fn a_workspace_of_vectors_reads_its_vectors_and_lists_the_rest() {
         not_read(&t),
         pairs(&[
             ("extra", "a struct"),
-            ("fs", "a scalar"),
+            ("fs", "a scalar, 10"),
             ("note", "text (1 × 11)"),
             ("A", "a 50 × 3 matrix"),
         ])
@@ -177,7 +177,7 @@ fn one_struct_gives_the_vectors_of_the_longest_length() {
     assert_eq!(
         not_read(&t),
         pairs(&[
-            ("TL_data.fs", "a scalar"),
+            ("TL_data.fs", "a scalar, 10"),
             ("TL_data.mag_1_uc_f_t", "a vector of 960 values"),
             ("TL_data.TL_a_1", "a vector of 18 values"),
         ])
