@@ -245,41 +245,14 @@ fn read_mat73(path: &Path, file: &str, root: &Group, opts: &ReadOptions) -> Resu
         message,
     };
     let variables = crate::mat73::variables(root, "", 0).map_err(mat)?;
-    let crate::matlab::Workspace {
-        fields,
-        n_rows,
-        not_read,
-    } = crate::matlab::flight_of(variables).map_err(mat)?;
-    let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
-    let (aliases, wanted) = mapped_fields(file, &header, opts)?;
-    check_reads(file, n_rows as u64, &wanted)?;
-    let mut columns = Vec::new();
-    for ((name, field), want) in fields.into_iter().zip(wanted) {
-        if !want {
-            continue;
-        }
-        let (data, integer) = match field {
-            crate::matlab::Field::Text(rows) => (ColumnData::Text(rows), false),
-            crate::matlab::Field::Numbers(ds, integer) => {
-                let (values, _) =
-                    read_f64(&ds).map_err(|e| mat((Some(name.clone()), e.to_string())))?;
-                if values.len() != n_rows {
-                    return Err(mat((
-                        Some(name),
-                        format!(
-                            "holds {} values where its dimensions say {n_rows}: damaged",
-                            values.len()
-                        ),
-                    )));
-                }
-                (ColumnData::numeric(values), integer)
-            }
-        };
-        columns.push((name, data, integer));
-    }
-    let mut table = FlightTable::from_fields(path, n_rows, columns, aliases, header);
-    table.set_not_read(not_read);
-    Ok(table)
+    crate::matlab::flight_of(variables)
+        .map_err(mat)?
+        .into_table(
+            path,
+            opts,
+            |n_rows, wanted| check_reads(file, n_rows as u64, wanted),
+            |ds| read_f64(&ds).map(|(v, _)| v).map_err(|e| e.to_string()),
+        )
 }
 
 /// A `units` attribute that contradicts the unit the layout gives the field

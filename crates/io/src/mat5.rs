@@ -35,9 +35,8 @@ use aeromag_core::memory::size_text;
 
 use crate::error::{IoError, Result};
 use crate::hdf5::MAX_READ_BYTES;
-use crate::matlab::{Field, Value, Variables, Workspace, dims_text, flight_of, text_value};
-use crate::table::{ColumnData, FlightTable};
-use crate::wanted::mapped_fields;
+use crate::matlab::{Value, Variables, dims_text, flight_of, text_value};
+use crate::table::FlightTable;
 
 /// The start of a MATLAB v5 MAT-file's header text.
 pub(crate) const SIGNATURE: &[u8] = b"MATLAB 5.0 MAT-file";
@@ -80,7 +79,7 @@ const MX_OPAQUE: u8 = 17;
 const FLAG_COMPLEX: u32 = 0x0800;
 const FLAG_LOGICAL: u32 = 0x0200;
 
-/// Whether the file at `path` begins as a MATLAB v5 MAT-file.
+/// Whether `head`, a file's first bytes, begins a MATLAB v5 MAT-file.
 pub(crate) fn is_mat5(head: &[u8]) -> bool {
     head.starts_with(SIGNATURE)
 }
@@ -125,29 +124,10 @@ pub fn read_mat5(path: &Path, opts: &ReadOptions) -> Result<FlightTable> {
         inflate: MAX_READ_BYTES as u64,
     };
     let variables = parse(&bytes, budget).map_err(|(v, m)| err(v.as_deref(), m))?;
-    let Workspace {
-        fields,
-        n_rows,
-        not_read,
-    } = flight_of(variables).map_err(|(v, m)| err(v.as_deref(), m))?;
-    let fields: Vec<(String, ColumnData, bool)> = fields
-        .into_iter()
-        .map(|(name, field)| match field {
-            Field::Numbers(values, integer) => (name, ColumnData::numeric(values), integer),
-            Field::Text(rows) => (name, ColumnData::Text(rows), false),
-        })
-        .collect();
-    let header: Vec<String> = fields.iter().map(|f| f.0.clone()).collect();
-    let (aliases, wanted) = mapped_fields(&file, &header, opts)?;
-    let columns: Vec<(String, ColumnData, bool)> = fields
-        .into_iter()
-        .zip(wanted)
-        .filter(|(_, want)| *want)
-        .map(|(field, _)| field)
-        .collect();
-    let mut table = FlightTable::from_fields(path, n_rows, columns, aliases, header);
-    table.set_not_read(not_read);
-    Ok(table)
+    flight_of(variables)
+        .map_err(|(v, m)| err(v.as_deref(), m))?
+        // Every value is in memory already.
+        .into_table(path, opts, |_, _| Ok(()), Ok)
 }
 
 /// An error while parsing: the variable concerned (if known) and what.

@@ -28,7 +28,12 @@
 //!   `aeromag inspect` prints, never dropped silently.
 //! - A MagNav.jl map (`map`, `xx`, `yy`) is refused as not a flight.
 
-use crate::table::NotRead;
+use std::path::Path;
+
+use crate::ReadOptions;
+use crate::error::{IoError, Result};
+use crate::table::{ColumnData, FlightTable, NotRead};
+use crate::wanted::mapped_fields;
 
 /// What a MagNav.jl map file (HDF5 or MAT: `map`, `xx`, `yy`) is, for the
 /// messages refusing it as a flight.
@@ -72,7 +77,10 @@ pub(crate) fn dims_text(dims: &[usize]) -> String {
 /// A 2-D `char` array of `dims` from its UTF-16 code units in MATLAB's
 /// column-major order: its rows, each row's padding spaces removed.
 /// Errors: not as many units as the dimensions say.
-pub(crate) fn text_value<D>(dims: Vec<usize>, units: &[u16]) -> Result<Value<D>, String> {
+pub(crate) fn text_value<D>(
+    dims: Vec<usize>,
+    units: &[u16],
+) -> std::result::Result<Value<D>, String> {
     let count = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
     if dims.len() != 2 || count != Some(units.len()) {
         return Err(format!(
@@ -147,6 +155,56 @@ pub(crate) struct Workspace<D> {
     pub fields: Vec<(String, Field<D>)>,
     pub n_rows: usize,
     pub not_read: Vec<NotRead>,
+}
+
+impl<D> Workspace<D> {
+    /// The flight table of the file `path`: its fields mapped like a CSV
+    /// header, those [`ReadOptions::fields`] asks for read; `check` sees
+    /// the rows and which fields (`true`: read) before any is, `read` gives
+    /// a field's numbers
+    /// (checked to be the rows), errors naming the variable.
+    pub(crate) fn into_table(
+        self,
+        path: &Path,
+        opts: &ReadOptions,
+        check: impl FnOnce(usize, &[bool]) -> Result<()>,
+        mut read: impl FnMut(D) -> std::result::Result<Vec<f64>, String>,
+    ) -> Result<FlightTable> {
+        let file = path.display().to_string();
+        let mat = |variable: &str, message: String| IoError::Mat {
+            file: file.clone(),
+            variable: Some(variable.to_string()),
+            message,
+        };
+        let header: Vec<String> = self.fields.iter().map(|f| f.0.clone()).collect();
+        let (aliases, wanted) = mapped_fields(&file, &header, opts)?;
+        check(self.n_rows, &wanted)?;
+        let mut columns = Vec::new();
+        for ((name, field), want) in self.fields.into_iter().zip(wanted) {
+            if !want {
+                continue;
+            }
+            let (data, integer) = match field {
+                Field::Text(rows) => (ColumnData::Text(rows), false),
+                Field::Numbers(data, integer) => {
+                    let values = read(data).map_err(|m| mat(&name, m))?;
+                    if values.len() != self.n_rows {
+                        let m = format!(
+                            "holds {} values where its dimensions say {}: damaged",
+                            values.len(),
+                            self.n_rows
+                        );
+                        return Err(mat(&name, m));
+                    }
+                    (ColumnData::numeric(values), integer)
+                }
+            };
+            columns.push((name, data, integer));
+        }
+        let mut table = FlightTable::from_fields(path, self.n_rows, columns, aliases, header);
+        table.set_not_read(self.not_read);
+        Ok(table)
+    }
 }
 
 /// An error naming the variable concerned (if one) and what.
