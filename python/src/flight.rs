@@ -470,9 +470,9 @@ impl PyFlight {
 
     /// Write the flight as a MATLAB v5 MAT-file (one n × 1 variable per
     /// column: double, int64 for integer columns, a space-padded char
-    /// matrix for text; as the CLI writes `--out X.mat`), which MATLAB's
-    /// `load`, Octave and scipy.io.loadmat read: bad input for a column
-    /// name that is not a MATLAB variable name.
+    /// matrix for text; as the CLI writes `--out X.mat`), in the format of
+    /// MATLAB's `load` (checked with scipy.io.loadmat): bad input for a
+    /// column name that is not a MATLAB variable name.
     fn to_mat(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         py.detach(|| aeromag::io::write_mat5(self.inner.table(), &path))
             .py_err()

@@ -176,6 +176,11 @@ pub fn check_map(map: Option<&Path>) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The help of a command's `--out` flight table (the formats of
+/// [`aeromag::io::TableFormat::of_path`]).
+pub const TABLE_OUT_HELP: &str = "Output file: CSV, or Geosoft XYZ when it ends in `.xyz`, HDF5 \
+     (one dataset per column, as MagNav/SGL files) in `.h5`, a MATLAB MAT-file in `.mat`";
+
 /// Check, before any work, that a flight table can be written in the
 /// format each of `tables` asks for (CSV, Geosoft XYZ for `.xyz`, HDF5 for
 /// `.h5`, MATLAB for `.mat`; a grid or model name is bad input).

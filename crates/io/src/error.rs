@@ -271,8 +271,8 @@ pub enum IoError {
         /// What the file holds instead.
         found: String,
     },
-    /// A MATLAB v5 MAT-file that cannot be read (damaged) or holds no
-    /// flight.
+    /// A MATLAB MAT-file (v5, or v7.3 read as a MATLAB workspace) that
+    /// cannot be read (damaged) or holds no flight.
     #[error("'{file}'{}: {message}", variable.as_ref().map(|v| format!(", variable '{v}'")).unwrap_or_default())]
     Mat {
         /// File as given.

@@ -194,7 +194,8 @@ impl Default for ReadOptions {
 /// With [`Format::Auto`]: extension `.xyz` → Geosoft XYZ; `.csv`, `.tsv` →
 /// CSV; `.h5`, `.hdf5`, `.he5` → HDF5; anything else (including `.txt` and
 /// `.mat`) → by content: HDF5 if the file has the HDF5 signature (MATLAB
-/// v7.3 files do), a MATLAB v5 MAT-file by its header, XYZ if the first
+/// v7.3 files do, read as MATLAB workspaces), a MATLAB v5 MAT-file by its
+/// header, XYZ if the first
 /// non-blank line starts with `/`, else CSV.
 ///
 /// Then the canonical columns in another unit are derived

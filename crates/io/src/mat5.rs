@@ -41,7 +41,7 @@ use crate::table::FlightTable;
 /// The start of a MATLAB v5 MAT-file's header text.
 pub(crate) const SIGNATURE: &[u8] = b"MATLAB 5.0 MAT-file";
 
-/// Deepest nesting of structs and cells read (MATLAB itself has no limit;
+/// Deepest nesting of structs read (MATLAB itself has no limit;
 /// a flight is one or two levels deep).
 pub const MAX_DEPTH: usize = 16;
 
@@ -172,19 +172,20 @@ fn parse(bytes: &[u8], mut budget: Budget) -> std::result::Result<Variables<Vec<
         } else {
             (kind, data)
         };
-        if kind != MI_MATRIX {
-            // Not a variable (a stray element): nothing of the flight.
-            budget.memory = budget.memory.saturating_add(decompressed_len);
-            continue;
-        }
-        let (name, value) = matrix(data, big, 0, "", &mut budget).map_err(|(v, m)| match v {
-            Some(v) => (Some(v), m),
-            None => (None, format!("variable {index}: {m}")),
-        })?;
+        // Anything but a variable (a stray element) holds nothing of the flight.
+        let variable = if kind == MI_MATRIX {
+            let v = matrix(data, big, 0, "", &mut budget).map_err(|(v, m)| match v {
+                Some(v) => (Some(v), m),
+                None => (None, format!("variable {index}: {m}")),
+            })?;
+            Some(v)
+        } else {
+            None
+        };
         // The decompressed bytes are freed with the variable read.
         budget.memory = budget.memory.saturating_add(decompressed_len);
         // The subsystem data (function handles, objects) has no name.
-        if !name.is_empty() {
+        if let Some((name, value)) = variable.filter(|(name, _)| !name.is_empty()) {
             variables.push((name, value));
         }
     }

@@ -1,6 +1,7 @@
 //! MATLAB v5 MAT-file writer: a flight table as MATLAB's `save` writes a
-//! workspace of column vectors, which MATLAB's `load`, GNU Octave,
-//! `scipy.io.loadmat` and [`crate::read_mat5`] read.
+//! workspace of column vectors, in the format MATLAB's `load` reads (the
+//! MathWorks "MAT-File Format", Level 5), checked with `scipy.io.loadmat`
+//! (Python tests) and [`crate::read_mat5`].
 //!
 //! - One variable per column, named as the column, in the table's order:
 //!   an n × 1 column vector (as a MATLAB table's columns are).

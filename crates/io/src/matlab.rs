@@ -144,7 +144,7 @@ impl<D> Value<D> {
 }
 
 /// A field of the flight: numbers (`D`, and whether integers) or text.
-pub(crate) enum Field<D> {
+enum Field<D> {
     Numbers(D, bool),
     Text(Vec<String>),
 }
@@ -152,17 +152,17 @@ pub(crate) enum Field<D> {
 /// The flight a workspace holds: its fields named as columns, in file
 /// order, their rows, and the variables that are not fields.
 pub(crate) struct Workspace<D> {
-    pub fields: Vec<(String, Field<D>)>,
-    pub n_rows: usize,
-    pub not_read: Vec<NotRead>,
+    fields: Vec<(String, Field<D>)>,
+    n_rows: usize,
+    not_read: Vec<NotRead>,
 }
 
 impl<D> Workspace<D> {
     /// The flight table of the file `path`: its fields mapped like a CSV
     /// header, those [`ReadOptions::fields`] asks for read; `check` sees
     /// the rows and which fields (`true`: read) before any is, `read` gives
-    /// a field's numbers
-    /// (checked to be the rows), errors naming the variable.
+    /// a field's numbers (checked to be the rows), errors naming the
+    /// variable.
     pub(crate) fn into_table(
         self,
         path: &Path,

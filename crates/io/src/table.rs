@@ -495,7 +495,6 @@ impl FlightTable {
         Ok(())
     }
 
-    /// Assembles a table read from a file (used by the readers).
     /// A table of the fields read from a binary file (HDF5, MAT) whose
     /// fields are `header`: the aliases of fields not read are dropped.
     pub(crate) fn from_fields(
@@ -515,6 +514,7 @@ impl FlightTable {
         table
     }
 
+    /// Assembles a table read from a file (used by the readers).
     pub(crate) fn from_parts(
         source: PathBuf,
         n_rows: usize,

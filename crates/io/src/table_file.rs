@@ -6,9 +6,8 @@
 //! clear error for the formats aeromag reads or writes elsewhere but not
 //! as a flight table (`out.tif` would be CSV under a grid's name).
 
-use std::path::Path;
-
 use std::io::BufWriter;
+use std::path::Path;
 
 use crate::atomic::Output;
 use crate::csv_write::written_columns;

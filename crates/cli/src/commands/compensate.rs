@@ -29,9 +29,7 @@ pub struct Args {
     model: PathBuf,
     #[command(flatten)]
     input: InputArgs,
-    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`, HDF5 (one
-    /// dataset per column, as MagNav/SGL files) in `.h5`, a MATLAB MAT-file in `.mat`.
-    #[arg(long, value_name = "OUT.csv")]
+    #[arg(long, value_name = "OUT.csv", help = crate::output::TABLE_OUT_HELP)]
     out: PathBuf,
     /// Apply the model causally (backward differences; see above).
     #[arg(long)]

@@ -28,9 +28,7 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     input: InputArgs,
-    /// Output file: CSV, or Geosoft XYZ when it ends in `.xyz`, HDF5 (one
-    /// dataset per column, as MagNav/SGL files) in `.h5`, a MATLAB MAT-file in `.mat`.
-    #[arg(long, value_name = "OUT.csv")]
+    #[arg(long, value_name = "OUT.csv", help = crate::output::TABLE_OUT_HELP)]
     out: PathBuf,
     /// Column to micro-level (default: the most processed magnetic column).
     #[arg(long)]
