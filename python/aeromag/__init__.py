@@ -459,7 +459,7 @@ def grid_flight(
 
 def read_grid(path: PathLike) -> Grid:
     """Read a grid file: GeoTIFF, ESRI ASCII, netCDF (classic or netCDF-4), GXF (as ``aeromag
-    grid`` writes them) or a Surfer ``.grd``."""
+    grid`` writes them), a Surfer ``.grd`` or an Oasis montaj (Geosoft) ``.grd``."""
     return _aeromag.read_grid(os.fspath(path))
 
 

@@ -316,7 +316,7 @@ pub fn grid_flight(
     })
 }
 
-/// Read a grid file (GeoTIFF, ESRI ASCII, netCDF, GXF or a Surfer .grd).
+/// Read a grid file (GeoTIFF, ESRI ASCII, netCDF, GXF, a Surfer or a Geosoft .grd).
 #[pyfunction]
 pub fn read_grid(path: std::path::PathBuf) -> PyResult<PyGrid> {
     Ok(PyGrid::plain(lib_read_grid(&path).py_err()?))

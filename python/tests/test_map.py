@@ -1,6 +1,8 @@
 """Maps from Python (grid_flight, read_grid, microlevel): the same grids as
 the CLI, NumPy arrays with coordinates and CRS."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -126,3 +128,18 @@ def test_projected_positions(survey_csv):
     assert found.x[0] < 0 < found.x[-1]
     with pytest.raises(aeromag.BadInputError, match="utm-zone"):
         aeromag.level(aeromag.Flight.from_dict({**d, "X": x, "Y": y}))
+
+
+GEOSOFT = Path(__file__).resolve().parents[2] / "crates/grid/tests/data/geosoft"
+
+
+@pytest.mark.parametrize("name", ["om_float.grd", "om_short.grd", "om_order.grd", "om_compress.grd"])
+def test_an_oasis_montaj_grid_reads_as_harmonica_reads_it(name):
+    g = aeromag.read_grid(GEOSOFT / name)
+    assert g.values.shape == (49, 50)
+    assert (g.cell, g.x[0], g.y[0], g.epsg) == (1.0, 1.0, -24.0, None)
+    assert np.isnan(g.values).sum() == 655
+    harmonica = pytest.importorskip("harmonica")
+    want = harmonica.load_oasis_montaj_grid(GEOSOFT / name).values
+    np.testing.assert_array_equal(np.isnan(g.values), np.isnan(want))
+    np.testing.assert_allclose(g.values, want, rtol=1e-14, atol=0)

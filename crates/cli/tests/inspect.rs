@@ -530,3 +530,48 @@ fn a_matlab_v5_file_lists_what_is_not_a_field() {
         stderr(&o)
     );
 }
+
+/// An Oasis montaj (Geosoft) grid, harmonica's compressed test grid:
+/// summarised as a grid, taken by `derive`, refused as a flight naming its
+/// kind; a rotated one exits 2 saying so.
+#[test]
+fn a_geosoft_grid_is_inspected_and_derived() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../grid/tests/data/geosoft");
+    let grd = data.join("om_compress.grd");
+    let o = aeromag(&["inspect", grd.to_str().unwrap()]);
+    assert_code(&o, 0);
+    let s = stdout(&o);
+    assert!(s.contains("grid     50 × 49 nodes, cell 1 m"), "{s}");
+    assert!(s.contains("1795 set, 655 blank"), "{s}");
+    let d = tempfile::tempdir().unwrap();
+    let tif = d.path().join("up.tif");
+    let o = aeromag(&[
+        "derive",
+        grd.to_str().unwrap(),
+        "--upward",
+        "1",
+        "--out",
+        tif.to_str().unwrap(),
+    ]);
+    assert_code(&o, 0);
+    let model = d.path().join("m.json");
+    let o = aeromag(&[
+        "calibrate",
+        grd.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ]);
+    assert_code(&o, 2);
+    assert!(
+        stderr(&o).contains("a grid file (Geosoft), not a flight table"),
+        "{}",
+        stderr(&o)
+    );
+    let o = aeromag(&["inspect", data.join("om_rotate.grd").to_str().unwrap()]);
+    assert_code(&o, 2);
+    let e = stderr(&o);
+    assert!(
+        e.contains("om_rotate.grd") && e.contains("rotated by -30°"),
+        "{e}"
+    );
+}

@@ -290,8 +290,8 @@ pub fn table_from_columns(
 }
 
 /// The kind of grid file whose first bytes are `head` (TIFF, netCDF
-/// classic, Surfer) or whose extension is `ext` (`gxf`); `None` for
-/// anything else.
+/// classic, Surfer) or whose extension is `ext` (`gxf`, and `grd` for
+/// Geosoft's); `None` for anything else.
 fn grid_kind(head: &[u8], ext: &str) -> Option<&'static str> {
     if ext == "gxf" {
         return Some("GXF");
@@ -307,6 +307,8 @@ fn grid_kind(head: &[u8], ext: &str) -> Option<&'static str> {
     .into_iter()
     .find(|(magic, _)| head.starts_with(magic))
     .map(|(_, kind)| kind)
+    // Geosoft's binary grid has no magic; a `.grd` is a grid format's.
+    .or((ext == "grd").then_some("Geosoft"))
 }
 
 fn detect_format(path: &Path) -> Result<Format> {

@@ -72,13 +72,13 @@ use std::path::Path;
 
 use super::{
     CoordinateUnit, check_declared_size, check_grid, check_values, checked_geometry,
-    label_from_file, north_up, not_metres, open_error, read_error, square_cell, stem, write_atomic,
+    fits_in_memory, label_from_file, north_up, not_metres, open_error, read_error, square_cell,
+    stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
 use crate::projection::{Crs, UtmZone};
 use aeromag_core::error::{shown, shown_text};
-use aeromag_core::memory::size_text;
 
 /// The dummy (blank node) written: Geosoft's float dummy.
 const DUMMY: &str = "-1e32";
@@ -441,23 +441,6 @@ pub fn read(path: &Path) -> Result<Grid> {
     check_values(path, &grid)?;
     grid.crs = crs;
     Ok(grid)
-}
-
-/// Repeats let a few bytes of a compressed file declare a large grid: its
-/// nodes (8 bytes each) must fit in the memory `left` (none: not known).
-fn fits_in_memory(path: &Path, nx: usize, ny: usize, left: Option<u64>) -> Result<()> {
-    let need = (nx * ny) as u64 * 8;
-    match left {
-        Some(left) if need > left => Err(read_error(
-            path,
-            format!(
-                "the header declares {nx} × {ny} nodes, {}, more than the {} this process can take",
-                size_text(need),
-                size_text(left)
-            ),
-        )),
-        _ => Ok(()),
-    }
 }
 
 /// The error of a row: the line (none: the file ended) and what is wrong.

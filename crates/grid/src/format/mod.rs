@@ -12,9 +12,9 @@
 //! | `.nc`, `.grd` | netCDF classic (CDF-2), COARDS/CF-1.7, GMT's gridline registration; netCDF-4 read | [`netcdf`] |
 //! | `.gxf` | GXF-3, Geosoft's Grid eXchange File (text; compressed form read) | [`gxf`] |
 //! | `.grd` read | a Surfer grid (ASCII, 6 or 7 binary) when its first bytes say so | [`surfer`] |
+//! | `.grd` read | a Geosoft grid (Oasis montaj's binary, any element type, compressed or not) when its first bytes say so | [`geosoft`] |
 //!
-//! (`.grd` is written as GMT's netCDF grid; Geosoft's binary `.grd` is not
-//! read, and the message says to export it as GXF.)
+//! (`.grd` is written as GMT's netCDF grid.)
 //!
 //! Every format keeps the node registration of [`Grid`]: the values are
 //! those of the nodes, and a reader that thinks in cells (GDAL, a GIS) sees
@@ -33,6 +33,7 @@
 //! never sees half a file and a failed write leaves the old file as it was.
 
 pub mod esri_ascii;
+pub mod geosoft;
 pub mod geotiff;
 pub mod gxf;
 pub mod netcdf;
@@ -48,6 +49,7 @@ use crate::error::{GridError, Result};
 use crate::grid::{Grid, GridGeometry, MAX_CELL, MAX_COORDINATE, MAX_NODES, MAX_VALUE, MIN_CELL};
 use crate::projection::{Crs, UtmZone};
 use aeromag_core::error::{shown, shown_text};
+use aeromag_core::memory::size_text;
 use aeromag_core::output_target::{OutputTarget, output_target};
 
 /// The value blank nodes take in the GeoTIFF (`GDAL_NODATA` tag) and ESRI
@@ -109,12 +111,16 @@ impl GridFormat {
         match self {
             GridFormat::GeoTiff => geotiff::read(path),
             GridFormat::EsriAscii => esri_ascii::read(path),
-            GridFormat::NetCdf
-                if surfer::kind(&aeromag_core::file_name::first_bytes(path, 4)).is_some() =>
-            {
-                surfer::read(path)
+            GridFormat::NetCdf => {
+                let head = aeromag_core::file_name::first_bytes(path, 20);
+                if surfer::kind(&head).is_some() {
+                    surfer::read(path)
+                } else if geosoft::looks_geosoft(&head) {
+                    geosoft::read(path)
+                } else {
+                    netcdf::read(path)
+                }
             }
-            GridFormat::NetCdf => netcdf::read(path),
             GridFormat::Gxf => gxf::read(path),
         }
     }
@@ -418,6 +424,24 @@ pub(crate) fn check_declared_size(
         ));
     }
     Ok(())
+}
+
+/// A compressed file's few bytes may declare a large grid (GXF's repeats,
+/// Geosoft's zlib blocks): its nodes (8 bytes each) must fit in the memory
+/// `left` (none: not known).
+pub(crate) fn fits_in_memory(path: &Path, nx: usize, ny: usize, left: Option<u64>) -> Result<()> {
+    let need = (nx * ny) as u64 * 8;
+    match left {
+        Some(left) if need > left => Err(read_error(
+            path,
+            format!(
+                "the header declares {nx} × {ny} nodes, {}, more than the {} this process can take",
+                size_text(need),
+                size_text(left)
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Checks the node values of a grid read from a file: each is blank (NaN:

@@ -478,24 +478,6 @@ fn decode(bytes: &[u8], t: NcType) -> Vec<f64> {
     }
 }
 
-/// Whether `bytes` start as a Geosoft binary grid (`.grd`) does: element
-/// size 1, 2, 4 or 8 bytes (1024 more when compressed), sign flag 0–3,
-/// positive counts of elements and vectors, orientation ±1 (little-endian
-/// 32-bit integers; Geosoft Grid File Format 2.0).
-fn looks_geosoft(bytes: &[u8]) -> bool {
-    let int = |k: usize| {
-        bytes
-            .get(4 * k..4 * k + 4)
-            .map(|b| i32::from_le_bytes(b.try_into().expect("4 bytes")))
-    };
-    matches!(
-        (int(0), int(1), int(2), int(3), int(4)),
-        (Some(es), Some(sf), Some(ne), Some(nv), Some(kx))
-            if [1, 2, 4, 8].contains(&(es % 1024)) && es < 2048
-                && (0..=3).contains(&sf) && ne > 0 && nv > 0 && kx.abs() == 1
-    )
-}
-
 /// The parsed header of a classic file (or the same from a netCDF-4 file,
 /// [`super::netcdf4`]).
 pub(super) struct Header {
@@ -513,12 +495,8 @@ fn parse_header(bytes: &[u8]) -> Parse<Header> {
         m if m.starts_with(b"\x89HDF") => {
             return Err("netCDF-4 (HDF5) is read from a file, not from bytes".into());
         }
-        _ if looks_geosoft(bytes) => {
-            return Err(
-                "a Geosoft binary grid, which aeromag does not read: export it from \
-                 Oasis montaj as GXF (.gxf) or GeoTIFF (.tif)"
-                    .into(),
-            );
+        _ if super::geosoft::looks_geosoft(bytes) => {
+            return Err("a Geosoft binary grid, not netCDF: read it with read_grid".into());
         }
         _ => return Err("not a netCDF classic file".into()),
     };

@@ -131,11 +131,12 @@ fn ascii(path: &Path, bytes: &[u8]) -> Result<(GridGeometry, Vec<f64>)> {
     Ok((geometry, values))
 }
 
-/// Little-endian fields of a binary grid.
-struct Fields<'a> {
-    path: &'a Path,
-    bytes: &'a [u8],
-    pos: usize,
+/// Little-endian fields of a binary grid (Surfer's, Geosoft's), read
+/// from `pos` on; reading past the end is an error naming the file.
+pub(super) struct Fields<'a> {
+    pub(super) path: &'a Path,
+    pub(super) bytes: &'a [u8],
+    pub(super) pos: usize,
 }
 
 impl Fields<'_> {
@@ -156,10 +157,13 @@ impl Fields<'_> {
     fn i16(&mut self) -> Result<i16> {
         Ok(i16::from_le_bytes(self.take()?))
     }
-    fn i32(&mut self) -> Result<i32> {
+    pub(super) fn i32(&mut self) -> Result<i32> {
         Ok(i32::from_le_bytes(self.take()?))
     }
-    fn f64(&mut self) -> Result<f64> {
+    pub(super) fn i64(&mut self) -> Result<i64> {
+        Ok(i64::from_le_bytes(self.take()?))
+    }
+    pub(super) fn f64(&mut self) -> Result<f64> {
         Ok(f64::from_le_bytes(self.take()?))
     }
     /// The values of `n` elements of `size` bytes from here, decoded.
