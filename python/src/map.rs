@@ -15,7 +15,7 @@ use aeromag::map::{
     GridOptions, MicrolevelOptions, Microlevelled, ProjectedColumns, grid_flight as lib_grid,
     microlevel as lib_microlevel,
 };
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -26,6 +26,38 @@ pub(crate) fn projected(xy: Option<(String, String)>) -> Option<ProjectedColumns
 
 pub(crate) fn zone(utm_zone: Option<&str>) -> PyResult<Option<UtmZone>> {
     utm_zone.map(|z| UtmZone::parse(z).py_err()).transpose()
+}
+
+/// The coordinate system of an EPSG code argument (None: none; else a
+/// WGS 84 / UTM code, 326zz or 327zz).
+fn crs_of_epsg(epsg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Crs>> {
+    whole_opt::<u16>("epsg", epsg)?
+        .map(|code| UtmZone::parse(&code.to_string()).map(Crs::Utm))
+        .transpose()
+        .py_err()
+}
+
+/// `v` as a flat, C-ordered float64 array of `ndim` dimensions (NumPy's
+/// `ascontiguousarray`: lists, integer arrays and xarray values too), with
+/// its shape; bad input naming `what` otherwise.
+fn float_array(
+    py: Python<'_>,
+    v: &Bound<'_, PyAny>,
+    what: &str,
+    ndim: usize,
+) -> PyResult<(Vec<f64>, Vec<usize>)> {
+    let a = py
+        .import("numpy")?
+        .call_method1("ascontiguousarray", (v, "float64"))
+        .map_err(|e| bad_argument(format!("{what}: not an array of numbers ({e})")))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    if shape.len() != ndim {
+        return Err(bad_argument(format!(
+            "{what}: a {ndim}-D array is needed, got shape {shape:?}"
+        )));
+    }
+    let flat: PyReadonlyArray1<'_, f64> = a.call_method0("ravel")?.extract()?;
+    Ok((flat.as_slice()?.to_vec(), shape))
 }
 
 /// A grid (`aeromag grid`): node values with their easting/northing (m)
@@ -154,6 +186,160 @@ impl PyGrid {
     /// This grid minus `other` (the same nodes).
     fn minus(&self, other: &PyGrid) -> PyResult<PyGrid> {
         Ok(PyGrid::plain(self.grid.difference(&other.grid).py_err()?))
+    }
+
+    /// A grid from a 2-D array of node values and the nodes' coordinates,
+    /// as NumPy holds a grid: `values` of shape `(len(y), len(x))`, row `k`
+    /// at northing `y[k]`, column `i` at easting `x[i]` (m, evenly spaced,
+    /// square cells); either axis may run backwards, as a north-up
+    /// raster's `y` does; NaN is a blank node. `epsg`: a WGS 84 / UTM code
+    /// (326zz, 327zz) or None. Bad input (`BadInputError`) for a shape that
+    /// is not `(len(y), len(x))`, uneven or unequal spacings, a value that
+    /// is infinite or beyond float32 (`aeromag_grid::Grid::from_axes`).
+    #[staticmethod]
+    #[pyo3(signature = (values, x, y, *, name=String::new(), unit=String::new(), epsg=None))]
+    fn from_array(
+        py: Python<'_>,
+        values: &Bound<'_, PyAny>,
+        x: &Bound<'_, PyAny>,
+        y: &Bound<'_, PyAny>,
+        name: String,
+        unit: String,
+        epsg: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<PyGrid> {
+        let crs = crs_of_epsg(epsg.as_ref())?;
+        let (values, shape) = float_array(py, values, "values", 2)?;
+        let (x, _) = float_array(py, x, "x", 1)?;
+        let (y, _) = float_array(py, y, "y", 1)?;
+        if shape != [y.len(), x.len()] {
+            return Err(bad_argument(format!(
+                "values of shape {shape:?}: a grid of len(y) × len(x) = [{}, {}] nodes takes \
+                 values of that shape (rows along y)",
+                y.len(),
+                x.len()
+            )));
+        }
+        let mut grid = Grid::from_axes(&x, &y, &values, &name, &unit).py_err()?;
+        grid.crs = crs;
+        Ok(PyGrid::plain(grid))
+    }
+
+    /// The grid as an `xarray.DataArray` (needs xarray): dimensions
+    /// `("y", "x")`, rows from the south, coordinates `x` and `y` in m,
+    /// named as the grid, `attrs["units"]` its unit; with a coordinate
+    /// system, a `spatial_ref` coordinate holding its WKT (`crs_wkt`,
+    /// `spatial_ref`) named by `attrs["grid_mapping"]`, as rioxarray and
+    /// CF write it. `Grid.from_xarray` reads it back.
+    fn to_xarray<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let xr = py.import("xarray").map_err(|_| {
+            pyo3::exceptions::PyImportError::new_err(
+                "Grid.to_xarray needs xarray: pip install xarray",
+            )
+        })?;
+        let axis = |values: Bound<'py, PyArray1<f64>>, dim: &str| -> PyResult<Bound<'py, PyAny>> {
+            let attrs = PyDict::new(py);
+            attrs.set_item("units", "m")?;
+            attrs.set_item("standard_name", format!("projection_{dim}_coordinate"))?;
+            ((dim,), values, attrs)
+                .into_pyobject(py)
+                .map(|t| t.into_any())
+        };
+        let coords = PyDict::new(py);
+        coords.set_item("x", axis(self.x(py), "x")?)?;
+        coords.set_item("y", axis(self.y(py), "y")?)?;
+        let attrs = PyDict::new(py);
+        if !self.grid.unit.is_empty() {
+            attrs.set_item("units", &self.grid.unit)?;
+        }
+        if let Some(crs) = self.grid.crs {
+            let wkt = crs.wkt();
+            let reference = PyDict::new(py);
+            reference.set_item("crs_wkt", &wkt)?;
+            reference.set_item("spatial_ref", &wkt)?;
+            coords.set_item("spatial_ref", ((), 0, reference))?;
+            attrs.set_item("grid_mapping", "spatial_ref")?;
+        }
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("dims", ("y", "x"))?;
+        kwargs.set_item("coords", coords)?;
+        kwargs.set_item("attrs", attrs)?;
+        if !self.grid.name.is_empty() {
+            kwargs.set_item("name", &self.grid.name)?;
+        }
+        xr.getattr("DataArray")?
+            .call((self.values(py)?,), Some(&kwargs))
+    }
+
+    /// A grid from a 2-D `xarray.DataArray` (`to_xarray`'s, verde's,
+    /// harmonica's, rioxarray's): its first dimension the rows (northing),
+    /// its second the columns (easting), each with a 1-D coordinate in m,
+    /// in either direction; the name from `.name`, the unit from
+    /// `attrs["units"]`; the coordinate system `epsg` if given, else the
+    /// WKT (`crs_wkt` or `spatial_ref`) of the coordinate
+    /// `attrs["grid_mapping"]` names (default `spatial_ref`), when it is a
+    /// WGS 84 / UTM zone. A WKT in degrees or feet is refused: aeromag's
+    /// grids are in metres.
+    #[staticmethod]
+    #[pyo3(signature = (array, *, epsg=None))]
+    fn from_xarray(
+        py: Python<'_>,
+        array: &Bound<'_, PyAny>,
+        epsg: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<PyGrid> {
+        let not_an_array = |_| bad_argument("from_xarray takes an xarray.DataArray");
+        let dims: Vec<String> = array
+            .getattr("dims")
+            .and_then(|d| d.extract())
+            .map_err(not_an_array)?;
+        let [rows, columns] = dims.as_slice() else {
+            return Err(bad_argument(format!(
+                "a DataArray of dimensions {dims:?}: a grid has two, rows (northing) then \
+                 columns (easting)"
+            )));
+        };
+        let coords = array.getattr("coords").map_err(not_an_array)?;
+        let axis = |dim: &str| -> PyResult<Bound<'_, PyAny>> {
+            if !coords.contains(dim)? {
+                return Err(bad_argument(format!(
+                    "dimension {dim:?} has no coordinate: give the nodes' coordinates in m \
+                     (array.assign_coords({dim}=...))"
+                )));
+            }
+            coords.get_item(dim)?.getattr("values")
+        };
+        let (y, x) = (axis(rows)?, axis(columns)?);
+        let text = |v: Bound<'_, PyAny>| -> PyResult<String> {
+            if v.is_none() {
+                Ok(String::new())
+            } else {
+                Ok(v.str()?.to_string())
+            }
+        };
+        let name = text(array.getattr("name")?)?;
+        let attrs = array.getattr("attrs")?;
+        let unit = text(attrs.call_method1("get", ("units",))?)?;
+        let crs = if epsg.as_ref().is_some_and(|e| !e.is_none()) {
+            crs_of_epsg(epsg.as_ref())?
+        } else {
+            let mapping = text(attrs.call_method1("get", ("grid_mapping", "spatial_ref"))?)?;
+            let wkt = if coords.contains(&mapping)? {
+                let a = coords.get_item(&mapping)?.getattr("attrs")?;
+                let w = text(a.call_method1("get", ("crs_wkt",))?)?;
+                if w.is_empty() {
+                    text(a.call_method1("get", ("spatial_ref",))?)?
+                } else {
+                    w
+                }
+            } else {
+                String::new()
+            };
+            aeromag::grid::projection::Crs::from_wkt_in_metres(&wkt)
+                .map_err(|reason| bad_argument(format!("the DataArray's {mapping}: {reason}")))?
+        };
+        let values = array.getattr("values")?;
+        let mut grid = Self::from_array(py, &values, &x, &y, name, unit, None)?;
+        grid.grid.crs = crs;
+        Ok(grid)
     }
 
     /// Write the grid; the format follows the extension (`.tif`, `.asc`,
@@ -338,7 +524,6 @@ pub fn grid_from_state(
     unit: String,
     info: &Bound<'_, PyDict>,
 ) -> PyResult<PyGrid> {
-    use aeromag::grid::grid::{MAX_CELL, MAX_COORDINATE, MAX_NODES, MIN_CELL};
     let what = "pickled grid";
     let values = crate::pickle::f64s_from_bytes(&format!("{what}: its values"), values)?;
     let (x0, y0, cell, nx, ny) = geometry;
@@ -350,8 +535,7 @@ pub fn grid_from_state(
         ny: crate::errors::whole("ny", &ny)?,
     };
     let g = geometry;
-    let nodes = g.nx.checked_mul(g.ny).filter(|&n| n > 0 && n <= MAX_NODES);
-    if nodes != Some(values.len()) {
+    if g.nx.checked_mul(g.ny) != Some(values.len()) {
         return Err(bad_argument(format!(
             "{what}: {} values for {} × {} nodes",
             values.len(),
@@ -359,19 +543,12 @@ pub fn grid_from_state(
             g.ny
         )));
     }
-    let inside = |v: f64| v.abs() <= MAX_COORDINATE;
-    let a_grid = (MIN_CELL..=MAX_CELL).contains(&g.cell)
-        && [g.x0, g.y0, g.x_max(), g.y_max()].into_iter().all(inside);
-    if !a_grid {
+    if let Some(problem) = g.problem() {
         return Err(bad_argument(format!(
-            "{what}: cell {} m from ({}, {}) m is not a grid's geometry",
-            g.cell, g.x0, g.y0
+            "{what}: not a grid's geometry: {problem}"
         )));
     }
-    let crs = whole_opt::<u16>("epsg", epsg.as_ref())?
-        .map(|code| UtmZone::parse(&code.to_string()).map(Crs::Utm))
-        .transpose()
-        .py_err()?;
+    let crs = crs_of_epsg(epsg.as_ref())?;
     let info = info
         .iter()
         .map(|(k, v)| Ok((k.extract::<String>()?, v.unbind())))

@@ -143,3 +143,67 @@ def test_an_oasis_montaj_grid_reads_as_harmonica_reads_it(name):
     want = harmonica.load_oasis_montaj_grid(GEOSOFT / name).values
     np.testing.assert_array_equal(np.isnan(g.values), np.isnan(want))
     np.testing.assert_allclose(g.values, want, rtol=1e-14, atol=0)
+
+
+def test_a_grid_from_arrays_in_either_direction():
+    x = 500000.0 + 25.0 * np.arange(4)
+    y = 6000000.0 + 25.0 * np.arange(3)
+    v = np.arange(12, dtype=float).reshape(3, 4)
+    v[1, 2] = np.nan
+    g = aeromag.Grid.from_array(v, x, y, name="tmi", unit="nT", epsg=32637)
+    assert (g.cell, g.x[0], g.y[0], g.epsg, g.name, g.unit) == (25.0, x[0], y[0], 32637, "tmi", "nT")
+    np.testing.assert_array_equal(g.values, v)
+    # A north-up raster (y descending) and x reversed: the same grid.
+    h = aeromag.Grid.from_array(v[::-1, ::-1], x[::-1], y[::-1])
+    np.testing.assert_array_equal(h.values, v)
+    assert (h.x[0], h.y[0], h.epsg) == (x[0], y[0], None)
+    # Integer values and lists are numbers too.
+    assert aeromag.Grid.from_array([[1, 2], [3, 4]], [0, 10], [0, 10]).values.tolist() == [[1.0, 2.0], [3.0, 4.0]]
+
+
+@pytest.mark.parametrize(
+    "values, x, y, needle",
+    [
+        (np.zeros((4, 3)), np.arange(4.0), np.arange(3.0), "values of shape [4, 3]"),
+        (np.zeros((2, 3)), [0.0, 1.0, 2.5], [0.0, 1.25], "not evenly spaced"),
+        (np.zeros((2, 3)), [0.0, 1.0, 2.0], [0.0, 2.0], "square cells"),
+        (np.zeros(6), np.arange(3.0), np.arange(2.0), "a 2-D array is needed"),
+        (np.full((2, 2), np.inf), [0.0, 1.0], [0.0, 1.0], "must be finite"),
+        ([["a", "b"], ["c", "d"]], [0.0, 1.0], [0.0, 1.0], "not an array of numbers"),
+    ],
+)
+def test_what_is_not_a_grid_is_refused(values, x, y, needle):
+    with pytest.raises(aeromag.BadInputError, match=None) as e:
+        aeromag.Grid.from_array(values, x, y)
+    assert needle in str(e.value)
+
+
+def test_xarray_round_trip_and_other_libraries_layouts(survey_csv):
+    xr = pytest.importorskip("xarray")
+    g = aeromag.grid_flight(aeromag.read_flight(survey_csv), column="true_anomaly", cell=100.0)
+    da = g.to_xarray()
+    assert da.dims == ("y", "x") and da.name == g.name and da.attrs["units"] == g.unit
+    assert da.attrs["grid_mapping"] == "spatial_ref" and "UTM" in da["spatial_ref"].attrs["crs_wkt"]
+    np.testing.assert_array_equal(da["x"].values, g.x)
+    back = aeromag.Grid.from_xarray(da)
+    np.testing.assert_array_equal(back.values, g.values)
+    assert (back.x[0], back.y[0], back.cell, back.epsg, back.name, back.unit) == (
+        g.x[0], g.y[0], g.cell, g.epsg, g.name, g.unit)
+    # harmonica's / verde's layout: northing then easting, no CRS; a
+    # north-up copy (y descending) is the same grid.
+    other = xr.DataArray(g.values[::-1], dims=("northing", "easting"),
+                         coords={"northing": g.y[::-1], "easting": g.x})
+    same = aeromag.Grid.from_xarray(other, epsg=g.epsg)
+    np.testing.assert_array_equal(same.values, g.values)
+    assert same.epsg == g.epsg
+    # Geographic coordinates are refused, as in the grid files.
+    geo = da.copy()
+    geo["spatial_ref"].attrs["crs_wkt"] = (
+        'GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],'
+        'PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433],AUTHORITY["EPSG","4326"]]')
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.Grid.from_xarray(geo)
+    assert "geographic coordinate system" in str(e.value)
+    with pytest.raises(aeromag.BadInputError) as e:
+        aeromag.Grid.from_xarray(xr.DataArray(np.zeros((2, 2)), dims=("a", "b")))
+    assert "dimension 'a' has no coordinate" in str(e.value) or 'dimension "a" has no coordinate' in str(e.value)

@@ -142,6 +142,37 @@ impl GridGeometry {
         })
     }
 
+    /// Why this is not the geometry of a grid, if it is not: a cell
+    /// outside [`MIN_CELL`]–[`MAX_CELL`] (or not finite), no node or more
+    /// than [`MAX_NODES`], a node beyond ±[`MAX_COORDINATE`]. Grid files
+    /// read, pickled grids and [`Grid::from_axes`] are checked with it.
+    pub fn problem(&self) -> Option<String> {
+        let g = self;
+        if !(MIN_CELL..=MAX_CELL).contains(&g.cell) {
+            return Some(format!(
+                "cell size {} m is out of range: {}–{} m",
+                shown(g.cell),
+                shown(MIN_CELL),
+                shown(MAX_CELL)
+            ));
+        }
+        if g.nx == 0 || g.ny == 0 || g.nx.saturating_mul(g.ny) > MAX_NODES {
+            return Some(format!("{} × {} nodes (at most {MAX_NODES})", g.nx, g.ny));
+        }
+        let inside = |v: f64| v.abs() <= MAX_COORDINATE;
+        if !(inside(g.x0) && inside(g.y0) && inside(g.x_max()) && inside(g.y_max())) {
+            return Some(format!(
+                "nodes from ({}, {}) to ({}, {}) m: coordinates must be within ±{} m",
+                shown(g.x0),
+                shown(g.y0),
+                shown(g.x_max()),
+                shown(g.y_max()),
+                shown(MAX_COORDINATE)
+            ));
+        }
+        None
+    }
+
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.nx * self.ny
@@ -190,6 +221,42 @@ impl GridGeometry {
     }
 }
 
+/// The spacing of an axis of node coordinates (negative when it runs
+/// backwards; `None` for fewer than two nodes), each coordinate within
+/// 10⁻⁶ of a spacing of where the spacing puts it: [`Grid::from_axes`]
+/// and the netCDF reader.
+pub(crate) fn axis_spacing(axis: &[f64], name: &str) -> Result<Option<f64>> {
+    let (Some(&first), Some(&last)) = (axis.first(), axis.last()) else {
+        return Ok(None);
+    };
+    if axis.len() < 2 {
+        return Ok(None);
+    }
+    let step = (last - first) / (axis.len() - 1) as f64;
+    if !(step.is_finite() && step != 0.0) {
+        return Err(GridError::Unusable(format!(
+            "the {name} coordinates run from {} to {}: not a grid axis",
+            shown(first),
+            shown(last)
+        )));
+    }
+    for (k, &v) in axis.iter().enumerate() {
+        let expected = first + k as f64 * step;
+        // NaN fails the comparison too.
+        let off = (v - expected).abs();
+        if off.is_nan() || off > 1e-6 * step.abs() {
+            return Err(GridError::Unusable(format!(
+                "the {name} coordinates are not evenly spaced: {name}[{k}] is {}, {} from a \
+                 spacing of {}",
+                shown(v),
+                shown(expected),
+                shown(step)
+            )));
+        }
+    }
+    Ok(Some(step))
+}
+
 /// `71 × 40 nodes of 50 m from (1000, -50)` (the south-western node's
 /// easting and northing, m).
 impl std::fmt::Display for GridGeometry {
@@ -232,6 +299,94 @@ impl Grid {
             name: name.to_string(),
             unit: unit.to_string(),
         }
+    }
+
+    /// A grid in the layout array libraries give one (NumPy, xarray):
+    /// `x` the nodes' eastings, one per column (m), `y` their northings,
+    /// one per row (m), `values` row after row in the order of `y`, each
+    /// row in the order of `x` (a C-ordered `(ny, nx)` array; NaN is a
+    /// blank node). Either axis may run backwards, as a north-up raster's
+    /// `y` does: the values are put in this crate's order (rows from the
+    /// south, west to east). No coordinate system (`crs` is `None`).
+    ///
+    /// Errors, all bad input: `values` not `ny × nx`
+    /// ([`GridError::LengthMismatch`]); and ([`GridError::Unusable`])
+    /// neither axis with two nodes (no spacing), an axis not evenly spaced
+    /// to 10⁻⁶ of its spacing, x and y spacings that differ by more than
+    /// 10⁻⁶ relative (cells are square; as the netCDF reader), a geometry
+    /// [`GridGeometry::problem`] refuses, a value that is infinite or
+    /// beyond float32's range (its row and column named as the grid files'
+    /// readers name them).
+    ///
+    /// ```
+    /// use aeromag_grid::Grid;
+    /// // Two rows, the northern one first (y descending), three columns.
+    /// let g = Grid::from_axes(&[0.0, 10.0, 20.0], &[110.0, 100.0], &[4.0, 5.0, 6.0, 1.0, 2.0, 3.0], "tmi", "nT")?;
+    /// assert_eq!((g.geometry.x0, g.geometry.y0, g.geometry.cell), (0.0, 100.0, 10.0));
+    /// assert_eq!(g.values, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    /// # Ok::<(), aeromag_grid::GridError>(())
+    /// ```
+    pub fn from_axes(x: &[f64], y: &[f64], values: &[f64], name: &str, unit: &str) -> Result<Grid> {
+        let (nx, ny) = (x.len(), y.len());
+        if values.len() != nx.saturating_mul(ny) {
+            return Err(GridError::LengthMismatch {
+                what: "grid values (ny × nx)",
+                got: values.len(),
+                expected: nx.saturating_mul(ny),
+            });
+        }
+        let (sx, sy) = (axis_spacing(x, "x")?, axis_spacing(y, "y")?);
+        let cell = match (sx, sy) {
+            (Some(a), Some(b)) if (a.abs() - b.abs()).abs() <= 1e-6 * a.abs() => a.abs(),
+            (Some(a), Some(b)) => {
+                return Err(GridError::Unusable(format!(
+                    "nodes {} apart in x and {} in y: aeromag's grids have square cells",
+                    shown(a.abs()),
+                    shown(b.abs())
+                )));
+            }
+            (Some(a), None) | (None, Some(a)) => a.abs(),
+            (None, None) => {
+                return Err(GridError::Unusable(format!(
+                    "{nx} × {ny} nodes have no spacing: a grid needs two nodes along x or y"
+                )));
+            }
+        };
+        let (flip_x, flip_y) = (sx.is_some_and(|s| s < 0.0), sy.is_some_and(|s| s < 0.0));
+        let first = |axis: &[f64], flip: bool| {
+            (if flip { axis.last() } else { axis.first() })
+                .copied()
+                .unwrap_or(0.0)
+        };
+        let geometry = GridGeometry {
+            x0: first(x, flip_x),
+            y0: first(y, flip_y),
+            cell,
+            nx,
+            ny,
+        };
+        if let Some(problem) = geometry.problem() {
+            return Err(GridError::Unusable(format!("not a grid: {problem}")));
+        }
+        let mut ordered = Vec::with_capacity(values.len());
+        for j in 0..ny {
+            let row = &values[if flip_y { ny - 1 - j } else { j } * nx..][..nx];
+            if flip_x {
+                ordered.extend(row.iter().rev());
+            } else {
+                ordered.extend(row);
+            }
+        }
+        let mut grid = Grid::blank(geometry, name, unit);
+        grid.values = ordered;
+        if let Some((row, column, value)) = crate::format::beyond_float32(&grid) {
+            return Err(GridError::Unusable(format!(
+                "the value at row {row}, column {column} (from the north-west corner, 1-based) \
+                 is {}: grid values must be finite and within float32's range",
+                shown(value)
+            )));
+        }
+        Ok(grid)
     }
 
     /// The value of node `(i, j)` (NaN when blank).
@@ -373,6 +528,100 @@ pub struct GridStats {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Any axis direction gives the same grid: the values reversed
+        /// along a reversed axis.
+        #[test]
+        fn from_axes_takes_either_direction(
+            nx in 1usize..6,
+            ny in 2usize..6,
+            x0 in -1e6f64..1e6,
+            y0 in -1e6f64..1e6,
+            cell in 0.5f64..100.0,
+            flip_x in any::<bool>(),
+            flip_y in any::<bool>(),
+        ) {
+            let axis = |o: f64, n: usize, flip: bool| -> Vec<f64> {
+                let a: Vec<f64> = (0..n).map(|k| o + k as f64 * cell).collect();
+                if flip { a.into_iter().rev().collect() } else { a }
+            };
+            let plain: Vec<f64> = (0..nx * ny).map(|k| k as f64).collect();
+            let (x, y) = (axis(x0, nx, flip_x), axis(y0, ny, flip_y));
+            let mut given = Vec::new();
+            for j in 0..ny {
+                let j = if flip_y { ny - 1 - j } else { j };
+                for i in 0..nx {
+                    let i = if flip_x { nx - 1 - i } else { i };
+                    given.push(plain[j * nx + i]);
+                }
+            }
+            let g = Grid::from_axes(&x, &y, &given, "v", "nT").unwrap();
+            // The cell is the x spacing (the y spacing with one column).
+            let cell = if nx > 1 {
+                (x[nx - 1] - x[0]).abs() / (nx - 1) as f64
+            } else {
+                (y[ny - 1] - y[0]).abs() / (ny - 1) as f64
+            };
+            prop_assert_eq!(g.geometry, GridGeometry { x0, y0, cell, nx, ny });
+            prop_assert_eq!(g.values, plain);
+        }
+    }
+
+    /// What is not a grid's layout is refused, saying why.
+    #[test]
+    fn from_axes_refuses_what_is_not_a_grid() {
+        let v6 = [0.0; 6];
+        for (x, y, values, needle) in [
+            (
+                &[0.0, 1.0, 2.0][..],
+                &[0.0, 1.0][..],
+                &v6[..5],
+                "has 5 values, expected 6",
+            ),
+            (
+                &[0.0, 1.0, 2.5],
+                &[0.0, 1.25],
+                &v6[..],
+                "not evenly spaced: x[1] is 1, 1.25 from",
+            ),
+            (
+                &[0.0, 1.0, 2.0],
+                &[0.0, 2.0],
+                &v6[..],
+                "1 apart in x and 2 in y",
+            ),
+            (
+                &[0.0, 0.0, 0.0],
+                &[0.0, 1.0],
+                &v6[..],
+                "x coordinates run from 0 to 0",
+            ),
+            (&[0.0], &[0.0], &v6[..1], "no spacing"),
+            (
+                &[0.0, 1e-9, 2e-9],
+                &[0.0, 1e-9],
+                &v6[..],
+                "cell size 0.000000001 m is out of range",
+            ),
+            (&[0.0, f64::NAN, 2.0], &[0.0, 1.0], &v6[..], "x[1] is NaN"),
+        ] {
+            let e = Grid::from_axes(x, y, values, "v", "nT").unwrap_err();
+            assert!(e.is_bad_input(), "{needle}: {e}");
+            assert!(e.to_string().contains(needle), "{needle}: {e}");
+        }
+        let mut values = v6;
+        values[1] = f64::INFINITY;
+        let e = Grid::from_axes(&[0.0, 1.0, 2.0], &[5.0, 6.0], &values, "v", "nT").unwrap_err();
+        assert!(e.to_string().contains("row 2, column 2"), "{e}");
+        // One row: its spacing is the cell.
+        let g = Grid::from_axes(&[3.0, 5.0], &[7.0], &[1.0, 2.0], "v", "nT").unwrap();
+        assert_eq!(
+            (g.geometry.cell, g.geometry.ny, g.geometry.y0),
+            (2.0, 1, 7.0)
+        );
+    }
 
     /// A grid needing more memory than the process can take is refused
     /// with the cell that fits; one that fits, or an unknown amount of

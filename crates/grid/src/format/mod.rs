@@ -46,7 +46,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{GridError, Result};
-use crate::grid::{Grid, GridGeometry, MAX_CELL, MAX_COORDINATE, MAX_NODES, MAX_VALUE, MIN_CELL};
+use crate::grid::{Grid, GridGeometry, MAX_VALUE};
 use crate::projection::{Crs, UtmZone};
 use aeromag_core::error::{shown, shown_text};
 use aeromag_core::memory::size_text;
@@ -245,7 +245,7 @@ pub fn label_from_file(text: &str) -> String {
 /// The first node (row from the north, column from the west, 1-based, and
 /// its value) that is neither blank (NaN) nor within [`MAX_VALUE`], the
 /// range of the float32 every format stores.
-fn beyond_float32(grid: &Grid) -> Option<(usize, usize, f64)> {
+pub(crate) fn beyond_float32(grid: &Grid) -> Option<(usize, usize, f64)> {
     let k = grid
         .values
         .iter()
@@ -336,39 +336,10 @@ pub(crate) fn open_error(path: &Path, source: std::io::Error) -> GridError {
 /// [`MIN_CELL`]–[`MAX_CELL`], node coordinates within ±[`MAX_COORDINATE`],
 /// a node count within [`MAX_NODES`].
 pub(crate) fn checked_geometry(path: &Path, geometry: GridGeometry) -> Result<GridGeometry> {
-    let g = geometry;
-    if !(MIN_CELL..=MAX_CELL).contains(&g.cell) {
-        return Err(read_error(
-            path,
-            format!(
-                "cell size {} m is out of range: {}–{} m",
-                shown(g.cell),
-                shown(MIN_CELL),
-                shown(MAX_CELL)
-            ),
-        ));
+    match geometry.problem() {
+        Some(reason) => Err(read_error(path, reason)),
+        None => Ok(geometry),
     }
-    if g.nx == 0 || g.ny == 0 || g.nx.saturating_mul(g.ny) > MAX_NODES {
-        return Err(read_error(
-            path,
-            format!("{} × {} nodes (at most {MAX_NODES})", g.nx, g.ny),
-        ));
-    }
-    let inside = |v: f64| v.abs() <= MAX_COORDINATE;
-    if !(inside(g.x0) && inside(g.y0) && inside(g.x_max()) && inside(g.y_max())) {
-        return Err(read_error(
-            path,
-            format!(
-                "nodes from ({}, {}) to ({}, {}) m: coordinates must be within ±{} m",
-                shown(g.x0),
-                shown(g.y0),
-                shown(g.x_max()),
-                shown(g.y_max()),
-                shown(MAX_COORDINATE)
-            ),
-        ));
-    }
-    Ok(g)
 }
 
 /// The cell of a grid file whose nodes are `dx` apart in x and `dy` in y:

@@ -580,20 +580,9 @@ impl Header {
 /// Origin and spacing of regular coordinates (`None` spacing for a single
 /// value).
 fn regular(values: &[f64], name: &str) -> Parse<(f64, Option<f64>)> {
-    let first = values[0];
-    if values.len() < 2 {
-        return Ok((first, None));
-    }
-    let step = (values[values.len() - 1] - first) / (values.len() - 1) as f64;
-    let tolerance = 1e-6 * step.abs();
-    let irregular = values
-        .iter()
-        .enumerate()
-        .any(|(k, &v)| v.is_nan() || (v - (first + k as f64 * step)).abs() > tolerance);
-    if irregular || step == 0.0 {
-        return Err(format!("{} is not regularly spaced", shown_text(name)));
-    }
-    Ok((first, Some(step)))
+    let step = crate::grid::axis_spacing(values, name)
+        .map_err(|_| format!("{} is not regularly spaced", shown_text(name)))?;
+    Ok((values[0], step))
 }
 
 /// Metres in a kilometre, the one other unit of coordinates read.
