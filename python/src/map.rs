@@ -343,7 +343,8 @@ impl PyGrid {
     }
 
     /// Write the grid; the format follows the extension (`.tif`, `.asc`,
-    /// `.nc`/`.grd`, `.gxf`).
+    /// `.nc`/`.grd`, `.gxf`; `name.grd(GRD)` writes Oasis montaj's own grid
+    /// to `name.grd`, without its coordinate system).
     fn write(&self, path: std::path::PathBuf) -> PyResult<()> {
         write_grid(&path, &self.grid).py_err()?;
         Ok(())

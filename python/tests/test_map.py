@@ -207,3 +207,14 @@ def test_xarray_round_trip_and_other_libraries_layouts(survey_csv):
     with pytest.raises(aeromag.BadInputError) as e:
         aeromag.Grid.from_xarray(xr.DataArray(np.zeros((2, 2)), dims=("a", "b")))
     assert "dimension 'a' has no coordinate" in str(e.value) or 'dimension "a" has no coordinate' in str(e.value)
+
+
+def test_a_grid_written_for_oasis_montaj_reads_back(tmp_path):
+    g = aeromag.read_grid(GEOSOFT / "om_float.grd")
+    g.write(tmp_path / "again.grd(GRD)")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["again.grd"]
+    assert (tmp_path / "again.grd").read_bytes()[184:] == (GEOSOFT / "om_float.grd").read_bytes()[184:]
+    back = aeromag.read_grid(tmp_path / "again.grd")
+    np.testing.assert_array_equal(back.values, g.values)
+    harmonica = pytest.importorskip("harmonica")
+    np.testing.assert_array_equal(harmonica.load_oasis_montaj_grid(tmp_path / "again.grd").values, g.values)

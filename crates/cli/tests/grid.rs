@@ -78,6 +78,20 @@ fn grids_in_every_format_with_defaults_from_the_lines() {
         g.values.iter().map(|v| (*v as f32).to_bits()).collect()
     };
     assert_eq!(bits(&tif), bits(&gxf));
+    // Oasis montaj's own grid, named with its decoration: the file
+    // `mag.grd`, the same float32 values, and a note that its coordinate
+    // system is not recorded.
+    let o = grid(&input, &d.path().join("mag.grd(GRD)"), &["--cell", "100"]);
+    assert_code(&o, 0);
+    assert!(stdout(&o).contains("(Geosoft)"), "{}", stdout(&o));
+    assert!(
+        stderr(&o).contains("does not record its coordinate system (WGS 84 / UTM zone 37N)"),
+        "{}",
+        stderr(&o)
+    );
+    let grd = aeromag::grid::format::read_grid(&d.path().join("mag.grd")).unwrap();
+    assert_eq!((grd.geometry, grd.crs), (tif.geometry, None));
+    assert_eq!(bits(&grd), bits(&tif));
     let o = grid(
         &input,
         &d.path().join("b.tif"),

@@ -50,7 +50,9 @@ pub enum GridError {
     #[error("projection: {0}")]
     Projection(String),
     /// A grid file format this crate does not write (the extension decides).
-    #[error("unknown grid format '{0}': use .tif, .asc, .nc, .grd or .gxf")]
+    #[error(
+        "unknown grid format '{0}': use .tif, .asc, .nc, .grd, .gxf or, for Oasis montaj's own, .grd(GRD)"
+    )]
     UnknownFormat(String),
     /// A grid file that cannot be read: missing, truncated, or not in the
     /// format its extension says.

@@ -191,3 +191,24 @@ fn every_cut_of_the_compressed_grid_is_an_error() {
         assert!(e.to_string().contains("cut.grd"), "{len}: {e}");
     }
 }
+
+/// Oasis montaj's float grid read and written again (`name.grd(GRD)`):
+/// the same bytes as Oasis montaj wrote, values and header alike, but for
+/// the variance's last bits (ZVAR, bytes 176–183: a sum in another order),
+/// which stays within 10⁻¹³ relative.
+#[test]
+fn a_grid_written_as_geosoft_has_oasis_montaj_bytes() {
+    let original = std::fs::read(data("om_float.grd")).unwrap();
+    let g = read_grid(&data("om_float.grd")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("again.grd");
+    let decorated = dir.path().join("again.grd(GRD)");
+    aeromag_grid::format::write_grid(&decorated, &g).unwrap();
+    let written = std::fs::read(&out).unwrap();
+    assert_eq!(written.len(), original.len());
+    assert_eq!(written[..176], original[..176]);
+    assert_eq!(written[184..], original[184..]);
+    let variance = |b: &[u8]| f64::from_le_bytes(b[176..184].try_into().unwrap());
+    let (a, b) = (variance(&written), variance(&original));
+    assert!((a - b).abs() <= 1e-13 * b, "{a} {b}");
+}

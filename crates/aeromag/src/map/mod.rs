@@ -24,6 +24,21 @@ pub use gridding::{GridOptions, SurveyGrid, grid_flight};
 pub use microlevel::{MicrolevelOptions, Microlevelled, microlevel};
 pub use survey::{LineGeometry, PROJECTED_NAMES, ProjectedColumns, ProjectedSurvey};
 
+/// The note of a grid written to a file `format` that does not record
+/// its coordinate system (Geosoft's grid), when it has one.
+pub fn crs_not_written(
+    format: aeromag_grid::format::GridFormat,
+    grid: &aeromag_grid::Grid,
+) -> Option<crate::Note> {
+    let crs = grid.crs.filter(|_| !format.keeps_crs())?;
+    Some(crate::Note::note(format!(
+        "the Geosoft grid does not record its coordinate system ({}): Oasis montaj keeps it \
+         in a .gi file, whose format is not published; set it there, or write .gxf or .tif, \
+         which record it",
+        crs.name()
+    )))
+}
+
 /// The processing stages of a survey's magnetic columns, the most
 /// processed first (suffixes of the column: micro-levelled levelled,
 /// levelled, as compensated or recorded): the default column to grid is

@@ -38,7 +38,8 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     input: crate::input::InputFile,
-    /// Output grid file.
+    /// Output grid file; the format follows the extension, as `aeromag
+    /// grid --out` (`NAME.grd(GRD)`: Oasis montaj's own grid).
     #[arg(long, value_name = "GRID")]
     out: PathBuf,
     /// First vertical derivative (z down), nT/m.
@@ -79,7 +80,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     };
     let g = derive(a.input.path(), &product)?;
-    aeromag::grid::format::write_grid(&a.out, &g)?;
+    let format = aeromag::grid::format::write_grid(&a.out, &g)?;
     let s = g.stats();
     println!(
         "{}: {} × {} nodes, {} not blank; mean {}, std {}, min {}, max {} {}",
@@ -94,6 +95,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         g.unit
     );
     println!("wrote {}", a.out.display());
+    if let Some(note) = aeromag::map::crs_not_written(format, &g) {
+        eprintln!("{note}");
+    }
     if let Some(path) = &a.map {
         let picture = match product {
             GridProduct::Upward(_) => MapPicture::field(&g),

@@ -33,8 +33,10 @@ pub struct Args {
     /// Output grid; the format follows the extension: `.tif` (GeoTIFF,
     /// float32), `.asc` (ESRI ASCII grid, with a `.prj`), `.nc` / `.grd`
     /// (netCDF, COARDS, as GMT reads and writes it; not Surfer's or
-    /// Geosoft's binary .grd) or `.gxf` (GXF-3, Geosoft's Grid eXchange
-    /// File, as Oasis montaj and GDAL read it).
+    /// Geosoft's binary .grd), `.gxf` (GXF-3, Geosoft's Grid eXchange
+    /// File, as Oasis montaj and GDAL read it) or `NAME.grd(GRD)` (Oasis
+    /// montaj's decoration: its own binary grid, written to NAME.grd,
+    /// without the coordinate system, which Oasis keeps in a .gi file).
     #[arg(long, value_name = "GRID")]
     out: PathBuf,
     /// Column to grid (default: the most processed magnetic column of the
@@ -185,6 +187,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         s.mean, s.std, s.min, s.max, g.grid.unit
     );
     println!("wrote {} ({format:?})", a.out.display());
+    if let Some(note) = aeromag::map::crs_not_written(format, &g.grid) {
+        eprintln!("{note}");
+    }
     if let Some(path) = &a.map {
         // A point of each line every so many rows: at most about 50 000.
         let step = (g.survey.x.len() / 50_000).max(1);

@@ -1,6 +1,8 @@
 //! Geosoft binary grids (`.grd`, Oasis montaj's own format, version 2 of
-//! the Geosoft Grid File Format), read; told from GMT's netCDF and
-//! Surfer's `.grd` by their first 20 bytes ([`looks_geosoft`]).
+//! the Geosoft Grid File Format), read, told from GMT's netCDF and
+//! Surfer's `.grd` by their first 20 bytes ([`looks_geosoft`]); written
+//! ([`write`]) when the file is named with Oasis montaj's decoration,
+//! `mag.grd(GRD)`.
 //!
 //! The file is a 512-byte header of little-endian fields, then the values:
 //!
@@ -42,13 +44,13 @@
 
 use std::borrow::Cow;
 use std::fs;
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::Path;
 
 use super::surfer::Fields;
 use super::{
     CoordinateUnit, checked_geometry, crs_from_epsg, crs_from_wkt, fits_in_memory, north_up,
-    not_metres, open_error, read_error, square_cell, stem,
+    not_metres, open_error, read_error, square_cell, stem, write_atomic,
 };
 use crate::error::Result;
 use crate::grid::{Grid, GridGeometry};
@@ -218,6 +220,83 @@ pub fn read(path: &Path) -> Result<Grid> {
     super::check_values(path, &grid)?;
     grid.crs = sidecar_crs(path)?;
     Ok(grid)
+}
+
+/// Writes `grid` as a Geosoft grid, atomically, in the layout of the
+/// float grids Oasis montaj 9.6 writes (uncompressed float32, `KX` 1, no
+/// scaling; blank nodes the float dummy −10³²; the header's count,
+/// minimum, maximum, mean and variance of the values, its median left 0
+/// and its application area holding four dummies, as Oasis montaj
+/// leaves them). The coordinate system is not written: Oasis montaj keeps
+/// it in the `.gi` sidecar, whose format is not published (GXF carries
+/// it). Written by naming the file with Oasis montaj's decoration,
+/// `mag.grd(GRD)` ([`super::GridFormat::from_path`]).
+pub fn write(path: &Path, grid: &Grid) -> Result<()> {
+    super::check_grid(grid)?;
+    write_atomic(path, |w| {
+        w.write_all(&header_bytes(grid))?;
+        let mut row = Vec::with_capacity(4 * grid.geometry.nx);
+        for values in grid.values.chunks(grid.geometry.nx) {
+            row.clear();
+            for &v in values {
+                let v = if v.is_nan() {
+                    FLOAT_DUMMY as f32
+                } else {
+                    v as f32
+                };
+                row.extend(v.to_le_bytes());
+            }
+            w.write_all(&row)?;
+        }
+        Ok(())
+    })
+}
+
+/// The 512-byte header [`write`] writes.
+fn header_bytes(grid: &Grid) -> Vec<u8> {
+    let g = grid.geometry;
+    let set: Vec<f64> = grid
+        .values
+        .iter()
+        .filter(|v| !v.is_nan())
+        .map(|&v| f64::from(v as f32))
+        .collect();
+    let n = set.len() as f64;
+    let mean = set.iter().sum::<f64>() / n;
+    let variance = set.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let (min, max) = set
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let stat = |v: f64| {
+        if set.is_empty() {
+            FLOAT_DUMMY as f32
+        } else {
+            v as f32
+        }
+    };
+    let mut h = Vec::with_capacity(HEADER_BYTES);
+    for i in [4, 2, g.nx as i32, g.ny as i32, 1] {
+        h.extend(i32::to_le_bytes(i));
+    }
+    for d in [g.cell, g.cell, g.x0, g.y0, 0.0, 0.0, 1.0] {
+        h.extend(f64::to_le_bytes(d));
+    }
+    // LABEL, MAPNO, then PROJ, UNITX, UNITY, UNITZ.
+    h.resize(156, 0);
+    h.extend(i32::to_le_bytes(set.len() as i32));
+    for f in [stat(min), stat(max), 0.0, stat(mean)] {
+        h.extend(f32::to_le_bytes(f));
+    }
+    let variance = if set.len() > 1 { variance } else { 0.0 };
+    h.extend(f64::to_le_bytes(variance));
+    h.extend(i32::to_le_bytes(0));
+    for _ in 0..4 {
+        h.extend(f32::to_le_bytes(FLOAT_DUMMY as f32));
+    }
+    h.resize(HEADER_BYTES, 0);
+    h
 }
 
 /// Parses and checks the 512-byte header.
@@ -807,6 +886,33 @@ mod tests {
         }
         fs::remove_file(&xml).unwrap();
         assert_eq!(read_grid(&path).unwrap().crs, None);
+    }
+
+    /// Written with the `(GRD)` decoration and read back: the same nodes
+    /// and values (float32), blanks; the file is `g.grd`, the decoration
+    /// not part of its name.
+    #[test]
+    fn a_written_grid_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut grid = super::super::test_support::sample_grid();
+        grid.crs = None;
+        let decorated = dir.path().join("g.grd(GRD)");
+        assert_eq!(
+            super::super::write_grid(&decorated, &grid).unwrap(),
+            super::super::GridFormat::Geosoft
+        );
+        let file = dir.path().join("g.grd");
+        assert_eq!(super::super::test_support::entries(dir.path()), ["g.grd"]);
+        for path in [&file, &decorated] {
+            let back = read_grid(path).unwrap();
+            assert_eq!(back.geometry, grid.geometry);
+            for (a, b) in grid.values.iter().zip(&back.values) {
+                assert!(
+                    a.is_nan() && b.is_nan() || f64::from(*a as f32) == *b,
+                    "{a} {b}"
+                );
+            }
+        }
     }
 
     proptest! {

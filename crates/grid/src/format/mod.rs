@@ -13,8 +13,9 @@
 //! | `.gxf` | GXF-3, Geosoft's Grid eXchange File (text; compressed form read) | [`gxf`] |
 //! | `.grd` read | a Surfer grid (ASCII, 6 or 7 binary) when its first bytes say so | [`surfer`] |
 //! | `.grd` read | a Geosoft grid (Oasis montaj's binary, any element type, compressed or not) when its first bytes say so | [`geosoft`] |
+//! | `.grd(GRD)` | a Geosoft grid, float32, written as Oasis montaj writes it (the file `.grd`; Oasis montaj's decoration) | [`geosoft`] |
 //!
-//! (`.grd` is written as GMT's netCDF grid.)
+//! (A plain `.grd` is written as GMT's netCDF grid.)
 //!
 //! Every format keeps the node registration of [`Grid`]: the values are
 //! those of the nodes, and a reader that thinks in cells (GDAL, a GIS) sees
@@ -69,13 +70,35 @@ pub enum GridFormat {
     NetCdf,
     /// GXF-3, Geosoft's Grid eXchange File ([`gxf`]).
     Gxf,
+    /// Geosoft's binary grid, Oasis montaj's own ([`geosoft`]): a file
+    /// named with Oasis montaj's decoration, `mag.grd(GRD)`.
+    Geosoft,
+}
+
+/// Oasis montaj's decoration of a grid file's name that names the Geosoft
+/// format: `mag.grd(GRD)` is the file `mag.grd` (any case).
+const GEOSOFT_DECORATION: &str = "(GRD)";
+
+/// `path` without Oasis montaj's `(GRD)` decoration, if it has one.
+fn undecorated(path: &Path) -> Option<PathBuf> {
+    let text = path.to_str()?;
+    let cut = text.len().checked_sub(GEOSOFT_DECORATION.len())?;
+    let decoration = text.get(cut..)?;
+    decoration
+        .eq_ignore_ascii_case(GEOSOFT_DECORATION)
+        .then(|| PathBuf::from(&text[..cut]))
 }
 
 impl GridFormat {
     /// The format of a file by its extension: `.tif`/`.tiff` GeoTIFF,
     /// `.asc` ESRI ASCII, `.nc`/`.grd` netCDF, `.gxf` GXF (case
-    /// insensitive); anything else is [`GridError::UnknownFormat`].
+    /// insensitive); a name ending in Oasis montaj's decoration `(GRD)`
+    /// (`mag.grd(GRD)`) Geosoft's grid; anything else is
+    /// [`GridError::UnknownFormat`].
     pub fn from_path(path: &Path) -> Result<Self> {
+        if undecorated(path).is_some() {
+            return Ok(GridFormat::Geosoft);
+        }
         match aeromag_core::file_name::extension(path).as_str() {
             "tif" | "tiff" => Ok(GridFormat::GeoTiff),
             "asc" => Ok(GridFormat::EsriAscii),
@@ -92,22 +115,37 @@ impl GridFormat {
             GridFormat::EsriAscii => "asc",
             GridFormat::NetCdf => "nc",
             GridFormat::Gxf => "gxf",
+            GridFormat::Geosoft => "grd",
         }
     }
 
+    /// Whether a file of this format records the grid's coordinate system
+    /// (all but Geosoft's grid, whose system Oasis montaj keeps in an
+    /// unpublished `.gi` sidecar).
+    pub fn keeps_crs(&self) -> bool {
+        !matches!(self, GridFormat::Geosoft)
+    }
+
     /// Writes `grid` to `path` in this format, atomically (module docs),
-    /// whatever the extension of `path`.
+    /// whatever the extension of `path` (the file named without a `(GRD)`
+    /// decoration).
     pub fn write(&self, path: &Path, grid: &Grid) -> Result<()> {
+        let undecorated = undecorated(path);
+        let path = undecorated.as_deref().unwrap_or(path);
         match self {
             GridFormat::GeoTiff => geotiff::write(path, grid),
             GridFormat::EsriAscii => esri_ascii::write(path, grid),
             GridFormat::NetCdf => netcdf::write(path, grid),
             GridFormat::Gxf => gxf::write(path, grid),
+            GridFormat::Geosoft => geosoft::write(path, grid),
         }
     }
 
-    /// Reads a grid of this format from `path`.
+    /// Reads a grid of this format from `path` (the file named without a
+    /// `(GRD)` decoration).
     pub fn read(&self, path: &Path) -> Result<Grid> {
+        let undecorated = undecorated(path);
+        let path = undecorated.as_deref().unwrap_or(path);
         match self {
             GridFormat::GeoTiff => geotiff::read(path),
             GridFormat::EsriAscii => esri_ascii::read(path),
@@ -122,6 +160,7 @@ impl GridFormat {
                 }
             }
             GridFormat::Gxf => gxf::read(path),
+            GridFormat::Geosoft => geosoft::read(path),
         }
     }
 }
