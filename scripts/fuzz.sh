@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-TARGETS=(csv xyz model_json scenario_toml em_raw hdf5 mat)
+TARGETS=(csv xyz model_json scenario_toml em_raw hdf5 mat grid)
 
 usage() {
     sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//' >&2
@@ -48,7 +48,7 @@ sanitizer=${FUZZ_SANITIZER:-none}
 # so that executions are fast.
 max_len() {
     case $1 in
-        csv | xyz | hdf5 | mat) echo 65536 ;;
+        csv | xyz | hdf5 | mat | grid) echo 65536 ;;
         em_raw) echo 16384 ;;
         *) echo 32768 ;;
     esac

@@ -197,7 +197,10 @@ impl PyGrid {
     /// is not `(len(y), len(x))`, uneven or unequal spacings, a value that
     /// is infinite or beyond float32 (`aeromag_grid::Grid::from_axes`).
     #[staticmethod]
-    #[pyo3(signature = (values, x, y, *, name=String::new(), unit=String::new(), epsg=None))]
+    #[pyo3(
+        signature = (values, x, y, *, name=String::new(), unit=String::new(), epsg=None),
+        text_signature = "(values, x, y, *, name='', unit='', epsg=None)"
+    )]
     fn from_array(
         py: Python<'_>,
         values: &Bound<'_, PyAny>,

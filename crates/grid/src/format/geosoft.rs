@@ -419,7 +419,9 @@ fn decompress(path: &Path, bytes: &[u8], h: &Header) -> Result<Vec<u8>> {
     let offsets: Vec<i64> = (0..blocks).map(|_| f.i64()).collect::<Result<_>>()?;
     let sizes: Vec<i32> = (0..blocks).map(|_| f.i32()).collect::<Result<_>>()?;
     let vector_bytes = h.ne * h.element.size();
-    let mut data = Vec::with_capacity(h.nv * vector_bytes);
+    // Grown block by block as the blocks decompress: a few bytes of header
+    // may declare gigabytes.
+    let mut data = Vec::new();
     for (b, (&offset, &size)) in offsets.iter().zip(&sizes).enumerate() {
         let block_error = |what: String| {
             read_error(
@@ -440,6 +442,7 @@ fn decompress(path: &Path, bytes: &[u8], h: &Header) -> Result<Vec<u8>> {
                 ))
             })?;
         let expected = per_block.min(h.nv - b * per_block) * vector_bytes;
+        data.reserve(expected.min(1 << 26));
         let start = data.len();
         let read = flate2::read::ZlibDecoder::new(stream)
             .take(expected as u64 + 1)

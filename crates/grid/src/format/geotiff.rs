@@ -240,6 +240,10 @@ fn tiff_reason(e: TiffError) -> String {
         TiffError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
             "the file ends inside the TIFF structure (truncated or damaged)".to_string()
         }
+        TiffError::LimitsExceeded => format!(
+            "a tag declares more values than a GeoTIFF holds (over {}; damaged)",
+            aeromag_core::memory::size_text(TAG_VALUES_BYTES as u64)
+        ),
         e => e.to_string(),
     }
 }
@@ -343,15 +347,27 @@ fn check_chunks<R: std::io::Read + Seek>(
     Ok(())
 }
 
+/// Most memory one tag's values may take while the tags are read (the
+/// `tiff` decoder's own `Value`s, about 24 bytes each): 64 MiB, far above
+/// any GeoTIFF's tie points, GeoKeys or GDAL metadata.
+const TAG_VALUES_BYTES: usize = 64 << 20;
+
 /// Reads a GeoTIFF (module docs for what is accepted). The name and unit
 /// come from `GDAL_METADATA` (else the file stem and no unit), the CRS
 /// from `ProjectedCSTypeGeoKey` when it is a WGS 84 / UTM code.
 pub fn read(path: &Path) -> Result<Grid> {
     let file = File::open(path).map_err(|e| open_error(path, e))?;
     let err = |e: TiffError| read_error(path, tiff_reason(e));
+    // Tags first, under a limit on the memory of one tag's values: a
+    // corrupt count (the fuzz target's: 40 GB declared in a 655-byte file)
+    // must be an error, not an allocation that aborts the process. The
+    // image's size is checked against the file below, and then decoded
+    // without a limit.
+    let mut limits = Limits::unlimited();
+    limits.decoding_buffer_size = TAG_VALUES_BYTES;
     let mut dec = Decoder::new(BufReader::new(file))
         .map_err(err)?
-        .with_limits(Limits::unlimited());
+        .with_limits(limits);
     let (nx, ny) = dec.dimensions().map_err(err)?;
     if !matches!(dec.colortype().map_err(err)?, ColorType::Gray(_)) {
         return Err(read_error(path, "not a single-band image"));
@@ -447,6 +463,7 @@ pub fn read(path: &Path) -> Result<Grid> {
         let end = metadata[start..].find('<')?;
         Some(xml_unescape(&metadata[start..start + end]))
     };
+    let mut dec = dec.with_limits(Limits::unlimited());
     let values: Vec<f64> = match dec.read_image().map_err(err)? {
         DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
         DecodingResult::F64(v) => v,
@@ -740,6 +757,22 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// A tag whose count declares 40 GB in a 655-byte file (found by the
+    /// `grid` fuzz target; the decoder's limits were off, and the
+    /// allocation aborted the process): an error naming the file.
+    #[test]
+    fn a_tag_larger_than_its_file_is_refused_without_allocating_it() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/hostile/huge_tag_count.tif");
+        let e = read(&path).unwrap_err();
+        assert!(e.is_bad_input(), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.contains("huge_tag_count.tif") && text.contains("a tag declares more values"),
+            "{text}"
+        );
     }
 
     /// An `ImageWidth` (or `ImageLength`) that does not match the strip:
