@@ -205,7 +205,8 @@ pub fn read(path: &Path) -> Result<Grid> {
         // The value: the rest of this line, then the lines up to the next
         // keyword (a line ending in `\` continues on the next).
         let mut values: Vec<String> = Vec::new();
-        let rest = line[keyword.len()..].trim();
+        // After the keyword, which may follow white space (a `\r`).
+        let rest = line.trim_start()[keyword.len()..].trim();
         if !rest.is_empty() {
             values.push(rest.to_string());
         }
@@ -714,6 +715,23 @@ mod tests {
         let s: Vec<f64> = (0..4).map(|i| g.values[g.geometry.index(i, 0)]).collect();
         assert_eq!(s, [1002.5, 1002.5, 1002.5, 1003.5]);
         assert_eq!(g.crs, None);
+    }
+
+    /// A keyword after white space (` #Xé`, `\r#UNITL…`: non-ASCII text)
+    /// panicked: its value was cut at the keyword's length from the line's
+    /// start, inside a character (found by the `grid` fuzz target). Now
+    /// the value is read after the keyword, and the file read or refused.
+    #[test]
+    fn a_keyword_after_white_space_is_read_after_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("g.gxf");
+        fs::write(
+            &path,
+            " #Xé 1\n#POINTS\n2\n#ROWS\n1\n#PTSEPARATION\n10\n#RWSEPARATION\n10\n \t#TITLE é x\n#GRID\n1 2\n",
+        )
+        .unwrap();
+        let g = read(&path).unwrap();
+        assert_eq!((g.geometry.nx, g.values.clone()), (2, vec![1.0, 2.0]));
     }
 
     #[test]

@@ -371,9 +371,8 @@ pub(crate) fn open_error(path: &Path, source: std::io::Error) -> GridError {
     }
 }
 
-/// Checks the geometry of a grid read from a file: a cell size within
-/// [`MIN_CELL`]–[`MAX_CELL`], node coordinates within ±[`MAX_COORDINATE`],
-/// a node count within [`MAX_NODES`].
+/// Checks the geometry of a grid read from a file
+/// ([`GridGeometry::problem`]): the reason is a read error naming the file.
 pub(crate) fn checked_geometry(path: &Path, geometry: GridGeometry) -> Result<GridGeometry> {
     match geometry.problem() {
         Some(reason) => Err(read_error(path, reason)),
