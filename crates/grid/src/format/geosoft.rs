@@ -215,10 +215,16 @@ pub fn read(path: &Path) -> Result<Grid> {
             values[node] = stored / h.zmult + h.zbase;
         }
     }
-    let mut grid = Grid::blank(g, &stem(path), "");
-    grid.values = values;
+    drop(data);
+    drop(bytes);
+    let grid = Grid {
+        geometry: g,
+        values,
+        crs: sidecar_crs(path)?,
+        name: stem(path),
+        unit: String::new(),
+    };
     super::check_values(path, &grid)?;
-    grid.crs = sidecar_crs(path)?;
     Ok(grid)
 }
 
