@@ -226,12 +226,10 @@ impl GridGeometry {
 /// 10⁻⁶ of a spacing of where the spacing puts it: [`Grid::from_axes`]
 /// and the netCDF reader.
 pub(crate) fn axis_spacing(axis: &[f64], name: &str) -> Result<Option<f64>> {
-    let (Some(&first), Some(&last)) = (axis.first(), axis.last()) else {
-        return Ok(None);
-    };
     if axis.len() < 2 {
         return Ok(None);
     }
+    let (first, last) = (axis[0], axis[axis.len() - 1]);
     let step = (last - first) / (axis.len() - 1) as f64;
     if !(step.is_finite() && step != 0.0) {
         return Err(GridError::Unusable(format!(
