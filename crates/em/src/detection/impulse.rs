@@ -94,13 +94,28 @@ pub fn sub_block_len(window_len: usize, sample_rate_hz: f64, lowest_hz: f64) -> 
 /// Robust centre `c` and spread `s` of `u` over sub-blocks of `sub_len`
 /// samples, `None` with fewer than three sub-blocks or no spread.
 fn centre_and_spread(u: &[f32], sub_len: usize) -> Option<(f64, f64)> {
+    centre_and_spread_of(&sub_block_extrema(u, sub_len)?)
+}
+
+/// `(min, max)` of each sub-block of `sub_len` samples of `u`, `None` with
+/// fewer than three sub-blocks.
+fn sub_block_extrema(u: &[f32], sub_len: usize) -> Option<Vec<(f32, f32)>> {
     if sub_len == 0 || u.len() < 3 * sub_len {
         return None;
     }
-    let (mut mids, mut halves): (Vec<f64>, Vec<f64>) = u
-        .chunks(sub_len)
-        .map(|sb| {
-            let (lo, hi) = min_max(sb);
+    Some(u.chunks(sub_len).map(min_max).collect())
+}
+
+/// Robust centre `c` (the upper median of the sub-blocks' mid-ranges) and
+/// spread `s` (of their half-ranges) from the sub-blocks' `(min, max)`;
+/// `None` with fewer than three sub-blocks or no spread.
+fn centre_and_spread_of(extrema: &[(f32, f32)]) -> Option<(f64, f64)> {
+    if extrema.len() < 3 {
+        return None;
+    }
+    let (mut mids, mut halves): (Vec<f64>, Vec<f64>) = extrema
+        .iter()
+        .map(|&(lo, hi)| {
             let (lo, hi) = (f64::from(lo), f64::from(hi));
             (0.5 * (hi + lo), 0.5 * (hi - lo))
         })
@@ -139,15 +154,23 @@ pub fn largest_statistic(u: &[f32], sub_len: usize) -> Option<(f64, usize)> {
 /// first sample at absolute frame `first`) in place; push one [`Spike`]
 /// per repaired run onto `out`.
 pub fn repair(u: &mut [f32], sub_len: usize, first: u64, channel: usize, out: &mut Vec<Spike>) {
-    let Some((c, s)) = centre_and_spread(u, sub_len) else {
+    // The sub-blocks' extrema as recorded serve both the centre and spread
+    // and the test of each sub-block below. A sub-block after a repaired
+    // run may hold repaired samples, but those lie before `next`, where
+    // the scan does not look again: the recorded extrema bound every
+    // sample it does look at, as a second pass over the repaired block
+    // would, so the same samples are found.
+    let Some(extrema) = sub_block_extrema(u, sub_len) else {
+        return;
+    };
+    let Some((c, s)) = centre_and_spread_of(&extrema) else {
         return;
     };
     let z = |v: f32| (f64::from(v) - c).abs() / s;
     let n = u.len();
     let mut next = 0;
-    for start in (0..n).step_by(sub_len) {
+    for (start, &(lo, hi)) in (0..n).step_by(sub_len).zip(&extrema) {
         let end = (start + sub_len).min(n);
-        let (lo, hi) = min_max(&u[start..end]);
         if z(lo).max(z(hi)) <= SPIKE_THRESHOLD {
             continue;
         }
@@ -252,6 +275,23 @@ mod tests {
         // The edge sample held at its neighbour: a first-order error.
         assert!((u[15_999] - clean[15_999]).abs() < 0.5);
         assert!((u[7_001] - clean[7_001]).abs() < 0.06);
+    }
+
+    /// A run longer than a sub-block (it covers the next sub-block whole
+    /// and ends in the one after) is one spike, repaired throughout, and a
+    /// spike further on in the sub-block where it ends is found as well.
+    #[test]
+    fn a_run_across_sub_blocks_is_one_spike_and_the_next_is_found() {
+        let l = sub_block_len(16_000, 1e5, 1000.0);
+        let mut u = tones(16_000);
+        u[1_100..1_700].iter_mut().for_each(|v| *v += 300.0);
+        u[1_720] = -500.0;
+        let mut spikes = Vec::new();
+        repair(&mut u, l, 0, 0, &mut spikes);
+        let found: Vec<(u64, usize)> = spikes.iter().map(|s| (s.frame, s.samples)).collect();
+        assert_eq!(found, [(1_100, 600), (1_720, 1)]);
+        let (z, _) = largest_statistic(&u, l).unwrap();
+        assert!(z <= SPIKE_THRESHOLD, "{z}");
     }
 
     #[test]

@@ -153,8 +153,17 @@ fn dot2_avx2(u: &[f32], re: &[f32], im: &[f32]) -> (f64, f64) {
 /// Three channels against one kernel: `[(Σ u_c·re, Σ u_c·im); 3]`, the
 /// kernel loaded once for all three (same arithmetic as [`dot2_body`] per
 /// channel, so results are bit-identical to it).
+///
+/// The 32 lanes of a tile are summed a quarter (8 lanes, one AVX2
+/// register) at a time: each lane still adds its products in sample
+/// order, so the bits are those of all 32 at once, but the six sums of a
+/// quarter (three channels, real and imaginary) stay in registers, where
+/// all 24 vectors of sums did not fit and were written to the stack and
+/// read back on every step (`perf annotate`: half the samples of the
+/// function on such a reload).
 #[inline(always)]
 fn dot2x3_body(u: [&[f32]; 3], re: &[f32], im: &[f32]) -> [(f64, f64); 3] {
+    const QUARTER: usize = LANES / 4;
     let mut out = [(0.0f64, 0.0f64); 3];
     let n = re.len();
     let mut start = 0;
@@ -163,18 +172,26 @@ fn dot2x3_body(u: [&[f32]; 3], re: &[f32], im: &[f32]) -> [(f64, f64); 3] {
         let mut ar = [[0.0f32; LANES]; 3];
         let mut ai = [[0.0f32; LANES]; 3];
         let nl = start + (end - start) / LANES * LANES;
-        let mut j0 = start;
-        while j0 < nl {
-            let rl = &re[j0..j0 + LANES];
-            let il = &im[j0..j0 + LANES];
-            for c in 0..3 {
-                let ul = &u[c][j0..j0 + LANES];
-                for j in 0..LANES {
-                    ar[c][j] += ul[j] * rl[j];
-                    ai[c][j] += ul[j] * il[j];
+        for q in (0..LANES).step_by(QUARTER) {
+            let mut sr = [[0.0f32; QUARTER]; 3];
+            let mut si = [[0.0f32; QUARTER]; 3];
+            let mut j0 = start + q;
+            while j0 < nl {
+                let rl = &re[j0..j0 + QUARTER];
+                let il = &im[j0..j0 + QUARTER];
+                for c in 0..3 {
+                    let ul = &u[c][j0..j0 + QUARTER];
+                    for j in 0..QUARTER {
+                        sr[c][j] += ul[j] * rl[j];
+                        si[c][j] += ul[j] * il[j];
+                    }
                 }
+                j0 += LANES;
             }
-            j0 += LANES;
+            for c in 0..3 {
+                ar[c][q..q + QUARTER].copy_from_slice(&sr[c]);
+                ai[c][q..q + QUARTER].copy_from_slice(&si[c]);
+            }
         }
         for j in nl..end {
             for c in 0..3 {
@@ -266,49 +283,80 @@ impl SyncDetector {
                 reason: format!("frequency {f} Hz outside (0, fs/2)"),
             });
         }
-        let weights = config
-            .window
-            .samples(config.window_len, Symmetry::Periodic)?;
-        let sum: f64 = weights.iter().sum();
-        if !crate::positive_finite(sum) {
-            return Err(EmError::InvalidArgument {
-                reason: "window sums to zero".into(),
-            });
-        }
-        let mut kernels_re = Vec::with_capacity(config.frequencies_hz.len());
-        let mut kernels_im = Vec::with_capacity(config.frequencies_hz.len());
         // On the bin grid (f = k f_s/N, the frequency plan's rule) the
         // phase 2π f n/f_s is 2π ((k n) mod N)/N: one table of N phasors
         // serves every frequency (N sines and cosines instead of N per
         // frequency; the phase is also exact, without the integer part
         // that f n/f_s carries).
         let len = config.window_len;
-        let mut unit: Vec<(f64, f64)> = Vec::new();
-        for &f in &config.frequencies_hz {
-            let bins = f * len as f64 / fs;
-            let on_grid = (bins - bins.round()).abs() <= 1e-9 * bins.max(1.0);
-            if on_grid && unit.is_empty() {
-                unit = (0..len)
-                    .map(|m| (TAU * (m as f64 / len as f64)).sin_cos())
-                    .collect();
+        let bins_of = |f: f64| f * len as f64 / fs;
+        let on_grid = |bins: f64| (bins - bins.round()).abs() <= 1e-9 * bins.max(1.0);
+        let any_on_grid = config.frequencies_hz.iter().any(|&f| on_grid(bins_of(f)));
+        let threads = aeromag_core::parallel::threads();
+        // The window and the table are independent: each on a core of its
+        // own where there are two (the detector is built before every
+        // record's detection, and these sines and cosines were a fifth of
+        // `em detect`'s time on the default 10 s record).
+        let table = || -> Vec<(f64, f64)> {
+            if !any_on_grid {
+                return Vec::new();
             }
+            (0..len)
+                .map(|m| (TAU * (m as f64 / len as f64)).sin_cos())
+                .collect()
+        };
+        let window = || config.window.samples(len, Symmetry::Periodic);
+        let (weights, unit) = if threads > 1 {
+            std::thread::scope(|scope| {
+                let unit = scope.spawn(table);
+                let weights = window();
+                (
+                    weights,
+                    unit.join().expect("the phasor table does not panic"),
+                )
+            })
+        } else {
+            (window(), table())
+        };
+        let weights = weights?;
+        let sum: f64 = weights.iter().sum();
+        if !crate::positive_finite(sum) {
+            return Err(EmError::InvalidArgument {
+                reason: "window sums to zero".into(),
+            });
+        }
+        let scaled: Vec<f64> = weights.iter().map(|w| 2.0 * w / sum).collect();
+        // One kernel per frequency, the frequencies shared out over the
+        // cores; each kernel is the same bits wherever it is made.
+        let kernel = |f: f64| -> (Vec<f32>, Vec<f32>) {
+            let bins = bins_of(f);
+            let grid = on_grid(bins);
+            // k n mod N, stepped (k < N) rather than divided for every n.
             let k = bins.round() as usize % len;
-            let (re, im): (Vec<f32>, Vec<f32>) = weights
+            let mut phase = 0usize;
+            scaled
                 .iter()
                 .enumerate()
-                .map(|(n, w)| {
-                    let (sin, cos) = if on_grid {
-                        unit[((k as u64 * n as u64) % len as u64) as usize]
+                .map(|(n, s)| {
+                    let (sin, cos) = if grid {
+                        let sc = unit[phase];
+                        phase += k;
+                        if phase >= len {
+                            phase -= len;
+                        }
+                        sc
                     } else {
                         (TAU * (f * n as f64 / fs).fract()).sin_cos()
                     };
-                    let s = 2.0 * w / sum;
                     ((s * cos) as f32, (s * sin) as f32)
                 })
+                .unzip()
+        };
+        let freqs = &config.frequencies_hz;
+        let (kernels_re, kernels_im): (Vec<Vec<f32>>, Vec<Vec<f32>>) =
+            aeromag_core::parallel::parallel_map(freqs.len(), threads, |i| kernel(freqs[i]))
+                .into_iter()
                 .unzip();
-            kernels_re.push(re);
-            kernels_im.push(im);
-        }
         #[cfg(target_arch = "x86_64")]
         let avx2 = std::arch::is_x86_feature_detected!("avx2");
         #[cfg(not(target_arch = "x86_64"))]
@@ -482,9 +530,18 @@ impl SyncDetector {
         let mut sums = vec![(0.0f64, 0.0f64); nf * channels];
         let mut out = Vec::with_capacity(data.len() / (n * channels));
         for (b, block) in data.chunks_exact(n * channels).enumerate() {
-            for (i, frame) in block.chunks_exact(channels).enumerate() {
-                for (c, &v) in frame.iter().enumerate() {
-                    buf[c][i] = v;
+            if let [b0, b1, b2] = &mut buf[..] {
+                // Three channels, the usual record: without the general
+                // loop's index checks and per-channel lookups (a quarter
+                // of a detection's time went there).
+                for (((f, x0), x1), x2) in block.chunks_exact(3).zip(b0).zip(b1).zip(b2) {
+                    (*x0, *x1, *x2) = (f[0], f[1], f[2]);
+                }
+            } else {
+                for (i, frame) in block.chunks_exact(channels).enumerate() {
+                    for (c, &v) in frame.iter().enumerate() {
+                        buf[c][i] = v;
+                    }
                 }
             }
             let first = start_index + (b * n) as u64;
@@ -667,6 +724,34 @@ mod tests {
             })
             .is_err()
         );
+    }
+
+    /// Three channels against one kernel give, in the plain build and in
+    /// the AVX2 build where the processor has it, the bits of each channel
+    /// alone (lengths with partial lanes and partial flush tiles).
+    #[test]
+    fn dot_products_are_the_same_bits_in_every_build() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        #[cfg(target_arch = "x86_64")]
+        let builds = [false, std::arch::is_x86_feature_detected!("avx2")];
+        #[cfg(not(target_arch = "x86_64"))]
+        let builds = [false];
+        for n in [1usize, 31, 32, 33, 1000, 1024, 2049, 16_000] {
+            let mut v = || -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.0f32..1.0)).collect() };
+            let (u0, u1, u2, re, im) = (v(), v(), v(), v(), v());
+            let u = [u0.as_slice(), u1.as_slice(), u2.as_slice()];
+            let bits = |x: [(f64, f64); 3]| x.map(|(a, b)| (a.to_bits(), b.to_bits()));
+            let alone = bits(std::array::from_fn(|c| dot2_body(u[c], &re, &im)));
+            for avx2 in builds {
+                assert_eq!(
+                    bits(dot2x3(u, &re, &im, avx2)),
+                    alone,
+                    "avx2 {avx2}, n = {n}"
+                );
+                let each = std::array::from_fn(|c| dot2(u[c], &re, &im, avx2));
+                assert_eq!(bits(each), alone, "avx2 {avx2} alone, n = {n}");
+            }
+        }
     }
 
     /// Frequency response against SciPy (`tools/reference/em_detector_response.py`).
