@@ -48,7 +48,9 @@ def missing(mod):
     except ModuleNotFoundError:
         return True
 print(" ".join(spec for spec, mod in [("maturin", "maturin"), ("pytest", "pytest"), ("pandas", "pandas"),
-                                      ("dask[distributed]", "dask.distributed"), ("mypy", "mypy")]
+                                      ("dask[distributed]", "dask.distributed"), ("mypy", "mypy"),
+                                      # the interchange tests with these libraries (skipped without them)
+                                      ("polars", "polars"), ("xarray", "xarray"), ("harmonica", "harmonica")]
                if missing(mod)))
 PY
 )
