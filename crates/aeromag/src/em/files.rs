@@ -195,12 +195,10 @@ fn check_finite(path: &Path, body_offset: u64, first: u64, samples: &[f32]) -> R
     };
     let threads = aeromag_core::parallel::threads();
     let all_finite = if threads > 1 && samples.len() >= 1 << 20 {
-        let part = samples.len().div_ceil(threads);
-        aeromag_core::parallel::parallel_map(threads, threads, |t| {
-            finite(&samples[(t * part).min(samples.len())..((t + 1) * part).min(samples.len())])
-        })
-        .into_iter()
-        .all(|ok| ok)
+        let parts: Vec<&[f32]> = samples.chunks(samples.len().div_ceil(threads)).collect();
+        aeromag_core::parallel::parallel_map(parts.len(), threads, |t| finite(parts[t]))
+            .into_iter()
+            .all(|ok| ok)
     } else {
         finite(samples)
     };
@@ -344,7 +342,9 @@ mod tests {
         let mut samples = vec![0.25f32; n];
         assert!(check_finite(path, 100, 0, &samples).is_ok());
         samples[n - 2] = f32::INFINITY;
-        let msg = check_finite(path, 100, 7, &samples).unwrap_err().to_string();
+        let msg = check_finite(path, 100, 7, &samples)
+            .unwrap_err()
+            .to_string();
         let k = n - 2;
         assert!(
             msg.contains(&format!(
@@ -356,7 +356,12 @@ mod tests {
             "{msg}"
         );
         samples[5] = f32::NAN;
-        let msg = check_finite(path, 100, 0, &samples).unwrap_err().to_string();
-        assert!(msg.contains("frame 1 channel 2 (byte offset 120) is NaN"), "{msg}");
+        let msg = check_finite(path, 100, 0, &samples)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("frame 1 channel 2 (byte offset 120) is NaN"),
+            "{msg}"
+        );
     }
 }

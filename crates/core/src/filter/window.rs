@@ -108,8 +108,9 @@ pub(crate) fn extended_len(len: usize, symmetry: Symmetry) -> usize {
     }
 }
 
-/// Windows at least this long are computed on all cores.
-const PARALLEL_WINDOW_LEN: usize = 8192;
+/// Windows at least twice this long are computed on all cores, in parts of
+/// a multiple of it.
+const WINDOW_PART: usize = 4096;
 
 /// General cosine-sum window `w[n] = Σ_k a_k cos(k φ_n)`,
 /// `φ_n = −π + 2π n/(M−1)` (SciPy `general_cosine`).
@@ -134,11 +135,17 @@ pub fn cosine_sum(len: usize, coeffs: &[f64], symmetry: Symmetry) -> Vec<f64> {
     // A long window (an EM detector's 16 000 samples: 48 000 cosines,
     // about a millisecond) in parts on the cores; each value is the same
     // bits wherever it is computed.
-    let mut w = if m >= PARALLEL_WINDOW_LEN {
-        crate::parallel::parallel_map(m, crate::parallel::threads(), value)
-    } else {
-        (0..m).map(value).collect()
-    };
+    let mut w = vec![0.0; m];
+    crate::parallel::for_each_part_mut(
+        &mut w,
+        crate::parallel::threads(),
+        WINDOW_PART,
+        |start, part| {
+            for (i, v) in part.iter_mut().enumerate() {
+                *v = value(start + i);
+            }
+        },
+    );
     w.truncate(len);
     w
 }

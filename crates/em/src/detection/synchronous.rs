@@ -292,33 +292,14 @@ impl SyncDetector {
         let bins_of = |f: f64| f * len as f64 / fs;
         let on_grid = |bins: f64| (bins - bins.round()).abs() <= 1e-9 * bins.max(1.0);
         let any_on_grid = config.frequencies_hz.iter().any(|&f| on_grid(bins_of(f)));
-        let threads = aeromag_core::parallel::threads();
-        // The window and the table are independent: each on a core of its
-        // own where there are two (the detector is built before every
-        // record's detection, and these sines and cosines were a fifth of
-        // `em detect`'s time on the default 10 s record).
-        let table = || -> Vec<(f64, f64)> {
-            if !any_on_grid {
-                return Vec::new();
-            }
+        let weights = config.window.samples(len, Symmetry::Periodic)?;
+        let unit: Vec<(f64, f64)> = if any_on_grid {
             (0..len)
                 .map(|m| (TAU * (m as f64 / len as f64)).sin_cos())
                 .collect()
-        };
-        let window = || config.window.samples(len, Symmetry::Periodic);
-        let (weights, unit) = if threads > 1 {
-            std::thread::scope(|scope| {
-                let unit = scope.spawn(table);
-                let weights = window();
-                (
-                    weights,
-                    unit.join().expect("the phasor table does not panic"),
-                )
-            })
         } else {
-            (window(), table())
+            Vec::new()
         };
-        let weights = weights?;
         let sum: f64 = weights.iter().sum();
         if !crate::positive_finite(sum) {
             return Err(EmError::InvalidArgument {
@@ -353,6 +334,7 @@ impl SyncDetector {
                 .unzip()
         };
         let freqs = &config.frequencies_hz;
+        let threads = aeromag_core::parallel::threads();
         let (kernels_re, kernels_im): (Vec<Vec<f32>>, Vec<Vec<f32>>) =
             aeromag_core::parallel::parallel_map(freqs.len(), threads, |i| kernel(freqs[i]))
                 .into_iter()
