@@ -108,6 +108,8 @@ pub struct AugmentedFilter {
 pub(super) struct RightHandSides {
     n: usize,
     prior_mean: Vec<f64>,
+    /// Every prior mean is zero ([`Self::absorb`] skips `z·β₀`).
+    zero_prior_mean: bool,
     prior_var: Vec<f64>,
     /// `m + 1` right-hand sides (the columns, then the reading) rounded up to
     /// a multiple of [`LANES`]; the padding stays zero.
@@ -169,6 +171,7 @@ impl AugmentedFilter {
             rhs: RightHandSides {
                 n,
                 prior_mean: prior_mean.to_vec(),
+                zero_prior_mean: prior_mean.iter().all(|v| *v == 0.0),
                 prior_var: prior_std.iter().map(|s| s * s).collect(),
                 width,
                 x: vec![0.0; n * width],
@@ -368,16 +371,23 @@ impl RightHandSides {
     /// The time update with `Φ` (`n × n`), applied with the next
     /// measurement update.
     pub(super) fn predict(&mut self, phi: &DMatrix<f64>) {
-        if self.pending {
-            self.propagate_now();
-        }
         let n = self.n;
-        self.phi.copy_from_slice(phi.as_slice());
-        self.phi_upper = (0..n).all(|j| {
-            self.phi[j * n + j + 1..(j + 1) * n]
+        let upper = (0..n).all(|j| {
+            phi.as_slice()[j * n + j + 1..(j + 1) * n]
                 .iter()
                 .all(|p| *p == 0.0)
         });
+        self.predict_known(phi, upper);
+    }
+
+    /// [`Self::predict`] with `Φ` known to be upper triangular or not
+    /// (`upper`; [`AugmentedLanes`] has checked it).
+    pub(super) fn predict_known(&mut self, phi: &DMatrix<f64>, upper: bool) {
+        if self.pending {
+            self.propagate_now();
+        }
+        self.phi.copy_from_slice(phi.as_slice());
+        self.phi_upper = upper;
         self.pending = true;
     }
 
@@ -412,7 +422,7 @@ impl RightHandSides {
                 z.len()
             )));
         }
-        if !y.is_finite() || z.iter().any(|v| !v.is_finite()) {
+        if !(y.is_finite() && aeromag_core::simd::all_finite(z)) {
             return Err(EstError::NonFinite {
                 what: "reading or regressor row",
             });
@@ -432,13 +442,23 @@ impl RightHandSides {
         gain: &[f64],
     ) -> Result<()> {
         let m = self.prior_mean.len();
-        let y0: f64 = z.iter().zip(&self.prior_mean).map(|(a, b)| a * b).sum();
         self.nu[..m].copy_from_slice(z);
-        self.nu[m] = y - y0;
+        // With a zero prior mean (the usual case) `z·β₀` is a sum of zeros
+        // and `y − z·β₀` is `y` (but for a reading of exactly −0): the
+        // 34-term dependent sum is not worth its latency on every sample.
+        self.nu[m] = if self.zero_prior_mean {
+            y
+        } else {
+            y - z
+                .iter()
+                .zip(&self.prior_mean)
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+        };
         let phi = self.pending.then_some(self.phi.as_slice());
         macro_rules! fixed {
-            ($k:literal) => {
-                aeromag_core::simd::run(Step::<$k> {
+            ($n:literal, $two:literal) => {
+                aeromag_core::simd::run(Step::<$n, $two> {
                     x: &mut self.x,
                     nu: &mut self.nu,
                     phi,
@@ -448,11 +468,16 @@ impl RightHandSides {
                 })
             };
         }
-        match (h.len(), self.phi_upper || phi.is_none()) {
-            // The field models of orders 3, 4 and 6 (upper-triangular Φ).
-            (5, true) => fixed!(5),
-            (6, true) => fixed!(6),
-            (8, true) => fixed!(8),
+        let upper = self.phi_upper || phi.is_none();
+        match (h.len(), upper) {
+            // The field models of orders 3, 4 and 6 (upper-triangular Φ,
+            // two chains read at their heads).
+            (5, true) if two_chains(phi, h) => fixed!(5, true),
+            (6, true) if two_chains(phi, h) => fixed!(6, true),
+            (8, true) if two_chains(phi, h) => fixed!(8, true),
+            (5, true) => fixed!(5, false),
+            (6, true) => fixed!(6, false),
+            (8, true) => fixed!(8, false),
             _ => {
                 if self.pending {
                     self.propagate_now();
@@ -589,10 +614,40 @@ impl aeromag_core::simd::Kernel for Innovate<'_> {
     }
 }
 
+/// Whether `Φ` (`n × n` column-major, if any) and `h` are those of two
+/// independent chains, states `0..n−2` and `n−2..n`, each read at its
+/// head: `Φ` block diagonal and `h` zero but for entries `0` and `n − 2`
+/// (the field models: the `B^h` chain and the two-state `B_z` chain).
+pub(super) fn two_chains(phi: Option<&[f64]>, h: &[f64]) -> bool {
+    let n = h.len();
+    let Some(split) = n.checked_sub(2) else {
+        return false;
+    };
+    let h_heads = h
+        .iter()
+        .enumerate()
+        .fold(true, |ok, (i, v)| ok & (i == 0 || i == split || *v == 0.0));
+    let blocks = phi.is_none_or(|p| {
+        (split..n).fold(true, |ok, j| {
+            ok & p[j * n..j * n + split]
+                .iter()
+                .fold(true, |z, v| z & (*v == 0.0))
+        })
+    });
+    h_heads && blocks
+}
+
 /// [`Propagate`] with an upper-triangular `Φ` (when given) and
 /// [`Innovate`] in one pass over `x`, four right-hand sides at a time held
 /// in registers, for `N` states: the same operations in the same order.
-struct Step<'a, const N: usize> {
+///
+/// With `TWO` the model is two chains ([`two_chains`]): the products with
+/// the structural zeros of `Φ` and `h` are left out. That changes no bit of
+/// the states: a sum started from +0 never becomes −0, so adding `0 · x`
+/// left it as it was; and `v − 0 · x` is `v` unless `v` is exactly −0,
+/// which changes only the sign of an innovation of exactly zero. Without:
+/// any upper-triangular `Φ` and any `h`.
+struct Step<'a, const N: usize, const TWO: bool> {
     x: &'a mut [f64],
     nu: &'a mut [f64],
     phi: Option<&'a [f64]>,
@@ -601,11 +656,13 @@ struct Step<'a, const N: usize> {
     width: usize,
 }
 
-impl<const N: usize> aeromag_core::simd::Kernel for Step<'_, N> {
+impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Step<'_, N, TWO> {
     type Output = ();
     #[inline(always)]
     fn run(self) {
         let w = self.width;
+        // The second chain's first state (N: none).
+        let split = if TWO { N - 2 } else { N };
         let h: [f64; N] = std::array::from_fn(|i| self.h[i]);
         let k: [f64; N] = std::array::from_fn(|i| self.gain[i]);
         let phi: Option<[[f64; N]; N]> = self
@@ -620,7 +677,9 @@ impl<const N: usize> aeromag_core::simd::Kernel for Step<'_, N> {
                 // Row i reads the states j ≥ i, not yet overwritten.
                 for i in 0..N {
                     let mut a = [0.0; LANES];
-                    for j in i..N {
+                    // Row i of the first chain ends at its last state.
+                    let end = if i < split { split } else { N };
+                    for j in i..end {
                         for l in 0..LANES {
                             a[l] += p[i][j] * xs[j][l];
                         }
@@ -631,8 +690,10 @@ impl<const N: usize> aeromag_core::simd::Kernel for Step<'_, N> {
             let mut v = [0.0; LANES];
             v.copy_from_slice(&self.nu[b..b + LANES]);
             for i in 0..N {
-                for l in 0..LANES {
-                    v[l] -= h[i] * xs[i][l];
+                if !TWO || i == 0 || i == split {
+                    for l in 0..LANES {
+                        v[l] -= h[i] * xs[i][l];
+                    }
                 }
             }
             for i in 0..N {
@@ -853,6 +914,75 @@ mod tests {
         assert!(recorded.log_likelihood().is_err() && recorded.solve().is_err());
         assert!(summed.merge(&mut recorded).is_err());
         assert!(recorded.take_innovations().unwrap().is_empty());
+    }
+
+    /// The two-chain step leaves out products with structural zeros of Φ
+    /// and h: the states and innovations are the dense step's to the bit;
+    /// and only such models are taken for two chains.
+    #[test]
+    fn two_chain_step_is_the_dense_step_bit_for_bit() {
+        use aeromag_core::simd::Kernel;
+        const N: usize = 8;
+        let mut seed = 0x5EEDu64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let w = 12;
+        let cross = |i: usize, j: usize| i < N - 2 && j >= N - 2;
+        for round in 0..200 {
+            // Column-major upper Φ, zero between the chains.
+            let phi: Vec<f64> = (0..N * N)
+                .map(|c| {
+                    let (i, j) = (c % N, c / N);
+                    if i <= j && !cross(i, j) { rnd() } else { 0.0 }
+                })
+                .collect();
+            let mut h = [0.0; N];
+            h[0] = 1.0;
+            h[N - 2] = if round % 5 == 0 { 0.0 } else { rnd() };
+            let gain: Vec<f64> = (0..N).map(|_| rnd()).collect();
+            // Some right-hand sides zero (a regressor column that is 0).
+            let x: Vec<f64> = (0..N * w)
+                .map(|k| if k % w == 3 { 0.0 } else { rnd() })
+                .collect();
+            let nu: Vec<f64> = (0..w).map(|k| if k == 3 { -0.0 } else { rnd() }).collect();
+            let with = (round % 4 != 0).then_some(phi.as_slice());
+            assert!(two_chains(with, &h));
+            let (mut xa, mut na, mut xb, mut nb) = (x.clone(), nu.clone(), x, nu);
+            Step::<N, true> {
+                x: &mut xa,
+                nu: &mut na,
+                phi: with,
+                h: &h,
+                gain: &gain,
+                width: w,
+            }
+            .run();
+            Step::<N, false> {
+                x: &mut xb,
+                nu: &mut nb,
+                phi: with,
+                h: &h,
+                gain: &gain,
+                width: w,
+            }
+            .run();
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&xa), bits(&xb), "states, round {round}");
+            assert_eq!(bits(&na), bits(&nb), "innovations, round {round}");
+        }
+        let mut phi = vec![0.0; N * N];
+        let mut h = [0.0; N];
+        h[0] = 1.0;
+        assert!(two_chains(Some(&phi), &h));
+        phi[(N - 1) * N] = 0.5; // Φ[0][N−1]: the chains coupled
+        assert!(!two_chains(Some(&phi), &h));
+        h[1] = 0.5; // a row reading the chain's second state
+        assert!(!two_chains(None, &h));
+        assert!(!two_chains(None, &[1.0]));
     }
 
     #[test]

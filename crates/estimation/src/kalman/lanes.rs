@@ -153,7 +153,7 @@ impl<const N: usize> AugmentedLanes<N> {
                     reading
                 }
             };
-            if reading.h.len() != N || reading.h.iter().any(|v| !v.is_finite()) {
+            if reading.h.len() != N || !aeromag_core::simd::all_finite(reading.h) {
                 return Err(EstError::NonFinite {
                     what: "scalar measurement or its row",
                 });
@@ -171,11 +171,24 @@ impl<const N: usize> AugmentedLanes<N> {
         }
         // Lanes not moving compute with whatever Φ and G they last had (the
         // lower parts are never written: zero); their results are not kept.
-        aeromag_core::simd::run(Predict {
+        // Two chains in every lane (the field models): the products with
+        // the structural zeros left out, as in `augmented::Step` (the same
+        // bits: every sum here starts from +0).
+        let two = self.two_chains(&h);
+        macro_rules! kernel {
+            ($k:ident { $($f:ident: $v:expr),* }) => {
+                if two {
+                    aeromag_core::simd::run($k::<N, true> { $($f: $v),* })
+                } else {
+                    aeromag_core::simd::run($k::<N, false> { $($f: $v),* })
+                }
+            };
+        }
+        kernel!(Predict {
             u: &mut self.u,
             phi: &self.phi,
-            g: &self.g,
-            moving,
+            g: &mut self.g,
+            moving: moving
         });
         // Idle lanes: h = 0, so every f_j is 0 and the factor is unchanged.
         let mut rr = [1.0; L];
@@ -184,18 +197,19 @@ impl<const N: usize> AugmentedLanes<N> {
                 rr[l] = r;
             }
         }
-        let variance = aeromag_core::simd::run(Update {
+        let variance = kernel!(Update {
             u: &mut self.u,
             gain: &mut self.gain,
             h: &h,
-            r: rr,
+            r: rr
         });
         for (l, step) in lanes.iter().enumerate() {
             let reading = match step {
                 LaneStep::Idle => continue,
                 LaneStep::Start(reading) => reading,
                 LaneStep::Next { phi, reading, .. } => {
-                    self.rhs[l].predict(phi);
+                    // Checked upper triangular above.
+                    self.rhs[l].predict_known(phi, true);
                     reading
                 }
             };
@@ -219,6 +233,27 @@ impl<const N: usize> AugmentedLanes<N> {
     /// given the coefficients after its last step.
     pub fn conditional(&self, l: usize) -> LeadingConditional {
         self.rhs[l].conditional(self.factor(l))
+    }
+
+    /// Whether every lane's `Φ` and `h` are two chains read at their
+    /// heads ([`super::augmented::two_chains`]; lanes not moving compute
+    /// with the `Φ` they last had, whose results are not kept).
+    fn two_chains(&self, h: &[[f64; L]; N]) -> bool {
+        let Some(split) = N.checked_sub(2) else {
+            return false;
+        };
+        let mut two = true;
+        for i in 0..N {
+            for l in 0..L {
+                two &= i == 0 || i == split || h[i][l] == 0.0;
+            }
+            for j in split.max(i)..N {
+                for l in 0..L {
+                    two &= i >= split || self.phi[i][j][l] == 0.0;
+                }
+            }
+        }
+        two
     }
 
     /// Lane `l`'s upper factor.
@@ -249,25 +284,29 @@ impl<const N: usize> AugmentedLanes<N> {
 
 /// `U ← tri([G, Φ U])` in every moving lane: [`super::SqrtKalmanFilter::predict`]'s
 /// arithmetic (`propagate_impl` with the pair triangularisation), lane by
-/// lane.
-struct Predict<'a, const N: usize> {
+/// lane. `G` is triangularised in place (each step brings its own).
+struct Predict<'a, const N: usize, const TWO: bool> {
     u: &'a mut [[[f64; L]; N]; N],
     phi: &'a [[[f64; L]; N]; N],
-    g: &'a [[[f64; L]; N]; N],
+    g: &'a mut [[[f64; L]; N]; N],
     moving: [bool; L],
 }
 
-impl<const N: usize> aeromag_core::simd::Kernel for Predict<'_, N> {
+impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_, N, TWO> {
     type Output = ();
     #[inline(always)]
     fn run(self) {
+        // The second chain's first state (N: none).
+        let split = if TWO { N - 2 } else { N };
         // [B, A] = [G, Φ U], row-major: b[i][j], a[i][j].
-        let mut b = *self.g;
+        let b = self.g;
         let mut a = [[[0.0; L]; N]; N];
         // A = Φ U: each entry summed over l ascending from +0 (the sparse
         // sum's order; the zeros of Φ add nothing).
         for k in 0..N {
-            for i in 0..=k {
+            // Φ is zero between the chains.
+            let from = if k >= split { split } else { 0 };
+            for i in from..=k {
                 let p = self.phi[i][k];
                 for j in k..N {
                     let ukj = self.u[j][k];
@@ -352,21 +391,27 @@ impl<const N: usize> aeromag_core::simd::Kernel for Predict<'_, N> {
 /// Carlson's update of every lane ([`super::carlson::carlson_update`]'s
 /// arithmetic, the state mean left out: it is zero in an augmented filter);
 /// returns the innovation variances.
-struct Update<'a, const N: usize> {
+struct Update<'a, const N: usize, const TWO: bool> {
     u: &'a mut [[[f64; L]; N]; N],
     gain: &'a mut [[f64; L]; N],
     h: &'a [[f64; L]; N],
     r: [f64; L],
 }
 
-impl<const N: usize> aeromag_core::simd::Kernel for Update<'_, N> {
+impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Update<'_, N, TWO> {
     type Output = [f64; L];
     #[inline(always)]
     fn run(self) -> [f64; L] {
-        // f = Uᵀh, each summed over its rows in order.
+        // The second chain's first state (N: none).
+        let split = if TWO { N - 2 } else { N };
+        // f = Uᵀh, each summed over its rows in order (h is zero but at
+        // the chains' heads).
         let mut f = [[0.0; L]; N];
         for (j, fj) in f.iter_mut().enumerate() {
             for i in 0..=j {
+                if TWO && i != 0 && i != split {
+                    continue;
+                }
                 for l in 0..L {
                     fj[l] += self.u[j][i][l] * self.h[i][l];
                 }
@@ -419,8 +464,11 @@ mod tests {
 
     /// Four lanes with their own transitions, rows, run starts and idle
     /// steps: each lane's filter is bit for bit the filter stepped alone.
-    fn lanes_equal_filters_alone<const N: usize>() {
-        let mut seed = 11 + N as u64;
+    /// With `two`, Φ, G and h are two chains (states `0..N−2` and
+    /// `N−2..N`, read at their heads: the kernels that skip the zeros).
+    fn lanes_equal_filters_alone<const N: usize>(two: bool) {
+        let mut seed = 11 + N as u64 + two as u64;
+        let cross = move |i: usize, j: usize| two && i < N - 2 && j >= N - 2;
         // A diagonal prior: at each run start `f_j = 0` for the states the
         // row does not see (Carlson leaves those columns alone).
         let s0 = DMatrix::from_fn(N, N, |i, j| if i == j { 2.0 / (1 + i) as f64 } else { 0.0 });
@@ -436,14 +484,14 @@ mod tests {
             let phi = DMatrix::from_fn(N, N, |i, j| {
                 if i == j {
                     1.0
-                } else if i < j {
+                } else if i < j && !cross(i, j) {
                     d.powi((j - i) as i32) / (1 + j - i) as f64
                 } else {
                     0.0
                 }
             });
             let g = DMatrix::from_fn(N, N, |i, j| {
-                if i <= j {
+                if i <= j && !cross(i, j) {
                     0.05 * d * (1.0 + 0.1 * (i + 2 * j) as f64)
                 } else {
                     0.0
@@ -471,7 +519,7 @@ mod tests {
                 };
                 let mut h = vec![0.0; N];
                 h[0] = 1.0 + 0.5 * rnd(&mut seed);
-                h[N - 1] = if (k + l) % 11 == 0 {
+                h[if two { N - 2 } else { N - 1 }] = if (k + l) % 11 == 0 {
                     0.0
                 } else {
                     rnd(&mut seed)
@@ -532,9 +580,99 @@ mod tests {
 
     #[test]
     fn each_lane_is_its_filter_alone_bit_for_bit() {
-        lanes_equal_filters_alone::<5>();
-        lanes_equal_filters_alone::<6>();
-        lanes_equal_filters_alone::<8>();
+        for two in [false, true] {
+            lanes_equal_filters_alone::<5>(two);
+            lanes_equal_filters_alone::<6>(two);
+            lanes_equal_filters_alone::<8>(two);
+        }
+    }
+
+    /// The two-chain kernels leave out products with structural zeros: the
+    /// factors, gains and variances are the dense kernels' to the bit.
+    #[test]
+    fn two_chain_kernels_are_the_dense_kernels_bit_for_bit() {
+        use aeromag_core::simd::Kernel;
+        const N: usize = 8;
+        let mut seed = 5;
+        let cross = |i: usize, j: usize| i < N - 2 && j >= N - 2;
+        for round in 0..200 {
+            let mut u = [[[0.0; L]; N]; N];
+            let (mut phi, mut g) = (u, u);
+            let mut h = [[0.0; L]; N];
+            for j in 0..N {
+                for i in 0..=j {
+                    for l in 0..L {
+                        u[j][i][l] = rnd(&mut seed) + if i == j { 1.0 } else { 0.0 };
+                        if !cross(i, j) {
+                            phi[i][j][l] = rnd(&mut seed);
+                            g[i][j][l] = 0.1 * rnd(&mut seed);
+                        }
+                    }
+                }
+            }
+            for l in 0..L {
+                h[0][l] = 1.0;
+                // Some rows read the B_z chain at exactly zero.
+                h[N - 2][l] = if (round + l) % 7 == 0 {
+                    0.0
+                } else {
+                    rnd(&mut seed)
+                };
+            }
+            let moving = [true, true, round % 3 != 0, true];
+            let (mut a, mut b) = (u, u);
+            let (mut ga, mut gb) = (g, g);
+            Predict::<N, true> {
+                u: &mut a,
+                phi: &phi,
+                g: &mut ga,
+                moving,
+            }
+            .run();
+            Predict::<N, false> {
+                u: &mut b,
+                phi: &phi,
+                g: &mut gb,
+                moving,
+            }
+            .run();
+            let bits = |x: &[[[f64; L]; N]; N]| {
+                x.as_flattened()
+                    .as_flattened()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&a), bits(&b), "predict, round {round}");
+            let (mut ga, mut gb) = ([[0.0; L]; N], [[0.0; L]; N]);
+            let r = [0.03, 0.1, 1.0, 0.5];
+            let va = Update::<N, true> {
+                u: &mut a,
+                gain: &mut ga,
+                h: &h,
+                r,
+            }
+            .run();
+            let vb = Update::<N, false> {
+                u: &mut b,
+                gain: &mut gb,
+                h: &h,
+                r,
+            }
+            .run();
+            assert_eq!(bits(&a), bits(&b), "update, round {round}");
+            assert_eq!(va.map(f64::to_bits), vb.map(f64::to_bits));
+            assert_eq!(
+                ga.as_flattened()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect::<Vec<_>>(),
+                gb.as_flattened()
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect::<Vec<_>>()
+            );
+        }
     }
 
     #[test]
