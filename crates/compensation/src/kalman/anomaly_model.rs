@@ -504,9 +504,15 @@ impl AnomalyTransition {
             phi.shape() == (dim, dim) && g.shape() == (dim, dim),
             "field transition matrices must be {dim}×{dim}"
         );
-        let d = d.max(0.0);
         phi.as_mut_slice().fill(0.0);
         g.as_mut_slice().fill(0.0);
+        self.fill_blocks(d, phi, g);
+    }
+
+    /// [`Self::fill`] of the two chains' diagonal blocks alone, the rest of
+    /// `phi` and `g` untouched (zero from an earlier fill).
+    fn fill_blocks(&self, d: f64, phi: &mut DMatrix<f64>, g: &mut DMatrix<f64>) {
+        let d = d.max(0.0);
         self.horizontal.fill(d, 0, phi, g);
         self.vertical.fill(d, b_z_index(self.order), phi, g);
     }
@@ -543,7 +549,9 @@ impl StepTransition {
             )));
         }
         if d_m != self.last_d {
-            self.transition.fill(d_m, &mut self.phi, &mut self.g);
+            // The entries outside the blocks are zero since `new`: only the
+            // blocks change from step to step.
+            self.transition.fill_blocks(d_m, &mut self.phi, &mut self.g);
             self.last_d = d_m;
         }
         Ok((&self.phi, &self.g))

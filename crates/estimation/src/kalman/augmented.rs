@@ -371,23 +371,16 @@ impl RightHandSides {
     /// The time update with `Φ` (`n × n`), applied with the next
     /// measurement update.
     pub(super) fn predict(&mut self, phi: &DMatrix<f64>) {
-        let n = self.n;
-        let upper = (0..n).all(|j| {
-            phi.as_slice()[j * n + j + 1..(j + 1) * n]
-                .iter()
-                .all(|p| *p == 0.0)
-        });
-        self.predict_known(phi, upper);
-    }
-
-    /// [`Self::predict`] with `Φ` known to be upper triangular or not
-    /// (`upper`; [`AugmentedLanes`] has checked it).
-    pub(super) fn predict_known(&mut self, phi: &DMatrix<f64>, upper: bool) {
         if self.pending {
             self.propagate_now();
         }
+        let n = self.n;
         self.phi.copy_from_slice(phi.as_slice());
-        self.phi_upper = upper;
+        self.phi_upper = (0..n).all(|j| {
+            self.phi[j * n + j + 1..(j + 1) * n]
+                .iter()
+                .all(|p| *p == 0.0)
+        });
         self.pending = true;
     }
 
@@ -441,6 +434,39 @@ impl RightHandSides {
         s: f64,
         gain: &[f64],
     ) -> Result<()> {
+        self.absorb_after(None, h, z, y, s, gain)
+    }
+
+    /// The time update with the upper-triangular `Φ`, then [`Self::absorb`]
+    /// ([`AugmentedLanes`], which has checked `Φ`): the arithmetic of
+    /// [`Self::predict`] and [`Self::absorb`], without a copy of `Φ` when
+    /// the fused step takes it.
+    pub(super) fn predict_absorb(
+        &mut self,
+        phi: &DMatrix<f64>,
+        h: &[f64],
+        z: &[f64],
+        y: f64,
+        s: f64,
+        gain: &[f64],
+    ) -> Result<()> {
+        if self.pending {
+            self.propagate_now();
+        }
+        self.absorb_after(Some(phi.as_slice()), h, z, y, s, gain)
+    }
+
+    /// [`Self::absorb`] after the waiting time update, or after `upper_phi`
+    /// (upper triangular, none waiting) when given.
+    fn absorb_after(
+        &mut self,
+        upper_phi: Option<&[f64]>,
+        h: &[f64],
+        z: &[f64],
+        y: f64,
+        s: f64,
+        gain: &[f64],
+    ) -> Result<()> {
         let m = self.prior_mean.len();
         self.nu[..m].copy_from_slice(z);
         // With a zero prior mean (the usual case) `z·β₀` is a sum of zeros
@@ -455,7 +481,7 @@ impl RightHandSides {
                 .map(|(a, b)| a * b)
                 .sum::<f64>()
         };
-        let phi = self.pending.then_some(self.phi.as_slice());
+        let phi = upper_phi.or(self.pending.then_some(self.phi.as_slice()));
         macro_rules! fixed {
             ($n:literal, $two:literal) => {
                 aeromag_core::simd::run(Step::<$n, $two> {
@@ -468,7 +494,7 @@ impl RightHandSides {
                 })
             };
         }
-        let upper = self.phi_upper || phi.is_none();
+        let upper = upper_phi.is_some() || self.phi_upper || phi.is_none();
         match (h.len(), upper) {
             // The field models of orders 3, 4 and 6 (upper-triangular Φ,
             // two chains read at their heads).
@@ -479,6 +505,10 @@ impl RightHandSides {
             (6, true) => fixed!(6, false),
             (8, true) => fixed!(8, false),
             _ => {
+                if let Some(p) = upper_phi {
+                    self.phi.copy_from_slice(p);
+                    self.pending = true;
+                }
                 if self.pending {
                     self.propagate_now();
                 }

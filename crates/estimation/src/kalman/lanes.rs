@@ -204,17 +204,16 @@ impl<const N: usize> AugmentedLanes<N> {
             r: rr
         });
         for (l, step) in lanes.iter().enumerate() {
-            let reading = match step {
-                LaneStep::Idle => continue,
-                LaneStep::Start(reading) => reading,
-                LaneStep::Next { phi, reading, .. } => {
-                    // Checked upper triangular above.
-                    self.rhs[l].predict_known(phi, true);
-                    reading
-                }
-            };
             let gain: [f64; N] = std::array::from_fn(|i| self.gain[i][l]);
-            self.rhs[l].absorb(reading.h, reading.z, reading.y, variance[l], &gain)?;
+            let rhs = &mut self.rhs[l];
+            match step {
+                LaneStep::Idle => continue,
+                LaneStep::Start(r) => rhs.absorb(r.h, r.z, r.y, variance[l], &gain)?,
+                // Φ checked upper triangular above.
+                LaneStep::Next {
+                    phi, reading: r, ..
+                } => rhs.predict_absorb(phi, r.h, r.z, r.y, variance[l], &gain)?,
+            }
         }
         Ok(())
     }
