@@ -214,7 +214,8 @@ impl AugmentedFilter {
     pub fn update(&mut self, h: &[f64], z: &[f64], y: f64, r: f64) -> Result<f64> {
         self.rhs.check(z, y)?;
         let s = self.filter.update(h, 0.0, r)?.variance;
-        self.rhs.absorb(h, z, y, s, self.filter.last_gain())?;
+        self.rhs
+            .absorb(Before::Waiting, h, z, y, s, self.filter.last_gain())?;
         Ok(s)
     }
 
@@ -425,48 +426,20 @@ impl RightHandSides {
 
     /// The measurement update of every right-hand side with the factor's
     /// innovation variance `s` and gain (the row checked by
-    /// [`Self::check`]), and the scaled innovations into the sums.
+    /// [`Self::check`]), and the scaled innovations into the sums, after
+    /// the time update `before`.
     pub(super) fn absorb(
         &mut self,
+        before: Before<'_>,
         h: &[f64],
         z: &[f64],
         y: f64,
         s: f64,
         gain: &[f64],
     ) -> Result<()> {
-        self.absorb_after(None, h, z, y, s, gain)
-    }
-
-    /// The time update with the upper-triangular `Φ`, then [`Self::absorb`]
-    /// ([`AugmentedLanes`], which has checked `Φ`): the arithmetic of
-    /// [`Self::predict`] and [`Self::absorb`], without a copy of `Φ` when
-    /// the fused step takes it.
-    pub(super) fn predict_absorb(
-        &mut self,
-        phi: &DMatrix<f64>,
-        h: &[f64],
-        z: &[f64],
-        y: f64,
-        s: f64,
-        gain: &[f64],
-    ) -> Result<()> {
-        if self.pending {
+        if matches!(before, Before::Upper { .. }) && self.pending {
             self.propagate_now();
         }
-        self.absorb_after(Some(phi.as_slice()), h, z, y, s, gain)
-    }
-
-    /// [`Self::absorb`] after the waiting time update, or after `upper_phi`
-    /// (upper triangular, none waiting) when given.
-    fn absorb_after(
-        &mut self,
-        upper_phi: Option<&[f64]>,
-        h: &[f64],
-        z: &[f64],
-        y: f64,
-        s: f64,
-        gain: &[f64],
-    ) -> Result<()> {
         let m = self.prior_mean.len();
         self.nu[..m].copy_from_slice(z);
         // With a zero prior mean (the usual case) `z·β₀` is a sum of zeros
@@ -481,7 +454,13 @@ impl RightHandSides {
                 .map(|(a, b)| a * b)
                 .sum::<f64>()
         };
-        let phi = upper_phi.or(self.pending.then_some(self.phi.as_slice()));
+        let (phi, upper, two) = match before {
+            Before::Waiting => {
+                let phi = self.pending.then_some(self.phi.as_slice());
+                (phi, self.phi_upper || phi.is_none(), two_chains(phi, h))
+            }
+            Before::Upper { phi, two_chains } => (Some(phi), true, two_chains),
+        };
         macro_rules! fixed {
             ($n:literal, $two:literal) => {
                 aeromag_core::simd::run(Step::<$n, $two> {
@@ -494,19 +473,18 @@ impl RightHandSides {
                 })
             };
         }
-        let upper = upper_phi.is_some() || self.phi_upper || phi.is_none();
-        match (h.len(), upper) {
+        match (h.len(), upper, two) {
             // The field models of orders 3, 4 and 6 (upper-triangular Φ,
             // two chains read at their heads).
-            (5, true) if two_chains(phi, h) => fixed!(5, true),
-            (6, true) if two_chains(phi, h) => fixed!(6, true),
-            (8, true) if two_chains(phi, h) => fixed!(8, true),
-            (5, true) => fixed!(5, false),
-            (6, true) => fixed!(6, false),
-            (8, true) => fixed!(8, false),
+            (5, true, true) => fixed!(5, true),
+            (6, true, true) => fixed!(6, true),
+            (8, true, true) => fixed!(8, true),
+            (5, true, false) => fixed!(5, false),
+            (6, true, false) => fixed!(6, false),
+            (8, true, false) => fixed!(8, false),
             _ => {
-                if let Some(p) = upper_phi {
-                    self.phi.copy_from_slice(p);
+                if let Before::Upper { phi, .. } = before {
+                    self.phi.copy_from_slice(phi);
                     self.pending = true;
                 }
                 if self.pending {
@@ -642,6 +620,18 @@ impl aeromag_core::simd::Kernel for Innovate<'_> {
             axpy(&mut self.x[i * w..(i + 1) * w], k, self.nu);
         }
     }
+}
+
+/// The time update a measurement update of [`RightHandSides::absorb`]
+/// comes after.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Before<'a> {
+    /// The one [`RightHandSides::predict`] left waiting, if any.
+    Waiting,
+    /// This upper-triangular `Φ` (`n × n`, column-major), and whether it
+    /// and the row are two chains ([`two_chains`]), as the caller
+    /// ([`AugmentedLanes`]) has checked.
+    Upper { phi: &'a [f64], two_chains: bool },
 }
 
 /// Whether `Φ` (`n × n` column-major, if any) and `h` are those of two

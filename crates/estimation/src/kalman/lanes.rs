@@ -24,7 +24,7 @@
 // scalar code they mirror does.
 #![allow(clippy::needless_range_loop)]
 
-use super::augmented::{AugmentedFilter, RightHandSides};
+use super::augmented::{AugmentedFilter, Before, RightHandSides};
 use super::filter::LeadingConditional;
 use crate::error::{EstError, Result};
 use nalgebra::DMatrix;
@@ -208,11 +208,20 @@ impl<const N: usize> AugmentedLanes<N> {
             let rhs = &mut self.rhs[l];
             match step {
                 LaneStep::Idle => continue,
-                LaneStep::Start(r) => rhs.absorb(r.h, r.z, r.y, variance[l], &gain)?,
-                // Φ checked upper triangular above.
+                LaneStep::Start(r) => {
+                    rhs.absorb(Before::Waiting, r.h, r.z, r.y, variance[l], &gain)?
+                }
+                // Φ checked upper triangular above, the two chains in
+                // every lane.
                 LaneStep::Next {
                     phi, reading: r, ..
-                } => rhs.predict_absorb(phi, r.h, r.z, r.y, variance[l], &gain)?,
+                } => {
+                    let before = Before::Upper {
+                        phi: phi.as_slice(),
+                        two_chains: two,
+                    };
+                    rhs.absorb(before, r.h, r.z, r.y, variance[l], &gain)?
+                }
             }
         }
         Ok(())
