@@ -1,5 +1,8 @@
-//! Four augmented filters of the same model stepped together: their
-//! `n`-state square-root factors in SIMD lanes.
+//! Four filters stepped together: their `n`-state square-root factors in
+//! SIMD lanes — augmented filters of one model ([`AugmentedLanes`]: the
+//! likelihood of the noise tuning, the field filter's groups of runs) or
+//! plain filters ([`FilterLanes`]: the smoother re-running four blocks at
+//! once, [`super::fixed_interval`]).
 //!
 //! The time update `U ← tri([G, Φ U])` (Householder, both halves upper
 //! triangular: [`super::triangularize::triangularize_upper_pair`]) and
@@ -26,6 +29,7 @@
 
 use super::augmented::{AugmentedFilter, Before, RightHandSides};
 use super::filter::LeadingConditional;
+use super::innovation::Innovation;
 use crate::error::{EstError, Result};
 use nalgebra::DMatrix;
 
@@ -64,15 +68,142 @@ pub struct Reading<'a> {
     pub y: f64,
 }
 
-/// Four [`AugmentedFilter`]s of `N` dynamic states and one prior, stepped
-/// together (module docs).
-pub struct AugmentedLanes<const N: usize> {
+/// Four upper-triangular `N × N` square-root factors in SIMD lanes, with
+/// each lane's last `Φ` and `G`: the time and measurement updates of
+/// [`super::SqrtKalmanFilter`] on all four at once, bit for bit (module
+/// docs). The factor part of [`AugmentedLanes`] and [`FilterLanes`].
+struct FactorLanes<const N: usize> {
     /// `u[j][i][l]`: entry `(i, j)` of lane `l`'s upper factor.
     u: [[[f64; L]; N]; N],
     gain: [[f64; L]; N],
     /// The lanes' last `Φ` and `G`, `phi[i][j][l]` (upper parts).
     phi: [[[f64; L]; N]; N],
     g: [[[f64; L]; N]; N],
+}
+
+impl<const N: usize> FactorLanes<N> {
+    fn new() -> Self {
+        Self {
+            u: [[[0.0; L]; N]; N],
+            gain: [[0.0; L]; N],
+            phi: [[[0.0; L]; N]; N],
+            g: [[[0.0; L]; N]; N],
+        }
+    }
+
+    /// Lane `l`'s `Φ` and `G` for the next [`Self::predict`]: both `N × N`
+    /// and upper triangular, else an error (nothing changed).
+    fn load(&mut self, l: usize, phi: &DMatrix<f64>, g: &DMatrix<f64>) -> Result<()> {
+        if phi.shape() != (N, N) || g.shape() != (N, N) {
+            return Err(EstError::Dimension(format!(
+                "filter lanes: Φ {:?}, G {:?} for {N} states",
+                phi.shape(),
+                g.shape()
+            )));
+        }
+        // Column-major: the upper part of column j is its rows 0..=j; the
+        // rest must be zero.
+        let (p, q) = (phi.as_slice(), g.as_slice());
+        for j in 0..N {
+            let (pc, qc) = (&p[j * N..(j + 1) * N], &q[j * N..(j + 1) * N]);
+            if pc[j + 1..].iter().chain(&qc[j + 1..]).any(|v| *v != 0.0) {
+                return Err(EstError::Dimension(
+                    "filter lanes: Φ and G must be upper triangular".into(),
+                ));
+            }
+        }
+        for j in 0..N {
+            for i in 0..=j {
+                self.phi[i][j][l] = p[i + j * N];
+                self.g[i][j][l] = q[i + j * N];
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether every lane's `Φ` and `h` are two chains read at their
+    /// heads ([`super::augmented::two_chains`]; lanes not moving compute
+    /// with the `Φ` they last had, whose results are not kept).
+    fn two_chains(&self, h: &[[f64; L]; N]) -> bool {
+        let Some(split) = N.checked_sub(2) else {
+            return false;
+        };
+        let mut two = true;
+        for i in 0..N {
+            for l in 0..L {
+                two &= i == 0 || i == split || h[i][l] == 0.0;
+            }
+            for j in split.max(i)..N {
+                for l in 0..L {
+                    two &= i >= split || self.phi[i][j][l] == 0.0;
+                }
+            }
+        }
+        two
+    }
+
+    /// `U ← tri([G, Φ U])` in the `moving` lanes (the others keep their
+    /// factor), then Carlson's update with rows `h` and noise variances
+    /// `r` in every lane (a lane with `h = 0` keeps its factor); returns
+    /// the innovation variances and whether every lane had two chains.
+    /// Two chains in every lane (the field models): the products with the
+    /// structural zeros left out, as in `augmented::Step` (the same bits:
+    /// every sum here starts from +0).
+    fn predict_update(
+        &mut self,
+        moving: [bool; L],
+        h: &[[f64; L]; N],
+        r: [f64; L],
+    ) -> ([f64; L], bool) {
+        let two = self.two_chains(h);
+        macro_rules! kernel {
+            ($k:ident { $($f:ident: $v:expr),* }) => {
+                if two {
+                    aeromag_core::simd::run($k::<N, true> { $($f: $v),* })
+                } else {
+                    aeromag_core::simd::run($k::<N, false> { $($f: $v),* })
+                }
+            };
+        }
+        kernel!(Predict {
+            u: &mut self.u,
+            phi: &self.phi,
+            g: &mut self.g,
+            moving: moving
+        });
+        let variance = kernel!(Update {
+            u: &mut self.u,
+            gain: &mut self.gain,
+            h: h,
+            r: r
+        });
+        (variance, two)
+    }
+
+    /// Lane `l`'s upper factor.
+    fn factor(&self, l: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(N, N, |i, j| if i <= j { self.u[j][i][l] } else { 0.0 })
+    }
+
+    /// Lane `l`'s factor from the upper part of `s` (`N × N`).
+    fn set_factor(&mut self, l: usize, s: impl Fn(usize, usize) -> f64) {
+        for j in 0..N {
+            for i in 0..N {
+                self.u[j][i][l] = if i <= j { s(i, j) } else { 0.0 };
+            }
+        }
+    }
+
+    /// Lane `l`'s gain.
+    fn gain(&self, l: usize) -> [f64; N] {
+        std::array::from_fn(|i| self.gain[i][l])
+    }
+}
+
+/// Four [`AugmentedFilter`]s of `N` dynamic states and one prior, stepped
+/// together (module docs).
+pub struct AugmentedLanes<const N: usize> {
+    factors: FactorLanes<N>,
     prior: [[f64; N]; N],
     /// A fresh filter (prior and right-hand sides), for each lane's start.
     fresh: AugmentedFilter,
@@ -98,10 +229,7 @@ impl<const N: usize> AugmentedLanes<N> {
             }
         }
         let mut lanes = Self {
-            u: [[[0.0; L]; N]; N],
-            gain: [[0.0; L]; N],
-            phi: [[[0.0; L]; N]; N],
-            g: [[[0.0; L]; N]; N],
+            factors: FactorLanes::new(),
             prior,
             rhs: vec![fresh.right_hand_sides().clone(); L],
             fresh,
@@ -127,28 +255,7 @@ impl<const N: usize> AugmentedLanes<N> {
                 LaneStep::Idle => continue,
                 LaneStep::Start(reading) => reading,
                 LaneStep::Next { phi, g, reading } => {
-                    if phi.shape() != (N, N) || g.shape() != (N, N) {
-                        return Err(EstError::Dimension(format!(
-                            "filter lanes: Φ {:?}, G {:?} for {N} states",
-                            phi.shape(),
-                            g.shape()
-                        )));
-                    }
-                    // Column-major: the upper part of column j is its rows
-                    // 0..=j; the rest must be zero.
-                    let (p, q) = (phi.as_slice(), g.as_slice());
-                    for j in 0..N {
-                        let (pc, qc) = (&p[j * N..(j + 1) * N], &q[j * N..(j + 1) * N]);
-                        if pc[j + 1..].iter().chain(&qc[j + 1..]).any(|v| *v != 0.0) {
-                            return Err(EstError::Dimension(
-                                "filter lanes: Φ and G must be upper triangular".into(),
-                            ));
-                        }
-                        for i in 0..=j {
-                            self.phi[i][j][l] = pc[i];
-                            self.g[i][j][l] = qc[i];
-                        }
-                    }
+                    self.factors.load(l, phi, g)?;
                     moving[l] = true;
                     reading
                 }
@@ -171,25 +278,6 @@ impl<const N: usize> AugmentedLanes<N> {
         }
         // Lanes not moving compute with whatever Φ and G they last had (the
         // lower parts are never written: zero); their results are not kept.
-        // Two chains in every lane (the field models): the products with
-        // the structural zeros left out, as in `augmented::Step` (the same
-        // bits: every sum here starts from +0).
-        let two = self.two_chains(&h);
-        macro_rules! kernel {
-            ($k:ident { $($f:ident: $v:expr),* }) => {
-                if two {
-                    aeromag_core::simd::run($k::<N, true> { $($f: $v),* })
-                } else {
-                    aeromag_core::simd::run($k::<N, false> { $($f: $v),* })
-                }
-            };
-        }
-        kernel!(Predict {
-            u: &mut self.u,
-            phi: &self.phi,
-            g: &mut self.g,
-            moving: moving
-        });
         // Idle lanes: h = 0, so every f_j is 0 and the factor is unchanged.
         let mut rr = [1.0; L];
         for (l, step) in lanes.iter().enumerate() {
@@ -197,14 +285,9 @@ impl<const N: usize> AugmentedLanes<N> {
                 rr[l] = r;
             }
         }
-        let variance = kernel!(Update {
-            u: &mut self.u,
-            gain: &mut self.gain,
-            h: &h,
-            r: rr
-        });
+        let (variance, two) = self.factors.predict_update(moving, &h, rr);
         for (l, step) in lanes.iter().enumerate() {
-            let gain: [f64; N] = std::array::from_fn(|i| self.gain[i][l]);
+            let gain = self.factors.gain(l);
             let rhs = &mut self.rhs[l];
             match step {
                 LaneStep::Idle => continue,
@@ -240,39 +323,13 @@ impl<const N: usize> AugmentedLanes<N> {
     /// Lane `l`'s [`AugmentedFilter::conditional`]: its dynamic states
     /// given the coefficients after its last step.
     pub fn conditional(&self, l: usize) -> LeadingConditional {
-        self.rhs[l].conditional(self.factor(l))
-    }
-
-    /// Whether every lane's `Φ` and `h` are two chains read at their
-    /// heads ([`super::augmented::two_chains`]; lanes not moving compute
-    /// with the `Φ` they last had, whose results are not kept).
-    fn two_chains(&self, h: &[[f64; L]; N]) -> bool {
-        let Some(split) = N.checked_sub(2) else {
-            return false;
-        };
-        let mut two = true;
-        for i in 0..N {
-            for l in 0..L {
-                two &= i == 0 || i == split || h[i][l] == 0.0;
-            }
-            for j in split.max(i)..N {
-                for l in 0..L {
-                    two &= i >= split || self.phi[i][j][l] == 0.0;
-                }
-            }
-        }
-        two
-    }
-
-    /// Lane `l`'s upper factor.
-    fn factor(&self, l: usize) -> DMatrix<f64> {
-        DMatrix::from_fn(N, N, |i, j| if i <= j { self.u[j][i][l] } else { 0.0 })
+        self.rhs[l].conditional(self.factors.factor(l))
     }
 
     /// Lane `l`'s filter (factor, right-hand sides and sums), the lane
     /// fresh again.
     pub fn take(&mut self, l: usize) -> Result<AugmentedFilter> {
-        let factor = self.factor(l);
+        let factor = self.factors.factor(l);
         let mut f = self.fresh.clone();
         let rhs = std::mem::replace(&mut self.rhs[l], self.fresh.right_hand_sides().clone());
         f.with_factor(&factor, rhs)?;
@@ -282,11 +339,171 @@ impl<const N: usize> AugmentedLanes<N> {
 
     /// Lane `l`'s factor back to the prior.
     fn reset_factor(&mut self, l: usize) {
-        for j in 0..N {
-            for i in 0..N {
-                self.u[j][i][l] = if i <= j { self.prior[j][i] } else { 0.0 };
+        let prior = &self.prior;
+        self.factors.set_factor(l, |i, j| prior[j][i]);
+    }
+}
+
+/// What one lane of [`FilterLanes::step`] does: the time update with `Φ`
+/// and `G` (`N × N`, upper triangular) if any, then the measurement
+/// `(h, y, r)` if any. Neither: the lane is idle and keeps its estimate.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FilterStep<'a> {
+    /// `(Φ, G)` of the time update.
+    pub predict: Option<(&'a DMatrix<f64>, &'a DMatrix<f64>)>,
+    /// The row `h` (length `N`), the reading `y` and its noise variance `r`.
+    pub measurement: Option<(&'a [f64], f64, f64)>,
+}
+
+/// Four [`super::SqrtKalmanFilter`]s of `N` states stepped together, their
+/// factors in SIMD lanes (module docs) and their means beside them: each
+/// lane's mean, factor, gain and innovation are bit for bit those of its
+/// filter stepped alone with [`super::SqrtKalmanFilter::predict`] and
+/// [`super::SqrtKalmanFilter::update`] (test
+/// `filter_lanes_are_filters_alone_bit_for_bit`). For the smoother's
+/// re-runs of four blocks at once ([`super::fixed_interval`]).
+pub struct FilterLanes<const N: usize> {
+    factors: FactorLanes<N>,
+    /// `x[i][l]`: state `i` of lane `l`.
+    x: [[f64; L]; N],
+}
+
+impl<const N: usize> Default for FilterLanes<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> FilterLanes<N> {
+    /// Four filters at zero (set each with [`Self::set`]).
+    pub fn new() -> Self {
+        Self {
+            factors: FactorLanes::new(),
+            x: [[0.0; L]; N],
+        }
+    }
+
+    /// Lane `l`'s mean `x` (length `N`) and upper factor `s` (`N × N`;
+    /// the lower part ignored), as [`super::SqrtKalmanFilter::set`].
+    pub fn set(&mut self, l: usize, x: &[f64], s: &DMatrix<f64>) -> Result<()> {
+        if x.len() != N || s.shape() != (N, N) {
+            return Err(EstError::Dimension(
+                "filter lanes: state or factor of another size".into(),
+            ));
+        }
+        for (i, v) in x.iter().enumerate() {
+            self.x[i][l] = *v;
+        }
+        self.factors.set_factor(l, |i, j| s[(i, j)]);
+        Ok(())
+    }
+
+    /// One step of every lane (see [`FilterStep`]); returns each measuring
+    /// lane's innovation. Errors (nothing changed): a `Φ` or `G` of another
+    /// size or not upper triangular, or the errors of
+    /// [`super::SqrtKalmanFilter::update`] (non-finite `h` or `y`, `r` not
+    /// finite and positive).
+    pub fn step(&mut self, lanes: [FilterStep<'_>; L]) -> Result<[Option<Innovation>; L]> {
+        let mut h = [[0.0; L]; N];
+        let mut y = [0.0; L];
+        let mut r = [1.0; L];
+        for (l, step) in lanes.iter().enumerate() {
+            if let Some((row, yl, rl)) = step.measurement {
+                if !(rl > 0.0 && rl.is_finite()) {
+                    return Err(EstError::NonFinite {
+                        what: "measurement noise variance (must be finite and > 0)",
+                    });
+                }
+                if row.len() != N {
+                    return Err(EstError::Dimension(format!(
+                        "Carlson update: state {N}, row {}",
+                        row.len()
+                    )));
+                }
+                if !yl.is_finite() || !aeromag_core::simd::all_finite(row) {
+                    return Err(EstError::NonFinite {
+                        what: "scalar measurement or its row",
+                    });
+                }
+                for i in 0..N {
+                    h[i][l] = row[i];
+                }
+                (y[l], r[l]) = (yl, rl);
             }
         }
+        let mut moving = [false; L];
+        for (l, step) in lanes.iter().enumerate() {
+            if let Some((phi, g)) = step.predict {
+                self.factors.load(l, phi, g)?;
+                moving[l] = true;
+            }
+        }
+        // x ← Φ x in the moving lanes: each entry summed over the non-zero
+        // Φ_ij, j ascending, from +0 (the order of the filter's sparse
+        // product).
+        let phi = &self.factors.phi;
+        let mut x = self.x;
+        for i in 0..N {
+            let mut acc = [0.0; L];
+            for j in i..N {
+                for l in 0..L {
+                    let p = phi[i][j][l];
+                    acc[l] = if p != 0.0 {
+                        acc[l] + p * self.x[j][l]
+                    } else {
+                        acc[l]
+                    };
+                }
+            }
+            for l in 0..L {
+                if moving[l] {
+                    x[i][l] = acc[l];
+                }
+            }
+        }
+        // ν = y − hᵀx⁻, subtracted term by term as Carlson's update does.
+        let mut nu = y;
+        for i in 0..N {
+            for l in 0..L {
+                nu[l] -= h[i][l] * x[i][l];
+            }
+        }
+        let (variance, _) = self.factors.predict_update(moving, &h, r);
+        let mut out = [None; L];
+        for (l, step) in lanes.iter().enumerate() {
+            if step.measurement.is_some() {
+                for i in 0..N {
+                    x[i][l] += self.factors.gain[i][l] * nu[l];
+                }
+                out[l] = Some(Innovation {
+                    value: nu[l],
+                    variance: variance[l],
+                });
+            }
+        }
+        self.x = x;
+        Ok(out)
+    }
+
+    /// Lane `l`'s mean.
+    pub fn state(&self, l: usize) -> [f64; N] {
+        std::array::from_fn(|i| self.x[i][l])
+    }
+
+    /// Lane `l`'s upper factor into `out` (column-major `N × N`, zeros
+    /// below the diagonal).
+    pub fn factor_into(&self, l: usize, out: &mut [f64]) {
+        for j in 0..N {
+            for i in 0..N {
+                out[i + j * N] = if i <= j { self.factors.u[j][i][l] } else { 0.0 };
+            }
+        }
+    }
+
+    /// Lane `l`'s Kalman gain of its last measurement
+    /// ([`super::SqrtKalmanFilter::last_gain`]).
+    pub fn gain(&self, l: usize) -> [f64; N] {
+        self.factors.gain(l)
     }
 }
 
@@ -470,13 +687,51 @@ mod tests {
         ((*seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     }
 
+    /// `Φ` and `G` (upper triangular) of chains of integrators over a
+    /// random step (0 when `k % 37 == 5`: `Φ = I` and `G = 0`, no
+    /// reflection); with `two`, two chains (states `0..N−2` and `N−2..N`).
+    fn lane_transition<const N: usize>(
+        seed: &mut u64,
+        k: usize,
+        two: bool,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let d = if k % 37 == 5 { 0.0 } else { 0.5 + rnd(seed) };
+        let cross = |i: usize, j: usize| two && i < N - 2 && j >= N - 2;
+        let phi = DMatrix::from_fn(N, N, |i, j| {
+            if i == j {
+                1.0
+            } else if i < j && !cross(i, j) {
+                d.powi((j - i) as i32) / (1 + j - i) as f64
+            } else {
+                0.0
+            }
+        });
+        let g = DMatrix::from_fn(N, N, |i, j| {
+            if i <= j && !cross(i, j) {
+                0.05 * d * (1.0 + 0.1 * (i + 2 * j) as f64)
+            } else {
+                0.0
+            }
+        });
+        (phi, g)
+    }
+
+    /// A measurement row reading the first state and (with `two`, the
+    /// head of the second chain, else the last state), that one exactly
+    /// zero when `k % 11 == 0`.
+    fn lane_row<const N: usize>(seed: &mut u64, k: usize, two: bool) -> Vec<f64> {
+        let mut h = vec![0.0; N];
+        h[0] = 1.0 + 0.5 * rnd(seed);
+        h[if two { N - 2 } else { N - 1 }] = if k.is_multiple_of(11) { 0.0 } else { rnd(seed) };
+        h
+    }
+
     /// Four lanes with their own transitions, rows, run starts and idle
     /// steps: each lane's filter is bit for bit the filter stepped alone.
     /// With `two`, Φ, G and h are two chains (states `0..N−2` and
     /// `N−2..N`, read at their heads: the kernels that skip the zeros).
     fn lanes_equal_filters_alone<const N: usize>(two: bool) {
         let mut seed = 11 + N as u64 + two as u64;
-        let cross = move |i: usize, j: usize| two && i < N - 2 && j >= N - 2;
         // A diagonal prior: at each run start `f_j = 0` for the states the
         // row does not see (Carlson leaves those columns alone).
         let s0 = DMatrix::from_fn(N, N, |i, j| if i == j { 2.0 / (1 + i) as f64 } else { 0.0 });
@@ -486,38 +741,13 @@ mod tests {
         let template = AugmentedFilter::new(&s0, &prior_mean, &prior_std).unwrap();
         let mut lanes = AugmentedLanes::<N>::new(&s0, &prior_mean, &prior_std).unwrap();
         let mut alone: Vec<AugmentedFilter> = (0..L).map(|_| template.clone()).collect();
-        // Per lane and step: a step length (Φ, G from it; 0 for some steps:
-        // Φ = I and G = 0, no reflection), a run start or idle.
-        let transition = |d: f64| {
-            let phi = DMatrix::from_fn(N, N, |i, j| {
-                if i == j {
-                    1.0
-                } else if i < j && !cross(i, j) {
-                    d.powi((j - i) as i32) / (1 + j - i) as f64
-                } else {
-                    0.0
-                }
-            });
-            let g = DMatrix::from_fn(N, N, |i, j| {
-                if i <= j && !cross(i, j) {
-                    0.05 * d * (1.0 + 0.1 * (i + 2 * j) as f64)
-                } else {
-                    0.0
-                }
-            });
-            (phi, g)
-        };
+        // Per lane and step: a transition, a run start or idle.
         let r = 0.03;
         for k in 0..900 {
             let mut mats = Vec::new();
             let mut plan = Vec::new();
             for l in 0..L {
-                let d = if (k + l) % 37 == 5 {
-                    0.0
-                } else {
-                    0.5 + rnd(&mut seed)
-                };
-                mats.push(transition(d));
+                mats.push(lane_transition::<N>(&mut seed, k + l, two));
                 let what = if k == 0 || (k + 3 * l) % 250 == 0 {
                     1
                 } else if l == 3 && k > 700 {
@@ -525,13 +755,7 @@ mod tests {
                 } else {
                     2
                 };
-                let mut h = vec![0.0; N];
-                h[0] = 1.0 + 0.5 * rnd(&mut seed);
-                h[if two { N - 2 } else { N - 1 }] = if (k + l) % 11 == 0 {
-                    0.0
-                } else {
-                    rnd(&mut seed)
-                };
+                let h = lane_row::<N>(&mut seed, k + l, two);
                 let z: Vec<f64> = (0..m).map(|_| 10.0 * rnd(&mut seed)).collect();
                 let y = 3.0 * rnd(&mut seed) + z[0] - 0.5 * z[3];
                 plan.push((what, h, z, y));
@@ -680,6 +904,139 @@ mod tests {
                     .map(|v| v.to_bits())
                     .collect::<Vec<_>>()
             );
+        }
+    }
+
+    /// Four plain filters with their own transitions, rows, restarts,
+    /// steps without a time update or a measurement and idle steps: each
+    /// lane's mean, factor, gain and innovation are bit for bit those of
+    /// its [`super::super::SqrtKalmanFilter`] stepped alone.
+    fn filter_lanes_equal_filters_alone<const N: usize>(two: bool) {
+        use super::super::SqrtKalmanFilter;
+        let mut seed = 29 + N as u64 + two as u64;
+        let s0 = DMatrix::from_fn(N, N, |i, j| {
+            if i <= j {
+                1.0 / (1 + i + j) as f64
+            } else {
+                0.0
+            }
+        });
+        let x0: Vec<f64> = (0..N).map(|i| 0.3 * i as f64 - 1.0).collect();
+        let mut lanes = FilterLanes::<N>::new();
+        let mut alone: Vec<SqrtKalmanFilter> = (0..L)
+            .map(|_| SqrtKalmanFilter::new(&x0, &s0).unwrap())
+            .collect();
+        for l in 0..L {
+            lanes.set(l, &x0, &s0).unwrap();
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for k in 0..600 {
+            let mut mats = Vec::new();
+            let mut rows = Vec::new();
+            let mut plan = Vec::new();
+            for l in 0..L {
+                mats.push(lane_transition::<N>(&mut seed, k + l, two));
+                let h = lane_row::<N>(&mut seed, k + l, two);
+                rows.push(h);
+                // 0: idle, 1: measurement only, 2: time update only, 3: both.
+                let what = if l == 2 && (300..320).contains(&k) {
+                    0
+                } else if (k + l) % 13 == 0 {
+                    1
+                } else if (k + 2 * l) % 17 == 0 {
+                    2
+                } else {
+                    3
+                };
+                plan.push((what, 3.0 * rnd(&mut seed), 0.01 + 0.1 * (l as f64)));
+            }
+            if k == 450 {
+                // A restart of lane 1 from another estimate.
+                let s = DMatrix::from_fn(N, N, |i, j| {
+                    if i <= j {
+                        0.5 + 0.1 * (i * j) as f64
+                    } else {
+                        0.0
+                    }
+                });
+                lanes.set(1, &vec![2.0; N], &s).unwrap();
+                alone[1].set(&vec![2.0; N], &s).unwrap();
+            }
+            let steps: [FilterStep; L] = std::array::from_fn(|l| {
+                let (what, y, r) = plan[l];
+                FilterStep {
+                    predict: (what >= 2).then_some((&mats[l].0, &mats[l].1)),
+                    measurement: (what == 1 || what == 3).then_some((&rows[l][..], y, r)),
+                }
+            });
+            let got = lanes.step(steps).unwrap();
+            for (l, f) in alone.iter_mut().enumerate() {
+                let (what, y, r) = plan[l];
+                if what >= 2 {
+                    f.predict(&mats[l].0, &mats[l].1).unwrap();
+                }
+                if what == 1 || what == 3 {
+                    let inn = f.update(&rows[l], y, r).unwrap();
+                    let lane = got[l].expect("a measuring lane has an innovation");
+                    assert_eq!(
+                        (lane.value.to_bits(), lane.variance.to_bits()),
+                        (inn.value.to_bits(), inn.variance.to_bits()),
+                        "N {N}, lane {l}, step {k}: innovation"
+                    );
+                    assert_eq!(
+                        bits(&lanes.gain(l)),
+                        bits(f.last_gain()),
+                        "N {N}, lane {l}, step {k}: gain"
+                    );
+                } else {
+                    assert!(got[l].is_none());
+                }
+                assert_eq!(
+                    bits(&lanes.state(l)),
+                    bits(f.state().as_slice()),
+                    "N {N}, lane {l}, step {k}: mean"
+                );
+                let mut s = vec![0.0; N * N];
+                lanes.factor_into(l, &mut s);
+                assert_eq!(
+                    bits(&s),
+                    bits(f.factor().as_slice()),
+                    "N {N}, lane {l}, step {k}: factor"
+                );
+            }
+        }
+        // Refused: a lower Φ, a bad reading; nothing changes.
+        let before = (lanes.state(0), lanes.gain(0));
+        let lower = DMatrix::from_fn(N, N, |i, j| if i >= j { 1.0 } else { 0.0 });
+        let g = DMatrix::zeros(N, N);
+        let h = vec![1.0; N];
+        let refused = [
+            FilterStep {
+                predict: Some((&lower, &g)),
+                measurement: None,
+            },
+            FilterStep {
+                predict: None,
+                measurement: Some((&h, f64::NAN, 1.0)),
+            },
+            FilterStep {
+                predict: None,
+                measurement: Some((&h, 1.0, 0.0)),
+            },
+        ];
+        for first in refused {
+            let idle = FilterStep::default();
+            assert!(lanes.step([first, idle, idle, idle]).is_err());
+        }
+        assert_eq!((lanes.state(0), lanes.gain(0)), before);
+    }
+
+    #[test]
+    fn filter_lanes_are_filters_alone_bit_for_bit() {
+        for two in [false, true] {
+            filter_lanes_equal_filters_alone::<5>(two);
+            filter_lanes_equal_filters_alone::<6>(two);
+            filter_lanes_equal_filters_alone::<8>(two);
         }
     }
 

@@ -38,6 +38,7 @@
 //! | [`rts`] | one square-root RTS backward step ([`SqrtRts`]) |
 //! | [`mbf`] | the modified Bryson–Frazier smoother: smoothed means by an adjoint recursion, no gain |
 //! | [`fixed_interval`] | forward filter + backward smoother over a record, with checkpointing (`O(√N n²)` memory) |
+//! | [`lanes`] | four filters of 5, 6 or 8 states stepped together in SIMD lanes, bit for bit each filter alone: augmented ([`AugmentedLanes`], the likelihood and the field filter's groups) and plain ([`FilterLanes`], the smoother's block re-runs) |
 //! | [`innovation`] | innovations and their Gaussian log-likelihood |
 //! | [`augmented`] | the likelihood with constant regression coefficients integrated out, from a filter of the dynamic states alone ([`AugmentedFilter`]) |
 //! | [`conventional`] | the Joseph-form filter and textbook RTS smoother: the test reference |
@@ -66,7 +67,7 @@ pub use fixed_interval::{
     fixed_interval_smooth, smooth_from_checkpoints,
 };
 pub use innovation::Innovation;
-pub use lanes::{AugmentedLanes, FILTER_LANES, LaneStep, Reading};
+pub use lanes::{AugmentedLanes, FILTER_LANES, FilterLanes, FilterStep, LaneStep, Reading};
 pub use mbf::{MbfAdjoint, MbfUpdate};
 pub use rts::SqrtRts;
 

@@ -10,6 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 /// A random time-varying linear-Gaussian system with its measurements.
+#[derive(Clone)]
 struct System {
     x0: Vec<f64>,
     s0: DMatrix<f64>,
@@ -351,4 +352,90 @@ proptest! {
             }
         }
     }
+}
+
+/// The smoother re-runs four blocks at a time in SIMD lanes for 5, 6 and 8
+/// states: the smoothed means are those of the blocks re-run one at a time
+/// with the filter alone, to the bit — dense and two-chain models, steps
+/// without a measurement, and a step whose `Φ` is not upper triangular (its
+/// batch is re-run block by block). A bad reading is the same error.
+#[test]
+fn smoothing_in_lanes_is_block_by_block_bit_for_bit() {
+    use super::filter_checkpoints;
+    use super::fixed_interval::smooth_means_block_by_block;
+    fn means<const N: usize>(sys: &System, block: usize, lanes: bool) -> Result<Vec<u64>, String> {
+        let (_, cps) = filter_checkpoints(sys, block, |_, _| {}).map_err(|e| e.to_string())?;
+        let mut out = vec![0u64; sys.ys.len() * N];
+        let keep = |k: usize, x: &[f64], _: Option<&DMatrix<f64>>| {
+            for (o, v) in out[k * N..(k + 1) * N].iter_mut().zip(x) {
+                *o = v.to_bits();
+            }
+        };
+        if lanes {
+            smooth_from_checkpoints(sys, &cps, false, keep)
+        } else {
+            smooth_means_block_by_block(sys, &cps, keep)
+        }
+        .map_err(|e| e.to_string())?;
+        Ok(out)
+    }
+    fn check<const N: usize>(seed: u64) {
+        let steps = 301;
+        for two in [false, true] {
+            let mut sys = triangular_system(seed, N, steps);
+            if two {
+                for m in sys.phis.iter_mut().chain(sys.gs.iter_mut()) {
+                    for j in N - 2..N {
+                        for i in 0..N - 2 {
+                            m[(i, j)] = 0.0;
+                        }
+                    }
+                }
+                for h in &mut sys.hs {
+                    for (i, v) in h.iter_mut().enumerate() {
+                        if i != 0 && i != N - 2 {
+                            *v = 0.0;
+                        }
+                    }
+                }
+            }
+            for block in [1, 7, 40, 301] {
+                let reference = means::<N>(&sys, block, false).unwrap();
+                assert_eq!(
+                    means::<N>(&sys, block, true).unwrap(),
+                    reference,
+                    "N {N}, two {two}, block {block}"
+                );
+            }
+            // A lower entry in one Φ: that batch block by block.
+            let mut lower = sys.clone();
+            lower.phis[150][(N - 1, 0)] = 0.01;
+            let reference = means::<N>(&lower, 7, false).unwrap();
+            assert_eq!(
+                means::<N>(&lower, 7, true).unwrap(),
+                reference,
+                "N {N}, lower Φ"
+            );
+            // A bad reading after the checkpoints were taken: the same error.
+            let (_, cps) = filter_checkpoints(&sys, 7, |_, _| {}).unwrap();
+            let mut bad = sys.clone();
+            bad.ys[200] = f64::NAN;
+            bad.gaps[200] = false;
+            let run = |lanes: bool| {
+                let keep = |_: usize, _: &[f64], _: Option<&DMatrix<f64>>| {};
+                if lanes {
+                    smooth_from_checkpoints(&bad, &cps, false, keep)
+                } else {
+                    smooth_means_block_by_block(&bad, &cps, keep)
+                }
+                .unwrap_err()
+                .to_string()
+            };
+            assert_eq!(run(true), run(false));
+            assert!(run(true).contains("200"), "{}", run(true));
+        }
+    }
+    check::<5>(3);
+    check::<6>(4);
+    check::<8>(5);
 }
