@@ -4,8 +4,11 @@
 //! Run: `cargo bench -p aeromag-compensation --bench kalman`. Environment:
 //! `AEROMAG_BENCH_N` sets the length (default 10⁶ samples at 10 Hz);
 //! `AEROMAG_BENCH_ORDER` the order of the field model (default
-//! [`DEFAULT_ORDER`]); `AEROMAG_BENCH_ONCE=1` runs the full fit once and prints its time
-//! (use with `/usr/bin/time -v` to see the peak memory, e.g. for 10⁷).
+//! [`DEFAULT_ORDER`]); `AEROMAG_BENCH_ONCE=1` runs the fit once with each
+//! coefficient pass (`Joint`, the default; `Augmented`, the CLI's pass 1;
+//! `Split`, the CLI's final fit), without and with the smoother's pass, and
+//! prints the times (use with `/usr/bin/time -v` to see the peak memory,
+//! e.g. for 10⁷).
 //!
 //! * `filter+smoother`: pass 1 (joint 24-state filter: the default field
 //!   model of order 6 has 8 states, plus 16 coefficients), compensated
@@ -14,7 +17,8 @@
 //! * `filter only`: pass 1 alone (coefficients and covariances).
 
 use aeromag_compensation::kalman::{
-    DEFAULT_ORDER, KalmanConfig, KalmanSegment, NoiseModel, TuningConfig, X2Prior, fit_kalman,
+    CoefficientPass, DEFAULT_ORDER, KalmanConfig, KalmanSegment, NoiseModel, TuningConfig, X2Prior,
+    fit_kalman,
 };
 use aeromag_compensation::tolles_lawson::fit_ls::Segment;
 use aeromag_compensation::tolles_lawson::terms::derivative;
@@ -126,17 +130,30 @@ fn bench(c: &mut Criterion) {
         speed_m_s: &f.speed,
     };
     if std::env::var("AEROMAG_BENCH_ONCE").is_ok() {
-        let t0 = std::time::Instant::now();
-        fit_kalman(std::slice::from_ref(&seg), &config(false)).unwrap();
-        let t1 = std::time::Instant::now();
-        let fit = fit_kalman(std::slice::from_ref(&seg), &config(true)).unwrap();
-        eprintln!(
-            "fit_kalman n={n}: filter only {:.2} s; filter+smoother {:.2} s (residual {:.4} nT, {} runs)",
-            (t1 - t0).as_secs_f64(),
-            t1.elapsed().as_secs_f64(),
-            fit.residual_rms_nt,
-            fit.runs
-        );
+        // Each coefficient pass alone, then with the smoother's pass: one
+        // segment is one run, so each runs on one core.
+        for pass in [
+            CoefficientPass::Joint,
+            CoefficientPass::Augmented,
+            CoefficientPass::Split,
+        ] {
+            let with = |series: bool| KalmanConfig {
+                coefficient_pass: pass,
+                ..config(series)
+            };
+            let t0 = std::time::Instant::now();
+            fit_kalman(std::slice::from_ref(&seg), &with(false)).unwrap();
+            let t1 = std::time::Instant::now();
+            let fit = fit_kalman(std::slice::from_ref(&seg), &with(true)).unwrap();
+            let (filter, both) = ((t1 - t0).as_secs_f64(), t1.elapsed().as_secs_f64());
+            eprintln!(
+                "fit_kalman n={n} {pass:?}: filter only {filter:.2} s; filter+smoother {both:.2} s, \
+                 the smoother's pass {:.2} s (residual {:.4} nT, {} runs)",
+                both - filter,
+                fit.residual_rms_nt,
+                fit.runs
+            );
+        }
         return;
     }
     let mut g = c.benchmark_group("fit_kalman");
