@@ -49,6 +49,7 @@
 
 use super::carlson::carlson_update;
 use super::innovation::Innovation;
+use super::lanes::Predict;
 use super::triangularize::{triangularize_upper, triangularize_upper_pair};
 use crate::error::{EstError, Result};
 use nalgebra::{DMatrix, DVector};
@@ -301,13 +302,82 @@ impl SqrtKalmanFilter {
         if self.v.len() < c {
             self.v.resize(c, 0.0);
         }
-        // The same code, specialised by the compiler for the field models of
-        // orders 3, 4 and 6 (5, 6 and 8 states).
+        // The field models of orders 3, 4 and 6 (5, 6 and 8 states, Φ and
+        // G upper triangular): the factor by the lanes' kernel, one lane
+        // wide; otherwise the same code specialised by the compiler.
+        let upper = |k: usize| {
+            self.nz_upper
+                && (0..k).all(|j| {
+                    g.as_slice()[j * k + j + 1..(j + 1) * k]
+                        .iter()
+                        .all(|x| *x == 0.0)
+                })
+        };
         match (k, g.ncols()) {
+            (5, 5) if upper(5) => self.propagate_fixed::<5>(g.as_slice()),
+            (6, 6) if upper(6) => self.propagate_fixed::<6>(g.as_slice()),
+            (8, 8) if upper(8) => self.propagate_fixed::<8>(g.as_slice()),
             (5, 5) => self.propagate_impl(5, 5, g.as_slice()),
             (6, 6) => self.propagate_impl(6, 6, g.as_slice()),
             (8, 8) => self.propagate_impl(8, 8, g.as_slice()),
             _ => self.propagate_impl(k, g.ncols(), g.as_slice()),
+        }
+    }
+
+    /// [`Self::propagate_impl`] for `K` leading states with `Φ_a` (in
+    /// `self.nz`) and `G_a` (`K × K`) both upper triangular: `x_a ← Φ_a
+    /// x_a` as there, `U_a ← tri([G_a, Φ_a U_a])` by the lanes' kernel one
+    /// lane wide ([`super::lanes`]: the operations of the pair
+    /// triangularisation in their order, the same bits; with the products
+    /// of a zero block between two chains left out). Test
+    /// `the_fixed_time_update_is_the_general_one_bit_for_bit`.
+    fn propagate_fixed<const K: usize>(&mut self, g: &[f64]) {
+        let n = self.dim();
+        let mut tmp = [0.0; K];
+        let x = self.x.as_mut_slice();
+        for &(i, l, p) in &self.nz {
+            tmp[i] += p * x[l];
+        }
+        x[..K].copy_from_slice(&tmp);
+        let mut phi = [[[0.0; 1]; K]; K];
+        for &(i, l, p) in &self.nz {
+            phi[i][l][0] = p;
+        }
+        let s = self.s.as_mut_slice();
+        let mut u = [[[0.0; 1]; K]; K];
+        let mut gl = [[[0.0; 1]; K]; K];
+        for j in 0..K {
+            for i in 0..=j {
+                u[j][i][0] = s[i + j * n];
+                gl[i][j][0] = g[i + j * K];
+            }
+        }
+        // Two chains: Φ zero between states 0..K−2 and K−2..K.
+        let two = K > 2 && (0..K - 2).all(|i| (K - 2..K).all(|j| phi[i][j][0] == 0.0));
+        // One lane: nothing for AVX to widen (and its dispatch measured
+        // slower).
+        use aeromag_core::simd::Kernel;
+        if two {
+            Predict::<K, 1, true> {
+                u: &mut u,
+                phi: &phi,
+                g: &mut gl,
+                moving: [true],
+            }
+            .run()
+        } else {
+            Predict::<K, 1, false> {
+                u: &mut u,
+                phi: &phi,
+                g: &mut gl,
+                moving: [true],
+            }
+            .run()
+        }
+        for j in 0..K {
+            for i in 0..K {
+                s[i + j * n] = if i <= j { u[j][i][0] } else { 0.0 };
+            }
         }
     }
 
@@ -586,6 +656,86 @@ mod tests {
                 .max()
                 < 1e-13
         );
+    }
+
+    /// The time update of 5, 6 and 8 leading states with `Φ` and `G` upper
+    /// triangular (the lanes' kernel one lane wide) is the general code's
+    /// (`propagate_impl` with the pair triangularisation) to the bit: dense
+    /// and two-chain transitions, zero steps (`Φ = I`, `G = 0`), alone and
+    /// as the leading block of a larger filter.
+    #[test]
+    fn the_fixed_time_update_is_the_general_one_bit_for_bit() {
+        fn check<const K: usize>(extra: usize, two: bool, seed: u64) {
+            let mut seed = seed;
+            let mut rnd = move || {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            };
+            let n = K + extra;
+            let cross = |i: usize, j: usize| two && i < K - 2 && j >= K - 2;
+            let s0 = DMatrix::from_fn(n, n, |i, j| {
+                if i <= j {
+                    0.3 + (i + 2 * j) as f64 * 0.1
+                } else {
+                    0.0
+                }
+            });
+            let x0: Vec<f64> = (0..n).map(|i| i as f64 - 2.0).collect();
+            let mut a = SqrtKalmanFilter::new(&x0, &s0).unwrap();
+            let mut h = vec![0.0; n];
+            for step in 0..200 {
+                let d = if step % 13 == 4 { 0.0 } else { 0.5 + rnd() };
+                let phi = DMatrix::from_fn(K, K, |i, j| {
+                    if i == j {
+                        1.0
+                    } else if i < j && !cross(i, j) {
+                        d.powi((j - i) as i32)
+                    } else {
+                        0.0
+                    }
+                });
+                let g = DMatrix::from_fn(K, K, |i, j| {
+                    if i <= j && !cross(i, j) {
+                        0.1 * d * (1.0 + rnd())
+                    } else {
+                        0.0
+                    }
+                });
+                let mut b = a.clone();
+                a.collect_nonzeros(&phi);
+                a.propagate_fixed::<K>(g.as_slice());
+                b.collect_nonzeros(&phi);
+                b.propagate_impl(K, K, g.as_slice());
+                let bits = |f: &SqrtKalmanFilter| {
+                    f.state()
+                        .iter()
+                        .chain(f.factor().iter())
+                        .map(|v| v.to_bits())
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(
+                    bits(&a),
+                    bits(&b),
+                    "K {K}, extra {extra}, two {two}, step {step}"
+                );
+                for (i, v) in h.iter_mut().enumerate() {
+                    *v = if i == 0 || i == K - 2 || i >= K {
+                        1.0 + rnd()
+                    } else {
+                        0.0
+                    };
+                }
+                a.update(&h, rnd(), 0.05).unwrap();
+            }
+        }
+        for two in [false, true] {
+            check::<5>(0, two, 1);
+            check::<6>(0, two, 2);
+            check::<8>(0, two, 3);
+            check::<8>(16, two, 4);
+        }
     }
 
     #[test]

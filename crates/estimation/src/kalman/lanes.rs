@@ -72,22 +72,22 @@ pub struct Reading<'a> {
 /// each lane's last `Φ` and `G`: the time and measurement updates of
 /// [`super::SqrtKalmanFilter`] on all four at once, bit for bit (module
 /// docs). The factor part of [`AugmentedLanes`] and [`FilterLanes`].
-struct FactorLanes<const N: usize> {
+struct FactorLanes<const N: usize, const W: usize> {
     /// `u[j][i][l]`: entry `(i, j)` of lane `l`'s upper factor.
-    u: [[[f64; L]; N]; N],
-    gain: [[f64; L]; N],
+    u: [[[f64; W]; N]; N],
+    gain: [[f64; W]; N],
     /// The lanes' last `Φ` and `G`, `phi[i][j][l]` (upper parts).
-    phi: [[[f64; L]; N]; N],
-    g: [[[f64; L]; N]; N],
+    phi: [[[f64; W]; N]; N],
+    g: [[[f64; W]; N]; N],
 }
 
-impl<const N: usize> FactorLanes<N> {
+impl<const N: usize, const W: usize> FactorLanes<N, W> {
     fn new() -> Self {
         Self {
-            u: [[[0.0; L]; N]; N],
-            gain: [[0.0; L]; N],
-            phi: [[[0.0; L]; N]; N],
-            g: [[[0.0; L]; N]; N],
+            u: [[[0.0; W]; N]; N],
+            gain: [[0.0; W]; N],
+            phi: [[[0.0; W]; N]; N],
+            g: [[[0.0; W]; N]; N],
         }
     }
 
@@ -124,17 +124,17 @@ impl<const N: usize> FactorLanes<N> {
     /// Whether every lane's `Φ` and `h` are two chains read at their
     /// heads ([`super::augmented::two_chains`]; lanes not moving compute
     /// with the `Φ` they last had, whose results are not kept).
-    fn two_chains(&self, h: &[[f64; L]; N]) -> bool {
+    fn two_chains(&self, h: &[[f64; W]; N]) -> bool {
         let Some(split) = N.checked_sub(2) else {
             return false;
         };
         let mut two = true;
         for i in 0..N {
-            for l in 0..L {
+            for l in 0..W {
                 two &= i == 0 || i == split || h[i][l] == 0.0;
             }
             for j in split.max(i)..N {
-                for l in 0..L {
+                for l in 0..W {
                     two &= i >= split || self.phi[i][j][l] == 0.0;
                 }
             }
@@ -151,17 +151,17 @@ impl<const N: usize> FactorLanes<N> {
     /// every sum here starts from +0).
     fn predict_update(
         &mut self,
-        moving: [bool; L],
-        h: &[[f64; L]; N],
-        r: [f64; L],
-    ) -> ([f64; L], bool) {
+        moving: [bool; W],
+        h: &[[f64; W]; N],
+        r: [f64; W],
+    ) -> ([f64; W], bool) {
         let two = self.two_chains(h);
         macro_rules! kernel {
             ($k:ident { $($f:ident: $v:expr),* }) => {
                 if two {
-                    aeromag_core::simd::run($k::<N, true> { $($f: $v),* })
+                    aeromag_core::simd::run($k::<N, W, true> { $($f: $v),* })
                 } else {
-                    aeromag_core::simd::run($k::<N, false> { $($f: $v),* })
+                    aeromag_core::simd::run($k::<N, W, false> { $($f: $v),* })
                 }
             };
         }
@@ -203,7 +203,7 @@ impl<const N: usize> FactorLanes<N> {
 /// Four [`AugmentedFilter`]s of `N` dynamic states and one prior, stepped
 /// together (module docs).
 pub struct AugmentedLanes<const N: usize> {
-    factors: FactorLanes<N>,
+    factors: FactorLanes<N, L>,
     prior: [[f64; N]; N],
     /// A fresh filter (prior and right-hand sides), for each lane's start.
     fresh: AugmentedFilter,
@@ -363,7 +363,7 @@ pub struct FilterStep<'a> {
 /// `filter_lanes_are_filters_alone_bit_for_bit`). For the smoother's
 /// re-runs of four blocks at once ([`super::fixed_interval`]).
 pub struct FilterLanes<const N: usize> {
-    factors: FactorLanes<N>,
+    factors: FactorLanes<N, L>,
     /// `x[i][l]`: state `i` of lane `l`.
     x: [[f64; L]; N],
 }
@@ -510,14 +510,16 @@ impl<const N: usize> FilterLanes<N> {
 /// `U ← tri([G, Φ U])` in every moving lane: [`super::SqrtKalmanFilter::predict`]'s
 /// arithmetic (`propagate_impl` with the pair triangularisation), lane by
 /// lane. `G` is triangularised in place (each step brings its own).
-struct Predict<'a, const N: usize, const TWO: bool> {
-    u: &'a mut [[[f64; L]; N]; N],
-    phi: &'a [[[f64; L]; N]; N],
-    g: &'a mut [[[f64; L]; N]; N],
-    moving: [bool; L],
+pub(super) struct Predict<'a, const N: usize, const W: usize, const TWO: bool> {
+    pub(super) u: &'a mut [[[f64; W]; N]; N],
+    pub(super) phi: &'a [[[f64; W]; N]; N],
+    pub(super) g: &'a mut [[[f64; W]; N]; N],
+    pub(super) moving: [bool; W],
 }
 
-impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_, N, TWO> {
+impl<const N: usize, const W: usize, const TWO: bool> aeromag_core::simd::Kernel
+    for Predict<'_, N, W, TWO>
+{
     type Output = ();
     #[inline(always)]
     fn run(self) {
@@ -525,7 +527,7 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
         let split = if TWO { N - 2 } else { N };
         // [B, A] = [G, Φ U], row-major: b[i][j], a[i][j].
         let b = self.g;
-        let mut a = [[[0.0; L]; N]; N];
+        let mut a = [[[0.0; W]; N]; N];
         // A = Φ U: each entry summed over l ascending from +0 (the sparse
         // sum's order; the zeros of Φ add nothing).
         for k in 0..N {
@@ -535,7 +537,7 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
                 let p = self.phi[i][k];
                 for j in k..N {
                     let ukj = self.u[j][k];
-                    for l in 0..L {
+                    for l in 0..W {
                         a[i][j][l] += p[l] * ukj[l];
                     }
                 }
@@ -545,17 +547,17 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
         // and the pivot column A[:, i].
         for i in (0..N).rev() {
             let pivot = a[i][i];
-            let mut off2 = [0.0; L];
+            let mut off2 = [0.0; W];
             for j in i..N {
-                for l in 0..L {
+                for l in 0..W {
                     off2[l] += b[i][j][l] * b[i][j][l];
                 }
             }
-            let mut reflect = [false; L];
-            let mut alpha = [0.0; L];
-            let mut vp = [0.0; L];
-            let mut beta = [0.0; L];
-            for l in 0..L {
+            let mut reflect = [false; W];
+            let mut alpha = [0.0; W];
+            let mut vp = [0.0; W];
+            let mut beta = [0.0; W];
+            for l in 0..W {
                 reflect[l] = off2[l] > 0.0;
                 let norm = (off2[l] + pivot[l] * pivot[l]).sqrt();
                 alpha[l] = if pivot[l] >= 0.0 { -norm } else { norm };
@@ -564,31 +566,31 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
             }
             let vb = b[i];
             for r in 0..i {
-                let mut t = [0.0; L];
-                for l in 0..L {
+                let mut t = [0.0; W];
+                for l in 0..W {
                     t[l] = a[r][i][l] * vp[l];
                 }
                 for j in i..N {
-                    for l in 0..L {
+                    for l in 0..W {
                         t[l] += b[r][j][l] * vb[j][l];
                     }
                 }
-                let mut bt = [0.0; L];
-                for l in 0..L {
+                let mut bt = [0.0; W];
+                for l in 0..W {
                     bt[l] = beta[l] * t[l];
                 }
                 for j in i..N {
-                    for l in 0..L {
+                    for l in 0..W {
                         let v = b[r][j][l] - bt[l] * vb[j][l];
                         b[r][j][l] = if reflect[l] { v } else { b[r][j][l] };
                     }
                 }
-                for l in 0..L {
+                for l in 0..W {
                     let v = a[r][i][l] - bt[l] * vp[l];
                     a[r][i][l] = if reflect[l] { v } else { a[r][i][l] };
                 }
             }
-            for l in 0..L {
+            for l in 0..W {
                 if reflect[l] {
                     a[i][i][l] = alpha[l];
                 }
@@ -603,7 +605,7 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
         }
         for j in 0..N {
             for i in 0..=j {
-                for l in 0..L {
+                for l in 0..W {
                     if self.moving[l] {
                         self.u[j][i][l] = a[i][j][l];
                     }
@@ -616,37 +618,39 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Predict<'_,
 /// Carlson's update of every lane ([`super::carlson::carlson_update`]'s
 /// arithmetic, the state mean left out: it is zero in an augmented filter);
 /// returns the innovation variances.
-struct Update<'a, const N: usize, const TWO: bool> {
-    u: &'a mut [[[f64; L]; N]; N],
-    gain: &'a mut [[f64; L]; N],
-    h: &'a [[f64; L]; N],
-    r: [f64; L],
+struct Update<'a, const N: usize, const W: usize, const TWO: bool> {
+    u: &'a mut [[[f64; W]; N]; N],
+    gain: &'a mut [[f64; W]; N],
+    h: &'a [[f64; W]; N],
+    r: [f64; W],
 }
 
-impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Update<'_, N, TWO> {
-    type Output = [f64; L];
+impl<const N: usize, const W: usize, const TWO: bool> aeromag_core::simd::Kernel
+    for Update<'_, N, W, TWO>
+{
+    type Output = [f64; W];
     #[inline(always)]
-    fn run(self) -> [f64; L] {
+    fn run(self) -> [f64; W] {
         // The second chain's first state (N: none).
         let split = if TWO { N - 2 } else { N };
         // f = Uᵀh, each summed over its rows in order (h is zero but at
         // the chains' heads).
-        let mut f = [[0.0; L]; N];
+        let mut f = [[0.0; W]; N];
         for (j, fj) in f.iter_mut().enumerate() {
             for i in 0..=j {
                 if TWO && i != 0 && i != split {
                     continue;
                 }
-                for l in 0..L {
+                for l in 0..W {
                     fj[l] += self.u[j][i][l] * self.h[i][l];
                 }
             }
         }
         let mut alpha = self.r;
-        let mut eta = [[0.0; L]; N];
-        let mut zeta = [[0.0; L]; N];
+        let mut eta = [[0.0; W]; N];
+        let mut zeta = [[0.0; W]; N];
         for j in 0..N {
-            for l in 0..L {
+            for l in 0..W {
                 let beta = alpha[l];
                 alpha[l] += f[j][l] * f[j][l];
                 let inv_gamma = 1.0 / (alpha[l] * beta).sqrt();
@@ -654,10 +658,10 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Update<'_, 
                 zeta[j][l] = f[j][l] * inv_gamma;
             }
         }
-        let mut k = [[0.0; L]; N];
+        let mut k = [[0.0; W]; N];
         for j in 0..N {
             for i in 0..=j {
-                for l in 0..L {
+                for l in 0..W {
                     let a = self.u[j][i][l];
                     let moves = f[j][l] != 0.0;
                     let s = eta[j][l] * a - zeta[j][l] * k[i][l];
@@ -668,7 +672,7 @@ impl<const N: usize, const TWO: bool> aeromag_core::simd::Kernel for Update<'_, 
             }
         }
         for i in 0..N {
-            for l in 0..L {
+            for l in 0..W {
                 self.gain[i][l] = k[i][l] * (1.0 / alpha[l]);
             }
         }
@@ -854,14 +858,14 @@ mod tests {
             let moving = [true, true, round % 3 != 0, true];
             let (mut a, mut b) = (u, u);
             let (mut ga, mut gb) = (g, g);
-            Predict::<N, true> {
+            Predict::<N, L, true> {
                 u: &mut a,
                 phi: &phi,
                 g: &mut ga,
                 moving,
             }
             .run();
-            Predict::<N, false> {
+            Predict::<N, L, false> {
                 u: &mut b,
                 phi: &phi,
                 g: &mut gb,
@@ -878,14 +882,14 @@ mod tests {
             assert_eq!(bits(&a), bits(&b), "predict, round {round}");
             let (mut ga, mut gb) = ([[0.0; L]; N], [[0.0; L]; N]);
             let r = [0.03, 0.1, 1.0, 0.5];
-            let va = Update::<N, true> {
+            let va = Update::<N, L, true> {
                 u: &mut a,
                 gain: &mut ga,
                 h: &h,
                 r,
             }
             .run();
-            let vb = Update::<N, false> {
+            let vb = Update::<N, L, false> {
                 u: &mut b,
                 gain: &mut gb,
                 h: &h,
