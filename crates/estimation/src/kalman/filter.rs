@@ -25,7 +25,9 @@
 //!   both upper triangular, as for chains of integrators with the upper
 //!   factor of `Q`, `[G, ΦS]` is a pair of triangles and the cheaper
 //!   [`super::triangularize::triangularize_upper_pair`] is used (detected
-//!   from the matrices; same result up to round-off).
+//!   from the matrices; same result up to round-off); for 5, 6 or 8
+//!   states (the field models) the same operations run as the lanes'
+//!   kernel one lane wide ([`super::lanes`]), the same bits.
 //! * [`SqrtKalmanFilter::predict_leading`]: when only the first `k` states
 //!   evolve and the others are constant parameters (`Φ = diag(Φ_a, I)`,
 //!   `G = [G_a; 0]`), the time update is exact and cheap *because the constant
