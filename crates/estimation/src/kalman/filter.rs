@@ -307,23 +307,37 @@ impl SqrtKalmanFilter {
         // The field models of orders 3, 4 and 6 (5, 6 and 8 states, Φ and
         // G upper triangular): the factor by the lanes' kernel, one lane
         // wide; otherwise the same code specialised by the compiler.
-        let upper = |k: usize| {
-            self.nz_upper
-                && (0..k).all(|j| {
-                    g.as_slice()[j * k + j + 1..(j + 1) * k]
-                        .iter()
-                        .all(|x| *x == 0.0)
-                })
-        };
+        let pair = self.upper_pair(k, g.ncols(), g.as_slice());
         match (k, g.ncols()) {
-            (5, 5) if upper(5) => self.propagate_fixed::<5>(g.as_slice()),
-            (6, 6) if upper(6) => self.propagate_fixed::<6>(g.as_slice()),
-            (8, 8) if upper(8) => self.propagate_fixed::<8>(g.as_slice()),
+            (5, 5) if pair => self.propagate_fixed::<5>(g.as_slice()),
+            (6, 6) if pair => self.propagate_fixed::<6>(g.as_slice()),
+            (8, 8) if pair => self.propagate_fixed::<8>(g.as_slice()),
             (5, 5) => self.propagate_impl(5, 5, g.as_slice()),
             (6, 6) => self.propagate_impl(6, 6, g.as_slice()),
             (8, 8) => self.propagate_impl(8, 8, g.as_slice()),
             _ => self.propagate_impl(k, g.ncols(), g.as_slice()),
         }
+    }
+
+    /// `x_a ← Φ_a x_a` on the leading `k` states, `Φ_a` by its non-zeros
+    /// in `self.nz` (each entry summed from +0 in their order).
+    fn advance_mean(&mut self, k: usize) {
+        let tmp = &mut self.tmp[..k];
+        tmp.fill(0.0);
+        let x = self.x.as_mut_slice();
+        for &(i, l, p) in &self.nz {
+            tmp[i] += p * x[l];
+        }
+        x[..k].copy_from_slice(tmp);
+    }
+
+    /// Whether `[G_a, Φ_a U_a]` is a pair of triangles: `G_a` (`k × q`,
+    /// column-major in `g`) square and upper triangular, `Φ_a` (in
+    /// `self.nz`) upper triangular.
+    fn upper_pair(&self, k: usize, q: usize, g: &[f64]) -> bool {
+        q == k
+            && self.nz_upper
+            && (0..k).all(|j| g[j * k + j + 1..(j + 1) * k].iter().all(|x| *x == 0.0))
     }
 
     /// [`Self::propagate_impl`] for `K` leading states with `Φ_a` (in
@@ -335,12 +349,7 @@ impl SqrtKalmanFilter {
     /// `the_fixed_time_update_is_the_general_one_bit_for_bit`.
     fn propagate_fixed<const K: usize>(&mut self, g: &[f64]) {
         let n = self.dim();
-        let mut tmp = [0.0; K];
-        let x = self.x.as_mut_slice();
-        for &(i, l, p) in &self.nz {
-            tmp[i] += p * x[l];
-        }
-        x[..K].copy_from_slice(&tmp);
+        self.advance_mean(K);
         let mut phi = [[[0.0; 1]; K]; K];
         for &(i, l, p) in &self.nz {
             phi[i][l][0] = p;
@@ -387,14 +396,10 @@ impl SqrtKalmanFilter {
     fn propagate_impl(&mut self, k: usize, q: usize, g: &[f64]) {
         let n = self.dim();
         let c = q + k;
-        let tmp = &mut self.tmp[..k];
-        // x_a ← Φ x_a.
-        tmp.fill(0.0);
-        let x = self.x.as_mut_slice();
-        for &(i, l, p) in &self.nz {
-            tmp[i] += p * x[l];
-        }
-        x[..k].copy_from_slice(tmp);
+        // Φ and G both upper triangular (and U_a always is): the cheaper
+        // kernel for two triangular halves.
+        let pair = self.upper_pair(k, q, g);
+        self.advance_mean(k);
         // wide (row-major k × (q+k)) = [G, Φ U_a]; U_a upper triangular.
         let w = &mut self.wide[..k * c];
         w.fill(0.0);
@@ -410,11 +415,6 @@ impl SqrtKalmanFilter {
                 w[i * c + q + j] += p * s[l + j * n];
             }
         }
-        // Φ and G both upper triangular (and U_a always is): the cheaper
-        // kernel for two triangular halves.
-        let pair = q == k
-            && self.nz_upper
-            && (0..k).all(|j| g[j * k + j + 1..(j + 1) * k].iter().all(|x| *x == 0.0));
         if pair {
             triangularize_upper_pair(w, k, &mut self.v[..c]);
         } else {

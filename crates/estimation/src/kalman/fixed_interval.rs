@@ -259,17 +259,27 @@ pub fn smooth_from_checkpoints<M: StateSpaceModel>(
     Ok(())
 }
 
-/// Put the filter at the start of block `blk`: the prior for the first
-/// block, else the checkpoint before it.
+/// Put the filter at the start of block `blk` ([`block_start`]).
 fn restart(
     filter: &mut SqrtKalmanFilter,
     b: &Buffers,
     checkpoints: &[Checkpoint],
     blk: usize,
 ) -> Result<()> {
+    let (x, s) = block_start(b, checkpoints, blk);
+    filter.set(x, s)
+}
+
+/// The filtered estimate block `blk` starts from: the prior for the first
+/// block, else the checkpoint before it.
+fn block_start<'a>(
+    b: &'a Buffers,
+    checkpoints: &'a [Checkpoint],
+    blk: usize,
+) -> (&'a [f64], &'a DMatrix<f64>) {
     match blk.checked_sub(1) {
-        None => filter.set(&b.x0, &b.s0),
-        Some(c) => filter.set(&checkpoints[c].mean, &checkpoints[c].factor),
+        None => (&b.x0, &b.s0),
+        Some(c) => (&checkpoints[c].mean, &checkpoints[c].factor),
     }
 }
 
@@ -525,10 +535,8 @@ impl<M: StateSpaceModel, F: FnMut(usize, &[f64], Option<&DMatrix<f64>>)> MeansRu
     ) -> Result<()> {
         let model = self.model;
         for (j, &blk) in blocks.iter().enumerate() {
-            match blk.checked_sub(1) {
-                None => lanes.set(j, &self.b.x0, &self.b.s0)?,
-                Some(c) => lanes.set(j, &self.checkpoints[c].mean, &self.checkpoints[c].factor)?,
-            }
+            let (x, s) = block_start(&self.b, self.checkpoints, blk);
+            lanes.set(j, x, s)?;
         }
         let len = |j: usize| blocks.get(j).map_or(0, |&b| self.ends[b] - self.starts[b]);
         let longest = (0..blocks.len()).map(len).max().unwrap_or(0);
