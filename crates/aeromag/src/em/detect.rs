@@ -91,7 +91,7 @@ pub struct Detection {
 pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) -> Result<Detection> {
     let mut notes = Notes::new(observer);
     let file = path.display().to_string();
-    let source = RawSource::open(path)?;
+    let mut source = RawSource::open(path)?;
     let header = source.header().clone();
     let system = opts.system.clone().unwrap_or(header.system.clone());
     // The tones are where the transmitter put them when the record was
@@ -153,9 +153,16 @@ pub fn detect(path: &Path, opts: &DetectOptions, observer: &mut dyn Observer) ->
         ));
     }
     system.check_tone_plan(fs, n).in_file(&file)?;
-    let chain = system
-        .chain(fs, n, opts.window, opts.pilot)
-        .in_file(&file)?;
+    // The detector (its window and nine kernels, 1–2 ms) is built while
+    // the mapped record is checked finite (the check brings its pages in):
+    // each on its own threads, neither waiting for the other.
+    let (chain, checked) = std::thread::scope(|s| {
+        let checking = s.spawn(|| source.check_in_advance(path));
+        let chain = system.chain(fs, n, opts.window, opts.pilot);
+        (chain, checking.join())
+    });
+    let chain = chain.in_file(&file)?;
+    checked.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
     notes.stage("detecting");
     notes.check_cancelled()?;
     // Streamed: whole detector blocks of about 2¹⁸ frames (3 MB) per

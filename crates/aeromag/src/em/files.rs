@@ -231,6 +231,8 @@ pub(super) struct MappedRaw {
     map: memmap2::Mmap,
     header: aeromag_em::sim::RawHeader,
     body_offset: usize,
+    /// The samples have been checked finite ([`RawSource::check_in_advance`]).
+    checked: bool,
 }
 
 impl MappedRaw {
@@ -246,7 +248,7 @@ impl MappedRaw {
         // the file and be aligned, as f32 (every bit pattern is an f32).
         // Another process shrinking the file while it is mapped would make
         // reads beyond the new end fault, as for any memory-mapped reader.
-        let Ok(map) = (unsafe { memmap2::MmapOptions::new().populate().map(&f) }) else {
+        let Ok(map) = (unsafe { memmap2::MmapOptions::new().map(&f) }) else {
             return Ok(None);
         };
         let r = raw_reader(path, &map[..])?;
@@ -261,14 +263,18 @@ impl MappedRaw {
             map,
             header,
             body_offset,
+            checked: false,
         }))
     }
 
-    /// The whole body, checked finite: the absolute index of its first
-    /// frame and its samples (no buffer to bound, so one piece).
+    /// The whole body, checked finite (unless it has been already): the
+    /// absolute index of its first frame and its samples (no buffer to
+    /// bound, so one piece).
     fn samples(&self, path: &Path) -> Result<(u64, &[f32])> {
         let samples: &[f32] = bytemuck::cast_slice(&self.map[self.body_offset..]);
-        check_finite(path, self.body_offset as u64, 0, samples)?;
+        if !self.checked {
+            check_finite(path, self.body_offset as u64, 0, samples)?;
+        }
         Ok((self.header.start_index, samples))
     }
 }
@@ -297,6 +303,19 @@ impl RawSource {
             Self::Mapped(m) => &m.header,
             Self::Streamed(r) => r.header(),
         }
+    }
+
+    /// Check a mapped record's samples finite now rather than in
+    /// [`Self::for_each_chunk`], so that the check (a pass over the whole
+    /// record, which also brings its pages in) can run alongside other
+    /// work: `em detect` builds its detector meanwhile. A streamed record
+    /// is checked chunk by chunk as it is read.
+    pub(super) fn check_in_advance(&mut self, path: &Path) -> Result<()> {
+        if let Self::Mapped(m) = self {
+            m.samples(path)?;
+            m.checked = true;
+        }
+        Ok(())
     }
 
     /// `f(first, samples)` for the record's samples in order, every one

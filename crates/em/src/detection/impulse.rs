@@ -128,14 +128,41 @@ fn centre_and_spread_of(extrema: &[(f32, f32)]) -> Option<(f64, f64)> {
         .map(|c| (c, s))
 }
 
-/// `(min, max)` of a non-empty slice (a loop without branches, which
-/// vectorises).
+/// `(min, max)` of a non-empty slice, in [`MIN_MAX_LANES`] independent
+/// lanes reduced at the end, each lane kept by a compare and select that
+/// passes over a NaN as `f32::min`/`max` do: a loop without branches or a
+/// chain through one pair of accumulators, which vectorises to the
+/// processor's own minimum and maximum (`f32::min` with its NaN rule, or
+/// one running pair, took a sixth of a detection's time). Minimum and
+/// maximum are exact, so the order does not change the result (for
+/// finite samples up to the sign of a zero extreme, which neither the
+/// centre nor the statistic sees).
 fn min_max(u: &[f32]) -> (f32, f32) {
-    u.iter()
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
+    let lower = |lo: f32, v: f32| if v < lo { v } else { lo };
+    let higher = |hi: f32, v: f32| if v > hi { v } else { hi };
+    let mut lo = [f32::INFINITY; MIN_MAX_LANES];
+    let mut hi = [f32::NEG_INFINITY; MIN_MAX_LANES];
+    let chunks = u.chunks_exact(MIN_MAX_LANES);
+    let tail = chunks.remainder();
+    for c in chunks {
+        for j in 0..MIN_MAX_LANES {
+            lo[j] = lower(lo[j], c[j]);
+            hi[j] = higher(hi[j], c[j]);
+        }
+    }
+    for (j, &v) in tail.iter().enumerate() {
+        lo[j] = lower(lo[j], v);
+        hi[j] = higher(hi[j], v);
+    }
+    lo.iter()
+        .zip(&hi)
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), (&a, &b)| {
+            (lower(l, a), higher(h, b))
         })
 }
+
+/// Independent lanes of [`min_max`].
+const MIN_MAX_LANES: usize = 16;
 
 /// The largest impulse statistic `z` of any sample of `u` (one channel of
 /// one block) over sub-blocks of `sub_len` samples, and its index; `None`
@@ -230,6 +257,45 @@ mod tests {
             .collect()
     }
 
+    /// The extrema in lanes are those of one running `f32::min`/`max`
+    /// pair: lengths around the lane count, NaNs skipped, all-NaN slices.
+    #[test]
+    fn extrema_in_lanes_are_those_of_one_running_pair() {
+        let running = |u: &[f32]| {
+            u.iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                })
+        };
+        let mut state = 0x2545_f491u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state
+        };
+        for len in [1usize, 2, 15, 16, 17, 31, 32, 33, 250, 257] {
+            for nan_every in [0u32, 3, 1] {
+                let u: Vec<f32> = (0..len)
+                    .map(|_| {
+                        let r = next();
+                        if nan_every > 0 && r % nan_every == 0 {
+                            f32::NAN
+                        } else {
+                            (r % 20_001) as f32 / 1000.0 - 10.0
+                        }
+                    })
+                    .collect();
+                let (lo, hi) = min_max(&u);
+                let (rlo, rhi) = running(&u);
+                assert_eq!(
+                    (lo.to_bits(), hi.to_bits()),
+                    (rlo.to_bits(), rhi.to_bits()),
+                    "len {len}, NaN every {nan_every}"
+                );
+            }
+        }
+    }
     #[test]
     fn clean_tones_are_untouched_and_below_the_threshold() {
         let l = sub_block_len(16_000, 1e5, 1000.0);
