@@ -60,23 +60,27 @@ pub fn threads_setting(value: &str) -> crate::error::Result<usize> {
 }
 
 /// `[f(0), f(1), …, f(n − 1)]`, computed on up to `threads` threads (≥ 1) in
-/// contiguous chunks.
+/// contiguous chunks, the first on the calling thread (one thread fewer
+/// to start: with two cores, one instead of two per call).
 pub fn parallel_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let threads = threads.clamp(1, n.max(1));
     let chunk = n.div_ceil(threads).max(1);
     let f = &f;
+    let run = move |start: usize| (start..(start + chunk).min(n)).map(f).collect::<Vec<T>>();
+    if n <= chunk {
+        return run(0);
+    }
     std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..n)
+        let handles: Vec<_> = (chunk..n)
             .step_by(chunk)
-            .map(|start| {
-                scope.spawn(move || (start..(start + chunk).min(n)).map(f).collect::<Vec<T>>())
-            })
+            .map(|start| scope.spawn(move || run(start)))
             .collect();
+        let mut out = run(0);
         // A worker only panics if `f` does; pass that panic on.
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
+        for h in handles {
+            out.extend(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
+        }
+        out
     })
 }
 
@@ -121,9 +125,16 @@ pub fn for_each_rows_mut<T: Send>(
         }
     }
     let f = &f;
+    // The first part on the calling thread, the others on threads of
+    // their own.
+    let mut split = split.into_iter().enumerate();
+    let first = split.next();
     std::thread::scope(|scope| {
-        for (t, mut parts) in split.into_iter().enumerate() {
+        for (t, mut parts) in split {
             scope.spawn(move || f(t * per, &mut parts));
+        }
+        if let Some((_, mut parts)) = first {
+            f(0, &mut parts);
         }
     });
 }
@@ -154,7 +165,12 @@ pub fn for_each_weighted_mut<T: Send>(
             }
             let (mine, tail) = std::mem::take(&mut rest).split_at_mut(k);
             rest = tail;
-            scope.spawn(move || mine.iter_mut().for_each(f));
+            if rest.is_empty() {
+                // The last group on the calling thread.
+                mine.iter_mut().for_each(f);
+            } else {
+                scope.spawn(move || mine.iter_mut().for_each(f));
+            }
         }
     });
 }

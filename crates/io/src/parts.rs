@@ -17,17 +17,8 @@ pub(crate) fn on_parts<T: Send>(v: &[f64], f: impl Fn(&[f64]) -> T + Sync) -> Ve
     if parts == 1 {
         return vec![f(v)];
     }
-    let per = v.len().div_ceil(parts);
-    std::thread::scope(|scope| {
-        let f = &f;
-        let jobs: Vec<_> = v
-            .chunks(per)
-            .map(|part| scope.spawn(move || f(part)))
-            .collect();
-        jobs.into_iter()
-            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
-    })
+    let chunks: Vec<&[f64]> = v.chunks(v.len().div_ceil(parts)).collect();
+    aeromag_core::parallel::parallel_map(chunks.len(), parts, |i| f(chunks[i]))
 }
 
 /// `[f(&jobs[0]), f(&jobs[1]), …]` worked out on the cores (up to
@@ -39,14 +30,15 @@ pub(crate) fn each_on_cores<J: Sync, T: Send>(jobs: &[J], f: impl Fn(&J) -> T + 
         return jobs.iter().map(f).collect();
     }
     let f = &f;
+    let deal = move |t: usize| -> Vec<T> { jobs.iter().skip(t).step_by(threads).map(f).collect() };
+    // Thread 0's jobs on the calling thread.
     let dealt: Vec<Vec<T>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| scope.spawn(move || jobs.iter().skip(t).step_by(threads).map(f).collect()))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
+        let handles: Vec<_> = (1..threads).map(|t| scope.spawn(move || deal(t))).collect();
+        let mut dealt = vec![deal(0)];
+        for h in handles {
+            dealt.push(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
+        }
+        dealt
     });
     // Job i is the (i / threads)-th of thread i % threads.
     let mut dealt: Vec<std::vec::IntoIter<T>> = dealt.into_iter().map(Vec::into_iter).collect();
