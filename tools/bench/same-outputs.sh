@@ -6,7 +6,10 @@
 #   - calibrate with the MagNav settings (the peers' comparison),
 #   - calibrate with the defaults (lines split, the eddy-lag search),
 #   - compensate with each of those models (each binary with its own),
-#     and compensate --causal.
+#     and compensate --causal,
+#   - em detect on simulated records (10.24 s and 102.4 s, one with
+#     impulsive spikes injected) with the default and other windows,
+#     without the pilots and with the system given.
 # Prints one line per case and exits 1 when any differs.
 #
 # Usage: tools/bench/same-outputs.sh OLD_AEROMAG [NEW_AEROMAG] [N …]
@@ -81,4 +84,29 @@ for n in "${sizes[@]}"; do
     same "$n-compensate-defaults" compensate -i "$f" --model @/$n-calibrate-defaults.json --out @/$n-compensate-defaults.csv
     same "$n-compensate-causal" compensate --causal -i "$f" --model @/$n-calibrate-defaults.json --out @/$n-compensate-causal.csv
 done
+# EM records, simulated once (by the new binary) for both.
+em=$out/em
+"$new" em simulate --out "$em/short" >/dev/null
+"$new" em simulate --print-config | sed 's/^duration_s = .*/duration_s = 102.4/' >"$out/long.toml"
+"$new" em simulate --config "$out/long.toml" --out "$em/long" >/dev/null
+# 408 runs of 1 to 600 samples far outside the tones (0.05–1 kV).
+python3 - "$em/short/em.raw" "$em/spikes.raw" <<'PY'
+import random, struct, sys
+data = bytearray(open(sys.argv[1], "rb").read())
+frames = 1024000
+body = len(data) - frames * 12
+rng = random.Random(3)
+for _ in range(408):
+    f, c = rng.randrange(frames - 700), rng.randrange(3)
+    for j in range(rng.choice([1, 1, 2, 5, 30, 600])):
+        struct.pack_into("<f", data, body + ((f + j) * 3 + c) * 4, rng.choice([-1, 1]) * rng.uniform(50, 1000))
+open(sys.argv[2], "wb").write(data)
+PY
+same em-detect em detect "$em/short/em.raw" --out @/em-detect.csv
+same em-detect-long em detect "$em/long/em.raw" --out @/em-detect-long.csv
+same em-detect-spikes em detect "$em/spikes.raw" --out @/em-detect-spikes.csv
+same em-detect-nuttall em detect "$em/short/em.raw" --window nuttall --window-len 8000 --out @/em-detect-nuttall.csv
+same em-detect-off-grid em detect "$em/short/em.raw" --window-len 10000 --out @/em-detect-off-grid.csv
+same em-detect-no-pilot em detect "$em/short/em.raw" --no-pilot --out @/em-detect-no-pilot.csv
+same em-detect-system em detect "$em/short/em.raw" --system "$em/short/em.system.json" --out @/em-detect-system.csv
 exit $differ
